@@ -1,0 +1,34 @@
+// floesim command line: dispatches to one subcommand per apps/cmd_*.cpp.
+#include <iostream>
+#include <map>
+
+#include "apps/commands.hpp"
+#include "core/error.hpp"
+
+int main(int argc, char** argv) {
+  CLI::App app{"floesim: sea-ice floes on waves (rigid floes, Lemke collisions, "
+               "penalised capillary-gravity sea)"};
+  app.require_subcommand(1);
+  app.set_version_flag("--version", std::string(FLOESIM_VERSION));
+
+  std::map<CLI::App*, floesim::apps::Handler> handlers;
+  // registrations (one line per command, alphabetical)
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int code = app.exit(e);
+    return code == 0 ? 0 : 2;
+  }
+  try {
+    for (auto& [sub, handler] : handlers)
+      if (sub->parsed()) return handler();
+  } catch (const floesim::InputError& e) {
+    std::cerr << "floesim: error: " << e.what() << "\n";
+    return 2;
+  } catch (const floesim::RunError& e) {
+    std::cerr << "floesim: run failed: " << e.what() << "\n";
+    return 1;
+  }
+  return 2;
+}
