@@ -1,0 +1,97 @@
+#pragma once
+// Run parameters as plain data: one struct per configuration section
+// (docs/config.md lists every key, its default and its range). The TOML reader
+// in core/config.cpp fills these; solvers and layers take the part they need.
+// SI units throughout.
+
+#include <array>
+#include <cmath>
+#include <limits>
+#include <string>
+#include <vector>
+
+namespace floesim {
+
+struct RunParams {
+  double t_end = 100.0;           // s, simulated end time
+  double dt_max = 0.05;           // s, upper bound on the step (the loop may take smaller)
+  double output_interval = 1.0;   // s, time between records in the run file
+  unsigned long seed = 1;         // seed of every random choice of the run
+};
+
+enum class SeaModel { none, spectral, bem };
+enum class WaveKind { none, regular, standing, jonswap };
+
+struct WaveParams {
+  WaveKind kind = WaveKind::none;
+  double amplitude = 0.0;         // m (regular, standing)
+  double wavelength = 0.0;        // m (regular, standing); 0 = derived from period
+  double period = 0.0;            // s; 0 = derived from wavelength
+  double direction = 0.0;         // degrees from +x
+  double hs = 0.0;                // m, significant wave height (jonswap)
+  double tp = 0.0;                // s, peak period (jonswap)
+  double gamma = 3.3;             // peak enhancement (jonswap)
+  double spreading = 0.0;         // directional spreading exponent s of cos^2s (0 = none)
+};
+
+struct SeaParams {
+  SeaModel model = SeaModel::none;
+  int dims = 2;                                   // 1 long-crested (x only), 2 full plane
+  std::array<double, 2> size = {200.0, 200.0};    // m
+  std::array<int, 2> cells = {128, 128};
+  double depth = std::numeric_limits<double>::infinity();  // m; inf = deep water
+  double rho = 1025.0;            // kg/m^3, water density (also for drag)
+  double g = 9.81;                // m/s^2
+  double sigma = 0.073;           // N/m, surface tension
+  std::vector<std::array<double, 2>> bottom;      // bem: bottom polyline (x, z), z < 0
+  WaveParams waves;
+};
+
+struct ContactParams {
+  double collision_distance = 0.01;  // m
+  double restitution = 0.4;          // Poisson restitution e in [0, 1]
+  double friction = 0.7;             // Coulomb mu >= 0
+};
+
+enum class PenaltyLaw { strong, weak, blend };
+
+struct CouplingParams {
+  PenaltyLaw law = PenaltyLaw::strong;
+  double stiffness = 1000.0;      // K: penalty stiffness kappa = K rho_w g
+  double blend = 1.0;             // s in [0, 1] (blend law)
+  double restitution = -1.0;      // blend law: target e; < 0 means "use blend"
+};
+
+struct ForcingParams {
+  std::array<double, 2> current = {0.0, 0.0};  // m/s
+  std::array<double, 2> wind = {0.0, 0.0};     // m/s, 10 m wind
+  std::string series;             // optional CSV: t_s,wind_u,wind_v,current_u,current_v
+  double coriolis = 0.0;          // f, 1/s (set from latitude when that is given)
+  double ocean_drag = 5.0e-3;     // C_w (a floe's own value overrides it)
+  double air_drag = 1.7e-3;       // C_a
+  double air_density = 1.341;     // rho_a, kg/m^3
+};
+
+enum class FractureCriterion { stress, griffith };
+
+struct FractureLoad {
+  std::array<double, 2> point = {0.0, 0.0};    // m, world
+  std::array<double, 2> force = {0.0, 0.0};    // N (static load)
+  std::array<double, 2> impulse = {0.0, 0.0};  // N s (percussion)
+  bool is_impulse = false;
+};
+
+struct FractureParams {
+  bool enabled = false;
+  FractureCriterion criterion = FractureCriterion::stress;
+  double strength = 0.5e6;        // Pa
+  double toughness = 1.5;         // J/m^2 (griffith)
+  double young = 6.0e9;           // Pa
+  double poisson = 0.3;
+  bool split = false;
+  double mesh_size = 2.0;         // m
+  double duration = 0.01;         // s
+  std::vector<FractureLoad> loads;
+};
+
+}  // namespace floesim
