@@ -62,10 +62,16 @@ struct CouplingParams {
   double restitution = -1.0;      // blend law: target e; < 0 means "use blend"
 };
 
+enum class SeriesInterpolation { linear, previous };
+
 struct ForcingParams {
   std::array<double, 2> current = {0.0, 0.0};  // m/s
   std::array<double, 2> wind = {0.0, 0.0};     // m/s, 10 m wind
   std::string series;             // optional CSV: t_s,wind_u,wind_v,current_u,current_v
+  // linear: interpolate between rows; previous: hold each row until the next
+  // (FloeDyn's per-minute forcing). Before the first row: the first row; after
+  // the last: the last row.
+  SeriesInterpolation series_interpolation = SeriesInterpolation::linear;
   double coriolis = 0.0;          // f, 1/s (set from latitude when that is given)
   double ocean_drag = 5.0e-3;     // C_w (a floe's own value overrides it)
   double air_drag = 1.7e-3;       // C_a

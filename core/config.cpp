@@ -1,0 +1,471 @@
+#include "core/config.hpp"
+
+#include <toml++/toml.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <numbers>
+#include <set>
+#include <sstream>
+
+#include "core/error.hpp"
+
+namespace floesim {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+// Reads the keys of one TOML table, remembering which were used so that the
+// rest can be reported as unknown. Every accessor checks type and range and
+// throws InputError "FILE:LINE: key '[section] name': expected ..., got ...".
+class Section {
+public:
+  Section(const toml::table* table, std::string name, const std::string& file)
+      : table_(table), name_(std::move(name)), file_(file) {}
+
+  bool present() const { return table_ != nullptr; }
+  bool has(const std::string& key) const { return table_ && table_->get(key) != nullptr; }
+
+  [[noreturn]] void fail(const std::string& key, const std::string& what) const {
+    const toml::node* n = table_ ? table_->get(key) : nullptr;
+    const long line = n ? static_cast<long>(n->source().begin.line)
+                        : (table_ ? static_cast<long>(table_->source().begin.line) : 0);
+    throw InputError(where(file_, line, qualified(key), what));
+  }
+  std::string qualified(const std::string& key) const {
+    return name_.empty() ? key : "[" + name_ + "] " + key;
+  }
+
+  const toml::node* node(const std::string& key) {
+    used_.insert(key);
+    return table_ ? table_->get(key) : nullptr;
+  }
+
+  double number(const std::string& key, double def, const std::function<bool(double)>& ok = {},
+                const std::string& expected = "a number") {
+    const toml::node* n = node(key);
+    if (!n) return def;
+    double v = to_double(key, *n, expected);
+    if (ok && !ok(v)) fail(key, "expected " + expected + ", got " + format(v));
+    return v;
+  }
+  long long integer(const std::string& key, long long def, const std::function<bool(long long)>& ok,
+                    const std::string& expected) {
+    const toml::node* n = node(key);
+    if (!n) return def;
+    if (!n->is_integer()) fail(key, "expected " + expected + " (an integer), got " + type_name(*n));
+    const long long v = n->as_integer()->get();
+    if (ok && !ok(v)) fail(key, "expected " + expected + ", got " + std::to_string(v));
+    return v;
+  }
+  bool boolean(const std::string& key, bool def) {
+    const toml::node* n = node(key);
+    if (!n) return def;
+    if (!n->is_boolean()) fail(key, "expected true or false, got " + type_name(*n));
+    return n->as_boolean()->get();
+  }
+  std::string string(const std::string& key, const std::string& def) {
+    const toml::node* n = node(key);
+    if (!n) return def;
+    if (!n->is_string()) fail(key, "expected a string, got " + type_name(*n));
+    return n->as_string()->get();
+  }
+  template <class E>
+  E choice(const std::string& key, E def, const std::vector<std::pair<std::string, E>>& options) {
+    const toml::node* n = node(key);
+    if (!n) return def;
+    std::string list;
+    for (auto& [s, e] : options) list += (list.empty() ? "" : " | ") + ("\"" + s + "\"");
+    if (!n->is_string()) fail(key, "expected one of " + list + ", got " + type_name(*n));
+    const std::string v = n->as_string()->get();
+    for (auto& [s, e] : options)
+      if (s == v) return e;
+    fail(key, "expected one of " + list + ", got \"" + v + "\"");
+  }
+  std::vector<double> numbers(const std::string& key, std::size_t count, const std::string& what) {
+    const toml::node* n = node(key);
+    const toml::array* a = n ? n->as_array() : nullptr;
+    if (!a || (count && a->size() != count))
+      fail(key, "expected " + what + ", got " + (n ? describe(*n) : std::string("nothing")));
+    std::vector<double> v;
+    for (const toml::node& e : *a) v.push_back(to_double(key, e, what));
+    return v;
+  }
+  std::array<double, 2> pair(const std::string& key, std::array<double, 2> def,
+                             const std::string& what = "an array of 2 numbers") {
+    if (!has(key)) { node(key); return def; }
+    auto v = numbers(key, 2, what);
+    for (double x : v)
+      if (!std::isfinite(x)) fail(key, "expected finite numbers");
+    return {v[0], v[1]};
+  }
+  std::vector<std::array<double, 2>> points(const std::string& key, const std::string& what) {
+    const toml::node* n = node(key);
+    if (!n) return {};
+    const toml::array* a = n->as_array();
+    if (!a) fail(key, "expected " + what + ", got " + type_name(*n));
+    std::vector<std::array<double, 2>> out;
+    for (std::size_t i = 0; i < a->size(); ++i) {
+      const toml::array* p = (*a)[i].as_array();
+      if (!p || p->size() != 2)
+        fail(key, "expected " + what + "; entry " + std::to_string(i) + " is " + describe((*a)[i]));
+      out.push_back({to_double(key, (*p)[0], what), to_double(key, (*p)[1], what)});
+    }
+    return out;
+  }
+  const toml::table* table(const std::string& key) {
+    const toml::node* n = node(key);
+    if (!n) return nullptr;
+    if (!n->is_table()) fail(key, "expected a table ([" + (name_.empty() ? key : name_ + "." + key) + "])");
+    return n->as_table();
+  }
+  const toml::array* table_array(const std::string& key) {
+    const toml::node* n = node(key);
+    if (!n) return nullptr;
+    if (!n->is_array_of_tables())
+      fail(key, "expected an array of tables ([[" + (name_.empty() ? key : name_ + "." + key) + "]])");
+    return n->as_array();
+  }
+  long line() const { return table_ ? static_cast<long>(table_->source().begin.line) : 0; }
+
+  // Any key not read by now is unknown.
+  void finish() const {
+    if (!table_) return;
+    for (auto&& [k, v] : *table_) {
+      const std::string key(k.str());
+      if (!used_.count(key)) {
+        std::string known;
+        for (const auto& u : used_) known += (known.empty() ? "" : ", ") + u;
+        fail(key, "unknown key (known keys here: " + known + ")");
+      }
+    }
+  }
+
+private:
+  double to_double(const std::string& key, const toml::node& n, const std::string& expected) const {
+    if (n.is_integer()) return static_cast<double>(n.as_integer()->get());
+    if (n.is_floating_point()) return n.as_floating_point()->get();
+    fail(key, "expected " + expected + ", got " + type_name(n));
+  }
+  static std::string type_name(const toml::node& n) {
+    switch (n.type()) {
+      case toml::node_type::string: return "a string";
+      case toml::node_type::integer: return "an integer";
+      case toml::node_type::floating_point: return "a number";
+      case toml::node_type::boolean: return "a boolean";
+      case toml::node_type::array: return "an array";
+      case toml::node_type::table: return "a table";
+      default: return "a date/time";
+    }
+  }
+  static std::string describe(const toml::node& n) {
+    if (const toml::array* a = n.as_array()) return "an array of " + std::to_string(a->size());
+    return type_name(n);
+  }
+  static std::string format(double v) {
+    std::ostringstream s;
+    s << v;
+    return s.str();
+  }
+
+  const toml::table* table_;
+  std::string name_;
+  const std::string& file_;
+  std::set<std::string> used_;
+};
+
+const auto positive = [](double v) { return std::isfinite(v) && v > 0.0; };
+const auto non_negative = [](double v) { return std::isfinite(v) && v >= 0.0; };
+const auto finite = [](double v) { return std::isfinite(v); };
+const auto unit_interval = [](double v) { return v >= 0.0 && v <= 1.0; };
+
+std::string resolve_path(const std::string& p, const std::string& base_dir) {
+  if (p.empty()) return p;
+  fs::path path(p);
+  if (path.is_relative()) path = fs::path(base_dir) / path;
+  return path.lexically_normal().string();
+}
+
+void read_run(Section s, RunParams& r) {
+  r.t_end = s.number("t_end", r.t_end, non_negative, "a time >= 0 (s)");
+  r.dt_max = s.number("dt_max", r.dt_max, positive, "a time step > 0 (s)");
+  r.output_interval = s.number("output_interval", r.output_interval, positive, "an interval > 0 (s)");
+  r.seed = static_cast<unsigned long>(
+      s.integer("seed", static_cast<long long>(r.seed), [](long long v) { return v >= 0; }, "a seed >= 0"));
+  s.finish();
+}
+
+void read_waves(Section s, WaveParams& w) {
+  w.kind = s.choice<WaveKind>("kind", w.kind, {{"none", WaveKind::none}, {"regular", WaveKind::regular},
+                                               {"standing", WaveKind::standing}, {"jonswap", WaveKind::jonswap}});
+  w.amplitude = s.number("amplitude", w.amplitude, non_negative, "an amplitude >= 0 (m)");
+  w.wavelength = s.number("wavelength", w.wavelength, non_negative, "a wavelength > 0 (m)");
+  w.period = s.number("period", w.period, non_negative, "a period > 0 (s)");
+  w.direction = s.number("direction", w.direction, finite, "an angle (degrees from +x)");
+  w.hs = s.number("hs", w.hs, non_negative, "a significant wave height >= 0 (m)");
+  w.tp = s.number("tp", w.tp, non_negative, "a peak period > 0 (s)");
+  w.gamma = s.number("gamma", w.gamma, [](double v) { return v >= 1.0 && v < 100.0; },
+                     "a peak enhancement factor in [1, 100)");
+  w.spreading = s.number("spreading", w.spreading, non_negative, "a spreading exponent >= 0");
+  if (s.has("wavelength") && s.has("period"))
+    s.fail("period", "give wavelength or period, not both");
+  if ((w.kind == WaveKind::regular || w.kind == WaveKind::standing) && w.wavelength <= 0.0 &&
+      w.period <= 0.0)
+    s.fail("kind", "regular and standing waves need a wavelength or a period > 0");
+  if (w.kind == WaveKind::jonswap && (w.hs <= 0.0 || w.tp <= 0.0))
+    s.fail("kind", "jonswap needs hs > 0 and tp > 0");
+  s.finish();
+}
+
+void read_sea(Section s, SeaParams& p, const std::string& file) {
+  p.model = s.choice<SeaModel>("model", p.model, {{"none", SeaModel::none}, {"spectral", SeaModel::spectral},
+                                                  {"bem", SeaModel::bem}});
+  p.dims = static_cast<int>(s.integer("dims", p.dims, [](long long v) { return v == 1 || v == 2; }, "1 or 2"));
+  p.size = s.pair("size", p.size, "[Lx, Ly], two sizes > 0 (m)");
+  if (!(p.size[0] > 0.0 && p.size[1] > 0.0)) s.fail("size", "expected two sizes > 0 (m)");
+  if (s.has("cells")) {
+    auto c = s.numbers("cells", 2, "[nx, ny], two cell counts >= 1");
+    for (double v : c)
+      if (!(v >= 1.0 && v == std::floor(v) && v < 1e6)) s.fail("cells", "expected two whole cell counts >= 1");
+    p.cells = {static_cast<int>(c[0]), static_cast<int>(c[1])};
+  } else {
+    s.node("cells");
+  }
+  p.depth = s.number("depth", p.depth, [](double v) { return v > 0.0; }, "a depth > 0 (m) or inf");
+  p.rho = s.number("rho", p.rho, positive, "a density > 0 (kg/m^3)");
+  p.g = s.number("g", p.g, positive, "a gravity > 0 (m/s^2)");
+  p.sigma = s.number("sigma", p.sigma, non_negative, "a surface tension >= 0 (N/m)");
+  p.bottom = s.points("bottom", "a polyline [[x, z], ...] (m)");
+  if (!p.bottom.empty() && p.model != SeaModel::bem) s.fail("bottom", "a bottom polyline needs model = \"bem\"");
+  for (auto& b : p.bottom)
+    if (!(std::isfinite(b[0]) && std::isfinite(b[1]) && b[1] < 0.0))
+      s.fail("bottom", "every bottom point must be finite and below the surface (z < 0)");
+  read_waves(Section(s.table("waves"), "sea.waves", file), p.waves);
+  s.finish();
+}
+
+FloeInput read_floe(Section s, const PackDefaults& def, std::size_t index, const std::string& file) {
+  FloeInput f;
+  f.origin = where(file, s.line(), "", "") + "[[floes.floe]] " + std::to_string(index);
+  auto pts = s.points("vertices", "an array of [x, y] vertices (m)");
+  if (!s.has("vertices")) s.fail("vertices", "every [[floes.floe]] needs vertices = [[x, y], ...]");
+  for (auto& p : pts) f.vertices.emplace_back(p[0], p[1]);
+  auto v = s.pair("velocity", {0.0, 0.0});
+  f.velocity = {v[0], v[1]};
+  f.angular_velocity = s.number("angular_velocity", 0.0, finite, "an angular velocity (rad/s)");
+  f.thickness = s.number("thickness", def.thickness, positive, "a thickness > 0 (m)");
+  f.density = s.number("density", def.density, positive, "a density > 0 (kg/m^3)");
+  f.is_static = s.boolean("static", false);
+  f.ocean_drag = s.number("ocean_drag", -1.0, non_negative, "a drag coefficient >= 0");
+  if (f.is_static && (s.has("velocity") || s.has("angular_velocity")) &&
+      (f.velocity.norm() > 0.0 || f.angular_velocity != 0.0))
+    s.fail("static", "a static floe (obstacle) cannot have a velocity");
+  s.finish();
+  return f;
+}
+
+void read_floes(Section s, FloesConfig& c, const std::string& file, const std::string& base_dir) {
+  c.pack = resolve_path(s.string("pack", ""), base_dir);
+  c.defaults.thickness = s.number("thickness", c.defaults.thickness, positive, "a thickness > 0 (m)");
+  c.defaults.density = s.number("density", c.defaults.density, positive, "a density > 0 (kg/m^3)");
+  if (!c.pack.empty() && !fs::exists(c.pack)) s.fail("pack", "file not found: " + c.pack);
+  if (const toml::array* a = s.table_array("floe")) {
+    for (std::size_t i = 0; i < a->size(); ++i)
+      c.floes.push_back(read_floe(Section((*a)[i].as_table(), "floes.floe", file), c.defaults, i, file));
+  }
+  s.finish();
+}
+
+void read_contact(Section s, ContactParams& c) {
+  c.collision_distance = s.number("collision_distance", c.collision_distance, positive, "a distance > 0 (m)");
+  c.restitution = s.number("restitution", c.restitution, unit_interval, "a restitution in [0, 1]");
+  c.friction = s.number("friction", c.friction, non_negative, "a friction coefficient >= 0");
+  s.finish();
+}
+
+void read_coupling(Section s, CouplingParams& c) {
+  c.law = s.choice<PenaltyLaw>("law", c.law, {{"strong", PenaltyLaw::strong}, {"weak", PenaltyLaw::weak},
+                                              {"blend", PenaltyLaw::blend}});
+  c.stiffness = s.number("stiffness", c.stiffness, positive, "a relative stiffness K > 0");
+  c.blend = s.number("blend", c.blend, unit_interval, "a blend s in [0, 1]");
+  c.restitution = s.number("restitution", c.restitution, unit_interval, "a restitution in [0, 1]");
+  if (s.has("blend") && s.has("restitution")) s.fail("restitution", "give blend or restitution, not both");
+  if ((s.has("blend") || s.has("restitution")) && c.law != PenaltyLaw::blend)
+    s.fail(s.has("blend") ? "blend" : "restitution", "only used with law = \"blend\"");
+  if (!s.has("restitution")) c.restitution = -1.0;
+  s.finish();
+}
+
+void read_forcing(Section s, ForcingParams& f, const std::string& base_dir) {
+  f.current = s.pair("current", f.current);
+  f.wind = s.pair("wind", f.wind);
+  f.series = resolve_path(s.string("series", ""), base_dir);
+  if (!f.series.empty() && !fs::exists(f.series)) s.fail("series", "file not found: " + f.series);
+  f.series_interpolation = s.choice<SeriesInterpolation>(
+      "series_interpolation", f.series_interpolation,
+      {{"linear", SeriesInterpolation::linear}, {"previous", SeriesInterpolation::previous}});
+  f.coriolis = s.number("coriolis", f.coriolis, finite, "a Coriolis parameter f (1/s)");
+  if (s.has("latitude")) {
+    if (s.has("coriolis")) s.fail("latitude", "give coriolis (f) or latitude, not both");
+    const double lat = s.number("latitude", 0.0, [](double v) { return v >= -90.0 && v <= 90.0; },
+                                "a latitude in [-90, 90] degrees");
+    // f = 2 Ω sin(latitude), Ω = 7.2921e-5 rad/s (sidereal rotation of the Earth).
+    f.coriolis = 2.0 * 7.2921e-5 * std::sin(lat * std::numbers::pi / 180.0);
+  } else {
+    s.node("latitude");
+  }
+  f.ocean_drag = s.number("ocean_drag", f.ocean_drag, non_negative, "a drag coefficient >= 0");
+  f.air_drag = s.number("air_drag", f.air_drag, non_negative, "a drag coefficient >= 0");
+  f.air_density = s.number("air_density", f.air_density, non_negative, "a density >= 0 (kg/m^3)");
+  s.finish();
+}
+
+void read_fracture(Section s, FractureParams& f, const std::string& file) {
+  f.enabled = s.boolean("enabled", f.enabled);
+  f.criterion = s.choice<FractureCriterion>("criterion", f.criterion,
+                                            {{"stress", FractureCriterion::stress},
+                                             {"griffith", FractureCriterion::griffith}});
+  f.strength = s.number("strength", f.strength, positive, "a strength > 0 (Pa)");
+  f.toughness = s.number("toughness", f.toughness, positive, "a toughness > 0 (J/m^2)");
+  f.young = s.number("young", f.young, positive, "a Young's modulus > 0 (Pa)");
+  f.poisson = s.number("poisson", f.poisson, [](double v) { return v > -1.0 && v < 0.5; },
+                       "a Poisson ratio in (-1, 0.5)");
+  f.split = s.boolean("split", f.split);
+  f.mesh_size = s.number("mesh_size", f.mesh_size, positive, "a mesh size > 0 (m)");
+  f.duration = s.number("duration", f.duration, positive, "a duration > 0 (s)");
+  if (const toml::array* a = s.table_array("load")) {
+    for (std::size_t i = 0; i < a->size(); ++i) {
+      Section l((*a)[i].as_table(), "fracture.load", file);
+      FractureLoad load;
+      load.point = l.pair("point", load.point);
+      if (!l.has("point")) l.fail("point", "every [[fracture.load]] needs a point = [x, y]");
+      if (l.has("force") == l.has("impulse"))
+        l.fail("force", "every [[fracture.load]] needs exactly one of force = [fx, fy] or impulse = [ix, iy]");
+      load.force = l.pair("force", load.force);
+      load.impulse = l.pair("impulse", load.impulse);
+      load.is_impulse = l.has("impulse");
+      l.finish();
+      f.loads.push_back(load);
+    }
+  }
+  s.finish();
+}
+
+}  // namespace
+
+Config parse_config(std::string_view text, const std::string& name, const std::string& base_dir) {
+  toml::table root;
+  try {
+    root = toml::parse(text, name);
+  } catch (const toml::parse_error& e) {
+    throw InputError(where(name, static_cast<long>(e.source().begin.line), "",
+                           "not valid TOML: " + std::string(e.description())));
+  }
+  Config c;
+  c.file = name;
+  Section top(&root, "", name);
+  read_run(Section(top.table("run"), "run", name), c.run);
+  read_sea(Section(top.table("sea"), "sea", name), c.sea, name);
+  read_floes(Section(top.table("floes"), "floes", name), c.floes, name, base_dir);
+  read_contact(Section(top.table("contact"), "contact", name), c.contact);
+  read_coupling(Section(top.table("coupling"), "coupling", name), c.coupling);
+  read_forcing(Section(top.table("forcing"), "forcing", name), c.forcing, base_dir);
+  read_fracture(Section(top.table("fracture"), "fracture", name), c.fracture, name);
+  top.finish();
+  return c;
+}
+
+Config load_config(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(path + ": cannot open the configuration file");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  const fs::path dir = fs::absolute(fs::path(path)).parent_path();
+  return parse_config(ss.str(), path, dir.string());
+}
+
+namespace {
+template <class E>
+std::string name_of(E e, const std::vector<std::pair<std::string, E>>& options) {
+  for (auto& [s, v] : options)
+    if (v == e) return s;
+  return "?";
+}
+toml::array pair_array(const std::array<double, 2>& a) { return toml::array{a[0], a[1]}; }
+}  // namespace
+
+std::string resolved_toml(const Config& c) {
+  toml::table run{{"t_end", c.run.t_end}, {"dt_max", c.run.dt_max},
+                  {"output_interval", c.run.output_interval},
+                  {"seed", static_cast<int64_t>(c.run.seed)}};
+  const WaveParams& w = c.sea.waves;
+  toml::table waves{{"kind", name_of<WaveKind>(w.kind, {{"none", WaveKind::none}, {"regular", WaveKind::regular},
+                                                         {"standing", WaveKind::standing}, {"jonswap", WaveKind::jonswap}})},
+                    {"amplitude", w.amplitude}, {"direction", w.direction}, {"hs", w.hs}, {"tp", w.tp}, {"gamma", w.gamma},
+                    {"spreading", w.spreading}};
+  if (w.wavelength > 0.0) waves.insert("wavelength", w.wavelength);
+  if (w.period > 0.0) waves.insert("period", w.period);
+  toml::array bottom;
+  for (auto& b : c.sea.bottom) bottom.push_back(pair_array(b));
+  toml::table sea{{"model", name_of<SeaModel>(c.sea.model, {{"none", SeaModel::none}, {"spectral", SeaModel::spectral},
+                                                             {"bem", SeaModel::bem}})},
+                  {"dims", c.sea.dims}, {"size", pair_array(c.sea.size)},
+                  {"cells", toml::array{c.sea.cells[0], c.sea.cells[1]}}, {"depth", c.sea.depth},
+                  {"rho", c.sea.rho}, {"g", c.sea.g}, {"sigma", c.sea.sigma}, {"waves", waves}};
+  if (!bottom.empty()) sea.insert("bottom", bottom);
+
+  toml::array floe_list;
+  for (const FloeInput& f : c.floes.floes) {
+    toml::array verts;
+    for (auto& v : f.vertices) verts.push_back(toml::array{v.x(), v.y()});
+    toml::table t{{"vertices", verts}, {"velocity", toml::array{f.velocity.x(), f.velocity.y()}},
+                  {"angular_velocity", f.angular_velocity}, {"thickness", f.thickness},
+                  {"density", f.density}, {"static", f.is_static}};
+    if (f.ocean_drag >= 0.0) t.insert("ocean_drag", f.ocean_drag);
+    floe_list.push_back(t);
+  }
+  toml::table floes{{"thickness", c.floes.defaults.thickness}, {"density", c.floes.defaults.density}};
+  if (!c.floes.pack.empty()) floes.insert("pack", c.floes.pack);
+  if (!floe_list.empty()) floes.insert("floe", floe_list);
+
+  toml::table contact{{"collision_distance", c.contact.collision_distance},
+                      {"restitution", c.contact.restitution}, {"friction", c.contact.friction}};
+  toml::table coupling{{"law", name_of<PenaltyLaw>(c.coupling.law, {{"strong", PenaltyLaw::strong},
+                                                                   {"weak", PenaltyLaw::weak},
+                                                                   {"blend", PenaltyLaw::blend}})},
+                       {"stiffness", c.coupling.stiffness}};
+  if (c.coupling.law == PenaltyLaw::blend) {
+    if (c.coupling.restitution >= 0.0) coupling.insert("restitution", c.coupling.restitution);
+    else coupling.insert("blend", c.coupling.blend);
+  }
+  toml::table forcing{{"current", pair_array(c.forcing.current)}, {"wind", pair_array(c.forcing.wind)},
+                      {"series_interpolation",
+                       c.forcing.series_interpolation == SeriesInterpolation::linear ? "linear" : "previous"},
+                      {"coriolis", c.forcing.coriolis}, {"ocean_drag", c.forcing.ocean_drag},
+                      {"air_drag", c.forcing.air_drag}, {"air_density", c.forcing.air_density}};
+  if (!c.forcing.series.empty()) forcing.insert("series", c.forcing.series);
+  const FractureParams& fr = c.fracture;
+  toml::array loads;
+  for (auto& l : fr.loads) {
+    toml::table t{{"point", pair_array(l.point)}};
+    t.insert(l.is_impulse ? "impulse" : "force", pair_array(l.is_impulse ? l.impulse : l.force));
+    loads.push_back(t);
+  }
+  toml::table fracture{{"enabled", fr.enabled},
+                       {"criterion", fr.criterion == FractureCriterion::stress ? "stress" : "griffith"},
+                       {"strength", fr.strength}, {"toughness", fr.toughness}, {"young", fr.young},
+                       {"poisson", fr.poisson}, {"split", fr.split}, {"mesh_size", fr.mesh_size},
+                       {"duration", fr.duration}};
+  if (!loads.empty()) fracture.insert("load", loads);
+
+  toml::table root{{"run", run}, {"sea", sea}, {"floes", floes}, {"contact", contact},
+                   {"coupling", coupling}, {"forcing", forcing}, {"fracture", fracture}};
+  std::ostringstream os;
+  os << root;
+  return os.str();
+}
+
+}  // namespace floesim

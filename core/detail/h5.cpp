@@ -1,0 +1,250 @@
+#include "core/detail/h5.hpp"
+
+#include <mutex>
+
+#include "core/error.hpp"
+
+namespace floesim::h5 {
+
+namespace {
+[[noreturn]] void fail(const std::string& msg) { throw InputError(msg); }
+}  // namespace
+
+void silence_errors() {
+  static std::once_flag once;
+  std::call_once(once, [] { H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr); });
+}
+
+bool is_hdf5(const std::string& path) {
+  silence_errors();
+  return H5Fis_hdf5(path.c_str()) > 0;
+}
+
+Handle open_file(const std::string& path, bool write) {
+  silence_errors();
+  if (!is_hdf5(path)) fail(path + ": not an HDF5 file (or it cannot be read)");
+  hid_t f = H5Fopen(path.c_str(), write ? H5F_ACC_RDWR : H5F_ACC_RDONLY, H5P_DEFAULT);
+  if (f < 0) fail(path + ": cannot open the HDF5 file");
+  return {f, H5Fclose};
+}
+
+Handle create_file(const std::string& path) {
+  silence_errors();
+  hid_t f = H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT);
+  if (f < 0) fail(path + ": cannot create the file (does its folder exist and is it writable?)");
+  return {f, H5Fclose};
+}
+
+bool exists(hid_t loc, const std::string& path) {
+  // Check each link along the path, as H5Lexists requires.
+  std::size_t pos = path[0] == '/' ? 1 : 0;
+  while (pos <= path.size()) {
+    const std::size_t next = path.find('/', pos);
+    const std::string prefix = path.substr(0, next);
+    if (H5Lexists(loc, prefix.c_str(), H5P_DEFAULT) <= 0) return false;
+    if (next == std::string::npos) break;
+    pos = next + 1;
+  }
+  return true;
+}
+
+Handle open_dataset(hid_t loc, const std::string& path, const std::string& file) {
+  if (!exists(loc, path)) fail(file + ": dataset '" + path + "' is missing");
+  hid_t d = H5Dopen2(loc, path.c_str(), H5P_DEFAULT);
+  if (d < 0) fail(file + ": '" + path + "' is not a readable dataset");
+  return {d, H5Dclose};
+}
+
+Handle open_group(hid_t loc, const std::string& path, const std::string& file) {
+  if (!exists(loc, path)) fail(file + ": group '" + path + "' is missing");
+  hid_t g = H5Gopen2(loc, path.c_str(), H5P_DEFAULT);
+  if (g < 0) fail(file + ": '" + path + "' is not a group");
+  return {g, H5Gclose};
+}
+
+Handle create_group(hid_t loc, const std::string& path) {
+  hid_t g = H5Gcreate2(loc, path.c_str(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+  if (g < 0) fail("cannot create HDF5 group '" + path + "'");
+  return {g, H5Gclose};
+}
+
+std::vector<hsize_t> dims(hid_t dataset) {
+  Handle space{H5Dget_space(dataset), H5Sclose};
+  const int rank = H5Sget_simple_extent_ndims(space);
+  std::vector<hsize_t> d(static_cast<std::size_t>(rank > 0 ? rank : 0));
+  if (rank > 0) H5Sget_simple_extent_dims(space, d.data(), nullptr);
+  return d;
+}
+
+namespace {
+std::size_t count(hid_t dataset) {
+  std::size_t n = 1;
+  for (hsize_t d : dims(dataset)) n *= d;
+  return n;
+}
+template <class T>
+std::vector<T> read_as(hid_t dataset, hid_t mem_type, const std::string& what) {
+  Handle type{H5Dget_type(dataset), H5Tclose};
+  const H5T_class_t cls = H5Tget_class(type);
+  if (cls != H5T_FLOAT && cls != H5T_INTEGER) fail(what + ": expected numbers");
+  std::vector<T> v(count(dataset));
+  if (!v.empty() && H5Dread(dataset, mem_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, v.data()) < 0)
+    fail(what + ": cannot read the dataset");
+  return v;
+}
+}  // namespace
+
+std::vector<double> read_doubles(hid_t dataset, const std::string& what) {
+  return read_as<double>(dataset, H5T_NATIVE_DOUBLE, what);
+}
+std::vector<long long> read_ints(hid_t dataset, const std::string& what) {
+  return read_as<long long>(dataset, H5T_NATIVE_LLONG, what);
+}
+
+namespace {
+void write_raw(hid_t loc, const std::string& name, const std::vector<hsize_t>& d, hid_t file_type,
+               hid_t mem_type, const void* data) {
+  Handle space{H5Screate_simple(static_cast<int>(d.size()), d.data(), nullptr), H5Sclose};
+  Handle set{H5Dcreate2(loc, name.c_str(), file_type, space, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT),
+             H5Dclose};
+  if (!set.valid()) fail("cannot create dataset '" + name + "'");
+  bool empty = false;
+  for (hsize_t x : d) empty = empty || x == 0;
+  if (!empty && H5Dwrite(set, mem_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data) < 0)
+    fail("cannot write dataset '" + name + "'");
+}
+}  // namespace
+
+void write_doubles(hid_t loc, const std::string& name, const std::vector<hsize_t>& d,
+                   const double* data) {
+  write_raw(loc, name, d, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, data);
+}
+void write_ints(hid_t loc, const std::string& name, const std::vector<hsize_t>& d,
+                const long long* data) {
+  write_raw(loc, name, d, H5T_STD_I64LE, H5T_NATIVE_LLONG, data);
+}
+void write_bytes(hid_t loc, const std::string& name, const std::vector<hsize_t>& d,
+                 const unsigned char* data) {
+  write_raw(loc, name, d, H5T_STD_U8LE, H5T_NATIVE_UCHAR, data);
+}
+
+Handle create_extendible(hid_t loc, const std::string& name, const std::vector<hsize_t>& row) {
+  std::vector<hsize_t> d{0}, maxd{H5S_UNLIMITED}, chunk{1};
+  std::size_t row_size = 1;
+  for (hsize_t r : row) { d.push_back(r); maxd.push_back(r); chunk.push_back(r); row_size *= r; }
+  // Aim for chunks of about 64 KiB: several rows per chunk when rows are small.
+  chunk[0] = std::max<hsize_t>(1, 8192 / std::max<std::size_t>(row_size, 1));
+  Handle space{H5Screate_simple(static_cast<int>(d.size()), d.data(), maxd.data()), H5Sclose};
+  Handle props{H5Pcreate(H5P_DATASET_CREATE), H5Pclose};
+  H5Pset_chunk(props, static_cast<int>(chunk.size()), chunk.data());
+  hid_t set = H5Dcreate2(loc, name.c_str(), H5T_IEEE_F64LE, space, H5P_DEFAULT, props, H5P_DEFAULT);
+  if (set < 0) fail("cannot create dataset '" + name + "'");
+  return {set, H5Dclose};
+}
+
+void append_row(hid_t dataset, const double* row) {
+  std::vector<hsize_t> d = dims(dataset);
+  const hsize_t t = d[0];
+  d[0] = t + 1;
+  if (H5Dset_extent(dataset, d.data()) < 0) fail("cannot extend a run-file dataset");
+  Handle space{H5Dget_space(dataset), H5Sclose};
+  std::vector<hsize_t> start(d.size(), 0), cnt = d;
+  start[0] = t;
+  cnt[0] = 1;
+  H5Sselect_hyperslab(space, H5S_SELECT_SET, start.data(), nullptr, cnt.data(), nullptr);
+  Handle mem{H5Screate_simple(static_cast<int>(cnt.size()), cnt.data(), nullptr), H5Sclose};
+  if (H5Dwrite(dataset, H5T_NATIVE_DOUBLE, mem, space, H5P_DEFAULT, row) < 0)
+    fail("cannot append to a run-file dataset");
+}
+
+namespace {
+Handle string_type(std::size_t) {
+  Handle t{H5Tcopy(H5T_C_S1), H5Tclose};
+  H5Tset_size(t, H5T_VARIABLE);
+  H5Tset_cset(t, H5T_CSET_UTF8);
+  return t;
+}
+void replace_attr(hid_t obj, const std::string& name) {
+  if (H5Aexists(obj, name.c_str()) > 0) H5Adelete(obj, name.c_str());
+}
+}  // namespace
+
+void set_attr(hid_t obj, const std::string& name, const std::string& value) {
+  replace_attr(obj, name);
+  Handle type = string_type(value.size());
+  Handle space{H5Screate(H5S_SCALAR), H5Sclose};
+  Handle a{H5Acreate2(obj, name.c_str(), type, space, H5P_DEFAULT, H5P_DEFAULT), H5Aclose};
+  const char* p = value.c_str();
+  if (!a.valid() || H5Awrite(a, type, &p) < 0) fail("cannot write attribute '" + name + "'");
+}
+
+void set_attr(hid_t obj, const std::string& name, const std::vector<std::string>& values) {
+  replace_attr(obj, name);
+  Handle type = string_type(0);
+  const hsize_t n = values.size();
+  Handle space{H5Screate_simple(1, &n, nullptr), H5Sclose};
+  Handle a{H5Acreate2(obj, name.c_str(), type, space, H5P_DEFAULT, H5P_DEFAULT), H5Aclose};
+  std::vector<const char*> p;
+  for (const auto& s : values) p.push_back(s.c_str());
+  if (!a.valid() || H5Awrite(a, type, p.data()) < 0) fail("cannot write attribute '" + name + "'");
+}
+
+namespace {
+template <class T>
+void set_scalar(hid_t obj, const std::string& name, hid_t file_type, hid_t mem_type, T value) {
+  replace_attr(obj, name);
+  Handle space{H5Screate(H5S_SCALAR), H5Sclose};
+  Handle a{H5Acreate2(obj, name.c_str(), file_type, space, H5P_DEFAULT, H5P_DEFAULT), H5Aclose};
+  if (!a.valid() || H5Awrite(a, mem_type, &value) < 0) fail("cannot write attribute '" + name + "'");
+}
+}  // namespace
+
+void set_attr(hid_t obj, const std::string& name, double value) {
+  set_scalar(obj, name, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, value);
+}
+void set_attr(hid_t obj, const std::string& name, long long value) {
+  set_scalar(obj, name, H5T_STD_I64LE, H5T_NATIVE_LLONG, value);
+}
+
+bool has_attr(hid_t obj, const std::string& name) { return H5Aexists(obj, name.c_str()) > 0; }
+
+std::vector<std::string> get_attr_strings(hid_t obj, const std::string& name) {
+  if (!has_attr(obj, name)) fail("attribute '" + name + "' is missing");
+  Handle a{H5Aopen(obj, name.c_str(), H5P_DEFAULT), H5Aclose};
+  Handle ftype{H5Aget_type(a), H5Tclose};
+  if (H5Tget_class(ftype) != H5T_STRING) fail("attribute '" + name + "' is not a string");
+  Handle space{H5Aget_space(a), H5Sclose};
+  const hssize_t n = H5Sget_simple_extent_npoints(space);
+  std::vector<std::string> out;
+  if (H5Tis_variable_str(ftype) > 0) {
+    Handle mtype = string_type(0);
+    std::vector<char*> p(static_cast<std::size_t>(n), nullptr);
+    if (H5Aread(a, mtype, p.data()) < 0) fail("cannot read attribute '" + name + "'");
+    for (char* s : p) out.emplace_back(s ? s : "");
+    H5Dvlen_reclaim(mtype, space, H5P_DEFAULT, p.data());
+  } else {
+    const std::size_t len = H5Tget_size(ftype);
+    std::vector<char> buf(len * static_cast<std::size_t>(n) + 1, '\0');
+    if (H5Aread(a, ftype, buf.data()) < 0) fail("cannot read attribute '" + name + "'");
+    for (hssize_t i = 0; i < n; ++i) {
+      std::string s(buf.data() + static_cast<std::size_t>(i) * len, len);
+      out.push_back(s.substr(0, s.find('\0')));
+    }
+  }
+  return out;
+}
+
+std::string get_attr_string(hid_t obj, const std::string& name) {
+  auto v = get_attr_strings(obj, name);
+  return v.empty() ? std::string{} : v[0];
+}
+
+double get_attr_double(hid_t obj, const std::string& name) {
+  if (!has_attr(obj, name)) fail("attribute '" + name + "' is missing");
+  Handle a{H5Aopen(obj, name.c_str(), H5P_DEFAULT), H5Aclose};
+  double v = 0.0;
+  if (H5Aread(a, H5T_NATIVE_DOUBLE, &v) < 0) fail("attribute '" + name + "' is not a number");
+  return v;
+}
+
+}  // namespace floesim::h5

@@ -1,0 +1,73 @@
+#pragma once
+// Private to core: a thin RAII layer over the HDF5 C API. Every failure becomes
+// an InputError naming the file and the object (HDF5's own error stack printing
+// is switched off so that users see one clear message).
+
+#include <hdf5.h>
+
+#include <string>
+#include <vector>
+
+namespace floesim::h5 {
+
+// Owns one hid_t and closes it with the right H5*close.
+class Handle {
+public:
+  Handle() = default;
+  Handle(hid_t id, herr_t (*close)(hid_t)) : id_(id), close_(close) {}
+  Handle(const Handle&) = delete;
+  Handle& operator=(const Handle&) = delete;
+  Handle(Handle&& o) noexcept : id_(o.id_), close_(o.close_) { o.id_ = -1; }
+  Handle& operator=(Handle&& o) noexcept {
+    if (this != &o) { reset(); id_ = o.id_; close_ = o.close_; o.id_ = -1; }
+    return *this;
+  }
+  ~Handle() { reset(); }
+  void reset() { if (id_ >= 0 && close_) close_(id_); id_ = -1; }
+  hid_t get() const { return id_; }
+  operator hid_t() const { return id_; }
+  bool valid() const { return id_ >= 0; }
+
+private:
+  hid_t id_ = -1;
+  herr_t (*close_)(hid_t) = nullptr;
+};
+
+void silence_errors();  // once per process: no HDF5 error-stack dumps on stderr
+
+bool is_hdf5(const std::string& path);
+Handle open_file(const std::string& path, bool write = false);
+Handle create_file(const std::string& path);  // truncates
+bool exists(hid_t loc, const std::string& path);  // a link path like "/floes/state"
+Handle open_dataset(hid_t loc, const std::string& path, const std::string& file);
+Handle open_group(hid_t loc, const std::string& path, const std::string& file);
+Handle create_group(hid_t loc, const std::string& path);
+
+std::vector<hsize_t> dims(hid_t dataset);
+std::vector<double> read_doubles(hid_t dataset, const std::string& what);
+std::vector<long long> read_ints(hid_t dataset, const std::string& what);
+
+// Whole fixed-size datasets.
+void write_doubles(hid_t loc, const std::string& name, const std::vector<hsize_t>& dims,
+                   const double* data);
+void write_ints(hid_t loc, const std::string& name, const std::vector<hsize_t>& dims,
+                const long long* data);
+void write_bytes(hid_t loc, const std::string& name, const std::vector<hsize_t>& dims,
+                 const unsigned char* data);
+
+// Extendible datasets along the first dimension (chunked): created with 0
+// rows, each append adds one row of the given row shape.
+Handle create_extendible(hid_t loc, const std::string& name, const std::vector<hsize_t>& row);
+void append_row(hid_t dataset, const double* row);
+
+// Attributes (on a file, group or dataset).
+void set_attr(hid_t obj, const std::string& name, const std::string& value);
+void set_attr(hid_t obj, const std::string& name, double value);
+void set_attr(hid_t obj, const std::string& name, long long value);
+void set_attr(hid_t obj, const std::string& name, const std::vector<std::string>& values);
+bool has_attr(hid_t obj, const std::string& name);
+std::string get_attr_string(hid_t obj, const std::string& name);
+double get_attr_double(hid_t obj, const std::string& name);
+std::vector<std::string> get_attr_strings(hid_t obj, const std::string& name);
+
+}  // namespace floesim::h5

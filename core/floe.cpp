@@ -1,0 +1,69 @@
+#include "core/floe.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include "core/error.hpp"
+
+namespace floesim {
+
+FloeShape make_floe_shape(const FloeInput& in) {
+  auto fail = [&](const std::string& what) {
+    throw InputError(in.origin.empty() ? what : in.origin + ": " + what);
+  };
+  if (in.vertices.size() < 3)
+    fail("a floe needs at least 3 vertices, got " + std::to_string(in.vertices.size()));
+  for (std::size_t i = 0; i < in.vertices.size(); ++i)
+    if (!in.vertices[i].allFinite()) fail("vertex " + std::to_string(i) + " is not a finite number");
+  if (!(std::isfinite(in.thickness) && in.thickness > 0.0))
+    fail("thickness must be a finite number > 0 (m), got " + std::to_string(in.thickness));
+  if (!(std::isfinite(in.density) && in.density > 0.0))
+    fail("density must be a finite number > 0 (kg/m^3), got " + std::to_string(in.density));
+  if (!in.velocity.allFinite() || !std::isfinite(in.angular_velocity) || !std::isfinite(in.yaw) ||
+      !in.position.allFinite())
+    fail("position, velocity, angular_velocity and yaw must be finite numbers");
+
+  FloeShape shape;
+  std::vector<Vec2> v = in.vertices;
+  // All vertices on one line (or one point): zero area, whatever the order.
+  double extent = 0.0, spread = 0.0;
+  for (const Vec2& p : v) extent = std::max(extent, (p - v[0]).norm());
+  for (const Vec2& p : v)
+    for (const Vec2& q : v) spread = std::max(spread, std::abs(cross(p - v[0], q - v[0])));
+  if (!(spread > 1e-12 * extent * extent) || extent == 0.0)
+    fail("the outline has zero area (all vertices on a line?)");
+  if (auto bad = find_self_intersection(v)) {
+    std::ostringstream s;
+    s << "the outline intersects itself (edges " << bad->first << " and " << bad->second
+      << ", counting from 0; edge i joins vertex i to vertex i+1)";
+    fail(s.str());
+  }
+  PolygonMoments m = polygon_moments(v);
+  if (!(std::abs(m.area) > 1e-12 * extent * extent))
+    fail("the outline has zero area");
+  if (m.area < 0.0) {
+    std::reverse(v.begin(), v.end());
+    m = polygon_moments(v);
+    shape.reoriented = true;
+  }
+  const Vec2 g = m.centroid();
+  shape.centroid = in.position + rotate(g, in.yaw);
+  shape.body.reserve(v.size());
+  for (const Vec2& p : v) shape.body.push_back(p - g);
+
+  // Second moments about the centroid: ∫(x-G)² = ∫x² - A Gx², etc.
+  const double jxx = m.sxx - m.area * g.x() * g.x();
+  const double jyy = m.syy - m.area * g.y() * g.y();
+  const double rho_h = in.density * in.thickness;
+  MassProperties& p = shape.props;
+  p.area = m.area;
+  p.mass = rho_h * m.area;
+  p.inertia_z = rho_h * (jxx + jyy);
+  const double plate = p.mass * in.thickness * in.thickness / 12.0;
+  p.inertia_x = rho_h * jyy + plate;
+  p.inertia_y = rho_h * jxx + plate;
+  return shape;
+}
+
+}  // namespace floesim

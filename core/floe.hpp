@@ -1,0 +1,60 @@
+#pragma once
+// A floe: a rigid slab with a simple polygonal footprint, uniform thickness and
+// density (MODEL.md §1). This header builds one floe from user input, checking
+// it, and derives its exact mass properties from polygon integrals.
+
+#include <string>
+#include <vector>
+
+#include "core/geometry.hpp"
+
+namespace floesim {
+
+// A floe as the user gives it. World position of vertex k at t = 0:
+//   position + R(yaw) vertices[k]
+// (inline floes: world vertices, position 0, yaw 0; pack files: body-frame
+// vertices with the floe's position and yaw). Either vertex order.
+struct FloeInput {
+  std::vector<Vec2> vertices;     // m, input frame
+  Vec2 position = Vec2::Zero();   // m, world
+  double thickness = 1.0;         // m
+  double density = 917.0;         // kg/m^3
+  bool is_static = false;         // obstacle: infinite mass, never moves
+  double yaw = 0.0;               // rad, initial yaw
+  Vec2 velocity = Vec2::Zero();   // m/s, of the centroid
+  double angular_velocity = 0.0;  // rad/s
+  double ocean_drag = -1.0;       // C_w of this floe; < 0: the [forcing] default
+  std::string origin;             // where it came from, for messages ("file.toml floe 3")
+};
+
+// Exact mass properties of a floe (body frame: origin at the centroid).
+// With rho = density, h = thickness, over the footprint ω:
+//   A = ∫ 1,  M = rho h A,
+//   I_z = rho h ∫ |x - G|²                (yaw),
+//   I_x = rho h ∫ (x2 - G2)² + M h²/12   (roll, about the body x axis),
+//   I_y = rho h ∫ (x1 - G1)² + M h²/12   (pitch),
+//   draft = rho h / rho_w (set by the caller, who knows rho_w).
+struct MassProperties {
+  double area = 0.0;     // m^2
+  double mass = 0.0;     // kg (infinite for static floes)
+  double inertia_z = 0.0;  // kg m^2, yaw
+  double inertia_x = 0.0;  // kg m^2, roll
+  double inertia_y = 0.0;  // kg m^2, pitch
+};
+
+// The validated shape: body-frame vertices (counter-clockwise, centroid at the
+// origin), the world centroid, mass properties.
+struct FloeShape {
+  std::vector<Vec2> body;   // m, body frame
+  Vec2 centroid;            // m, world position of the centroid at t = 0
+  MassProperties props;     // of the slab (finite even for a static floe)
+  bool reoriented = false;  // the input was clockwise and was reversed
+};
+
+// Checks a floe and builds its shape. Throws InputError naming input.origin
+// when: fewer than 3 vertices, a non-finite number, zero or negative area
+// (degenerate), a self-intersecting outline, thickness or density <= 0.
+// A clockwise outline is reversed (reported through FloeShape::reoriented).
+FloeShape make_floe_shape(const FloeInput& input);
+
+}  // namespace floesim

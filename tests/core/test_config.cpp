@@ -1,0 +1,113 @@
+// Configuration: defaults, every error names the file, the line and the key.
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <string>
+
+#include "core/config.hpp"
+#include "core/error.hpp"
+
+using namespace floesim;
+
+namespace {
+Config parse(const std::string& text) { return parse_config(text, "case.toml", "/tmp"); }
+
+// Parsing must fail with a message holding every fragment.
+void refused(const std::string& text, std::initializer_list<std::string> fragments) {
+  try {
+    parse(text);
+  } catch (const InputError& e) {
+    const std::string m = e.what();
+    for (const auto& f : fragments) CHECK_MESSAGE(m.find(f) != std::string::npos, "'" << f << "' not in: " << m);
+    return;
+  }
+  FAIL("accepted: " << text);
+}
+}  // namespace
+
+TEST_CASE("an empty configuration gives the documented defaults") {
+  const Config c = parse("");
+  CHECK(c.run.t_end == 100.0);
+  CHECK(c.run.dt_max == 0.05);
+  CHECK(c.sea.model == SeaModel::none);
+  CHECK(c.sea.rho == 1025.0);
+  CHECK(std::isinf(c.sea.depth));
+  CHECK(c.contact.restitution == 0.4);
+  CHECK(c.coupling.law == PenaltyLaw::strong);
+  CHECK(c.forcing.ocean_drag == 5.0e-3);
+  CHECK(c.floes.floes.empty());
+}
+
+TEST_CASE("a full configuration is read") {
+  const Config c = parse(R"(
+[run]
+t_end = 10
+dt_max = 0.5
+output_interval = 2.0
+seed = 7
+[sea]
+model = "spectral"
+dims = 1
+size = [100.0, 5.0]
+cells = [64, 1]
+depth = 3.0
+[sea.waves]
+kind = "regular"
+amplitude = 0.1
+period = 2.0
+[floes]
+density = 900.0
+[[floes.floe]]
+vertices = [[0, 0], [1, 0], [1, 1]]
+velocity = [0.5, 0]
+[[floes.floe]]
+vertices = [[5, 0], [6, 0], [6, 1]]
+thickness = 0.3
+static = true
+[forcing]
+wind = [10, 0]
+latitude = 80.0
+)");
+  CHECK(c.run.seed == 7);
+  CHECK(c.sea.cells[0] == 64);
+  CHECK(c.sea.waves.kind == WaveKind::regular);
+  REQUIRE(c.floes.floes.size() == 2);
+  CHECK(c.floes.floes[0].density == 900.0);
+  CHECK(c.floes.floes[0].thickness == 1.0);
+  CHECK(c.floes.floes[1].thickness == 0.3);
+  CHECK(c.floes.floes[1].is_static);
+  // f = 2 Ω sin(80°)
+  CHECK(c.forcing.coriolis == doctest::Approx(2 * 7.2921e-5 * std::sin(80.0 * M_PI / 180)));
+}
+
+TEST_CASE("unknown keys, wrong types and out-of-range values name file, line and key") {
+  refused("[run]\nt_end = 1\nt_edn = 2\n", {"case.toml:3", "[run] t_edn", "unknown key"});
+  refused("[run]\ndt_max = \"fast\"\n", {"case.toml:2", "[run] dt_max", "a string"});
+  refused("[run]\ndt_max = -1.0\n", {"case.toml:2", "[run] dt_max", "> 0"});
+  refused("[sea]\ndims = 3\n", {"case.toml:2", "[sea] dims", "1 or 2"});
+  refused("[sea]\nmodel = \"fem\"\n", {"[sea] model", "\"spectral\""});
+  refused("[sea]\ncells = [0, 4]\n", {"[sea] cells"});
+  refused("[contact]\nrestitution = 1.5\n", {"[contact] restitution", "[0, 1]"});
+  refused("[forcing]\nwind = [1]\n", {"[forcing] wind", "2 numbers"});
+  refused("[forcing]\ncoriolis = 1e-4\nlatitude = 80\n", {"[forcing] latitude", "not both"});
+  refused("[bogus]\nx = 1\n", {"case.toml:1", "bogus", "unknown key"});
+  refused("[floes]\npack = \"does_not_exist.h5\"\n", {"[floes] pack", "not found"});
+  refused("[[floes.floe]]\nvelocity = [1, 0]\n", {"[floes.floe] vertices"});
+  refused("[[floes.floe]]\nvertices = [[0,0],[1,0],[1,1]]\ncolour = 1\n", {"case.toml:3", "colour"});
+  refused("[[floes.floe]]\nvertices = [[0,0],[1,0],[1,1]]\nstatic = true\nvelocity = [1, 0]\n",
+          {"[floes.floe] static", "cannot have a velocity"});
+  refused("[coupling]\nblend = 0.5\n", {"[coupling] blend", "blend"});
+  refused("[sea.waves]\nkind = \"regular\"\n", {"[sea.waves] kind", "wavelength or a period"});
+  refused("[run\n", {"case.toml:1", "not valid TOML"});
+}
+
+TEST_CASE("the resolved configuration parses back to the same values") {
+  const Config c = parse("[run]\nt_end = 3\n[[floes.floe]]\nvertices = [[0,0],[1,0],[1,1]]\n"
+                         "[coupling]\nlaw = \"blend\"\nrestitution = 0.3\n");
+  const std::string text = resolved_toml(c);
+  const Config d = parse(text);
+  CHECK(d.run.t_end == 3.0);
+  CHECK(d.floes.floes.size() == 1);
+  CHECK(d.coupling.restitution == 0.3);
+  CHECK(resolved_toml(d) == text);
+}
