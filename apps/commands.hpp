@@ -5,12 +5,17 @@
 
 #include <CLI/CLI.hpp>
 #include <functional>
+#include <map>
 
 namespace floesim::apps {
 
 using Handler = std::function<int()>;
+using Registry = std::map<CLI::App*, Handler>;
 
-// Adds the subcommand and returns the function to call when it was chosen.
-// (Add one line per command; keep alphabetical.)
+// Each adds its subcommand to `app` and its handler to `registry`.
+// (One line per command; keep alphabetical.)
+void add_compare_command(CLI::App& app, Registry& registry);
+void add_info_command(CLI::App& app, Registry& registry);
+void add_run_command(CLI::App& app, Registry& registry);
 
 }  // namespace floesim::apps

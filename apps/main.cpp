@@ -11,8 +11,11 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   app.set_version_flag("--version", std::string(FLOESIM_VERSION));
 
-  std::map<CLI::App*, floesim::apps::Handler> handlers;
+  floesim::apps::Registry handlers;
   // registrations (one line per command, alphabetical)
+  floesim::apps::add_compare_command(app, handlers);
+  floesim::apps::add_info_command(app, handlers);
+  floesim::apps::add_run_command(app, handlers);
 
   try {
     app.parse(argc, argv);

@@ -1,0 +1,68 @@
+#include "coupling/run.hpp"
+
+#include <chrono>
+#include <cmath>
+
+#include "core/error.hpp"
+#include "core/run_file.hpp"
+
+namespace floesim {
+
+RunSummary run_simulation(Simulation& sim, const RunOptions& options) {
+  const Config& cfg = sim.scenario().config;
+  const double t_end = options.until >= 0.0 ? options.until : cfg.run.t_end;
+  const double interval = cfg.run.output_interval;
+  const auto start = std::chrono::steady_clock::now();
+
+  RunSummary summary;
+  summary.output = options.output;
+  summary.energy_first = sim.energies();
+  summary.warnings = sim.scenario().notes;
+  RunWriter writer(options.output, sim.floes(), resolved_toml(cfg), summary.energy_first.names);
+  summary.xdmf = writer.xdmf_path();
+
+  const LcpCounters no_lcp;  // collisions arrive with the contact layer
+  auto record = [&] {
+    PhaseTimer _(sim.profile(), Phase::record);
+    const Energies e = sim.energies();
+    writer.record(sim.time(), sim.floes(), e.values, no_lcp);
+  };
+  auto wall = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); };
+
+  summary.status = "complete";
+  try {
+    record();
+    std::size_t next = 1;  // index of the next scheduled record
+    while (sim.time() < t_end) {
+      // Next record time; a record that would fall within 1e-9 s of the end merges with it.
+      double t_record = std::min(static_cast<double>(next) * interval, t_end);
+      if (t_end - t_record < 1e-9 * std::max(1.0, t_end)) t_record = t_end;
+      bool stop = false;
+      while (sim.time() < t_record && !stop) {
+        sim.step(t_record);
+        if (options.progress) options.progress({sim.time(), t_end, sim.steps(), wall()});
+        stop = options.should_stop && options.should_stop();
+      }
+      record();  // on schedule, or the last state of an interrupted run
+      ++next;
+      if (stop) {
+        summary.status = "interrupted";
+        break;
+      }
+    }
+  } catch (const RunError& e) {
+    writer.finish(std::string("failed: ") + e.what());
+    throw;
+  }
+  writer.finish(summary.status == "complete" ? "complete"
+                                             : "interrupted at t = " + std::to_string(sim.time()) + " s");
+  summary.steps = sim.steps();
+  summary.records = writer.records();
+  summary.t_end = sim.time();
+  summary.wall_seconds = wall();
+  summary.energy_last = sim.energies();
+  summary.profile = sim.profile();
+  return summary;
+}
+
+}  // namespace floesim

@@ -1,0 +1,91 @@
+#pragma once
+// The time loop of a run. One call to step() advances the floes (and, as the
+// model grows, the sea) by one step; the step reads as a table of contents,
+// one named and timed phase per line (MODEL.md §5):
+//
+//   choose dt -> sample forcing -> drift (drag, Coriolis) -> check state
+//
+// Step contract: on entry the state is at time(); step(t_stop) advances it to
+// time() + dt with 0 < dt <= min(dt_max, t_stop - time()) and returns dt.
+// Units: SI; the state layout is FloeState (core/floes.hpp).
+
+#include <array>
+#include <chrono>
+#include <string>
+#include <vector>
+
+#include "coupling/drift.hpp"
+#include "coupling/scenario.hpp"
+
+namespace floesim {
+
+enum class Phase { choose_dt, forcing, drift, check, record, count };
+inline constexpr std::array<const char*, static_cast<std::size_t>(Phase::count)> kPhaseNames = {
+    "choose_dt", "forcing", "drift", "check", "record"};
+
+// Wall time spent in each phase (s), for `floesim run --profile`.
+struct Profile {
+  std::array<double, static_cast<std::size_t>(Phase::count)> seconds{};
+  double& operator[](Phase p) { return seconds[static_cast<std::size_t>(p)]; }
+  double operator[](Phase p) const { return seconds[static_cast<std::size_t>(p)]; }
+};
+
+// Per-step data passed from phase to phase.
+struct StepContext {
+  double t = 0.0;      // s, time at the start of the step
+  double dt = 0.0;     // s
+  ForcingSample forcing;
+};
+
+// Energies by part (J), named as the columns of /diagnostics/energy; the last
+// column is the total.
+struct Energies {
+  std::vector<std::string> names;
+  std::vector<double> values;
+};
+
+class Simulation {
+public:
+  explicit Simulation(Scenario scenario);
+
+  double step(double t_stop);
+
+  double time() const { return t_; }
+  std::size_t steps() const { return steps_; }
+  const Floes& floes() const { return scenario_.floes; }
+  const Scenario& scenario() const { return scenario_; }
+  const Profile& profile() const { return profile_; }
+  Profile& profile() { return profile_; }
+  Energies energies() const;
+
+private:
+  StepContext choose_dt(double t_stop) const;
+  void sample_forcing(StepContext& ctx) const;
+  void drift(const StepContext& ctx);
+  void check_state(const StepContext& ctx) const;
+
+  Scenario scenario_;
+  DriftParams drift_params_;
+  FootprintQuadrature quadrature_;
+  Profile profile_;
+  double t_ = 0.0;
+  std::size_t steps_ = 0;
+};
+
+// Times a phase into a profile: `PhaseTimer timer(profile, Phase::drift);`.
+class PhaseTimer {
+public:
+  PhaseTimer(Profile& p, Phase phase) : p_(p), phase_(phase), start_(std::chrono::steady_clock::now()) {}
+  ~PhaseTimer() {
+    p_[phase_] += std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+  }
+  PhaseTimer(const PhaseTimer&) = delete;
+  PhaseTimer& operator=(const PhaseTimer&) = delete;
+
+private:
+  Profile& p_;
+  Phase phase_;
+  std::chrono::steady_clock::time_point start_;
+};
+
+}  // namespace floesim
