@@ -1,0 +1,75 @@
+#pragma once
+// The modal integrator shared by every sea backend.
+//
+// The linearised surface equation m_sf(eta'', v) + a_sf(eta, v) = -∫ p v
+// (MODEL.md §3), written in any basis that diagonalises m_sf and a_sf together
+// (Fourier modes of a periodic box; the generalised eigenvectors of a BEM
+// basin), is a bank of independent oscillators
+//
+//     q_j'' + omega_j^2 q_j = gain_j s_j(p),
+//
+// where q_j is the modal amplitude, s_j(p) the projection of the pressure on
+// mode j (computed by the backend: an FFT, or X^T D p) and gain_j turns it into
+// an acceleration. A mode has `components` real amplitudes sharing omega_j (2 for
+// a complex Fourier coefficient, 1 for a real eigenvector).
+//
+// Two operators, each exact:
+//   flow(dt): free evolution, a rotation of (q_j, q_j'/omega_j) by omega_j dt.
+//             No stability limit from gravity or capillarity. A mode with
+//             omega_j = 0 drifts, q += v dt.
+//   kick(s, h): v_j += h gain_j s_j (the impulse of a pressure held over h).
+// A forced step is their Strang composition kick(h/2) flow(h) kick(h/2):
+// second order in dt and symplectic.
+//
+// Energy of the bank: kinetic 1/2 sum mass_j |v_j|^2 = 1/2 m_sf(eta', eta'),
+// potential 1/2 sum mass_j omega_j^2 |q_j|^2 = 1/2 a_sf(eta, eta). A frozen
+// mode (the mean of the surface, held at zero for volume conservation) has
+// mass 0 and gain 0.
+
+#include <cstddef>
+#include <span>
+#include <vector>
+
+namespace floesim::fluid {
+
+class ModalBank {
+public:
+  ModalBank() = default;
+  // omega (rad/s), mass (J per unit amplitude^2 per (rad/s)^2) and gain, one per mode.
+  ModalBank(std::vector<double> omega, std::vector<double> mass, std::vector<double> gain,
+            int components);
+
+  std::size_t modes() const { return omega_.size(); }
+  int components() const { return components_; }
+
+  // Modal amplitudes and rates, contiguous: mode j, component c at j * components + c.
+  std::span<double> q() { return q_; }
+  std::span<double> v() { return v_; }
+  std::span<const double> q() const { return q_; }
+  std::span<const double> v() const { return v_; }
+  std::span<const double> omega() const { return omega_; }
+  std::span<const double> mass() const { return mass_; }
+  std::span<const double> gain() const { return gain_; }
+
+  // Exact free evolution over dt (any sign). The rotation coefficients are
+  // cached for the last dt: a change of dt costs one sin/cos per mode.
+  void flow(double dt);
+  // v += h * gain * s, s laid out like v.
+  void kick(std::span<const double> s, double h);
+
+  double kinetic() const;
+  double potential() const;
+
+private:
+  void prepare(double dt);
+
+  int components_ = 1;
+  std::vector<double> omega_, mass_, gain_;
+  std::vector<double> q_, v_;
+  // Rotation over cached_dt_: q' = c q + sw v, v' = -ws q + c v.
+  double cached_dt_ = 0.0;
+  bool cache_valid_ = false;
+  std::vector<double> c_, sw_, ws_;
+};
+
+}  // namespace floesim::fluid

@@ -1,0 +1,146 @@
+#include "fluid/sea.hpp"
+
+#include <cmath>
+#include <sstream>
+
+#include "core/error.hpp"
+#include "fluid/bem.hpp"
+#include "fluid/spectral.hpp"
+#include "fluid/waves.hpp"
+
+namespace floesim::fluid {
+
+Sea::Sea(const SurfaceGrid& grid) : grid_(grid) {}
+
+Sea::~Sea() = default;
+
+void Sea::step(double dt, const PressureFn& pressure) {
+  if (p_scratch_.size() != grid_.size()) p_scratch_.assign(grid_.size(), 0.0);
+  pressure(*this, time_, p_scratch_);
+  kick(p_scratch_, 0.5 * dt);
+  flow(dt);
+  pressure(*this, time_, p_scratch_);
+  kick(p_scratch_, 0.5 * dt);
+}
+
+std::span<const double> Sea::field(Field f) {
+  const auto i = static_cast<std::size_t>(f);
+  if (!valid_[i]) {
+    if (fields_[i].size() != grid_.size()) fields_[i].assign(grid_.size(), 0.0);
+    compute_field(f, fields_[i]);
+    valid_[i] = true;
+  }
+  return fields_[i];
+}
+
+SurfaceSample Sea::sample(double x, double y) {
+  auto at = [&](Field f, Parity parity) { return interpolate(grid_, field(f), x, y, parity); };
+  SurfaceSample s;
+  s.eta = at(Field::elevation, Parity::even);
+  s.slope_x = at(Field::slope_x, Parity::odd);
+  s.u = at(Field::velocity_x, Parity::odd);
+  s.w = at(Field::velocity_z, Parity::even);
+  if (grid_.dims == 2) {
+    s.slope_y = at(Field::slope_y, Parity::even);
+    s.v = at(Field::velocity_y, Parity::even);
+  }
+  return s;
+}
+
+namespace {
+
+template <class T>
+std::string str(const T& v) {
+  std::ostringstream s;
+  s << v;
+  return s.str();
+}
+
+[[noreturn]] void bad(const std::string& key, const std::string& what) {
+  throw InputError("[sea] " + key + ": " + what);
+}
+
+void validate_bottom(const SeaParams& p) {
+  const auto& b = p.bottom;
+  if (b.size() < 2)
+    bad("bottom", "expected a polyline of at least 2 points [x, z] spanning the basin [0, " +
+                      str(p.size[0]) + "] m, got " + str(b.size()) + " point(s)");
+  for (std::size_t i = 0; i < b.size(); ++i) {
+    if (!std::isfinite(b[i][0]) || !std::isfinite(b[i][1]))
+      bad("bottom", "point " + str(i) + " is not finite");
+    if (i > 0 && !(b[i][0] > b[i - 1][0]))
+      bad("bottom", "x must increase along the polyline (point " + str(i) + " at x = " +
+                        str(b[i][0]) + " m)");
+    if (!(b[i][1] < 0.0))
+      bad("bottom", "point " + str(i) + " (x = " + str(b[i][0]) + " m, z = " + str(b[i][1]) +
+                        " m) is not below the surface z = 0");
+  }
+  if (b.front()[0] > 0.0 || b.back()[0] < p.size[0])
+    bad("bottom", "the polyline covers x in [" + str(b.front()[0]) + ", " + str(b.back()[0]) +
+                      "] m but must span the basin [0, " + str(p.size[0]) + "] m");
+}
+
+}  // namespace
+
+void validate(const SeaParams& p) {
+  if (!(p.rho > 0.0) || !std::isfinite(p.rho))
+    bad("rho", "expected a water density > 0 kg/m^3, got " + str(p.rho));
+  if (p.model == SeaModel::none) return;
+  if (p.dims != 1 && p.dims != 2) bad("dims", "expected 1 or 2, got " + str(p.dims));
+  if (!(p.size[0] > 0.0) || !std::isfinite(p.size[0]))
+    bad("size", "expected a length > 0 m along x, got " + str(p.size[0]));
+  if (!(p.size[1] > 0.0) || !std::isfinite(p.size[1]))
+    bad("size", std::string("expected a ") + (p.dims == 1 ? "width" : "length") +
+                    " > 0 m along y, got " + str(p.size[1]));
+  if (p.model == SeaModel::bem && p.dims != 1)
+    bad("dims", "model = \"bem\" is a vertical slice: expected dims = 1, got " + str(p.dims));
+  const int min_cells = p.model == SeaModel::bem ? 4 : 2;
+  if (p.cells[0] < min_cells)
+    bad("cells", "expected at least " + str(min_cells) + " cells along x, got " +
+                     str(p.cells[0]));
+  if (p.dims == 2 && p.cells[1] < 2)
+    bad("cells", "expected at least 2 cells along y, got " + str(p.cells[1]));
+  if (!(p.depth > 0.0))
+    bad("depth", "expected a depth > 0 m (inf for deep water), got " + str(p.depth));
+  if (!(p.g >= 0.0) || !std::isfinite(p.g)) bad("g", "expected g >= 0 m/s^2, got " + str(p.g));
+  if (!(p.sigma >= 0.0) || !std::isfinite(p.sigma))
+    bad("sigma", "expected a surface tension >= 0 N/m, got " + str(p.sigma));
+  if (p.g == 0.0 && p.sigma == 0.0)
+    bad("g", "with g = 0 and sigma = 0 the surface has no restoring force");
+  if (p.model == SeaModel::spectral && !p.bottom.empty())
+    bad("bottom", "only model = \"bem\" takes a bottom polyline; the spectral sea has a flat "
+                  "bottom at [sea] depth");
+  if (p.model == SeaModel::bem) {
+    if (p.bottom.empty() && !std::isfinite(p.depth))
+      bad("depth", "model = \"bem\" needs a finite depth or a [sea] bottom polyline");
+    if (!p.bottom.empty()) validate_bottom(p);
+  }
+}
+
+std::unique_ptr<Sea> make_sea(const SeaParams& params, unsigned long seed,
+                              const SeaOptions& options) {
+  validate(params);
+  std::unique_ptr<Sea> sea;
+  switch (params.model) {
+    case SeaModel::none:
+      return nullptr;
+    case SeaModel::spectral:
+      sea = std::make_unique<SpectralSea>(params, options);
+      break;
+    case SeaModel::bem:
+      if (options.tank.enabled)
+        throw InputError("[sea] model: relaxation zones are for the spectral sea; a bem basin "
+                         "has walls");
+      sea = std::make_unique<BemSea>(params, options);
+      break;
+  }
+  if (!options.tank.enabled) {
+    const std::size_t n = sea->grid().size();
+    std::vector<double> eta(n), eta_t(n);
+    initial_surface(params, sea->grid(), seed, eta, eta_t);
+    sea->set_surface(eta, eta_t);
+  }
+  return sea;
+}
+
+}  // namespace floesim::fluid

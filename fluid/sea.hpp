@@ -1,0 +1,125 @@
+#pragma once
+// fluid::Sea — the sea surface as the rest of floesim sees it.
+//
+// Linear potential flow under a capillary-gravity free surface (MODEL.md §3):
+//     m_sf(eta'', v) + a_sf(eta, v) = -∫ p v   for every zero-mean v,
+// where p (Pa) is the pressure that floes apply to the water on the surface grid.
+// A backend (spectral: periodic box; bem: vertical-slice basin) turns this into
+// a ModalBank; the Sea owns it and offers the same operations for both.
+//
+// Step contract (Strang splitting, MODEL.md §5):
+//   on entry      state (eta, eta') at time t = time();
+//   kick(p, h)    eta' += h M^-1 F(p), F(p) = the load v -> -∫ p v; eta and t unchanged;
+//   flow(dt)      exact free evolution over dt; t += dt (and, in a tank, the
+//                 relaxation zones act over the same dt);
+//   on exit       state at t + dt.
+// A forced step is kick(p(t), dt/2); flow(dt); kick(p(t + dt), dt/2), where
+// p(t + dt) may be computed from the surface after flow (step() does exactly that).
+// The mean of p does nothing (the surface keeps zero mean: volume conservation).
+//
+// Fields on the grid (SurfaceGrid: cell centres, x contiguous) and point queries
+// are computed lazily from the modal state and cached until the state changes.
+
+#include <array>
+#include <functional>
+#include <memory>
+#include <span>
+#include <vector>
+
+#include "core/params.hpp"
+#include "fluid/aligned.hpp"
+#include "fluid/grid.hpp"
+#include "fluid/modal.hpp"
+#include "fluid/tank.hpp"
+
+namespace floesim::fluid {
+
+// Surface fields a sea provides, all at z = 0 (linear theory).
+enum class Field {
+  elevation,   // eta, m
+  slope_x,     // d eta / dx
+  slope_y,     // d eta / dy (0 in dims = 1)
+  velocity_x,  // d phi / dx, m/s (orbital velocity, horizontal)
+  velocity_y,  // d phi / dy (0 in dims = 1)
+  velocity_z,  // d phi / dz = eta'
+};
+inline constexpr int field_count = 6;
+
+struct SurfaceSample {
+  double eta = 0.0;                       // m
+  double slope_x = 0.0, slope_y = 0.0;    // grad eta
+  double u = 0.0, v = 0.0, w = 0.0;       // grad phi at z = 0, m/s
+};
+
+// Energies over the whole surface (dims = 1: times the width ly), J.
+struct SeaEnergy {
+  double kinetic = 0.0;    // 1/2 m_sf(eta', eta')
+  double potential = 0.0;  // 1/2 a_sf(eta, eta)
+  double total() const { return kinetic + potential; }
+};
+
+// Fluid-side options that are not part of the [sea] configuration.
+struct SeaOptions {
+  TankParams tank;              // relaxation zones (spectral only)
+  bool measure_fft_plans = false;  // FFTW_MEASURE instead of FFTW_ESTIMATE (benchmarks)
+  double bem_panel_ratio = 1.0;    // bem: wall and bottom panel length / surface panel length
+};
+
+class Sea {
+public:
+  virtual ~Sea();
+  Sea(const Sea&) = delete;
+  Sea& operator=(const Sea&) = delete;
+
+  const SurfaceGrid& grid() const { return grid_; }
+  double time() const { return time_; }
+  void set_time(double t) { time_ = t; }
+
+  // The step contract is in the comment at the top of this file.
+  virtual void kick(std::span<const double> pressure, double h) = 0;
+  virtual void flow(double dt) = 0;
+
+  // pressure(sea, t, p) fills p (grid().size() values, Pa) for time t; it may
+  // query the sea (called with the state at t, then at t + dt).
+  using PressureFn = std::function<void(Sea& sea, double t, std::span<double> p)>;
+  void step(double dt, const PressureFn& pressure);
+
+  // Replaces the state by a surface given on the grid (its mean is removed).
+  virtual void set_surface(std::span<const double> eta, std::span<const double> eta_t) = 0;
+
+  std::span<const double> field(Field f);
+  std::span<const double> elevation() { return field(Field::elevation); }
+  SurfaceSample sample(double x, double y = 0.0);
+  SeaEnergy energy() const { return {bank_.kinetic(), bank_.potential()}; }
+
+  const ModalBank& modes() const { return bank_; }
+  ModalBank& modes() {
+    invalidate();
+    return bank_;
+  }
+
+protected:
+  explicit Sea(const SurfaceGrid& grid);
+  virtual void compute_field(Field f, std::span<double> out) = 0;
+  void invalidate() { valid_.fill(false); }
+
+  SurfaceGrid grid_;
+  ModalBank bank_;
+  double time_ = 0.0;
+
+private:
+  std::array<AlignedVector, field_count> fields_;
+  std::array<bool, field_count> valid_{};
+  AlignedVector p_scratch_;
+};
+
+// Checks a [sea] section; throws InputError naming the key ("[sea] cells: ...").
+void validate(const SeaParams& params);
+
+// The sea of a configuration, with its initial waves ([sea.waves]; `seed` draws
+// the random phases of an irregular sea). Returns nullptr for model = "none".
+// A tank run (options.tank.enabled) starts calm and generates its target wave.
+std::unique_ptr<Sea> make_sea(const SeaParams& params, unsigned long seed,
+                              const SeaOptions& options = {});
+
+}  // namespace floesim::fluid

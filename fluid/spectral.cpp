@@ -1,0 +1,231 @@
+#include "fluid/spectral.hpp"
+
+#include <fftw3.h>
+
+#include <cmath>
+#include <numbers>
+#include <optional>
+
+#include "core/error.hpp"
+#include "fluid/waves.hpp"
+
+namespace floesim::fluid {
+
+namespace {
+
+SurfaceGrid periodic_grid(const SeaParams& p) {
+  SurfaceGrid g;
+  g.dims = p.dims;
+  g.nx = p.cells[0];
+  g.ny = p.dims == 2 ? p.cells[1] : 1;
+  g.lx = p.size[0];
+  g.ly = p.size[1];
+  g.edge = GridEdge::periodic;
+  return g;
+}
+
+}  // namespace
+
+struct SpectralSea::Impl {
+  int nx = 0, ny = 1, hx = 0;
+  std::size_t n = 0, nc = 0;
+  Dispersion disp;
+  double lx = 0.0, ly = 0.0;
+  // Per mode: derivative wavenumbers (0 on the Nyquist line of that axis, where
+  // an odd derivative of a real field is not representable) and the factor
+  // coth(|k| H) / |k| that maps eta' to the surface potential phi.
+  std::vector<double> kx, ky, phi;
+  double* real = nullptr;         // n reals, scratch
+  fftw_complex* spec = nullptr;   // nc complex, scratch
+  fftw_plan r2c = nullptr, c2r = nullptr;
+  std::optional<TankZones> tank;
+  AlignedVector tank_eta, tank_rate;
+
+  ~Impl() {
+    if (r2c) fftw_destroy_plan(r2c);
+    if (c2r) fftw_destroy_plan(c2r);
+    fftw_free(real);
+    fftw_free(spec);
+  }
+
+  bool aligned(const double* p) const {
+    return fftw_alignment_of(const_cast<double*>(p)) == fftw_alignment_of(real);
+  }
+
+  // spec <- FFT(field)
+  void forward(std::span<const double> field) {
+    if (aligned(field.data())) {
+      // r2c plans preserve their input (FFTW_PRESERVE_INPUT is the default).
+      fftw_execute_dft_r2c(r2c, const_cast<double*>(field.data()), spec);
+    } else {
+      std::copy(field.begin(), field.end(), real);
+      fftw_execute_dft_r2c(r2c, real, spec);
+    }
+  }
+  // out <- IFFT(spec) (unnormalised; spec is destroyed)
+  void backward(std::span<double> out) {
+    if (aligned(out.data())) {
+      fftw_execute_dft_c2r(c2r, spec, out.data());
+    } else {
+      fftw_execute_dft_c2r(c2r, spec, real);
+      std::copy(real, real + n, out.begin());
+    }
+  }
+  // spec <- (i k)^d factor * a / n, for a = q or v (d = 0 or 1 via `deriv`).
+  void load(std::span<const double> a, const std::vector<double>* deriv,
+            const std::vector<double>* factor) {
+    const double inv_n = 1.0 / static_cast<double>(n);
+    for (std::size_t c = 0; c < nc; ++c) {
+      double s = inv_n;
+      if (factor) s *= (*factor)[c];
+      const double re = a[2 * c] * s, im = a[2 * c + 1] * s;
+      if (deriv) {
+        const double k = (*deriv)[c];
+        spec[c][0] = -k * im;
+        spec[c][1] = k * re;
+      } else {
+        spec[c][0] = re;
+        spec[c][1] = im;
+      }
+    }
+  }
+};
+
+SpectralSea::SpectralSea(const SeaParams& params, const SeaOptions& options)
+    : Sea(periodic_grid(params)), impl_(std::make_unique<Impl>()) {
+  Impl& m = *impl_;
+  m.nx = grid_.nx;
+  m.ny = grid_.ny;
+  m.hx = m.nx / 2 + 1;
+  m.n = grid_.size();
+  m.nc = static_cast<std::size_t>(m.ny) * m.hx;
+  m.disp = Dispersion::of(params);
+  m.lx = grid_.lx;
+  m.ly = grid_.ly;
+
+  m.real = fftw_alloc_real(m.n);
+  m.spec = fftw_alloc_complex(m.nc);
+  const unsigned flags = options.measure_fft_plans ? FFTW_MEASURE : FFTW_ESTIMATE;
+  if (m.ny > 1) {
+    m.r2c = fftw_plan_dft_r2c_2d(m.ny, m.nx, m.real, m.spec, flags);
+    m.c2r = fftw_plan_dft_c2r_2d(m.ny, m.nx, m.spec, m.real, flags);
+  } else {
+    m.r2c = fftw_plan_dft_r2c_1d(m.nx, m.real, m.spec, flags);
+    m.c2r = fftw_plan_dft_c2r_1d(m.nx, m.spec, m.real, flags);
+  }
+  if (!m.r2c || !m.c2r) throw RunError("fluid: FFTW could not plan the spectral sea transforms");
+
+  // Oscillator bank. Parseval on the half spectrum: a coefficient with
+  // 0 < ix < nx/2 stands for itself and its conjugate (weight 2).
+  std::vector<double> omega(m.nc), mass(m.nc), gain(m.nc);
+  m.kx.assign(m.nc, 0.0);
+  m.ky.assign(m.nc, 0.0);
+  m.phi.assign(m.nc, 0.0);
+  const double da_over_n = grid_.cell_area() / static_cast<double>(m.n);
+  const double two_pi = 2.0 * std::numbers::pi;
+  for (int iy = 0; iy < m.ny; ++iy) {
+    const int my = iy <= m.ny / 2 ? iy : iy - m.ny;
+    for (int ix = 0; ix < m.hx; ++ix) {
+      const std::size_t c = static_cast<std::size_t>(iy) * m.hx + ix;
+      const double kx = two_pi * ix / m.lx;
+      const double ky = m.ny > 1 ? two_pi * my / m.ly : 0.0;
+      const double k = std::hypot(kx, ky);
+      if (k == 0.0) {  // the mean: frozen
+        omega[c] = mass[c] = gain[c] = 0.0;
+        continue;
+      }
+      const double weight = (ix > 0 && 2 * ix != m.nx) ? 2.0 : 1.0;
+      const double mu = m.disp.mass_density(k);
+      omega[c] = m.disp.omega(k);
+      mass[c] = weight * mu * da_over_n;
+      gain[c] = -1.0 / mu;
+      m.kx[c] = 2 * ix == m.nx ? 0.0 : kx;
+      m.ky[c] = (m.ny > 1 && 2 * iy == m.ny) ? 0.0 : ky;
+      m.phi[c] = 1.0 / (k * std::tanh(k * m.disp.depth));
+    }
+  }
+  bank_ = ModalBank(std::move(omega), std::move(mass), std::move(gain), 2);
+
+  if (options.tank.enabled) {
+    if (params.waves.kind != WaveKind::regular)
+      throw InputError("[sea.waves] kind: a tank run generates a regular wave; got another kind");
+    m.tank.emplace(grid_, options.tank, plane_wave(params, grid_));
+    m.tank_eta.assign(m.n, 0.0);
+    m.tank_rate.assign(m.n, 0.0);
+  }
+}
+
+SpectralSea::~SpectralSea() = default;
+
+double SpectralSea::omega(int mx, int my) const {
+  const double two_pi = 2.0 * std::numbers::pi;
+  return impl_->disp.omega(std::hypot(two_pi * mx / impl_->lx, two_pi * my / impl_->ly));
+}
+
+const TankZones* SpectralSea::tank() const { return impl_->tank ? &*impl_->tank : nullptr; }
+
+void SpectralSea::kick(std::span<const double> pressure, double h) {
+  FLOESIM_ASSERT(pressure.size() == impl_->n);
+  impl_->forward(pressure);
+  bank_.kick(std::span<const double>(reinterpret_cast<const double*>(impl_->spec), 2 * impl_->nc),
+             h);
+  invalidate();
+}
+
+void SpectralSea::set_surface(std::span<const double> eta, std::span<const double> eta_t) {
+  Impl& m = *impl_;
+  FLOESIM_ASSERT(eta.size() == m.n && eta_t.size() == m.n);
+  auto copy_in = [&](std::span<const double> f, std::span<double> a) {
+    m.forward(f);
+    const double* s = reinterpret_cast<const double*>(m.spec);
+    std::copy(s, s + 2 * m.nc, a.begin());
+    a[0] = a[1] = 0.0;  // zero mean
+  };
+  copy_in(eta, bank_.q());
+  copy_in(eta_t, bank_.v());
+  invalidate();
+}
+
+void SpectralSea::flow(double dt) {
+  Impl& m = *impl_;
+  if (!m.tank) {
+    bank_.flow(dt);
+  } else {
+    // Strang: relax(dt/2) flow(dt) relax(dt/2), relaxing in physical space.
+    auto relax = [&](double t0, double h) {
+      m.load(bank_.q(), nullptr, nullptr);
+      m.backward(m.tank_eta);
+      m.load(bank_.v(), nullptr, nullptr);
+      m.backward(m.tank_rate);
+      m.tank->relax(t0, h, m.tank_eta, m.tank_rate);
+      set_surface(m.tank_eta, m.tank_rate);
+    };
+    relax(time_, 0.5 * dt);
+    bank_.flow(dt);
+    relax(time_ + 0.5 * dt, 0.5 * dt);
+  }
+  time_ += dt;
+  invalidate();
+}
+
+void SpectralSea::compute_field(Field f, std::span<double> out) {
+  Impl& m = *impl_;
+  const bool one_d = m.ny == 1;
+  switch (f) {
+    case Field::elevation: m.load(bank_.q(), nullptr, nullptr); break;
+    case Field::slope_x: m.load(bank_.q(), &m.kx, nullptr); break;
+    case Field::slope_y:
+      if (one_d) return std::fill(out.begin(), out.end(), 0.0);
+      m.load(bank_.q(), &m.ky, nullptr);
+      break;
+    case Field::velocity_x: m.load(bank_.v(), &m.kx, &m.phi); break;
+    case Field::velocity_y:
+      if (one_d) return std::fill(out.begin(), out.end(), 0.0);
+      m.load(bank_.v(), &m.ky, &m.phi);
+      break;
+    case Field::velocity_z: m.load(bank_.v(), nullptr, nullptr); break;
+  }
+  m.backward(out);
+}
+
+}  // namespace floesim::fluid

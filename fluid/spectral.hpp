@@ -1,0 +1,44 @@
+#pragma once
+// Spectral sea: a periodic box lx (x ly) with a flat bottom at depth H (or deep
+// water), dims = 1 (long-crested) or 2. Each Fourier mode k of the real-to-
+// complex transform of eta is an oscillator of the ModalBank (two real
+// components, re and im) with
+//     omega_k^2 = (g |k| + sigma |k|^3 / rho) tanh(|k| H),
+//     added-mass density mu_k = rho coth(|k| H) / |k|,
+// so that a pressure p acts on mode k as eta_k'' = -omega_k^2 eta_k - p_k / mu_k.
+// The k = 0 mode (the mean) is frozen at zero: volume conservation.
+//
+// Modal amplitudes are the unnormalised FFTW coefficients of eta on the cell
+// centres. FFTW plans (r2c, c2r) are made once at construction and reused; a
+// kick costs one r2c, each grid field one c2r. All scratch is allocated once.
+
+#include <memory>
+
+#include "fluid/sea.hpp"
+
+namespace floesim::fluid {
+
+class SpectralSea final : public Sea {
+public:
+  // params must have passed validate(); tank zones need a regular target wave.
+  SpectralSea(const SeaParams& params, const SeaOptions& options = {});
+  ~SpectralSea() override;
+
+  void kick(std::span<const double> pressure, double h) override;
+  void flow(double dt) override;
+  void set_surface(std::span<const double> eta, std::span<const double> eta_t) override;
+
+  // omega of the Fourier mode with wave vector 2 pi (mx / lx, my / ly).
+  double omega(int mx, int my = 0) const;
+  // The tank's relaxation zones, or nullptr.
+  const TankZones* tank() const;
+
+protected:
+  void compute_field(Field f, std::span<double> out) override;
+
+private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace floesim::fluid

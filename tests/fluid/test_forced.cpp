@@ -1,0 +1,89 @@
+// Forced response: the Strang-split step kick(dt/2) flow(dt) kick(dt/2)
+// converges at second order in dt. Issue 5, "Forced response".
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <numbers>
+#include <vector>
+
+#include "fluid/sea.hpp"
+#include "fluid/waves.hpp"
+#include "tests/fluid/sea_cases.hpp"
+
+using namespace floesim;
+using namespace floesim::fluid;
+constexpr double pi = std::numbers::pi;
+
+namespace {
+
+// Max-norm of the elevation after integrating to t_end with steps dt.
+std::vector<double> run(const SeaParams& p, const Sea::PressureFn& pressure, double dt,
+                        double t_end) {
+  auto sea = make_sea(p, 1);
+  const int steps = static_cast<int>(std::lround(t_end / dt));
+  for (int s = 0; s < steps; ++s) sea->step(dt, pressure);
+  const auto e = sea->elevation();
+  return {e.begin(), e.end()};
+}
+
+double max_diff(const std::vector<double>& a, const std::vector<double>& b) {
+  double m = 0.0;
+  for (std::size_t i = 0; i < a.size(); ++i) m = std::max(m, std::abs(a[i] - b[i]));
+  return m;
+}
+
+}  // namespace
+
+TEST_CASE("a pressure mode P cos(kx) sin(Wt) drives the Duhamel response at second order in dt") {
+  // mu A'' + mu w^2 A = -P sin(W t), mu = rho coth(kH)/k, A(0) = A'(0) = 0:
+  // A(t) = -(P / mu) (sin(W t) - (W / w) sin(w t)) / (w^2 - W^2).
+  SeaParams p = cases::lab_box_1d(64);
+  const double k = 2.0 * pi * 3.0, big_p = 50.0, big_w = 5.0, t_end = 2.0;
+  const Dispersion d = Dispersion::of(p);
+  const double w = d.omega(k), mu = d.mass_density(k);
+  auto pressure = [&](Sea& sea, double t, std::span<double> out) {
+    for (int i = 0; i < sea.grid().nx; ++i)
+      out[i] = big_p * std::cos(k * sea.grid().x(i)) * std::sin(big_w * t);
+  };
+  const double amp = -(big_p / mu) * (std::sin(big_w * t_end) - big_w / w * std::sin(w * t_end)) /
+                     (w * w - big_w * big_w);
+  std::vector<double> err;
+  for (double dt : {0.04, 0.02, 0.01, 0.005}) {
+    const auto e = run(p, pressure, dt, t_end);
+    double m = 0.0;
+    for (int i = 0; i < 64; ++i) m = std::max(m, std::abs(e[i] - amp * std::cos(k * (i + 0.5) / 64)));
+    err.push_back(m);
+  }
+  for (std::size_t i = 1; i < err.size(); ++i) {
+    const double order = std::log2(err[i - 1] / err[i]);
+    CAPTURE(i);
+    CAPTURE(err[i]);
+    CHECK(order == doctest::Approx(2.0).epsilon(0.05));
+  }
+}
+
+TEST_CASE("a pulsating pressure patch: the Strang step converges at second order in dt") {
+  // No closed form here: the order is measured from successive refinements,
+  // log2(|e(dt) - e(dt/2)| / |e(dt/2) - e(dt/4)|) -> 2.
+  SeaParams p;
+  p.model = SeaModel::spectral;
+  p.dims = 2;
+  p.size = {10.0, 10.0};
+  p.cells = {64, 64};
+  p.depth = 1.0;
+  auto pressure = [](Sea& sea, double t, std::span<double> out) {
+    const auto& g = sea.grid();
+    for (int j = 0; j < g.ny; ++j)
+      for (int i = 0; i < g.nx; ++i) {
+        const double r2 = (g.x(i) - 5.0) * (g.x(i) - 5.0) + (g.y(j) - 5.0) * (g.y(j) - 5.0);
+        out[static_cast<std::size_t>(j) * g.nx + i] = 200.0 * std::exp(-r2 / 0.5) * std::sin(4.0 * t);
+      }
+  };
+  std::vector<std::vector<double>> runs;
+  for (double dt : {0.04, 0.02, 0.01, 0.005}) runs.push_back(run(p, pressure, dt, 1.6));
+  for (std::size_t i = 2; i < runs.size(); ++i) {
+    const double order = std::log2(max_diff(runs[i - 2], runs[i - 1]) / max_diff(runs[i - 1], runs[i]));
+    CAPTURE(i);
+    CHECK(order == doctest::Approx(2.0).epsilon(0.05));
+  }
+}
