@@ -1,0 +1,70 @@
+#include "contact/lcp/fallback.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace floesim::lcp {
+
+std::string_view to_string(Method method) {
+  switch (method) {
+    case Method::lemke: return "lemke";
+    case Method::lemke_other_covering: return "lemke_other_covering";
+    case Method::lemke_regularised: return "lemke_regularised";
+    case Method::pgs: return "pgs";
+  }
+  return "lemke";
+}
+
+namespace {
+
+Lcp regularised(const Lcp& lcp, double relative_shift) {
+  Lcp shifted;
+  shifted.q = lcp.q;
+  SparseMatrix M = sparse_copy(lcp);
+  const double scale = std::max(1.0, M.diagonal().cwiseAbs().maxCoeff());
+  SparseMatrix I(M.rows(), M.cols());
+  I.setIdentity();
+  shifted.M = SparseMatrix(M + relative_shift * scale * I);
+  if (!lcp.is_sparse()) shifted.M = DenseMatrix(std::get<SparseMatrix>(shifted.M));
+  return shifted;
+}
+
+}  // namespace
+
+FallbackResult solve_with_fallbacks(const Lcp& lcp, const FallbackOptions& options) {
+  FallbackResult out;
+  // Records an attempt, judged on the original LCP; true when it is accepted.
+  auto record = [&](Method method, Result result) {
+    finish(lcp, result);
+    if (result.status == Status::solved && result.residual > options.accept_residual)
+      result.status = Status::failed;
+    out.attempts.push_back({method, result.status, std::max(result.pivots, result.iterations),
+                            result.residual});
+    const bool accepted = result.status == Status::solved;
+    if (accepted || out.attempts.size() == 1 || result.residual < out.result.residual) {
+      out.result = std::move(result);
+      out.method = method;
+    }
+    return accepted;
+  };
+
+  if (record(Method::lemke, solve_lemke(lcp, options.lemke))) return out;
+
+  LemkeOptions other = options.lemke;
+  other.covering.resize(lcp.size());
+  for (Index i = 0; i < lcp.size(); ++i) other.covering(i) = 1.0 + static_cast<double>(i % 7) / 7.0;
+  if (record(Method::lemke_other_covering, solve_lemke(lcp, other))) return out;
+
+  const Lcp shifted = regularised(lcp, options.regularisation);
+  if (record(Method::lemke_regularised, solve_lemke(shifted, options.lemke))) return out;
+
+  if (options.allow_pgs) {
+    PgsOptions pgs = options.pgs;
+    pgs.tolerance = std::min(pgs.tolerance, options.accept_residual);
+    record(Method::pgs, solve_pgs(lcp, pgs));
+    out.flagged = out.method == Method::pgs;
+  }
+  return out;
+}
+
+}  // namespace floesim::lcp

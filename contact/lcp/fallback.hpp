@@ -1,0 +1,55 @@
+#pragma once
+// The robust LCP solve used by the contact layer: Lemke, and when Lemke does not
+// deliver a solution, a fixed chain of fallbacks, every step recorded.
+//
+//   1. Lemke, covering vector of ones (the options' own covering if given);
+//   2. Lemke with another covering vector, d_i = 1 + (i mod 7) / 7, which
+//      changes the path of the method (not its lexicographic safety);
+//   3. Lemke on the regularised LCP(M + delta I, q), delta = regularisation *
+//      max(1, max_i |M_ii|); accepted if its z solves the ORIGINAL LCP within
+//      `accept_residual` (the residual is always computed with the original M);
+//   4. projected Gauss–Seidel (pgs.hpp), flagged: its answer is approximate.
+//
+// A step succeeds when its status is solved and its residual (on the original
+// LCP) is at most accept_residual; a "solved" above that counts as failed. The
+// chain stops at the first success. If no step succeeds, the result is the
+// attempt with the smallest residual, with that attempt's status (never
+// solved); `attempts` says how each step ended.
+
+#include <string>
+#include <vector>
+
+#include "contact/lcp/lemke.hpp"
+#include "contact/lcp/pgs.hpp"
+
+namespace floesim::lcp {
+
+enum class Method { lemke, lemke_other_covering, lemke_regularised, pgs };
+std::string_view to_string(Method method);
+
+struct FallbackOptions {
+  LemkeOptions lemke;
+  PgsOptions pgs;
+  double accept_residual = 1e-9;
+  double regularisation = 1e-10;  // relative diagonal shift of step 3
+  bool allow_pgs = true;
+};
+
+struct Attempt {
+  Method method;
+  Status status;
+  long pivots;      // or sweeps, for PGS
+  double residual;  // on the original LCP
+};
+
+struct FallbackResult {
+  Result result;                  // the accepted (or best) attempt
+  Method method = Method::lemke;  // which step produced it
+  std::vector<Attempt> attempts;  // every step tried, in order
+  bool flagged = false;           // the answer came from PGS (approximate)
+  bool solved() const { return result.status == Status::solved; }
+};
+
+FallbackResult solve_with_fallbacks(const Lcp& lcp, const FallbackOptions& options = {});
+
+}  // namespace floesim::lcp

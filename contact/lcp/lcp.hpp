@@ -1,0 +1,75 @@
+#pragma once
+// The linear complementarity problem as plain data, and what every LCP solver
+// returns. Solvers (Lemke in lemke.hpp, projected Gauss–Seidel in pgs.hpp, the
+// fallback chain in fallback.hpp) are functions of an `Lcp` and typed options.
+//
+//   LCP(M, q):  find z in R^n with
+//                 z >= 0,   w = M z + q >= 0,   z . w = 0     (componentwise).
+//
+// Nothing here knows about floes: the contact layer assembles M and q.
+
+#include <Eigen/Core>
+#include <Eigen/SparseCore>
+#include <string_view>
+#include <variant>
+
+namespace floesim::lcp {
+
+using Index = Eigen::Index;
+using Vector = Eigen::VectorXd;
+using DenseMatrix = Eigen::MatrixXd;
+// Compressed sparse columns; the solvers read M by columns.
+using SparseMatrix = Eigen::SparseMatrix<double, Eigen::ColMajor, int>;
+
+// M is stored dense or sparse, whichever the caller has; the solvers accept both.
+struct Lcp {
+  std::variant<DenseMatrix, SparseMatrix> M;
+  Vector q;
+
+  Index size() const { return q.size(); }
+  bool is_sparse() const { return std::holds_alternative<SparseMatrix>(M); }
+};
+
+// w = M z + q.
+Vector affine_map(const Lcp& lcp, const Vector& z);
+
+// M in compressed sparse columns (a copy; exact zeros of a dense M are dropped).
+SparseMatrix sparse_copy(const Lcp& lcp);
+
+// Number of stored non-zeros of M (for a dense M: the entries that are not 0).
+Index nonzeros(const Lcp& lcp);
+
+// Checks that M is n x n with n = q.size() >= 1 and every entry finite; throws
+// floesim::InputError naming what is wrong. Every solver calls it first.
+void check_lcp(const Lcp& lcp);
+
+enum class Status {
+  solved,       // z, w satisfy the LCP (see the residual for how well)
+  ray,          // Lemke ended on a secondary ray: no solution found this way
+  pivot_limit,  // the pivot (or iteration) limit was reached first
+  failed,       // numerical breakdown (singular basis, non-finite values, ...)
+};
+std::string_view to_string(Status status);
+
+struct Result {
+  Status status = Status::failed;
+  Vector z;                 // the candidate solution (z >= 0 by construction)
+  Vector w;                 // M z + q, recomputed from M (never the solver's own copy)
+  long pivots = 0;          // Lemke: pivots, counting the one where z0 enters
+  long iterations = 0;      // iterative solvers: sweeps
+  double residual = 0.0;    // residual(lcp, z), see below
+};
+
+// The scaled complementarity residual, the same for every solver:
+//
+//   residual(z) = || min(z, M z + q) ||_2 / (1 + || q ||_2),
+//
+// the componentwise minimum being the "natural map" of the LCP: it is zero
+// exactly when z >= 0, w >= 0 and z_i w_i = 0 for every i, and it measures the
+// distance to a solution for a well-conditioned M. Non-finite input gives +inf.
+double residual(const Lcp& lcp, const Vector& z);
+
+// Fills result.w and result.residual from result.z.
+void finish(const Lcp& lcp, Result& result);
+
+}  // namespace floesim::lcp

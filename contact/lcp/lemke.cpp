@@ -1,0 +1,237 @@
+#include "contact/lcp/lemke.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include "contact/lcp/lemke_basis.hpp"
+#include "core/error.hpp"
+
+namespace floesim::lcp {
+
+namespace {
+
+using detail::LemkeBasis;
+
+// Keeps the candidates whose key is minimal within the relative tie tolerance:
+// key_i - min <= tol * max(|key_i|, |min|).
+void keep_minimal(std::vector<Index>& rows, const std::vector<double>& keys, double tol) {
+  const double lo = *std::min_element(keys.begin(), keys.end());
+  std::size_t kept = 0;
+  for (std::size_t c = 0; c < rows.size(); ++c)
+    if (keys[c] - lo <= tol * std::max(std::abs(keys[c]), std::abs(lo))) rows[kept++] = rows[c];
+  rows.resize(kept);
+}
+
+class Lemke {
+public:
+  Lemke(const Lcp& lcp, const LemkeOptions& options, LemkeStats& stats)
+      : lcp_(lcp), opt_(options), stats_(stats), n_(lcp.size()), M_(sparse_copy(lcp)),
+        d_(options.covering.size() ? options.covering : Vector::Ones(n_)) {}
+
+  Result run();
+
+private:
+  bool use_sparse() const;
+  Index first_leaving() const;
+  Index ratio_test(const Vector& u);
+  Index lexicographic(std::vector<Index> tied, const Vector& u);
+  Result finish_solved(LemkeBasis& basis);
+
+  const Lcp& lcp_;
+  const LemkeOptions& opt_;
+  LemkeStats& stats_;
+  Index n_;
+  SparseMatrix M_;
+  Vector d_;
+  LemkeBasis* basis_ = nullptr;
+  Vector x_;  // basic values x_B = B^-1 q, by position
+};
+
+bool Lemke::use_sparse() const {
+  switch (opt_.factorization) {
+    case Factorization::dense: return false;
+    case Factorization::sparse: return true;
+    case Factorization::automatic: break;
+  }
+  const double size = static_cast<double>(n_);
+  const double density = static_cast<double>(M_.nonZeros()) / (size * size);
+  return n_ >= opt_.sparse_min_size && density <= opt_.sparse_max_density;
+}
+
+// z0 enters at max_i (-q_i / d_i); the row attaining it leaves. Ties: with q
+// perturbed to q + (eps, ..., eps^n), -(q_i + eps^i) / d_i is largest for the
+// largest tied index.
+Index Lemke::first_leaving() const {
+  std::vector<Index> rows(static_cast<std::size_t>(n_));
+  std::vector<double> keys(static_cast<std::size_t>(n_));
+  for (Index i = 0; i < n_; ++i) {
+    rows[i] = i;
+    keys[i] = lcp_.q(i) / d_(i);  // minimal q_i / d_i == maximal -q_i / d_i
+  }
+  keep_minimal(rows, keys, opt_.tie_tolerance);
+  return rows.back();
+}
+
+// Minimum-ratio test on the entering column u = B^-1 a: returns the leaving
+// position, or -1 for a ray.
+Index Lemke::ratio_test(const Vector& u) {
+  const double umax = u.cwiseAbs().maxCoeff();
+  if (!(umax > 0.0) || !std::isfinite(umax)) return -1;
+  const double pivot_min = opt_.pivot_tolerance * umax;
+  const double x_zero = opt_.zero_tolerance * x_.cwiseAbs().maxCoeff();
+  std::vector<Index> rows;
+  std::vector<double> ratios;
+  for (Index p = 0; p < n_; ++p) {
+    if (u(p) <= pivot_min) continue;
+    const double x = x_(p) <= x_zero ? 0.0 : x_(p);  // degenerate rows are exactly 0
+    rows.push_back(p);
+    ratios.push_back(x / u(p));
+  }
+  if (rows.empty()) return -1;
+  keep_minimal(rows, ratios, opt_.tie_tolerance);
+  if (rows.size() == 1) return rows.front();
+  const Index z0_pos = basis_->position_of(basis_->z0_var());
+  if (std::find(rows.begin(), rows.end(), z0_pos) != rows.end()) return z0_pos;
+  ++stats_.tie_breaks;
+  return lexicographic(std::move(rows), u);
+}
+
+// Lexicographic rule on the tied positions: compare (B^-1)_{p, j} / u_p for
+// j = 0, 1, ... keeping the minimal ones until a single position remains.
+Index Lemke::lexicographic(std::vector<Index> tied, const Vector& u) {
+  Vector y(n_);
+  std::vector<double> keys;
+  for (Index j = 0; j < n_ && tied.size() > 1; ++j) {
+    const Index p = basis_->position_of(basis_->w_var(j));
+    if (p >= 0) {
+      // B^-1 e_j = e_p: row p has 1 / u_p > 0 there, the others 0.
+      tied.erase(std::remove(tied.begin(), tied.end(), p), tied.end());
+      continue;
+    }
+    y.setZero();
+    y(j) = 1.0;
+    basis_->solve(y);
+    const double y_zero = opt_.zero_tolerance * y.cwiseAbs().maxCoeff();
+    keys.clear();
+    for (Index t : tied) keys.push_back((std::abs(y(t)) <= y_zero ? 0.0 : y(t)) / u(t));
+    keep_minimal(tied, keys, opt_.tie_tolerance);
+  }
+  // Ties that survive every column (only possible within the tolerances): the
+  // largest pivot is the stablest.
+  return *std::max_element(tied.begin(), tied.end(),
+                           [&](Index a, Index b) { return u(a) < u(b); });
+}
+
+// z0 has left: the basis is complementary. Recompute x_B = B^-1 q from a fresh
+// factorisation with one step of iterative refinement, read off z.
+Result Lemke::finish_solved(LemkeBasis& basis) {
+  Result result;
+  result.status = Status::solved;
+  if (!basis.refactor()) result.status = Status::failed;
+  Vector x = lcp_.q;
+  basis.solve(x);
+  Vector r;
+  basis.multiply(x, r);
+  r = lcp_.q - r;
+  basis.solve(r);
+  x += r;
+  result.z = Vector::Zero(n_);
+  for (Index j = 0; j < n_; ++j) {
+    const Index p = basis.position_of(basis.z_var(j));
+    if (p >= 0) result.z(j) = std::max(x(p), 0.0);
+  }
+  return result;
+}
+
+Result Lemke::run() {
+  Result result;
+  result.z = Vector::Zero(n_);
+  if ((lcp_.q.array() >= 0.0).all()) {
+    result.status = Status::solved;
+    return result;
+  }
+  const long max_pivots = opt_.max_pivots > 0 ? opt_.max_pivots : 50 * (n_ + 1) + 1000;
+  stats_.sparse = use_sparse();
+  LemkeBasis basis(M_, d_, stats_.sparse ? detail::make_sparse_factor() : detail::make_dense_factor(),
+                   std::max(1, opt_.refactor_interval));
+  basis_ = &basis;
+  stats_.refactorisations = basis.refactorisations();
+
+  // First pivot: z0 enters at row r; with B = I, u = B^-1 (-d) = -d.
+  const Index r = first_leaving();
+  Vector u = -d_;
+  x_ = lcp_.q;
+  int entering = basis.complement(basis.w_var(r));
+  bool ok = basis.replace(r, basis.z0_var(), u);
+  const double theta0 = x_(r) / u(r);
+  x_ -= theta0 * u;
+  x_(r) = theta0;
+  long pivots = 1;
+
+  Vector a;
+  while (ok) {
+    if (pivots >= max_pivots) {
+      result.status = Status::pivot_limit;
+      break;
+    }
+    basis.column(entering, a);
+    u = a;
+    basis.solve(u);
+    const Index p = ratio_test(u);
+    if (p < 0) {
+      result.status = Status::ray;
+      break;
+    }
+    const int leaving = basis.variable_at(p);
+    // x <- E^-1 x: the entering variable takes the ratio, the others move along u.
+    const double x_zero = opt_.zero_tolerance * x_.cwiseAbs().maxCoeff();
+    const double theta = x_(p) <= x_zero ? 0.0 : x_(p) / u(p);
+    x_ -= theta * u;
+    x_(p) = theta;
+    ok = basis.replace(p, entering, u);
+    ++pivots;
+    if (ok && basis.refactorisations() > stats_.refactorisations) {
+      // Fresh factorisation: recompute the basic values to shed drift.
+      stats_.refactorisations = basis.refactorisations();
+      x_ = lcp_.q;
+      basis.solve(x_);
+    }
+    if (leaving == basis.z0_var()) {
+      result = finish_solved(basis);
+      break;
+    }
+    entering = basis.complement(leaving);
+  }
+  if (!ok) result.status = Status::failed;
+  if (result.status != Status::solved) {
+    // Report the point reached (z0 > 0 there, so it does not solve the LCP).
+    result.z = Vector::Zero(n_);
+    for (Index j = 0; j < n_; ++j) {
+      const Index p = basis.position_of(basis.z_var(j));
+      if (p >= 0) result.z(j) = std::max(x_(p), 0.0);
+    }
+  }
+  result.pivots = pivots;
+  stats_.solves = basis.solves();
+  stats_.refactorisations = basis.refactorisations();
+  return result;
+}
+
+}  // namespace
+
+Result solve_lemke(const Lcp& lcp, const LemkeOptions& options, LemkeStats* stats) {
+  check_lcp(lcp);
+  if (options.covering.size() != 0 &&
+      (options.covering.size() != lcp.size() || !(options.covering.array() > 0.0).all() ||
+       !options.covering.allFinite()))
+    throw InputError("Lemke: the covering vector must have n positive finite entries");
+  LemkeStats local;
+  Lemke lemke(lcp, options, stats ? *stats : local);
+  if (stats) *stats = {};
+  Result result = lemke.run();
+  finish(lcp, result);
+  return result;
+}
+
+}  // namespace floesim::lcp

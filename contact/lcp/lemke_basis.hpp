@@ -1,0 +1,114 @@
+#pragma once
+// Private to contact/lcp: the basis of Lemke's system and its factorisation
+// (the "revised" method: no tableau is ever formed).
+//
+// Lemke's system, n equations in the 2n + 1 variables (w, z, z0):
+//
+//     I w - M z - d z0 = q,                                             (1)
+//
+// variable ids: w_i -> i, z_j -> n + j, z0 -> 2n. A basis B picks n of the
+// columns of [I, -M, -d]; position p of the basis holds variable basis[p].
+//
+// Factorisation. Let B0 be the basis at the last refactorisation. Its unit
+// columns e_i (basic w_i) need no work: with R the k rows NOT covered by a basic
+// w and S the k positions holding z's or z0, B0 x = b splits into
+//
+//     C x_S = b_R,          C = [-M, -d](R, vars(S))   (k x k, "reduced basis")
+//     x_{pos(w_i)} = b_i - sum_{s in S} a_{var(s)}(i) x_s   for the covered rows i,
+//
+// so only C is factorised: densely (Eigen partial-pivoting LU) or sparsely
+// (UMFPACK), chosen by the caller. k is the number of basic z's, usually well
+// below n.
+//
+// Updates. A pivot replaces the column at position r by a with u = B^-1 a, so
+// B_new = B E with E = I + (u - e_r) e_r^T and B_new^-1 = E^-1 B^-1: the
+// product form. Each pivot appends one eta vector (r, u); B^-1 b is then the
+// reduced solve followed by the etas in order. After `refactor_interval` etas the
+// current basis is factorised afresh (bounds both the work per solve and the
+// growth of rounding errors).
+
+#include <memory>
+#include <vector>
+
+#include "contact/lcp/lcp.hpp"
+
+namespace floesim::lcp::detail {
+
+// A factorisation of the reduced basis C (k x k); k may be 0.
+class ReducedFactor {
+public:
+  virtual ~ReducedFactor() = default;
+  // Factorises C; false if C is (numerically) singular.
+  virtual bool factor(const SparseMatrix& C) = 0;
+  // x <- C^-1 x, x of length k.
+  virtual void solve(double* x) = 0;
+};
+std::unique_ptr<ReducedFactor> make_dense_factor();
+std::unique_ptr<ReducedFactor> make_sparse_factor();  // UMFPACK
+
+class LemkeBasis {
+public:
+  // M: the LCP matrix (columns are read), d: the covering vector; the initial
+  // basis is all w (B = I).
+  LemkeBasis(const SparseMatrix& M, const Vector& d, std::unique_ptr<ReducedFactor> lu,
+             int refactor_interval);
+
+  Index size() const { return n_; }
+  int w_var(Index i) const { return static_cast<int>(i); }
+  int z_var(Index j) const { return static_cast<int>(n_ + j); }
+  int z0_var() const { return static_cast<int>(2 * n_); }
+  bool is_w(int var) const { return var < n_; }
+  // The complement of w_i is z_i and vice versa (z0 has none).
+  int complement(int var) const;
+
+  int variable_at(Index pos) const { return basis_[pos]; }
+  Index position_of(int var) const { return position_[var]; }
+
+  // a <- the column of `var` in (1).
+  void column(int var, Vector& a) const;
+  // x <- B^-1 x  (x enters indexed by rows, leaves indexed by positions).
+  void solve(Vector& x);
+  // out <- B x  (x indexed by positions, out by rows).
+  void multiply(const Vector& x, Vector& out) const;
+
+  // The pivot: `var` enters at position `pos`, u = B^-1 a_var (u(pos) != 0).
+  // Returns false if a refactorisation it triggered found B singular.
+  bool replace(Index pos, int var, const Vector& u);
+  // Factorises the current basis afresh, dropping the etas.
+  bool refactor();
+
+  long solves() const { return solves_; }
+  long refactorisations() const { return refactorisations_; }
+
+private:
+  void add_column(int var, double scale, Vector& t) const;  // t += scale * a_var
+
+  const SparseMatrix& M_;
+  const Vector& d_;
+  Index n_;
+  std::unique_ptr<ReducedFactor> lu_;
+  int refactor_interval_;
+
+  std::vector<int> basis_;       // variable at each position
+  std::vector<Index> position_;  // position of each variable, -1 when non-basic
+
+  // The factorised basis B0: its positions holding z / z0, the uncovered rows R,
+  // and for each covered row the position of its w.
+  std::vector<Index> s_positions_;
+  std::vector<int> s_vars_;
+  std::vector<Index> r_rows_;
+  std::vector<Index> w_rows_;        // rows covered by a basic w in B0
+  std::vector<Index> w_positions_;   // ... and their positions
+
+  struct Eta {
+    Index pos;
+    Vector u;
+  };
+  std::vector<Eta> etas_;
+  Vector scratch_;
+  Vector reduced_;
+  long solves_ = 0;
+  long refactorisations_ = 0;
+};
+
+}  // namespace floesim::lcp::detail

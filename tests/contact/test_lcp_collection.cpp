@@ -1,0 +1,143 @@
+// The LCP problem collections of ../shared/data/lcp against the solvers:
+// the Siconos test collection with the outcome its README tabulates, and every
+// rigid-body contact LCP (including the degenerate friction ones) solved.
+#include <doctest/doctest.h>
+
+#include <filesystem>
+#include <optional>
+
+#include "contact/lcp/fallback.hpp"
+#include "contact/lcp/lemke.hpp"
+#include "contact/lcp/siconos_io.hpp"
+#include "tests/contact/lcp_checks.hpp"
+
+namespace floesim::lcp {
+namespace {
+
+using testing::check_complementary;
+using testing::lcp_data;
+
+struct Expected {
+  const char* file;
+  Status status;
+  long pivots;  // for a solve; the README's count for a lexicographic Lemke
+};
+
+// ../shared/data/lcp/README.md, table "siconos/".
+constexpr Expected kSiconos[] = {
+    {"lcp_CPS_1", Status::solved, 2},
+    {"lcp_CPS_2", Status::solved, 5},
+    {"lcp_CPS_3", Status::ray, 0},  // copositive, not copositive-plus: secondary ray
+    {"lcp_CPS_4", Status::solved, 5},
+    {"lcp_CPS_4bis", Status::solved, 5},
+    {"lcp_CPS_5", Status::solved, 2},
+    {"lcp_Pang_isolated_sol", Status::solved, 3},
+    {"lcp_Pang_isolated_sol_perturbed", Status::ray, 0},  // infeasible
+    {"lcp_inf_sol_perturbed", Status::solved, 5},
+    {"lcp_deudeu", Status::solved, 3},
+    {"lcp_deudeu_block", Status::solved, 3},
+    {"lcp_ortiz", Status::solved, 3},
+    {"lcp_ortiz_block", Status::solved, 3},
+    {"lcp_trivial", Status::solved, 10},
+    {"lcp_trivial_block", Status::solved, 10},
+    {"lcp_enum_fails", Status::solved, 8},
+    {"lcp_exp_murty", Status::solved, 2},
+    {"lcp_exp_murty2", Status::solved, 64},  // Murty's exponential example: 2^6
+    {"lcp_mmc", Status::solved, 23},
+    {"lcp_tobenna", Status::solved, 127},
+};
+
+TEST_CASE("lcp: every Siconos collection problem has its tabulated outcome") {
+  for (const Factorization f : {Factorization::dense, Factorization::sparse}) {
+    for (const Expected& e : kSiconos) {
+      const std::string file = e.file;
+      CAPTURE(file);
+      const std::string factorization = f == Factorization::dense ? "dense" : "sparse";
+      CAPTURE(factorization);
+      const Lcp lcp = read_siconos_lcp(lcp_data(std::string("siconos/") + e.file + ".dat"));
+      LemkeOptions options;
+      options.factorization = f;
+      const Result r = solve_lemke(lcp, options);
+      CHECK(to_string(r.status) == to_string(e.status));
+      if (e.status == Status::solved) {
+        CHECK(r.residual <= 1e-10);
+        CHECK(r.pivots == e.pivots);
+        check_complementary(lcp, r.z, 1e-10);
+      }
+    }
+  }
+}
+
+TEST_CASE("lcp: the block-stored files hold the same LCP as their dense twins") {
+  for (const char* name : {"lcp_deudeu", "lcp_ortiz", "lcp_trivial"}) {
+    CAPTURE(name);
+    const Lcp dense = read_siconos_lcp(lcp_data(std::string("siconos/") + name + ".dat"));
+    const Lcp block = read_siconos_lcp(lcp_data(std::string("siconos/") + name + "_block.dat"));
+    REQUIRE(block.is_sparse());
+    REQUIRE_FALSE(dense.is_sparse());
+    CHECK((DenseMatrix(std::get<SparseMatrix>(block.M)) - std::get<DenseMatrix>(dense.M)).norm() ==
+          0.0);
+    CHECK((block.q - dense.q).norm() == 0.0);
+  }
+}
+
+TEST_CASE("lcp: Murty's matrix is read column-major (upper triangular)") {
+  const Lcp lcp = read_siconos_lcp(lcp_data("siconos/lcp_exp_murty.dat"));
+  const auto& M = std::get<DenseMatrix>(lcp.M);
+  CHECK(M(0, 5) == 2.0);
+  CHECK(M(5, 0) == 0.0);
+  CHECK(M.isUpperTriangular());
+}
+
+TEST_CASE("lcp: the secondary rays are genuine (the fallback chain cannot solve them either)") {
+  // Pang's perturbed problem is infeasible: every step of the chain must fail.
+  const Lcp lcp = read_siconos_lcp(lcp_data("siconos/lcp_Pang_isolated_sol_perturbed.dat"));
+  const FallbackResult r = solve_with_fallbacks(lcp);
+  CHECK_FALSE(r.solved());
+  CHECK(r.attempts.size() == 4);
+  CHECK(r.attempts.front().status == Status::ray);
+}
+
+std::vector<std::string> contact_files() {
+  std::vector<std::string> files;
+  for (const auto& entry : std::filesystem::directory_iterator(lcp_data("contact")))
+    if (entry.path().extension() == ".dat") files.push_back(entry.path().string());
+  std::sort(files.begin(), files.end());
+  return files;
+}
+
+TEST_CASE("lcp: every rigid-body contact LCP is solved, friction ones included") {
+  const auto files = contact_files();
+  REQUIRE(files.size() >= 20);
+  for (const std::string& file : files) {
+    CAPTURE(file);
+    const Lcp lcp = read_siconos_lcp(file);
+    LemkeStats stats;
+    const Result r = solve_lemke(lcp, {}, &stats);
+    CHECK(r.status == Status::solved);
+    CHECK(r.residual <= 1e-9);
+    check_complementary(lcp, r.z, 1e-9);
+    MESSAGE(std::filesystem::path(file).filename().string() << ": n " << lcp.size() << ", pivots "
+            << r.pivots << ", residual " << r.residual << ", tie-breaks " << stats.tie_breaks
+            << ", solves " << stats.solves << std::string(stats.sparse ? ", sparse" : ", dense"));
+  }
+}
+
+TEST_CASE("lcp: dense and sparse factorisations walk the same pivots on the friction LCPs") {
+  for (const char* name : {"friction_m10_s1", "friction_m50_s2", "delassus_red_m50_s1"}) {
+    CAPTURE(name);
+    const Lcp lcp = read_siconos_lcp(lcp_data(std::string("contact/") + name + ".dat"));
+    LemkeOptions dense, sparse;
+    dense.factorization = Factorization::dense;
+    sparse.factorization = Factorization::sparse;
+    const Result a = solve_lemke(lcp, dense);
+    const Result b = solve_lemke(lcp, sparse);
+    REQUIRE(a.status == Status::solved);
+    REQUIRE(b.status == Status::solved);
+    CHECK(a.pivots == b.pivots);
+    CHECK((a.z - b.z).cwiseAbs().maxCoeff() <= 1e-8 * (1.0 + a.z.cwiseAbs().maxCoeff()));
+  }
+}
+
+}  // namespace
+}  // namespace floesim::lcp
