@@ -70,33 +70,43 @@ void ModalBank::flow(double dt) {
 void ModalBank::kick(std::span<const double> s, double h) {
   FLOESIM_ASSERT(s.size() == v_.size());
   const std::size_t n = omega_.size();
-  const auto m = static_cast<std::size_t>(components_);
-  for (std::size_t j = 0; j < n; ++j) {
-    const double a = h * gain_[j];
-    for (std::size_t c = 0; c < m; ++c) v_[j * m + c] += a * s[j * m + c];
+  double* v = v_.data();
+  const double* g = gain_.data();
+  const double* f = s.data();
+  if (components_ == 2) {
+    for (std::size_t j = 0; j < n; ++j) {
+      const double a = h * g[j];
+      v[2 * j] += a * f[2 * j];
+      v[2 * j + 1] += a * f[2 * j + 1];
+    }
+  } else {
+    for (std::size_t j = 0; j < n; ++j) v[j] += h * g[j] * f[j];
   }
 }
 
-double ModalBank::kinetic() const {
-  const auto m = static_cast<std::size_t>(components_);
+namespace {
+
+// 1/2 sum_j weight_j |a_j|^2 over the components of each mode.
+double half_weighted_norm2(std::span<const double> a, std::span<const double> weight, int components,
+                           bool square_omega, std::span<const double> omega) {
+  const auto m = static_cast<std::size_t>(components);
   double e = 0.0;
-  for (std::size_t j = 0; j < omega_.size(); ++j) {
-    double v2 = 0.0;
-    for (std::size_t c = 0; c < m; ++c) v2 += v_[j * m + c] * v_[j * m + c];
-    e += mass_[j] * v2;
+  for (std::size_t j = 0; j < weight.size(); ++j) {
+    double a2 = 0.0;
+    for (std::size_t c = 0; c < m; ++c) a2 += a[j * m + c] * a[j * m + c];
+    e += (square_omega ? weight[j] * omega[j] * omega[j] : weight[j]) * a2;
   }
   return 0.5 * e;
+}
+
+}  // namespace
+
+double ModalBank::kinetic() const {
+  return half_weighted_norm2(v_, mass_, components_, false, omega_);
 }
 
 double ModalBank::potential() const {
-  const auto m = static_cast<std::size_t>(components_);
-  double e = 0.0;
-  for (std::size_t j = 0; j < omega_.size(); ++j) {
-    double q2 = 0.0;
-    for (std::size_t c = 0; c < m; ++c) q2 += q_[j * m + c] * q_[j * m + c];
-    e += mass_[j] * omega_[j] * omega_[j] * q2;
-  }
-  return 0.5 * e;
+  return half_weighted_norm2(q_, mass_, components_, true, omega_);
 }
 
 }  // namespace floesim::fluid

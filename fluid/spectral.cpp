@@ -71,12 +71,15 @@ struct SpectralSea::Impl {
       std::copy(real, real + n, out.begin());
     }
   }
-  // spec <- (i k)^d factor * a / n, for a = q or v (d = 0 or 1 via `deriv`).
+  // spec <- (i k)^d factor * a, for a = q or v (d = 0 or 1 via `deriv`).
   void load(std::span<const double> a, const std::vector<double>* deriv,
             const std::vector<double>* factor) {
-    const double inv_n = 1.0 / static_cast<double>(n);
+    if (!deriv && !factor) {
+      std::copy(a.begin(), a.end(), reinterpret_cast<double*>(spec));
+      return;
+    }
     for (std::size_t c = 0; c < nc; ++c) {
-      double s = inv_n;
+      double s = 1.0;
       if (factor) s *= (*factor)[c];
       const double re = a[2 * c] * s, im = a[2 * c + 1] * s;
       if (deriv) {
@@ -115,13 +118,17 @@ SpectralSea::SpectralSea(const SeaParams& params, const SeaOptions& options)
   }
   if (!m.r2c || !m.c2r) throw RunError("fluid: FFTW could not plan the spectral sea transforms");
 
-  // Oscillator bank. Parseval on the half spectrum: a coefficient with
-  // 0 < ix < nx/2 stands for itself and its conjugate (weight 2).
+  // Oscillator bank on the normalised coefficients eta_k = FFT(eta) / n, so that
+  // a field is the plain c2r of its coefficients. Parseval on the half spectrum:
+  // ∫ f g = dA n sum_full f_k conj(g_k), and a coefficient with 0 < ix < nx/2
+  // stands for itself and its conjugate (weight 2). A kick receives the
+  // unnormalised FFT of p, hence gain = -1 / (mu n).
   std::vector<double> omega(m.nc), mass(m.nc), gain(m.nc);
   m.kx.assign(m.nc, 0.0);
   m.ky.assign(m.nc, 0.0);
   m.phi.assign(m.nc, 0.0);
-  const double da_over_n = grid_.cell_area() / static_cast<double>(m.n);
+  const double da_n = grid_.cell_area() * static_cast<double>(m.n);
+  const double inv_n = 1.0 / static_cast<double>(m.n);
   const double two_pi = 2.0 * std::numbers::pi;
   for (int iy = 0; iy < m.ny; ++iy) {
     const int my = iy <= m.ny / 2 ? iy : iy - m.ny;
@@ -137,8 +144,8 @@ SpectralSea::SpectralSea(const SeaParams& params, const SeaOptions& options)
       const double weight = (ix > 0 && 2 * ix != m.nx) ? 2.0 : 1.0;
       const double mu = m.disp.mass_density(k);
       omega[c] = m.disp.omega(k);
-      mass[c] = weight * mu * da_over_n;
-      gain[c] = -1.0 / mu;
+      mass[c] = weight * mu * da_n;
+      gain[c] = -inv_n / mu;
       m.kx[c] = 2 * ix == m.nx ? 0.0 : kx;
       m.ky[c] = (m.ny > 1 && 2 * iy == m.ny) ? 0.0 : ky;
       m.phi[c] = 1.0 / (k * std::tanh(k * m.disp.depth));
@@ -178,7 +185,8 @@ void SpectralSea::set_surface(std::span<const double> eta, std::span<const doubl
   auto copy_in = [&](std::span<const double> f, std::span<double> a) {
     m.forward(f);
     const double* s = reinterpret_cast<const double*>(m.spec);
-    std::copy(s, s + 2 * m.nc, a.begin());
+    const double inv_n = 1.0 / static_cast<double>(m.n);
+    for (std::size_t i = 0; i < 2 * m.nc; ++i) a[i] = s[i] * inv_n;
     a[0] = a[1] = 0.0;  // zero mean
   };
   copy_in(eta, bank_.q());

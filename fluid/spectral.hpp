@@ -8,8 +8,8 @@
 // so that a pressure p acts on mode k as eta_k'' = -omega_k^2 eta_k - p_k / mu_k.
 // The k = 0 mode (the mean) is frozen at zero: volume conservation.
 //
-// Modal amplitudes are the unnormalised FFTW coefficients of eta on the cell
-// centres. FFTW plans (r2c, c2r) are made once at construction and reused; a
+// Modal amplitudes are the normalised coefficients FFT(eta) / n of eta on the
+// cell centres (n cells), so eta is the plain c2r of them. FFTW plans (r2c, c2r) are made once at construction and reused; a
 // kick costs one r2c, each grid field one c2r. All scratch is allocated once.
 
 #include <memory>

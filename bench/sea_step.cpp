@@ -1,0 +1,103 @@
+// floesim_bench_sea_step: cost of a forced spectral step against the cost of
+// the FFTs it performs, on 2-D boxes of 256^2, 512^2 and 1024^2 cells.
+//
+// A forced step as the coupling loop runs it: kick(p(t), dt/2) [one r2c],
+// flow(dt) [modal rotation], elevation() [one c2r, the new surface that the
+// next pressure depends on], kick(p(t + dt), dt/2) [one r2c]. Its FFTs alone
+// are timed with plans of the same size and flags (FFTW_MEASURE). Each figure
+// is the median of `repeats` timings after a warm-up. CSV on stdout.
+//
+// usage: floesim_bench_sea_step [max_cells = 1024] [repeats = 15]
+
+#include <fftw3.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <vector>
+
+#include "fluid/sea.hpp"
+#include "fluid/spectral.hpp"
+
+using namespace floesim;
+using namespace floesim::fluid;
+using clock_type = std::chrono::steady_clock;
+
+namespace {
+
+template <class F>
+double median_ms(int repeats, F&& f) {
+  f();  // warm-up
+  std::vector<double> t;
+  for (int r = 0; r < repeats; ++r) {
+    const auto a = clock_type::now();
+    f();
+    t.push_back(std::chrono::duration<double, std::milli>(clock_type::now() - a).count());
+  }
+  std::nth_element(t.begin(), t.begin() + repeats / 2, t.end());
+  return t[repeats / 2];
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const int max_cells = argc > 1 ? std::atoi(argv[1]) : 1024;
+  const int repeats = argc > 2 ? std::atoi(argv[2]) : 15;
+  std::printf("cells,modes,fft_r2c_ms,fft_c2r_ms,step_ffts_ms,step_ms,ratio,flow_ms,kick_ms\n");
+  for (int n = 256; n <= max_cells; n *= 2) {
+    SeaParams p;
+    p.model = SeaModel::spectral;
+    p.dims = 2;
+    p.size = {200.0, 200.0};
+    p.cells = {n, n};
+    p.depth = 50.0;
+    SeaOptions opt;
+    opt.measure_fft_plans = true;
+    SpectralSea sea(p, opt);
+    const auto& g = sea.grid();
+    std::vector<double> p0(g.size()), p1(g.size());
+    for (std::size_t i = 0; i < g.size(); ++i) {
+      p0[i] = 100.0 * std::sin(0.001 * static_cast<double>(i));
+      p1[i] = 100.0 * std::cos(0.001 * static_cast<double>(i));
+    }
+    const double dt = 0.05;
+
+    // The FFTs alone, same sizes and flags.
+    const std::size_t nc = static_cast<std::size_t>(n) * (n / 2 + 1);
+    double* real = fftw_alloc_real(g.size());
+    fftw_complex* spec = fftw_alloc_complex(nc);
+    fftw_plan r2c = fftw_plan_dft_r2c_2d(n, n, real, spec, FFTW_MEASURE);
+    fftw_plan c2r = fftw_plan_dft_c2r_2d(n, n, spec, real, FFTW_MEASURE);
+    std::copy(p0.begin(), p0.end(), real);
+    const double t_r2c = median_ms(repeats, [&] { fftw_execute(r2c); });
+    const double t_c2r = median_ms(repeats, [&] {
+      for (std::size_t c = 0; c < nc; ++c) spec[c][0] = spec[c][1] = 1.0;  // c2r destroys input
+      fftw_execute(c2r);
+    });
+    const double t_fill = median_ms(repeats, [&] {
+      for (std::size_t c = 0; c < nc; ++c) spec[c][0] = spec[c][1] = 1.0;
+    });
+    fftw_destroy_plan(r2c);
+    fftw_destroy_plan(c2r);
+    fftw_free(real);
+    fftw_free(spec);
+    const double ffts = 2.0 * t_r2c + (t_c2r - t_fill);
+
+    double sink = 0.0;
+    const double t_step = median_ms(repeats, [&] {
+      sea.kick(p0, 0.5 * dt);
+      sea.flow(dt);
+      sink += sea.elevation()[0];
+      sea.kick(p1, 0.5 * dt);
+    });
+    const double t_flow = median_ms(repeats, [&] { sea.flow(dt); });
+    const double t_kick = median_ms(repeats, [&] { sea.kick(p0, 0.0); });
+    std::printf("%d,%zu,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f\n", n, sea.modes().modes(), t_r2c,
+                t_c2r - t_fill, ffts, t_step, t_step / ffts, t_flow, t_kick);
+    std::fflush(stdout);
+    if (sink == 12345.0) std::printf("#\n");
+  }
+  return 0;
+}
