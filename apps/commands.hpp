@@ -16,6 +16,7 @@ using Registry = std::map<CLI::App*, Handler>;
 // (One line per command; keep alphabetical.)
 void add_compare_command(CLI::App& app, Registry& registry);
 void add_info_command(CLI::App& app, Registry& registry);
+void add_lcp_command(CLI::App& app, Registry& registry);
 void add_run_command(CLI::App& app, Registry& registry);
 
 }  // namespace floesim::apps

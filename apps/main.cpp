@@ -15,6 +15,7 @@ int main(int argc, char** argv) {
   // registrations (one line per command, alphabetical)
   floesim::apps::add_compare_command(app, handlers);
   floesim::apps::add_info_command(app, handlers);
+  floesim::apps::add_lcp_command(app, handlers);
   floesim::apps::add_run_command(app, handlers);
 
   try {
