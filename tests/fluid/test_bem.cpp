@@ -14,6 +14,8 @@
 
 using namespace floesim;
 using namespace floesim::fluid;
+
+TEST_SUITE_BEGIN("fluid");
 constexpr double pi = std::numbers::pi;
 
 namespace {
@@ -30,7 +32,7 @@ double worst_error(const SeaParams& p, const BemSea& sea, int count) {
 
 }  // namespace
 
-TEST_CASE("BEM rectangular tank: the first 10 sloshing frequencies within 0.5%, second order in panels") {
+TEST_CASE("BEM rectangular tank: the first 10 sloshing frequencies within 0.5% and second order in panels") {
   std::vector<double> err;
   for (int ns : {50, 100, 200}) {
     const SeaParams p = cases::lab_tank_bem(ns);
@@ -63,7 +65,7 @@ TEST_CASE("BEM flat tank agrees with the spectral sea: sloshing mode n is Fourie
   }
 }
 
-TEST_CASE("BEM sloping bottom: frequencies converge, and lie between the shallow and deep flat tanks") {
+TEST_CASE("BEM sloping bottom: frequencies converge and lie between the shallow and deep flat tanks") {
   // Kelvin's minimum-energy theorem: deepening the basin can only lower the added
   // mass m_sf, so by min-max each omega_n lies between those of the flat basins
   // at the smallest and largest depth.
@@ -95,7 +97,7 @@ TEST_CASE("BEM sloping bottom: frequencies converge, and lie between the shallow
   }
 }
 
-TEST_CASE("BEM sea: a sloshing mode oscillates at its frequency, conserves energy; uniform pressure is inert") {
+TEST_CASE("BEM sea: a sloshing mode oscillates at its frequency and conserves energy under uniform pressure") {
   SeaParams p = cases::lab_tank_bem(64);
   p.waves.kind = WaveKind::standing;
   p.waves.amplitude = 1e-3;
@@ -120,3 +122,5 @@ TEST_CASE("BEM sea: a sloshing mode oscillates at its frequency, conserves energ
   auto again = make_sea(p, 1);
   CHECK(dynamic_cast<BemSea&>(*again).from_cache());
 }
+
+TEST_SUITE_END();

@@ -12,6 +12,8 @@
 
 using namespace floesim;
 using namespace floesim::fluid;
+
+TEST_SUITE_BEGIN("fluid");
 constexpr double pi = std::numbers::pi;
 
 namespace {
@@ -86,3 +88,5 @@ TEST_CASE("a pulsating pressure patch: the Strang step converges at second order
     CHECK(order == doctest::Approx(2.0).epsilon(0.05));
   }
 }
+
+TEST_SUITE_END();

@@ -14,6 +14,8 @@
 
 using namespace floesim;
 using namespace floesim::fluid;
+
+TEST_SUITE_BEGIN("fluid");
 constexpr double pi = std::numbers::pi;
 
 namespace {
@@ -42,7 +44,7 @@ double measured_period(Sea& sea, double guess, int periods) {
 
 }  // namespace
 
-TEST_CASE("standing waves in the L = 1 m, H = 0.1 m box oscillate at the dispersion periods") {
+TEST_CASE("standing waves in the 1 m box of 0.1 m depth oscillate at the dispersion periods") {
   // omega^2 = (g k + sigma k^3 / rho) tanh(k H), k = 2 pi n / L; the issue quotes
   // T = 1.0723, 0.6134, 0.40185, 0.28035, 0.19297, 0.12408 s (0.14148 s without capillarity).
   const int modes[] = {1, 2, 4, 8, 16, 32};
@@ -109,7 +111,7 @@ TEST_CASE("the energy of a free sea is conserved to round-off over 1e5 steps") {
   CHECK(worst < 1e5 * std::numeric_limits<double>::epsilon());
 }
 
-TEST_CASE("a progressive wave has equal kinetic and potential energy, (rho g + sigma k^2) a^2 A / 4 each") {
+TEST_CASE("a progressive wave has kinetic = potential energy = (rho g + sigma k^2) a^2 A / 4") {
   SeaParams p = cases::lab_box_1d(128);
   p.dims = 2;
   p.size = {1.0, 0.5};
@@ -139,7 +141,7 @@ TEST_CASE("a progressive wave has equal kinetic and potential energy, (rho g + s
   CHECK(pot == doctest::Approx(sea->energy().potential).epsilon(1e-12));
 }
 
-TEST_CASE("point queries give the elevation, slope and orbital velocity of linear theory") {
+TEST_CASE("point queries give the elevation and slope and orbital velocity of linear theory") {
   // eta = a cos(k.x - w t); grad phi at z = 0: horizontal a w coth(k H) cos(.) k/|k|,
   // vertical a w sin(.).
   SeaParams p;
@@ -196,3 +198,5 @@ TEST_CASE("a uniform pressure does nothing: the surface keeps zero mean") {
   CHECK(std::abs(mean) < 1e-15);
   CHECK(diff < 1e-15);
 }
+
+TEST_SUITE_END();

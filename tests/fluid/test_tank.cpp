@@ -15,16 +15,18 @@
 
 using namespace floesim;
 using namespace floesim::fluid;
+
+TEST_SUITE_BEGIN("fluid");
 using cplx = std::complex<double>;
 constexpr double pi = std::numbers::pi;
 
-TEST_CASE("relaxation weight: 0 at the inner edge, 1 at the outer end, increasing") {
+TEST_CASE("relaxation weight rises from 0 at the inner edge to 1 at the outer end") {
   CHECK(relaxation_weight(0.0) == 0.0);
   CHECK(relaxation_weight(1.0) == doctest::Approx(1.0).epsilon(1e-15));
   for (double c = 0.05; c <= 1.0; c += 0.05) CHECK(relaxation_weight(c) > relaxation_weight(c - 0.05));
 }
 
-TEST_CASE("a tank wave reaches the middle at the target amplitude; the absorbing zone hardly reflects") {
+TEST_CASE("a tank wave reaches the middle at the target amplitude and the absorbing zone hardly reflects") {
   SeaParams p = cases::lab_box_1d(512);
   p.size = {16.0, 1.0};
   p.depth = 0.5;
@@ -85,3 +87,5 @@ TEST_CASE("tank zones that do not fit are an InputError") {
   opt.tank.enabled = true;  // 1.5 m + 1 m zones in a 1 m box
   CHECK_THROWS_AS(make_sea(p, 1, opt), InputError);
 }
+
+TEST_SUITE_END();

@@ -13,6 +13,8 @@
 
 using namespace floesim;
 using namespace floesim::fluid;
+
+TEST_SUITE_BEGIN("fluid");
 constexpr double pi = std::numbers::pi;
 
 namespace {
@@ -30,7 +32,7 @@ bool has(const std::string& s, const std::string& part) { return s.find(part) !=
 
 }  // namespace
 
-TEST_CASE("dispersion: wavenumber inverts omega; deep water limit; group velocity") {
+TEST_CASE("dispersion: wavenumber inverts omega and deep-water and group-velocity limits hold") {
   Dispersion d{9.81, 0.073, 1025.0, 3.0};
   for (double k : {0.01, 0.5, 3.0, 200.0}) CHECK(d.wavenumber(d.omega(k)) == doctest::Approx(k).epsilon(1e-12));
   Dispersion deep{9.81, 0.0, 1025.0, std::numeric_limits<double>::infinity()};
@@ -40,7 +42,7 @@ TEST_CASE("dispersion: wavenumber inverts omega; deep water limit; group velocit
   CHECK(d.group_velocity(1.3) == doctest::Approx((d.omega(1.3 + h) - d.omega(1.3 - h)) / (2 * h)).epsilon(1e-7));
 }
 
-TEST_CASE("a JONSWAP sea has the requested Hs, is reproducible from its seed, and peaks near Tp") {
+TEST_CASE("a JONSWAP sea has the requested Hs and is reproducible from its seed and peaks near Tp") {
   SeaParams p;
   p.model = SeaModel::spectral;
   p.dims = 1;
@@ -145,3 +147,5 @@ TEST_CASE("bad [sea] input is an InputError that names the key") {
   b.dims = 2;
   CHECK(has(input_error(b), "[sea] dims"));
 }
+
+TEST_SUITE_END();
