@@ -30,7 +30,12 @@ Handle open_file(const std::string& path, bool write) {
 
 Handle create_file(const std::string& path) {
   silence_errors();
-  hid_t f = H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT);
+  // No file lock: a run file is written by one process and may be read by
+  // others (scripts, `floesim info`) while the run goes on; every record is
+  // flushed, so readers see whole records.
+  Handle fapl{H5Pcreate(H5P_FILE_ACCESS), H5Pclose};
+  H5Pset_file_locking(fapl, false, true);
+  hid_t f = H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, fapl);
   if (f < 0) fail(path + ": cannot create the file (does its folder exist and is it writable?)");
   return {f, H5Fclose};
 }

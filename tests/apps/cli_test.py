@@ -1,0 +1,208 @@
+#!/usr/bin/env python3
+"""End-to-end tests of the floesim command line.
+
+usage: cli_test.py FLOESIM SOURCE_DIR CASE [ARGS]
+Each case runs the binary as a user would and checks exit codes, messages and
+the files it writes. Exits non-zero with a message on the first failure.
+"""
+import json
+import os
+import signal
+import subprocess
+import sys
+import tempfile
+import time
+import xml.etree.ElementTree as ET
+
+import h5py
+import numpy as np
+
+FLOESIM, SRC, CASE = sys.argv[1], sys.argv[2], sys.argv[3]
+EXAMPLE = os.path.join(SRC, "examples", "floes_on_waves.toml")
+WORK = tempfile.mkdtemp(prefix="floesim_cli_")
+
+
+def run(*args, expect=0, cwd=WORK):
+    p = subprocess.run([FLOESIM, *args], cwd=cwd, capture_output=True, text=True, timeout=280)
+    if p.returncode != expect:
+        sys.exit(f"floesim {' '.join(args)}: exit {p.returncode}, expected {expect}\n"
+                 f"stdout:\n{p.stdout}\nstderr:\n{p.stderr}")
+    return p
+
+
+def check(cond, msg):
+    if not cond:
+        sys.exit("FAILED: " + msg)
+
+
+def keyvals(text):
+    out = {}
+    for line in text.splitlines():
+        if ": " in line and not line.startswith(" "):
+            k, v = line.split(": ", 1)
+            out[k] = v
+    return out
+
+
+def write(name, text):
+    path = os.path.join(WORK, name)
+    with open(path, "w") as f:
+        f.write(text)
+    return path
+
+
+def case_run_default():
+    # No CONFIG: the default example; the run file goes to the current folder.
+    p = run("run", "-q", "--until", "600")
+    kv = keyvals(p.stdout)
+    check(kv.get("status") == "complete", "status complete")
+    out = kv["output"]
+    check(os.path.isabs(out) and os.path.exists(out), f"run file printed and present: {out}")
+    check(os.path.dirname(out) == os.path.realpath(WORK) or os.path.dirname(out) == WORK, "written here")
+    check(os.path.exists(kv["paraview"]), "xdmf beside the run file")
+    with h5py.File(out) as f:
+        check(f.attrs["format"] == "floesim-1", "format attribute")
+        check("[forcing]" in f.attrs["config"], "resolved config echoed")
+        t = f["time"][:]
+        check(np.isclose(t[-1], 600.0), "ran until 600 s")
+        st = f["floes/state"][:]
+        check(st.shape == (len(t), 30, 12), f"state shape {st.shape}")
+        # The pack drifts: every floe moved, downwind (wind has +x).
+        dx = st[-1, :, 0] - st[0, :, 0]
+        check(np.all(dx > 0), "every floe drifted downwind")
+        e = f["diagnostics/energy"]
+        check(list(e.attrs["columns"])[-1] == "total", "energy columns end with total")
+
+
+def case_info_json():
+    run("run", EXAMPLE, "-q", "--until", "120", "-o", "a.h5")
+    info = json.loads(run("info", "a.h5", "--json").stdout)
+    check(info["status"] == "complete", "json status")
+    check(info["floes"] == 30 and info["records"] == 3, f"json counts {info['floes']} {info['records']}")
+    check(info["datasets"]["/floes/state"] == [3, 30, 12], "json dataset shape")
+    text = run("info", "a.h5").stdout
+    check("energy.total:" in text, "text info has energy")
+    run("info", os.path.join(WORK, "missing.h5"), expect=2)
+    run("info", EXAMPLE, expect=2)  # not HDF5
+
+
+def case_compare():
+    run("run", EXAMPLE, "-q", "--until", "120", "-o", "a.h5")
+    run("run", EXAMPLE, "-q", "--until", "120", "-o", "b.h5")
+    p = run("compare", "a.h5", "b.h5")  # deterministic: identical
+    check("equal: true" in p.stdout, "identical runs compare equal")
+    cfg = open(EXAMPLE).read().replace("wind = [10.0, 4.0]", "wind = [10.5, 4.0]")
+    run("run", write("c.toml", cfg), "-q", "--until", "120", "-o", "c.h5")
+    p = run("compare", "a.h5", "c.h5", expect=1)
+    check("/floes/state" in p.stdout and "equal: false" in p.stdout, "difference reported")
+    run("compare", "a.h5", "c.h5", "--rtol", "1", "--atol", "1e3")
+
+
+def case_bad_input():
+    bad = write("bad.toml", "[run]\nt_end = 10\n\n[forcing]\nwnd = [1, 2]\n")
+    p = run("run", bad, "-o", "bad.h5", expect=2)
+    check("bad.toml:5" in p.stderr and "[forcing] wnd" in p.stderr, f"names file:line and key: {p.stderr}")
+    check(not os.path.exists(os.path.join(WORK, "bad.h5")), "no output file for bad input")
+    bad = write("bad2.toml", "[[floes.floe]]\nvertices = [[0,0],[1,1],[1,0],[0,1]]\n")
+    p = run("run", bad, "-o", "bad2.h5", expect=2)
+    check("intersects itself" in p.stderr and "bad2.toml" in p.stderr, p.stderr)
+    p = run("run", os.path.join(WORK, "nope.toml"), expect=2)
+    check("not found" in p.stderr, p.stderr)
+    run("run", EXAMPLE, "--until", "-3", expect=2)
+    run("frobnicate", expect=2)
+    run("--help")
+    for sub in ("run", "info", "compare"):
+        p = run(sub, "--help")
+        check("Usage" in p.stdout or "usage" in p.stdout.lower(), f"{sub} --help")
+
+
+def case_killed_run():
+    # A long run killed midway leaves a readable file with the records so far.
+    cfg = open(EXAMPLE).read().replace("t_end = 3600.0", "t_end = 1.0e9").replace(
+        "output_interval = 60.0", "output_interval = 5.0").replace("dt_max = 5.0", "dt_max = 0.5")
+    path = write("long.toml", cfg)
+    p = subprocess.Popen([FLOESIM, "run", path, "-q", "-o", "long.h5"], cwd=WORK,
+                         stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    out = os.path.join(WORK, "long.h5")
+    deadline = time.time() + 60
+    records = 0
+    while time.time() < deadline and records < 20:
+        time.sleep(0.3)
+        try:
+            with h5py.File(out, "r") as f:
+                records = f["time"].shape[0]
+        except Exception:
+            pass
+    p.send_signal(signal.SIGKILL)
+    p.wait()
+    check(records >= 20, f"records appeared while running ({records})")
+    with h5py.File(out, "r") as f:
+        t = f["time"][:]
+        st = f["floes/state"][:]
+        check(f.attrs["status"] == "running", "no end mark after a kill")
+        check(st.shape[0] >= records and np.all(np.isfinite(st)), "state readable")
+        check(np.all(np.diff(t) > 0), "times increasing")
+    info = run("info", "long.h5").stdout
+    check("killed" in info, "info says the run has no end mark")
+
+
+def case_xdmf():
+    # Validate the XDMF against the run file: every HDF reference exists, has
+    # the declared dimensions, and every hyperslab selection is in bounds.
+    run("run", EXAMPLE, "-q", "--until", "300", "-o", "x.h5")
+    tree = ET.parse(os.path.join(WORK, "x.xmf"))
+    root = tree.getroot()
+    check(root.tag == "Xdmf", "root element")
+    grids = root.findall("./Domain/Grid")
+    check(len(grids) >= 1 and grids[0].get("CollectionType") == "Temporal", "temporal collection")
+    steps = grids[0].findall("Grid")
+    with h5py.File(os.path.join(WORK, "x.h5")) as f:
+        check(len(steps) == f["time"].shape[0], "one grid per record")
+        for g in steps:
+            for item in g.iter("DataItem"):
+                if item.get("Format") != "HDF":
+                    continue
+                fname, dset = item.text.strip().split(":")
+                check(fname == "x.h5", "relative file name")
+                dims = tuple(int(d) for d in item.get("Dimensions").split())
+                check(dset in f and f[dset].shape == dims, f"{dset}: {dims} vs {f[dset].shape if dset in f else None}")
+            for slab in g.iter("DataItem"):
+                if slab.get("ItemType") != "HyperSlab":
+                    continue
+                sel, data = list(slab)
+                s = np.array(sel.text.split(), dtype=int).reshape(3, -1)
+                shape = tuple(int(d) for d in data.get("Dimensions").split())
+                end = s[0] + s[1] * (s[2] - 1)
+                check(np.all(end < shape), "hyperslab in bounds")
+                check(int(np.prod(s[2])) == int(np.prod([int(d) for d in slab.get("Dimensions").split()])),
+                      "hyperslab size = declared")
+            topo = g.find("Topology")
+            check(topo.get("TopologyType") == "Mixed" and int(topo.get("NumberOfElements")) == 30, "topology")
+        # The mixed topology lists 30 polygons (type 3) covering every vertex.
+        tp = f["xdmf/topology"][:]
+        k, polys = 0, 0
+        while k < len(tp):
+            check(tp[k] == 3, "polygon type")
+            k += 2 + tp[k + 1]
+            polys += 1
+        check(polys == 30, "30 polygons")
+        # World vertices are the body vertices moved by the state.
+        st = f["floes/state"][-1]
+        off = f["floes/offsets"][:]
+        body = f["floes/vertices"][:]
+        world = f["xdmf/vertices"][-1]
+        i = 7
+        c, s_ = np.cos(st[i, 2]), np.sin(st[i, 2])
+        b = body[off[i]:off[i + 1]]
+        w = np.stack([st[i, 0] + c * b[:, 0] - s_ * b[:, 1], st[i, 1] + s_ * b[:, 0] + c * b[:, 1]], axis=1)
+        check(np.allclose(w, world[off[i]:off[i + 1], :2]), "world vertices from state")
+
+
+def case_example():
+    cfg = sys.argv[4]
+    p = run("run", cfg, "-q", "--until", "60", "-o", "example.h5")
+    check(keyvals(p.stdout).get("status") == "complete", f"{cfg} runs")
+
+
+globals()["case_" + CASE]()
+print(f"cli.{CASE}: 1 passed, 0 failed")
