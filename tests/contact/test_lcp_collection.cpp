@@ -14,6 +14,8 @@
 namespace floesim::lcp {
 namespace {
 
+TEST_SUITE_BEGIN("contact");
+
 using testing::check_complementary;
 using testing::lcp_data;
 
@@ -138,6 +140,8 @@ TEST_CASE("lcp: dense and sparse factorisations walk the same pivots on the fric
     CHECK((a.z - b.z).cwiseAbs().maxCoeff() <= 1e-8 * (1.0 + a.z.cwiseAbs().maxCoeff()));
   }
 }
+
+TEST_SUITE_END();
 
 }  // namespace
 }  // namespace floesim::lcp

@@ -1,0 +1,93 @@
+// Projected Gauss–Seidel and the fallback chain: each step is reached when the
+// previous fails, reported in order, and the PGS answer is flagged.
+#include <doctest/doctest.h>
+
+#include "contact/lcp/fallback.hpp"
+#include "contact/lcp/siconos_io.hpp"
+#include "tests/contact/lcp_checks.hpp"
+
+namespace floesim::lcp {
+namespace {
+
+TEST_SUITE_BEGIN("contact");
+
+using testing::check_complementary;
+using testing::lcp_data;
+
+TEST_CASE("lcp pgs: solves a symmetric positive definite contact LCP to tolerance") {
+  const Lcp lcp = read_siconos_lcp(lcp_data("contact/delassus_m50_s1.dat"));
+  PgsOptions options;
+  options.tolerance = 1e-11;
+  const Result r = solve_pgs(lcp, options);
+  REQUIRE(r.status == Status::solved);
+  CHECK(r.residual <= 1e-11);
+  CHECK(r.iterations > 0);
+  check_complementary(lcp, r.z, 1e-9);
+}
+
+TEST_CASE("lcp pgs: refuses a zero diagonal, stops at the iteration limit") {
+  const Lcp friction = read_siconos_lcp(lcp_data("contact/friction_m10_s1.dat"));
+  CHECK(solve_pgs(friction).status == Status::failed);  // the beta block has M_ii = 0
+
+  const Lcp lcp = read_siconos_lcp(lcp_data("contact/delassus_m50_s1.dat"));
+  PgsOptions few;
+  few.max_iterations = 2;
+  few.tolerance = 1e-14;
+  const Result r = solve_pgs(lcp, few);
+  CHECK(r.status == Status::pivot_limit);
+  CHECK(r.iterations == 2);
+}
+
+TEST_CASE("lcp fallback: a Lemke success is taken at once") {
+  const Lcp lcp = read_siconos_lcp(lcp_data("contact/friction_m10_s2.dat"));
+  const FallbackResult r = solve_with_fallbacks(lcp);
+  CHECK(r.solved());
+  CHECK(r.method == Method::lemke);
+  CHECK(r.attempts.size() == 1);
+  CHECK_FALSE(r.flagged);
+}
+
+TEST_CASE("lcp fallback: every step is tried and reported, PGS answers are flagged") {
+  // A pivot limit too small for any Lemke step leaves PGS as the last resort.
+  const Lcp lcp = read_siconos_lcp(lcp_data("contact/delassus_m50_s2.dat"));
+  FallbackOptions options;
+  options.lemke.max_pivots = 2;
+  const FallbackResult r = solve_with_fallbacks(lcp, options);
+  REQUIRE(r.attempts.size() == 4);
+  CHECK(r.attempts[0].method == Method::lemke);
+  CHECK(r.attempts[1].method == Method::lemke_other_covering);
+  CHECK(r.attempts[2].method == Method::lemke_regularised);
+  CHECK(r.attempts[3].method == Method::pgs);
+  for (int k = 0; k < 3; ++k) CHECK(r.attempts[k].status == Status::pivot_limit);
+  CHECK(r.solved());
+  CHECK(r.method == Method::pgs);
+  CHECK(r.flagged);
+  check_complementary(lcp, r.result.z, 1e-8);
+
+  options.allow_pgs = false;
+  const FallbackResult without = solve_with_fallbacks(lcp, options);
+  CHECK(without.attempts.size() == 3);
+  CHECK_FALSE(without.solved());
+  CHECK_FALSE(without.flagged);
+}
+
+TEST_CASE("lcp fallback: an infeasible LCP fails every step, the regularised one included") {
+  // Copositive-plus and infeasible. M + delta I is positive definite, so the
+  // regularised LCP has a solution, of order 1/delta: whether Lemke reaches it
+  // within its tolerances or not, it must not pass on the ORIGINAL LCP.
+  DenseMatrix M(2, 2);
+  M << 1, -1, -1, 1;
+  const Lcp lcp{M, Vector::Constant(2, -1.0)};
+  const FallbackResult r = solve_with_fallbacks(lcp);
+  REQUIRE(r.attempts.size() == 4);
+  CHECK(r.attempts[0].status == Status::ray);
+  CHECK(r.attempts[2].method == Method::lemke_regularised);
+  CHECK(r.attempts[2].status != Status::solved);
+  CHECK(r.attempts[2].residual > 1e-3);
+  CHECK_FALSE(r.solved());
+}
+
+TEST_SUITE_END();
+
+}  // namespace
+}  // namespace floesim::lcp
