@@ -3,6 +3,7 @@
 #include <doctest/doctest.h>
 
 #include <cmath>
+#include <iomanip>
 #include <numbers>
 #include <sstream>
 
@@ -125,7 +126,7 @@ TEST_CASE("an inertial oscillation under Coriolis has period 2 pi / f") {
   }
   REQUIRE(crossings.size() >= 3);
   const double period = (crossings.back() - crossings.front()) / static_cast<double>(crossings.size() - 1);
-  MESSAGE("measured period " << period << " s, 2 pi / f = " << T << " s");
+  MESSAGE("measured period " << std::setprecision(12) << period << " s, 2 pi / f = " << T << " s");
   CHECK(period == doctest::Approx(T).epsilon(1e-5));
 }
 
