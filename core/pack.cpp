@@ -35,6 +35,14 @@ void require_finite(const std::vector<double>& v, const std::string& path, const
                        std::to_string(k));
 }
 
+// /window (xmin, xmax, ymin, ymax), optional in both formats.
+std::optional<std::array<double, 4>> read_window(hid_t file, const std::string& path) {
+  if (!h5::exists(file, "/window")) return std::nullopt;
+  auto w = read_checked(file, path, "/window", {4});
+  require_finite(w, path, "/window");
+  return std::array<double, 4>{w[0], w[1], w[2], w[3]};
+}
+
 Pack read_floedyn(hid_t file, const std::string& path, const PackDefaults& def) {
   Pack pack;
   pack.format = "floedyn";
@@ -78,11 +86,7 @@ Pack read_floedyn(hid_t file, const std::string& path, const PackDefaults& def) 
     if (h5::has_attr(d, "obstacle")) f.is_static = h5::get_attr_double(d, "obstacle") != 0.0;
     pack.floes.push_back(std::move(f));
   }
-  if (h5::exists(file, "/window")) {
-    auto w = read_checked(file, path, "/window", {4});
-    require_finite(w, path, "/window");
-    pack.window = std::array<double, 4>{w[0], w[1], w[2], w[3]};
-  }
+  pack.window = read_window(file, path);
   return pack;
 }
 
@@ -137,11 +141,7 @@ Pack read_ours(hid_t file, const std::string& path, const PackDefaults& def) {
     f.is_static = !stat.empty() && stat[i] != 0;
     pack.floes.push_back(std::move(f));
   }
-  if (h5::exists(file, "/window")) {
-    auto w = read_checked(file, path, "/window", {4});
-    require_finite(w, path, "/window");
-    pack.window = std::array<double, 4>{w[0], w[1], w[2], w[3]};
-  }
+  pack.window = read_window(file, path);
   return pack;
 }
 
