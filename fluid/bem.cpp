@@ -226,7 +226,7 @@ void BemSea::kick(std::span<const double> pressure, double h) {
   const Eigen::Map<const VectorXd> p(pressure.data(), ops.surface);
   impl_->work_modes.noalias() = ops.load * p;
   bank_.kick(std::span<const double>(impl_->work_modes.data(), bank_.modes()), h);
-  invalidate();
+  invalidate_rates();
 }
 
 void BemSea::flow(double dt) {

@@ -1,5 +1,6 @@
 #include "fluid/modal.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <utility>
 
@@ -63,6 +64,43 @@ void ModalBank::flow(double dt) {
       const double q0 = q[j], v0 = v[j];
       q[j] = c[j] * q0 + sw[j] * v0;
       v[j] = c[j] * v0 - ws[j] * q0;
+    }
+  }
+}
+
+void ModalBank::kick_flow(std::span<const Kick> kicks, double dt, double* q_out) {
+  if (components_ != 2 || kicks.size() > 2) {
+    for (const Kick& k : kicks) kick(std::span<const double>(k.s, v_.size()), k.h);
+    flow(dt);
+    if (q_out) std::copy(q_.begin(), q_.end(), q_out);
+    return;
+  }
+  prepare(dt);
+  const std::size_t n = omega_.size();
+  double* q = q_.data();
+  double* v = v_.data();
+  const double* c = c_.data();
+  const double* sw = sw_.data();
+  const double* ws = ws_.data();
+  const double* g = gain_.data();
+  // Unused kick slots read a zero impulse from the first one (h = 0).
+  const double* s0 = kicks.size() > 0 ? kicks[0].s : q;
+  const double* s1 = kicks.size() > 1 ? kicks[1].s : s0;
+  const double h0 = kicks.size() > 0 ? kicks[0].h : 0.0;
+  const double h1 = kicks.size() > 1 ? kicks[1].h : 0.0;
+  for (std::size_t j = 0; j < n; ++j) {
+    const double a0 = h0 * g[j], a1 = h1 * g[j];
+    const double q0 = q[2 * j], q1 = q[2 * j + 1];
+    const double v0 = v[2 * j] + a0 * s0[2 * j] + a1 * s1[2 * j];
+    const double v1 = v[2 * j + 1] + a0 * s0[2 * j + 1] + a1 * s1[2 * j + 1];
+    const double nq0 = c[j] * q0 + sw[j] * v0, nq1 = c[j] * q1 + sw[j] * v1;
+    q[2 * j] = nq0;
+    q[2 * j + 1] = nq1;
+    v[2 * j] = c[j] * v0 - ws[j] * q0;
+    v[2 * j + 1] = c[j] * v1 - ws[j] * q1;
+    if (q_out) {
+      q_out[2 * j] = nq0;
+      q_out[2 * j + 1] = nq1;
     }
   }
 }

@@ -57,6 +57,14 @@ public:
   // v += h * gain * s, s laid out like v.
   void kick(std::span<const double> s, double h);
 
+  // The same operations fused in one pass over the modes (memory-bound banks):
+  // the kicks, then flow(dt); if q_out is not null the new q is also written there.
+  struct Kick {
+    const double* s;
+    double h;
+  };
+  void kick_flow(std::span<const Kick> kicks, double dt, double* q_out = nullptr);
+
   double kinetic() const;
   double potential() const;
 

@@ -23,6 +23,11 @@ void Sea::step(double dt, const PressureFn& pressure) {
   kick(p_scratch_, 0.5 * dt);
 }
 
+void Sea::invalidate_rates() {
+  for (Field f : {Field::velocity_x, Field::velocity_y, Field::velocity_z})
+    valid_[static_cast<std::size_t>(f)] = false;
+}
+
 std::span<const double> Sea::field(Field f) {
   const auto i = static_cast<std::size_t>(f);
   if (!valid_[i]) {

@@ -90,10 +90,14 @@ public:
   std::span<const double> field(Field f);
   std::span<const double> elevation() { return field(Field::elevation); }
   SurfaceSample sample(double x, double y = 0.0);
-  SeaEnergy energy() const { return {bank_.kinetic(), bank_.potential()}; }
+  SeaEnergy energy() {
+    settle();
+    return {bank_.kinetic(), bank_.potential()};
+  }
 
-  const ModalBank& modes() const { return bank_; }
+  // The modal state (settled: every kick applied).
   ModalBank& modes() {
+    settle();
     invalidate();
     return bank_;
   }
@@ -101,7 +105,12 @@ public:
 protected:
   explicit Sea(const SurfaceGrid& grid);
   virtual void compute_field(Field f, std::span<double> out) = 0;
+  // A backend may defer kicks (to fuse them into the next flow); settle()
+  // applies the deferred ones. The state seen through the public API is always
+  // the settled one.
+  virtual void settle() {}
   void invalidate() { valid_.fill(false); }
+  void invalidate_rates();  // only the fields that depend on eta' (after a kick)
 
   SurfaceGrid grid_;
   ModalBank bank_;

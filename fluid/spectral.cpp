@@ -2,6 +2,7 @@
 
 #include <fftw3.h>
 
+#include <array>
 #include <cmath>
 #include <numbers>
 #include <optional>
@@ -38,6 +39,13 @@ struct SpectralSea::Impl {
   double* real = nullptr;         // n reals, scratch
   fftw_complex* spec = nullptr;   // nc complex, scratch
   fftw_plan r2c = nullptr, c2r = nullptr;
+  // Deferred kicks: the FFTs of up to two pressures and their h, applied fused
+  // with the next flow. `staged`: spec holds the current q (written by that flow),
+  // so the elevation needs no copy before its c2r.
+  std::array<fftw_complex*, 2> kick_spec{nullptr, nullptr};
+  std::array<double, 2> kick_h{0.0, 0.0};
+  int pending = 0;
+  bool staged = false;
   std::optional<TankZones> tank;
   AlignedVector tank_eta, tank_rate;
 
@@ -46,20 +54,21 @@ struct SpectralSea::Impl {
     if (c2r) fftw_destroy_plan(c2r);
     fftw_free(real);
     fftw_free(spec);
+    for (auto* k : kick_spec) fftw_free(k);
   }
 
   bool aligned(const double* p) const {
     return fftw_alignment_of(const_cast<double*>(p)) == fftw_alignment_of(real);
   }
 
-  // spec <- FFT(field)
-  void forward(std::span<const double> field) {
+  // to <- FFT(field); `to` is spec or a kick buffer (same alignment).
+  void forward(std::span<const double> field, fftw_complex* to) {
     if (aligned(field.data())) {
       // r2c plans preserve their input (FFTW_PRESERVE_INPUT is the default).
-      fftw_execute_dft_r2c(r2c, const_cast<double*>(field.data()), spec);
+      fftw_execute_dft_r2c(r2c, const_cast<double*>(field.data()), to);
     } else {
       std::copy(field.begin(), field.end(), real);
-      fftw_execute_dft_r2c(r2c, real, spec);
+      fftw_execute_dft_r2c(r2c, real, to);
     }
   }
   // out <- IFFT(spec) (unnormalised; spec is destroyed)
@@ -74,6 +83,7 @@ struct SpectralSea::Impl {
   // spec <- (i k)^d factor * a, for a = q or v (d = 0 or 1 via `deriv`).
   void load(std::span<const double> a, const std::vector<double>* deriv,
             const std::vector<double>* factor) {
+    staged = false;
     if (!deriv && !factor) {
       std::copy(a.begin(), a.end(), reinterpret_cast<double*>(spec));
       return;
@@ -108,6 +118,7 @@ SpectralSea::SpectralSea(const SeaParams& params, const SeaOptions& options)
 
   m.real = fftw_alloc_real(m.n);
   m.spec = fftw_alloc_complex(m.nc);
+  for (auto*& k : m.kick_spec) k = fftw_alloc_complex(m.nc);
   const unsigned flags = options.measure_fft_plans ? FFTW_MEASURE : FFTW_ESTIMATE;
   if (m.ny > 1) {
     m.r2c = fftw_plan_dft_r2c_2d(m.ny, m.nx, m.real, m.spec, flags);
@@ -172,18 +183,30 @@ double SpectralSea::omega(int mx, int my) const {
 const TankZones* SpectralSea::tank() const { return impl_->tank ? &*impl_->tank : nullptr; }
 
 void SpectralSea::kick(std::span<const double> pressure, double h) {
-  FLOESIM_ASSERT(pressure.size() == impl_->n);
-  impl_->forward(pressure);
-  bank_.kick(std::span<const double>(reinterpret_cast<const double*>(impl_->spec), 2 * impl_->nc),
-             h);
-  invalidate();
+  Impl& m = *impl_;
+  FLOESIM_ASSERT(pressure.size() == m.n);
+  if (m.pending == 2) settle();
+  m.forward(pressure, m.kick_spec[m.pending]);
+  m.kick_h[m.pending] = h;
+  ++m.pending;
+  invalidate_rates();
+}
+
+void SpectralSea::settle() {
+  Impl& m = *impl_;
+  for (int i = 0; i < m.pending; ++i)
+    bank_.kick(std::span<const double>(reinterpret_cast<const double*>(m.kick_spec[i]), 2 * m.nc),
+               m.kick_h[i]);
+  m.pending = 0;
 }
 
 void SpectralSea::set_surface(std::span<const double> eta, std::span<const double> eta_t) {
   Impl& m = *impl_;
   FLOESIM_ASSERT(eta.size() == m.n && eta_t.size() == m.n);
+  m.pending = 0;  // the state is replaced: deferred kicks are void
+  m.staged = false;
   auto copy_in = [&](std::span<const double> f, std::span<double> a) {
-    m.forward(f);
+    m.forward(f, m.spec);
     const double* s = reinterpret_cast<const double*>(m.spec);
     const double inv_n = 1.0 / static_cast<double>(m.n);
     for (std::size_t i = 0; i < 2 * m.nc; ++i) a[i] = s[i] * inv_n;
@@ -197,8 +220,16 @@ void SpectralSea::set_surface(std::span<const double> eta, std::span<const doubl
 void SpectralSea::flow(double dt) {
   Impl& m = *impl_;
   if (!m.tank) {
-    bank_.flow(dt);
+    // One pass: deferred kicks, rotation, and q staged in spec for the elevation.
+    std::array<ModalBank::Kick, 2> kicks{};
+    for (int i = 0; i < m.pending; ++i)
+      kicks[i] = {reinterpret_cast<const double*>(m.kick_spec[i]), m.kick_h[i]};
+    bank_.kick_flow(std::span(kicks.data(), static_cast<std::size_t>(m.pending)), dt,
+                    reinterpret_cast<double*>(m.spec));
+    m.pending = 0;
+    m.staged = true;
   } else {
+    settle();
     // Strang: relax(dt/2) flow(dt) relax(dt/2), relaxing in physical space.
     auto relax = [&](double t0, double h) {
       m.load(bank_.q(), nullptr, nullptr);
@@ -219,8 +250,11 @@ void SpectralSea::flow(double dt) {
 void SpectralSea::compute_field(Field f, std::span<double> out) {
   Impl& m = *impl_;
   const bool one_d = m.ny == 1;
+  if (f == Field::velocity_x || f == Field::velocity_y || f == Field::velocity_z) settle();
   switch (f) {
-    case Field::elevation: m.load(bank_.q(), nullptr, nullptr); break;
+    case Field::elevation:
+      if (!m.staged) m.load(bank_.q(), nullptr, nullptr);
+      break;
     case Field::slope_x: m.load(bank_.q(), &m.kx, nullptr); break;
     case Field::slope_y:
       if (one_d) return std::fill(out.begin(), out.end(), 0.0);
@@ -233,7 +267,8 @@ void SpectralSea::compute_field(Field f, std::span<double> out) {
       break;
     case Field::velocity_z: m.load(bank_.v(), nullptr, nullptr); break;
   }
-  m.backward(out);
+  m.backward(out);  // destroys spec
+  m.staged = false;
 }
 
 }  // namespace floesim::fluid

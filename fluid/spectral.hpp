@@ -9,8 +9,14 @@
 // The k = 0 mode (the mean) is frozen at zero: volume conservation.
 //
 // Modal amplitudes are the normalised coefficients FFT(eta) / n of eta on the
-// cell centres (n cells), so eta is the plain c2r of them. FFTW plans (r2c, c2r) are made once at construction and reused; a
-// kick costs one r2c, each grid field one c2r. All scratch is allocated once.
+// cell centres (n cells), so eta is the plain c2r of them. FFTW plans (r2c,
+// c2r) are made once at construction and reused; a kick costs one r2c, each
+// grid field one c2r. All scratch is allocated once.
+//
+// The modal work is memory-bound, so kicks are deferred (up to two) and applied
+// in the same pass over the modes as the next flow, which also stages q for the
+// elevation's c2r. Callers see no difference: velocity fields, energy() and
+// modes() settle the deferred kicks first.
 
 #include <memory>
 
@@ -35,6 +41,7 @@ public:
 
 protected:
   void compute_field(Field f, std::span<double> out) override;
+  void settle() override;
 
 private:
   struct Impl;
