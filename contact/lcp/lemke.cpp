@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <vector>
 
 #include "contact/lcp/lemke_basis.hpp"
@@ -32,7 +33,7 @@ public:
   Result run();
 
 private:
-  bool use_sparse() const;
+  detail::FactorPolicy factor_policy() const;
   Index first_leaving() const;
   Index ratio_test(const Vector& u);
   Index lexicographic(std::vector<Index> tied, const Vector& u);
@@ -48,15 +49,13 @@ private:
   Vector x_;  // basic values x_B = B^-1 q, by position
 };
 
-bool Lemke::use_sparse() const {
+detail::FactorPolicy Lemke::factor_policy() const {
   switch (opt_.factorization) {
-    case Factorization::dense: return false;
-    case Factorization::sparse: return true;
+    case Factorization::dense: return {std::numeric_limits<Index>::max(), 0.0};
+    case Factorization::sparse: return {0, 1.0};
     case Factorization::automatic: break;
   }
-  const double size = static_cast<double>(n_);
-  const double density = static_cast<double>(M_.nonZeros()) / (size * size);
-  return n_ >= opt_.sparse_min_size && density <= opt_.sparse_max_density;
+  return {opt_.sparse_min_size, opt_.sparse_max_density};
 }
 
 // z0 enters at max_i (-q_i / d_i); the row attaining it leaves. Ties: with q
@@ -99,7 +98,20 @@ Index Lemke::ratio_test(const Vector& u) {
 
 // Lexicographic rule on the tied positions: compare (B^-1)_{p, j} / u_p for
 // j = 0, 1, ... keeping the minimal ones until a single position remains.
+// Entries of B^-1 come from one transposed solve per tied row (few ties: the
+// usual case) or from one solve per column consulted (many ties); entries below
+// zero_tolerance times their row's (column's) largest count as 0.
 Index Lemke::lexicographic(std::vector<Index> tied, const Vector& u) {
+  constexpr std::size_t kMaxRowSolves = 8;
+  std::vector<std::pair<Index, Vector>> rows;  // (position p, row p of B^-1)
+  auto row_of = [&](Index p) -> const Vector& {
+    return std::find_if(rows.begin(), rows.end(), [p](const auto& r) { return r.first == p; })
+        ->second;
+  };
+  auto clean = [&](Vector& v) {
+    const double zero = opt_.zero_tolerance * v.cwiseAbs().maxCoeff();
+    v = (v.array().abs() <= zero).select(0.0, v);
+  };
   Vector y(n_);
   std::vector<double> keys;
   for (Index j = 0; j < n_ && tied.size() > 1; ++j) {
@@ -109,12 +121,25 @@ Index Lemke::lexicographic(std::vector<Index> tied, const Vector& u) {
       tied.erase(std::remove(tied.begin(), tied.end(), p), tied.end());
       continue;
     }
-    y.setZero();
-    y(j) = 1.0;
-    basis_->solve(y);
-    const double y_zero = opt_.zero_tolerance * y.cwiseAbs().maxCoeff();
+    if (rows.empty() && tied.size() <= kMaxRowSolves) {
+      for (Index t : tied) {
+        y.setZero();
+        y(t) = 1.0;
+        basis_->solve_transposed(y);
+        clean(y);
+        rows.emplace_back(t, y);
+      }
+    }
     keys.clear();
-    for (Index t : tied) keys.push_back((std::abs(y(t)) <= y_zero ? 0.0 : y(t)) / u(t));
+    if (!rows.empty()) {
+      for (Index t : tied) keys.push_back(row_of(t)(j) / u(t));
+    } else {
+      y.setZero();
+      y(j) = 1.0;
+      basis_->solve(y);
+      clean(y);
+      for (Index t : tied) keys.push_back(y(t) / u(t));
+    }
     keep_minimal(tied, keys, opt_.tie_tolerance);
   }
   // Ties that survive every column (only possible within the tolerances): the
@@ -152,9 +177,7 @@ Result Lemke::run() {
     return result;
   }
   const long max_pivots = opt_.max_pivots > 0 ? opt_.max_pivots : 50 * (n_ + 1) + 1000;
-  stats_.sparse = use_sparse();
-  LemkeBasis basis(M_, d_, stats_.sparse ? detail::make_sparse_factor() : detail::make_dense_factor(),
-                   std::max(1, opt_.refactor_interval));
+  LemkeBasis basis(M_, d_, factor_policy(), std::max(1, opt_.refactor_interval));
   basis_ = &basis;
   stats_.refactorisations = basis.refactorisations();
 
@@ -215,6 +238,7 @@ Result Lemke::run() {
   result.pivots = pivots;
   stats_.solves = basis.solves();
   stats_.refactorisations = basis.refactorisations();
+  stats_.sparse_refactorisations = basis.sparse_refactorisations();
   return result;
 }
 

@@ -62,17 +62,19 @@ struct LemkeOptions {
   double zero_tolerance = 1e-12;   // relative to ||x_B||_inf (and ||B^-1 e_j||_inf)
   double tie_tolerance = 1e-9;     // relative difference of tied ratios
   Factorization factorization = Factorization::automatic;
-  // automatic: sparse LU when n >= sparse_min_size and the density of M is at
-  // most sparse_max_density, dense LU otherwise (measured, see docs/lcp.md).
-  Index sparse_min_size = 300;
-  double sparse_max_density = 0.05;
+  // automatic: at each refactorisation, the reduced basis C (k x k, k = number
+  // of basic z's) goes to UMFPACK when k >= sparse_min_size and C has at most
+  // sparse_max_density k^2 non-zeros, to dense LU otherwise (measured, see
+  // docs/lcp.md).
+  Index sparse_min_size = 120;
+  double sparse_max_density = 0.1;
   // Etas (pivots) between refactorisations of the basis.
-  int refactor_interval = 40;
+  int refactor_interval = 100;
 };
 
 // What the revised method did, for benchmarks and diagnostics.
 struct LemkeStats {
-  bool sparse = false;        // the factorisation used
+  long sparse_refactorisations = 0;  // of `refactorisations`, how many used UMFPACK
   long solves = 0;            // solves with the basis (entering columns + tie-breaks)
   long tie_breaks = 0;        // pivots whose ratio test needed the lexicographic rule
   long refactorisations = 0;

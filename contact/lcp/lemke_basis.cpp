@@ -30,6 +30,11 @@ public:
     Eigen::Map<Vector> v(x, k_);
     v = lu_.solve(v);
   }
+  void solve_transposed(double* x) override {
+    if (k_ == 0) return;
+    Eigen::Map<Vector> v(x, k_);
+    v = lu_.transpose().solve(v);
+  }
 
 private:
   Index k_ = 0;
@@ -72,14 +77,16 @@ public:
     rhs_.resize(k);
     return true;
   }
-  void solve(double* x) override {
-    if (k_ == 0) return;
-    rhs_ = Eigen::Map<Vector>(x, k_);
-    umfpack_di_wsolve(UMFPACK_A, C_.outerIndexPtr(), C_.innerIndexPtr(), C_.valuePtr(), x,
-                      rhs_.data(), numeric_, control_, info_, wi_.data(), w_.data());
-  }
+  void solve(double* x) override { solve_system(UMFPACK_A, x); }
+  void solve_transposed(double* x) override { solve_system(UMFPACK_Aat, x); }
 
 private:
+  void solve_system(int system, double* x) {
+    if (k_ == 0) return;
+    rhs_ = Eigen::Map<Vector>(x, k_);
+    umfpack_di_wsolve(system, C_.outerIndexPtr(), C_.innerIndexPtr(), C_.valuePtr(), x,
+                      rhs_.data(), numeric_, control_, info_, wi_.data(), w_.data());
+  }
   void release() {
     if (numeric_) umfpack_di_free_numeric(&numeric_);
     numeric_ = nullptr;
@@ -102,9 +109,9 @@ std::unique_ptr<ReducedFactor> make_sparse_factor() { return std::make_unique<Um
 // ---------------------------------------------------------------------------
 // The basis.
 
-LemkeBasis::LemkeBasis(const SparseMatrix& M, const Vector& d, std::unique_ptr<ReducedFactor> lu,
+LemkeBasis::LemkeBasis(const SparseMatrix& M, const Vector& d, FactorPolicy policy,
                        int refactor_interval)
-    : M_(M), d_(d), n_(M.rows()), lu_(std::move(lu)), refactor_interval_(refactor_interval),
+    : M_(M), d_(d), n_(M.rows()), policy_(policy), refactor_interval_(refactor_interval),
       basis_(static_cast<std::size_t>(n_)), position_(static_cast<std::size_t>(2 * n_ + 1), -1),
       scratch_(n_) {
   for (Index i = 0; i < n_; ++i) {
@@ -128,6 +135,14 @@ void LemkeBasis::add_column(int var, double scale, Vector& t) const {
     for (SparseMatrix::InnerIterator it(M_, var - n_); it; ++it)
       t(it.index()) -= scale * it.value();
   }
+}
+
+double LemkeBasis::dot_column(int var, const Vector& y) const {
+  if (is_w(var)) return y(var);
+  if (var == z0_var()) return -d_.dot(y);
+  double sum = 0.0;
+  for (SparseMatrix::InnerIterator it(M_, var - n_); it; ++it) sum -= it.value() * y(it.index());
+  return sum;
 }
 
 void LemkeBasis::column(int var, Vector& a) const {
@@ -160,6 +175,27 @@ void LemkeBasis::solve(Vector& x) {
       x(eta.pos) = xr;
     }
   }
+}
+
+void LemkeBasis::solve_transposed(Vector& y) {
+  ++solves_;
+  // The etas transposed, newest first: E^-T changes only entry r,
+  // y_r <- y_r - ((u . y) - y_r) / u_r.
+  for (auto eta = etas_.rbegin(); eta != etas_.rend(); ++eta) {
+    const double ur = eta->u(eta->pos);
+    const double yr = y(eta->pos);
+    y(eta->pos) = yr - (eta->u.dot(y) - yr) / ur;
+  }
+  // B0^T t = y: a covered row i (w_i at position p) has t_i = y_p; the uncovered
+  // rows solve C^T t_R = y_S - A(W, S)^T t_W.
+  scratch_.setZero();
+  for (std::size_t c = 0; c < w_rows_.size(); ++c) scratch_(w_rows_[c]) = y(w_positions_[c]);
+  const Index k = static_cast<Index>(r_rows_.size());
+  for (Index s = 0; s < k; ++s)  // rows R of scratch_ are still 0: the dot sees W only
+    reduced_(s) = y(s_positions_[s]) - dot_column(s_vars_[s], scratch_);
+  lu_->solve_transposed(reduced_.data());
+  for (Index s = 0; s < k; ++s) scratch_(r_rows_[s]) = reduced_(s);
+  y = scratch_;
 }
 
 bool LemkeBasis::replace(Index pos, int var, const Vector& u) {
@@ -216,6 +252,13 @@ bool LemkeBasis::refactor() {
   }
   SparseMatrix C(k, k);
   C.setFromTriplets(entries.begin(), entries.end());
+  const double size = static_cast<double>(k);
+  const bool sparse = k >= policy_.sparse_min_size &&
+                      static_cast<double>(C.nonZeros()) <= policy_.sparse_max_density * size * size;
+  auto& factor = sparse ? sparse_lu_ : dense_lu_;
+  if (!factor) factor = sparse ? make_sparse_factor() : make_dense_factor();
+  lu_ = factor.get();
+  if (sparse) ++sparse_refactorisations_;
   return lu_->factor(C);
 }
 

@@ -17,13 +17,15 @@
 //     x_{pos(w_i)} = b_i - sum_{s in S} a_{var(s)}(i) x_s   for the covered rows i,
 //
 // so only C is factorised: densely (Eigen partial-pivoting LU) or sparsely
-// (UMFPACK), chosen by the caller. k is the number of basic z's, usually well
+// (UMFPACK), chosen at each refactorisation from k and the density of C (or
+// fixed by the caller). k is the number of basic z's (plus z0), usually well
 // below n.
 //
 // Updates. A pivot replaces the column at position r by a with u = B^-1 a, so
 // B_new = B E with E = I + (u - e_r) e_r^T and B_new^-1 = E^-1 B^-1: the
 // product form. Each pivot appends one eta vector (r, u); B^-1 b is then the
-// reduced solve followed by the etas in order. After `refactor_interval` etas the
+// reduced solve followed by the etas in order (and B^-T y the transposed etas
+// in reverse order, then the transposed reduced solve). After `refactor_interval` etas the
 // current basis is factorised afresh (bounds both the work per solve and the
 // growth of rounding errors).
 
@@ -42,16 +44,25 @@ public:
   virtual bool factor(const SparseMatrix& C) = 0;
   // x <- C^-1 x, x of length k.
   virtual void solve(double* x) = 0;
+  // x <- C^-T x.
+  virtual void solve_transposed(double* x) = 0;
 };
 std::unique_ptr<ReducedFactor> make_dense_factor();
 std::unique_ptr<ReducedFactor> make_sparse_factor();  // UMFPACK
+
+// Which factorisation a refactorisation uses: `sparse_min_size` = 0 forces
+// UMFPACK, a huge value forces dense LU; otherwise UMFPACK when k >=
+// sparse_min_size and nnz(C) <= sparse_max_density k^2.
+struct FactorPolicy {
+  Index sparse_min_size = 0;
+  double sparse_max_density = 1.0;
+};
 
 class LemkeBasis {
 public:
   // M: the LCP matrix (columns are read), d: the covering vector; the initial
   // basis is all w (B = I).
-  LemkeBasis(const SparseMatrix& M, const Vector& d, std::unique_ptr<ReducedFactor> lu,
-             int refactor_interval);
+  LemkeBasis(const SparseMatrix& M, const Vector& d, FactorPolicy policy, int refactor_interval);
 
   Index size() const { return n_; }
   int w_var(Index i) const { return static_cast<int>(i); }
@@ -68,6 +79,9 @@ public:
   void column(int var, Vector& a) const;
   // x <- B^-1 x  (x enters indexed by rows, leaves indexed by positions).
   void solve(Vector& x);
+  // y <- B^-T y (y enters indexed by positions, leaves indexed by rows); with
+  // y = e_p on entry this is row p of B^-1.
+  void solve_transposed(Vector& y);
   // out <- B x  (x indexed by positions, out by rows).
   void multiply(const Vector& x, Vector& out) const;
 
@@ -79,14 +93,18 @@ public:
 
   long solves() const { return solves_; }
   long refactorisations() const { return refactorisations_; }
+  long sparse_refactorisations() const { return sparse_refactorisations_; }
 
 private:
   void add_column(int var, double scale, Vector& t) const;  // t += scale * a_var
+  double dot_column(int var, const Vector& y) const;        // a_var . y
 
   const SparseMatrix& M_;
   const Vector& d_;
   Index n_;
-  std::unique_ptr<ReducedFactor> lu_;
+  FactorPolicy policy_;
+  std::unique_ptr<ReducedFactor> dense_lu_, sparse_lu_;  // created when first used
+  ReducedFactor* lu_ = nullptr;                           // the one factorising B0
   int refactor_interval_;
 
   std::vector<int> basis_;       // variable at each position
@@ -109,6 +127,7 @@ private:
   Vector reduced_;
   long solves_ = 0;
   long refactorisations_ = 0;
+  long sparse_refactorisations_ = 0;
 };
 
 }  // namespace floesim::lcp::detail

@@ -121,7 +121,8 @@ TEST_CASE("lcp: every rigid-body contact LCP is solved, friction ones included")
     check_complementary(lcp, r.z, 1e-9);
     MESSAGE(std::filesystem::path(file).filename().string() << ": n " << lcp.size() << ", pivots "
             << r.pivots << ", residual " << r.residual << ", tie-breaks " << stats.tie_breaks
-            << ", solves " << stats.solves << std::string(stats.sparse ? ", sparse" : ", dense"));
+            << ", solves " << stats.solves << ", UMFPACK refactorisations " << stats.sparse_refactorisations << " of "
+            << stats.refactorisations);
   }
 }
 
