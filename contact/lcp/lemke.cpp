@@ -38,6 +38,7 @@ private:
   Index ratio_test(const Vector& u);
   Index lexicographic(std::vector<Index> tied, const Vector& u);
   Result finish_solved(LemkeBasis& basis);
+  Vector read_z(const LemkeBasis& basis, const Vector& x) const;
 
   const Lcp& lcp_;
   const LemkeOptions& opt_;
@@ -161,12 +162,19 @@ Result Lemke::finish_solved(LemkeBasis& basis) {
   r = lcp_.q - r;
   basis.solve(r);
   x += r;
-  result.z = Vector::Zero(n_);
+  result.z = read_z(basis, x);
+  return result;
+}
+
+// z from basic values x (by position): z_j = x at z_j's position, 0 if non-basic;
+// rounding-level negatives are cut to 0.
+Vector Lemke::read_z(const LemkeBasis& basis, const Vector& x) const {
+  Vector z = Vector::Zero(n_);
   for (Index j = 0; j < n_; ++j) {
     const Index p = basis.position_of(basis.z_var(j));
-    if (p >= 0) result.z(j) = std::max(x(p), 0.0);
+    if (p >= 0) z(j) = std::max(x(p), 0.0);
   }
-  return result;
+  return z;
 }
 
 Result Lemke::run() {
@@ -229,11 +237,7 @@ Result Lemke::run() {
   if (!ok) result.status = Status::failed;
   if (result.status != Status::solved) {
     // Report the point reached (z0 > 0 there, so it does not solve the LCP).
-    result.z = Vector::Zero(n_);
-    for (Index j = 0; j < n_; ++j) {
-      const Index p = basis.position_of(basis.z_var(j));
-      if (p >= 0) result.z(j) = std::max(x_(p), 0.0);
-    }
+    result.z = read_z(basis, x_);
   }
   result.pivots = pivots;
   stats_.solves = basis.solves();
