@@ -9,6 +9,8 @@
 
 using namespace floesim;
 
+TEST_SUITE_BEGIN("core");
+
 namespace {
 Config parse(const std::string& text) { return parse_config(text, "case.toml", "/tmp"); }
 
@@ -111,3 +113,5 @@ TEST_CASE("the resolved configuration parses back to the same values") {
   CHECK(d.coupling.restitution == 0.3);
   CHECK(resolved_toml(d) == text);
 }
+
+TEST_SUITE_END();

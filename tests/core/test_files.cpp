@@ -14,6 +14,8 @@
 using namespace floesim;
 namespace fs = std::filesystem;
 
+TEST_SUITE_BEGIN("core");
+
 namespace {
 const std::string kShared = FLOESIM_SHARED_DIR;
 
@@ -133,3 +135,5 @@ TEST_CASE("run file: records are readable, compare detects differences") {
   CHECK(state_differs);
   CHECK(compare_runs(a, b, {.rtol = 1e-2, .atol = 1e-2}).equal());
 }
+
+TEST_SUITE_END();

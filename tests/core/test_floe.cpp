@@ -9,6 +9,8 @@
 
 using namespace floesim;
 
+TEST_SUITE_BEGIN("core");
+
 namespace {
 FloeInput rect(double w, double h, double thick = 2.0, double rho = 900.0) {
   FloeInput f;
@@ -105,3 +107,5 @@ TEST_CASE("Floes: contiguous storage, static floes have zero inverse mass") {
   CHECK(w[0].x() == doctest::Approx(10.0));
   CHECK(w[0].y() == doctest::Approx(20.0));
 }
+
+TEST_SUITE_END();

@@ -9,6 +9,8 @@
 
 using namespace floesim;
 
+TEST_SUITE_BEGIN("core");
+
 namespace {
 std::string write_tmp(const std::string& name, const std::string& text) {
   const auto p = std::filesystem::temp_directory_path() / name;
@@ -60,3 +62,5 @@ TEST_CASE("bad CSV rows are refused naming file and line") {
   refused("t_s,wind_u,wind_v,current_u,current_v\n0,1,2,3,nan\n", "not finite");
   refused("t_s,wind_u,wind_v,current_u,current_v\n", "no data row");
 }
+
+TEST_SUITE_END();

@@ -8,6 +8,8 @@
 
 using namespace floesim;
 
+TEST_SUITE_BEGIN("core");
+
 TEST_CASE("rectangle moments match the closed forms") {
   // Rectangle [1, 4] x [2, 4]: A = 6, centroid (2.5, 3),
   // ∫(x-Gx)² = b³h/12 = 27*2/12 = 4.5, ∫(y-Gy)² = b h³/12 = 3*8/12 = 2.
@@ -76,3 +78,5 @@ TEST_CASE("point in polygon") {
   CHECK(point_in_polygon(l, {0.5, 1.5}));
   CHECK_FALSE(point_in_polygon(l, {1.5, 1.5}));
 }
+
+TEST_SUITE_END();

@@ -14,6 +14,8 @@
 
 using namespace floesim;
 
+TEST_SUITE_BEGIN("coupling");
+
 namespace {
 
 constexpr double kRhoW = 1025.0, kRhoI = 917.0, kCw = 5e-3, kRhoA = 1.341, kCa = 1.7e-3;
@@ -178,3 +180,5 @@ TEST_CASE("stiff drag: a thin floe with a step far above its drag time stays sta
   }
   CHECK(prev == doctest::Approx(1.0).epsilon(1e-3));
 }
+
+TEST_SUITE_END();

@@ -15,6 +15,8 @@
 using namespace floesim;
 namespace fs = std::filesystem;
 
+TEST_SUITE_BEGIN("coupling");
+
 namespace {
 const std::string kShared = FLOESIM_SHARED_DIR;
 
@@ -122,3 +124,5 @@ TEST_CASE("a numerical failure marks the run file failed and keeps the records")
   CHECK(info.status.rfind("failed:", 0) == 0);
   CHECK(info.records == 1);
 }
+
+TEST_SUITE_END();
