@@ -204,5 +204,50 @@ def case_example():
     check(keyvals(p.stdout).get("status") == "complete", f"{cfg} runs")
 
 
+def case_pack():
+    # floesim pack: key: value lines, a floesim-pack-1 file that `floesim run`
+    # loads, the same file for the same seed, exit 2 for bad arguments.
+    args = ["pack", "--floes", "60", "--concentration", "0.6", "--box", "400", "300", "--seed", "5",
+            "--size-distribution", "power:2.5", "--min-size", "5", "--max-size", "50",
+            "--thickness-range", "0.5", "1.5", "--walls", "10"]
+    kv = keyvals(run(*args, "-o", "pack.h5").stdout)
+    check(kv["floes"] == "60" and kv["walls"] == "4", f"counts {kv}")
+    check(abs(float(kv["concentration"]) - 0.6) < 0.012, f"concentration {kv['concentration']}")
+    check(float(kv["min_gap"].split()[0]) >= float(kv["required_gap"].split()[0]) > 0, "gap")
+    check(float(kv["time_ms"]) >= 0 and os.path.samefile(kv["output"], os.path.join(WORK, "pack.h5")), "output")
+    with h5py.File(os.path.join(WORK, "pack.h5")) as f:
+        check(f.attrs["format"] == "floesim-pack-1", "pack format")
+        check(f["floes/offsets"].shape == (65,) and f["floes/pose"].shape == (64, 3), "64 floes")
+        check(list(f["floes/static"][:]) == [0] * 60 + [1] * 4, "walls last, static")
+        check(np.allclose(f["window"][:], [0, 400, 0, 300]), "window is the box")
+        h = f["floes/thickness"][:60]
+        check(h.min() >= 0.5 and h.max() <= 1.5 and h.max() > h.min(), "thickness range")
+        pose = f["floes/pose"][:60]
+        check(np.all((pose[:, 0] > 0) & (pose[:, 0] < 400) & (pose[:, 1] > 0) & (pose[:, 1] < 300)), "in box")
+        first = f["floes/vertices"][:]
+    run(*args, "-o", "pack2.h5")
+    with h5py.File(os.path.join(WORK, "pack2.h5")) as f:
+        check(np.array_equal(f["floes/vertices"][:], first), "same seed, same pack")
+    cfg = write("pack_run.toml", '[run]\nt_end = 60.0\ndt_max = 5.0\noutput_interval = 30.0\n\n'
+                '[sea]\nmodel = "none"\n\n[floes]\npack = "pack.h5"\n\n[forcing]\nwind = [5.0, 0.0]\n')
+    p = run("run", cfg, "-q", "-o", "pack_run.h5")
+    check(keyvals(p.stdout).get("status") == "complete", "a run from the pack completes")
+    with h5py.File(os.path.join(WORK, "pack_run.h5")) as f:
+        check(f["floes/state"].shape[1] == 64, "the run has the pack's floes")
+        check(list(f["floes/static"][:]) == [0] * 60 + [1] * 4, "walls static in the run")
+    base = ["pack", "--floes", "10", "--box", "100", "100", "-o", "bad.h5"]
+    for bad, word in [(["--concentration", "0"], "concentration"), (["--concentration", "0.99"], "concentration"),
+                      (["--concentration", "0.5", "--size-distribution", "powr:2"], "size-distribution"),
+                      (["--concentration", "0.5", "--size-distribution", "power:-1"], "exponent"),
+                      (["--concentration", "0.5", "--min-size", "5", "--max-size", "1"], "max_size"),
+                      (["--concentration", "0.5", "--thickness-range", "2", "1"], "thickness"),
+                      (["--concentration", "0.5", "--thickness", "1", "--thickness-range", "1", "2"], "excludes")]:
+        p = run(*base, *bad, expect=2)
+        check(word in p.stderr, f"{bad}: message names {word}: {p.stderr}")
+        check(not os.path.exists(os.path.join(WORK, "bad.h5")), "no file for bad arguments")
+    run("pack", "--floes", "10", "--concentration", "0.5", "-o", "bad.h5", expect=2)  # no --box
+    run("pack", "--help")
+
+
 globals()["case_" + CASE]()
 print(f"cli.{CASE}: 1 passed, 0 failed")
