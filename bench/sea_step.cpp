@@ -11,7 +11,8 @@
 // q for the c2r); kick_ms a kick alone (r2c; its modal update is deferred and
 // fused into the next flow); in_step_* the four phases timed inside the step
 // sequence; ratio_in_step = their sum / (kick1 + elevation + kick2), the step
-// against its FFTs as they run inside it (cache-cold, unlike the bare FFTs).
+// against its FFTs as they run inside it (cache-cold, unlike the bare FFTs);
+// flow_new_dt_ms a flow whose dt differs from the previous one (one sin/cos per mode).
 //
 // usage: floesim_bench_sea_step [max_cells = 1024] [repeats = 30]
 
@@ -54,7 +55,8 @@ int main(int argc, char** argv) {
   const int max_cells = argc > 1 ? std::atoi(argv[1]) : 1024;
   const int repeats = argc > 2 ? std::atoi(argv[2]) : 30;
   std::printf("cells,modes,fft_r2c_ms,fft_c2r_ms,step_ffts_ms,step_ms,ratio,flow_ms,kick_ms,"
-              "in_step_kick1_ms,in_step_flow_ms,in_step_elevation_ms,in_step_kick2_ms,ratio_in_step\n");
+              "in_step_kick1_ms,in_step_flow_ms,in_step_elevation_ms,in_step_kick2_ms,ratio_in_step,"
+              "flow_new_dt_ms\n");
   for (int n = 256; n <= max_cells; n *= 2) {
     SeaParams p;
     p.model = SeaModel::spectral;
@@ -120,15 +122,21 @@ int main(int argc, char** argv) {
       for (int i = 0; i < 4; ++i) phase[i] = std::min(phase[i], d[i]);
     }
     const double t_flow = min_ms(repeats, [&] { sea.flow(dt); });
+    double alt = dt;  // a new dt every call: the rotation coefficients are recomputed
+    const double t_flow_new_dt = min_ms(repeats, [&] {
+      alt = alt == dt ? 0.9 * dt : dt;
+      sea.flow(alt);
+    });
     const double t_kick = min_ms(repeats, [&] { sea.kick(p0, 0.0); });
     // In the step a kick is its r2c (the modal update is deferred) and the
     // elevation is its c2r (q is staged by the flow): their sum is the step's
     // FFT time as it runs there, with the caches as the step leaves them.
     const double in_step_ffts = phase[0] + phase[2] + phase[3];
     const double in_step = phase[0] + phase[1] + phase[2] + phase[3];
-    std::printf("%d,%zu,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f\n", n,
+    std::printf("%d,%zu,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f\n", n,
                 sea.modes().modes(), t_r2c, t_c2r - t_fill, ffts, t_step, t_step / ffts, t_flow,
-                t_kick, phase[0], phase[1], phase[2], phase[3], in_step / in_step_ffts);
+                t_kick, phase[0], phase[1], phase[2], phase[3], in_step / in_step_ffts,
+                t_flow_new_dt);
     std::fflush(stdout);
     if (sink == 12345.0) std::printf("#\n");
   }
