@@ -108,7 +108,7 @@ std::vector<std::string> contact_files() {
   return files;
 }
 
-TEST_CASE("lcp: every rigid-body contact LCP is solved, friction ones included") {
+TEST_CASE("lcp: every rigid-body contact LCP is solved - friction ones included") {
   const auto files = contact_files();
   REQUIRE(files.size() >= 20);
   for (const std::string& file : files) {

@@ -25,7 +25,7 @@ TEST_CASE("lcp pgs: solves a symmetric positive definite contact LCP to toleranc
   check_complementary(lcp, r.z, 1e-9);
 }
 
-TEST_CASE("lcp pgs: refuses a zero diagonal, stops at the iteration limit") {
+TEST_CASE("lcp pgs: refuses a zero diagonal and stops at the iteration limit") {
   const Lcp friction = read_siconos_lcp(lcp_data("contact/friction_m10_s1.dat"));
   CHECK(solve_pgs(friction).status == Status::failed);  // the beta block has M_ii = 0
 
@@ -47,7 +47,7 @@ TEST_CASE("lcp fallback: a Lemke success is taken at once") {
   CHECK_FALSE(r.flagged);
 }
 
-TEST_CASE("lcp fallback: every step is tried and reported, PGS answers are flagged") {
+TEST_CASE("lcp fallback: every step is tried and reported - PGS answers are flagged") {
   // A pivot limit too small for any Lemke step leaves PGS as the last resort.
   const Lcp lcp = read_siconos_lcp(lcp_data("contact/delassus_m50_s2.dat"));
   FallbackOptions options;
@@ -71,7 +71,7 @@ TEST_CASE("lcp fallback: every step is tried and reported, PGS answers are flagg
   CHECK_FALSE(without.flagged);
 }
 
-TEST_CASE("lcp fallback: an infeasible LCP fails every step, the regularised one included") {
+TEST_CASE("lcp fallback: an infeasible LCP fails every step - the regularised one included") {
   // Copositive-plus and infeasible. M + delta I is positive definite, so the
   // regularised LCP has a solution, of order 1/delta: whether Lemke reaches it
   // within its tolerances or not, it must not pass on the ORIGINAL LCP.

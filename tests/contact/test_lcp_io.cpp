@@ -28,7 +28,7 @@ bool contains(const std::string& s, const std::string& part) {
 
 const std::string kHeader2 = "2\n0\n2\n2\n2 2\n";
 
-TEST_CASE("lcp io: a dense file is column-major, the comment after q ignored") {
+TEST_CASE("lcp io: a dense file is column-major - the comment after q ignored") {
   const Lcp lcp = parse_siconos_lcp(kHeader2 + "1 2\n3 4\n-1 -2\n# a comment 5 6\n", "ok.dat");
   const auto& M = std::get<DenseMatrix>(lcp.M);
   CHECK(M(0, 0) == 1.0);
@@ -52,7 +52,7 @@ TEST_CASE("lcp io: a sparse-block file becomes a sparse M") {
   CHECK(M(2, 0) == 0.0);
 }
 
-TEST_CASE("lcp io: malformed files are refused with file, line and reason") {
+TEST_CASE("lcp io: malformed files are refused naming the file and line and the reason") {
   struct Case {
     const char* what;
     std::string text;

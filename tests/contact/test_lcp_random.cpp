@@ -48,7 +48,7 @@ void check_solved(const Lcp& lcp, double tol = 1e-9) {
   }
 }
 
-TEST_CASE("lcp random: symmetric positive definite M, any q") {
+TEST_CASE("lcp random: symmetric positive definite M - any q") {
   std::mt19937_64 rng(20240601);
   for (const Index n : {1, 2, 7, 40, 120, 300}) {
     CAPTURE(n);
@@ -88,7 +88,7 @@ TEST_CASE("lcp random: non-symmetric P-matrices") {
   }
 }
 
-TEST_CASE("lcp random: a P-matrix LCP has one solution, whatever the covering vector") {
+TEST_CASE("lcp random: a P-matrix LCP has one solution - whatever the covering vector") {
   std::mt19937_64 rng(3);
   const Index n = 60;
   const DenseMatrix A = gaussian(rng, n, n);
@@ -103,7 +103,7 @@ TEST_CASE("lcp random: a P-matrix LCP has one solution, whatever the covering ve
   CHECK((a.z - b.z).cwiseAbs().maxCoeff() <= 1e-9 * (1.0 + a.z.cwiseAbs().maxCoeff()));
 }
 
-TEST_CASE("lcp degenerate: duplicated contacts, repeated rows and zero blocks of q") {
+TEST_CASE("lcp degenerate: duplicated contacts - repeated rows and zero blocks of q") {
   std::mt19937_64 rng(11);
   const Index m = 40;
   // Each contact appears twice (rows of J duplicated): M = J J^T is PSD with
@@ -164,7 +164,7 @@ TEST_CASE("lcp: an infeasible copositive-plus LCP ends on a ray") {
   CHECK(r.residual > 0.1);
 }
 
-TEST_CASE("lcp: the pivot limit is reported, and a malformed LCP is refused") {
+TEST_CASE("lcp: the pivot limit is reported and a malformed LCP is refused") {
   std::mt19937_64 rng(1);
   const DenseMatrix A = gaussian(rng, 30, 30);
   const Lcp lcp{DenseMatrix(A * A.transpose()), Vector::Constant(30, -1.0)};
