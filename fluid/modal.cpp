@@ -21,22 +21,38 @@ ModalBank::ModalBank(std::vector<double> omega, std::vector<double> mass, std::v
       ws_(omega_.size()) {
   FLOESIM_ASSERT(components == 1 || components == 2);
   FLOESIM_ASSERT(mass_.size() == omega_.size() && gain_.size() == omega_.size());
+  distinct_ = omega_;
+  std::sort(distinct_.begin(), distinct_.end());
+  distinct_.erase(std::unique(distinct_.begin(), distinct_.end()), distinct_.end());
+  level_.resize(omega_.size());
+  for (std::size_t j = 0; j < omega_.size(); ++j)
+    level_[j] = static_cast<std::uint32_t>(
+        std::lower_bound(distinct_.begin(), distinct_.end(), omega_[j]) - distinct_.begin());
+  dc_.resize(distinct_.size());
+  dsw_.resize(distinct_.size());
+  dws_.resize(distinct_.size());
 }
 
 void ModalBank::prepare(double dt) {
   if (cache_valid_ && dt == cached_dt_) return;
-  for (std::size_t j = 0; j < omega_.size(); ++j) {
-    const double w = omega_[j];
+  for (std::size_t d = 0; d < distinct_.size(); ++d) {
+    const double w = distinct_[d];
     if (w == 0.0) {
-      c_[j] = 1.0;
-      sw_[j] = dt;
-      ws_[j] = 0.0;
+      dc_[d] = 1.0;
+      dsw_[d] = dt;
+      dws_[d] = 0.0;
     } else {
       const double s = std::sin(w * dt);
-      c_[j] = std::cos(w * dt);
-      sw_[j] = s / w;
-      ws_[j] = w * s;
+      dc_[d] = std::cos(w * dt);
+      dsw_[d] = s / w;
+      dws_[d] = w * s;
     }
+  }
+  for (std::size_t j = 0; j < omega_.size(); ++j) {
+    const std::uint32_t d = level_[j];
+    c_[j] = dc_[d];
+    sw_[j] = dsw_[d];
+    ws_[j] = dws_[d];
   }
   cached_dt_ = dt;
   cache_valid_ = true;

@@ -27,6 +27,7 @@
 // mass 0 and gain 0.
 
 #include <cstddef>
+#include <cstdint>
 #include <span>
 #include <vector>
 
@@ -74,10 +75,15 @@ private:
   int components_ = 1;
   std::vector<double> omega_, mass_, gain_;
   std::vector<double> q_, v_;
-  // Rotation over cached_dt_: q' = c q + sw v, v' = -ws q + c v.
+  // Rotation over cached_dt_: q' = c q + sw v, v' = -ws q + c v. Modes that
+  // share a frequency (a spectral box has many: |k| is shared by symmetric wave
+  // vectors) share one sin/cos evaluation: distinct_[level_[j]] = omega_[j].
   double cached_dt_ = 0.0;
   bool cache_valid_ = false;
   std::vector<double> c_, sw_, ws_;
+  std::vector<double> distinct_;
+  std::vector<std::uint32_t> level_;
+  std::vector<double> dc_, dsw_, dws_;
 };
 
 }  // namespace floesim::fluid
