@@ -5,6 +5,7 @@
 #include <cmath>
 #include <numbers>
 #include <string>
+#include <vector>
 
 #include "core/error.hpp"
 #include "fluid/sea.hpp"
@@ -93,6 +94,35 @@ TEST_CASE("a long-crested 2-D JONSWAP sea along x does not vary along y") {
   for (int j = 1; j < 16; ++j)
     for (int i = 0; i < 128; ++i) dev = std::max(dev, std::abs(e[j * 128 + i] - e[i]));
   CHECK(dev < 1e-12);
+}
+
+TEST_CASE("a spread JONSWAP sea travels in its mean direction") {
+  // For a progressive wave along k, eta = a cos(theta) and the orbital velocity
+  // is a w coth(kH) cos(theta) k/|k|: <eta (u, v)> points along the propagation.
+  // cos^2s((theta - theta0)/2) spreading is symmetric about theta0.
+  SeaParams p;
+  p.model = SeaModel::spectral;
+  p.dims = 2;
+  p.size = {400.0, 400.0};
+  p.cells = {128, 128};
+  p.depth = 30.0;
+  p.waves.kind = WaveKind::jonswap;
+  p.waves.hs = 1.5;
+  p.waves.tp = 6.0;
+  p.waves.direction = 30.0;
+  p.waves.spreading = 10.0;
+  auto sea = make_sea(p, 21);
+  const auto eta = sea->elevation();
+  std::vector<double> u(sea->field(Field::velocity_x).begin(), sea->field(Field::velocity_x).end());
+  const auto v = sea->field(Field::velocity_y);
+  double mx = 0.0, my = 0.0;
+  for (std::size_t i = 0; i < eta.size(); ++i) {
+    mx += eta[i] * u[i];
+    my += eta[i] * v[i];
+  }
+  const double mean = std::atan2(my, mx) * 180.0 / pi;
+  MESSAGE("mean direction " << mean << " degrees (requested 30)");
+  CHECK(mean == doctest::Approx(30.0).epsilon(0.05));
 }
 
 TEST_CASE("bad [sea] input is an InputError that names the key") {
