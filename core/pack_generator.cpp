@@ -124,30 +124,35 @@ void power_cells(const std::vector<Vec2>& sites, const std::vector<double>& weig
     input.emplace_back(Regular::Weighted_point(Regular::Bare_point(sites[i].x(), sites[i].y()), weights[i]), i);
   Regular rt(input.begin(), input.end());
 
+  // Adjacency in compressed rows: neighbours of i are adj[start[i] .. start[i+1]).
   std::vector<std::pair<std::size_t, std::size_t>> edges;
-  edges.reserve(6 * n);
-  for (auto e = rt.finite_edges_begin(); e != rt.finite_edges_end(); ++e) {
-    const std::size_t a = e->first->vertex(Regular::cw(e->second))->info();
-    const std::size_t b = e->first->vertex(Regular::ccw(e->second))->info();
-    edges.emplace_back(a, b);
-    edges.emplace_back(b, a);
-  }
-  std::sort(edges.begin(), edges.end());
+  edges.reserve(3 * n);
+  for (auto e = rt.finite_edges_begin(); e != rt.finite_edges_end(); ++e)
+    edges.emplace_back(e->first->vertex(Regular::cw(e->second))->info(),
+                       e->first->vertex(Regular::ccw(e->second))->info());
+  std::vector<std::size_t> start(n + 1, 0), adj(2 * edges.size());
+  for (const auto& [a, b] : edges) ++start[a + 1], ++start[b + 1];
+  for (std::size_t i = 0; i < n; ++i) start[i + 1] += start[i];
+  std::vector<std::size_t> next(start.begin(), start.end() - 1);
+  for (const auto& [a, b] : edges) adj[next[a]++] = b, adj[next[b]++] = a;
+  // CGAL's edge order can depend on memory addresses (it differs between two
+  // calls in one process); the clipping order sets the last bits of the cell
+  // vertices, so fix it: neighbours by index.
+  for (std::size_t i = 0; i < n; ++i)
+    std::sort(adj.begin() + static_cast<std::ptrdiff_t>(start[i]), adj.begin() + static_cast<std::ptrdiff_t>(start[i + 1]));
   std::vector<char> present(n, 0);
   for (auto v = rt.finite_vertices_begin(); v != rt.finite_vertices_end(); ++v) present[v->info()] = 1;
 
   cells.resize(n);
   std::vector<Vec2> scratch_v;
   std::vector<std::ptrdiff_t> scratch_owner;
-  auto e = edges.begin();
   for (std::size_t i = 0; i < n; ++i) {
     Cell& cell = cells[i];
     cell.v.assign({{0.0, 0.0}, {W, 0.0}, {W, H}, {0.0, H}});
     cell.owner.assign(4, -1);
     if (!present[i]) cell.v.clear(), cell.owner.clear();
-    for (; e != edges.end() && e->first == i; ++e) {
-      if (cell.v.empty()) continue;
-      const std::size_t j = e->second;
+    for (std::size_t e = start[i]; e < start[i + 1] && !cell.v.empty(); ++e) {
+      const std::size_t j = adj[e];
       const Vec2 normal = 2.0 * (sites[j] - sites[i]);
       const double c = sites[j].squaredNorm() - sites[i].squaredNorm() + weights[i] - weights[j];
       clip(cell, normal, c, static_cast<std::ptrdiff_t>(j), scratch_v, scratch_owner);

@@ -62,18 +62,37 @@ double distance(const Polygon& a, const Polygon& b) {
   return d;
 }
 
-// All pairs (walls among themselves excepted): disjoint, and the smallest gap.
+// Every pair (walls among themselves excepted) whose x-extents come within the
+// smallest gap found so far: disjoint, and the smallest gap. Pairs farther
+// apart in x cannot be closer, so the result is the exact minimum.
 double check_disjoint(const GeneratedPack& pack) {
   const auto polys = world_polygons(pack.floes);
+  std::vector<std::size_t> order(polys.size());
+  std::iota(order.begin(), order.end(), 0);
+  auto xmin = [&](std::size_t i) {
+    double x = polys[i][0].x();
+    for (const Vec2& p : polys[i]) x = std::min(x, p.x());
+    return x;
+  };
+  auto xmax = [&](std::size_t i) {
+    double x = polys[i][0].x();
+    for (const Vec2& p : polys[i]) x = std::max(x, p.x());
+    return x;
+  };
+  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return xmin(a) < xmin(b); });
   double smallest = std::numeric_limits<double>::infinity();
   int overlaps = 0;
-  for (std::size_t i = 0; i < polys.size(); ++i)
-    for (std::size_t j = i + 1; j < polys.size(); ++j) {
+  std::size_t pairs = 0;
+  for (std::size_t a = 0; a < order.size(); ++a)
+    for (std::size_t b = a + 1; b < order.size() && xmin(order[b]) <= xmax(order[a]) + smallest; ++b) {
+      const std::size_t i = order[a], j = order[b];
       if (pack.floes.is_static[i] && pack.floes.is_static[j]) continue;
+      ++pairs;
       if (separation(polys[i], polys[j]) <= 0.0) ++overlaps;
       else smallest = std::min(smallest, distance(polys[i], polys[j]));
     }
   CHECK(overlaps == 0);
+  CHECK(pairs >= polys.size() - 1);  // the sweep looked at neighbours at least
   return smallest;
 }
 
@@ -129,6 +148,17 @@ double fit_power_law(const std::vector<double>& d, double a, double b) {
 }
 
 }  // namespace
+
+TEST_CASE("pack test helpers: separation and distance of two squares") {
+  const Polygon a{{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+  const Polygon b{{1.25, 0.5}, {2, 0.5}, {2, 2}, {1.25, 2}};  // 0.25 to the right
+  const Polygon c{{0.9, 0.9}, {2, 0.9}, {2, 2}, {0.9, 2}};    // overlaps a's corner
+  const Polygon d{{1, 0}, {2, 0}, {2, 1}, {1, 1}};            // touches a along x = 1
+  CHECK(separation(a, b) == doctest::Approx(0.25));
+  CHECK(distance(a, b) == doctest::Approx(0.25));
+  CHECK(separation(a, c) < 0.0);
+  CHECK(separation(a, d) <= 0.0);
+}
 
 TEST_CASE("pack: floes valid, inside the box, disjoint with the requested gap") {
   PackOptions o;
