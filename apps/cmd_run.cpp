@@ -97,10 +97,14 @@ void add_run_command(CLI::App& app, Registry& registry) {
     RunSummary s;
     try {
       s = run_simulation(sim, options);
-    } catch (...) {
+    } catch (const RunError&) {
       progress.done();
       std::signal(SIGINT, previous);
       std::cerr << "floesim: the run file " << output << " keeps every record written before the failure\n";
+      throw;
+    } catch (...) {
+      progress.done();
+      std::signal(SIGINT, previous);
       throw;
     }
     progress.done();

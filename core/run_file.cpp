@@ -166,7 +166,7 @@ void RunWriter::Impl::write_xdmf() const {
   const std::string sn = std::to_string(n), sv = std::to_string(nverts), sT = std::to_string(T);
   o << "<?xml version=\"1.0\" ?>\n<Xdmf Version=\"3.0\">\n<Domain>\n";
   o << "<Grid Name=\"floes\" GridType=\"Collection\" CollectionType=\"Temporal\">\n";
-  for (std::size_t k = 0; k < T; ++k) {
+  for (std::size_t k = 0; k < T && n > 0; ++k) {
     const std::string sk = std::to_string(k);
     o << "<Grid Name=\"floes_" << k << "\" GridType=\"Uniform\"><Time Value=\"" << times[k] << "\"/>\n";
     o << "<Topology TopologyType=\"Mixed\" NumberOfElements=\"" << n << "\">"

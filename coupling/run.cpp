@@ -18,14 +18,14 @@ RunSummary run_simulation(Simulation& sim, const RunOptions& options) {
   summary.output = options.output;
   summary.energy_first = sim.energies();
   summary.warnings = sim.scenario().notes;
-  RunWriter writer(options.output, sim.floes(), resolved_toml(cfg), summary.energy_first.names);
+  RunWriter writer(options.output, sim.floes(), resolved_toml(cfg), summary.energy_first.names, sim.sea_grid());
   summary.xdmf = writer.xdmf_path();
 
   const LcpCounters no_lcp;  // collisions arrive with the contact layer
   auto record = [&] {
     PhaseTimer _(sim.profile(), Phase::record);
     const Energies e = sim.energies();
-    writer.record(sim.time(), sim.floes(), e.values, no_lcp);
+    writer.record(sim.time(), sim.floes(), e.values, no_lcp, sim.sea_elevation());
   };
   auto wall = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); };
 

@@ -1,6 +1,7 @@
 #include "coupling/scenario.hpp"
 
 #include "core/error.hpp"
+#include "fluid/sea.hpp"
 
 namespace floesim {
 
@@ -22,9 +23,11 @@ Scenario build_scenario(const Config& config) {
   if (reoriented)
     s.notes.push_back(std::to_string(reoriented) + " floe outline(s) given clockwise were reoriented "
                       "counter-clockwise");
-  if (config.sea.model != SeaModel::none)
-    throw InputError(where(config.file, 0, "[sea] model",
-                           "the sea models are not available in this build yet; use model = \"none\""));
+  try {
+    fluid::validate(config.sea);  // names the [sea] key; add the file
+  } catch (const InputError& e) {
+    throw InputError(config.file + ": " + e.what());
+  }
   return s;
 }
 

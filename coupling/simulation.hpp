@@ -3,7 +3,7 @@
 // model grows, the sea) by one step; the step reads as a table of contents,
 // one named and timed phase per line (MODEL.md §5):
 //
-//   choose dt -> sample forcing -> drift (drag, Coriolis) -> check state
+//   choose dt -> sample forcing -> sea flow -> drift (drag, Coriolis) -> check state
 //
 // Step contract: on entry the state is at time(); step(t_stop) advances it to
 // time() + dt with 0 < dt <= min(dt_max, t_stop - time()) and returns dt.
@@ -11,17 +11,22 @@
 
 #include <array>
 #include <chrono>
+#include <memory>
+#include <span>
 #include <string>
 #include <vector>
 
 #include "coupling/drift.hpp"
+#include "core/run_file.hpp"
 #include "coupling/scenario.hpp"
 
 namespace floesim {
 
-enum class Phase { choose_dt, forcing, drift, check, record, count };
+namespace fluid { class Sea; }
+
+enum class Phase { choose_dt, forcing, sea, drift, check, record, count };
 inline constexpr std::array<const char*, static_cast<std::size_t>(Phase::count)> kPhaseNames = {
-    "choose_dt", "forcing", "drift", "check", "record"};
+    "choose_dt", "forcing", "sea", "drift", "check", "record"};
 
 // Wall time spent in each phase (s), for `floesim run --profile`.
 struct Profile {
@@ -47,6 +52,8 @@ struct Energies {
 class Simulation {
 public:
   explicit Simulation(Scenario scenario);
+  ~Simulation();
+  Simulation(Simulation&&) noexcept;
 
   double step(double t_stop);
 
@@ -58,13 +65,20 @@ public:
   Profile& profile() { return profile_; }
   Energies energies() const;
 
+  // The sea surface, if the run has one ([sea] model != "none").
+  bool has_sea() const { return sea_ != nullptr; }
+  SeaGridInfo sea_grid() const;
+  std::span<const double> sea_elevation();  // on the grid, x fastest; empty without a sea
+
 private:
   StepContext choose_dt(double t_stop) const;
   void sample_forcing(StepContext& ctx) const;
+  void sea_flow(const StepContext& ctx);
   void drift(const StepContext& ctx);
   void check_state(const StepContext& ctx) const;
 
   Scenario scenario_;
+  std::unique_ptr<fluid::Sea> sea_;
   DriftParams drift_params_;
   FootprintQuadrature quadrature_;
   Profile profile_;

@@ -136,7 +136,13 @@ void write_bytes(hid_t loc, const std::string& name, const std::vector<hsize_t>&
 Handle create_extendible(hid_t loc, const std::string& name, const std::vector<hsize_t>& row) {
   std::vector<hsize_t> d{0}, maxd{H5S_UNLIMITED}, chunk{1};
   std::size_t row_size = 1;
-  for (hsize_t r : row) { d.push_back(r); maxd.push_back(r); chunk.push_back(r); row_size *= r; }
+  for (hsize_t r : row) {
+    // An empty dimension (a run without floes) cannot be chunked as fixed-size.
+    d.push_back(r);
+    maxd.push_back(r ? r : H5S_UNLIMITED);
+    chunk.push_back(r ? r : 1);
+    row_size *= r ? r : 1;
+  }
   // Aim for chunks of about 64 KiB: several rows per chunk when rows are small.
   chunk[0] = std::max<hsize_t>(1, 8192 / std::max<std::size_t>(row_size, 1));
   Handle space{H5Screate_simple(static_cast<int>(d.size()), d.data(), maxd.data()), H5Sclose};

@@ -125,4 +125,30 @@ TEST_CASE("a numerical failure marks the run file failed and keeps the records")
   CHECK(info.records == 1);
 }
 
+TEST_CASE("a wave-only run writes the sea elevation and keeps the sea's energy") {
+  // Free linear waves: the modal flow is exact, so the sea energy is conserved to round-off;
+  // a progressive wave has equal kinetic and potential energy, each rho g a^2 / 4 per unit area.
+  const std::string out = (fs::temp_directory_path() / "floesim_waves.h5").string();
+  const std::string text =
+      "[run]\nt_end = 20\ndt_max = 0.1\noutput_interval = 1\n"
+      "[sea]\nmodel = \"spectral\"\ndims = 2\nsize = [200.0, 100.0]\ncells = [64, 32]\ndepth = 40.0\n"
+      "[sea.waves]\nkind = \"regular\"\namplitude = 0.25\nwavelength = 20.0\n";
+  Simulation sim(build_scenario(parse_config(text, "waves.toml", ".")));
+  REQUIRE(sim.has_sea());
+  const RunSummary s = run_simulation(sim, {out, -1.0, {}, {}});
+  CHECK(s.steps == 200);
+  const Energies& a = s.energy_first;
+  const Energies& b = s.energy_last;
+  REQUIRE(a.names == std::vector<std::string>{"floes_horizontal_kinetic", "sea_kinetic", "sea_potential", "total"});
+  const double per_part = 1025.0 * 9.81 * 0.25 * 0.25 / 4.0 * 200.0 * 100.0;
+  CHECK(a.values[2] == doctest::Approx(per_part).epsilon(1e-3));
+  CHECK(a.values[1] == doctest::Approx(a.values[2]).epsilon(1e-3));
+  CHECK(b.values[3] == doctest::Approx(a.values[3]).epsilon(1e-10));
+  const RunInfo info = read_run_info(out);
+  bool has_eta = false;
+  for (const auto& [path, shape] : info.datasets)
+    if (path == "/sea/eta") has_eta = shape == std::vector<unsigned long long>{21, 32, 64};
+  CHECK(has_eta);
+}
+
 TEST_SUITE_END();
