@@ -85,7 +85,7 @@ struct GeneratedPack {
   std::size_t walls = 0;            // static floes at the end of `floes`
   double concentration = 0.0;       // achieved: floe area (walls excluded) / W H
   double min_gap = 0.0;             // m, smallest distance between two floes (exact;
-                                    // wall–wall pairs excluded), or to the box sides
+                                    // wall–wall pairs excluded; inf for a lone floe)
   double required_gap = 0.0;        // m, the min_gap that was enforced
   double mean_size = 0.0;           // m, mean equivalent diameter
   std::array<double, 2> size_range{};  // m, [a, b] of the size law after scaling

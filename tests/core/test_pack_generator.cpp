@@ -147,6 +147,14 @@ double fit_power_law(const std::vector<double>& d, double a, double b) {
   return 0.5 * (lo + hi);
 }
 
+PackOptions options(std::size_t floes, double concentration, std::uint64_t seed) {
+  PackOptions o;
+  o.floes = floes;
+  o.concentration = concentration;
+  o.seed = seed;
+  return o;
+}
+
 }  // namespace
 
 TEST_CASE("pack test helpers: separation and distance of two squares") {
@@ -161,12 +169,9 @@ TEST_CASE("pack test helpers: separation and distance of two squares") {
 }
 
 TEST_CASE("pack: floes valid, inside the box, disjoint with the requested gap") {
-  PackOptions o;
-  o.floes = 300;
-  o.concentration = 0.7;
+  PackOptions o = options(300, 0.7, 7);
   o.width = 1000.0;
   o.height = 600.0;
-  o.seed = 7;
   o.thickness_min = 0.5;
   o.thickness_max = 2.0;
   const GeneratedPack pack = generate_pack(o);
@@ -189,10 +194,7 @@ TEST_CASE("pack: floes valid, inside the box, disjoint with the requested gap") 
 TEST_CASE("pack: achieved concentration within 2% of the target") {
   for (double c : {0.1, 0.3, 0.5, 0.7, 0.9, 0.95}) {
     CAPTURE(c);
-    PackOptions o;
-    o.floes = 200;
-    o.concentration = c;
-    o.seed = 3;
+    PackOptions o = options(200, c, 3);
     o.width = 500.0;
     o.height = 800.0;
     const GeneratedPack pack = generate_pack(o);
@@ -205,10 +207,7 @@ TEST_CASE("pack: achieved concentration within 2% of the target") {
 }
 
 TEST_CASE("pack: the same seed gives the same pack, another seed another") {
-  PackOptions o;
-  o.floes = 150;
-  o.concentration = 0.6;
-  o.seed = 11;
+  PackOptions o = options(150, 0.6, 11);
   o.sizes.kind = SizeDistribution::Kind::power_law;
   o.sizes.exponent = 2.0;
   o.thickness_max = 3.0;
@@ -228,11 +227,8 @@ TEST_CASE("pack: the same seed gives the same pack, another seed another") {
 TEST_CASE("pack: power-law sizes recover the requested exponent") {
   for (double alpha : {1.5, 2.5}) {
     CAPTURE(alpha);
-    PackOptions o;
-    o.floes = 3000;
-    o.concentration = 0.6;
+    PackOptions o = options(3000, 0.6, 5);
     o.width = o.height = 10000.0;
-    o.seed = 5;
     o.sizes.kind = SizeDistribution::Kind::power_law;
     o.sizes.exponent = alpha;
     o.sizes.min_size = 10.0;
@@ -254,10 +250,7 @@ TEST_CASE("pack: power-law sizes recover the requested exponent") {
 }
 
 TEST_CASE("pack: uniform law with equal sizes gives equal floe areas") {
-  PackOptions o;
-  o.floes = 400;
-  o.concentration = 0.8;
-  o.seed = 9;
+  PackOptions o = options(400, 0.8, 9);
   const GeneratedPack pack = generate_pack(o);
   const auto [lo, hi] = std::minmax_element(pack.floes.area.begin(), pack.floes.area.end());
   CHECK(*hi / *lo == doctest::Approx(1.0).epsilon(1e-6));
@@ -265,10 +258,7 @@ TEST_CASE("pack: uniform law with equal sizes gives equal floe areas") {
 }
 
 TEST_CASE("pack: static walls around the box keep the gap") {
-  PackOptions o;
-  o.floes = 100;
-  o.concentration = 0.85;
-  o.seed = 2;
+  PackOptions o = options(100, 0.85, 2);
   o.wall_width = 20.0;
   const GeneratedPack pack = generate_pack(o);
   REQUIRE(pack.floes.size() == 104);
@@ -280,10 +270,7 @@ TEST_CASE("pack: static walls around the box keep the gap") {
 }
 
 TEST_CASE("pack: a larger requested gap is honoured, an impossible one refused") {
-  PackOptions o;
-  o.floes = 200;
-  o.concentration = 0.5;
-  o.seed = 4;
+  PackOptions o = options(200, 0.5, 4);
   o.min_gap = 2.0;  // m; mean size ~ 56 m
   GeneratedPack pack = generate_pack(o);
   CHECK(pack.required_gap == 2.0);
@@ -334,10 +321,7 @@ TEST_CASE("pack: bad options are refused with the option named") {
 }
 
 TEST_CASE("pack: write_pack / read_pack round trip") {
-  PackOptions o;
-  o.floes = 50;
-  o.concentration = 0.6;
-  o.seed = 8;
+  PackOptions o = options(50, 0.6, 8);
   o.wall_width = 5.0;
   const GeneratedPack pack = generate_pack(o);
   const auto path = (std::filesystem::temp_directory_path() / "floesim_test_pack_generator.h5").string();
