@@ -53,7 +53,7 @@ public:
   std::span<const double> gain() const { return gain_; }
 
   // Exact free evolution over dt (any sign). The rotation coefficients are
-  // cached for the last dt: a change of dt costs one sin/cos per mode.
+  // cached for the last dt: a change of dt costs one sin/cos per distinct omega.
   void flow(double dt);
   // v += h * gain * s, s laid out like v.
   void kick(std::span<const double> s, double h);
