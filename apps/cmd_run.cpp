@@ -120,6 +120,10 @@ void add_run_command(CLI::App& app, Registry& registry) {
     for (std::size_t k = 0; k < s.energy_last.names.size(); ++k)
       o << "energy." << s.energy_last.names[k] << ": " << s.energy_first.values[k] << " -> "
         << s.energy_last.values[k] << " J\n";
+    const contact::CollisionStats& c = s.collisions;
+    o << "collisions.lcps: " << c.lcps << "\ncollisions.contacts: " << c.contacts << "\ncollisions.pivots: " << c.pivots
+      << "\ncollisions.largest_lcp: " << c.largest << "\ncollisions.failures: " << c.failures
+      << "\ncollisions.fallbacks: " << c.fallbacks << "\n";
     o << "warnings: " << s.warnings.size() << "\n";
     for (const auto& w : s.warnings) o << "  " << w << "\n";
     if (args->profile) {

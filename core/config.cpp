@@ -283,6 +283,16 @@ void read_contact(Section s, ContactParams& c) {
   c.collision_distance = s.number("collision_distance", c.collision_distance, positive, "a distance > 0 (m)");
   c.restitution = s.number("restitution", c.restitution, unit_interval, "a restitution in [0, 1]");
   c.friction = s.number("friction", c.friction, non_negative, "a friction coefficient >= 0");
+  const std::string domain = s.string("domain", "open");
+  if (domain != "open" && domain != "periodic") s.fail("domain", "expected \"open\" or \"periodic\", got \"" + domain + "\"");
+  c.periodic = domain == "periodic";
+  if (s.has("box")) {
+    auto b = s.numbers("box", 4, "[xmin, xmax, ymin, ymax] (m)");
+    if (!(b[1] > b[0] && b[3] > b[2])) s.fail("box", "expected xmin < xmax and ymin < ymax");
+    c.box = {b[0], b[1], b[2], b[3]};
+  } else {
+    s.node("box");
+  }
   s.finish();
 }
 
@@ -432,7 +442,10 @@ std::string resolved_toml(const Config& c) {
   if (!floe_list.empty()) floes.insert("floe", floe_list);
 
   toml::table contact{{"collision_distance", c.contact.collision_distance},
-                      {"restitution", c.contact.restitution}, {"friction", c.contact.friction}};
+                      {"restitution", c.contact.restitution}, {"friction", c.contact.friction},
+                      {"domain", c.contact.periodic ? "periodic" : "open"}};
+  if (c.contact.box[1] > c.contact.box[0])
+    contact.insert("box", toml::array{c.contact.box[0], c.contact.box[1], c.contact.box[2], c.contact.box[3]});
   toml::table coupling{{"law", name_of<PenaltyLaw>(c.coupling.law, {{"strong", PenaltyLaw::strong},
                                                                    {"weak", PenaltyLaw::weak},
                                                                    {"blend", PenaltyLaw::blend}})},

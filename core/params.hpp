@@ -51,6 +51,8 @@ struct ContactParams {
   double collision_distance = 0.01;  // m
   double restitution = 0.4;          // Poisson restitution e in [0, 1]
   double friction = 0.7;             // Coulomb mu >= 0
+  bool periodic = false;             // a torus made from `box`
+  std::array<double, 4> box = {0.0, 0.0, 0.0, 0.0};  // xmin, xmax, ymin, ymax (m); empty: the pack's window
 };
 
 enum class PenaltyLaw { strong, weak, blend };

@@ -84,8 +84,8 @@ DragLoad drag_load(const Floes& floes, const FootprintQuadrature& q, std::size_t
   return load;
 }
 
-void drift_step(Floes& floes, const FootprintQuadrature& q, const DriftParams& p,
-                const Vec2& current, const Vec2& wind, double dt, std::size_t begin, std::size_t end) {
+void drift_velocities(Floes& floes, const FootprintQuadrature& q, const DriftParams& p,
+                      const Vec2& current, const Vec2& wind, double dt, std::size_t begin, std::size_t end) {
   for (std::size_t i = begin; i < end; ++i) {
     if (floes.is_static[i]) continue;
     FloeState& s = floes.state[i];
@@ -105,6 +105,13 @@ void drift_step(Floes& floes, const FootprintQuadrature& q, const DriftParams& p
     s.vx += dW.x();
     s.vy += dW.y();
     s.yaw_rate += dW.z();
+  }
+}
+
+void advance_positions(Floes& floes, double dt, std::size_t begin, std::size_t end) {
+  for (std::size_t i = begin; i < end; ++i) {
+    if (floes.is_static[i]) continue;
+    FloeState& s = floes.state[i];
     s.x += dt * s.vx;
     s.y += dt * s.vy;
     s.yaw += dt * s.yaw_rate;

@@ -61,8 +61,13 @@ DragLoad drag_load(const Floes& floes, const FootprintQuadrature& q, std::size_t
                    const DriftParams& p, const Vec2& current, const Vec2& wind,
                    std::span<const Vec2> water = {});
 
-// Advances floes [begin, end) over dt as stated above. Static floes do not move.
-void drift_step(Floes& floes, const FootprintQuadrature& q, const DriftParams& p,
-                const Vec2& current, const Vec2& wind, double dt, std::size_t begin, std::size_t end);
+// Velocities W_n -> W_{n+1} of floes [begin, end) over dt as stated above
+// (positions are moved separately, after collisions, by advance_positions).
+// Static floes do not move.
+void drift_velocities(Floes& floes, const FootprintQuadrature& q, const DriftParams& p,
+                      const Vec2& current, const Vec2& wind, double dt, std::size_t begin, std::size_t end);
+
+// x_{n+1} = x_n + dt W for floes [begin, end).
+void advance_positions(Floes& floes, double dt, std::size_t begin, std::size_t end);
 
 }  // namespace floesim

@@ -21,11 +21,10 @@ RunSummary run_simulation(Simulation& sim, const RunOptions& options) {
   RunWriter writer(options.output, sim.floes(), resolved_toml(cfg), summary.energy_first.names, sim.sea_grid());
   summary.xdmf = writer.xdmf_path();
 
-  const LcpCounters no_lcp;  // collisions arrive with the contact layer
   auto record = [&] {
     PhaseTimer _(sim.profile(), Phase::record);
     const Energies e = sim.energies();
-    writer.record(sim.time(), sim.floes(), e.values, no_lcp, sim.sea_elevation());
+    writer.record(sim.time(), sim.floes(), e.values, sim.lcp_counters(), sim.sea_elevation());
   };
   auto wall = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); };
 
@@ -62,6 +61,8 @@ RunSummary run_simulation(Simulation& sim, const RunOptions& options) {
   summary.wall_seconds = wall();
   summary.energy_last = sim.energies();
   summary.profile = sim.profile();
+  for (const std::string& w : sim.warnings()) summary.warnings.push_back(w);
+  summary.collisions = sim.collision_stats();
   return summary;
 }
 

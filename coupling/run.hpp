@@ -31,6 +31,7 @@ struct RunSummary {
   Energies energy_first, energy_last;
   std::vector<std::string> warnings;
   Profile profile;
+  contact::CollisionStats collisions;
 };
 
 // Throws RunError when the numerics fail; the run file then says

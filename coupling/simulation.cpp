@@ -4,16 +4,51 @@
 #include <cmath>
 #include <sstream>
 
+#include "contact/step_limit.hpp"
 #include "core/error.hpp"
 #include "fluid/sea.hpp"
 
 namespace floesim {
+
+namespace {
+// Steps are never cut below this fraction of dt_max by the collision limit;
+// when the limit asks for less, the step is taken at the floor and counted.
+constexpr double kFloorFraction = 1e-6;
+// A step that overlaps is halved at most this many times before the run fails.
+constexpr int kMaxHalvings = 40;
+
+contact::Domain make_domain(const Scenario& s) {
+  contact::Domain d;
+  const ContactParams& c = s.config.contact;
+  if (!c.periodic) return d;
+  std::array<double, 4> box = c.box;
+  if (!(box[1] > box[0]) && s.window) box = *s.window;
+  if (!(box[1] > box[0] && box[3] > box[2]))
+    throw InputError(where(s.config.file, 0, "[contact] box",
+                           "a periodic domain needs a box = [xmin, xmax, ymin, ymax] (or a pack with a window)"));
+  d.periodic = true;
+  d.xmin = box[0]; d.xmax = box[1]; d.ymin = box[2]; d.ymax = box[3];
+  return d;
+}
+}  // namespace
 
 Simulation::Simulation(Scenario scenario) : scenario_(std::move(scenario)) {
   const Config& c = scenario_.config;
   drift_params_ = DriftParams{c.sea.rho, c.forcing.ocean_drag, c.forcing.air_density, c.forcing.air_drag,
                               c.forcing.coriolis};
   quadrature_ = build_footprint_quadrature(scenario_.floes);
+  shapes_ = contact::build_collision_shapes(scenario_.floes);
+  detection_options_.collision_distance = c.contact.collision_distance;
+  detection_options_.domain = make_domain(scenario_);
+  impulse_options_.restitution = c.contact.restitution;
+  impulse_options_.friction = c.contact.friction;
+  wrap_periodic();
+  detection_options_.search_margin = c.contact.collision_distance;
+  detection_ = contact::detect(scenario_.floes, shapes_, detection_options_);
+  for (const contact::NearPair& p : detection_.pairs)
+    if (p.overlap)
+      throw InputError(where(c.file, 0, "", "floes " + std::to_string(p.a) + " and " + std::to_string(p.b) +
+                                                " overlap at t = 0 (floes are numbered from 0: pack floes first, then inline ones)"));
   sea_ = fluid::make_sea(c.sea, c.run.seed);
 }
 
@@ -23,9 +58,14 @@ Simulation::Simulation(Simulation&&) noexcept = default;
 double Simulation::step(double t_stop) {
   StepContext ctx;
   { PhaseTimer _(profile_, Phase::choose_dt); ctx = choose_dt(t_stop); }
-  { PhaseTimer _(profile_, Phase::forcing);   sample_forcing(ctx); }
+  for (bool accepted = false; !accepted;) {
+    { PhaseTimer _(profile_, Phase::forcing); sample_forcing(ctx); }
+    { PhaseTimer _(profile_, Phase::drift);   drift(ctx); }
+    { PhaseTimer _(profile_, Phase::collide); collide(ctx); }
+    { PhaseTimer _(profile_, Phase::advance); advance(ctx); }
+    { PhaseTimer _(profile_, Phase::detect);  accepted = detect_and_check(ctx); }
+  }
   { PhaseTimer _(profile_, Phase::sea);       sea_flow(ctx); }
-  { PhaseTimer _(profile_, Phase::drift);     drift(ctx); }
   { PhaseTimer _(profile_, Phase::check);     check_state(ctx); }
   // Land exactly on t_stop when the step was cut to reach it.
   t_ = ctx.dt == t_stop - ctx.t ? t_stop : ctx.t + ctx.dt;
@@ -33,7 +73,7 @@ double Simulation::step(double t_stop) {
   return ctx.dt;
 }
 
-StepContext Simulation::choose_dt(double t_stop) const {
+StepContext Simulation::choose_dt(double t_stop) {
   StepContext ctx;
   ctx.t = t_;
   const double remaining = t_stop - t_;
@@ -45,6 +85,20 @@ StepContext Simulation::choose_dt(double t_stop) const {
   else if (remaining < 1.5 * dt_max) ctx.dt = 0.5 * remaining;
   else ctx.dt = dt_max;
   if (!(ctx.dt > 0.0)) throw RunError("step requested with no time left (t = " + std::to_string(t_) + ")");
+  // Event-driven limit from the near pairs (contact/step_limit.hpp).
+  const contact::StepLimit limit = contact::collision_step_limit(
+      scenario_.floes, shapes_, detection_.pairs, detection_options_.collision_distance);
+  if (limit.dt < ctx.dt) {
+    const double floor = kFloorFraction * dt_max;
+    if (limit.dt < floor) {
+      ++floor_steps_;
+      std::ostringstream m;
+      m << "floes " << limit.a << " and " << limit.b << " at distance " << limit.distance << " m, t = " << t_ << " s";
+      floor_pair_ = m.str();
+    }
+    ctx.dt = std::max(limit.dt, std::min(floor, ctx.dt));
+  }
+  ctx.start = scenario_.floes.state;
   return ctx;
 }
 
@@ -54,16 +108,61 @@ void Simulation::sample_forcing(StepContext& ctx) const {
   ctx.forcing = scenario_.forcing.at(ctx.t + 0.5 * ctx.dt);
 }
 
+void Simulation::drift(const StepContext& ctx) {
+  const Vec2 current{ctx.forcing.current[0], ctx.forcing.current[1]};
+  const Vec2 wind{ctx.forcing.wind[0], ctx.forcing.wind[1]};
+  drift_velocities(scenario_.floes, quadrature_, drift_params_, current, wind, ctx.dt, 0, scenario_.floes.size());
+}
+
+void Simulation::collide(const StepContext&) {
+  // Contacts were found at the positions of the start of the step; the LCPs
+  // turn W(t-) into W(t+) (contact/impulse.hpp).
+  contact::resolve_collisions(scenario_.floes, detection_.contacts, impulse_options_, stats_);
+}
+
+void Simulation::advance(const StepContext& ctx) {
+  advance_positions(scenario_.floes, ctx.dt, 0, scenario_.floes.size());
+  wrap_periodic();
+}
+
+bool Simulation::detect_and_check(StepContext& ctx) {
+  // Search far enough to see every pair that could meet within the next step.
+  double vmax = 0.0;
+  for (std::size_t i = 0; i < scenario_.floes.size(); ++i) {
+    const FloeState& s = scenario_.floes.state[i];
+    vmax = std::max(vmax, std::hypot(s.vx, s.vy) + std::abs(s.yaw_rate) * shapes_.radius[i]);
+  }
+  detection_options_.search_margin =
+      std::max(detection_options_.collision_distance, 2.0 * vmax * scenario_.config.run.dt_max);
+  contact::Detection next = contact::detect(scenario_.floes, shapes_, detection_options_);
+  for (const contact::NearPair& p : next.pairs) {
+    if (!p.overlap) continue;
+    // Redo the step with half the time.
+    ++rejected_steps_;
+    scenario_.floes.state = ctx.start;
+    ctx.dt *= 0.5;
+    if (ctx.dt < kFloorFraction * scenario_.config.run.dt_max * std::pow(0.5, kMaxHalvings / 2))
+      throw RunError("floes " + std::to_string(p.a) + " and " + std::to_string(p.b) +
+                     " overlap however short the step from t = " + std::to_string(ctx.t) + " s");
+    return false;
+  }
+  detection_ = std::move(next);
+  return true;
+}
+
+void Simulation::wrap_periodic() {
+  const contact::Domain& d = detection_options_.domain;
+  if (!d.periodic) return;
+  for (FloeState& s : scenario_.floes.state) {
+    s.x = d.xmin + std::fmod(std::fmod(s.x - d.xmin, d.width()) + d.width(), d.width());
+    s.y = d.ymin + std::fmod(std::fmod(s.y - d.ymin, d.height()) + d.height(), d.height());
+  }
+}
+
 void Simulation::sea_flow(const StepContext& ctx) {
   // Free evolution, exact per mode. Floe pressures (half kicks around this
   // flow, MODEL.md §5) arrive with the floe–sea coupling.
   if (sea_) sea_->flow(ctx.dt);
-}
-
-void Simulation::drift(const StepContext& ctx) {
-  const Vec2 current{ctx.forcing.current[0], ctx.forcing.current[1]};
-  const Vec2 wind{ctx.forcing.wind[0], ctx.forcing.wind[1]};
-  drift_step(scenario_.floes, quadrature_, drift_params_, current, wind, ctx.dt, 0, scenario_.floes.size());
 }
 
 void Simulation::check_state(const StepContext& ctx) const {
@@ -99,6 +198,24 @@ Energies Simulation::energies() const {
   e.names.push_back("total");
   e.values.push_back(total);
   return e;
+}
+
+LcpCounters Simulation::lcp_counters() const {
+  return {static_cast<double>(stats_.lcps), static_cast<double>(stats_.pivots),
+          static_cast<double>(stats_.failures), static_cast<double>(stats_.fallbacks)};
+}
+
+std::vector<std::string> Simulation::warnings() const {
+  std::vector<std::string> w;
+  if (floor_steps_)
+    w.push_back(std::to_string(floor_steps_) + " step(s) were held at the floor " +
+                std::to_string(kFloorFraction) + " dt_max although the collision limit asked for less (last: " +
+                floor_pair_ + ")");
+  if (stats_.failures)
+    w.push_back(std::to_string(stats_.failures) + " collision LCP(s) failed; those floes kept their velocities");
+  if (stats_.flagged)
+    w.push_back(std::to_string(stats_.flagged) + " collision LCP(s) were answered by projected Gauss–Seidel (approximate)");
+  return w;
 }
 
 SeaGridInfo Simulation::sea_grid() const {

@@ -3,10 +3,15 @@
 // model grows, the sea) by one step; the step reads as a table of contents,
 // one named and timed phase per line (MODEL.md §5):
 //
-//   choose dt -> sample forcing -> sea flow -> drift (drag, Coriolis) -> check state
+//   choose dt (output schedule, dt_max, collision limit)
+//   -> sample forcing -> drift velocities (drag, Coriolis) -> collide (LCPs)
+//   -> advance positions -> detect (new contacts; an overlap rejects the step,
+//      which is redone with half the dt) -> sea flow -> check state
 //
-// Step contract: on entry the state is at time(); step(t_stop) advances it to
-// time() + dt with 0 < dt <= min(dt_max, t_stop - time()) and returns dt.
+// Step contract: on entry the state is at time() and the contact detection
+// matches the positions; step(t_stop) advances both to time() + dt with
+// 0 < dt <= min(dt_max, t_stop - time()) and returns dt. At the end of every
+// step no two floes overlap (or the step throws RunError naming the pair).
 // Units: SI; the state layout is FloeState (core/floes.hpp).
 
 #include <array>
@@ -17,6 +22,9 @@
 #include <vector>
 
 #include "coupling/drift.hpp"
+#include "contact/detection.hpp"
+#include "contact/impulse.hpp"
+#include "contact/shapes.hpp"
 #include "core/run_file.hpp"
 #include "coupling/scenario.hpp"
 
@@ -24,9 +32,9 @@ namespace floesim {
 
 namespace fluid { class Sea; }
 
-enum class Phase { choose_dt, forcing, sea, drift, check, record, count };
+enum class Phase { choose_dt, forcing, drift, collide, advance, detect, sea, check, record, count };
 inline constexpr std::array<const char*, static_cast<std::size_t>(Phase::count)> kPhaseNames = {
-    "choose_dt", "forcing", "sea", "drift", "check", "record"};
+    "choose_dt", "forcing", "drift", "collide", "advance", "detect", "sea", "check", "record"};
 
 // Wall time spent in each phase (s), for `floesim run --profile`.
 struct Profile {
@@ -40,6 +48,7 @@ struct StepContext {
   double t = 0.0;      // s, time at the start of the step
   double dt = 0.0;     // s
   ForcingSample forcing;
+  std::vector<FloeState> start;  // the floes at t, to redo a rejected step
 };
 
 // Energies by part (J), named as the columns of /diagnostics/energy; the last
@@ -65,22 +74,40 @@ public:
   Profile& profile() { return profile_; }
   Energies energies() const;
 
+  const contact::CollisionStats& collision_stats() const { return stats_; }
+  LcpCounters lcp_counters() const;
+  const contact::Detection& detection() const { return detection_; }
+  // Things a user should hear about once, with a count (e.g. steps cut to the floor).
+  std::vector<std::string> warnings() const;
+
   // The sea surface, if the run has one ([sea] model != "none").
   bool has_sea() const { return sea_ != nullptr; }
   SeaGridInfo sea_grid() const;
   std::span<const double> sea_elevation();  // on the grid, x fastest; empty without a sea
 
 private:
-  StepContext choose_dt(double t_stop) const;
+  StepContext choose_dt(double t_stop);
   void sample_forcing(StepContext& ctx) const;
   void sea_flow(const StepContext& ctx);
   void drift(const StepContext& ctx);
+  void collide(const StepContext& ctx);
+  void advance(const StepContext& ctx);
+  bool detect_and_check(StepContext& ctx);  // false: the step overlapped, dt halved
+  void wrap_periodic();
   void check_state(const StepContext& ctx) const;
 
   Scenario scenario_;
   std::unique_ptr<fluid::Sea> sea_;
   DriftParams drift_params_;
   FootprintQuadrature quadrature_;
+  contact::CollisionShapes shapes_;
+  contact::DetectionOptions detection_options_;
+  contact::ImpulseOptions impulse_options_;
+  contact::Detection detection_;  // at the present positions
+  contact::CollisionStats stats_;
+  long floor_steps_ = 0;          // steps the collision limit wanted below the floor
+  long rejected_steps_ = 0;       // steps redone after an overlap
+  std::string floor_pair_;        // the last pair that did it
   Profile profile_;
   double t_ = 0.0;
   std::size_t steps_ = 0;
