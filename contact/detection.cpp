@@ -49,26 +49,35 @@ Vec2 closest_on_boundary(std::span<const Vec2> poly, const Vec2& x) {
   return best;
 }
 
-// Separating axis test for convex CCW polygons: true if some edge of a or b
-// has the whole other polygon strictly outside.
-bool separated(std::span<const Vec2> a, std::span<const Vec2> b) {
-  auto outside = [](std::span<const Vec2> p, std::span<const Vec2> q) {
+// Largest separation of two convex CCW polygons along the outward normals of
+// their edges: > 0 means disjoint, and then it is a lower bound on their
+// distance; `normal` is that axis oriented from a towards b.
+struct Separation {
+  double gap = -std::numeric_limits<double>::infinity();
+  Vec2 normal = Vec2::UnitX();
+};
+Separation separation(std::span<const Vec2> a, std::span<const Vec2> b) {
+  Separation best;
+  auto scan = [&](std::span<const Vec2> p, std::span<const Vec2> q, double sign) {
     for (std::size_t i = 0; i < p.size(); ++i) {
       const Vec2& v = p[i];
       const Vec2 e = p[(i + 1) % p.size()] - v;
-      const Vec2 n{e.y(), -e.x()};  // outward for counter-clockwise p
+      const double len = e.norm();
+      if (len == 0.0) continue;
+      const Vec2 n{e.y() / len, -e.x() / len};  // outward for counter-clockwise p
       double m = std::numeric_limits<double>::infinity();
       for (const Vec2& x : q) m = std::min(m, n.dot(x - v));
-      if (m > 0.0) return true;
+      if (m > best.gap) { best.gap = m; best.normal = sign * n; }
     }
-    return false;
   };
-  return outside(a, b) || outside(b, a);
+  scan(a, b, 1.0);
+  scan(b, a, -1.0);
+  return best;
 }
 
 ConvexDistance distance_of(std::span<const Vec2> a, std::span<const Vec2> b) {
   ConvexDistance r;
-  if (!separated(a, b)) {
+  if (!(separation(a, b).gap > 0.0)) {
     r.overlap = true;
     r.pa = r.pb = a[0];
     return r;
@@ -107,7 +116,7 @@ Detection detect(const Floes& floes, const CollisionShapes& shapes, const Detect
   // World vertices of every part, same layout as shapes.vertices.
   std::vector<Vec2> world(shapes.vertices.size());
   std::vector<Box> part_box(shapes.vertex_offsets.size() - 1);
-  std::vector<Box> floe_box(n);
+  std::vector<Box> floe_box(n);  // padded by half the search margin
   for (std::size_t i = 0; i < n; ++i) {
     const FloeState& s = floes.state[i];
     const double c = std::cos(s.yaw), sn = std::sin(s.yaw);
@@ -183,8 +192,26 @@ Detection detect(const Floes& floes, const CollisionShapes& shapes, const Detect
 
   // Narrow phase.
   std::vector<Vec2> shifted;
+  const double pad = 0.5 * opt.search_margin;
   for (const Candidate& c : candidates) {
-    NearPair pair{c.a, c.b, c.shift, std::numeric_limits<double>::infinity(), Vec2::Zero(), Vec2::Zero(), false};
+    NearPair pair;
+    pair.a = c.a;
+    pair.b = c.b;
+    pair.shift = c.shift;
+    // Box gap (unpadded boxes): a cheap lower bound for pairs well apart.
+    const Box& A0 = floe_box[c.a];
+    const Box& B0 = floe_box[c.b];
+    const double gaps[4] = {B0.xmin + c.shift.x() - A0.xmax + 2 * pad, A0.xmin - B0.xmax - c.shift.x() + 2 * pad,
+                            B0.ymin + c.shift.y() - A0.ymax + 2 * pad, A0.ymin - B0.ymax - c.shift.y() + 2 * pad};
+    const Vec2 axes[4] = {Vec2::UnitX(), -Vec2::UnitX(), Vec2::UnitY(), -Vec2::UnitY()};
+    const int widest = static_cast<int>(std::max_element(gaps, gaps + 4) - gaps);
+    if (gaps[widest] > xi) {
+      pair.distance = gaps[widest];
+      pair.normal = axes[widest];
+      out.pairs.push_back(pair);
+      continue;
+    }
+    pair.distance = std::numeric_limits<double>::infinity();
     const std::size_t first_contact = out.contacts.size();
     for (std::size_t pa = shapes.part_offsets[c.a]; pa < shapes.part_offsets[c.a + 1]; ++pa) {
       const std::span<const Vec2> A{world.data() + shapes.vertex_offsets[pa],
@@ -196,9 +223,26 @@ Detection detect(const Floes& floes, const CollisionShapes& shapes, const Detect
         shifted.clear();
         for (std::size_t k = shapes.vertex_offsets[pb]; k < shapes.vertex_offsets[pb + 1]; ++k)
           shifted.push_back(world[k] + c.shift);
+        // Parts separated by more than xi along an edge normal: that separation
+        // is a lower bound (no contact points to find).
+        const Separation sep = separation(A, shifted);
+        if (sep.gap > xi) {
+          if (sep.gap < pair.distance) {
+            pair.distance = sep.gap;
+            pair.normal = sep.normal;
+            pair.exact = false;
+          }
+          continue;
+        }
         const ConvexDistance dist = distance_of(A, shifted);
         if (dist.overlap) pair.overlap = true;
-        if (dist.distance < pair.distance) { pair.distance = dist.distance; pair.pa = dist.pa; pair.pb = dist.pb; }
+        if (dist.distance < pair.distance) {
+          pair.distance = dist.distance;
+          pair.pa = dist.pa;
+          pair.pb = dist.pb;
+          pair.exact = true;
+          if (dist.distance > 0.0) pair.normal = (dist.pb - dist.pa) / dist.distance;
+        }
         if (dist.overlap || dist.distance >= xi) continue;
         // Contact points: vertices of one part within xi of the other part.
         auto add = [&](const Vec2& v, const Vec2& q, bool from_a) {

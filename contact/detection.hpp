@@ -6,7 +6,9 @@
 // domain a floe whose box crosses the domain's edge is also entered shifted by
 // the period, so pairs across the seam are found with the shift to apply.
 //
-// Narrow phase, per candidate pair and per pair of convex parts:
+// Pairs whose (unpadded) boxes are more than xi apart get the box gap as a
+// lower bound on their distance. Closer pairs get the narrow phase, per pair of
+// convex parts:
 //   * separation test (separating axes of both parts); overlapping parts give
 //     distance 0 and `overlap = true`;
 //   * distance = min over the vertices of each part of the distance to the
@@ -43,8 +45,14 @@ struct DetectionOptions {
 struct NearPair {
   std::uint32_t a = 0, b = 0;  // floe indices, a < b
   Vec2 shift = Vec2::Zero();   // periodic shift added to floe b's positions
-  double distance = 0.0;       // m, between the two floes (0 if they overlap)
-  Vec2 pa = Vec2::Zero(), pb = Vec2::Zero();  // closest points (world; pb shifted)
+  // Distance between the floes (0 if they overlap). When `exact` is false it is
+  // a lower bound: the gap between their bounding boxes along `normal` (pairs
+  // whose boxes are further apart than the collision distance are not measured
+  // in detail).
+  double distance = 0.0;       // m
+  Vec2 normal = Vec2::UnitX(); // unit, from a towards b: the gap closes at -normal . (V_b - V_a)
+  Vec2 pa = Vec2::Zero(), pb = Vec2::Zero();  // closest points when exact (world; pb shifted)
+  bool exact = false;
   bool overlap = false;
 };
 

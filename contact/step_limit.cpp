@@ -12,7 +12,7 @@ StepLimit collision_step_limit(const Floes& floes, const CollisionShapes& shapes
     const FloeState &a = floes.state[p.a], &b = floes.state[p.b];
     const double d = p.distance;
     if (!(d > 0.0)) continue;
-    const Vec2 n = (p.pb - p.pa) / d;
+    const Vec2& n = p.normal;
     const double approach = -n.dot(Vec2{b.vx - a.vx, b.vy - a.vy});
     const double s = std::max(0.0, approach) + std::abs(a.yaw_rate) * shapes.radius[p.a] +
                      std::abs(b.yaw_rate) * shapes.radius[p.b];

@@ -6,6 +6,8 @@
 // between them is a convex function of t (the distance from a point moving on
 // a line to a fixed convex set — their Minkowski difference — is convex), so
 // d(t) >= d(0) + t n.(V_b - V_a), n the unit vector between the closest points.
+// The same bound holds for the separation of the two floes along any fixed axis
+// n, which is how pairs far apart are handled (their box gap, detection.hpp).
 // Rotation moves a point at radius r from its centroid by at most |omega| r t.
 // Hence, with R_a, R_b the floes' radii,
 //   d(t) >= d(0) - t s,   s = max(0, -n.(V_b - V_a)) + |omega_a| R_a + |omega_b| R_b,

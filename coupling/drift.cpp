@@ -54,29 +54,39 @@ DragLoad drag_load(const Floes& floes, const FootprintQuadrature& q, std::size_t
   const FloeState& s = floes.state[i];
   const double cw = floes.ocean_drag[i] >= 0.0 ? floes.ocean_drag[i] : p.ocean_drag;
   const double k = p.rho_water * cw;
-  const Vec2 V{s.vx, s.vy};
   const double c = std::cos(s.yaw), sn = std::sin(s.yaw);
   const std::size_t begin = q.offsets[i], end = q.offsets[i + 1];
+  // Force, torque and the six entries of the symmetric Jacobian, accumulated as
+  // scalars: with B = [I | kr], B^T (|u| I + u u^T/|u|) B = |u| B^T B + (B^T u)(B^T u)^T / |u|,
+  // B^T B = [[1, 0, kr_x], [0, 1, kr_y], [kr_x, kr_y, |r|^2]], B^T u = (u_x, u_y, kr . u).
+  double fx = 0, fy = 0, tz = 0;
+  double j00 = 0, j01 = 0, j02 = 0, j11 = 0, j12 = 0, j22 = 0;
   for (std::size_t j = begin; j < end; ++j) {
     const Vec2& b = q.point[j];
-    const Vec2 r{c * b.x() - sn * b.y(), sn * b.x() + c * b.y()};
-    const Vec2 kr{-r.y(), r.x()};  // k x r
+    const double rx = c * b.x() - sn * b.y(), ry = sn * b.x() + c * b.y();
+    const double krx = -ry, kry = rx;  // k x r
     const Vec2 U = water.empty() ? current : water[j - begin];
-    const Vec2 u = U - (V + s.yaw_rate * kr);
-    const double un = u.norm();
+    const double ux = U.x() - (s.vx + s.yaw_rate * krx);
+    const double uy = U.y() - (s.vy + s.yaw_rate * kry);
+    const double un = std::sqrt(ux * ux + uy * uy);
     const double w = q.weight[j] * k;
-    const Vec2 tau = w * un * u;
-    load.force.x() += tau.x();
-    load.force.y() += tau.y();
-    load.force.z() += kr.dot(tau);
-    // A = |u| I + u u^T/|u|  (derivative of |u| u), B = [I | kr].
+    const double tx = w * un * ux, ty = w * un * uy;
+    fx += tx;
+    fy += ty;
+    tz += krx * tx + kry * ty;
     if (un > 0.0) {
-      Eigen::Matrix2d A = un * Eigen::Matrix2d::Identity() + (u * u.transpose()) / un;
-      Eigen::Matrix<double, 2, 3> B;
-      B << 1.0, 0.0, kr.x(), 0.0, 1.0, kr.y();
-      load.jacobian.noalias() -= w * B.transpose() * A * B;
+      const double a0 = ux, a1 = uy, a2 = krx * ux + kry * uy;  // B^T u
+      const double wu = w * un, wi = w / un;
+      j00 += wu + wi * a0 * a0;
+      j01 += wi * a0 * a1;
+      j02 += wu * krx + wi * a0 * a2;
+      j11 += wu + wi * a1 * a1;
+      j12 += wu * kry + wi * a1 * a2;
+      j22 += wu * (rx * rx + ry * ry) + wi * a2 * a2;
     }
   }
+  load.force << fx, fy, tz;
+  load.jacobian << -j00, -j01, -j02, -j01, -j11, -j12, -j02, -j12, -j22;
   // Air drag: uniform stress over the footprint, no torque about G.
   const Vec2 ta = p.rho_air * p.air_drag * wind.norm() * wind * floes.area[i];
   load.force.x() += ta.x();

@@ -22,7 +22,8 @@
 //
 // The footprint integrals use a fixed quadrature in the body frame: the fan
 // triangles (G, v_i, v_{i+1}) (signed, so exact for non-convex floes),
-// each split into 4^level sub-triangles with the 6-point degree-4 rule.
+// each split into 4^level sub-triangles (level 0 by default: the fan
+// triangles themselves) with the 6-point degree-4 rule.
 
 #include <span>
 #include <vector>
@@ -48,7 +49,7 @@ struct FootprintQuadrature {
     return {point.data() + offsets[i], offsets[i + 1] - offsets[i]};
   }
 };
-FootprintQuadrature build_footprint_quadrature(const Floes& floes, int level = 1);
+FootprintQuadrature build_footprint_quadrature(const Floes& floes, int level = 0);
 
 // Force and Jacobian of ocean + air drag on floe i (world frame, about G).
 struct DragLoad {
