@@ -1,0 +1,453 @@
+// floesim_bench_collisions: the collision time loop (coupling/simulation.hpp:
+// drift, contact LCPs, advance, detection, step limit) on named scenarios.
+//
+//   floedyn_100  FloeDyn's own example (examples/floedyn_100.toml: its 100
+//                floes, Topaz forcing, constants) to 10^4 s.
+//   pack_N       N = 500, 2000, 10000 floes from generate_pack: 50% cover,
+//                equivalent diameters uniform in [a, 3a] with mean 100 m (the
+//                box side is 130.4 sqrt(N) m so the cover holds), thickness
+//                uniform in [0.5, 2] m, each floe started with a random
+//                velocity (speed uniform in [0, 0.1] m/s, random direction);
+//                periodic box, wind 10 m/s along x, Coriolis at 80.2 N,
+//                FloeDyn's constants (restitution 0.4, friction 0.7,
+//                collision distance 0.01 m, dt_max 10 s, rho_w 1024.071,
+//                C_w 5e-3, C_a 1.7e-3, rho_a 1.341), to 10^3 s. The pack is
+//                written once to a temporary pack file and read through the
+//                [floes] pack key, like a user's run.
+//
+// Per scenario: a warm-up run (to 10% of the simulated time), then R timed
+// runs (each a fresh Simulation; the minimum wall time is kept, the median is
+// shown); the steps follow `floesim run` (steps land on the output times) but
+// nothing is written. Peak memory is measured in a separate process (this
+// binary re-executed with --child NAME) that runs the scenario once:
+// ru_maxrss from wait4, so pack generation and the timing runs do not count.
+// A scenario that throws, or runs past --time-limit, is reported with its
+// status and the simulated time it reached.
+//
+// Usage: floesim_bench_collisions [--repeats R] [--repeats-large R] [--only NAME...]
+//                                 [--csv FILE] [--time-limit S] [--note TEXT...] [--pack-dir DIR]
+// To profile one scenario: run once with --pack-dir DIR --only NAME, then
+//   perf record -g floesim_bench_collisions --child NAME --pack-dir DIR
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <ctime>
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <numbers>
+#include <random>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+
+#include "core/config.hpp"
+#include "core/error.hpp"
+#include "core/pack.hpp"
+#include "core/pack_generator.hpp"
+#include "coupling/scenario.hpp"
+#include "coupling/simulation.hpp"
+
+using namespace floesim;
+namespace fs = std::filesystem;
+
+namespace {
+
+struct BenchScenario {
+  std::string name;
+  std::size_t floes = 0;      // 0: FloeDyn's example
+  double t_end = 0.0;         // s simulated
+  double floedyn_s = -1.0;    // FloeDyn, one core of this machine kind (issue 4); < 0: unknown
+};
+
+const std::vector<BenchScenario> kScenarios = {
+    {"floedyn_100", 0, 1.0e4, 13.8},
+    {"pack_500", 500, 1.0e3, 24.6},
+    {"pack_2000", 2000, 1.0e3, 204.0},
+    {"pack_10000", 10000, 1.0e3, -1.0},
+};
+
+constexpr double kMeanDiameter = 100.0;  // m
+constexpr double kSizeRatio = 3.0;       // d ~ U[a, 3a]
+constexpr double kConcentration = 0.5;
+
+std::string pack_file(const std::string& dir, const BenchScenario& s) { return dir + "/" + s.name + ".h5"; }
+
+// Box side for N floes of mean diameter 100 m at 50% cover: for d ~ U[a, r a],
+// E[d^2] = a^2 (r^3 - 1) / (3 (r - 1)), with a = 2 mean / (1 + r).
+double box_side(std::size_t n) {
+  const double a = 2.0 * kMeanDiameter / (1.0 + kSizeRatio);
+  const double mean_d2 = a * a * (std::pow(kSizeRatio, 3) - 1.0) / (3.0 * (kSizeRatio - 1.0));
+  const double mean_area = std::numbers::pi / 4.0 * mean_d2;
+  return std::sqrt(static_cast<double>(n) * mean_area / kConcentration);
+}
+
+// Generates the pack of a pack_N scenario and writes it; returns a one-line description.
+std::string write_scenario_pack(const BenchScenario& s, const std::string& dir) {
+  PackOptions o;
+  o.floes = s.floes;
+  o.concentration = kConcentration;
+  o.width = o.height = box_side(s.floes);
+  o.seed = 1;
+  o.sizes.kind = SizeDistribution::Kind::uniform;
+  o.sizes.min_size = 1.0;
+  o.sizes.max_size = kSizeRatio;
+  o.thickness_min = 0.5;
+  o.thickness_max = 2.0;
+  GeneratedPack pack = generate_pack(o);
+  std::mt19937_64 rng(2);
+  for (FloeState& st : pack.floes.state) {
+    // Own mapping to [0, 1) (53 high bits), like the pack generator, so the
+    // velocities do not depend on the standard library.
+    const double u1 = static_cast<double>(rng() >> 11) * 0x1.0p-53;
+    const double u2 = static_cast<double>(rng() >> 11) * 0x1.0p-53;
+    const double speed = 0.1 * u1, dir_rad = 2.0 * std::numbers::pi * u2;
+    st.vx = speed * std::cos(dir_rad);
+    st.vy = speed * std::sin(dir_rad);
+  }
+  write_pack(pack_file(dir, s), pack.floes, pack.window);
+  std::ostringstream m;
+  m << s.name << ": box " << o.width << " m, mean diameter " << pack.mean_size << " m, cover "
+    << pack.concentration << ", min gap " << pack.min_gap << " m";
+  return m.str();
+}
+
+Config scenario_config(const BenchScenario& s, const std::string& pack_dir) {
+  if (s.floes == 0) return load_config(std::string(FLOESIM_BENCH_SOURCE_DIR) + "/examples/floedyn_100.toml");
+  std::ostringstream t;
+  t << "[run]\nt_end = " << s.t_end << "\ndt_max = 10.0\noutput_interval = 60.0\n"
+    << "[sea]\nmodel = \"none\"\nrho = 1024.071\n"
+    << "[floes]\npack = \"" << pack_file(pack_dir, s) << "\"\ndensity = 917.0\n"
+    << "[contact]\ncollision_distance = 0.01\nrestitution = 0.4\nfriction = 0.7\ndomain = \"periodic\"\n"
+    << "[forcing]\nwind = [10.0, 0.0]\ncoriolis = 1.4370225e-4\nocean_drag = 5.0e-3\n"
+    << "air_drag = 1.7e-3\nair_density = 1.341\n";
+  return parse_config(t.str(), s.name, pack_dir);
+}
+
+struct RunResult {
+  std::string status = "ok";
+  std::size_t floes = 0;
+  double simulated = 0.0;  // s reached
+  double wall = 0.0;       // s: Simulation construction + steps
+  double setup = 0.0;      // s: Simulation construction (shapes, quadrature, first detection)
+  std::size_t steps = 0;
+  contact::CollisionStats stats;
+  Profile profile;
+  std::vector<std::string> warnings;
+};
+
+struct TimeLimitReached {};
+
+double seconds_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+// One run to t_end, stepping to the output times as `floesim run` does, with no output.
+RunResult run_once(const Config& config, double t_end, double time_limit) {
+  RunResult r;
+  Scenario scenario = build_scenario(config);  // reads the files: not timed
+  r.floes = scenario.floes.size();
+  const auto t0 = std::chrono::steady_clock::now();
+  try {
+    Simulation sim(std::move(scenario));
+    r.setup = seconds_since(t0);
+    const double interval = config.run.output_interval;
+    try {
+      for (std::size_t next = 1; sim.time() < t_end; ++next) {
+        double t_record = std::min(static_cast<double>(next) * interval, t_end);
+        if (t_end - t_record < 1e-9 * std::max(1.0, t_end)) t_record = t_end;
+        while (sim.time() < t_record) {
+          sim.step(t_record);
+          if (seconds_since(t0) > time_limit) throw TimeLimitReached{};
+        }
+      }
+    } catch (const TimeLimitReached&) {
+      std::ostringstream m;
+      m << "timeout: " << time_limit << " s wall reached at t = " << sim.time() << " s";
+      r.status = m.str();
+    } catch (const RunError& e) {
+      r.status = std::string("RunError: ") + e.what();
+    } catch (const std::exception& e) {
+      r.status = std::string("exception: ") + e.what();
+    }
+    r.wall = seconds_since(t0);
+    r.simulated = sim.time();
+    r.steps = sim.steps();
+    r.stats = sim.collision_stats();
+    r.profile = sim.profile();
+    r.warnings = sim.warnings();
+  } catch (const std::exception& e) {  // construction (e.g. floes overlapping at t = 0)
+    r.status = std::string("setup failed: ") + e.what();
+    r.wall = seconds_since(t0);
+  }
+  return r;
+}
+
+// Runs this binary with --child NAME; returns its peak resident set (MiB) from
+// wait4, or -1 when it could not run or failed.
+double child_peak_rss_mb(const std::vector<std::string>& args) {
+  std::vector<char*> argv;
+  for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+  argv.push_back(nullptr);
+  std::fflush(stdout);
+  const pid_t pid = fork();
+  if (pid < 0) return -1.0;
+  if (pid == 0) {
+    execv("/proc/self/exe", argv.data());
+    _exit(127);
+  }
+  int status = 0;
+  rusage usage{};
+  if (wait4(pid, &status, 0, &usage) != pid) return -1.0;
+  if (!WIFEXITED(status) || WEXITSTATUS(status) == 127) return -1.0;
+  return static_cast<double>(usage.ru_maxrss) / 1024.0;  // ru_maxrss is in KiB on Linux
+}
+
+std::string csv_field(const std::string& s) {
+  if (s.find_first_of(",\"\n") == std::string::npos) return s;
+  std::string q = "\"";
+  for (char c : s) q += c == '"' ? std::string("\"\"") : std::string(1, c);
+  return q + "\"";
+}
+
+std::string machine_line() {
+  std::ifstream cpu("/proc/cpuinfo");
+  std::string line, model = "unknown cpu";
+  while (std::getline(cpu, line))
+    if (line.rfind("model name", 0) == 0) {
+      model = line.substr(line.find(':') + 2);
+      break;
+    }
+  double load[3] = {0, 0, 0};
+  if (getloadavg(load, 3) != 3) load[0] = load[1] = load[2] = -1;
+  char date[32];
+  const std::time_t now = std::time(nullptr);
+  std::strftime(date, sizeof date, "%Y-%m-%d %H:%M", std::localtime(&now));
+  std::ostringstream m;
+  m << model << ", " << sysconf(_SC_NPROCESSORS_ONLN) << " cores (shared); load before: " << load[0] << " "
+    << load[1] << " " << load[2] << "; g++ " << __VERSION__ << "; " << date;
+  return m.str();
+}
+
+struct Row {
+  const BenchScenario* scenario = nullptr;
+  RunResult best;
+  int repeats = 0;
+  double wall_median = 0.0;
+  double peak_rss_mb = -1.0;
+};
+
+// Least-squares slope of log y against log x.
+double loglog_slope(const std::vector<double>& x, const std::vector<double>& y) {
+  const double n = static_cast<double>(x.size());
+  double sx = 0, sy = 0, sxx = 0, sxy = 0;
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    const double lx = std::log(x[i]), ly = std::log(y[i]);
+    sx += lx; sy += ly; sxx += lx * lx; sxy += lx * ly;
+  }
+  return (n * sxy - sx * sy) / (n * sxx - sx * sx);
+}
+
+const BenchScenario* find_scenario(const std::string& name) {
+  for (const BenchScenario& s : kScenarios)
+    if (s.name == name) return &s;
+  return nullptr;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"floesim collision benchmarks (named scenarios; CSV with --csv)"};
+  int repeats = 3, repeats_large = 1;
+  double time_limit = 600.0;
+  std::vector<std::string> only, notes;
+  std::string csv, child, pack_dir_arg;
+  app.add_option("--repeats", repeats, "timed runs per scenario after the warm-up (minimum kept)")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--repeats-large", repeats_large, "timed runs for scenarios of 10^4 floes or more")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--only", only, "scenarios to run (default: all)");
+  app.add_option("--csv", csv, "write the results as CSV to this file");
+  app.add_option("--time-limit", time_limit, "wall seconds after which a run is stopped and reported");
+  app.add_option("--note", notes, "extra comment lines for the CSV header");
+  app.add_option("--child", child, "internal: run one scenario once (peak memory)");
+  app.add_option("--pack-dir", pack_dir_arg, "keep the generated packs in this folder (default: a temporary one)");
+  CLI11_PARSE(app, argc, argv);
+
+  if (child == "none") return 0;  // the baseline: a process that only starts
+  if (!child.empty()) {
+    const BenchScenario* s = find_scenario(child);
+    if (!s) return 3;
+    const RunResult r = run_once(scenario_config(*s, pack_dir_arg), s->t_end, time_limit);
+    return r.status == "ok" ? 0 : 2;
+  }
+
+  for (const std::string& name : only)
+    if (!find_scenario(name)) {
+      std::fprintf(stderr, "unknown scenario %s\n", name.c_str());
+      return 1;
+    }
+  std::string command;
+  for (int i = 0; i < argc; ++i) command += (i ? " " : "") + std::string(argv[i]);
+  const std::string machine = machine_line();
+
+  // The packs go to a temporary folder, removed at the end, unless --pack-dir
+  // names one to keep them (e.g. to profile a single `--child NAME` run).
+  std::string pack_dir = pack_dir_arg;
+  if (pack_dir.empty()) {
+    char tmpl[] = "/tmp/floesim_bench_collisions_XXXXXX";
+    if (!mkdtemp(tmpl)) {
+      std::perror("mkdtemp");
+      return 1;
+    }
+    pack_dir = tmpl;
+  } else {
+    fs::create_directories(pack_dir);
+    pack_dir = fs::absolute(pack_dir).string();
+  }
+  const std::string self = fs::read_symlink("/proc/self/exe").string();
+  const double base_rss = child_peak_rss_mb({self, "--child", "none"});
+  std::printf("# machine: %s\n# process baseline (start and exit, no scenario): %.1f MiB\n", machine.c_str(),
+              base_rss);
+
+  std::vector<Row> rows;
+  for (const BenchScenario& s : kScenarios) {
+    if (!only.empty() && std::find(only.begin(), only.end(), s.name) == only.end()) continue;
+    if (s.floes > 0) {
+      const auto t0 = std::chrono::steady_clock::now();
+      const std::string d = write_scenario_pack(s, pack_dir);
+      std::printf("# %s (generated and written in %.2f s)\n", d.c_str(), seconds_since(t0));
+    }
+    const Config config = scenario_config(s, pack_dir);
+    Row row;
+    row.scenario = &s;
+    row.repeats = s.floes >= 10000 ? repeats_large : repeats;
+    const RunResult warm = run_once(config, 0.1 * s.t_end, time_limit);
+    std::vector<double> walls;
+    if (warm.status != "ok") {
+      row.best = warm;  // failed already in the warm-up: report that
+      row.repeats = 0;
+    } else {
+      for (int k = 0; k < row.repeats; ++k) {
+        RunResult r = run_once(config, s.t_end, time_limit);
+        walls.push_back(r.wall);
+        const bool better = k == 0 || (r.status == "ok" && (row.best.status != "ok" || r.wall < row.best.wall));
+        if (better) row.best = std::move(r);
+        if (row.best.status != "ok") break;  // do not repeat a failure or a timeout
+      }
+      std::sort(walls.begin(), walls.end());
+      row.wall_median = walls[walls.size() / 2];
+    }
+    row.peak_rss_mb = child_peak_rss_mb({self, "--child", s.name, "--pack-dir", pack_dir, "--time-limit",
+                                         std::to_string(time_limit)});
+    const RunResult& b = row.best;
+    std::printf("# %s: %s, %zu floes, t = %g s, wall %.3f s (min of %d), %zu steps, %ld LCPs, peak %.1f MiB\n",
+                s.name.c_str(), b.status.c_str(), b.floes, b.simulated, b.wall, row.repeats, b.steps, b.stats.lcps,
+                row.peak_rss_mb);
+    for (const std::string& w : b.warnings) std::printf("#   warning: %s\n", w.c_str());
+    std::fflush(stdout);
+    rows.push_back(std::move(row));
+  }
+  if (pack_dir_arg.empty()) fs::remove_all(pack_dir);
+
+  // Table and CSV.
+  std::ostringstream out;
+  out << "scenario,status,floes,simulated_s,repeats,wall_s,wall_s_median,setup_s,steps,lcps,pivots,failures,"
+         "fallbacks,contacts,largest_lcp,peak_rss_mb,floedyn_s,speedup";
+  for (const char* p : kPhaseNames) out << "," << p << "_s";
+  out << "\n";
+  for (const Row& row : rows) {
+    const RunResult& b = row.best;
+    char buf[512];
+    std::snprintf(buf, sizeof buf, "%s,%s,%zu,%g,%d,%.3f,%.3f,%.4f,%zu,%ld,%ld,%ld,%ld,%ld,%ld,%.1f,", row.scenario->name.c_str(),
+                  csv_field(b.status).c_str(), b.floes, b.simulated, row.repeats, b.wall, row.wall_median, b.setup,
+                  b.steps, b.stats.lcps, b.stats.pivots, b.stats.failures, b.stats.fallbacks, b.stats.contacts,
+                  b.stats.largest, row.peak_rss_mb);
+    out << buf;
+    if (row.scenario->floedyn_s > 0 && b.status == "ok") {
+      std::snprintf(buf, sizeof buf, "%.1f,%.1f", row.scenario->floedyn_s, row.scenario->floedyn_s / b.wall);
+      out << buf;
+    } else if (row.scenario->floedyn_s > 0) {
+      std::snprintf(buf, sizeof buf, "%.1f,", row.scenario->floedyn_s);
+      out << buf;
+    } else {
+      out << ",";
+    }
+    for (double sec : b.profile.seconds) {
+      std::snprintf(buf, sizeof buf, ",%.4f", sec);
+      out << buf;
+    }
+    out << "\n";
+  }
+
+  std::printf("\n%-12s %-8s %6s %8s %9s %7s %7s %9s %5s %8s %8s  %s\n", "scenario", "status", "floes", "sim_s",
+              "wall_s", "steps", "lcps", "pivots", "fail", "rss_MiB", "speedup", "top phases (s)");
+  for (const Row& row : rows) {
+    const RunResult& b = row.best;
+    std::vector<std::size_t> order(b.profile.seconds.size());
+    for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+    std::sort(order.begin(), order.end(),
+              [&](std::size_t i, std::size_t j) { return b.profile.seconds[i] > b.profile.seconds[j]; });
+    std::string phases;
+    for (std::size_t k = 0; k < 3; ++k) {
+      char buf[64];
+      std::snprintf(buf, sizeof buf, "%s%s %.3f", k ? ", " : "", kPhaseNames[order[k]], b.profile.seconds[order[k]]);
+      phases += buf;
+    }
+    char speed[32] = "-";
+    if (row.scenario->floedyn_s > 0 && b.status == "ok")
+      std::snprintf(speed, sizeof speed, "%.1fx", row.scenario->floedyn_s / b.wall);
+    std::printf("%-12s %-8s %6zu %8g %9.3f %7zu %7ld %9ld %5ld %8.1f %8s  %s\n", row.scenario->name.c_str(),
+                b.status == "ok" ? "ok" : "FAILED", b.floes, b.simulated, b.wall, b.steps, b.stats.lcps,
+                b.stats.pivots, b.stats.failures, row.peak_rss_mb, speed, phases.c_str());
+    if (b.status != "ok") std::printf("%-12s   %s\n", "", b.status.c_str());
+  }
+
+  // Scaling of the cost per simulated second with N, from the pack cases that completed.
+  std::vector<double> n, cost;
+  for (const Row& row : rows)
+    if (row.scenario->floes > 0 && row.best.status == "ok" && row.best.simulated > 0) {
+      n.push_back(static_cast<double>(row.best.floes));
+      cost.push_back(row.best.wall / row.best.simulated);
+    }
+  std::ostringstream scaling;
+  if (n.size() >= 2) {
+    scaling << "cost per simulated second ~ N^" << std::setprecision(3) << loglog_slope(n, cost) << " (least squares over";
+    for (double v : n) scaling << " " << v;
+    scaling << " floes; pairwise:";
+    for (std::size_t i = 1; i < n.size(); ++i)
+      scaling << " " << n[i - 1] << "->" << n[i] << " N^" << std::log(cost[i] / cost[i - 1]) / std::log(n[i] / n[i - 1]);
+    scaling << "; target <= 1.1)";
+  } else {
+    scaling << "cost scaling: fewer than two completed pack scenarios";
+  }
+  std::printf("\n%s\n", scaling.str().c_str());
+
+  if (!csv.empty()) {
+    std::ofstream f(csv);
+    f << "# command: " << command << "\n# machine: " << machine << "\n";
+    for (const std::string& note : notes) f << "# " << note << "\n";
+    f << "# wall_s: minimum over `repeats` runs after a warm-up run to 10% of simulated_s (Simulation construction + "
+         "steps, no output); phases from Simulation::profile() of that run\n"
+      << "# peak_rss_mb: MiB, ru_maxrss of a separate process running the scenario once (baseline of a process "
+         "that only starts: "
+      << std::fixed << std::setprecision(1) << base_rss << " MiB)\n"
+      << "# floedyn_s: FloeDyn on one core of this machine kind (issue 4); speedup = floedyn_s / wall_s\n"
+      << "# " << scaling.str() << "\n"
+      << out.str();
+    if (!f) {
+      std::fprintf(stderr, "cannot write %s\n", csv.c_str());
+      return 1;
+    }
+    std::printf("wrote %s\n", csv.c_str());
+  }
+  return 0;
+}
