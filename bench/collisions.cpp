@@ -421,10 +421,11 @@ int main(int argc, char** argv) {
   std::ostringstream scaling;
   if (n.size() >= 2) {
     scaling << "cost per simulated second ~ N^" << std::setprecision(3) << loglog_slope(n, cost) << " (least squares over";
-    for (double v : n) scaling << " " << v;
+    for (double v : n) scaling << " " << static_cast<long>(v);
     scaling << " floes; pairwise:";
     for (std::size_t i = 1; i < n.size(); ++i)
-      scaling << " " << n[i - 1] << "->" << n[i] << " N^" << std::log(cost[i] / cost[i - 1]) / std::log(n[i] / n[i - 1]);
+      scaling << " " << static_cast<long>(n[i - 1]) << "->" << static_cast<long>(n[i]) << " N^"
+              << std::log(cost[i] / cost[i - 1]) / std::log(n[i] / n[i - 1]);
     scaling << "; target <= 1.1)";
   } else {
     scaling << "cost scaling: fewer than two completed pack scenarios";
