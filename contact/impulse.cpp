@@ -94,9 +94,15 @@ std::vector<ContactImpulse> resolve_collisions(Floes& floes, const std::vector<C
       if (r.fb >= 0) s += r.gb.dot(v.segment<3>(3 * r.fb));
       return s;
     };
+    // Normal velocity each contact must reach (>= 0 plus the gap stabilisation).
+    std::vector<double> target(m, 0.0);
+    for (std::size_t k = 0; k < m; ++k) {
+      const double g = contacts[list[k]].gap;
+      if (g < opt.min_gap) target[k] = (opt.min_gap - g) / opt.relaxation_time;
+    }
     // Is anything approaching?
     double most_negative = 0.0;
-    for (std::size_t k = 0; k < m; ++k) most_negative = std::min(most_negative, apply(rows[k], W));
+    for (std::size_t k = 0; k < m; ++k) most_negative = std::min(most_negative, apply(rows[k], W) - target[k]);
     if (!(most_negative < -opt.approach_tolerance)) continue;
 
     // Delassus blocks G A^-1 G^T: rows interact through shared floes.
@@ -110,6 +116,21 @@ std::vector<ContactImpulse> resolve_collisions(Floes& floes, const std::vector<C
       if (r.fb == f) return &r.gb;
       return nullptr;
     };
+    // Scaling: impulses of contact k are solved for in units of s_k = 1 / D_kk
+    // (D = Gn A^-1 Gn^T, so s_k is the effective mass at the contact): the
+    // columns of lambda_k and beta_k are multiplied by s_k, and the friction
+    // row of contact k, mu lambda_k - beta_k+ - beta_k-, is divided by s_k,
+    // which leaves it unchanged. Without this, inverse masses of 1e-7 next to
+    // the O(1) friction rows defeat the pivoting tolerances.
+    std::vector<double> scale(m, 1.0);
+    for (std::size_t k = 0; k < m; ++k) {
+      double dkk = 0.0;
+      const Row& r = rows[k];
+      if (r.fa >= 0) dkk += r.ga.cwiseProduct(Ainv.segment<3>(3 * r.fa)).dot(r.ga);
+      if (r.fb >= 0) dkk += r.gb.cwiseProduct(Ainv.segment<3>(3 * r.fb)).dot(r.gb);
+      if (dkk > 0.0) scale[k] = 1.0 / dkk;
+    }
+    auto contact_of = [m](std::size_t r) { return r < m ? r : (r - m) / 2; };
     const std::size_t n = 4 * m;
     std::vector<Eigen::Triplet<double>> trip;
     trip.reserve(n * 8);
@@ -119,7 +140,8 @@ std::vector<ContactImpulse> resolve_collisions(Floes& floes, const std::vector<C
         for (std::size_t r2 : rows_of[f]) {
           const Eigen::Vector3d& g1 = *block(rows[r1], static_cast<int>(f));
           const Eigen::Vector3d& g2 = *block(rows[r2], static_cast<int>(f));
-          trip.emplace_back(static_cast<int>(r1), static_cast<int>(r2), g1.cwiseProduct(ai).dot(g2));
+          trip.emplace_back(static_cast<int>(r1), static_cast<int>(r2),
+                            g1.cwiseProduct(ai).dot(g2) * scale[contact_of(r2)]);
         }
     }
     for (std::size_t k = 0; k < m; ++k) {
@@ -133,45 +155,60 @@ std::vector<ContactImpulse> resolve_collisions(Floes& floes, const std::vector<C
     lcp::SparseMatrix S(static_cast<int>(n), static_cast<int>(n));
     S.setFromTriplets(trip.begin(), trip.end());  // duplicates (same floe twice) are summed
     lcp::Lcp problem;
-    problem.q = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(n));
-    for (std::size_t r = 0; r < 3 * m; ++r) problem.q[static_cast<Eigen::Index>(r)] = apply(rows[r], W);
     if (n <= opt.dense_max) problem.M = lcp::DenseMatrix(S);
     else problem.M = std::move(S);
 
-    const lcp::FallbackResult res = lcp::solve_with_fallbacks(problem, opt.solver);
-    ++stats.lcps;
-    stats.contacts += static_cast<long>(m);
-    stats.pivots += res.result.pivots;
-    stats.largest = std::max(stats.largest, static_cast<long>(n));
-    stats.total_size += static_cast<long>(n);
-    if (res.attempts.size() > 1) ++stats.fallbacks;
-    if (res.flagged) ++stats.flagged;
-    if (!res.solved()) {
-      ++stats.failures;
-      continue;  // leave these velocities unchanged: counted and reported
+    // Pass 0: compression LCP on W^-, then Poisson's decompression. Poisson's
+    // law applied to several contacts at once can leave a contact that was
+    // separating before the collision approaching after it; pass 1 then
+    // solves a compression LCP (restitution 0) from W^+ so that no contact
+    // ends approaching.
+    Eigen::VectorXd total = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(3 * m));  // impulses applied
+    for (int pass = 0; pass < 2; ++pass) {
+      const double e = pass == 0 ? opt.restitution : 0.0;
+      problem.q = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(n));
+      for (std::size_t r = 0; r < 3 * m; ++r) problem.q[static_cast<Eigen::Index>(r)] = apply(rows[r], W);
+      for (std::size_t k = 0; k < m; ++k) problem.q[static_cast<Eigen::Index>(k)] -= target[k];
+      if (pass == 1) {
+        double worst = 0.0;
+        for (std::size_t k = 0; k < m; ++k) worst = std::min(worst, problem.q[static_cast<Eigen::Index>(k)]);
+        if (!(worst < -opt.approach_tolerance)) break;
+      }
+      const lcp::FallbackResult res = lcp::solve_with_fallbacks(problem, opt.solver);
+      ++stats.lcps;
+      stats.contacts += static_cast<long>(m);
+      stats.pivots += res.result.pivots;
+      stats.largest = std::max(stats.largest, static_cast<long>(n));
+      stats.total_size += static_cast<long>(n);
+      if (res.attempts.size() > 1) ++stats.fallbacks;
+      if (res.flagged) ++stats.flagged;
+      if (!res.solved()) {
+        ++stats.failures;
+        break;  // leave these velocities as they are: counted and reported
+      }
+      // W += (1 + e) A^-1 G^T z.
+      Eigen::VectorXd z = (1.0 + e) * res.result.z.head(static_cast<Eigen::Index>(3 * m));
+      for (std::size_t r = 0; r < 3 * m; ++r) z[static_cast<Eigen::Index>(r)] *= scale[contact_of(r)];
+      total += z;
+      Eigen::VectorXd p = Eigen::VectorXd::Zero(3 * static_cast<Eigen::Index>(nf));
+      for (std::size_t r = 0; r < 3 * m; ++r) {
+        const double zr = z[static_cast<Eigen::Index>(r)];
+        if (zr == 0.0) continue;
+        if (rows[r].fa >= 0) p.segment<3>(3 * rows[r].fa) += zr * rows[r].ga;
+        if (rows[r].fb >= 0) p.segment<3>(3 * rows[r].fb) += zr * rows[r].gb;
+      }
+      W += Ainv.cwiseProduct(p);
     }
-    // W^+ = W^- + (1 + e) A^-1 G^T z.
-    const Eigen::VectorXd& z = res.result.z;
-    Eigen::VectorXd p = Eigen::VectorXd::Zero(3 * static_cast<Eigen::Index>(nf));
-    for (std::size_t r = 0; r < 3 * m; ++r) {
-      const double zr = z[static_cast<Eigen::Index>(r)];
-      if (zr == 0.0) continue;
-      if (rows[r].fa >= 0) p.segment<3>(3 * rows[r].fa) += zr * rows[r].ga;
-      if (rows[r].fb >= 0) p.segment<3>(3 * rows[r].fb) += zr * rows[r].gb;
-    }
-    const double e = opt.restitution;
     for (std::size_t f = 0; f < nf; ++f) {
       FloeState& s = floes.state[global[f]];
-      const Eigen::Vector3d dv = (1.0 + e) * Ainv.segment<3>(3 * static_cast<Eigen::Index>(f)).cwiseProduct(
-                                                 p.segment<3>(3 * static_cast<Eigen::Index>(f)));
-      s.vx += dv.x();
-      s.vy += dv.y();
-      s.yaw_rate += dv.z();
+      s.vx = W[3 * static_cast<Eigen::Index>(f)];
+      s.vy = W[3 * static_cast<Eigen::Index>(f) + 1];
+      s.yaw_rate = W[3 * static_cast<Eigen::Index>(f) + 2];
     }
     for (std::size_t k = 0; k < m; ++k) {
       ContactImpulse& ci = impulses[list[k]];
-      ci.normal = (1.0 + e) * z[static_cast<Eigen::Index>(k)];
-      ci.tangential = (1.0 + e) * (z[static_cast<Eigen::Index>(m + 2 * k)] - z[static_cast<Eigen::Index>(m + 2 * k + 1)]);
+      ci.normal = total[static_cast<Eigen::Index>(k)];
+      ci.tangential = total[static_cast<Eigen::Index>(m + 2 * k)] - total[static_cast<Eigen::Index>(m + 2 * k + 1)];
     }
   }
   return impulses;

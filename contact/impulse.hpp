@@ -24,6 +24,14 @@
 // A^-1 (Gn^T lambda + Gt^T beta); Poisson's law then gives
 //   W^+ = (1 + e) W^c - e W^-   (decompression impulse e times the compression one).
 //
+// Gap stabilisation: a contact whose gap g has fallen below min_gap (round-off
+// and rotation make gaps creep down over many steps) asks for the small
+// separating normal velocity (min_gap - g)/tau instead of 0, i.e.
+// q_j -= (min_gap - g)/tau, with a fixed relaxation time tau (not the step:
+// a short step must not turn a tiny gap error into a large velocity). Contacts
+// at or above min_gap keep the exact Signorini condition (and the exact
+// restitution law).
+//
 // Components are built from dynamic floes joined by contacts; an obstacle
 // (static floe) does not join components since it transmits no impulse.
 
@@ -40,6 +48,8 @@ struct ImpulseOptions {
   double friction = 0.7;     // mu >= 0
   // A component is solved only if some contact approaches faster than this (m/s).
   double approach_tolerance = 1e-12;
+  double min_gap = 0.0;      // m, see "gap stabilisation" above
+  double relaxation_time = 10.0;  // s, tau of the gap stabilisation
   std::size_t dense_max = 400;  // LCPs up to this size are assembled dense, larger sparse
   lcp::FallbackOptions solver;
 };

@@ -13,7 +13,12 @@
 //   d(t) >= d(0) - t s,   s = max(0, -n.(V_b - V_a)) + |omega_a| R_a + |omega_b| R_b,
 // and a pair keeps at least `keep` of its gap over dt <= (d - keep)/s. We keep
 // half of the gap below the collision distance xi and let pairs further away
-// come to xi/2:  keep = min(d, xi)/2.
+// come to xi/2:  keep = min(d, xi)/2. That bound is rigorous but pessimistic
+// for floes in contact that turn slowly; for pairs whose closest points are
+// known, the step uses d'(0) = n.(v_b(p_b) - v_a(p_a)) (exact, rotation
+// included) and a bound kappa on d'' from the rotation rates (step_limit.cpp).
+// The step itself re-detects after moving and redoes a step that overlapped,
+// so no estimate here can let floes overlap.
 
 #include <cstdint>
 #include <limits>

@@ -244,6 +244,19 @@ void read_sea(Section s, SeaParams& p, const std::string& file) {
     if (!(std::isfinite(b[0]) && std::isfinite(b[1]) && b[1] < 0.0))
       s.fail("bottom", "every bottom point must be finite and below the surface (z < 0)");
   read_waves(Section(s.table("waves"), "sea.waves", file), p.waves);
+  {
+    Section t(s.table("tank"), "sea.tank", file);
+    TankConfig& k = p.tank;
+    k.enabled = t.boolean("enabled", k.enabled);
+    k.generation_length = t.number("generation_length", k.generation_length, non_negative, "a length >= 0 (m; 0: 3 wavelengths)");
+    k.absorption_length = t.number("absorption_length", k.absorption_length, non_negative, "a length >= 0 (m; 0: 2 wavelengths)");
+    k.rate = t.number("rate", k.rate, non_negative, "a rate >= 0 (1/s; 0: 4 omega)");
+    k.ramp_periods = t.number("ramp_periods", k.ramp_periods, non_negative, "a number of periods >= 0");
+    if (k.enabled && p.model != SeaModel::spectral) t.fail("enabled", "tank zones need model = \"spectral\"");
+    if (k.enabled && p.waves.kind != WaveKind::regular)
+      t.fail("enabled", "tank zones generate the regular wave of [sea.waves] (kind = \"regular\")");
+    t.finish();
+  }
   s.finish();
 }
 
@@ -426,6 +439,10 @@ std::string resolved_toml(const Config& c) {
                   {"cells", toml::array{c.sea.cells[0], c.sea.cells[1]}}, {"depth", c.sea.depth},
                   {"rho", c.sea.rho}, {"g", c.sea.g}, {"sigma", c.sea.sigma}, {"waves", waves}};
   if (!bottom.empty()) sea.insert("bottom", bottom);
+  if (c.sea.tank.enabled)
+    sea.insert("tank", toml::table{{"enabled", true}, {"generation_length", c.sea.tank.generation_length},
+                                   {"absorption_length", c.sea.tank.absorption_length}, {"rate", c.sea.tank.rate},
+                                   {"ramp_periods", c.sea.tank.ramp_periods}});
 
   toml::array floe_list;
   for (const FloeInput& f : c.floes.floes) {

@@ -34,6 +34,16 @@ struct WaveParams {
   double spreading = 0.0;         // directional spreading exponent s of cos^2s (0 = none)
 };
 
+// Tank-like runs (spectral sea): a zone at x = 0 that relaxes the surface
+// toward the target wave of [sea.waves] and an absorbing zone at the far end.
+struct TankConfig {
+  bool enabled = false;
+  double generation_length = 0.0;  // m; 0 = 3 target wavelengths
+  double absorption_length = 0.0;  // m; 0 = 2 target wavelengths
+  double rate = 0.0;               // 1/s, relaxation rate; 0 = 4 omega of the target
+  double ramp_periods = 3.0;       // target amplitude ramp, in wave periods
+};
+
 struct SeaParams {
   SeaModel model = SeaModel::none;
   int dims = 2;                                   // 1 long-crested (x only), 2 full plane
@@ -45,6 +55,7 @@ struct SeaParams {
   double sigma = 0.073;           // N/m, surface tension
   std::vector<std::array<double, 2>> bottom;      // bem: bottom polyline (x, z), z < 0
   WaveParams waves;
+  TankConfig tank;
 };
 
 struct ContactParams {

@@ -42,6 +42,8 @@ Simulation::Simulation(Scenario scenario) : scenario_(std::move(scenario)) {
   detection_options_.domain = make_domain(scenario_);
   impulse_options_.restitution = c.contact.restitution;
   impulse_options_.friction = c.contact.friction;
+  impulse_options_.min_gap = 0.1 * c.contact.collision_distance;
+  impulse_options_.relaxation_time = c.run.dt_max;
   wrap_periodic();
   detection_options_.search_margin = c.contact.collision_distance;
   detection_ = contact::detect(scenario_.floes, shapes_, detection_options_);
@@ -49,7 +51,10 @@ Simulation::Simulation(Scenario scenario) : scenario_(std::move(scenario)) {
     if (p.overlap)
       throw InputError(where(c.file, 0, "", "floes " + std::to_string(p.a) + " and " + std::to_string(p.b) +
                                                 " overlap at t = 0 (floes are numbered from 0: pack floes first, then inline ones)"));
-  sea_ = fluid::make_sea(c.sea, c.run.seed);
+  fluid::SeaOptions sea_options;
+  sea_options.tank = {c.sea.tank.enabled, c.sea.tank.generation_length, c.sea.tank.absorption_length,
+                      c.sea.tank.rate, c.sea.tank.ramp_periods};
+  sea_ = fluid::make_sea(c.sea, c.run.seed, sea_options);
 }
 
 Simulation::~Simulation() = default;
@@ -65,6 +70,8 @@ double Simulation::step(double t_stop) {
     { PhaseTimer _(profile_, Phase::advance); advance(ctx); }
     { PhaseTimer _(profile_, Phase::detect);  accepted = detect_and_check(ctx); }
   }
+  budget_.external += step_budget_.external;
+  budget_.collisions += step_budget_.collisions;
   { PhaseTimer _(profile_, Phase::sea);       sea_flow(ctx); }
   { PhaseTimer _(profile_, Phase::check);     check_state(ctx); }
   // Land exactly on t_stop when the step was cut to reach it.
@@ -111,13 +118,25 @@ void Simulation::sample_forcing(StepContext& ctx) const {
 void Simulation::drift(const StepContext& ctx) {
   const Vec2 current{ctx.forcing.current[0], ctx.forcing.current[1]};
   const Vec2 wind{ctx.forcing.wind[0], ctx.forcing.wind[1]};
+  const Vec2 before = momentum();
   drift_velocities(scenario_.floes, quadrature_, drift_params_, current, wind, ctx.dt, 0, scenario_.floes.size());
+  step_budget_.external = momentum() - before;
 }
 
 void Simulation::collide(const StepContext&) {
   // Contacts were found at the positions of the start of the step; the LCPs
   // turn W(t-) into W(t+) (contact/impulse.hpp).
+  const Vec2 before = momentum();
   contact::resolve_collisions(scenario_.floes, detection_.contacts, impulse_options_, stats_);
+  step_budget_.collisions = momentum() - before;
+}
+
+Vec2 Simulation::momentum() const {
+  const Floes& f = scenario_.floes;
+  Vec2 p = Vec2::Zero();
+  for (std::size_t i = 0; i < f.size(); ++i)
+    if (!f.is_static[i]) p += f.mass[i] * Vec2{f.state[i].vx, f.state[i].vy};
+  return p;
 }
 
 void Simulation::advance(const StepContext& ctx) {
@@ -141,9 +160,15 @@ bool Simulation::detect_and_check(StepContext& ctx) {
     ++rejected_steps_;
     scenario_.floes.state = ctx.start;
     ctx.dt *= 0.5;
-    if (ctx.dt < kFloorFraction * scenario_.config.run.dt_max * std::pow(0.5, kMaxHalvings / 2))
-      throw RunError("floes " + std::to_string(p.a) + " and " + std::to_string(p.b) +
-                     " overlap however short the step from t = " + std::to_string(ctx.t) + " s");
+    if (ctx.dt < kFloorFraction * scenario_.config.run.dt_max * std::pow(0.5, kMaxHalvings / 2)) {
+      double before = -1.0;
+      for (const contact::NearPair& q : detection_.pairs)
+        if (q.a == p.a && q.b == p.b) before = q.distance;
+      std::ostringstream m;
+      m << "floes " << p.a << " and " << p.b << " overlap however short the step from t = " << ctx.t
+        << " s (their distance at t was " << before << " m)";
+      throw RunError(m.str());
+    }
     return false;
   }
   detection_ = std::move(next);

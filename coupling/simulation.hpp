@@ -75,6 +75,15 @@ public:
   Energies energies() const;
 
   const contact::CollisionStats& collision_stats() const { return stats_; }
+  // Momentum given to the dynamic floes since t = 0 (kg m/s): by the smooth
+  // forces (drag, wind, Coriolis) and by collisions. Between dynamic floes
+  // impulses cancel, so the collision part is what obstacles gave.
+  struct MomentumBudget {
+    Vec2 external = Vec2::Zero();
+    Vec2 collisions = Vec2::Zero();
+  };
+  const MomentumBudget& momentum_budget() const { return budget_; }
+  Vec2 momentum() const;  // of the dynamic floes now
   LcpCounters lcp_counters() const;
   const contact::Detection& detection() const { return detection_; }
   // Things a user should hear about once, with a count (e.g. steps cut to the floor).
@@ -105,6 +114,7 @@ private:
   contact::ImpulseOptions impulse_options_;
   contact::Detection detection_;  // at the present positions
   contact::CollisionStats stats_;
+  MomentumBudget budget_, step_budget_;  // run total; this step's (redone steps do not count)
   long floor_steps_ = 0;          // steps the collision limit wanted below the floor
   long rejected_steps_ = 0;       // steps redone after an overlap
   std::string floor_pair_;        // the last pair that did it

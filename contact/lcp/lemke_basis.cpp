@@ -73,7 +73,9 @@ public:
     umfpack_di_free_symbolic(&symbolic);
     if (status != UMFPACK_OK || !(info_[UMFPACK_RCOND] > kSingularRcond)) return false;
     wi_.resize(static_cast<std::size_t>(k));
-    w_.resize(static_cast<std::size_t>(k));
+    // UMFPACK asks for n doubles without iterative refinement and 5 n with
+    // it; take the larger so a change of Control can never overrun.
+    w_.resize(5 * static_cast<std::size_t>(k));
     rhs_.resize(k);
     return true;
   }

@@ -165,4 +165,100 @@ TEST_CASE("Newton's cradle: five equal floes in a row pass the first one's veloc
   CHECK(f.state[4].x > 40.12 + 0.5 * 10.0);
 }
 
+// ---------------------------------------------------------------- packs
+
+#include <filesystem>
+#include <random>
+
+#include "core/pack.hpp"
+#include "core/pack_generator.hpp"
+
+namespace {
+// A generated pack with random velocities written to a temporary pack file.
+std::string pack_file(const std::string& name, std::size_t n, double conc, double box, double speed,
+                      double wall, std::uint64_t seed) {
+  PackOptions o;
+  o.floes = n;
+  o.concentration = conc;
+  o.width = o.height = box;
+  o.seed = seed;
+  o.wall_width = wall;
+  GeneratedPack g = generate_pack(o);
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  for (std::size_t i = 0; i < g.floes.size(); ++i) {
+    if (g.floes.is_static[i]) continue;
+    g.floes.state[i].vx = speed * u(rng);
+    g.floes.state[i].vy = speed * u(rng);
+    g.floes.state[i].yaw_rate = 1e-3 * speed * u(rng);
+  }
+  const std::string path = (std::filesystem::temp_directory_path() / name).string();
+  write_pack(path, g.floes, g.window);
+  return path;
+}
+}  // namespace
+
+TEST_CASE("a dense periodic pack: collisions conserve momentum, floes never overlap") {
+  // Newton's third law: impulses between floes cancel, so with no forcing and no obstacle the
+  // pack's momentum stays as it was while hundreds of collisions happen across the seams too.
+  const std::string pack = pack_file("floesim_periodic_pack.h5", 100, 0.6, 1000.0, 0.5, 0.0, 7);
+  std::ostringstream t;
+  t << "[run]\ndt_max = 10\n[floes]\npack = \"" << pack << "\"\n"
+    << "[contact]\ndomain = \"periodic\"\nrestitution = 0.4\nfriction = 0.7\n"
+    << "[forcing]\nocean_drag = 0\nair_drag = 0\n";
+  Simulation sim(build_scenario(parse_config(t.str(), "periodic.toml", ".")));
+  const Vec2 p0 = sim.momentum();
+  double scale = 0;
+  for (std::size_t i = 0; i < sim.floes().size(); ++i) scale += sim.floes().mass[i] * 0.5;
+  while (sim.time() < 600.0) sim.step(600.0);
+  const auto& st = sim.collision_stats();
+  MESSAGE("steps " << sim.steps() << ", LCPs " << st.lcps << ", contacts " << st.contacts << ", largest " << st.largest);
+  CHECK(st.lcps > 50);
+  CHECK(st.failures == 0);
+  CHECK((sim.momentum() - p0).norm() < 1e-10 * scale);
+  CHECK(sim.warnings().empty());
+  // Floes stay in the box (wrapped) and apart.
+  for (const FloeState& s : sim.floes().state) {
+    CHECK(s.x >= 0.0);
+    CHECK(s.x < 1000.0);
+  }
+  for (const auto& p : sim.detection().pairs) CHECK_FALSE(p.overlap);
+  // Inelastic collisions (e = 0.4, friction) lose kinetic energy.
+  CHECK(sim.energies().values[0] < 0.9 * Simulation(build_scenario(parse_config(t.str(), "p.toml", "."))).energies().values[0]);
+}
+
+// Known failure, skipped by default (run with --no-skip): after about 10^4 s of jamming, a
+// pair's gap creeps to round-off and the step cannot avoid an overlap; it also takes ~10 min
+// because jammed floes that turn hold the step far below dt_max. Open in issue 4.
+TEST_CASE("a pack pushed by wind against a wall: jammed, no overlap, the wall takes the wind force" *
+          doctest::skip(true)) {
+  // Momentum balance of the pack: dP/dt = F_wind + F_drag + F_wall. Once the pack has jammed
+  // against the obstacle and stopped, drag vanishes and the wall's impulse per unit time equals
+  // minus the total wind force  rho_a C_a |U_a| U_a A_total.
+  const std::string pack = pack_file("floesim_wall_pack.h5", 100, 0.5, 1000.0, 0.0, 20.0, 11);
+  std::ostringstream t;
+  t << "[run]\ndt_max = 10\n[floes]\npack = \"" << pack << "\"\n"
+    << "[contact]\nrestitution = 0.4\nfriction = 0.7\n[forcing]\nwind = [15.0, 0.0]\n";
+  Simulation sim(build_scenario(parse_config(t.str(), "wall.toml", ".")));
+  double area = 0;
+  for (std::size_t i = 0; i < sim.floes().size(); ++i)
+    if (!sim.floes().is_static[i]) area += sim.floes().area[i];
+  const double wind_force = 1.341 * 1.7e-3 * 15.0 * 15.0 * area;
+  const double T1 = 3.0e4, T2 = 4.0e4;
+  while (sim.time() < T1) sim.step(T1);
+  const Vec2 wall1 = sim.momentum_budget().collisions;
+  const Vec2 P1 = sim.momentum();
+  while (sim.time() < T2) sim.step(T2);
+  const Vec2 wall_rate = (sim.momentum_budget().collisions - wall1) / (T2 - T1);
+  const Vec2 P2 = sim.momentum();
+  MESSAGE("steps " << sim.steps() << ", LCPs " << sim.collision_stats().lcps << ", wall force " << wall_rate.transpose()
+                   << " N, wind force " << wind_force << " N, pack momentum " << P2.transpose());
+  CHECK(sim.collision_stats().failures == 0);
+  CHECK(sim.warnings().empty());  // no step held at the floor, no failed or approximate LCP
+  for (const auto& p : sim.detection().pairs) CHECK_FALSE(p.overlap);
+  CHECK(wall_rate.x() == doctest::Approx(-wind_force).epsilon(0.05));
+  CHECK(std::abs(wall_rate.y()) < 0.05 * wind_force);
+  CHECK((P2 - P1).norm() < 0.05 * wind_force * (T2 - T1));
+}
+
 TEST_SUITE_END();
