@@ -49,8 +49,11 @@ void add_info_command(CLI::App& app, Registry& registry) {
         << ",\n  \"t_first\": " << r.t_first << ",\n  \"t_last\": " << r.t_last << ",\n  \"floes\": " << r.floes
         << ",\n  \"vertices\": " << r.vertices << ",\n  \"energy\": {";
       for (std::size_t k = 0; k < r.energy_columns.size(); ++k)
-        o << (k ? ", " : "") << json_string(r.energy_columns[k]) << ": "
-          << (k < r.energy_last.size() ? std::to_string(r.energy_last[k]) : std::string("null"));
+      {
+        o << (k ? ", " : "") << json_string(r.energy_columns[k]) << ": ";
+        if (k < r.energy_last.size()) o << r.energy_last[k];
+        else o << "null";
+      }
       o << "},\n  \"lcp\": {\"solves\": " << r.lcp_last[0] << ", \"pivots\": " << r.lcp_last[1]
         << ", \"failures\": " << r.lcp_last[2] << ", \"fallbacks\": " << r.lcp_last[3] << "},\n  \"datasets\": {";
       for (std::size_t k = 0; k < r.datasets.size(); ++k)

@@ -75,6 +75,14 @@ Separation separation(std::span<const Vec2> a, std::span<const Vec2> b) {
   return best;
 }
 
+// Distance between two convex polygons with the closest points; 0 and
+// overlap = true when they intersect.
+struct ConvexDistance {
+  double distance = 0.0;
+  Vec2 pa = Vec2::Zero(), pb = Vec2::Zero();
+  bool overlap = false;
+};
+
 ConvexDistance distance_of(std::span<const Vec2> a, std::span<const Vec2> b) {
   ConvexDistance r;
   if (!(separation(a, b).gap > 0.0)) {
@@ -103,10 +111,6 @@ struct Entry {
 };
 
 }  // namespace
-
-ConvexDistance convex_distance(const std::vector<Vec2>& a, const std::vector<Vec2>& b) {
-  return distance_of(a, b);
-}
 
 Detection detect(const Floes& floes, const CollisionShapes& shapes, const DetectionOptions& opt) {
   Detection out;
@@ -144,14 +148,13 @@ Detection detect(const Floes& floes, const CollisionShapes& shapes, const Detect
     const Box& b = floe_box[i];
     entries.push_back({b, i, Vec2::Zero()});
     if (!d.periodic) continue;
-    std::vector<double> sx{0.0}, sy{0.0};
-    if (b.xmax > d.xmax) sx.push_back(-d.width());
-    if (b.xmin < d.xmin) sx.push_back(d.width());
-    if (b.ymax > d.ymax) sy.push_back(-d.height());
-    if (b.ymin < d.ymin) sy.push_back(d.height());
-    for (double ox : sx)
-      for (double oy : sy) {
-        if (ox == 0.0 && oy == 0.0) continue;
+    // Shifts of the images: 0 and, where the box crosses an edge, one period.
+    const double sx[2] = {0.0, b.xmax > d.xmax ? -d.width() : (b.xmin < d.xmin ? d.width() : 0.0)};
+    const double sy[2] = {0.0, b.ymax > d.ymax ? -d.height() : (b.ymin < d.ymin ? d.height() : 0.0)};
+    for (int kx = 0; kx < 2; ++kx)
+      for (int ky = 0; ky < 2; ++ky) {
+        const double ox = sx[kx], oy = sy[ky];
+        if ((kx == 1 && ox == 0.0) || (ky == 1 && oy == 0.0) || (kx == 0 && ky == 0)) continue;
         entries.push_back({{b.xmin + ox, b.xmax + ox, b.ymin + oy, b.ymax + oy}, i, Vec2{ox, oy}});
       }
   }

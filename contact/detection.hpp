@@ -71,13 +71,4 @@ struct Detection {
 
 Detection detect(const Floes& floes, const CollisionShapes& shapes, const DetectionOptions& options);
 
-// Distance between two convex polygons (world coordinates), with the closest
-// points; 0 and overlap = true when they intersect.
-struct ConvexDistance {
-  double distance = 0.0;
-  Vec2 pa = Vec2::Zero(), pb = Vec2::Zero();
-  bool overlap = false;
-};
-ConvexDistance convex_distance(const std::vector<Vec2>& a, const std::vector<Vec2>& b);
-
 }  // namespace floesim::contact

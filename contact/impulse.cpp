@@ -100,10 +100,20 @@ std::vector<ContactImpulse> resolve_collisions(Floes& floes, const std::vector<C
       const double g = contacts[list[k]].gap;
       if (g < opt.min_gap) target[k] = (opt.min_gap - g) / opt.relaxation_time;
     }
-    // Is anything approaching?
-    double most_negative = 0.0;
-    for (std::size_t k = 0; k < m; ++k) most_negative = std::min(most_negative, apply(rows[k], W) - target[k]);
-    if (!(most_negative < -opt.approach_tolerance)) continue;
+    // q = (Gn W - target, Gt W, 0); returns its most negative normal entry
+    // (the fastest approach, once the targets are met: nothing to do if >= 0).
+    lcp::Lcp problem;
+    auto fill_q = [&] {
+      problem.q = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(4 * m));
+      for (std::size_t r = 0; r < 3 * m; ++r) problem.q[static_cast<Eigen::Index>(r)] = apply(rows[r], W);
+      double worst = 0.0;
+      for (std::size_t k = 0; k < m; ++k) {
+        problem.q[static_cast<Eigen::Index>(k)] -= target[k];
+        worst = std::min(worst, problem.q[static_cast<Eigen::Index>(k)]);
+      }
+      return worst;
+    };
+    if (!(fill_q() < -opt.approach_tolerance)) continue;
 
     // Delassus blocks G A^-1 G^T: rows interact through shared floes.
     std::vector<std::vector<std::size_t>> rows_of(nf);
@@ -154,7 +164,6 @@ std::vector<ContactImpulse> resolve_collisions(Floes& floes, const std::vector<C
     }
     lcp::SparseMatrix S(static_cast<int>(n), static_cast<int>(n));
     S.setFromTriplets(trip.begin(), trip.end());  // duplicates (same floe twice) are summed
-    lcp::Lcp problem;
     if (n <= opt.dense_max) problem.M = lcp::DenseMatrix(S);
     else problem.M = std::move(S);
 
@@ -166,14 +175,7 @@ std::vector<ContactImpulse> resolve_collisions(Floes& floes, const std::vector<C
     Eigen::VectorXd total = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(3 * m));  // impulses applied
     for (int pass = 0; pass < 2; ++pass) {
       const double e = pass == 0 ? opt.restitution : 0.0;
-      problem.q = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(n));
-      for (std::size_t r = 0; r < 3 * m; ++r) problem.q[static_cast<Eigen::Index>(r)] = apply(rows[r], W);
-      for (std::size_t k = 0; k < m; ++k) problem.q[static_cast<Eigen::Index>(k)] -= target[k];
-      if (pass == 1) {
-        double worst = 0.0;
-        for (std::size_t k = 0; k < m; ++k) worst = std::min(worst, problem.q[static_cast<Eigen::Index>(k)]);
-        if (!(worst < -opt.approach_tolerance)) break;
-      }
+      if (pass == 1 && !(fill_q() < -opt.approach_tolerance)) break;  // pass 0 uses the q above
       const lcp::FallbackResult res = lcp::solve_with_fallbacks(problem, opt.solver);
       ++stats.lcps;
       stats.contacts += static_cast<long>(m);

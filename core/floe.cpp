@@ -27,10 +27,13 @@ FloeShape make_floe_shape(const FloeInput& in) {
   FloeShape shape;
   std::vector<Vec2> v = in.vertices;
   // All vertices on one line (or one point): zero area, whatever the order.
-  double extent = 0.0, spread = 0.0;
-  for (const Vec2& p : v) extent = std::max(extent, (p - v[0]).norm());
+  // They are collinear iff all lie on the line from v[0] to the vertex farthest from it.
+  Vec2 far = v[0];
   for (const Vec2& p : v)
-    for (const Vec2& q : v) spread = std::max(spread, std::abs(cross(p - v[0], q - v[0])));
+    if ((p - v[0]).squaredNorm() > (far - v[0]).squaredNorm()) far = p;
+  const double extent = (far - v[0]).norm();
+  double spread = 0.0;
+  for (const Vec2& p : v) spread = std::max(spread, std::abs(cross(p - v[0], far - v[0])));
   if (!(spread > 1e-12 * extent * extent) || extent == 0.0)
     fail("the outline has zero area (all vertices on a line?)");
   if (auto bad = find_self_intersection(v)) {

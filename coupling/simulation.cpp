@@ -115,20 +115,22 @@ void Simulation::sample_forcing(StepContext& ctx) const {
   ctx.forcing = scenario_.forcing.at(ctx.t + 0.5 * ctx.dt);
 }
 
-void Simulation::drift(const StepContext& ctx) {
+void Simulation::drift(StepContext& ctx) {
   const Vec2 current{ctx.forcing.current[0], ctx.forcing.current[1]};
   const Vec2 wind{ctx.forcing.wind[0], ctx.forcing.wind[1]};
   const Vec2 before = momentum();
   drift_velocities(scenario_.floes, quadrature_, drift_params_, current, wind, ctx.dt, 0, scenario_.floes.size());
-  step_budget_.external = momentum() - before;
+  ctx.momentum = momentum();
+  step_budget_.external = ctx.momentum - before;
 }
 
-void Simulation::collide(const StepContext&) {
+void Simulation::collide(StepContext& ctx) {
   // Contacts were found at the positions of the start of the step; the LCPs
   // turn W(t-) into W(t+) (contact/impulse.hpp).
-  const Vec2 before = momentum();
   contact::resolve_collisions(scenario_.floes, detection_.contacts, impulse_options_, stats_);
-  step_budget_.collisions = momentum() - before;
+  const Vec2 after = momentum();
+  step_budget_.collisions = after - ctx.momentum;
+  ctx.momentum = after;
 }
 
 Vec2 Simulation::momentum() const {

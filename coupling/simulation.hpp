@@ -49,6 +49,7 @@ struct StepContext {
   double dt = 0.0;     // s
   ForcingSample forcing;
   std::vector<FloeState> start;  // the floes at t, to redo a rejected step
+  Vec2 momentum = Vec2::Zero();   // of the dynamic floes, updated by the phases that change it
 };
 
 // Energies by part (J), named as the columns of /diagnostics/energy; the last
@@ -98,8 +99,8 @@ private:
   StepContext choose_dt(double t_stop);
   void sample_forcing(StepContext& ctx) const;
   void sea_flow(const StepContext& ctx);
-  void drift(const StepContext& ctx);
-  void collide(const StepContext& ctx);
+  void drift(StepContext& ctx);
+  void collide(StepContext& ctx);
   void advance(const StepContext& ctx);
   bool detect_and_check(StepContext& ctx);  // false: the step overlapped, dt halved
   void wrap_periodic();

@@ -112,8 +112,8 @@ TEST_CASE("the run loop records on schedule and the file holds the state") {
 
 TEST_CASE("a numerical failure marks the run file failed and keeps the records") {
   const std::string out = (fs::temp_directory_path() / "floesim_fail.h5").string();
-  // A huge angular velocity overflows nothing, but a NaN velocity from a pack would be refused
-  // as input; provoke a failure instead through an absurd step on a huge drag coefficient.
+  // Valid input whose numerics overflow: a 1e300 m/s floe under a 1e300 drag coefficient gives a
+  // non-finite velocity in the first step, which the step's state check turns into a RunError.
   const std::string text =
       "[run]\nt_end = 10\ndt_max = 1\noutput_interval = 1\n"
       "[[floes.floe]]\nvertices = [[0,0],[1,0],[1,1],[0,1]]\nvelocity = [1e300, 0]\n"
