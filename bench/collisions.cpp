@@ -140,6 +140,8 @@ struct RunResult {
   double setup = 0.0;      // s: Simulation construction (shapes, quadrature, first detection)
   std::size_t steps = 0;
   contact::CollisionStats stats;
+  contact::SubstepReport substeps;
+  long rejected_steps = 0;
   Profile profile;
   std::vector<std::string> warnings;
 };
@@ -182,6 +184,8 @@ RunResult run_once(const Config& config, double t_end, double time_limit) {
     r.simulated = sim.time();
     r.steps = sim.steps();
     r.stats = sim.collision_stats();
+    r.substeps = sim.substep_report();
+    r.rejected_steps = sim.rejected_steps();
     r.profile = sim.profile();
     r.warnings = sim.warnings();
   } catch (const std::exception& e) {  // construction (e.g. floes overlapping at t = 0)
@@ -349,9 +353,13 @@ int main(int argc, char** argv) {
     row.peak_rss_mb = child_peak_rss_mb({self, "--child", s.name, "--pack-dir", pack_dir, "--time-limit",
                                          std::to_string(time_limit)});
     const RunResult& b = row.best;
-    std::printf("# %s: %s, %zu floes, t = %g s, wall %.3f s (min of %d), %zu steps, %ld LCPs, peak %.1f MiB\n",
-                s.name.c_str(), b.status.c_str(), b.floes, b.simulated, b.wall, row.repeats, b.steps, b.stats.lcps,
-                row.peak_rss_mb);
+    std::printf("# %s: %s, %zu floes, t = %g s, wall %.3f s (min of %d), %zu steps (%ld redone), %ld LCPs, peak %.1f MiB\n"
+                "#   %ld clusters, %ld sub-steps, largest %ld floes, %ld joined, %ld merges, %ld sub-steps redone, "
+                "%ld at the floor, %ld pair lists rebuilt\n",
+                s.name.c_str(), b.status.c_str(), b.floes, b.simulated, b.wall, row.repeats, b.steps, b.rejected_steps,
+                b.stats.lcps, row.peak_rss_mb, b.substeps.clusters, b.substeps.substeps, b.substeps.largest_cluster,
+                b.substeps.joined, b.substeps.merges, b.substeps.rejected, b.substeps.floor_steps,
+                b.substeps.rebuilt);
     for (const std::string& w : b.warnings) std::printf("#   warning: %s\n", w.c_str());
     std::fflush(stdout);
     rows.push_back(std::move(row));
@@ -361,16 +369,19 @@ int main(int argc, char** argv) {
   // Table and CSV.
   std::ostringstream out;
   out << "scenario,status,floes,simulated_s,repeats,wall_s,wall_s_median,setup_s,steps,lcps,pivots,failures,"
-         "fallbacks,contacts,largest_lcp,peak_rss_mb,floedyn_s,speedup";
+         "fallbacks,contacts,largest_lcp,rejected_steps,clusters,substeps,largest_cluster,joined,merges,"
+         "rejected_substeps,floor_substeps,pairs_rebuilt,peak_rss_mb,floedyn_s,speedup";
   for (const char* p : kPhaseNames) out << "," << p << "_s";
   out << "\n";
   for (const Row& row : rows) {
     const RunResult& b = row.best;
     char buf[512];
-    std::snprintf(buf, sizeof buf, "%s,%s,%zu,%g,%d,%.3f,%.3f,%.4f,%zu,%ld,%ld,%ld,%ld,%ld,%ld,%.1f,", row.scenario->name.c_str(),
-                  csv_field(b.status).c_str(), b.floes, b.simulated, row.repeats, b.wall, row.wall_median, b.setup,
-                  b.steps, b.stats.lcps, b.stats.pivots, b.stats.failures, b.stats.fallbacks, b.stats.contacts,
-                  b.stats.largest, row.peak_rss_mb);
+    const contact::SubstepReport& sr = b.substeps;
+    std::snprintf(buf, sizeof buf, "%s,%s,%zu,%g,%d,%.3f,%.3f,%.4f,%zu,%ld,%ld,%ld,%ld,%ld,%ld,%ld,%ld,%ld,%ld,%ld,%ld,%ld,%ld,%ld,%.1f,",
+                  row.scenario->name.c_str(), csv_field(b.status).c_str(), b.floes, b.simulated, row.repeats, b.wall,
+                  row.wall_median, b.setup, b.steps, b.stats.lcps, b.stats.pivots, b.stats.failures, b.stats.fallbacks,
+                  b.stats.contacts, b.stats.largest, b.rejected_steps, sr.clusters, sr.substeps, sr.largest_cluster,
+                  sr.joined, sr.merges, sr.rejected, sr.floor_steps, sr.rebuilt, row.peak_rss_mb);
     out << buf;
     if (row.scenario->floedyn_s > 0 && b.status == "ok") {
       std::snprintf(buf, sizeof buf, "%.1f,%.1f", row.scenario->floedyn_s, row.scenario->floedyn_s / b.wall);

@@ -3,10 +3,12 @@
 // model grows, the sea) by one step; the step reads as a table of contents,
 // one named and timed phase per line (MODEL.md §5):
 //
-//   choose dt (output schedule, dt_max, collision limit)
+//   choose dt (output schedule, dt_max)
 //   -> sample forcing -> drift velocities (drag, Coriolis) -> collide (LCPs)
-//   -> advance positions -> detect (new contacts; an overlap rejects the step,
-//      which is redone with half the dt) -> sea flow -> check state
+//   -> advance positions (floes that may collide within the step are
+//      sub-stepped event by event, contact/substep.hpp)
+//   -> detect (new contacts; an overlap rejects the step, which is redone
+//      with half the dt) -> sea flow -> check state
 //
 // Step contract: on entry the state is at time() and the contact detection
 // matches the positions; step(t_stop) advances both to time() + dt with
@@ -25,6 +27,7 @@
 #include "contact/detection.hpp"
 #include "contact/impulse.hpp"
 #include "contact/shapes.hpp"
+#include "contact/substep.hpp"
 #include "core/run_file.hpp"
 #include "coupling/scenario.hpp"
 
@@ -87,6 +90,8 @@ public:
   Vec2 momentum() const;  // of the dynamic floes now
   LcpCounters lcp_counters() const;
   const contact::Detection& detection() const { return detection_; }
+  const contact::SubstepReport& substep_report() const { return substeps_; }
+  long rejected_steps() const { return rejected_steps_; }
   // Things a user should hear about once, with a count (e.g. steps cut to the floor).
   std::vector<std::string> warnings() const;
 
@@ -104,6 +109,7 @@ private:
   void advance(const StepContext& ctx);
   bool detect_and_check(StepContext& ctx);  // false: the step overlapped, dt halved
   void wrap_periodic();
+  void set_reach();  // detection reach of each floe for the next step
   void check_state(const StepContext& ctx) const;
 
   Scenario scenario_;
@@ -116,9 +122,8 @@ private:
   contact::Detection detection_;  // at the present positions
   contact::CollisionStats stats_;
   MomentumBudget budget_, step_budget_;  // run total; this step's (redone steps do not count)
-  long floor_steps_ = 0;          // steps the collision limit wanted below the floor
+  contact::SubstepReport substeps_;  // collision sub-steps (floors, merges, ...)
   long rejected_steps_ = 0;       // steps redone after an overlap
-  std::string floor_pair_;        // the last pair that did it
   Profile profile_;
   double t_ = 0.0;
   std::size_t steps_ = 0;
