@@ -189,6 +189,12 @@ private:
       }
       if (da && db) parent[find(q.a)] = find(q.b);
     }
+    // A jam (a contact component of jam_floes floes or more, impulse.hpp)
+    // joins a cluster whole: its floes would come in one by one anyway, each
+    // time with an LCP of the part that came in so far.
+    find_jams();
+    for (std::uint32_t i = 0; i < n; ++i)
+      if (jam_of_[i] >= 0) parent[find(i)] = find(jams_[static_cast<std::size_t>(jam_of_[i])].front());
     std::vector<std::uint8_t> active_root(n, 0);
     for (std::uint32_t i = 0; i < n; ++i)
       if (hot[i]) active_root[find(i)] = 1;
@@ -203,6 +209,34 @@ private:
       }
       cluster_of_[i] = of_root[r];
       clusters_[static_cast<std::size_t>(of_root[r])].members.push_back(i);
+    }
+  }
+
+  // jam_of_[i]: the jam of floe i (-1: none), jams_: their floes.
+  void find_jams() {
+    const std::size_t n = floes_.size();
+    std::vector<std::uint32_t> parent(n);
+    std::iota(parent.begin(), parent.end(), 0u);
+    auto find = [&](std::uint32_t i) {
+      while (parent[i] != i) i = parent[i] = parent[parent[i]];
+      return i;
+    };
+    for (const ContactPoint& c : det_->contacts)
+      if (!floes_.is_static[c.a] && !floes_.is_static[c.b]) parent[find(c.a)] = find(c.b);
+    std::vector<std::uint32_t> size(n, 0);
+    for (std::uint32_t i = 0; i < n; ++i)
+      if (!floes_.is_static[i]) ++size[find(i)];
+    jam_of_.assign(n, -1);
+    std::vector<int> of_root(n, -1);
+    for (std::uint32_t i = 0; i < n; ++i) {
+      const std::uint32_t r = find(i);
+      if (floes_.is_static[i] || size[r] < opt_.impulse.jam_floes) continue;
+      if (of_root[r] < 0) {
+        of_root[r] = static_cast<int>(jams_.size());
+        jams_.emplace_back();
+      }
+      jam_of_[i] = of_root[r];
+      jams_[static_cast<std::size_t>(of_root[r])].push_back(i);
     }
   }
 
@@ -414,6 +448,15 @@ private:
   // now: time order). Then the collisions at that time are resolved.
   void bring_in(int k) {
     Cluster& c = clusters_[static_cast<std::size_t>(k)];
+    // A jam comes in whole (make_clusters).
+    for (std::size_t m = 0, n = joining_.size(); m < n; ++m) {
+      const int jam = jam_of_[joining_[m]];
+      if (jam < 0) continue;
+      for (std::uint32_t f : jams_[static_cast<std::size_t>(jam)]) {
+        if (cluster_of_[f] == kFree) joining_.push_back(f);
+        else if (cluster_of_[f] != k) merging_.push_back(cluster_of_[f]);
+      }
+    }
     std::sort(joining_.begin(), joining_.end());
     joining_.erase(std::unique(joining_.begin(), joining_.end()), joining_.end());
     for (std::uint32_t j : joining_) {
@@ -471,6 +514,8 @@ private:
   Measured next_;                      // a cluster's pairs after the sub-step being tried
   std::vector<std::uint32_t> joining_;
   std::vector<int> merging_;
+  std::vector<int> jam_of_;                      // per floe: its jam, or -1
+  std::vector<std::vector<std::uint32_t>> jams_; // the floes of each jam
 };
 
 }  // namespace
