@@ -87,7 +87,7 @@ void add_run_command(CLI::App& app, Registry& registry) {
       throw InputError(output + ": the output would overwrite the configuration");
 
     Simulation sim(build_scenario(load_config(config_path)));
-    for (const std::string& note : sim.scenario().notes) std::cerr << "floesim: note: " << note << "\n";
+    for (const std::string& note : sim.notes()) std::cerr << "floesim: note: " << note << "\n";
 
     ProgressLine progress(!args->quiet && isatty(STDERR_FILENO));
     g_interrupted = false;

@@ -30,6 +30,8 @@ std::size_t Floes::add(const FloeShape& shape, const FloeInput& input) {
     s.vx = input.velocity.x();
     s.vy = input.velocity.y();
     s.yaw_rate = input.angular_velocity;
+    s.heave = input.heave;
+    s.heave_rate = input.heave_rate;
   }
   state.push_back(s);
   return i;

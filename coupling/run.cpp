@@ -17,7 +17,7 @@ RunSummary run_simulation(Simulation& sim, const RunOptions& options) {
   RunSummary summary;
   summary.output = options.output;
   summary.energy_first = sim.energies();
-  summary.warnings = sim.scenario().notes;
+  summary.warnings = sim.notes();
   RunWriter writer(options.output, sim.floes(), resolved_toml(cfg), summary.energy_first.names, sim.sea_grid());
   summary.xdmf = writer.xdmf_path();
 
