@@ -12,10 +12,9 @@ std::vector<double> nice_ticks(double lo, double hi, int target) {
   if (!std::isfinite(lo) || !std::isfinite(hi)) lo = 0.0, hi = 1.0;
   if (hi < lo) std::swap(lo, hi);
   if (hi - lo <= 1e-12 * std::max(std::abs(lo), std::abs(hi))) {
-    // A constant: a unit interval around it (or a tenth of its size).
-    const double pad = lo == 0.0 ? 1.0 : 0.1 * std::abs(lo);
-    lo -= pad;
-    hi += pad;
+    // A constant: [0, 1] for zero (counters, energies at rest), else a tenth of its size around it.
+    if (lo == 0.0) hi = 1.0;
+    else lo -= 0.1 * std::abs(lo), hi += 0.1 * std::abs(hi);
   }
   const double raw = (hi - lo) / std::max(target, 1);
   const double p = std::pow(10.0, std::floor(std::log10(raw)));
@@ -69,7 +68,14 @@ void line_plot(Canvas& c, const Rect& area, const PlotSpec& spec, const std::vec
   double x_lo, x_hi, y_lo, y_hi;
   extent(series, true, x_lo, x_hi);
   extent(series, false, y_lo, y_hi);
-  const std::vector<double> xt = nice_ticks(x_lo, x_hi, std::max(2, static_cast<int>(area.w / 110)));
+  // x (time) spans exactly the data, with the nice ticks inside it; y spans the nice ticks.
+  std::vector<double> xt = nice_ticks(x_lo, x_hi, std::max(2, static_cast<int>(area.w / 110)));
+  double x0 = xt.front(), x1 = xt.back();
+  if (x_hi > x_lo) {
+    x0 = x_lo, x1 = x_hi;
+    const double slack = 1e-9 * (x_hi - x_lo);
+    std::erase_if(xt, [&](double v) { return v < x_lo - slack || v > x_hi + slack; });
+  }
   const std::vector<double> yt = nice_ticks(y_lo, y_hi, std::max(2, static_cast<int>(area.h / 70)));
   const std::vector<std::string> xl = tick_labels(xt), yl = tick_labels(yt);
 
@@ -83,7 +89,7 @@ void line_plot(Canvas& c, const Rect& area, const PlotSpec& spec, const std::vec
   const double left = area.x + ylab_w + 2.2 * fs, right = area.x + area.w - legend_w - 0.8 * fs;
   const double top = area.y + (spec.title.empty() ? 0.8 : 2.0) * fs, bottom = area.y + area.h - 3.0 * fs;
   const Rect box{left, top, std::max(right - left, 10.0), std::max(bottom - top, 10.0)};
-  auto px = [&](double x) { return box.x + (x - xt.front()) / (xt.back() - xt.front()) * box.w; };
+  auto px = [&](double x) { return box.x + (x - x0) / (x1 - x0) * box.w; };
   auto py = [&](double y) { return box.y + box.h - (y - yt.front()) / (yt.back() - yt.front()) * box.h; };
 
   const Rgb grid{0.88, 0.88, 0.88};
@@ -104,7 +110,7 @@ void line_plot(Canvas& c, const Rect& area, const PlotSpec& spec, const std::vec
   c.text({box.x + 0.5 * box.w, area.y + area.h - 0.5 * fs}, spec.xlabel, fs, kInk, Align::centre);
   c.text({area.x + 1.0 * fs, box.y + 0.5 * box.h}, spec.ylabel, fs, kInk, Align::centre, true);
 
-  c.clip(box);
+  c.clip({box.x - 2, box.y - 2, box.w + 4, box.h + 4});  // a line along an axis stays visible
   std::vector<Point> pts;
   for (std::size_t k = 0; k < series.size(); ++k) {
     const Series& s = series[k];

@@ -26,6 +26,8 @@ TEST_CASE("nice ticks cover the data with 1, 2 or 5 times a power of ten") {
     for (std::size_t k = 1; k < t.size(); ++k) CHECK(t[k] - t[k - 1] == doctest::Approx(step));
     CHECK(t.size() <= 12);
   }
+  CHECK(nice_ticks(0, 0).front() == 0.0);  // a zero counter: [0, 1], not below zero
+  CHECK(nice_ticks(0, 0).back() == 1.0);
 }
 
 TEST_CASE("tick labels tell ticks apart in one notation") {
