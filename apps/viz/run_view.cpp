@@ -34,6 +34,13 @@ RunView::RunView(const std::string& path) : reader_(path) {
     if (got != want) fail(dataset, "shape " + shape_text(got) + ", expected " + shape_text(want));
   };
   times_ = reader_.read("/time");
+  // A run being written appends /time first: take the records every dataset has.
+  const auto rows = [&](const std::string& d) {
+    if (!reader_.has(d)) return times_.size();
+    const auto shape = reader_.shape(d);
+    return shape.empty() ? std::size_t{0} : shape[0];
+  };
+  times_.resize(std::min({times_.size(), rows("/floes/state"), rows("/sea/eta")}));
   const std::size_t T = times_.size();
   const auto off = reader_.read("/floes/offsets");
   if (off.empty() || off[0] != 0.0) fail("/floes/offsets", "expected n + 1 offsets starting at 0");
@@ -49,7 +56,13 @@ RunView::RunView(const std::string& path) : reader_(path) {
   }
   if (offsets_[n] != V) fail("/floes/offsets", "the last offset is not the vertex count " + std::to_string(V));
   body_ = reader_.read("/floes/vertices");
-  expect("/floes/state", {T, n, kStateWidth});
+  {
+    auto st = reader_.shape("/floes/state");
+    if (!st.empty()) st[0] = std::min<std::size_t>(st[0], T);
+    if (st != std::vector<std::size_t>{T, n, kStateWidth})
+      fail("/floes/state", "shape " + shape_text(reader_.shape("/floes/state")) + ", expected [T, " + std::to_string(n) +
+                               ", " + std::to_string(kStateWidth) + "]");
+  }
   expect("/floes/static", {n});
   const auto st = reader_.read("/floes/static");
   is_static_.assign(n, 0);
@@ -64,14 +77,11 @@ RunView::RunView(const std::string& path) : reader_(path) {
     sea_.y = reader_.read("/sea/y");
     const std::size_t nx = sea_.x.size(), ny = sea_.y.size();
     if (nx == 0 || ny == 0) fail("/sea/x", "the sea grid is empty");
-    const auto e = reader_.shape("/sea/eta");
-    if (e.size() == 2) {
-      sea_.dims = 1;
-      expect("/sea/eta", {T, nx});
-    } else {
-      sea_.dims = 2;
-      expect("/sea/eta", {T, ny, nx});
-    }
+    auto e = reader_.shape("/sea/eta");
+    sea_.dims = e.size() == 2 ? 1 : 2;
+    if (!e.empty()) e[0] = std::min<std::size_t>(e[0], T);
+    const std::vector<std::size_t> want = sea_.dims == 1 ? std::vector<std::size_t>{T, nx} : std::vector<std::size_t>{T, ny, nx};
+    if (e != want) fail("/sea/eta", "shape " + shape_text(reader_.shape("/sea/eta")) + ", expected " + shape_text(want));
   }
 }
 
