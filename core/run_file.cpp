@@ -152,16 +152,19 @@ void RunWriter::Impl::write_xdmf() const {
   const std::string tmp = xmf + ".tmp";
   std::ofstream o(tmp);
   if (!o) return;  // ParaView support is a convenience: never fail a run for it
+  o.precision(15);  // times and grid spacings as written, not to 6 digits
   const std::size_t T = times.size();
   auto hdf = [&](const std::string& dims, const std::string& type, const std::string& set) {
     return "<DataItem Dimensions=\"" + dims + "\" NumberType=\"" + type + "\" Precision=\"8\" Format=\"HDF\">" +
            h5name + ":" + set + "</DataItem>";
   };
-  auto slab = [&](const std::string& out, const std::string& sel, int rank, const std::string& full,
-                  const std::string& set) {
-    return "<DataItem ItemType=\"HyperSlab\" Dimensions=\"" + out + "\" Type=\"HyperSlab\">"
-           "<DataItem Dimensions=\"3 " + std::to_string(rank) + "\" Format=\"XML\">" + sel + "</DataItem>" +
-           hdf(full, "Float", set) + "</DataItem>";
+  // A hyperslab of an HDF5 dataset in the Xdmf3 library's own notation
+  // (file:path|start:stride:count:dataset dims), which ParaView's XDMF3 readers
+  // read; they skip XDMF2-style ItemType="HyperSlab" items (tests/apps/paraview_check.py).
+  auto slab = [&](const std::string& out, const std::string& start, const std::string& stride,
+                  const std::string& count, const std::string& full, const std::string& set) {
+    return "<DataItem Dimensions=\"" + out + "\" NumberType=\"Float\" Precision=\"8\" Format=\"HDF\">" + h5name +
+           ":" + set + "|" + start + ":" + stride + ":" + count + ":" + full + "</DataItem>";
   };
   const std::string sn = std::to_string(n), sv = std::to_string(nverts), sT = std::to_string(T);
   o << "<?xml version=\"1.0\" ?>\n<Xdmf Version=\"3.0\">\n<Domain>\n";
@@ -172,11 +175,11 @@ void RunWriter::Impl::write_xdmf() const {
     o << "<Topology TopologyType=\"Mixed\" NumberOfElements=\"" << n << "\">"
       << hdf(std::to_string(topology_size), "Int", "/xdmf/topology") << "</Topology>\n";
     o << "<Geometry GeometryType=\"XYZ\">"
-      << slab(sv + " 3", sk + " 0 0 1 1 1 1 " + sv + " 3", 3, sT + " " + sv + " 3", "/xdmf/vertices")
+      << slab(sv + " 3", sk + " 0 0", "1 1 1", "1 " + sv + " 3", sT + " " + sv + " 3", "/xdmf/vertices")
       << "</Geometry>\n";
     for (int c = 0; c < kStateColumns; ++c)
       o << "<Attribute Name=\"" << kStateColumnNames[c] << "\" AttributeType=\"Scalar\" Center=\"Cell\">"
-        << slab(sn, sk + " 0 " + std::to_string(c) + " 1 1 1 1 " + sn + " 1", 3,
+        << slab(sn, sk + " 0 " + std::to_string(c), "1 1 1", "1 " + sn + " 1",
                 sT + " " + sn + " " + std::to_string(kStateColumns), "/floes/state")
         << "</Attribute>\n";
     o << "<Attribute Name=\"thickness\" AttributeType=\"Scalar\" Center=\"Cell\">"
@@ -190,16 +193,19 @@ void RunWriter::Impl::write_xdmf() const {
     const std::string dims = std::to_string(ny) + " " + std::to_string(nx);
     o << "<Grid Name=\"sea\" GridType=\"Collection\" CollectionType=\"Temporal\">\n";
     for (std::size_t k = 0; k < T; ++k) {
+      // A flat 3D grid (z slowest, one layer): ParaView's XDMF3 reader puts a
+      // 2DCoRectMesh in the y-z plane, this one in the x-y plane.
       o << "<Grid Name=\"sea_" << k << "\" GridType=\"Uniform\"><Time Value=\"" << times[k] << "\"/>\n";
-      o << "<Topology TopologyType=\"2DCoRectMesh\" Dimensions=\"" << dims << "\"/>\n";
-      o << "<Geometry GeometryType=\"ORIGIN_DXDY\"><DataItem Dimensions=\"2\" Format=\"XML\">" << 0.5 * dy
-        << " " << 0.5 * dx << "</DataItem><DataItem Dimensions=\"2\" Format=\"XML\">" << dy << " " << dx
+      o << "<Topology TopologyType=\"3DCoRectMesh\" Dimensions=\"1 " << dims << "\"/>\n";
+      o << "<Geometry GeometryType=\"ORIGIN_DXDYDZ\"><DataItem Dimensions=\"3\" Format=\"XML\">0 " << 0.5 * dy
+        << " " << 0.5 * dx << "</DataItem><DataItem Dimensions=\"3\" Format=\"XML\">1 " << dy << " " << dx
         << "</DataItem></Geometry>\n";
-      const std::string full = sea.dims == 2 ? sT + " " + dims : sT + " " + std::to_string(nx);
-      const std::string sel = sea.dims == 2 ? std::to_string(k) + " 0 0 1 1 1 1 " + dims
-                                            : std::to_string(k) + " 0 1 1 1 " + std::to_string(nx);
+      const std::string sk = std::to_string(k);
       o << "<Attribute Name=\"eta\" AttributeType=\"Scalar\" Center=\"Node\">"
-        << slab(dims, sel, sea.dims == 2 ? 3 : 2, full, "/sea/eta") << "</Attribute>\n";
+        << (sea.dims == 2 ? slab("1 " + dims, sk + " 0 0", "1 1 1", "1 " + dims, sT + " " + dims, "/sea/eta")
+                          : slab("1 " + dims, sk + " 0", "1 1", "1 " + std::to_string(nx), sT + " " + std::to_string(nx),
+                                 "/sea/eta"))
+        << "</Attribute>\n";
       o << "</Grid>\n";
     }
     o << "</Grid>\n";
