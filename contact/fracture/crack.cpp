@@ -69,29 +69,32 @@ std::vector<int> triangles_cut(const Mesh& mesh, const Vec2& a, const Vec2& b) {
   if (!(len > 0.0)) return out;
   const Vec2 nab{-ab.y() / len, ab.x() / len};
   const double tol = 1e-9 * mesh.size;
-  // Separating axes of a segment and a triangle: the segment's normal and the
-  // triangle's edge normals. Overlaps thinner than tol (touching) do not cut.
-  auto separated = [&](const Vec2& axis, const std::array<Vec2, 3>& t) {
+  // Separating axes of a segment and a triangle: the segment's normal, the
+  // segment's direction and the triangle's edge normals. Touching counts as a
+  // cut (projections that meet within tol): a node on the crack line would
+  // otherwise still join the two faces.
+  auto range = [](const Vec2& axis, const std::array<Vec2, 3>& t) {
     double lo = std::numeric_limits<double>::infinity(), hi = -lo;
     for (const Vec2& q : t) {
       lo = std::min(lo, axis.dot(q));
       hi = std::max(hi, axis.dot(q));
     }
+    return std::pair{lo, hi};
+  };
+  auto separated = [&](const Vec2& axis, const std::array<Vec2, 3>& t) {
+    const auto [lo, hi] = range(axis, t);
     const double pa = axis.dot(a), pb = axis.dot(b);
-    return std::min(hi, std::max(pa, pb)) - std::max(lo, std::min(pa, pb)) <= tol;
+    return std::min(hi, std::max(pa, pb)) - std::max(lo, std::min(pa, pb)) < -tol;
   };
   for (std::size_t k = 0; k < mesh.triangles.size(); ++k) {
     const auto& tri = mesh.triangles[k];
     const std::array<Vec2, 3> t{mesh.nodes[static_cast<std::size_t>(tri[0])], mesh.nodes[static_cast<std::size_t>(tri[1])],
                                 mesh.nodes[static_cast<std::size_t>(tri[2])]};
-    if (separated(nab, t)) continue;
-    bool apart = false;
+    bool apart = separated(nab, t) || separated(ab / len, t);
     for (int i = 0; i < 3 && !apart; ++i) {
       const Vec2 e = t[static_cast<std::size_t>((i + 1) % 3)] - t[static_cast<std::size_t>(i)];
       apart = separated(Vec2{-e.y(), e.x()}.normalized(), t);
     }
-    // Also along the segment itself (an end inside the triangle is a cut).
-    if (!apart) apart = separated(ab / len, t);
     if (!apart) out.push_back(static_cast<int>(k));
   }
   return out;

@@ -32,8 +32,8 @@ Chord chord_through(std::span<const Vec2> polygon, const Vec2& p, const Vec2& d)
 std::optional<std::array<std::vector<Vec2>, 2>> split_polygon(std::span<const Vec2> polygon, const Chord& chord,
                                                               double merge);
 
-// Triangles of the mesh whose interior the segment [a, b] crosses (touching a
-// vertex or running along an edge does not count).
+// Triangles of the mesh that the segment [a, b] meets (touching a vertex or
+// running along an edge counts: removing them separates the two faces).
 std::vector<int> triangles_cut(const Mesh& mesh, const Vec2& a, const Vec2& b);
 
 }  // namespace floesim::fracture

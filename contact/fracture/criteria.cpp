@@ -1,6 +1,7 @@
 #include "contact/fracture/criteria.hpp"
 
 #include <algorithm>
+#include <functional>
 #include <cmath>
 #include <limits>
 
@@ -45,13 +46,16 @@ Initiation judge_stress(const Responder& responder, const Response& response, st
 
 struct Candidate {
   double angle = 0.0;
-  double first_ratio = 0.0;  // released / needed over the first increment
+  double ratio = 0.0;  // released / needed over the first growth increment
   bool initiates = false, through = false;
   Vec2 from = Vec2::Zero(), to = Vec2::Zero();
   double released = 0.0, needed = 0.0;
+  double growth_released = 0.0, growth_needed = 0.0;
   int downdates = 0;
 };
 
+// Grows one candidate crack (criteria.hpp). Increment 1 is the flaw,
+// increment 2 decides initiation, later ones propagation.
 Candidate grow(Responder& responder, const Eigen::VectorXd& f, const Eigen::VectorXd& u0, const Vec2& p,
                double angle, std::span<const Vec2> polygon, double gc_h) {
   Candidate c;
@@ -65,7 +69,7 @@ Candidate grow(Responder& responder, const Eigen::VectorXd& f, const Eigen::Vect
   SpdFactor factor = responder.static_factor().copy();
   std::vector<char> cut(mesh.triangles.size(), 0);
   double lo = 0.0, hi = 0.0, released_prev = 0.0, length_prev = 0.0;
-  for (bool first = true;; first = false) {
+  for (int increment = 1;; ++increment) {
     lo = std::max(chord.s0, lo - step);
     hi = std::min(chord.s1, hi + step);
     const Vec2 a = p + lo * d, b = p + hi * d;
@@ -76,26 +80,25 @@ Candidate grow(Responder& responder, const Eigen::VectorXd& f, const Eigen::Vect
     double released = released_prev;
     if (!fresh.empty()) {
       try {
-        factor.modify(responder.model().element_factors(fresh), /*downdate=*/true);
+        factor.modify(responder.model().crack_factors(fresh, angle), /*downdate=*/true);
       } catch (const RunError&) {
-        break;  // numerically singular: the crack is not followed further
+        return c;  // numerically singular: the crack is not followed further
       }
       c.downdates += static_cast<int>(fresh.size());
       for (int t : fresh) cut[static_cast<std::size_t>(t)] = 1;
       released = 0.5 * f.dot(factor.solve(f) - u0);
     }
     const double length = hi - lo;
-    if (first) {
-      c.released = released;
-      c.needed = gc_h * length;
-      c.first_ratio = c.needed > 0.0 ? released / c.needed : 0.0;
-      c.initiates = released >= c.needed;
-      if (!c.initiates) {
-        c.from = a;
-        c.to = b;
-        return c;
-      }
-    } else if (released - released_prev < gc_h * (length - length_prev)) {
+    const double gained = released - released_prev, needed = gc_h * (length - length_prev);
+    // A flaw that already spans the floe is judged on its own energy.
+    const bool decides = increment == 2 || (increment == 1 && at_ends);
+    if (decides) {
+      c.growth_released = gained;
+      c.growth_needed = needed;
+      c.ratio = needed > 0.0 ? gained / needed : 0.0;
+      c.initiates = gained >= needed;
+      if (!c.initiates) return c;
+    } else if (increment > 2 && gained < needed) {
       return c;  // arrest: the last increment did not pay for itself
     }
     c.from = a;
@@ -105,11 +108,10 @@ Candidate grow(Responder& responder, const Eigen::VectorXd& f, const Eigen::Vect
     released_prev = released;
     length_prev = length;
     if (at_ends) {
-      c.through = true;
+      c.through = c.initiates;
       return c;
     }
   }
-  return c;
 }
 
 Initiation judge_griffith(Responder& responder, const Response& response, std::span<const Vec2> polygon,
@@ -127,16 +129,31 @@ Initiation judge_griffith(Responder& responder, const Response& response, std::s
   const Eigen::VectorXd f = model.relieve(model.stiffness() * s.u);
   const Eigen::VectorXd u0 = responder.static_factor().solve(f);
   const double gc_h = options.toughness * model.material().thickness;
-  const int half = static_cast<int>(std::floor(options.angle_range / options.angle_step + 1e-9));
+  // The most stressed nodes, two mesh sizes apart at least.
+  const Mesh& mesh = model.mesh();
+  const std::vector<Eigen::Vector3d> stress = model.nodal_stress(s.u);
+  std::vector<std::pair<double, std::size_t>> order;
+  for (std::size_t i = 0; i < stress.size(); ++i) order.emplace_back(principal(stress[i]).value, i);
+  std::sort(order.begin(), order.end(), std::greater<>());
+  std::vector<std::size_t> seeds;
+  for (const auto& [value, node] : order) {
+    if (static_cast<int>(seeds.size()) >= options.candidates || value < options.region * order.front().first) break;
+    bool apart = true;
+    for (std::size_t other : seeds) apart = apart && (mesh.nodes[node] - mesh.nodes[other]).norm() >= 2.0 * mesh.size;
+    if (apart) seeds.push_back(node);
+  }
   Candidate best;
-  best.first_ratio = -1.0;
-  for (int k = 0; k <= 2 * half; ++k) {
-    // 0, +1, -1, +2, -2, ...: the principal direction first.
-    const int offset = (k % 2 == 1) ? (k + 1) / 2 : -(k / 2);
-    const Candidate c = grow(responder, f, u0, r.point, r.direction + offset * options.angle_step, polygon, gc_h);
+  best.ratio = -1.0;
+  for (std::size_t node : seeds) {
+    const double angle = crack_direction(principal(stress[node]).angle);
+    Candidate c = grow(responder, f, u0, mesh.nodes[node], angle, polygon, gc_h);
     ++r.candidates;
     r.downdates += c.downdates;
-    if (c.first_ratio > best.first_ratio) best = c;
+    if (c.ratio > best.ratio) {
+      best = c;
+      r.point = mesh.nodes[node];
+      r.stress = principal(stress[node]).value;
+    }
   }
   r.initiates = best.initiates;
   r.direction = line_direction(best.angle);
@@ -145,6 +162,8 @@ Initiation judge_griffith(Responder& responder, const Response& response, std::s
   r.through = best.through;
   r.energy_released = best.released;
   r.energy_needed = best.needed;
+  r.growth_released = best.growth_released;
+  r.growth_needed = best.growth_needed;
   return r;
 }
 
@@ -156,11 +175,11 @@ Initiation judge(Responder& responder, const Response& response, std::span<const
                                                 : judge_griffith(responder, response, polygon, options);
 }
 
-double energy_release(Responder& responder, const Eigen::VectorXd& f, std::span<const int> triangles) {
+double energy_release(Responder& responder, const Eigen::VectorXd& f, std::span<const int> triangles, double angle) {
   const Eigen::VectorXd fr = responder.model().relieve(f);
   const Eigen::VectorXd u0 = responder.static_factor().solve(fr);
   SpdFactor factor = responder.static_factor().copy();
-  factor.modify(responder.model().element_factors(triangles), /*downdate=*/true);
+  factor.modify(responder.model().crack_factors(triangles, angle), /*downdate=*/true);
   return 0.5 * fr.dot(factor.solve(fr) - u0);
 }
 

@@ -119,6 +119,34 @@ Eigen::SparseMatrix<double> ElasticModel::element_factors(std::span<const int> t
   return out;
 }
 
+Eigen::SparseMatrix<double> ElasticModel::crack_factors(std::span<const int> triangles, double angle) const {
+  const double e = material_.young, nu = material_.poisson;
+  const double c = std::cos(angle), s = std::sin(angle);
+  // Strain in the crack frame: (eps_tt, eps_nn, gamma_tn) = T (exx, eyy, gxy).
+  Eigen::Matrix3d t;
+  t << c * c, s * s, c * s, s * s, c * c, -c * s, -2.0 * c * s, 2.0 * c * s, c * c - s * s;
+  Eigen::Matrix<double, 3, 2> l = Eigen::Matrix<double, 3, 2>::Zero();
+  l(0, 0) = nu * std::sqrt(e / (1.0 - nu * nu));
+  l(1, 0) = std::sqrt(e / (1.0 - nu * nu));
+  l(2, 1) = std::sqrt(e / (2.0 * (1.0 + nu)));
+  const Eigen::Matrix<double, 3, 2> tl = t.transpose() * l;
+  std::vector<Eigen::Triplet<double>> trip;
+  trip.reserve(12 * triangles.size());
+  int col = 0;
+  for (int tr : triangles) {
+    const auto ts = static_cast<std::size_t>(tr);
+    const Eigen::Matrix<double, 6, 2> w = std::sqrt(material_.thickness * mesh_.area(ts)) * b_[ts].transpose() * tl;
+    const auto& tri = mesh_.triangles[ts];
+    for (int i = 0; i < 6; ++i)
+      for (int j = 0; j < 2; ++j)
+        if (w(i, j) != 0.0) trip.emplace_back(2 * tri[static_cast<std::size_t>(i / 2)] + i % 2, col + j, w(i, j));
+    col += 2;
+  }
+  Eigen::SparseMatrix<double> out(dofs(), col);
+  out.setFromTriplets(trip.begin(), trip.end());
+  return out;
+}
+
 std::vector<Eigen::Vector3d> ElasticModel::element_stress(const Eigen::VectorXd& u) const {
   std::vector<Eigen::Vector3d> s(mesh_.triangles.size());
   for (std::size_t t = 0; t < mesh_.triangles.size(); ++t) {

@@ -59,6 +59,15 @@ public:
 
   // W (dofs x 3k): the columns W_e of the listed triangles, K_e = W_e W_e^T.
   Eigen::SparseMatrix<double> element_factors(std::span<const int> triangles) const;
+  // W (dofs x 2k): what a crack along the direction `angle` (rad from +x)
+  // removes from the listed triangles (a smeared crack): in the crack's frame
+  // (t along it, n across it) a cracked triangle keeps only the stiffness
+  // along the crack, sigma_tt = E eps_tt, sigma_nn = sigma_tn = 0, so it loses
+  //   D - E e_t e_t^T = E / (1 - nu^2) (nu, 1, 0)(nu, 1, 0)^T + G (0, 0, 1)(0, 0, 1)^T
+  // (rank 2, in (tt, nn, tn) Voigt components; G = E / (2 (1 + nu))), and
+  // K <- K - W W^T. Opening and sliding are free, the material along the
+  // crack still carries its own load.
+  Eigen::SparseMatrix<double> crack_factors(std::span<const int> triangles, double angle) const;
 
   // Constant stress of each triangle, and the area-weighted average of the
   // triangles around each node (the recovered nodal stress).

@@ -46,7 +46,7 @@ void observe_state(const ElasticModel& model, double t, const Eigen::VectorXd& u
 }  // namespace
 
 Responder::Responder(const ElasticModel& model, const ResponseOptions& options) : model_(model), options_(options) {
-  if (!(options.duration > 0.0) || !(options.load_radius > 0.0) || options.steps_per_pulse < 1 || options.max_steps < 1)
+  if (!(options.duration > 0.0) || !(options.load_radius > 0.0) || !(options.damping >= 0.0) || options.steps_per_pulse < 1 || options.max_steps < 1)
     throw InputError("fracture: duration > 0, load radius > 0 and positive step counts are required");
   const double c = model.wave_speed();
   const double d = std::max(model.diameter(), model.mesh().size);
@@ -59,7 +59,7 @@ Responder::Responder(const ElasticModel& model, const ResponseOptions& options) 
     dt_ = t_end_ / steps_;
   }
   t_end_ = steps_ * dt_;
-  beta_ = model.mesh().size / (M_PI * c);
+  beta_ = 2.0 * options.damping * model.mesh().size / (M_PI * c);
   eps_ = 1e-6 * (c / d) * (c / d);
 }
 

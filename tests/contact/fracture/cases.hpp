@@ -22,8 +22,9 @@ inline std::vector<Vec2> disc(double r, int n) {
 }
 
 // Consistent nodal forces of a uniform normal traction sigma (Pa) on the
-// outline edges that lie on x = x0 (outward normal along sign * x).
-inline void add_end_traction(const ElasticModel& m, Eigen::VectorXd& f, double x0, double sigma, double sign) {
+// outline edges that lie on x_axis = x0 (outward normal along sign * e_axis).
+inline void add_edge_traction(const ElasticModel& m, Eigen::VectorXd& f, int axis, double x0, double sigma,
+                              double sign) {
   const Mesh& mesh = m.mesh();
   const double tol = 1e-9 * mesh.size;
   const double h = m.material().thickness;
@@ -31,11 +32,14 @@ inline void add_end_traction(const ElasticModel& m, Eigen::VectorXd& f, double x
     for (int k = 0; k < 3; ++k) {
       const int a = tri[static_cast<std::size_t>(k)], b = tri[static_cast<std::size_t>((k + 1) % 3)];
       const Vec2 &pa = mesh.nodes[static_cast<std::size_t>(a)], &pb = mesh.nodes[static_cast<std::size_t>(b)];
-      if (std::abs(pa.x() - x0) > tol || std::abs(pb.x() - x0) > tol) continue;
+      if (std::abs(pa[axis] - x0) > tol || std::abs(pb[axis] - x0) > tol) continue;
       const double half = 0.5 * sigma * h * (pa - pb).norm() * sign;
-      f[2 * a] += half;
-      f[2 * b] += half;
+      f[2 * a + axis] += half;
+      f[2 * b + axis] += half;
     }
+}
+inline void add_end_traction(const ElasticModel& m, Eigen::VectorXd& f, double x0, double sigma, double sign) {
+  add_edge_traction(m, f, 0, x0, sigma, sign);
 }
 
 }  // namespace floesim::fracture::testing
