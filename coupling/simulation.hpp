@@ -5,7 +5,7 @@
 //
 //   choose dt (output schedule, dt_max, collision limit)
 //   -> sample forcing -> drift velocities (drag, Coriolis) -> collide (LCPs)
-//   -> advance positions -> detect (new contacts; an overlap rejects the step,
+//   -> percussion (fracture checks; a split floe becomes two) -> advance positions -> detect (new contacts; an overlap rejects the step,
 //      which is redone with half the dt) -> sea flow -> check state
 //
 // Step contract: on entry the state is at time() and the contact detection
@@ -22,6 +22,7 @@
 #include <vector>
 
 #include "coupling/drift.hpp"
+#include "coupling/percussion.hpp"
 #include "contact/detection.hpp"
 #include "contact/impulse.hpp"
 #include "contact/shapes.hpp"
@@ -32,9 +33,9 @@ namespace floesim {
 
 namespace fluid { class Sea; }
 
-enum class Phase { choose_dt, forcing, drift, collide, advance, detect, sea, check, record, count };
+enum class Phase { choose_dt, forcing, drift, collide, percussion, advance, detect, sea, check, record, count };
 inline constexpr std::array<const char*, static_cast<std::size_t>(Phase::count)> kPhaseNames = {
-    "choose_dt", "forcing", "drift", "collide", "advance", "detect", "sea", "check", "record"};
+    "choose_dt", "forcing", "drift", "collide", "percussion", "advance", "detect", "sea", "check", "record"};
 
 // Wall time spent in each phase (s), for `floesim run --profile`.
 struct Profile {
@@ -50,6 +51,7 @@ struct StepContext {
   ForcingSample forcing;
   std::vector<FloeState> start;  // the floes at t, to redo a rejected step
   Vec2 momentum = Vec2::Zero();   // of the dynamic floes, updated by the phases that change it
+  std::vector<contact::ContactImpulse> impulses;  // of the collide phase, one per contact of detection()
 };
 
 // Energies by part (J), named as the columns of /diagnostics/energy; the last
@@ -90,6 +92,10 @@ public:
   // Things a user should hear about once, with a count (e.g. steps cut to the floor).
   std::vector<std::string> warnings() const;
 
+  // Fracture initiations since the last call ([fracture] enabled), and counts.
+  std::vector<FractureEventRow> take_fracture_events();
+  const PercussionStats* percussion_stats() const { return percussion_ ? &percussion_->stats() : nullptr; }
+
   // The sea surface, if the run has one ([sea] model != "none").
   bool has_sea() const { return sea_ != nullptr; }
   SeaGridInfo sea_grid() const;
@@ -101,6 +107,8 @@ private:
   void sea_flow(const StepContext& ctx);
   void drift(StepContext& ctx);
   void collide(StepContext& ctx);
+  void percussion(StepContext& ctx);
+  void on_floes_changed();  // rebuilds every per-floe structure (after a split)
   void advance(const StepContext& ctx);
   bool detect_and_check(StepContext& ctx);  // false: the step overlapped, dt halved
   void wrap_periodic();
@@ -115,6 +123,7 @@ private:
   contact::ImpulseOptions impulse_options_;
   contact::Detection detection_;  // at the present positions
   contact::CollisionStats stats_;
+  std::unique_ptr<Percussion> percussion_;  // [fracture] enabled
   MomentumBudget budget_, step_budget_;  // run total; this step's (redone steps do not count)
   long floor_steps_ = 0;          // steps the collision limit wanted below the floor
   long rejected_steps_ = 0;       // steps redone after an overlap
