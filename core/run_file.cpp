@@ -74,11 +74,13 @@ RunWriter::RunWriter(const std::string& path, const Floes& floes, const std::str
   // ParaView helpers: mixed-polygon topology (type 3 = polygon, vertex count,
   // vertex indices) and per-record world vertices.
   w.xdmf_group = h5::create_group(w.file, "/xdmf");
-  w.state = h5::create_growable(w.floes_group, "state", {0, kStateColumns});
+  note_floes(floes);  // the tables (the growing datasets do not exist yet)
+  w.write_tables();   // also when there is no floe
+  // Chunks sized on the floes at the start (a row of 1 floe per chunk would
+  // make every record touch n chunks).
+  w.state = h5::create_growable(w.floes_group, "state", {w.n, kStateColumns});
   h5::set_attr(w.state, "columns", std::vector<std::string>(std::begin(kStateColumnNames), std::end(kStateColumnNames)));
-  w.verts = h5::create_growable(w.xdmf_group, "vertices", {0, 3});
-  note_floes(floes);
-  w.write_tables();  // also when there is no floe
+  w.verts = h5::create_growable(w.xdmf_group, "vertices", {w.nverts, 3});
 
   h5::Handle d = h5::create_group(w.file, "/diagnostics");
   w.energy = h5::create_extendible(d, "energy", {w.energy_columns.size()});
