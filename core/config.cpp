@@ -359,7 +359,7 @@ void read_fracture(Section s, FractureParams& f, const std::string& file) {
   f.split = s.boolean("split", f.split);
   f.mesh_size = s.number("mesh_size", f.mesh_size, positive, "a mesh size > 0 (m)");
   f.duration = s.number("duration", f.duration, positive, "a duration > 0 (s)");
-  f.load_radius = s.number("load_radius", f.load_radius, non_negative, "a radius >= 0 (m; 0: the mesh size)");
+  f.load_radius = s.number("load_radius", f.load_radius, non_negative, "a radius >= 0 (m; 0: the floe's thickness)");
   if (const toml::array* a = s.table_array("load")) {
     for (std::size_t i = 0; i < a->size(); ++i) {
       Section l((*a)[i].as_table(), "fracture.load", file);

@@ -58,7 +58,8 @@ bool Percussion::check(Floes& floes, const std::vector<contact::ContactPoint>& c
     fresh_time_ = t;
   } else {
     // The step is being redone: its initiations without a split are found again.
-    std::erase_if(events_, [&](const FractureEventRow& e) { return e.time == t && e.piece_a < 0.0; });
+    stats_.initiations -= static_cast<long>(
+        std::erase_if(events_, [&](const FractureEventRow& e) { return e.time == t && e.piece_a < 0.0; }));
   }
   // The impulses on each floe, in its body frame (ordered by floe index).
   struct Struck {
@@ -88,9 +89,9 @@ bool Percussion::check(Floes& floes, const std::vector<contact::ContactPoint>& c
   const double needed = params_.criterion == FractureCriterion::stress
                             ? params_.strength
                             : std::sqrt(params_.young * params_.toughness / (M_PI * params_.mesh_size));
-  const double radius = params_.load_radius > 0.0 ? params_.load_radius : params_.mesh_size;
   bool changed = false;
   for (auto& [i, st] : struck) {
+    const double radius = params_.load_radius > 0.0 ? params_.load_radius : floes.thickness[i];
     const double pressure = M_PI * st.largest / (2.0 * params_.duration) / (floes.thickness[i] * 2.0 * radius);
     if (pressure < screen_ * needed) {
       ++stats_.screened;

@@ -12,7 +12,8 @@
 //
 // Screening. An analysis costs a dynamic solve per floe, so a floe is
 // analysed only when the contact pressure scale of its largest impulse,
-//   p = (pi |J| / (2 tau)) / (h 2 r)   (peak force over thickness x patch width),
+//   p = (pi |J| / (2 tau)) / (h 2 r)   (peak force over thickness x patch width,
+//                                      r the load radius),
 // reaches `screen` times the stress the criterion needs (the strength; for
 // griffith the stress sqrt(E G_c / (pi s)) that would open a flaw of one mesh
 // size s). The largest tensile stress of the tests stays below p
@@ -38,9 +39,9 @@ namespace floesim {
 namespace fracture { class FloeFracture; }
 
 struct PercussionStats {
-  long checks = 0;        // floes analysed
+  long checks = 0;        // floes analysed (again when a step is redone)
   long screened = 0;      // floes struck but below the screen
-  long initiations = 0;
+  long initiations = 0;   // events (a crack whose line leaves the floe at once, from a corner, is not split)
   long splits = 0;
   long failed_splits = 0;  // cracked through but not split (sliver, or the pieces would overlap)
   double seconds = 0.0;    // wall time in analyses

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <map>
 
 #include "core/error.hpp"
 
@@ -84,6 +85,22 @@ ElasticModel::ElasticModel(Mesh mesh, const Material& material) : mesh_(std::mov
     phi_(k + 1, 2) = r.x();
   }
   rigid_inv_ = (phi_.transpose() * m_.asDiagonal() * phi_).inverse();
+
+  // Outline edges (in one triangle only) and each node's share of their length.
+  std::map<std::pair<int, int>, int> edges;
+  for (const auto& tri : mesh_.triangles)
+    for (int k = 0; k < 3; ++k) {
+      const int a = tri[static_cast<std::size_t>(k)], b = tri[static_cast<std::size_t>((k + 1) % 3)];
+      ++edges[{std::min(a, b), std::max(a, b)}];
+    }
+  node_outline_.assign(nn, 0.0);
+  for (const auto& [edge, count] : edges) {
+    if (count != 1) continue;
+    outline_edges_.push_back({edge.first, edge.second});
+    const double len = (mesh_.nodes[static_cast<std::size_t>(edge.first)] - mesh_.nodes[static_cast<std::size_t>(edge.second)]).norm();
+    node_outline_[static_cast<std::size_t>(edge.first)] += 0.5 * len;
+    node_outline_[static_cast<std::size_t>(edge.second)] += 0.5 * len;
+  }
 
   // Diameter: the outline's nodes bound it.
   std::vector<Vec2> outline;
@@ -185,13 +202,24 @@ void ElasticModel::remove_rigid(Eigen::VectorXd& u) const {
 }
 
 void ElasticModel::add_point_load(Eigen::VectorXd& f, const Vec2& point, const Vec2& force, double radius) const {
+  // On the outline? (distance to the nearest outline edge)
+  double to_outline = std::numeric_limits<double>::infinity();
+  for (const auto& e : outline_edges_) {
+    const Vec2& a = mesh_.nodes[static_cast<std::size_t>(e[0])];
+    const Vec2 ab = mesh_.nodes[static_cast<std::size_t>(e[1])] - a;
+    const double s = std::clamp((point - a).dot(ab) / ab.squaredNorm(), 0.0, 1.0);
+    to_outline = std::min(to_outline, (a + s * ab - point).norm());
+  }
+  const bool surface = to_outline <= 0.25 * radius;
   std::vector<std::pair<std::size_t, double>> w;
   double sum = 0.0;
   for (std::size_t i = 0; i < mesh_.node_count(); ++i) {
+    const double share = surface ? node_outline_[i] : node_area_[i];
+    if (!(share > 0.0)) continue;
     const double d = (mesh_.nodes[i] - point).norm();
     if (d >= radius) continue;
     const double x = 1.0 - (d / radius) * (d / radius);
-    w.emplace_back(i, node_area_[i] * x * x);
+    w.emplace_back(i, share * x * x);
     sum += w.back().second;
   }
   if (w.empty() || !(sum > 0.0)) {
@@ -199,7 +227,10 @@ void ElasticModel::add_point_load(Eigen::VectorXd& f, const Vec2& point, const V
     double best_d = std::numeric_limits<double>::infinity();
     for (std::size_t i = 0; i < mesh_.node_count(); ++i) {
       const double d = (mesh_.nodes[i] - point).norm();
-      if (d < best_d) { best_d = d; best = i; }
+      if (d < best_d && (!surface || node_outline_[i] > 0.0)) {
+        best_d = d;
+        best = i;
+      }
     }
     w.assign(1, {best, 1.0});
     sum = 1.0;

@@ -21,6 +21,7 @@
 
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
+#include <array>
 #include <span>
 #include <vector>
 
@@ -82,10 +83,15 @@ public:
   Eigen::VectorXd relieve(const Eigen::VectorXd& f) const;
   void remove_rigid(Eigen::VectorXd& u) const;
 
-  // Adds to f (N, per dof) the force `force` applied at `point`, spread over
-  // the nodes within `radius` of it with the weights A_i (1 - (d_i/radius)^2)^2
-  // (A_i the node's share of area), which sum to one: the resultant is exactly
-  // `force`. A point farther than `radius` from every node goes to the nearest.
+  // Adds to f (N, per dof) the force `force` applied at `point`, spread with
+  // the weights w_i (1 - (d_i/radius)^2)^2, normalised to sum to one (so the
+  // resultant is exactly `force`), over
+  //  * the outline's nodes within `radius`, w_i their share of outline length,
+  //    when the point is on the outline (within radius / 4 of it): a contact
+  //    pressure, as in a collision (a body force there would pull on the
+  //    free surface behind it and make spurious tension);
+  //  * otherwise the nodes within `radius`, w_i their share of area.
+  // A point farther than `radius` from every such node goes to the nearest.
   void add_point_load(Eigen::VectorXd& f, const Vec2& point, const Vec2& force, double radius) const;
 
   // Linear interpolation of nodal values at a point of the mesh; false if outside.
@@ -100,6 +106,8 @@ private:
   Eigen::SparseMatrix<double> k_;
   Eigen::VectorXd m_;
   std::vector<double> node_area_;
+  std::vector<double> node_outline_;                 // share of outline length per node (m)
+  std::vector<std::array<int, 2>> outline_edges_;
   Eigen::MatrixXd phi_;        // dofs x 3
   Eigen::Matrix3d rigid_inv_;  // (Phi^T M Phi)^-1
   Vec2 centre_ = Vec2::Zero();

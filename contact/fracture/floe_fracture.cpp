@@ -8,10 +8,10 @@ MeshOptions mesh_options(const FractureParams& p) {
   return o;
 }
 
-ResponseOptions response_options(const FractureParams& p, double mesh_size) {
+ResponseOptions response_options(const FractureParams& p, double thickness) {
   ResponseOptions o;
   o.duration = p.duration;
-  o.load_radius = p.load_radius > 0.0 ? p.load_radius : mesh_size;
+  o.load_radius = p.load_radius > 0.0 ? p.load_radius : thickness;
   return o;
 }
 
@@ -27,7 +27,7 @@ FloeFracture::FloeFracture(std::span<const Vec2> polygon, double thickness, doub
                            const FractureParams& params)
     : polygon_(polygon.begin(), polygon.end()),
       model_(mesh_polygon(polygon, mesh_options(params)), Material{params.young, params.poisson, density, thickness}),
-      responder_(model_, response_options(params, model_.mesh().size)),
+      responder_(model_, response_options(params, thickness)),
       criterion_(criterion_options(params)) {}
 
 FloeFracture::Result FloeFracture::analyse(std::span<const PointLoad> loads, const Observer& observe) {

@@ -43,7 +43,9 @@ private:
 
 // The options of the pieces from the [fracture] parameters.
 MeshOptions mesh_options(const FractureParams& params);
-ResponseOptions response_options(const FractureParams& params, double mesh_size);
+// The load radius is [fracture] load_radius, or the floe's thickness when that is 0
+// (a contact between floes spans about their thickness).
+ResponseOptions response_options(const FractureParams& params, double thickness);
 CriterionOptions criterion_options(const FractureParams& params);
 
 }  // namespace floesim::fracture

@@ -45,6 +45,8 @@ Brazil squeeze(double d, double mesh, double p, double strength) {
 TEST_CASE("fracture brazilian: centre tension 2P/(pi D h) under refinement and a crack along the loaded diameter") {
   const double d = 20.0, p = 1.0e6, strength = 0.5e6;
   const double exact = 2.0 * p / (M_PI * d * 1.0);
+  // Loads spread over the default radius, the thickness (1 m); Hondros's
+  // solution for such a patch lowers the centre's tension by well under 1%.
   double previous = 1.0;
   for (double mesh : {2.0, 1.0, 0.5}) {
     const Brazil b = squeeze(d, mesh, p, strength);
@@ -54,8 +56,8 @@ TEST_CASE("fracture brazilian: centre tension 2P/(pi D h) under refinement and a
                     << "), max sigma_1 " << i.stress << " at " << i.point.transpose() << ", direction "
                     << i.direction * 180 / M_PI << " deg, P_c " << i.load_factor * p << " (exact "
                     << M_PI * d * strength / 2 << ")");
-    CHECK(err < 0.05);
-    CHECK(err < previous + 0.005);
+    CHECK(err < (mesh < 2.0 ? 0.05 : 0.06));
+    CHECK(err < previous);
     previous = err;
     CHECK(std::abs(i.direction * 180.0 / M_PI - 90.0) < 5.0);
     CHECK(std::abs(i.point.x()) < 0.1 * d);
@@ -63,6 +65,11 @@ TEST_CASE("fracture brazilian: centre tension 2P/(pi D h) under refinement and a
     CHECK(i.through);
     CHECK(std::abs(i.crack_from.x()) < 0.1 * d);
   }
+}
+
+TEST_CASE("fracture brazilian: the finest mesh is within 1.5% at the centre") {
+  const double d = 20.0, p = 1.0e6;
+  CHECK(squeeze(d, 0.5, p, 0.5e6).centre == doctest::Approx(2.0 * p / (M_PI * d)).epsilon(0.015));
 }
 
 TEST_CASE("fracture brazilian: the stress criterion initiates at the predicted load") {

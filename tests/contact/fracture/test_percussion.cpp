@@ -32,7 +32,7 @@ struct Hit {
 
 // A square floe of side L at rest, struck in the middle of its left side by a
 // vertex of an octagon of diameter L / 2 moving at 1 m/s along +x.
-Hit threshold(double side, double tau, double mesh) {
+Hit threshold(double side, double tau, double mesh, double load_radius) {
   Floes f;
   FloeInput t;
   t.vertices = {{-side / 2, -side / 2}, {side / 2, -side / 2}, {side / 2, side / 2}, {-side / 2, side / 2}};
@@ -58,6 +58,7 @@ Hit threshold(double side, double tau, double mesh) {
   FractureParams fp;
   fp.mesh_size = mesh;
   fp.duration = tau;
+  fp.load_radius = load_radius;
   FloeFracture floe(f.vertices(0), 1.0, 917.0, fp);
   const PointLoad load{c.point, j, true};
   const FloeFracture::Result res = floe.analyse(std::span<const PointLoad>(&load, 1));
@@ -77,10 +78,12 @@ TEST_CASE("fracture percussion: threshold speed against floe size, quasi-static 
   const double sizes[3] = {10.0, 20.0, 40.0};
   Hit dynamic[3], quasi[3];
   for (int k = 0; k < 3; ++k) {
-    dynamic[k] = threshold(sizes[k], 0.01, 1.0);
-    quasi[k] = threshold(sizes[k], 1.0, sizes[k] / 20.0);
-    MESSAGE("L " << sizes[k] << " m: v_c " << dynamic[k].speed << " m/s (tau 0.01 s, mesh 1 m), " << quasi[k].speed
-                 << " m/s (tau 1 s, mesh L/20)");
+    // A run's setting (mesh and load radius fixed), and a self-similar one.
+    dynamic[k] = threshold(sizes[k], 0.01, 1.0, 0.0);
+    quasi[k] = threshold(sizes[k], 1.0, sizes[k] / 20.0, sizes[k] / 20.0);
+    MESSAGE("L " << sizes[k] << " m: v_c " << dynamic[k].speed << " m/s (tau 0.01 s, mesh 1 m, load radius h), "
+                 << quasi[k].speed << " m/s (tau 1 s, mesh and load radius L/20); stress / pressure scale "
+                 << dynamic[k].stress / dynamic[k].pressure << ", " << quasi[k].stress / quasi[k].pressure);
     // The percussion screen's premise: the largest stress stays well below the contact pressure scale.
     CHECK(dynamic[k].stress < 0.5 * dynamic[k].pressure);
     CHECK(quasi[k].stress < 0.5 * quasi[k].pressure);
@@ -89,9 +92,10 @@ TEST_CASE("fracture percussion: threshold speed against floe size, quasi-static 
   CHECK(dynamic[2].speed < dynamic[1].speed);
   CHECK(quasi[1].speed < quasi[0].speed);
   CHECK(quasi[2].speed < quasi[1].speed);
-  // Quasi-static: v_c ~ 1 / L (self-similar meshes, so only the size changes).
+  // Quasi-static: v_c ~ 1 / L (self-similar meshes and loads, so only the size changes).
   const double qs = slope(sizes[0], quasi[0].speed, sizes[2], quasi[2].speed);
-  CHECK(qs == doctest::Approx(-1.0).epsilon(0.1));
+  CHECK(qs > -1.1);
+  CHECK(qs < -0.9);
   // Dynamic: steeper, towards L^-2.
   const double dyn = slope(sizes[0], dynamic[0].speed, sizes[2], dynamic[2].speed);
   MESSAGE("slopes: quasi-static " << qs << ", dynamic " << dyn);
