@@ -13,10 +13,13 @@
 //   energies, one probe line per --probe (sxx syy sxy at that point, Pa, at
 //   the instant of max_principal_stress), time_ms.
 // Exit 0 when the analysis ran (whether or not it initiates), 2 for bad input.
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <iostream>
+#include <limits>
 #include <memory>
+#include <sstream>
 
 #include "apps/commands.hpp"
 #include "contact/fracture/floe_fracture.hpp"

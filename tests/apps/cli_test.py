@@ -146,24 +146,23 @@ def case_killed_run():
     check("killed" in info, "info says the run has no end mark")
 
 
-def case_xdmf():
-    # Validate the XDMF against the run file: every HDF reference exists, has
-    # the declared dimensions, and every hyperslab selection is in bounds.
-    run("run", EXAMPLE, "-q", "--until", "300", "-o", "x.h5")
-    tree = ET.parse(os.path.join(WORK, "x.xmf"))
+def check_xdmf(name):
+    # Validate NAME.xmf against NAME.h5: every HDF reference exists, has the
+    # declared dimensions, and every hyperslab selection is in bounds.
+    tree = ET.parse(os.path.join(WORK, name + ".xmf"))
     root = tree.getroot()
     check(root.tag == "Xdmf", "root element")
     grids = root.findall("./Domain/Grid")
     check(len(grids) >= 1 and grids[0].get("CollectionType") == "Temporal", "temporal collection")
     steps = grids[0].findall("Grid")
-    with h5py.File(os.path.join(WORK, "x.h5")) as f:
+    with h5py.File(os.path.join(WORK, name + ".h5")) as f:
         check(len(steps) == f["time"].shape[0], "one grid per record")
         for g in steps:
             for item in g.iter("DataItem"):
                 if item.get("Format") != "HDF":
                     continue
                 fname, dset = item.text.strip().split(":")
-                check(fname == "x.h5", "relative file name")
+                check(fname == name + ".h5", "relative file name")
                 dims = tuple(int(d) for d in item.get("Dimensions").split())
                 check(dset in f and f[dset].shape == dims, f"{dset}: {dims} vs {f[dset].shape if dset in f else None}")
             for slab in g.iter("DataItem"):
@@ -176,6 +175,16 @@ def case_xdmf():
                 check(np.all(end < shape), "hyperslab in bounds")
                 check(int(np.prod(s[2])) == int(np.prod([int(d) for d in slab.get("Dimensions").split()])),
                       "hyperslab size = declared")
+    return steps
+
+
+def case_xdmf():
+    # Validate the XDMF against the run file: every HDF reference exists, has
+    # the declared dimensions, and every hyperslab selection is in bounds.
+    run("run", EXAMPLE, "-q", "--until", "300", "-o", "x.h5")
+    steps = check_xdmf("x")
+    with h5py.File(os.path.join(WORK, "x.h5")) as f:
+        for g in steps:
             topo = g.find("Topology")
             check(topo.get("TopologyType") == "Mixed" and int(topo.get("NumberOfElements")) == 30, "topology")
         # The mixed topology lists 30 polygons (type 3) covering every vertex.
@@ -324,8 +333,10 @@ def case_fracture_run():
             after = t > e[0] + 1e-9
             check(np.all(np.isnan(st[after, parent, 0])), "the parent ends")
             check(np.all(np.isnan(st[t < e[0], a, 0])) and np.all(np.isfinite(st[after, a, 0])), "pieces appear")
-        # The XDMF still describes every record.
-        check(os.path.exists(os.path.join(WORK, "perc.xmf")), "xdmf")
+    # The XDMF still describes every record: before the split 2 floes, after it 6 numbers.
+    steps = check_xdmf("perc")
+    counts = [int(g.find("Topology").get("NumberOfElements")) for g in steps]
+    check(counts[0] == 2 and counts[-1] == 6, f"floes per record {counts[0]} -> {counts[-1]}")
     info = json.loads(run("info", "perc.h5", "--json").stdout)
     check(info["status"] == "complete", "info reads it")
 
