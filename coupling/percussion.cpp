@@ -69,15 +69,14 @@ bool Percussion::check(Floes& floes, const std::vector<contact::ContactPoint>& c
   std::map<std::size_t, Struck> struck;
   for (std::size_t j = 0; j < contacts.size() && j < impulses.size(); ++j) {
     const contact::ContactPoint& c = contacts[j];
-    const Vec2 tangent{-c.normal.y(), c.normal.x()};
-    const Vec2 impulse = impulses[j].normal * c.normal + impulses[j].tangential * tangent;  // on b
+    const Vec2& impulse = impulses[j].vector;  // on b
     const double size = impulse.norm();
     if (!(size > 0.0)) continue;
     const std::pair<std::size_t, double> sides[2] = {{c.a, -1.0}, {c.b, 1.0}};
     for (const auto& [f, sign] : sides) {
       if (floes.is_static[f] || fresh_.count(floes.id[f])) continue;
       const FloeState& s = floes.state[f];
-      const Vec2 point = sign > 0.0 ? Vec2(c.point - c.shift) : c.point;
+      const Vec2 point = sign > 0.0 ? Vec2(impulses[j].point - c.shift) : impulses[j].point;
       Struck& st = struck[f];
       st.loads.push_back({rotate(point - Vec2{s.x, s.y}, -s.yaw), rotate(sign * impulse, -s.yaw), true});
       st.total += size;

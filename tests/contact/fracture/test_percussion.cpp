@@ -54,13 +54,17 @@ Hit threshold(double side, double tau, double mesh, double load_radius) {
   contact::CollisionStats stats;
   const auto imp = contact::resolve_collisions(f, det.contacts, io, stats);
   const contact::ContactPoint& c = det.contacts[0];
-  const Vec2 j = -(imp[0].normal * c.normal + imp[0].tangential * Vec2{-c.normal.y(), c.normal.x()});  // on floe a = 0
+  REQUIRE(c.a == 0);
+  const Vec2 j = -imp[0].vector;  // floe a = 0 gets the opposite of b's impulse
+  CHECK((imp[0].point - c.point).norm() == 0.0);
+  // b (the octagon) gave up (1 + e) times its approach momentum relative to the pair's.
+  CHECK(imp[0].vector.x() < 0.0);
   FractureParams fp;
   fp.mesh_size = mesh;
   fp.duration = tau;
   fp.load_radius = load_radius;
   FloeFracture floe(f.vertices(0), 1.0, 917.0, fp);
-  const PointLoad load{c.point, j, true};
+  const PointLoad load{imp[0].point, j, true};
   const FloeFracture::Result res = floe.analyse(std::span<const PointLoad>(&load, 1));
   Hit h;
   const double scale = fp.strength / res.initiation.stress;  // the response is linear in v
