@@ -118,6 +118,7 @@ RunWriter::~RunWriter() {
 
 void RunWriter::note_floes(const Floes& floes) {
   Impl& w = *impl_;
+  if (floes.ids_issued <= w.n && floes.size() <= w.n) return;  // nothing new (the usual step)
   std::size_t issued = floes.ids_issued;
   for (std::size_t i = 0; i < floes.size(); ++i) issued = std::max<std::size_t>(issued, id_of(floes, i) + 1);
   if (issued <= w.n) return;
