@@ -366,6 +366,7 @@ void read_fracture(Section s, FractureParams& f, const std::string& file) {
   f.split = s.boolean("split", f.split);
   f.mesh_size = s.number("mesh_size", f.mesh_size, positive, "a mesh size > 0 (m)");
   f.duration = s.number("duration", f.duration, positive, "a duration > 0 (s)");
+  f.load_radius = s.number("load_radius", f.load_radius, non_negative, "a radius >= 0 (m; 0: the floe's thickness)");
   if (const toml::array* a = s.table_array("load")) {
     for (std::size_t i = 0; i < a->size(); ++i) {
       Section l((*a)[i].as_table(), "fracture.load", file);
@@ -503,7 +504,7 @@ std::string resolved_toml(const Config& c) {
                        {"criterion", fr.criterion == FractureCriterion::stress ? "stress" : "griffith"},
                        {"strength", fr.strength}, {"toughness", fr.toughness}, {"young", fr.young},
                        {"poisson", fr.poisson}, {"split", fr.split}, {"mesh_size", fr.mesh_size},
-                       {"duration", fr.duration}};
+                       {"duration", fr.duration}, {"load_radius", fr.load_radius}};
   if (!loads.empty()) fracture.insert("load", loads);
 
   toml::table root{{"run", run}, {"sea", sea}, {"floes", floes}, {"contact", contact},

@@ -114,6 +114,7 @@ struct FractureParams {
   bool split = false;
   double mesh_size = 2.0;         // m
   double duration = 0.01;         // s
+  double load_radius = 0.0;       // m, loads spread over this radius; 0: the floe's thickness
   std::vector<FractureLoad> loads;
 };
 

@@ -39,6 +39,8 @@ RunSummary run_simulation(Simulation& sim, const RunOptions& options) {
       bool stop = false;
       while (sim.time() < t_record && !stop) {
         sim.step(t_record);
+        writer.note_floes(sim.floes());  // floes made by splits (numbers are never reused)
+        writer.record_fracture(sim.take_fracture_events());
         if (options.progress) options.progress({sim.time(), t_end, sim.steps(), wall()});
         stop = options.should_stop && options.should_stop();
       }

@@ -62,6 +62,8 @@ Simulation::Simulation(Scenario scenario) : scenario_(std::move(scenario)) {
     floe_sea_->start(scenario_.floes, *sea_, c.coupling.start_given);
     evaluate_penalty(0.5 * c.run.dt_max);
   }
+  // Pieces of a split are opened by the gap that collisions keep between floes.
+  if (c.fracture.enabled) percussion_ = std::make_unique<Percussion>(c.fracture, impulse_options_.min_gap);
 }
 
 Simulation::~Simulation() = default;
@@ -75,6 +77,7 @@ double Simulation::step(double t_stop) {
     { PhaseTimer _(profile_, Phase::penalty); floes_half_kick(ctx); }
     { PhaseTimer _(profile_, Phase::drift);   drift(ctx); }
     { PhaseTimer _(profile_, Phase::collide); collide(ctx); }
+    { PhaseTimer _(profile_, Phase::percussion); percussion(ctx); }
     { PhaseTimer _(profile_, Phase::advance); advance(ctx); }
     { PhaseTimer _(profile_, Phase::detect);  accepted = detect_and_check(ctx); }
   }
@@ -158,10 +161,33 @@ void Simulation::drift(StepContext& ctx) {
 void Simulation::collide(StepContext& ctx) {
   // Contacts were found at the positions of the start of the step; the LCPs
   // turn W(t-) into W(t+) (contact/impulse.hpp).
-  contact::resolve_collisions(scenario_.floes, detection_.contacts, impulse_options_, stats_);
+  ctx.impulses = contact::resolve_collisions(scenario_.floes, detection_.contacts, impulse_options_, stats_);
   const Vec2 after = momentum();
   step_budget_.collisions = after - ctx.momentum;
   ctx.momentum = after;
+}
+
+void Simulation::percussion(StepContext& ctx) {
+  // Positions are still those of ctx.t, where the contacts were found.
+  if (percussion_ && percussion_->check(scenario_.floes, detection_.contacts, ctx.impulses, ctx.t, ctx.start))
+    on_floes_changed();
+}
+
+void Simulation::on_floes_changed() {
+  quadrature_ = build_footprint_quadrature(scenario_.floes);
+  shapes_ = contact::build_collision_shapes(scenario_.floes);
+  detection_ = contact::detect(scenario_.floes, shapes_, detection_options_);
+  if (floe_sea_) {
+    // A split piece keeps its parent's reference bottom (same thickness);
+    // the loads are evaluated afresh for the new footprints.
+    floe_sea_->floes_changed(scenario_.floes);
+    water_velocity_.assign(scenario_.floes.size(), Vec2::Zero());
+    loads_h_ = -1.0;
+  }
+}
+
+std::vector<FractureEventRow> Simulation::take_fracture_events() {
+  return percussion_ ? percussion_->take_events() : std::vector<FractureEventRow>{};
 }
 
 Vec2 Simulation::momentum() const {
@@ -298,6 +324,9 @@ std::vector<std::string> Simulation::warnings() const {
                 floor_pair_ + ")");
   if (stats_.failures)
     w.push_back(std::to_string(stats_.failures) + " collision LCP(s) failed; those floes kept their velocities");
+  if (percussion_ && percussion_->stats().failed_splits)
+    w.push_back(std::to_string(percussion_->stats().failed_splits) +
+                " floe(s) cracked through but were not split (a piece too small, or the pieces would overlap a neighbour)");
   if (stats_.flagged)
     w.push_back(std::to_string(stats_.flagged) + " collision LCP(s) were answered by projected Gauss–Seidel (approximate)");
   return w;

@@ -8,6 +8,8 @@
 //   -> floes' half kick from the sea (penalty loads at t, coupling/floe_sea.hpp)
 //   -> drift velocities (drag relative to current + orbital velocity, wind,
 //      Coriolis) -> collide (LCPs: W(t-) -> W(t+))
+//   -> percussion (fracture checks on the collision impulses; a split floe
+//      becomes two)
 //   -> advance positions (horizontal with W(t+), and the vertical DOFs)
 //   -> detect (new contacts; an overlap rejects the step, which is redone
 //      with half the dt from the floes at t: the sea has not moved yet)
@@ -33,6 +35,7 @@
 
 #include "coupling/drift.hpp"
 #include "coupling/floe_sea.hpp"
+#include "coupling/percussion.hpp"
 #include "contact/detection.hpp"
 #include "contact/impulse.hpp"
 #include "contact/shapes.hpp"
@@ -43,9 +46,9 @@ namespace floesim {
 
 namespace fluid { class Sea; }
 
-enum class Phase { choose_dt, forcing, drift, collide, advance, detect, sea, check, record, penalty, count };
+enum class Phase { choose_dt, forcing, drift, collide, percussion, advance, detect, sea, check, record, penalty, count };
 inline constexpr std::array<const char*, static_cast<std::size_t>(Phase::count)> kPhaseNames = {
-    "choose_dt", "forcing", "drift", "collide", "advance", "detect", "sea", "check", "record", "penalty"};
+    "choose_dt", "forcing", "drift", "collide", "percussion", "advance", "detect", "sea", "check", "record", "penalty"};
 
 // Wall time spent in each phase (s), for `floesim run --profile`.
 struct Profile {
@@ -61,6 +64,7 @@ struct StepContext {
   ForcingSample forcing;
   std::vector<FloeState> start;  // the floes at t, to redo a rejected step
   Vec2 momentum = Vec2::Zero();   // of the dynamic floes, updated by the phases that change it
+  std::vector<contact::ContactImpulse> impulses;  // of the collide phase, one per contact of detection()
 };
 
 // Energies by part (J), named as the columns of /diagnostics/energy; the last
@@ -101,6 +105,10 @@ public:
   // Things a user should hear about once, with a count (e.g. steps cut to the floor).
   std::vector<std::string> warnings() const;
 
+  // Fracture initiations since the last call ([fracture] enabled), and counts.
+  std::vector<FractureEventRow> take_fracture_events();
+  const PercussionStats* percussion_stats() const { return percussion_ ? &percussion_->stats() : nullptr; }
+
   // The sea surface, if the run has one ([sea] model != "none").
   bool has_sea() const { return sea_ != nullptr; }
   SeaGridInfo sea_grid() const;
@@ -118,6 +126,8 @@ private:
   void evaluate_penalty(double h);
   void drift(StepContext& ctx);
   void collide(StepContext& ctx);
+  void percussion(StepContext& ctx);
+  void on_floes_changed();  // rebuilds every per-floe structure (after a split)
   void advance(const StepContext& ctx);
   bool detect_and_check(StepContext& ctx);  // false: the step overlapped, dt halved
   void wrap_periodic();
@@ -136,6 +146,7 @@ private:
   contact::ImpulseOptions impulse_options_;
   contact::Detection detection_;  // at the present positions
   contact::CollisionStats stats_;
+  std::unique_ptr<Percussion> percussion_;  // [fracture] enabled
   MomentumBudget budget_, step_budget_;  // run total; this step's (redone steps do not count)
   long floor_steps_ = 0;          // steps the collision limit wanted below the floor
   long rejected_steps_ = 0;       // steps redone after an overlap

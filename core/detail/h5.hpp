@@ -59,6 +59,12 @@ void write_bytes(hid_t loc, const std::string& name, const std::vector<hsize_t>&
 // rows, each append adds one row of the given row shape.
 Handle create_extendible(hid_t loc, const std::string& name, const std::vector<hsize_t>& row);
 void append_row(hid_t dataset, const double* row);
+// Like create_extendible, but every dimension may grow (set_extent), and
+// elements never written read as NaN (the fill value).
+Handle create_growable(hid_t loc, const std::string& name, const std::vector<hsize_t>& row);
+void set_extent(hid_t dataset, const std::vector<hsize_t>& dims);
+// Deletes a link (a dataset written whole, before writing it again).
+void remove(hid_t loc, const std::string& name);
 
 // Attributes (on a file, group or dataset).
 void set_attr(hid_t obj, const std::string& name, const std::string& value);
