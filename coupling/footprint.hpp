@@ -7,13 +7,15 @@
 //   edge piece  (cell c, segment A -> B):           ∂omega_i ∩ cell_c
 //
 // Positions are relative to the floe's centroid G, in world orientation (so a
-// floe far from the origin keeps full precision). Area pieces come from
-// clipping the polygon by the cell's row then column (Sutherland–Hodgman by
-// half-planes: for a non-convex polygon the clipped chain may carry zero-width
-// slivers, but its area and first moments — Green's theorem — are exact).
-// Pieces are sorted by cell, so an edge piece finds its area piece by binary
-// search. Forces built on these areas change continuously as a floe crosses
-// cell boundaries (MODEL.md §4: smooth forces).
+// floe far from the origin keeps full precision). Area pieces come from the
+// edges alone (Green's theorem per cell, footprint.cpp): each edge is split at
+// the grid lines it crosses, every sub-segment adds its exact integrals to its
+// cell and, through one carry summed down the column, to the cells below it.
+// Exact up to round-off for convex and non-convex polygons, in time
+// proportional to the sub-segments plus the cells of the floe's bounding box.
+// Pieces are sorted by cell; each edge piece knows its area piece. Forces built
+// on these areas change continuously as a floe crosses cell boundaries
+// (MODEL.md §4: smooth forces).
 //
 // Periodic grids (spectral sea) wrap cell indices; a walled basin (bem) has no
 // water outside [0, lx], so pieces there are dropped. With dims = 1 cells are
@@ -39,6 +41,7 @@ struct Footprints {
   std::vector<std::size_t> edge_offsets{0};
   std::vector<std::uint32_t> edge_cell;
   std::vector<Vec2> edge_a, edge_b;  // m, relative to G
+  std::vector<std::ptrdiff_t> edge_piece;  // index of the area piece in the same cell, or -1
 
   std::size_t floes() const { return offsets.size() - 1; }
   // Index of the area piece of floe i in `cell_index`, or -1.
