@@ -45,6 +45,7 @@ struct SpectralSea::Impl {
   std::array<fftw_complex*, 2> kick_spec{nullptr, nullptr};
   std::array<double, 2> kick_h{0.0, 0.0};
   int pending = 0;
+  int last = -1;  // slot holding the FFT of the last kick's pressure (-1: none yet)
   bool staged = false;
   std::optional<TankZones> tank;
   AlignedVector tank_eta, tank_rate;
@@ -80,18 +81,28 @@ struct SpectralSea::Impl {
       std::copy(real, real + n, out.begin());
     }
   }
-  // spec <- (i k)^d factor * a, for a = q or v (d = 0 or 1 via `deriv`).
+  // spec <- (i k)^d factor * a, for a = q or v (d = 0 or 1 via `deriv`); with
+  // `gain`, the deferred kicks are added to a on the way (a = v: the rates as
+  // settle() would leave them, in the same order of operations).
   void load(std::span<const double> a, const std::vector<double>* deriv,
-            const std::vector<double>* factor) {
+            const std::vector<double>* factor, std::span<const double> gain = {}) {
     staged = false;
-    if (!deriv && !factor) {
+    const int kicks = gain.empty() ? 0 : pending;
+    if (!deriv && !factor && kicks == 0) {
       std::copy(a.begin(), a.end(), reinterpret_cast<double*>(spec));
       return;
     }
     for (std::size_t c = 0; c < nc; ++c) {
+      double a0 = a[2 * c], a1 = a[2 * c + 1];
+      for (int i = 0; i < kicks; ++i) {
+        const double g = kick_h[i] * gain[c];
+        const double* s = reinterpret_cast<const double*>(kick_spec[i]);
+        a0 += g * s[2 * c];
+        a1 += g * s[2 * c + 1];
+      }
       double s = 1.0;
       if (factor) s *= (*factor)[c];
-      const double re = a[2 * c] * s, im = a[2 * c + 1] * s;
+      const double re = a0 * s, im = a1 * s;
       if (deriv) {
         const double k = (*deriv)[c];
         spec[c][0] = -k * im;
@@ -188,7 +199,23 @@ void SpectralSea::kick(std::span<const double> pressure, double h) {
   if (m.pending == 2) settle();
   m.forward(pressure, m.kick_spec[m.pending]);
   m.kick_h[m.pending] = h;
+  m.last = m.pending;
   ++m.pending;
+  invalidate_rates();
+}
+
+void SpectralSea::repeat_kick(double h) {
+  Impl& m = *impl_;
+  FLOESIM_ASSERT(m.last >= 0);
+  if (m.last < m.pending) {
+    m.kick_h[m.last] += h;  // still deferred: kicks by one pressure add up
+  } else {
+    // Applied already (then nothing else is pending): defer it again from slot 0.
+    std::swap(m.kick_spec[0], m.kick_spec[m.last]);
+    m.last = 0;
+    m.kick_h[0] = h;
+    m.pending = 1;
+  }
   invalidate_rates();
 }
 
@@ -250,7 +277,9 @@ void SpectralSea::flow(double dt) {
 void SpectralSea::compute_field(Field f, std::span<double> out) {
   Impl& m = *impl_;
   const bool one_d = m.ny == 1;
-  if (f == Field::velocity_x || f == Field::velocity_y || f == Field::velocity_z) settle();
+  // Rate fields see the deferred kicks without settling them (they stay
+  // fused with the next flow).
+  const std::span<const double> gain = bank_.gain();
   switch (f) {
     case Field::elevation:
       if (!m.staged) m.load(bank_.q(), nullptr, nullptr);
@@ -260,12 +289,12 @@ void SpectralSea::compute_field(Field f, std::span<double> out) {
       if (one_d) return std::fill(out.begin(), out.end(), 0.0);
       m.load(bank_.q(), &m.ky, nullptr);
       break;
-    case Field::velocity_x: m.load(bank_.v(), &m.kx, &m.phi); break;
+    case Field::velocity_x: m.load(bank_.v(), &m.kx, &m.phi, gain); break;
     case Field::velocity_y:
       if (one_d) return std::fill(out.begin(), out.end(), 0.0);
-      m.load(bank_.v(), &m.ky, &m.phi);
+      m.load(bank_.v(), &m.ky, &m.phi, gain);
       break;
-    case Field::velocity_z: m.load(bank_.v(), nullptr, nullptr); break;
+    case Field::velocity_z: m.load(bank_.v(), nullptr, nullptr, gain); break;
   }
   m.backward(out);  // destroys spec
   m.staged = false;
