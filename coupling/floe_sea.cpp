@@ -141,6 +141,8 @@ Eigen::Matrix2d FloeSeaContact::tilt_inertia(const Floes& floes, std::size_t i) 
 void FloeSeaContact::start(Floes& floes, fluid::Sea& sea, bool given) {
   const fluid::SurfaceGrid& grid = sea.grid();
   const std::size_t n = floes.size();
+  pressure_.assign(grid.size(), 0.0);  // evaluate() clears only the footprints' cells
+  pressure_kicked_ = false;
   build_footprints(floes, dynamic_, grid, footprints_);
   if (given) {
     for (std::size_t i = 0; i < n; ++i) bottom0_[i] = -floes.draft(i, rho_) * (1.0 + 1.0 / K_);
@@ -242,16 +244,20 @@ void FloeSeaContact::start(Floes& floes, fluid::Sea& sea, bool given) {
 
 void FloeSeaContact::evaluate(const Floes& floes, fluid::Sea& sea, double h) {
   const fluid::SurfaceGrid& grid = sea.grid();
+  // The pressure is zero outside the footprints: clear the cells of the last
+  // ones rather than the whole grid.
+  if (pressure_.size() != grid.size()) pressure_.assign(grid.size(), 0.0);
+  else for (std::uint32_t c : footprints_.cell) pressure_[c] = 0.0;
+  pressure_kicked_ = false;
   build_footprints(floes, dynamic_, grid, footprints_);
   const Footprints& fp = footprints_;
   const std::span<const double> eta = sea.elevation();
   std::span<const double> w;
   if (s_ < 1.0) w = sea.field(fluid::Field::velocity_z);
-  pressure_.assign(grid.size(), 0.0);
-  penalty_energy_ = 0.0;
-  const double ks = s_ * kappa_;
+  const double ks = s_ * kappa_, inv_cell_area = 1.0 / cell_area_;
+  double energy = 0.0;
   thread_local std::vector<double> u;  // [delta]^+ of each area piece
-  u.assign(fp.cell.size(), 0.0);
+  u.resize(fp.cell.size());
   for (std::size_t i = 0; i < floes.size(); ++i) {
     FloeSeaLoad& load = loads_[i];
     load = {};
@@ -261,33 +267,39 @@ void FloeSeaContact::evaluate(const Floes& floes, fluid::Sea& sea, double h) {
     const Vec2 a{st.pitch, st.roll}, ar{st.pitch_rate, st.roll_rate};
     const double c = (1.0 - s_) * weak_coefficient(floes, i);
     const double damper = c / (1.0 + h * c * (1.0 / (floes.density[i] * floes.thickness[i]) + sea_inverse_mass_));
-    double fz = 0.0;
+    double fz = 0.0, wetted = 0.0;  // wetted: sum a_c u_c
     Vec2 moment = Vec2::Zero(), fh = Vec2::Zero();
     double torque = 0.0;
     for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k) {
       const Vec2& r = fp.centroid[k];
-      const double delta = eta[fp.cell[k]] - z - a.dot(r);
-      if (delta <= 0.0) continue;
+      const std::uint32_t cell = fp.cell[k];
+      const double delta = eta[cell] - z - a.dot(r);
+      if (delta <= 0.0) {
+        u[k] = 0.0;
+        continue;
+      }
       u[k] = delta;
-      double f = ks * fp.area[k] * delta;
-      penalty_energy_ += 0.5 * ks * fp.area[k] * delta * delta;
+      const double area = fp.area[k];
+      double f = ks * area * delta;
+      energy += 0.5 * ks * area * delta * delta;
+      wetted += area * delta;
       if (c > 0.0) {
-        const double rate = w[fp.cell[k]] - st.heave_rate - ar.dot(r);
-        const double fw = fp.area[k] * damper * rate;
+        const double rate = w[cell] - st.heave_rate - ar.dot(r);
+        const double fw = area * damper * rate;
         f += fw;
         // The damper's horizontal share: -f_w grad eta.
-        const Vec2 slope = grid_slope(grid, eta, fp.cell[k]);
+        const Vec2 slope = grid_slope(grid, eta, cell);
         fh -= fw * slope;
         torque -= fw * cross(r, slope);
       }
-      pressure_[fp.cell[k]] += f / cell_area_;
+      pressure_[cell] += f * inv_cell_area;
       fz += f;
       moment += f * r;
     }
     // Strong part, horizontal: -dV/dG and -dV/dyaw through the edge pieces.
     if (ks > 0.0) {
       for (std::size_t k = fp.edge_offsets[i]; k < fp.edge_offsets[i + 1]; ++k) {
-        const std::ptrdiff_t piece = fp.find(i, fp.edge_cell[k]);
+        const std::ptrdiff_t piece = fp.edge_piece[k];
         if (piece < 0 || u[piece] <= 0.0) continue;
         const double up = u[piece];
         const Vec2& A = fp.edge_a[k];
@@ -308,16 +320,22 @@ void FloeSeaContact::evaluate(const Floes& floes, fluid::Sea& sea, double h) {
         torque -= dVdyaw;
       }
       // The explicit-G term of dV/dG: -u a_c a, summed over the area pieces.
-      double sum = 0.0;
-      for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k) sum += fp.area[k] * u[k];
-      fh -= ks * sum * a;
+      fh -= ks * wetted * a;
     }
     load.vertical = {fz - floes.mass[i] * g_, moment.x(), moment.y()};
     load.horizontal = {fh.x(), fh.y(), torque};
   }
+  penalty_energy_ = energy;
 }
 
-void FloeSeaContact::kick_sea(fluid::Sea& sea, double h) const { sea.kick(pressure_, h); }
+void FloeSeaContact::kick_sea(fluid::Sea& sea, double h) {
+  if (pressure_kicked_) {
+    sea.repeat_kick(h);
+  } else {
+    sea.kick(pressure_, h);
+    pressure_kicked_ = true;
+  }
+}
 
 void FloeSeaContact::kick_floes(Floes& floes, double h) const {
   for (std::size_t i = 0; i < floes.size(); ++i) {

@@ -76,9 +76,11 @@ public:
   // pressure on the sea grid and the loads on the floes.
   void evaluate(const Floes& floes, fluid::Sea& sea, double h);
   // Apply the last evaluation over h: to the floes' vertical and horizontal
-  // rates; to the sea's modal velocities.
+  // rates; to the sea's modal velocities (a second kick_sea with the same
+  // evaluation repeats the sea's last kick, without projecting the pressure
+  // again: nothing else may kick the sea in between).
   void kick_floes(Floes& floes, double h) const;
-  void kick_sea(fluid::Sea& sea, double h) const;
+  void kick_sea(fluid::Sea& sea, double h);
   // Vertical drift of the floes: zeta += h zeta', a += h a'.
   static void drift(Floes& floes, double h);
 
@@ -121,6 +123,7 @@ private:
   Footprints footprints_;
   std::vector<FloeSeaLoad> loads_;
   std::vector<double> pressure_;
+  bool pressure_kicked_ = false;  // the sea's last kick was with pressure_ as it is
   double penalty_energy_ = 0.0;
   std::vector<std::string> notes_;
 };

@@ -61,6 +61,7 @@ Simulation::Simulation(Scenario scenario) : scenario_(std::move(scenario)) {
     floe_sea_ = std::make_unique<FloeSeaContact>(c.coupling, c.sea, scenario_.floes, *sea_);
     floe_sea_->start(scenario_.floes, *sea_, c.coupling.start_given);
     evaluate_penalty(0.5 * c.run.dt_max);
+    update_water_velocity();
   }
   // Pieces of a split are opened by the gap that collisions keep between floes.
   if (c.fracture.enabled) percussion_ = std::make_unique<Percussion>(c.fracture, impulse_options_.min_gap);
@@ -107,7 +108,12 @@ StepContext Simulation::choose_dt(double t_stop) {
   // The explicit penalty spring's stability limit (coupling/floe_sea.hpp).
   if (floe_sea_ && floe_sea_->stable_step() < ctx.dt) {
     const double n = std::ceil(remaining / floe_sea_->stable_step());
-    ctx.dt = std::min(ctx.dt, remaining / n);  // equal steps up to t_stop
+    // Equal steps up to t_stop; the last equal step is kept while it divides
+    // what remains to round-off (the sea's rotations, cached for one dt, stay
+    // valid), and the last step of all lands on t_stop.
+    const bool same = n > 1.0 && equal_dt_ > 0.0 && std::abs(remaining / equal_dt_ - n) < 1e-9 * n;
+    equal_dt_ = same ? equal_dt_ : remaining / n;
+    ctx.dt = std::min(ctx.dt, equal_dt_);
   }
   // Event-driven limit from the near pairs (contact/step_limit.hpp).
   const contact::StepLimit limit = contact::collision_step_limit(
@@ -137,7 +143,10 @@ void Simulation::floes_half_kick(const StepContext& ctx) {
   // its half step was the same) kick the floes' vertical and horizontal rates.
   ctx_momentum_before_ = momentum();
   if (!floe_sea_) return;
-  if (loads_h_ != 0.5 * ctx.dt) evaluate_penalty(0.5 * ctx.dt);
+  // The strong law's loads do not depend on the kick length; the damper's do.
+  const bool depends_on_h = floe_sea_->strong_share() < 1.0;
+  if (loads_h_ < 0.0 || (depends_on_h && loads_h_ != 0.5 * ctx.dt)) evaluate_penalty(0.5 * ctx.dt);
+  if (water_stale_) update_water_velocity();
   floe_sea_->kick_floes(scenario_.floes, 0.5 * ctx.dt);
 }
 
@@ -181,8 +190,8 @@ void Simulation::on_floes_changed() {
     // A split piece keeps its parent's reference bottom (same thickness);
     // the loads are evaluated afresh for the new footprints.
     floe_sea_->floes_changed(scenario_.floes);
-    water_velocity_.assign(scenario_.floes.size(), Vec2::Zero());
     loads_h_ = -1.0;
+    water_stale_ = true;
   }
 }
 
@@ -260,6 +269,9 @@ void Simulation::sea_half_kick(const StepContext& ctx) {
   floe_sea_->kick_floes(scenario_.floes, 0.5 * ctx.dt);
   floe_sea_->kick_sea(*sea_, 0.5 * ctx.dt);
   step_budget_.external += momentum() - before;
+  // The water under the floes at t + dt, the sea's kick included (its rates
+  // are then synchronous with its elevation, as the floes' are).
+  update_water_velocity();
   // The damper part depends on the rates the kick just changed: evaluate it
   // afresh at the next step.
   if (floe_sea_->strong_share() < 1.0) loads_h_ = -1.0;
@@ -267,8 +279,13 @@ void Simulation::sea_half_kick(const StepContext& ctx) {
 
 void Simulation::evaluate_penalty(double h) {
   floe_sea_->evaluate(scenario_.floes, *sea_, h);
-  floe_sea_->orbital_velocity(scenario_.floes, *sea_, water_velocity_);
   loads_h_ = h;
+}
+
+void Simulation::update_water_velocity() {
+  // Over the footprints of the last evaluate_penalty.
+  floe_sea_->orbital_velocity(scenario_.floes, *sea_, water_velocity_);
+  water_stale_ = false;
 }
 
 void Simulation::check_state(const StepContext& ctx) const {

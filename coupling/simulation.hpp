@@ -14,12 +14,18 @@
 //   -> detect (new contacts; an overlap rejects the step, which is redone
 //      with half the dt from the floes at t: the sea has not moved yet)
 //   -> sea: half kick with the pressures at t, exact modal flow over dt
-//   -> penalty loads at t + dt: second half kick of the sea and the floes
+//   -> penalty loads at t + dt: second half kick of the sea and the floes,
+//      then the orbital velocity under the floes (for the next drag)
 //   -> check state
 //
 // The kicks and flows are the Strang splitting of the floe–sea Hamiltonian
 // (second order, energy conserving for the strong law without drag); drag
 // and collisions sit in the middle, where the floes' horizontal drift is.
+// The loads at t + dt serve as the next step's first half kick (the strong
+// law's do not depend on the kick length; the damper's are made afresh), and
+// the sea's two half kicks by that one pressure share its projection
+// (Sea::repeat_kick). Steps cut by the penalty limit are equal and keep one
+// dt, so the sea's rotations are computed once.
 // Step contract: on entry the state is at time() and the contact detection
 // matches the positions; step(t_stop) advances both to time() + dt with
 // 0 < dt <= min(dt_max, t_stop - time()) and returns dt. At the end of every
@@ -124,6 +130,7 @@ private:
   void floes_half_kick(const StepContext& ctx);
   void sea_half_kick(const StepContext& ctx);
   void evaluate_penalty(double h);
+  void update_water_velocity();  // orbital velocity under each floe, for drag
   void drift(StepContext& ctx);
   void collide(StepContext& ctx);
   void percussion(StepContext& ctx);
@@ -137,7 +144,9 @@ private:
   std::unique_ptr<fluid::Sea> sea_;
   std::unique_ptr<FloeSeaContact> floe_sea_;
   double loads_h_ = -1.0;             // the kick length the floe–sea loads were evaluated for (< 0: stale)
+  double equal_dt_ = -1.0;            // the last of the equal steps the penalty limit asked for
   std::vector<Vec2> water_velocity_;  // orbital velocity under each floe at t, for drag
+  bool water_stale_ = false;          // the floes changed since water_velocity_ was made
   Vec2 ctx_momentum_before_ = Vec2::Zero();  // of the floes at the start of the step's try
   DriftParams drift_params_;
   FootprintQuadrature quadrature_;
