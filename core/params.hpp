@@ -74,7 +74,7 @@ struct CouplingParams {
   double blend = 1.0;             // s in [0, 1] (blend law)
   double restitution = -1.0;      // blend law: target e; < 0 means "use blend"
   // false: the floes start at rest on the sea (the static problem is solved,
-  // then the initial waves are added); true: the floes' heave and heave rate
+  // on the initial waves); true: the floes' heave and heave rate
   // are as given ([[floes.floe]] heave, heave_rate), e.g. for a drop test.
   bool start_given = false;
 };

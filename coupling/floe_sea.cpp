@@ -148,74 +148,80 @@ void FloeSeaContact::start(Floes& floes, fluid::Sea& sea, bool given) {
     for (std::size_t i = 0; i < n; ++i) bottom0_[i] = -floes.draft(i, rho_) * (1.0 + 1.0 / K_);
     return;
   }
-  // The static problem (see the header), far-field level L = 0 first.
+  // The static problem (see the header): on the calm sea first, which fixes
+  // each floe's reference bottom (heave 0), then on the sea's waves.
   const Footprints& fp = footprints_;
-  std::vector<double> F(grid.size(), 0.0), S(grid.size(), 0.0);
+  std::vector<double> F(grid.size(), 0.0), S(grid.size(), 0.0), eta(grid.size());
   std::vector<double> z(n, 0.0);
   std::vector<Vec2> a(n, Vec2::Zero());
   auto zb = [&](std::size_t i, std::size_t k) { return z[i] + a[i].dot(fp.centroid[k]); };
   for (std::size_t i = 0; i < n; ++i) {
     if (!dynamic_[i]) continue;
     z[i] = -floes.draft(i, rho_) * (1.0 + 1.0 / K_);
-    for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k) {
-      const double f = fp.area[k] / cell_area_;
-      F[fp.cell[k]] += f;
-      S[fp.cell[k]] += f * zb(i, k);
-    }
+    for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k) F[fp.cell[k]] += fp.area[k] / cell_area_;
   }
-  double change = INFINITY;
-  int sweeps = 0;
-  for (; sweeps < 200 && change > 1e-13; ++sweeps) {
-    change = 0.0;
-    for (std::size_t i = 0; i < n; ++i) {
-      if (!dynamic_[i] || fp.offsets[i] == fp.offsets[i + 1]) continue;
-      Eigen::Matrix3d A = Eigen::Matrix3d::Zero();
-      Eigen::Vector3d b(-floes.mass[i] * g_ / kappa_, 0.0, 0.0);
-      for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k) {
-        const std::uint32_t c = fp.cell[k];
-        const double f = fp.area[k] / cell_area_;
-        const double Fo = F[c] - f, So = S[c] - f * zb(i, k);
-        const double alpha = K_ * So / (1.0 + K_ * F[c]), beta = (1.0 + K_ * Fo) / (1.0 + K_ * F[c]);
-        const Eigen::Vector3d phi(1.0, fp.centroid[k].x(), fp.centroid[k].y());
-        A += fp.area[k] * beta * phi * phi.transpose();
-        b += fp.area[k] * alpha * phi;
+  // Gauss–Seidel over the floes from the present z, a, with the free level W
+  // (+ L); fills eta (zero mean) and returns the L that makes it so.
+  auto solve = [&](std::span<const double> W) {
+    std::fill(S.begin(), S.end(), 0.0);
+    for (std::size_t i = 0; i < n; ++i)
+      if (dynamic_[i])
+        for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k) S[fp.cell[k]] += fp.area[k] / cell_area_ * zb(i, k);
+    double change = INFINITY;
+    int sweeps = 0;
+    for (; sweeps < 200 && change > 1e-13; ++sweeps) {
+      change = 0.0;
+      for (std::size_t i = 0; i < n; ++i) {
+        if (!dynamic_[i] || fp.offsets[i] == fp.offsets[i + 1]) continue;
+        Eigen::Matrix3d A = Eigen::Matrix3d::Zero();
+        Eigen::Vector3d b(-floes.mass[i] * g_ / kappa_, 0.0, 0.0);
+        for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k) {
+          const std::uint32_t c = fp.cell[k];
+          const double f = fp.area[k] / cell_area_;
+          const double Fo = F[c] - f, So = S[c] - f * zb(i, k);
+          const double alpha = (W[c] + K_ * So) / (1.0 + K_ * F[c]), beta = (1.0 + K_ * Fo) / (1.0 + K_ * F[c]);
+          const Eigen::Vector3d phi(1.0, fp.centroid[k].x(), fp.centroid[k].y());
+          A += fp.area[k] * beta * phi * phi.transpose();
+          b += fp.area[k] * alpha * phi;
+        }
+        // Slopes the discrete footprint cannot resist stay 0 (a floe within a
+        // few cells; roll in a long-crested sea).
+        const Eigen::Vector3d x = solve_tilted(A, b, tilt_[i]);
+        for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k) S[fp.cell[k]] -= fp.area[k] / cell_area_ * zb(i, k);
+        change = std::max(change, std::abs(x[0] - z[i]) / floes.draft(i, rho_));
+        z[i] = x[0];
+        a[i] = {x[1], x[2]};
+        for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k) S[fp.cell[k]] += fp.area[k] / cell_area_ * zb(i, k);
       }
-      // Slopes the discrete footprint cannot resist stay 0 (a floe within a
-      // few cells; roll in a long-crested sea).
-      const Eigen::Vector3d x = solve_tilted(A, b, tilt_[i]);
-      for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k) S[fp.cell[k]] -= fp.area[k] / cell_area_ * zb(i, k);
-      change = std::max(change, std::abs(x[0] - z[i]) / floes.draft(i, rho_));
-      z[i] = x[0];
-      a[i] = {x[1], x[2]};
-      for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k) S[fp.cell[k]] += fp.area[k] / cell_area_ * zb(i, k);
     }
-  }
-  if (change > 1e-9) {
-    std::ostringstream m;
-    m << "the floes' static equilibrium on the sea did not converge in " << sweeps
-      << " sweeps (last relative change " << change << ")";
-    throw RunError(m.str());
-  }
-  std::vector<double> eta(grid.size());
-  double mean = 0.0;
-  for (std::size_t c = 0; c < grid.size(); ++c) {
-    eta[c] = K_ * S[c] / (1.0 + K_ * F[c]);
-    mean += eta[c];
-  }
-  mean /= static_cast<double>(grid.size());
-  for (double& e : eta) e -= mean;
-  // The waves already in the sea, superposed.
+    if (change > 1e-9) {
+      std::ostringstream m;
+      m << "the floes' static equilibrium on the sea did not converge in " << sweeps
+        << " sweeps (last relative change " << change << ")";
+      throw RunError(m.str());
+    }
+    double mean = 0.0;
+    for (std::size_t c = 0; c < grid.size(); ++c) {
+      eta[c] = (W[c] + K_ * S[c]) / (1.0 + K_ * F[c]);
+      mean += eta[c];
+    }
+    mean /= static_cast<double>(grid.size());
+    for (double& e : eta) e -= mean;
+    return mean;
+  };
+  const double calm_level = solve(std::vector<double>(grid.size(), 0.0));
+  for (std::size_t i = 0; i < n; ++i)
+    if (dynamic_[i]) bottom0_[i] = z[i] - calm_level;
+  // The waves in the sea: the floes start from the least-squares plane of the
+  // waves under them (and take the plane of the waves' rates as theirs),
+  // then settle on the waves.
   const std::span<const double> wave = sea.elevation();
-  std::vector<double> wave_eta(wave.begin(), wave.end());
+  const std::vector<double> wave_eta(wave.begin(), wave.end());
   const std::span<const double> wave_w = sea.field(fluid::Field::velocity_z);
-  std::vector<double> eta_t(wave_w.begin(), wave_w.end());
-  for (std::size_t c = 0; c < grid.size(); ++c) eta[c] += wave_eta[c];
-  sea.set_surface(eta, eta_t);
+  const std::vector<double> eta_t(wave_w.begin(), wave_w.end());
   for (std::size_t i = 0; i < n; ++i) {
     if (!dynamic_[i]) continue;
-    bottom0_[i] = z[i] - mean;
     FloeState& st = floes.state[i];
-    // Least-squares plane of the waves over the footprint: heave, slopes, rates.
     Eigen::Matrix3d A = Eigen::Matrix3d::Zero();
     Eigen::Vector3d be = Eigen::Vector3d::Zero(), bw = Eigen::Vector3d::Zero();
     for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k) {
@@ -226,12 +232,20 @@ void FloeSeaContact::start(Floes& floes, fluid::Sea& sea, bool given) {
     }
     if (!(A(0, 0) > 0.0)) continue;
     const Eigen::Vector3d xe = solve_tilted(A, be, tilt_[i]), xw = solve_tilted(A, bw, tilt_[i]);
-    st.heave = xe[0];
-    st.pitch = a[i].x() + xe[1];
-    st.roll = a[i].y() + xe[2];
+    z[i] += xe[0];
+    a[i] += Vec2{xe[1], xe[2]};
     st.heave_rate = xw[0];
     st.pitch_rate = xw[1];
     st.roll_rate = xw[2];
+  }
+  const double wave_level = solve(wave_eta);
+  sea.set_surface(eta, eta_t);
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!dynamic_[i]) continue;
+    FloeState& st = floes.state[i];
+    st.heave = z[i] - wave_level - bottom0_[i];
+    st.pitch = a[i].x();
+    st.roll = a[i].y();
   }
   const double capillary =
       sigma_ * (std::pow(M_PI / grid.dx(), 2) + (grid.dims == 2 ? std::pow(M_PI / grid.dy(), 2) : 0.0)) / (rho_ * g_);

@@ -35,13 +35,18 @@
 // (restitution 0) and never destabilises.
 //
 // Start (MODEL.md §1): the static problem is solved first. The sea's static
-// response to a pressure is local, eta = -p / (rho_w g) + const, up to
-// capillarity (relative size sigma k^2 / (rho_w g) <= sigma (pi / dx)^2 /
-// (rho_w g), reported), so on each cell eta_c (1 + K sum_i f_ci) = L + K
-// sum_i f_ci z_b,i(r_ci) with f_ci = a_ci / cell area; each floe's heave and
-// slopes solve the 3x3 equilibrium of its weight (Gauss–Seidel over floes
-// sharing cells), and L is set by the zero mean of eta. The initial waves are
-// then superposed: floes take the mean wave elevation and slope under them.
+// response to a pressure is local, eta = W - p / (rho_w g) + const, W the
+// surface without floes, up to capillarity (relative size sigma k^2 /
+// (rho_w g) <= sigma (pi / dx)^2 / (rho_w g), reported), so on each cell
+// eta_c (1 + K sum_i f_ci) = W_c + L + K sum_i f_ci z_b,i(r_ci) with f_ci =
+// a_ci / cell area; each floe's heave and slopes solve the 3x3 equilibrium of
+// its weight (Gauss–Seidel over floes sharing cells), and L is set by the zero
+// mean of eta. Solved on the calm sea (W = 0) it gives each floe's reference
+// bottom z0_i; solved again with W = the initial waves it puts the floes at
+// rest on them: a rigid bottom cannot follow the waves' curvature, so the
+// water under it is displaced instead of the floe being lifted by the
+// penetration (which, at K = 1000, would hold many times the floe's weight).
+// The sea keeps the waves' rates; each floe takes their least-squares plane.
 
 #include <span>
 #include <string>
