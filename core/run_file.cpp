@@ -257,6 +257,20 @@ RunInfo read_run_info(const std::string& path) {
   return r;
 }
 
+RunDataset read_run_dataset(const std::string& path, const std::string& dataset) {
+  h5::Handle f = h5::open_file(path);
+  if (!h5::has_attr(f, "format") || h5::get_attr_string(f, "format") != kRunFormat)
+    throw InputError(path + ": not a floesim run file (attribute 'format' is not '" + std::string(kRunFormat) + "')");
+  if (dataset.empty() || !h5::exists(f, dataset)) throw InputError(path + ": no dataset '" + dataset + "'");
+  h5::Handle d = h5::open_dataset(f, dataset, path);
+  RunDataset r;
+  const auto dims = h5::dims(d);
+  r.shape.assign(dims.begin(), dims.end());
+  r.values = h5::read_doubles(d, path + ": " + dataset);
+  if (h5::has_attr(d, "columns")) r.columns = h5::get_attr_strings(d, "columns");
+  return r;
+}
+
 CompareResult compare_runs(const std::string& a, const std::string& b, const CompareOptions& opt) {
   h5::Handle fa = h5::open_file(a), fb = h5::open_file(b);
   for (auto [f, p] : {std::pair{fa.get(), a}, std::pair{fb.get(), b}})

@@ -81,6 +81,17 @@ struct RunInfo {
 };
 RunInfo read_run_info(const std::string& path);
 
+// One numeric dataset of a run file (any stored type, converted to double),
+// row-major with its shape, and its `columns` attribute if it has one. For
+// scripts (the Python module) and tools. Throws InputError naming the file
+// and the dataset when either is missing or unreadable.
+struct RunDataset {
+  std::vector<unsigned long long> shape;
+  std::vector<double> values;
+  std::vector<std::string> columns;
+};
+RunDataset read_run_dataset(const std::string& path, const std::string& dataset);
+
 // Regression comparison of two run files: every numeric dataset of A must
 // exist in B with the same shape and |a - b| <= atol + rtol |b| element-wise
 // (NaN equals NaN). Attributes other than format are not compared.
