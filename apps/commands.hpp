@@ -18,6 +18,7 @@ void add_compare_command(CLI::App& app, Registry& registry);
 void add_info_command(CLI::App& app, Registry& registry);
 void add_lcp_command(CLI::App& app, Registry& registry);
 void add_pack_command(CLI::App& app, Registry& registry);
+void add_regress_command(CLI::App& app, Registry& registry);
 void add_run_command(CLI::App& app, Registry& registry);
 
 }  // namespace floesim::apps

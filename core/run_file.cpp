@@ -29,7 +29,8 @@ struct RunWriter::Impl {
 };
 
 RunWriter::RunWriter(const std::string& path, const Floes& floes, const std::string& config_toml,
-                     std::vector<std::string> energy_columns, const SeaGridInfo& sea)
+                     std::vector<std::string> energy_columns, const SeaGridInfo& sea,
+                     std::size_t expected_records)
     : impl_(std::make_unique<Impl>()) {
   Impl& w = *impl_;
   w.path = path;
@@ -37,12 +38,13 @@ RunWriter::RunWriter(const std::string& path, const Floes& floes, const std::str
   w.nverts = floes.body.size();
   w.energy_columns = std::move(energy_columns);
   w.sea = sea;
+  const hsize_t rows = expected_records;
   w.file = h5::create_file(path);
   h5::set_attr(w.file, "format", std::string(kRunFormat));
   h5::set_attr(w.file, "config", config_toml);
   h5::set_attr(w.file, "status", std::string("running"));
 
-  w.time = h5::create_extendible(w.file, "time", {});
+  w.time = h5::create_extendible(w.file, "time", {}, rows);
   h5::set_attr(w.time, "units", std::string("s"));
 
   h5::Handle g = h5::create_group(w.file, "/floes");
@@ -54,14 +56,14 @@ RunWriter::RunWriter(const std::string& path, const Floes& floes, const std::str
   h5::write_doubles(g, "area", {w.n}, floes.area.data());
   std::vector<unsigned char> stat(floes.is_static.begin(), floes.is_static.end());
   h5::write_bytes(g, "static", {w.n}, stat.data());
-  w.state = h5::create_extendible(g, "state", {w.n, kStateColumns});
+  w.state = h5::create_extendible(g, "state", {w.n, kStateColumns}, rows);
   h5::set_attr(w.state, "columns", std::vector<std::string>(std::begin(kStateColumnNames), std::end(kStateColumnNames)));
 
   h5::Handle d = h5::create_group(w.file, "/diagnostics");
-  w.energy = h5::create_extendible(d, "energy", {w.energy_columns.size()});
+  w.energy = h5::create_extendible(d, "energy", {w.energy_columns.size()}, rows);
   h5::set_attr(w.energy, "columns", w.energy_columns);
   h5::set_attr(w.energy, "units", std::string("J"));
-  w.lcp = h5::create_extendible(d, "lcp", {4});
+  w.lcp = h5::create_extendible(d, "lcp", {4}, rows);
   h5::set_attr(w.lcp, "columns", std::vector<std::string>{"solves", "pivots", "failures", "fallbacks"});
 
   if (sea.dims > 0) {
@@ -74,7 +76,7 @@ RunWriter::RunWriter(const std::string& path, const Floes& floes, const std::str
     h5::write_doubles(s, "y", {y.size()}, y.data());
     std::vector<hsize_t> row = sea.dims == 2 ? std::vector<hsize_t>{hsize_t(ny), hsize_t(nx)}
                                              : std::vector<hsize_t>{hsize_t(nx)};
-    w.eta = h5::create_extendible(s, "eta", row);
+    w.eta = h5::create_extendible(s, "eta", row, rows);
     h5::set_attr(w.eta, "units", std::string("m"));
   }
 
@@ -89,7 +91,7 @@ RunWriter::RunWriter(const std::string& path, const Floes& floes, const std::str
   }
   w.topology_size = topo.size();
   h5::write_ints(x, "topology", {topo.size()}, topo.data());
-  w.verts = h5::create_extendible(x, "vertices", {w.nverts, 3});
+  w.verts = h5::create_extendible(x, "vertices", {w.nverts, 3}, rows);
   H5Fflush(w.file, H5F_SCOPE_GLOBAL);
 }
 

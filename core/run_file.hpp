@@ -44,9 +44,11 @@ struct LcpCounters {
 class RunWriter {
 public:
   // Creates (truncates) the file and writes the static parts. Throws
-  // InputError if the file cannot be created.
+  // InputError if the file cannot be created. expected_records (0: unknown)
+  // sizes the chunks of the per-record datasets (more records still fit).
   RunWriter(const std::string& path, const Floes& floes, const std::string& config_toml,
-            std::vector<std::string> energy_columns, const SeaGridInfo& sea = {});
+            std::vector<std::string> energy_columns, const SeaGridInfo& sea = {},
+            std::size_t expected_records = 0);
   ~RunWriter();  // closes; leaves status "running" unless finish() was called
   RunWriter(const RunWriter&) = delete;
   RunWriter& operator=(const RunWriter&) = delete;

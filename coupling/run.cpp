@@ -18,7 +18,10 @@ RunSummary run_simulation(Simulation& sim, const RunOptions& options) {
   summary.output = options.output;
   summary.energy_first = sim.energies();
   summary.warnings = sim.scenario().notes;
-  RunWriter writer(options.output, sim.floes(), resolved_toml(cfg), summary.energy_first.names, sim.sea_grid());
+  // Records at t = 0, at every multiple of the interval and at the end.
+  const auto expected_records = static_cast<std::size_t>(std::ceil(t_end / interval - 1e-9)) + 1;
+  RunWriter writer(options.output, sim.floes(), resolved_toml(cfg), summary.energy_first.names, sim.sea_grid(),
+                   expected_records);
   summary.xdmf = writer.xdmf_path();
 
   auto record = [&] {

@@ -56,8 +56,11 @@ void write_bytes(hid_t loc, const std::string& name, const std::vector<hsize_t>&
                  const unsigned char* data);
 
 // Extendible datasets along the first dimension (chunked): created with 0
-// rows, each append adds one row of the given row shape.
-Handle create_extendible(hid_t loc, const std::string& name, const std::vector<hsize_t>& row);
+// rows, each append adds one row of the given row shape. rows_hint, when not
+// 0, is the number of rows expected: chunks hold no more rows than that, so a
+// short run does not carry a mostly empty 64 KiB chunk per dataset.
+Handle create_extendible(hid_t loc, const std::string& name, const std::vector<hsize_t>& row,
+                         hsize_t rows_hint = 0);
 void append_row(hid_t dataset, const double* row);
 
 // Attributes (on a file, group or dataset).

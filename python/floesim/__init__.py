@@ -162,6 +162,8 @@ class Config:
     def _replace(self, doc):
         text = _floesim.dict_to_toml(doc)
         resolved = self._call(_floesim.check_config, text=text)
+        # Read back from the text: tuples, NumPy arrays and scalars become plain lists and numbers.
+        doc = _floesim.toml_to_dict(text, self._name)
         self._doc, self._text, self._resolved, self._resolved_doc = doc, text, resolved, None
         self._modified = True
 
