@@ -34,7 +34,10 @@ RunSummary run_simulation(Simulation& sim, const RunOptions& options) {
   summary.status = "complete";
   try {
     record();
-    std::size_t next = 1;  // index of the next scheduled record
+    // Index of the next scheduled record: the first multiple of the interval
+    // after the start (a simulation may come here already advanced).
+    auto next = static_cast<std::size_t>(std::floor(sim.time() / interval)) + 1;
+    if (static_cast<double>(next) * interval <= sim.time()) ++next;
     while (sim.time() < t_end) {
       // Next record time; a record that would fall within 1e-9 s of the end merges with it.
       double t_record = std::min(static_cast<double>(next) * interval, t_end);

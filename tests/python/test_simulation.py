@@ -126,6 +126,12 @@ class MatchesTheCommandLine(unittest.TestCase):
             # the committed reference holds the same case
             cmp = floesim.compare_runs(summary["output"], ref)
             self.assertTrue(cmp["equal"], cmp["differences"])
+            # run() from an advanced simulation: records from there on the same schedule
+            sim = floesim.Simulation(cfg)
+            sim.run_until(5.0)
+            sim.run(os.path.join(d, "b.h5"))
+            np.testing.assert_array_equal(floesim.read_run(os.path.join(d, "b.h5")).time,
+                                          [5.0, 6.0, 8.0, 10.0, 12.0, 14.0, 16.0, 18.0, 20.0])
 
 
 class Arrays(unittest.TestCase):
