@@ -211,6 +211,9 @@ std::vector<ContactImpulse> resolve_collisions(Floes& floes, const std::vector<C
       ContactImpulse& ci = impulses[list[k]];
       ci.normal = total[static_cast<Eigen::Index>(k)];
       ci.tangential = total[static_cast<Eigen::Index>(m + 2 * k)] - total[static_cast<Eigen::Index>(m + 2 * k + 1)];
+      const ContactPoint& c = contacts[list[k]];
+      ci.vector = ci.normal * c.normal + ci.tangential * Vec2{-c.normal.y(), c.normal.x()};
+      ci.point = c.point;
     }
   }
   return impulses;

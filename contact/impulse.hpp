@@ -67,8 +67,12 @@ struct CollisionStats {
 };
 
 // Per contact: the total impulse applied (compression + decompression), N s.
+// Floe b received `vector` = normal N + tangential T at `point` (the contact's,
+// in a's image of a periodic domain), floe a its opposite (percussion loads).
 struct ContactImpulse {
   double normal = 0.0, tangential = 0.0;
+  Vec2 vector = Vec2::Zero();  // N s, world
+  Vec2 point = Vec2::Zero();   // m, world
 };
 
 // Changes the velocities of the floes in contact (W^- -> W^+). Returns the

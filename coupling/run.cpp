@@ -17,7 +17,7 @@ RunSummary run_simulation(Simulation& sim, const RunOptions& options) {
   RunSummary summary;
   summary.output = options.output;
   summary.energy_first = sim.energies();
-  summary.warnings = sim.scenario().notes;
+  summary.warnings = sim.notes();
   // Records at t = 0, at every multiple of the interval and at the end.
   const auto expected_records = static_cast<std::size_t>(std::ceil(t_end / interval - 1e-9)) + 1;
   RunWriter writer(options.output, sim.floes(), resolved_toml(cfg), summary.energy_first.names, sim.sea_grid(),
@@ -45,6 +45,8 @@ RunSummary run_simulation(Simulation& sim, const RunOptions& options) {
       bool stop = false;
       while (sim.time() < t_record && !stop) {
         sim.step(t_record);
+        writer.note_floes(sim.floes());  // floes made by splits (numbers are never reused)
+        writer.record_fracture(sim.take_fracture_events());
         if (options.progress) options.progress({sim.time(), t_end, sim.steps(), wall()});
         stop = options.should_stop && options.should_stop();
       }

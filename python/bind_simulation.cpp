@@ -7,6 +7,7 @@
 
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <memory>
 #include <string>
 
@@ -89,8 +90,14 @@ void bind_simulation(py::module_& m) {
       .def_property_readonly("time", &Simulation::time, "Simulated time (s).")
       .def_property_readonly("steps", &Simulation::steps, "Steps taken so far.")
       .def_property_readonly("floe_count", [](const Simulation& s) { return s.floes().size(); })
-      .def("step", &Simulation::step, py::arg("t_stop") = std::numeric_limits<double>::infinity(),
-           "One step, of at most dt_max and not past t_stop; returns dt (s).")
+      .def(
+          "step",
+          [](Simulation& s, std::optional<double> t_stop) {
+            // Without t_stop: at most dt_max ahead (a finite stop, so that limits
+            // that share the time left into equal steps still apply).
+            return s.step(t_stop ? *t_stop : s.time() + s.scenario().config.run.dt_max);
+          },
+          py::arg("t_stop") = py::none(), "One step, of at most dt_max and not past t_stop; returns dt (s).")
       .def("run_until", &run_until, py::arg("t"))
       .def("run", &run_to_file, py::arg("output"), py::arg("until") = -1.0)
       .def_property_readonly("state",
@@ -116,6 +123,23 @@ void bind_simulation(py::module_& m) {
              }
              return out;
            })
+      .def_property_readonly("ids",
+                             [](const Simulation& s) {
+                               const auto& v = s.floes().id;
+                               py::array_t<long long> a(static_cast<py::ssize_t>(v.size()));
+                               std::copy(v.begin(), v.end(), a.mutable_data());
+                               return a;
+                             },
+                             "Each floe's number in the run file (the floe axis of /floes/state); "
+                             "a floe that splits ends and its pieces get new numbers.")
+      .def("take_fracture_events",
+           [](Simulation& s) {
+             const std::vector<FractureEventRow> rows = s.take_fracture_events();
+             Array a({static_cast<py::ssize_t>(rows.size()), static_cast<py::ssize_t>(kFractureEventColumns)});
+             if (!rows.empty()) std::copy_n(&rows[0].time, rows.size() * kFractureEventColumns, a.mutable_data());
+             return a;
+           },
+           "Fracture initiations since the last call, rows of FRACTURE_EVENT_COLUMNS.")
       .def_property_readonly("mass", [](const Simulation& s) { return per_floe(s.floes().mass); })
       .def_property_readonly("thickness", [](const Simulation& s) { return per_floe(s.floes().thickness); })
       .def_property_readonly("area", [](const Simulation& s) { return per_floe(s.floes().area); })
@@ -176,7 +200,7 @@ void bind_simulation(py::module_& m) {
            })
       .def("warnings",
            [](const Simulation& s) {
-             std::vector<std::string> w = s.scenario().notes;
+             std::vector<std::string> w = s.notes();
              for (const std::string& x : s.warnings()) w.push_back(x);
              return w;
            })

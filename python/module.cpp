@@ -3,6 +3,7 @@
 
 #include "core/error.hpp"
 #include "core/floes.hpp"
+#include "core/run_file.hpp"
 #include "python/bindings.hpp"
 
 namespace py = pybind11;
@@ -17,6 +18,10 @@ PYBIND11_MODULE(_floesim, m) {
   for (int k = 0; k < floesim::kStateColumns; ++k) columns[static_cast<std::size_t>(k)] = floesim::kStateColumnNames[k];
   m.attr("STATE_COLUMNS") = columns;
   m.attr("LCP_COLUMNS") = py::make_tuple("solves", "pivots", "failures", "fallbacks");
+  py::tuple events(floesim::kFractureEventColumns);
+  for (int k = 0; k < floesim::kFractureEventColumns; ++k)
+    events[static_cast<std::size_t>(k)] = floesim::kFractureEventColumnNames[k];
+  m.attr("FRACTURE_EVENT_COLUMNS") = events;
   floesim::python::bind_config(m);
   floesim::python::bind_simulation(m);
   floesim::python::bind_run_file(m);

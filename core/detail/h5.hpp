@@ -62,6 +62,13 @@ void write_bytes(hid_t loc, const std::string& name, const std::vector<hsize_t>&
 Handle create_extendible(hid_t loc, const std::string& name, const std::vector<hsize_t>& row,
                          hsize_t rows_hint = 0);
 void append_row(hid_t dataset, const double* row);
+// Like create_extendible, but every dimension may grow (set_extent), and
+// elements never written read as NaN (the fill value).
+Handle create_growable(hid_t loc, const std::string& name, const std::vector<hsize_t>& row,
+                       hsize_t rows_hint = 0);
+void set_extent(hid_t dataset, const std::vector<hsize_t>& dims);
+// Deletes a link (a dataset written whole, before writing it again).
+void remove(hid_t loc, const std::string& name);
 
 // Attributes (on a file, group or dataset).
 void set_attr(hid_t obj, const std::string& name, const std::string& value);

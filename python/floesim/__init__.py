@@ -21,10 +21,10 @@ import re
 import numpy as np
 
 from . import _floesim
-from ._floesim import LCP_COLUMNS, STATE_COLUMNS, InputError, RunError, __version__
+from ._floesim import FRACTURE_EVENT_COLUMNS, LCP_COLUMNS, STATE_COLUMNS, InputError, RunError, __version__
 
 __all__ = ["Config", "Simulation", "RunFile", "read_run", "compare_runs", "InputError", "RunError",
-           "STATE_COLUMNS", "LCP_COLUMNS", "__version__"]
+           "STATE_COLUMNS", "LCP_COLUMNS", "FRACTURE_EVENT_COLUMNS", "__version__"]
 
 
 def _frozen(value):
@@ -301,7 +301,7 @@ class _TableArray:
 class Simulation(_floesim.Simulation):
     """A simulation built from a Config (or a configuration file's path).
 
-    step(t_stop=inf) takes one step (at most dt_max) and returns dt;
+    step(t_stop=None) takes one step (at most dt_max) and returns dt;
     run_until(t) advances to t landing on every output time on the way, as
     `floesim run --until t` does, so states at those times equal its records;
     run(output, until=-1) runs to [run] t_end (or until) writing a run file.
@@ -414,6 +414,13 @@ class RunFile:
         return self["/sea/y"]
 
     @property
+    def fracture_events(self):
+        """[k, 17] fracture initiations (FRACTURE_EVENT_COLUMNS); empty without fracture."""
+        if "/events/fracture" not in self.info["datasets"]:
+            return np.zeros((0, len(FRACTURE_EVENT_COLUMNS)))
+        return self["/events/fracture"]
+
+    @property
     def mass(self):
         return self["/floes/mass"]
 
@@ -426,13 +433,17 @@ class RunFile:
         return self["/floes/static"] != 0
 
     def polygons(self, record=-1):
-        """World outlines of the floes at one record, as (k, 2) arrays."""
+        """World outlines of the floes at one record, as (k, 2) arrays indexed by
+        floe number; None for a floe that does not exist then (split, or not yet made)."""
         offsets = self["/floes/offsets"].astype(int)
         body = self["/floes/vertices"]
         state = self.state[record]
         out = []
         for i in range(len(offsets) - 1):
             x, y, yaw = state[i, 0], state[i, 1], state[i, 2]
+            if np.isnan(x):
+                out.append(None)
+                continue
             c, s = np.cos(yaw), np.sin(yaw)
             p = body[offsets[i]:offsets[i + 1]]
             out.append(np.column_stack((x + c * p[:, 0] - s * p[:, 1], y + s * p[:, 0] + c * p[:, 1])))
