@@ -14,46 +14,30 @@ namespace floesim {
 
 namespace {
 
-// Response eta' of cell `cell` to a unit pressure impulse (1 Pa s) on it,
-// from rest: the inverse mass per unit area of the sea under one cell.
-double cell_response(fluid::Sea& sea, std::size_t cell) {
+// Response eta' at cell `cell` to a pressure impulse (Pa s) from rest: a unit
+// impulse on that cell alone, or (checkerboard) +-1 alternating on every
+// cell, the grid's shortest wave, which the sea answers fastest. Per unit
+// pressure impulse, so an inverse mass per unit area.
+double cell_response(fluid::Sea& sea, std::size_t cell, bool checkerboard) {
   fluid::ModalBank& bank = sea.modes();
   const std::vector<double> q(bank.q().begin(), bank.q().end());
   const std::vector<double> v(bank.v().begin(), bank.v().end());
   std::fill(bank.q().begin(), bank.q().end(), 0.0);
   std::fill(bank.v().begin(), bank.v().end(), 0.0);
-  std::vector<double> p(sea.grid().size(), 0.0);
-  p[cell] = 1.0;
+  const fluid::SurfaceGrid& g = sea.grid();
+  std::vector<double> p(g.size(), 0.0);
+  if (checkerboard) {
+    for (std::size_t c = 0; c < g.size(); ++c)
+      p[c] = ((c % static_cast<std::size_t>(g.nx)) + c / static_cast<std::size_t>(g.nx)) % 2 ? -1.0 : 1.0;
+  } else {
+    p[cell] = 1.0;
+  }
   sea.kick(p, 1.0);
-  const double r = -sea.field(fluid::Field::velocity_z)[cell];
+  const double r = std::abs(sea.field(fluid::Field::velocity_z)[cell]);
   fluid::ModalBank& back = sea.modes();
   std::copy(q.begin(), q.end(), back.q().begin());
   std::copy(v.begin(), v.end(), back.v().begin());
   return r;
-}
-
-// Grid slope of eta at cell c (central differences; one-sided at walls).
-Vec2 grid_slope(const fluid::SurfaceGrid& g, std::span<const double> eta, std::uint32_t c) {
-  const int i = static_cast<int>(c % static_cast<std::uint32_t>(g.nx));
-  const int j = static_cast<int>(c / static_cast<std::uint32_t>(g.nx));
-  const bool periodic = g.edge == fluid::GridEdge::periodic;
-  auto diff = [&](int k, int n, double h, auto at) {
-    int lo = k - 1, hi = k + 1;
-    if (periodic) {
-      lo = (lo + n) % n;
-      hi = hi % n;
-    } else {
-      lo = std::max(lo, 0);
-      hi = std::min(hi, n - 1);
-    }
-    const double span = periodic ? 2.0 * h : (hi - lo) * h;
-    return span > 0.0 ? (at(hi) - at(lo)) / span : 0.0;
-  };
-  Vec2 s;
-  s.x() = diff(i, g.nx, g.dx(), [&](int k) { return eta[static_cast<std::size_t>(j) * g.nx + k]; });
-  s.y() = g.dims == 2 ? diff(j, g.ny, g.dy(), [&](int k) { return eta[static_cast<std::size_t>(k) * g.nx + i]; })
-                      : 0.0;
-  return s;
 }
 
 // Solves A x = b for (heave, pitch, roll) with only the slopes that `tilt`
@@ -91,10 +75,12 @@ FloeSeaContact::FloeSeaContact(const CouplingParams& params, const SeaParams& se
   }
   const fluid::SurfaceGrid& grid = sea.grid();
   cell_area_ = grid.dx() * (grid.dims == 2 ? grid.dy() : grid.ly);
-  // The sea under one cell: the most responsive of a few cells (a walled
-  // basin responds more near its walls).
+  // The sea under the floes, as fast as it can answer: one cell, or the
+  // grid's shortest wave, at a few places (a walled basin answers faster near
+  // its walls).
   for (std::size_t c : {std::size_t{0}, grid.size() / 4, grid.size() / 2, grid.size() - 1})
-    sea_inverse_mass_ = std::max(sea_inverse_mass_, cell_response(sea, c) * cell_area_);
+    for (bool checkerboard : {false, true})
+      sea_inverse_mass_ = std::max(sea_inverse_mass_, cell_response(sea, c, checkerboard));
   floes_changed(floes);
 }
 
@@ -157,8 +143,8 @@ void FloeSeaContact::start(Floes& floes, fluid::Sea& sea, bool given) {
     z[i] = -floes.draft(i, rho_) * (1.0 + 1.0 / K_);
     for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k) {
       const double f = fp.area[k] / cell_area_;
-      F[fp.cell[k]] += f;
-      S[fp.cell[k]] += f * zb(i, k);
+      F[fp.cell[k]] += f * f;
+      S[fp.cell[k]] += f * f * zb(i, k);
     }
   }
   double change = INFINITY;
@@ -172,20 +158,21 @@ void FloeSeaContact::start(Floes& floes, fluid::Sea& sea, bool given) {
       for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k) {
         const std::uint32_t c = fp.cell[k];
         const double f = fp.area[k] / cell_area_;
-        const double Fo = F[c] - f, So = S[c] - f * zb(i, k);
+        const double Fo = F[c] - f * f, So = S[c] - f * f * zb(i, k);
         const double alpha = K_ * So / (1.0 + K_ * F[c]), beta = (1.0 + K_ * Fo) / (1.0 + K_ * F[c]);
         const Eigen::Vector3d phi(1.0, fp.centroid[k].x(), fp.centroid[k].y());
-        A += fp.area[k] * beta * phi * phi.transpose();
-        b += fp.area[k] * alpha * phi;
+        A += f * fp.area[k] * beta * phi * phi.transpose();
+        b += f * fp.area[k] * alpha * phi;
       }
       // Slopes the discrete footprint cannot resist stay 0 (a floe within a
       // few cells; roll in a long-crested sea).
       const Eigen::Vector3d x = solve_tilted(A, b, tilt_[i]);
-      for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k) S[fp.cell[k]] -= fp.area[k] / cell_area_ * zb(i, k);
+      auto weight = [&](std::size_t k) { return std::pow(fp.area[k] / cell_area_, 2); };
+      for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k) S[fp.cell[k]] -= weight(k) * zb(i, k);
       change = std::max(change, std::abs(x[0] - z[i]) / floes.draft(i, rho_));
       z[i] = x[0];
       a[i] = {x[1], x[2]};
-      for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k) S[fp.cell[k]] += fp.area[k] / cell_area_ * zb(i, k);
+      for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k) S[fp.cell[k]] += weight(k) * zb(i, k);
     }
   }
   if (change > 1e-9) {
@@ -269,16 +256,13 @@ void FloeSeaContact::evaluate(const Floes& floes, fluid::Sea& sea, double h) {
       const double delta = eta[fp.cell[k]] - z - a.dot(r);
       if (delta <= 0.0) continue;
       u[k] = delta;
-      double f = ks * fp.area[k] * delta;
-      penalty_energy_ += 0.5 * ks * fp.area[k] * delta * delta;
+      const double cover = fp.area[k] / cell_area_;
+      double f = ks * cover * fp.area[k] * delta;
+      penalty_energy_ += 0.5 * ks * cover * fp.area[k] * delta * delta;
       if (c > 0.0) {
         const double rate = w[fp.cell[k]] - st.heave_rate - ar.dot(r);
-        const double fw = fp.area[k] * damper * rate;
+        const double fw = cover * fp.area[k] * damper * rate;
         f += fw;
-        // The damper's horizontal share: -f_w grad eta.
-        const Vec2 slope = grid_slope(grid, eta, fp.cell[k]);
-        fh -= fw * slope;
-        torque -= fw * cross(r, slope);
       }
       pressure_[fp.cell[k]] += f / cell_area_;
       fz += f;
@@ -302,14 +286,15 @@ void FloeSeaContact::evaluate(const Floes& floes, fluid::Sea& sea, double h) {
         const double ae = A.dot(e), ee = e.dot(e);
         const Vec2 S = -(A * ae + 0.5 * (A * ee + e * ae) + e * (ee / 3.0));
         const Vec2& rc = fp.centroid[piece];
-        const Vec2 dVdG = ks * (0.5 * up * up * N - up * (ra * N - a.dot(rc) * N));
-        const double dVdyaw = ks * (0.5 * up * up * T - up * a.dot(S - rc * T));
+        const double kf = ks * fp.area[piece] / cell_area_;
+        const Vec2 dVdG = kf * (up * up * N - up * (ra * N - a.dot(rc) * N));
+        const double dVdyaw = kf * (up * up * T - up * a.dot(S - rc * T));
         fh -= dVdG;
         torque -= dVdyaw;
       }
-      // The explicit-G term of dV/dG: -u a_c a, summed over the area pieces.
+      // The explicit-G term of dV/dG: -phi_c a_c u a, summed over the area pieces.
       double sum = 0.0;
-      for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k) sum += fp.area[k] * u[k];
+      for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k) sum += fp.area[k] * fp.area[k] / cell_area_ * u[k];
       fh -= ks * sum * a;
     }
     load.vertical = {fz - floes.mass[i] * g_, moment.x(), moment.y()};

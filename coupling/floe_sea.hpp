@@ -8,10 +8,21 @@
 // piece c of its footprint (coupling/footprint.hpp: cell c of the sea grid,
 // area a_c, centroid r_c) the penetration is delta_c = eta_c - z_b(G + r_c)
 // and the law (coupling/penalty_law.hpp) gives the force
-//     f_c = a_c (s kappa [delta_c]^+ + (1 - s) c_i delta_c' 1[delta_c > 0]),
-// up on the floe, down on the water (pressure f_c / cell area on cell c).
+//     f_c = phi_c a_c (s kappa [delta_c]^+ + (1 - s) c_i delta_c' 1[delta_c > 0]),
+// up on the floe, down on the water (pressure f_c / cell area on cell c), with
+// phi_c = a_c / cell area the piece's share of its cell.
 //
-// Energy (strong part). With V = s kappa / 2 sum_c a_c [delta_c]^+^2, the
+// Why phi_c: the sea knows one elevation per cell. A floe edge that covers a
+// sliver of a cell sees that cell's mean water level, which at rest sits
+// close to the free level, not to the floe's bottom, so an unweighted law
+// would push there with the full draft as penetration: a force that jumps as
+// the edge enters a cell. Weighted by phi_c the penalty energy of a piece
+// grows as a_c^2 from zero and the forces are continuous (C^1 energy). The
+// grid still resolves the edge only to a cell: a partly covered cell's water
+// is held down nearly as a whole, so the floating depth converges as O(dx / L)
+// (docs/coupling.md gives the measured figures).
+//
+// Energy (strong part). With V = s kappa / 2 sum_c phi_c a_c [delta_c]^+^2, the
 // vertical forces are exactly -dV/d(zeta, a) and -dV/d eta_c, so floes + sea
 // + V + the floes' weight M g zeta is a Hamiltonian that the Strang splitting
 // (half kick, exact sea flow and floe drift, half kick) conserves to O(dt^2).
@@ -21,12 +32,18 @@
 // cell c (Reynolds' transport theorem), so with the edge pieces A -> B in the
 // cell, N_c = ∮ n ds, Q_c = ∮ r n^T ds, T_c = ∮ r x n ds, S_c = ∮ r (r x n) ds,
 // and u = [delta_c]^+,
-//     dV/dG   = sum_c kappa s [u^2/2 N_c - u (Q_c^T a - (a . r_c) N_c - a_c a)],
-//     dV/dyaw = sum_c kappa s [u^2/2 T_c - u a . (S_c - r_c T_c)]
+//     dV/dG   = sum_c kappa s phi_c [u^2 N_c - u (Q_c^T a - (a . r_c) N_c - a_c a)],
+//     dV/dyaw = sum_c kappa s phi_c [u^2 T_c - u a . (S_c - r_c T_c)]
 // (the bottom slope a is held in the world frame). In the continuum limit this
 // is the pressure-slope force -∫ p grad eta. The damping (weak) part has no
-// potential; its horizontal force is -f_c times the grid slope of eta at c.
+// potential and no horizontal share.
 //
+// KNOWN PROBLEM (docs/coupling.md): through the partly covered edge cells the
+// floe feels its own static depression, a cogging potential of period dx
+// that holds slow floes in place (a 10 m floe on 1.6 m cells at 0.5 m/s is
+// trapped). Tried and rejected: -a ∫ p (the continuum limit under a stiff
+// penalty) and the grid slope: neither is the gradient of V, and both pump
+// energy into heave as floes cross cells.
 // The damper is integrated implicitly per piece over a kick of length h,
 // using the inverse mass per unit area of the floe (1 / rho_i h) and of the
 // sea under one cell (measured once from the sea's response to a unit
@@ -40,7 +57,8 @@
 // (rho_w g), reported), so on each cell eta_c (1 + K sum_i f_ci) = L + K
 // sum_i f_ci z_b,i(r_ci) with f_ci = a_ci / cell area; each floe's heave and
 // slopes solve the 3x3 equilibrium of its weight (Gauss–Seidel over floes
-// sharing cells), and L is set by the zero mean of eta. The initial waves are
+// sharing cells), and L is set by the zero mean of eta (with the phi_c
+// weights: f_ci enters as f_ci^2). The initial waves are
 // then superposed: floes take the mean wave elevation and slope under them.
 
 #include <span>
@@ -95,6 +113,8 @@ public:
   double floes_vertical_kinetic(const Floes& floes) const;
   double floes_weight_energy(const Floes& floes) const;
 
+  // Height of floe i's bottom at its centroid, z_b(G) = zeta + z0 (m).
+  double bottom(const Floes& floes, std::size_t i) const { return floes.state[i].heave + bottom0_[i]; }
   const Footprints& footprints() const { return footprints_; }
   std::span<const FloeSeaLoad> loads() const { return loads_; }
   std::span<const double> pressure() const { return pressure_; }

@@ -66,15 +66,22 @@ double obstacle_restitution(double s, double K) {
 }
 
 BlendCalibration calibrate_blend(double K, int points) {
+  // Tabulated along the damping ratio zeta = (1 - s) sqrt(K / s) / 2, where e
+  // varies (for large K all of it happens within 1 - s ~ 1 / sqrt(K)):
+  // s = q^2 with q^2 + b q - 1 = 0, b = 2 zeta / sqrt(K); zeta from 0 (s = 1)
+  // log-spaced over 10^-3 .. 10^3, then s = 0.
   BlendCalibration cal;
   cal.stiffness = K;
-  for (int k = 0; k < points; ++k) {
-    // Denser toward s = 0, where e rises steeply for large K.
-    const double u = static_cast<double>(k) / (points - 1);
-    const double s = u * u;
-    cal.share.push_back(s);
-    cal.restitution.push_back(obstacle_restitution(s, K));
+  std::vector<double> zetas{0.0};
+  for (int k = 0; k < points - 2; ++k) zetas.push_back(std::pow(10.0, -3.0 + 6.0 * k / (points - 3)));
+  for (double zeta : zetas) {
+    const double b = 2.0 * zeta / std::sqrt(K);
+    const double q = 2.0 / (b + std::sqrt(b * b + 4.0));  // the root of q^2 + b q - 1, cancellation-free
+    cal.share.push_back(q * q);
   }
+  cal.share.push_back(0.0);
+  std::reverse(cal.share.begin(), cal.share.end());  // increasing s
+  for (double s : cal.share) cal.restitution.push_back(obstacle_restitution(s, K));
   // Round-off may leave the table flat at its ends; keep it non-decreasing.
   for (std::size_t k = 1; k < cal.restitution.size(); ++k)
     cal.restitution[k] = std::max(cal.restitution[k], cal.restitution[k - 1]);

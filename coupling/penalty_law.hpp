@@ -43,6 +43,6 @@ struct BlendCalibration {
   // The share s that gives restitution e (monotone cubic interpolation).
   double share_for(double e) const;
 };
-BlendCalibration calibrate_blend(double stiffness, int points = 41);
+BlendCalibration calibrate_blend(double stiffness, int points = 61);
 
 }  // namespace floesim
