@@ -33,7 +33,7 @@ struct Case {
 };
 
 struct Row {
-  std::string status;    // pass | DIFFERS | FAILED | updated | new
+  std::string status;    // pass | DIFFERS | FAILED | new | updated | unchanged
   std::string max_diff = "-", where = "-", time = "-";
   double wall = 0.0;
   std::vector<std::string> details;  // one line per differing dataset, or the failure
@@ -144,10 +144,19 @@ Row run_case(const Case& c, const fs::path& out, const CompareOptions& opt, bool
   }
   row.wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (update) {
+    // A reference equal to the fresh run within the tolerances is left as it
+    // is (rewriting changes its bytes, not its numbers: churn in git).
     const bool existed = fs::exists(c.reference);
-    if (existed) summarise(compare_runs(out.string(), c.reference.string(), opt), c.reference.string(), row);
+    if (existed) {
+      const CompareResult r = compare_runs(out.string(), c.reference.string(), opt);
+      summarise(r, c.reference.string(), row);
+      if (r.equal()) {
+        row.status = "unchanged";
+        return row;
+      }
+    }
     fs::copy_file(out, c.reference, fs::copy_options::overwrite_existing);
-    row.status = !existed ? "new" : row.details.empty() ? "updated" : "updated*";
+    row.status = existed ? "updated" : "new";
     return row;
   }
   const CompareResult r = compare_runs(out.string(), c.reference.string(), opt);
@@ -219,8 +228,9 @@ void add_regress_command(CLI::App& app, Registry& registry) {
       for (const std::string& d : row.details) std::cout << "  " << d << "\n";
     }
     if (args->update) {
-      std::cout << "\nreferences written in " << args->dir
-                << " (updated*: results changed); commit them and say why the results changed\n";
+      std::cout << "\nreferences in " << args->dir
+                << " (new, updated: written; unchanged: equal to the fresh run, left as they were); "
+                   "commit them and say why the results changed\n";
       return bad ? 1 : 0;
     }
     std::cout << "\n" << cases.size() - bad << " of " << cases.size() << " case(s) pass\n";
