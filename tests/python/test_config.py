@@ -13,18 +13,19 @@ import numpy as np
 import floesim
 
 SRC = os.environ["FLOESIM_SOURCE_DIR"]
-EXAMPLE = os.path.join(SRC, "examples", "floes_on_waves.toml")
+EXAMPLE = os.path.join(SRC, "tests", "regression", "pack_wind_periodic.toml")
 
 
 class LoadAndRead(unittest.TestCase):
     def test_file_values_and_defaults(self):
         cfg = floesim.Config.load(EXAMPLE)
-        self.assertEqual(cfg["run"]["t_end"], 3600.0)              # written in the file
-        self.assertEqual(cfg["forcing"]["wind"], (10.0, 4.0))      # arrays read as tuples
-        self.assertEqual(cfg["contact"]["restitution"], 0.4)       # a default ([contact] absent)
+        self.assertEqual(cfg["run"]["t_end"], 1200.0)              # written in the file
+        self.assertEqual(cfg["forcing"]["wind"], (18.0, 6.0))      # arrays read as tuples
+        self.assertEqual(cfg["contact"]["collision_distance"], 0.01)  # a default (key absent)
+        self.assertEqual(cfg["coupling"]["law"], "strong")         # a default ([coupling] absent)
         self.assertEqual(cfg["sea"]["depth"], math.inf)            # default: deep water
-        self.assertEqual(len(cfg["floes"]["floe"]), 30)
-        self.assertEqual(cfg["floes"]["floe"][0]["thickness"], 1.68)
+        self.assertEqual(len(cfg["floes"]["floe"]), 16)
+        self.assertEqual(cfg["floes"]["floe"][1]["thickness"], 0.95)
         # latitude = 75 is resolved into f = 2 Omega sin(75 deg)
         self.assertAlmostEqual(cfg.resolved()["forcing"]["coriolis"],
                                2 * 7.2921e-5 * math.sin(math.radians(75.0)), places=15)
@@ -53,11 +54,11 @@ class Write(unittest.TestCase):
     def test_set_value_reaches_the_resolved_configuration(self):
         cfg = floesim.Config.load(EXAMPLE)
         cfg["run"]["t_end"] = 10
-        cfg["contact"]["restitution"] = 0.25        # a section the file does not have
+        cfg["coupling"]["stiffness"] = 250.0        # a section the file does not have
         self.assertEqual(cfg["run"]["t_end"], 10)
         self.assertEqual(cfg.resolved()["run"]["t_end"], 10.0)
-        self.assertEqual(cfg.resolved()["contact"]["restitution"], 0.25)
-        self.assertIn("restitution = 0.25", cfg.resolved_toml())
+        self.assertEqual(cfg.resolved()["coupling"]["stiffness"], 250.0)
+        self.assertIn("stiffness = 250.0", cfg.resolved_toml())
         sim = floesim.Simulation(cfg)
         self.assertIn("t_end = 10.0", sim.resolved_toml())
 
