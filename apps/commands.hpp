@@ -20,6 +20,7 @@ void add_info_command(CLI::App& app, Registry& registry);
 void add_lcp_command(CLI::App& app, Registry& registry);
 void add_pack_command(CLI::App& app, Registry& registry);
 void add_plot_command(CLI::App& app, Registry& registry);
+void add_regress_command(CLI::App& app, Registry& registry);
 void add_render_command(CLI::App& app, Registry& registry);
 void add_run_command(CLI::App& app, Registry& registry);
 

@@ -19,6 +19,7 @@ int main(int argc, char** argv) {
   floesim::apps::add_lcp_command(app, handlers);
   floesim::apps::add_pack_command(app, handlers);
   floesim::apps::add_plot_command(app, handlers);
+  floesim::apps::add_regress_command(app, handlers);
   floesim::apps::add_render_command(app, handlers);
   floesim::apps::add_run_command(app, handlers);
 

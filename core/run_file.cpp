@@ -56,18 +56,20 @@ void RunWriter::Impl::write_tables() {
 }
 
 RunWriter::RunWriter(const std::string& path, const Floes& floes, const std::string& config_toml,
-                     std::vector<std::string> energy_columns, const SeaGridInfo& sea)
+                     std::vector<std::string> energy_columns, const SeaGridInfo& sea,
+                     std::size_t expected_records)
     : impl_(std::make_unique<Impl>()) {
   Impl& w = *impl_;
   w.path = path;
   w.energy_columns = std::move(energy_columns);
   w.sea = sea;
+  const hsize_t rows = expected_records;
   w.file = h5::create_file(path);
   h5::set_attr(w.file, "format", std::string(kRunFormat));
   h5::set_attr(w.file, "config", config_toml);
   h5::set_attr(w.file, "status", std::string("running"));
 
-  w.time = h5::create_extendible(w.file, "time", {});
+  w.time = h5::create_extendible(w.file, "time", {}, rows);
   h5::set_attr(w.time, "units", std::string("s"));
 
   w.floes_group = h5::create_group(w.file, "/floes");
@@ -78,15 +80,15 @@ RunWriter::RunWriter(const std::string& path, const Floes& floes, const std::str
   w.write_tables();   // also when there is no floe
   // Chunks sized on the floes at the start (a row of 1 floe per chunk would
   // make every record touch n chunks).
-  w.state = h5::create_growable(w.floes_group, "state", {w.n, kStateColumns});
+  w.state = h5::create_growable(w.floes_group, "state", {w.n, kStateColumns}, rows);
   h5::set_attr(w.state, "columns", std::vector<std::string>(std::begin(kStateColumnNames), std::end(kStateColumnNames)));
-  w.verts = h5::create_growable(w.xdmf_group, "vertices", {w.nverts, 3});
+  w.verts = h5::create_growable(w.xdmf_group, "vertices", {w.nverts, 3}, rows);
 
   h5::Handle d = h5::create_group(w.file, "/diagnostics");
-  w.energy = h5::create_extendible(d, "energy", {w.energy_columns.size()});
+  w.energy = h5::create_extendible(d, "energy", {w.energy_columns.size()}, rows);
   h5::set_attr(w.energy, "columns", w.energy_columns);
   h5::set_attr(w.energy, "units", std::string("J"));
-  w.lcp = h5::create_extendible(d, "lcp", {4});
+  w.lcp = h5::create_extendible(d, "lcp", {4}, rows);
   h5::set_attr(w.lcp, "columns", std::vector<std::string>{"solves", "pivots", "failures", "fallbacks"});
 
   h5::Handle ev = h5::create_group(w.file, "/events");
@@ -104,7 +106,7 @@ RunWriter::RunWriter(const std::string& path, const Floes& floes, const std::str
     h5::write_doubles(s, "y", {y.size()}, y.data());
     std::vector<hsize_t> row = sea.dims == 2 ? std::vector<hsize_t>{hsize_t(ny), hsize_t(nx)}
                                              : std::vector<hsize_t>{hsize_t(nx)};
-    w.eta = h5::create_extendible(s, "eta", row);
+    w.eta = h5::create_extendible(s, "eta", row, rows);
     h5::set_attr(w.eta, "units", std::string("m"));
   }
   H5Fflush(w.file, H5F_SCOPE_GLOBAL);
@@ -337,6 +339,20 @@ RunInfo read_run_info(const std::string& path) {
     auto d = h5::dims(h5::open_dataset(f, p, path));
     r.datasets.emplace_back(p, std::vector<unsigned long long>(d.begin(), d.end()));
   }
+  return r;
+}
+
+RunDataset read_run_dataset(const std::string& path, const std::string& dataset) {
+  h5::Handle f = h5::open_file(path);
+  if (!h5::has_attr(f, "format") || h5::get_attr_string(f, "format") != kRunFormat)
+    throw InputError(path + ": not a floesim run file (attribute 'format' is not '" + std::string(kRunFormat) + "')");
+  if (dataset.empty() || !h5::exists(f, dataset)) throw InputError(path + ": no dataset '" + dataset + "'");
+  h5::Handle d = h5::open_dataset(f, dataset, path);
+  RunDataset r;
+  const auto dims = h5::dims(d);
+  r.shape.assign(dims.begin(), dims.end());
+  r.values = h5::read_doubles(d, path + ": " + dataset);
+  if (h5::has_attr(d, "columns")) r.columns = h5::get_attr_strings(d, "columns");
   return r;
 }
 

@@ -70,9 +70,11 @@ struct LcpCounters {
 class RunWriter {
 public:
   // Creates (truncates) the file and writes the static parts. Throws
-  // InputError if the file cannot be created.
+  // InputError if the file cannot be created. expected_records (0: unknown)
+  // sizes the chunks of the per-record datasets (more records still fit).
   RunWriter(const std::string& path, const Floes& floes, const std::string& config_toml,
-            std::vector<std::string> energy_columns, const SeaGridInfo& sea = {});
+            std::vector<std::string> energy_columns, const SeaGridInfo& sea = {},
+            std::size_t expected_records = 0);
   ~RunWriter();  // closes; leaves status "running" unless finish() was called
   RunWriter(const RunWriter&) = delete;
   RunWriter& operator=(const RunWriter&) = delete;
@@ -112,6 +114,17 @@ struct RunInfo {
   std::vector<std::pair<std::string, std::vector<unsigned long long>>> datasets;  // path, shape
 };
 RunInfo read_run_info(const std::string& path);
+
+// One numeric dataset of a run file (any stored type, converted to double),
+// row-major with its shape, and its `columns` attribute if it has one. For
+// scripts (the Python module) and tools. Throws InputError naming the file
+// and the dataset when either is missing or unreadable.
+struct RunDataset {
+  std::vector<unsigned long long> shape;
+  std::vector<double> values;
+  std::vector<std::string> columns;
+};
+RunDataset read_run_dataset(const std::string& path, const std::string& dataset);
 
 // Regression comparison of two run files: every numeric dataset of A must
 // exist in B with the same shape and |a - b| <= atol + rtol |b| element-wise

@@ -18,7 +18,10 @@ RunSummary run_simulation(Simulation& sim, const RunOptions& options) {
   summary.output = options.output;
   summary.energy_first = sim.energies();
   summary.warnings = sim.notes();
-  RunWriter writer(options.output, sim.floes(), resolved_toml(cfg), summary.energy_first.names, sim.sea_grid());
+  // Records at t = 0, at every multiple of the interval and at the end.
+  const auto expected_records = static_cast<std::size_t>(std::ceil(t_end / interval - 1e-9)) + 1;
+  RunWriter writer(options.output, sim.floes(), resolved_toml(cfg), summary.energy_first.names, sim.sea_grid(),
+                   expected_records);
   summary.xdmf = writer.xdmf_path();
 
   auto record = [&] {
@@ -31,7 +34,10 @@ RunSummary run_simulation(Simulation& sim, const RunOptions& options) {
   summary.status = "complete";
   try {
     record();
-    std::size_t next = 1;  // index of the next scheduled record
+    // Index of the next scheduled record: the first multiple of the interval
+    // after the start (a simulation may come here already advanced).
+    auto next = static_cast<std::size_t>(std::floor(sim.time() / interval)) + 1;
+    if (static_cast<double>(next) * interval <= sim.time()) ++next;
     while (sim.time() < t_end) {
       // Next record time; a record that would fall within 1e-9 s of the end merges with it.
       double t_record = std::min(static_cast<double>(next) * interval, t_end);

@@ -135,7 +135,8 @@ void write_bytes(hid_t loc, const std::string& name, const std::vector<hsize_t>&
   write_raw(loc, name, d, H5T_STD_U8LE, H5T_NATIVE_UCHAR, data);
 }
 
-Handle create_extendible(hid_t loc, const std::string& name, const std::vector<hsize_t>& row) {
+Handle create_extendible(hid_t loc, const std::string& name, const std::vector<hsize_t>& row,
+                         hsize_t rows_hint) {
   std::vector<hsize_t> d{0}, maxd{H5S_UNLIMITED}, chunk{1};
   std::size_t row_size = 1;
   for (hsize_t r : row) {
@@ -147,6 +148,7 @@ Handle create_extendible(hid_t loc, const std::string& name, const std::vector<h
   }
   // Aim for chunks of about 64 KiB: several rows per chunk when rows are small.
   chunk[0] = std::max<hsize_t>(1, 8192 / std::max<std::size_t>(row_size, 1));
+  if (rows_hint > 0) chunk[0] = std::min(chunk[0], rows_hint);
   Handle space{H5Screate_simple(static_cast<int>(d.size()), d.data(), maxd.data()), H5Sclose};
   Handle props{H5Pcreate(H5P_DATASET_CREATE), H5Pclose};
   H5Pset_chunk(props, static_cast<int>(chunk.size()), chunk.data());
@@ -170,7 +172,8 @@ void append_row(hid_t dataset, const double* row) {
     fail("cannot append to a run-file dataset");
 }
 
-Handle create_growable(hid_t loc, const std::string& name, const std::vector<hsize_t>& row) {
+Handle create_growable(hid_t loc, const std::string& name, const std::vector<hsize_t>& row,
+                       hsize_t rows_hint) {
   std::vector<hsize_t> d{0}, maxd{H5S_UNLIMITED}, chunk{1};
   std::size_t row_size = 1;
   for (hsize_t r : row) {
@@ -180,6 +183,7 @@ Handle create_growable(hid_t loc, const std::string& name, const std::vector<hsi
     row_size *= std::max<hsize_t>(r, 1);
   }
   chunk[0] = std::max<hsize_t>(1, 8192 / std::max<std::size_t>(row_size, 1));
+  if (rows_hint > 0) chunk[0] = std::min(chunk[0], rows_hint);
   Handle space{H5Screate_simple(static_cast<int>(d.size()), d.data(), maxd.data()), H5Sclose};
   Handle props{H5Pcreate(H5P_DATASET_CREATE), H5Pclose};
   H5Pset_chunk(props, static_cast<int>(chunk.size()), chunk.data());
