@@ -106,8 +106,12 @@ StepContext Simulation::choose_dt(double t_stop) {
   if (!(ctx.dt > 0.0)) throw RunError("step requested with no time left (t = " + std::to_string(t_) + ")");
   // The explicit penalty spring's stability limit (coupling/floe_sea.hpp).
   if (floe_sea_ && floe_sea_->stable_step() < ctx.dt) {
-    const double n = std::ceil(remaining / floe_sea_->stable_step());
-    ctx.dt = std::min(ctx.dt, remaining / n);  // equal steps up to t_stop
+    if (std::isfinite(remaining)) {
+      const double n = std::ceil(remaining / floe_sea_->stable_step());
+      ctx.dt = std::min(ctx.dt, remaining / n);  // equal steps up to t_stop
+    } else {
+      ctx.dt = floe_sea_->stable_step();  // no stop in sight (step(inf))
+    }
   }
   // Event-driven limit from the near pairs (contact/step_limit.hpp).
   const contact::StepLimit limit = contact::collision_step_limit(
