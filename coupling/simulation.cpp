@@ -107,13 +107,17 @@ StepContext Simulation::choose_dt(double t_stop) {
   if (!(ctx.dt > 0.0)) throw RunError("step requested with no time left (t = " + std::to_string(t_) + ")");
   // The explicit penalty spring's stability limit (coupling/floe_sea.hpp).
   if (floe_sea_ && floe_sea_->stable_step() < ctx.dt) {
-    const double n = std::ceil(remaining / floe_sea_->stable_step());
-    // Equal steps up to t_stop; the last equal step is kept while it divides
-    // what remains to round-off (the sea's rotations, cached for one dt, stay
-    // valid), and the last step of all lands on t_stop.
-    const bool same = n > 1.0 && equal_dt_ > 0.0 && std::abs(remaining / equal_dt_ - n) < 1e-9 * n;
-    equal_dt_ = same ? equal_dt_ : remaining / n;
-    ctx.dt = std::min(ctx.dt, equal_dt_);
+    if (std::isfinite(remaining)) {
+      const double n = std::ceil(remaining / floe_sea_->stable_step());
+      // Equal steps up to t_stop; the last equal step is kept while it
+      // divides what remains to round-off (the sea's rotations, cached for
+      // one dt, stay valid), and the last step of all lands on t_stop.
+      const bool same = n > 1.0 && equal_dt_ > 0.0 && std::abs(remaining / equal_dt_ - n) < 1e-9 * n;
+      equal_dt_ = same ? equal_dt_ : remaining / n;
+      ctx.dt = std::min(ctx.dt, equal_dt_);
+    } else {
+      ctx.dt = floe_sea_->stable_step();  // no stop in sight (step(inf))
+    }
   }
   // Event-driven limit from the near pairs (contact/step_limit.hpp).
   const contact::StepLimit limit = contact::collision_step_limit(
