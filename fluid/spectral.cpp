@@ -43,13 +43,17 @@ struct SpectralSea::Impl {
   fftw_complex* spec_vy = nullptr;
   bool staged_vy = false;
   fftw_plan r2c = nullptr, c2r = nullptr;
-  // Deferred kicks: the FFTs of up to two pressures and their h, applied fused
-  // with the next flow. `staged`: spec holds the current q (written by that flow),
-  // so the elevation needs no copy before its c2r.
+  // Deferred kicks: up to two (spectrum, h), applied fused with the next flow,
+  // in order. kick_spec holds the FFTs of up to two pressures; pending kick i
+  // uses kick_spec[kick_buf[i]] (a repeated kick uses the buffer of the last
+  // one again). `staged`: spec holds the current q (written by that flow), so
+  // the elevation needs no copy before its c2r.
   std::array<fftw_complex*, 2> kick_spec{nullptr, nullptr};
+  std::array<int, 2> kick_buf{0, 0};
   std::array<double, 2> kick_h{0.0, 0.0};
   int pending = 0;
-  int last = -1;  // slot holding the FFT of the last kick's pressure (-1: none yet)
+  int last = -1;  // buffer holding the FFT of the last kick's pressure (-1: none yet)
+  const double* kick_data(int i) const { return reinterpret_cast<const double*>(kick_spec[kick_buf[i]]); }
   bool staged = false;
   std::optional<TankZones> tank;
   AlignedVector tank_eta, tank_rate;
@@ -104,7 +108,7 @@ struct SpectralSea::Impl {
       double a0 = a[2 * c], a1 = a[2 * c + 1];
       for (int i = 0; i < kicks; ++i) {
         const double g = kick_h[i] * gain[c];
-        const double* s = reinterpret_cast<const double*>(kick_spec[i]);
+        const double* s = kick_data(i);
         a0 += g * s[2 * c];
         a1 += g * s[2 * c + 1];
       }
@@ -211,9 +215,11 @@ void SpectralSea::kick(std::span<const double> pressure, double h) {
   Impl& m = *impl_;
   FLOESIM_ASSERT(pressure.size() == m.n);
   if (m.pending == 2) settle();
-  m.forward(pressure, m.kick_spec[m.pending]);
+  const int buf = m.pending == 1 ? 1 - m.kick_buf[0] : 0;  // one not in use
+  m.forward(pressure, m.kick_spec[buf]);
+  m.kick_buf[m.pending] = buf;
   m.kick_h[m.pending] = h;
-  m.last = m.pending;
+  m.last = buf;
   ++m.pending;
   m.staged_vy = false;
   invalidate_rates();
@@ -222,24 +228,20 @@ void SpectralSea::kick(std::span<const double> pressure, double h) {
 void SpectralSea::repeat_kick(double h) {
   Impl& m = *impl_;
   FLOESIM_ASSERT(m.last >= 0);
-  if (m.last < m.pending) {
-    m.kick_h[m.last] += h;  // still deferred: kicks by one pressure add up
-  } else {
-    // Applied already (then nothing else is pending): defer it again from slot 0.
-    std::swap(m.kick_spec[0], m.kick_spec[m.last]);
-    m.last = 0;
-    m.kick_h[0] = h;
-    m.pending = 1;
-  }
+  // A kick of its own (not h added to a deferred one), so that the
+  // arithmetic, and the result to the bit, does not depend on whether a
+  // query settled the first one in between.
+  if (m.pending == 2) settle();
+  m.kick_buf[m.pending] = m.last;
+  m.kick_h[m.pending] = h;
+  ++m.pending;
   m.staged_vy = false;
   invalidate_rates();
 }
 
 void SpectralSea::settle() {
   Impl& m = *impl_;
-  for (int i = 0; i < m.pending; ++i)
-    bank_.kick(std::span<const double>(reinterpret_cast<const double*>(m.kick_spec[i]), 2 * m.nc),
-               m.kick_h[i]);
+  for (int i = 0; i < m.pending; ++i) bank_.kick(std::span<const double>(m.kick_data(i), 2 * m.nc), m.kick_h[i]);
   m.pending = 0;
   // Base::modes() settles before handing out the state to be changed: the
   // staged spectra may not outlive that.
@@ -271,7 +273,7 @@ void SpectralSea::flow(double dt) {
     // One pass: deferred kicks, rotation, and q staged in spec for the elevation.
     std::array<ModalBank::Kick, 2> kicks{};
     for (int i = 0; i < m.pending; ++i)
-      kicks[i] = {reinterpret_cast<const double*>(m.kick_spec[i]), m.kick_h[i]};
+      kicks[i] = {m.kick_data(i), m.kick_h[i]};
     bank_.kick_flow(std::span(kicks.data(), static_cast<std::size_t>(m.pending)), dt,
                     reinterpret_cast<double*>(m.spec));
     m.pending = 0;

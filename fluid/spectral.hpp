@@ -17,8 +17,8 @@
 // in the same pass over the modes as the next flow, which also stages q for the
 // elevation's c2r. Callers see no difference: velocity fields add the deferred
 // kicks as they load the rates, energy() and modes() settle them first. A
-// repeated kick costs no FFT: it adds its h to the deferred kick of the same
-// spectrum, or defers that spectrum again.
+// repeated kick costs no FFT: it defers the spectrum of the last kick again,
+// as a kick of its own, so a query that settles in between changes no bit.
 
 #include <memory>
 
