@@ -87,7 +87,7 @@ void add_run_command(CLI::App& app, Registry& registry) {
       throw InputError(output + ": the output would overwrite the configuration");
 
     Simulation sim(build_scenario(load_config(config_path)));
-    for (const std::string& note : sim.scenario().notes) std::cerr << "floesim: note: " << note << "\n";
+    for (const std::string& note : sim.notes()) std::cerr << "floesim: note: " << note << "\n";
 
     ProgressLine progress(!args->quiet && isatty(STDERR_FILENO));
     g_interrupted = false;
@@ -124,6 +124,9 @@ void add_run_command(CLI::App& app, Registry& registry) {
     o << "collisions.lcps: " << c.lcps << "\ncollisions.contacts: " << c.contacts << "\ncollisions.pivots: " << c.pivots
       << "\ncollisions.largest_lcp: " << c.largest << "\ncollisions.failures: " << c.failures
       << "\ncollisions.fallbacks: " << c.fallbacks << "\n";
+    if (const PercussionStats* f = sim.percussion_stats())
+      o << "fracture.checks: " << f->checks << "\nfracture.screened: " << f->screened
+        << "\nfracture.initiations: " << f->initiations << "\nfracture.splits: " << f->splits << "\n";
     o << "warnings: " << s.warnings.size() << "\n";
     for (const auto& w : s.warnings) o << "  " << w << "\n";
     if (args->profile) {

@@ -14,9 +14,13 @@ int main(int argc, char** argv) {
   floesim::apps::Registry handlers;
   // registrations (one line per command, alphabetical)
   floesim::apps::add_compare_command(app, handlers);
+  floesim::apps::add_fracture_command(app, handlers);
   floesim::apps::add_info_command(app, handlers);
   floesim::apps::add_lcp_command(app, handlers);
   floesim::apps::add_pack_command(app, handlers);
+  floesim::apps::add_plot_command(app, handlers);
+  floesim::apps::add_regress_command(app, handlers);
+  floesim::apps::add_render_command(app, handlers);
   floesim::apps::add_run_command(app, handlers);
 
   try {

@@ -270,13 +270,17 @@ std::vector<ContactImpulse> resolve_collisions(Floes& floes, const std::vector<C
       ContactImpulse& ci = impulses[list[k]];
       ci.normal = total[static_cast<Eigen::Index>(k)];
       ci.tangential = total[static_cast<Eigen::Index>(m + 2 * k)] - total[static_cast<Eigen::Index>(m + 2 * k + 1)];
+      const ContactPoint& c = contacts[list[k]];
+      ci.vector = ci.normal * c.normal + ci.tangential * Vec2{-c.normal.y(), c.normal.x()};
+      ci.point = c.point;
     }
   }
   return impulses;
 }
 
 std::size_t resolve_step_collisions(Floes& floes, std::span<const FloeState> start, const Detection& detection,
-                                    double step, const ImpulseOptions& options, CollisionStats& stats) {
+                                    double step, const ImpulseOptions& options, CollisionStats& stats,
+                                    std::vector<ContactImpulse>* impulses) {
   const double xi = options.collision_distance;
   ImpulseOptions opt = options;
   opt.speculative_step = step;
@@ -324,7 +328,8 @@ std::size_t resolve_step_collisions(Floes& floes, std::span<const FloeState> sta
   const std::vector<FloeState> before = floes.state;  // W^-
   std::vector<ContactPoint> again;  // the contacts to solve again: components that gained speculative ones
   std::vector<std::uint8_t> again_resting;
-  resolve_collisions(floes, contacts, opt, stats, resting);
+  std::vector<std::size_t> again_index;  // their places in contacts
+  std::vector<ContactImpulse> total = resolve_collisions(floes, contacts, opt, stats, resting);
   for (int round = 1; round <= 2; ++round) {
     // Pushed points beyond xi that would now close below xi/2 within the step.
     const std::size_t first_new = contacts.size();
@@ -362,10 +367,12 @@ std::size_t resolve_step_collisions(Floes& floes, std::span<const FloeState> sta
     for (std::size_t k = first_new; k < contacts.size(); ++k) redo[comp.find(node.at(dynamic_end(contacts[k])))] = 1;
     again.clear();
     again_resting.clear();
+    again_index.clear();
     for (std::size_t k = 0; k < contacts.size(); ++k)
       if (redo[comp.find(node.at(dynamic_end(contacts[k])))]) {
         again.push_back(contacts[k]);
         again_resting.push_back(resting[k]);
+        again_index.push_back(k);
       }
     for (const auto& [f, local] : node)
       if (redo[comp.find(local)]) {
@@ -373,7 +380,13 @@ std::size_t resolve_step_collisions(Floes& floes, std::span<const FloeState> sta
         floes.state[f].vy = before[f].vy;
         floes.state[f].yaw_rate = before[f].yaw_rate;
       }
-    resolve_collisions(floes, again, opt, stats, again_resting);
+    const std::vector<ContactImpulse> redone = resolve_collisions(floes, again, opt, stats, again_resting);
+    total.resize(contacts.size());
+    for (std::size_t j = 0; j < again.size(); ++j) total[again_index[j]] = redone[j];
+  }
+  if (impulses) {
+    total.resize(detection.contacts.size());
+    *impulses = std::move(total);
   }
   return added;
 }

@@ -111,8 +111,12 @@ struct CollisionStats {
 };
 
 // Per contact: the total impulse applied (compression + decompression), N s.
+// Floe b received `vector` = normal N + tangential T at `point` (the contact's,
+// in a's image of a periodic domain), floe a its opposite (percussion loads).
 struct ContactImpulse {
   double normal = 0.0, tangential = 0.0;
+  Vec2 vector = Vec2::Zero();  // N s, world
+  Vec2 point = Vec2::Zero();   // m, world
 };
 
 // Changes the velocities of the floes in contact (W^- -> W^+). Returns the
@@ -126,8 +130,10 @@ std::vector<ContactImpulse> resolve_collisions(Floes& floes, const std::vector<C
 // `detection` (measured at the present positions) with their resting flags,
 // and the speculative contacts (above). `start`: the floes at the start of the
 // step, before its smooth forces. Returns how many speculative contacts took
-// part.
+// part. `impulses` (optional) receives the impulses of detection.contacts, in
+// their order (percussion).
 std::size_t resolve_step_collisions(Floes& floes, std::span<const FloeState> start, const Detection& detection,
-                                    double step, const ImpulseOptions& options, CollisionStats& stats);
+                                    double step, const ImpulseOptions& options, CollisionStats& stats,
+                                    std::vector<ContactImpulse>* impulses = nullptr);
 
 }  // namespace floesim::contact

@@ -272,6 +272,9 @@ FloeInput read_floe(Section s, const PackDefaults& def, std::size_t index, const
   f.thickness = s.number("thickness", def.thickness, positive, "a thickness > 0 (m)");
   f.density = s.number("density", def.density, positive, "a density > 0 (kg/m^3)");
   f.is_static = s.boolean("static", false);
+  f.heave = s.number("heave", 0.0, finite, "a heave (m, from floating equilibrium; with [coupling] start = \"given\")");
+  f.heave_rate = s.number("heave_rate", 0.0, finite, "a heave rate (m/s; with [coupling] start = \"given\")");
+  if (f.is_static && (f.heave != 0.0 || f.heave_rate != 0.0)) s.fail("static", "a static floe (obstacle) cannot heave");
   f.ocean_drag = s.number("ocean_drag", -1.0, non_negative, "a drag coefficient >= 0");
   if (f.is_static && (s.has("velocity") || s.has("angular_velocity")) &&
       (f.velocity.norm() > 0.0 || f.angular_velocity != 0.0))
@@ -319,6 +322,10 @@ void read_coupling(Section s, CouplingParams& c) {
   if ((s.has("blend") || s.has("restitution")) && c.law != PenaltyLaw::blend)
     s.fail(s.has("blend") ? "blend" : "restitution", "only used with law = \"blend\"");
   if (!s.has("restitution")) c.restitution = -1.0;
+  const std::string start = s.string("start", "equilibrium");
+  if (start != "equilibrium" && start != "given")
+    s.fail("start", "expected \"equilibrium\" (floes at rest on the sea, then the waves) or \"given\" (the floes' heave as given), got \"" + start + "\"");
+  c.start_given = start == "given";
   s.finish();
 }
 
@@ -359,6 +366,7 @@ void read_fracture(Section s, FractureParams& f, const std::string& file) {
   f.split = s.boolean("split", f.split);
   f.mesh_size = s.number("mesh_size", f.mesh_size, positive, "a mesh size > 0 (m)");
   f.duration = s.number("duration", f.duration, positive, "a duration > 0 (s)");
+  f.load_radius = s.number("load_radius", f.load_radius, non_negative, "a radius >= 0 (m; 0: the floe's thickness)");
   if (const toml::array* a = s.table_array("load")) {
     for (std::size_t i = 0; i < a->size(); ++i) {
       Section l((*a)[i].as_table(), "fracture.load", file);
@@ -398,6 +406,11 @@ Config parse_config(std::string_view text, const std::string& name, const std::s
   read_forcing(Section(top.table("forcing"), "forcing", name), c.forcing, base_dir);
   read_fracture(Section(top.table("fracture"), "fracture", name), c.fracture, name);
   top.finish();
+  if (!c.coupling.start_given)
+    for (const FloeInput& f : c.floes.floes)
+      if (f.heave != 0.0 || f.heave_rate != 0.0)
+        throw InputError(f.origin + ": heave and heave_rate are initial values for [coupling] start = \"given\"; "
+                         "with start = \"equilibrium\" (the default) the floes start at rest on the sea");
   return c;
 }
 
@@ -452,6 +465,8 @@ std::string resolved_toml(const Config& c) {
                   {"angular_velocity", f.angular_velocity}, {"thickness", f.thickness},
                   {"density", f.density}, {"static", f.is_static}};
     if (f.ocean_drag >= 0.0) t.insert("ocean_drag", f.ocean_drag);
+    if (f.heave != 0.0) t.insert("heave", f.heave);
+    if (f.heave_rate != 0.0) t.insert("heave_rate", f.heave_rate);
     floe_list.push_back(t);
   }
   toml::table floes{{"thickness", c.floes.defaults.thickness}, {"density", c.floes.defaults.density}};
@@ -466,7 +481,8 @@ std::string resolved_toml(const Config& c) {
   toml::table coupling{{"law", name_of<PenaltyLaw>(c.coupling.law, {{"strong", PenaltyLaw::strong},
                                                                    {"weak", PenaltyLaw::weak},
                                                                    {"blend", PenaltyLaw::blend}})},
-                       {"stiffness", c.coupling.stiffness}};
+                       {"stiffness", c.coupling.stiffness},
+                       {"start", c.coupling.start_given ? "given" : "equilibrium"}};
   if (c.coupling.law == PenaltyLaw::blend) {
     if (c.coupling.restitution >= 0.0) coupling.insert("restitution", c.coupling.restitution);
     else coupling.insert("blend", c.coupling.blend);
@@ -488,7 +504,7 @@ std::string resolved_toml(const Config& c) {
                        {"criterion", fr.criterion == FractureCriterion::stress ? "stress" : "griffith"},
                        {"strength", fr.strength}, {"toughness", fr.toughness}, {"young", fr.young},
                        {"poisson", fr.poisson}, {"split", fr.split}, {"mesh_size", fr.mesh_size},
-                       {"duration", fr.duration}};
+                       {"duration", fr.duration}, {"load_radius", fr.load_radius}};
   if (!loads.empty()) fracture.insert("load", loads);
 
   toml::table root{{"run", run}, {"sea", sea}, {"floes", floes}, {"contact", contact},

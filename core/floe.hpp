@@ -23,6 +23,8 @@ struct FloeInput {
   double yaw = 0.0;               // rad, initial yaw
   Vec2 velocity = Vec2::Zero();   // m/s, of the centroid
   double angular_velocity = 0.0;  // rad/s
+  double heave = 0.0;             // m, from floating equilibrium ([coupling] start = "given")
+  double heave_rate = 0.0;        // m/s
   double ocean_drag = -1.0;       // C_w of this floe; < 0: the [forcing] default
   std::string origin;             // where it came from, for messages ("file.toml floe 3")
 };

@@ -42,6 +42,10 @@ struct Floes {
   std::vector<double> ocean_drag;       // C_w per floe (< 0: use the run's default)
   std::vector<std::uint8_t> is_static;  // 1: obstacle, infinite mass
   std::vector<FloeState> state;
+  // The floe's number in the run file (/floes/...): the order of creation.
+  // A floe that splits ends; its pieces get new numbers (core/run_file.hpp).
+  std::vector<std::uint32_t> id;
+  std::uint32_t ids_issued = 0;         // numbers given so far
 
   std::size_t size() const { return thickness.size(); }
   bool empty() const { return thickness.empty(); }
@@ -65,6 +69,12 @@ struct Floes {
 
   // Appends a validated floe; returns its index.
   std::size_t add(const FloeShape& shape, const FloeInput& input);
+  // Puts a new floe (with a new id) in the place of floe i; the state is the
+  // input's, as add() sets it.
+  void replace(std::size_t i, const FloeShape& shape, const FloeInput& input);
+  // A copy of the listed floes, in that order, with their ids.
+  Floes select(std::span<const std::size_t> which) const;
+  // Every per-floe array above must be handled by add, replace and select.
 };
 
 }  // namespace floesim

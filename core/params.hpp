@@ -73,6 +73,10 @@ struct CouplingParams {
   double stiffness = 1000.0;      // K: penalty stiffness kappa = K rho_w g
   double blend = 1.0;             // s in [0, 1] (blend law)
   double restitution = -1.0;      // blend law: target e; < 0 means "use blend"
+  // false: the floes start at rest on the sea (the static problem is solved,
+  // on the initial waves); true: the floes' heave and heave rate
+  // are as given ([[floes.floe]] heave, heave_rate), e.g. for a drop test.
+  bool start_given = false;
 };
 
 enum class SeriesInterpolation { linear, previous };
@@ -110,6 +114,7 @@ struct FractureParams {
   bool split = false;
   double mesh_size = 2.0;         // m
   double duration = 0.01;         // s
+  double load_radius = 0.0;       // m, loads spread over this radius; 0: the floe's thickness
   std::vector<FractureLoad> loads;
 };
 

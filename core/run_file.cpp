@@ -1,5 +1,6 @@
 #include "core/run_file.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
@@ -16,53 +17,84 @@ namespace fs = std::filesystem;
 
 struct RunWriter::Impl {
   std::string path;
-  h5::Handle file, time, state, energy, lcp, verts, eta;
-  std::size_t n = 0, nverts = 0, records = 0;
-  std::size_t topology_size = 0;
+  h5::Handle file, floes_group, xdmf_group, time, state, energy, lcp, verts, eta, events;
+  std::size_t n = 0, nverts = 0, records = 0;  // floes (numbers) and vertices in the /floes tables
+  // The /floes tables, one row per floe number, and the XDMF topology.
+  std::vector<long long> offsets{0}, topology;
+  std::vector<double> vertices, thickness, mass, area;
+  std::vector<unsigned char> is_static;
   std::vector<double> times;
+  // Sizes of the tables at each record (the XDMF grid of a record uses those).
+  std::vector<std::size_t> record_floes, record_vertices, record_topology;
   std::vector<std::string> energy_columns;
   SeaGridInfo sea;
   std::chrono::steady_clock::time_point last_xdmf = std::chrono::steady_clock::now();
   std::vector<double> scratch;
 
+  void write_tables();
   void write_xdmf() const;
 };
 
+namespace {
+std::uint32_t id_of(const Floes& floes, std::size_t i) {
+  return i < floes.id.size() ? floes.id[i] : static_cast<std::uint32_t>(i);
+}
+}  // namespace
+
+// (Re)writes the per-floe tables; they are small, and rewritten only when
+// floes appear.
+void RunWriter::Impl::write_tables() {
+  for (const char* name : {"offsets", "vertices", "thickness", "mass", "area", "static"}) h5::remove(floes_group, name);
+  h5::remove(xdmf_group, "topology");
+  h5::write_ints(floes_group, "offsets", {n + 1}, offsets.data());
+  h5::write_doubles(floes_group, "vertices", {nverts, 2}, nverts ? vertices.data() : nullptr);
+  h5::write_doubles(floes_group, "thickness", {n}, thickness.data());
+  h5::write_doubles(floes_group, "mass", {n}, mass.data());
+  h5::write_doubles(floes_group, "area", {n}, area.data());
+  h5::write_bytes(floes_group, "static", {n}, is_static.data());
+  h5::write_ints(xdmf_group, "topology", {topology.size()}, topology.data());
+}
+
 RunWriter::RunWriter(const std::string& path, const Floes& floes, const std::string& config_toml,
-                     std::vector<std::string> energy_columns, const SeaGridInfo& sea)
+                     std::vector<std::string> energy_columns, const SeaGridInfo& sea,
+                     std::size_t expected_records)
     : impl_(std::make_unique<Impl>()) {
   Impl& w = *impl_;
   w.path = path;
-  w.n = floes.size();
-  w.nverts = floes.body.size();
   w.energy_columns = std::move(energy_columns);
   w.sea = sea;
+  const hsize_t rows = expected_records;
   w.file = h5::create_file(path);
   h5::set_attr(w.file, "format", std::string(kRunFormat));
   h5::set_attr(w.file, "config", config_toml);
   h5::set_attr(w.file, "status", std::string("running"));
 
-  w.time = h5::create_extendible(w.file, "time", {});
+  w.time = h5::create_extendible(w.file, "time", {}, rows);
   h5::set_attr(w.time, "units", std::string("s"));
 
-  h5::Handle g = h5::create_group(w.file, "/floes");
-  std::vector<long long> off(floes.offsets.begin(), floes.offsets.end());
-  h5::write_ints(g, "offsets", {w.n + 1}, off.data());
-  h5::write_doubles(g, "vertices", {w.nverts, 2}, w.nverts ? floes.body[0].data() : nullptr);
-  h5::write_doubles(g, "thickness", {w.n}, floes.thickness.data());
-  h5::write_doubles(g, "mass", {w.n}, floes.mass.data());
-  h5::write_doubles(g, "area", {w.n}, floes.area.data());
-  std::vector<unsigned char> stat(floes.is_static.begin(), floes.is_static.end());
-  h5::write_bytes(g, "static", {w.n}, stat.data());
-  w.state = h5::create_extendible(g, "state", {w.n, kStateColumns});
+  w.floes_group = h5::create_group(w.file, "/floes");
+  // ParaView helpers: mixed-polygon topology (type 3 = polygon, vertex count,
+  // vertex indices) and per-record world vertices.
+  w.xdmf_group = h5::create_group(w.file, "/xdmf");
+  note_floes(floes);  // the tables (the growing datasets do not exist yet)
+  w.write_tables();   // also when there is no floe
+  // Chunks sized on the floes at the start (a row of 1 floe per chunk would
+  // make every record touch n chunks).
+  w.state = h5::create_growable(w.floes_group, "state", {w.n, kStateColumns}, rows);
   h5::set_attr(w.state, "columns", std::vector<std::string>(std::begin(kStateColumnNames), std::end(kStateColumnNames)));
+  w.verts = h5::create_growable(w.xdmf_group, "vertices", {w.nverts, 3}, rows);
 
   h5::Handle d = h5::create_group(w.file, "/diagnostics");
-  w.energy = h5::create_extendible(d, "energy", {w.energy_columns.size()});
+  w.energy = h5::create_extendible(d, "energy", {w.energy_columns.size()}, rows);
   h5::set_attr(w.energy, "columns", w.energy_columns);
   h5::set_attr(w.energy, "units", std::string("J"));
-  w.lcp = h5::create_extendible(d, "lcp", {4});
+  w.lcp = h5::create_extendible(d, "lcp", {4}, rows);
   h5::set_attr(w.lcp, "columns", std::vector<std::string>{"solves", "pivots", "failures", "fallbacks"});
+
+  h5::Handle ev = h5::create_group(w.file, "/events");
+  w.events = h5::create_extendible(ev, "fracture", {kFractureEventColumns});
+  h5::set_attr(w.events, "columns",
+               std::vector<std::string>(std::begin(kFractureEventColumnNames), std::end(kFractureEventColumnNames)));
 
   if (sea.dims > 0) {
     h5::Handle s = h5::create_group(w.file, "/sea");
@@ -74,22 +106,9 @@ RunWriter::RunWriter(const std::string& path, const Floes& floes, const std::str
     h5::write_doubles(s, "y", {y.size()}, y.data());
     std::vector<hsize_t> row = sea.dims == 2 ? std::vector<hsize_t>{hsize_t(ny), hsize_t(nx)}
                                              : std::vector<hsize_t>{hsize_t(nx)};
-    w.eta = h5::create_extendible(s, "eta", row);
+    w.eta = h5::create_extendible(s, "eta", row, rows);
     h5::set_attr(w.eta, "units", std::string("m"));
   }
-
-  // ParaView helpers: mixed-polygon topology (type 3 = polygon, vertex count,
-  // vertex indices) and per-record world vertices.
-  h5::Handle x = h5::create_group(w.file, "/xdmf");
-  std::vector<long long> topo;
-  for (std::size_t i = 0; i < w.n; ++i) {
-    topo.push_back(3);
-    topo.push_back(static_cast<long long>(floes.offsets[i + 1] - floes.offsets[i]));
-    for (std::size_t k = floes.offsets[i]; k < floes.offsets[i + 1]; ++k) topo.push_back(static_cast<long long>(k));
-  }
-  w.topology_size = topo.size();
-  h5::write_ints(x, "topology", {topo.size()}, topo.data());
-  w.verts = h5::create_extendible(x, "vertices", {w.nverts, 3});
   H5Fflush(w.file, H5F_SCOPE_GLOBAL);
 }
 
@@ -99,22 +118,68 @@ RunWriter::~RunWriter() {
   }
 }
 
+void RunWriter::note_floes(const Floes& floes) {
+  Impl& w = *impl_;
+  if (floes.ids_issued <= w.n && floes.size() <= w.n) return;  // nothing new (the usual step)
+  std::size_t issued = floes.ids_issued;
+  for (std::size_t i = 0; i < floes.size(); ++i) issued = std::max<std::size_t>(issued, id_of(floes, i) + 1);
+  if (issued <= w.n) return;
+  std::vector<long long> where(issued - w.n, -1);  // index in `floes` of each new number
+  for (std::size_t i = 0; i < floes.size(); ++i)
+    if (id_of(floes, i) >= w.n) where[id_of(floes, i) - w.n] = static_cast<long long>(i);
+  for (std::size_t k = 0; k < where.size(); ++k) {
+    // A number not present (made and ended between two notes) keeps an empty outline.
+    const long long i = where[k];
+    const std::size_t first = w.nverts;
+    if (i >= 0) {
+      const auto fi = static_cast<std::size_t>(i);
+      for (const Vec2& p : floes.vertices(fi)) {
+        w.vertices.push_back(p.x());
+        w.vertices.push_back(p.y());
+      }
+      w.nverts += floes.vertices(fi).size();
+    }
+    w.offsets.push_back(static_cast<long long>(w.nverts));
+    w.thickness.push_back(i >= 0 ? floes.thickness[static_cast<std::size_t>(i)] : std::nan(""));
+    w.mass.push_back(i >= 0 ? floes.mass[static_cast<std::size_t>(i)] : std::nan(""));
+    w.area.push_back(i >= 0 ? floes.area[static_cast<std::size_t>(i)] : std::nan(""));
+    w.is_static.push_back(i >= 0 ? floes.is_static[static_cast<std::size_t>(i)] : 0);
+    w.topology.push_back(3);
+    w.topology.push_back(static_cast<long long>(w.nverts - first));
+    for (std::size_t v = first; v < w.nverts; ++v) w.topology.push_back(static_cast<long long>(v));
+  }
+  w.n = issued;
+  if (w.state.valid()) {
+    // Earlier records read NaN for the new floes (the fill value).
+    h5::set_extent(w.state, {w.records, w.n, kStateColumns});
+    h5::set_extent(w.verts, {w.records, w.nverts, 3});
+  }
+  if (w.floes_group.valid() && h5::exists(w.floes_group, "offsets")) w.write_tables();
+}
+
 void RunWriter::record(double t, const Floes& floes, std::span<const double> energy,
                        const LcpCounters& lcp, std::span<const double> eta) {
   Impl& w = *impl_;
-  FLOESIM_ASSERT(floes.size() == w.n && energy.size() == w.energy_columns.size());
+  FLOESIM_ASSERT(energy.size() == w.energy_columns.size());
+  note_floes(floes);
   h5::append_row(w.time, &t);
-  h5::append_row(w.state, reinterpret_cast<const double*>(floes.state.data()));
+  w.scratch.assign(w.n * kStateColumns, std::nan(""));
+  for (std::size_t i = 0; i < floes.size(); ++i)
+    std::copy_n(reinterpret_cast<const double*>(&floes.state[i]), kStateColumns,
+                w.scratch.begin() + static_cast<std::ptrdiff_t>(id_of(floes, i) * kStateColumns));
+  h5::append_row(w.state, w.scratch.data());
   h5::append_row(w.energy, energy.data());
   const double l[4] = {lcp.solves, lcp.pivots, lcp.failures, lcp.fallbacks};
   h5::append_row(w.lcp, l);
-  w.scratch.resize(3 * w.nverts);
-  for (std::size_t i = 0; i < w.n; ++i) {
-    for (std::size_t k = floes.offsets[i]; k < floes.offsets[i + 1]; ++k) {
-      const Vec2 p = floes.to_world(i, floes.body[k]);
+  w.scratch.assign(3 * w.nverts, std::nan(""));
+  for (std::size_t i = 0; i < floes.size(); ++i) {
+    std::size_t k = static_cast<std::size_t>(w.offsets[id_of(floes, i)]);
+    for (const Vec2& b : floes.vertices(i)) {
+      const Vec2 p = floes.to_world(i, b);
       w.scratch[3 * k] = p.x();
       w.scratch[3 * k + 1] = p.y();
       w.scratch[3 * k + 2] = floes.state[i].heave;
+      ++k;
     }
   }
   h5::append_row(w.verts, w.scratch.data());
@@ -123,6 +188,9 @@ void RunWriter::record(double t, const Floes& floes, std::span<const double> ene
     h5::append_row(w.eta, eta.data());
   }
   w.times.push_back(t);
+  w.record_floes.push_back(w.n);
+  w.record_vertices.push_back(w.nverts);
+  w.record_topology.push_back(w.topology.size());
   ++w.records;
   H5Fflush(w.file, H5F_SCOPE_GLOBAL);
   // Keep the XDMF reasonably current without rewriting it at every record.
@@ -133,12 +201,20 @@ void RunWriter::record(double t, const Floes& floes, std::span<const double> ene
   }
 }
 
+void RunWriter::record_fracture(std::span<const FractureEventRow> events) {
+  Impl& w = *impl_;
+  for (const FractureEventRow& e : events) h5::append_row(w.events, reinterpret_cast<const double*>(&e));
+  if (!events.empty()) H5Fflush(w.file, H5F_SCOPE_GLOBAL);
+}
+
 void RunWriter::finish(const std::string& status) {
   Impl& w = *impl_;
   h5::set_attr(w.file, "status", status);
   h5::set_attr(w.file, "records", static_cast<long long>(w.records));
   H5Fflush(w.file, H5F_SCOPE_GLOBAL);
   w.write_xdmf();
+  w.floes_group.reset();
+  w.xdmf_group.reset();
   w.file.reset();
 }
 
@@ -152,35 +228,41 @@ void RunWriter::Impl::write_xdmf() const {
   const std::string tmp = xmf + ".tmp";
   std::ofstream o(tmp);
   if (!o) return;  // ParaView support is a convenience: never fail a run for it
+  o.precision(15);  // times and grid spacings as written, not to 6 digits
   const std::size_t T = times.size();
-  auto hdf = [&](const std::string& dims, const std::string& type, const std::string& set) {
-    return "<DataItem Dimensions=\"" + dims + "\" NumberType=\"" + type + "\" Precision=\"8\" Format=\"HDF\">" +
-           h5name + ":" + set + "</DataItem>";
+  // A hyperslab of an HDF5 dataset in the Xdmf3 library's own notation
+  // (file:path|start:stride:count:dataset dims), which ParaView's XDMF3 readers
+  // read; they skip XDMF2-style ItemType="HyperSlab" items (tests/apps/paraview_check.py).
+  auto slab = [&](const std::string& out, const std::string& start, const std::string& stride,
+                  const std::string& count, const std::string& full, const std::string& set,
+                  const std::string& type = "Float") {
+    return "<DataItem Dimensions=\"" + out + "\" NumberType=\"" + type + "\" Precision=\"8\" Format=\"HDF\">" +
+           h5name + ":" + set + "|" + start + ":" + stride + ":" + count + ":" + full + "</DataItem>";
   };
-  auto slab = [&](const std::string& out, const std::string& sel, int rank, const std::string& full,
-                  const std::string& set) {
-    return "<DataItem ItemType=\"HyperSlab\" Dimensions=\"" + out + "\" Type=\"HyperSlab\">"
-           "<DataItem Dimensions=\"3 " + std::to_string(rank) + "\" Format=\"XML\">" + sel + "</DataItem>" +
-           hdf(full, "Float", set) + "</DataItem>";
-  };
+  // Each record shows the floes numbered so far (the tables' sizes then);
+  // floes that ended have NaN coordinates.
   const std::string sn = std::to_string(n), sv = std::to_string(nverts), sT = std::to_string(T);
+  const std::string stopo = std::to_string(topology.size());
   o << "<?xml version=\"1.0\" ?>\n<Xdmf Version=\"3.0\">\n<Domain>\n";
   o << "<Grid Name=\"floes\" GridType=\"Collection\" CollectionType=\"Temporal\">\n";
-  for (std::size_t k = 0; k < T && n > 0; ++k) {
-    const std::string sk = std::to_string(k);
+  for (std::size_t k = 0; k < T; ++k) {
+    const std::size_t nk = record_floes[k];
+    if (nk == 0) continue;
+    const std::string sk = std::to_string(k), snk = std::to_string(nk), svk = std::to_string(record_vertices[k]);
+    const std::string stk = std::to_string(record_topology[k]);
     o << "<Grid Name=\"floes_" << k << "\" GridType=\"Uniform\"><Time Value=\"" << times[k] << "\"/>\n";
-    o << "<Topology TopologyType=\"Mixed\" NumberOfElements=\"" << n << "\">"
-      << hdf(std::to_string(topology_size), "Int", "/xdmf/topology") << "</Topology>\n";
+    o << "<Topology TopologyType=\"Mixed\" NumberOfElements=\"" << nk << "\">"
+      << slab(stk, "0", "1", stk, stopo, "/xdmf/topology", "Int") << "</Topology>\n";
     o << "<Geometry GeometryType=\"XYZ\">"
-      << slab(sv + " 3", sk + " 0 0 1 1 1 1 " + sv + " 3", 3, sT + " " + sv + " 3", "/xdmf/vertices")
+      << slab(svk + " 3", sk + " 0 0", "1 1 1", "1 " + svk + " 3", sT + " " + sv + " 3", "/xdmf/vertices")
       << "</Geometry>\n";
     for (int c = 0; c < kStateColumns; ++c)
       o << "<Attribute Name=\"" << kStateColumnNames[c] << "\" AttributeType=\"Scalar\" Center=\"Cell\">"
-        << slab(sn, sk + " 0 " + std::to_string(c) + " 1 1 1 1 " + sn + " 1", 3,
+        << slab(snk, sk + " 0 " + std::to_string(c), "1 1 1", "1 " + snk + " 1",
                 sT + " " + sn + " " + std::to_string(kStateColumns), "/floes/state")
         << "</Attribute>\n";
     o << "<Attribute Name=\"thickness\" AttributeType=\"Scalar\" Center=\"Cell\">"
-      << hdf(sn, "Float", "/floes/thickness") << "</Attribute>\n";
+      << slab(snk, "0", "1", snk, sn, "/floes/thickness") << "</Attribute>\n";
     o << "</Grid>\n";
   }
   o << "</Grid>\n";
@@ -190,16 +272,19 @@ void RunWriter::Impl::write_xdmf() const {
     const std::string dims = std::to_string(ny) + " " + std::to_string(nx);
     o << "<Grid Name=\"sea\" GridType=\"Collection\" CollectionType=\"Temporal\">\n";
     for (std::size_t k = 0; k < T; ++k) {
+      // A flat 3D grid (z slowest, one layer): ParaView's XDMF3 reader puts a
+      // 2DCoRectMesh in the y-z plane, this one in the x-y plane.
       o << "<Grid Name=\"sea_" << k << "\" GridType=\"Uniform\"><Time Value=\"" << times[k] << "\"/>\n";
-      o << "<Topology TopologyType=\"2DCoRectMesh\" Dimensions=\"" << dims << "\"/>\n";
-      o << "<Geometry GeometryType=\"ORIGIN_DXDY\"><DataItem Dimensions=\"2\" Format=\"XML\">" << 0.5 * dy
-        << " " << 0.5 * dx << "</DataItem><DataItem Dimensions=\"2\" Format=\"XML\">" << dy << " " << dx
+      o << "<Topology TopologyType=\"3DCoRectMesh\" Dimensions=\"1 " << dims << "\"/>\n";
+      o << "<Geometry GeometryType=\"ORIGIN_DXDYDZ\"><DataItem Dimensions=\"3\" Format=\"XML\">0 " << 0.5 * dy
+        << " " << 0.5 * dx << "</DataItem><DataItem Dimensions=\"3\" Format=\"XML\">1 " << dy << " " << dx
         << "</DataItem></Geometry>\n";
-      const std::string full = sea.dims == 2 ? sT + " " + dims : sT + " " + std::to_string(nx);
-      const std::string sel = sea.dims == 2 ? std::to_string(k) + " 0 0 1 1 1 1 " + dims
-                                            : std::to_string(k) + " 0 1 1 1 " + std::to_string(nx);
+      const std::string sk = std::to_string(k);
       o << "<Attribute Name=\"eta\" AttributeType=\"Scalar\" Center=\"Node\">"
-        << slab(dims, sel, sea.dims == 2 ? 3 : 2, full, "/sea/eta") << "</Attribute>\n";
+        << (sea.dims == 2 ? slab("1 " + dims, sk + " 0 0", "1 1 1", "1 " + dims, sT + " " + dims, "/sea/eta")
+                          : slab("1 " + dims, sk + " 0", "1 1", "1 " + std::to_string(nx), sT + " " + std::to_string(nx),
+                                 "/sea/eta"))
+        << "</Attribute>\n";
       o << "</Grid>\n";
     }
     o << "</Grid>\n";
@@ -254,6 +339,20 @@ RunInfo read_run_info(const std::string& path) {
     auto d = h5::dims(h5::open_dataset(f, p, path));
     r.datasets.emplace_back(p, std::vector<unsigned long long>(d.begin(), d.end()));
   }
+  return r;
+}
+
+RunDataset read_run_dataset(const std::string& path, const std::string& dataset) {
+  h5::Handle f = h5::open_file(path);
+  if (!h5::has_attr(f, "format") || h5::get_attr_string(f, "format") != kRunFormat)
+    throw InputError(path + ": not a floesim run file (attribute 'format' is not '" + std::string(kRunFormat) + "')");
+  if (dataset.empty() || !h5::exists(f, dataset)) throw InputError(path + ": no dataset '" + dataset + "'");
+  h5::Handle d = h5::open_dataset(f, dataset, path);
+  RunDataset r;
+  const auto dims = h5::dims(d);
+  r.shape.assign(dims.begin(), dims.end());
+  r.values = h5::read_doubles(d, path + ": " + dataset);
+  if (h5::has_attr(d, "columns")) r.columns = h5::get_attr_strings(d, "columns");
   return r;
 }
 

@@ -12,6 +12,12 @@
 //   /floes/thickness, /floes/mass, /floes/static, /floes/area [n]
 //   /floes/state [T, n, 12] (columns attribute: x, y, yaw, vx, vy, yaw_rate,
 //     heave, pitch, roll, heave_rate, pitch_rate, roll_rate)
+//   Floes are numbered by creation (Floes::id): a floe that splits ends and
+//   its two pieces are new floes appended to the /floes tables, so n grows
+//   during a run; /floes/state (and /xdmf/vertices) hold NaN for a floe at the
+//   records where it does not exist (before it was made, after it split).
+//   /events/fracture [E, 17] (columns attribute): one row per fracture
+//     initiation, FractureEventRow below.
 //   /sea/x [nx], /sea/y [ny], /sea/eta [T, ny, nx] (dims 2) or [T, nx] (dims 1)
 //   /diagnostics/energy [T, k] (columns attribute; the last column is "total")
 //   /diagnostics/lcp [T, 4]: solves, pivots, failures, fallbacks (cumulative)
@@ -37,6 +43,26 @@ struct SeaGridInfo {
   std::array<double, 2> size{};       // m
 };
 
+// One fracture initiation: a row of /events/fracture.
+struct FractureEventRow {
+  double time = 0.0;        // s, of the collision
+  double floe = 0.0;        // number of the floe that cracked
+  double x = 0.0, y = 0.0;  // m, world: where the crack starts
+  double direction = 0.0;   // degrees from +x, in [0, 180): the crack's direction
+  double load = 0.0;        // N s: the magnitudes of the contact impulses on the floe, summed
+  double stress = 0.0;      // Pa: the largest tensile principal stress
+  double x0 = 0.0, y0 = 0.0, x1 = 0.0, y1 = 0.0;  // m, world: the crack's ends
+  double criterion = 0.0;   // 0: stress, 1: griffith
+  double energy_released = 0.0, energy_needed = 0.0;  // J (griffith; 0 for stress)
+  double delay = 0.0;       // s after the collision of the state judged
+  double piece_a = -1.0, piece_b = -1.0;  // numbers of the two pieces (-1: no split)
+};
+inline constexpr int kFractureEventColumns = 17;
+static_assert(sizeof(FractureEventRow) == kFractureEventColumns * sizeof(double));
+inline constexpr const char* kFractureEventColumnNames[kFractureEventColumns] = {
+    "time", "floe", "x", "y", "direction", "load", "stress", "x0", "y0", "x1", "y1",
+    "criterion", "energy_released", "energy_needed", "delay", "piece_a", "piece_b"};
+
 struct LcpCounters {
   double solves = 0, pivots = 0, failures = 0, fallbacks = 0;  // cumulative
 };
@@ -44,18 +70,26 @@ struct LcpCounters {
 class RunWriter {
 public:
   // Creates (truncates) the file and writes the static parts. Throws
-  // InputError if the file cannot be created.
+  // InputError if the file cannot be created. expected_records (0: unknown)
+  // sizes the chunks of the per-record datasets (more records still fit).
   RunWriter(const std::string& path, const Floes& floes, const std::string& config_toml,
-            std::vector<std::string> energy_columns, const SeaGridInfo& sea = {});
+            std::vector<std::string> energy_columns, const SeaGridInfo& sea = {},
+            std::size_t expected_records = 0);
   ~RunWriter();  // closes; leaves status "running" unless finish() was called
   RunWriter(const RunWriter&) = delete;
   RunWriter& operator=(const RunWriter&) = delete;
 
   // Appends one record and flushes the file. `energy` has one value per
   // column; `eta` is the sea elevation on the grid (row-major, y slowest), or
-  // empty when there is no sea.
+  // empty when there is no sea. Floes new since the last call are added to
+  // the /floes tables first (note_floes).
   void record(double t, const Floes& floes, std::span<const double> energy,
               const LcpCounters& lcp, std::span<const double> eta = {});
+  // Adds to the /floes tables the floes with numbers not seen yet (call it
+  // after every step that may create floes, so none is missed).
+  void note_floes(const Floes& floes);
+  // Appends rows to /events/fracture and flushes.
+  void record_fracture(std::span<const FractureEventRow> events);
 
   // Marks the run complete, or failed with a reason, and writes the XDMF.
   void finish(const std::string& status);
@@ -80,6 +114,17 @@ struct RunInfo {
   std::vector<std::pair<std::string, std::vector<unsigned long long>>> datasets;  // path, shape
 };
 RunInfo read_run_info(const std::string& path);
+
+// One numeric dataset of a run file (any stored type, converted to double),
+// row-major with its shape, and its `columns` attribute if it has one. For
+// scripts (the Python module) and tools. Throws InputError naming the file
+// and the dataset when either is missing or unreadable.
+struct RunDataset {
+  std::vector<unsigned long long> shape;
+  std::vector<double> values;
+  std::vector<std::string> columns;
+};
+RunDataset read_run_dataset(const std::string& path, const std::string& dataset);
 
 // Regression comparison of two run files: every numeric dataset of A must
 // exist in B with the same shape and |a - b| <= atol + rtol |b| element-wise

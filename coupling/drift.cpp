@@ -95,12 +95,13 @@ DragLoad drag_load(const Floes& floes, const FootprintQuadrature& q, std::size_t
 }
 
 void drift_velocities(Floes& floes, const FootprintQuadrature& q, const DriftParams& p,
-                      const Vec2& current, const Vec2& wind, double dt, std::size_t begin, std::size_t end) {
+                      const Vec2& current, const Vec2& wind, double dt, std::size_t begin, std::size_t end,
+                      std::span<const Vec2> floe_current) {
   for (std::size_t i = begin; i < end; ++i) {
     if (floes.is_static[i]) continue;
     FloeState& s = floes.state[i];
     const double m = floes.mass[i];
-    const DragLoad load = drag_load(floes, q, i, p, current, wind);
+    const DragLoad load = drag_load(floes, q, i, p, floe_current.empty() ? current : floe_current[i], wind);
     // Coriolis -f k x (m V) = f m (vy, -vx).
     const double fm = p.coriolis * m;
     Eigen::Vector3d F = load.force;

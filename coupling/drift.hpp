@@ -64,9 +64,11 @@ DragLoad drag_load(const Floes& floes, const FootprintQuadrature& q, std::size_t
 
 // Velocities W_n -> W_{n+1} of floes [begin, end) over dt as stated above
 // (positions are moved separately, after collisions, by advance_positions).
-// Static floes do not move.
+// Static floes do not move. `floe_current`, if not empty, replaces `current`
+// floe by floe (the current plus the waves' orbital velocity under each floe).
 void drift_velocities(Floes& floes, const FootprintQuadrature& q, const DriftParams& p,
-                      const Vec2& current, const Vec2& wind, double dt, std::size_t begin, std::size_t end);
+                      const Vec2& current, const Vec2& wind, double dt, std::size_t begin, std::size_t end,
+                      std::span<const Vec2> floe_current = {});
 
 // x_{n+1} = x_n + dt W for floes [begin, end).
 void advance_positions(Floes& floes, double dt, std::size_t begin, std::size_t end);

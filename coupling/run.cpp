@@ -17,8 +17,11 @@ RunSummary run_simulation(Simulation& sim, const RunOptions& options) {
   RunSummary summary;
   summary.output = options.output;
   summary.energy_first = sim.energies();
-  summary.warnings = sim.scenario().notes;
-  RunWriter writer(options.output, sim.floes(), resolved_toml(cfg), summary.energy_first.names, sim.sea_grid());
+  summary.warnings = sim.notes();
+  // Records at t = 0, at every multiple of the interval and at the end.
+  const auto expected_records = static_cast<std::size_t>(std::ceil(t_end / interval - 1e-9)) + 1;
+  RunWriter writer(options.output, sim.floes(), resolved_toml(cfg), summary.energy_first.names, sim.sea_grid(),
+                   expected_records);
   summary.xdmf = writer.xdmf_path();
 
   auto record = [&] {
@@ -31,7 +34,10 @@ RunSummary run_simulation(Simulation& sim, const RunOptions& options) {
   summary.status = "complete";
   try {
     record();
-    std::size_t next = 1;  // index of the next scheduled record
+    // Index of the next scheduled record: the first multiple of the interval
+    // after the start (a simulation may come here already advanced).
+    auto next = static_cast<std::size_t>(std::floor(sim.time() / interval)) + 1;
+    if (static_cast<double>(next) * interval <= sim.time()) ++next;
     while (sim.time() < t_end) {
       // Next record time; a record that would fall within 1e-9 s of the end merges with it.
       double t_record = std::min(static_cast<double>(next) * interval, t_end);
@@ -39,6 +45,8 @@ RunSummary run_simulation(Simulation& sim, const RunOptions& options) {
       bool stop = false;
       while (sim.time() < t_record && !stop) {
         sim.step(t_record);
+        writer.note_floes(sim.floes());  // floes made by splits (numbers are never reused)
+        writer.record_fracture(sim.take_fracture_events());
         if (options.progress) options.progress({sim.time(), t_end, sim.steps(), wall()});
         stop = options.should_stop && options.should_stop();
       }

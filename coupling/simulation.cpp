@@ -4,6 +4,7 @@
 #include <cmath>
 #include <sstream>
 
+#include "contact/step_limit.hpp"
 #include "contact/substep.hpp"
 #include "core/error.hpp"
 #include "fluid/sea.hpp"
@@ -57,6 +58,16 @@ Simulation::Simulation(Scenario scenario) : scenario_(std::move(scenario)) {
   sea_options.tank = {c.sea.tank.enabled, c.sea.tank.generation_length, c.sea.tank.absorption_length,
                       c.sea.tank.rate, c.sea.tank.ramp_periods};
   sea_ = fluid::make_sea(c.sea, c.run.seed, sea_options);
+  const Floes& f = scenario_.floes;
+  const bool any_dynamic = std::any_of(f.is_static.begin(), f.is_static.end(), [](std::uint8_t s) { return !s; });
+  if (sea_ && any_dynamic) {
+    floe_sea_ = std::make_unique<FloeSeaContact>(c.coupling, c.sea, scenario_.floes, *sea_);
+    floe_sea_->start(scenario_.floes, *sea_, c.coupling.start_given);
+    evaluate_penalty(0.5 * c.run.dt_max);
+    update_water_velocity();
+  }
+  // Pieces of a split are opened by the gap that collisions keep between floes.
+  if (c.fracture.enabled) percussion_ = std::make_unique<Percussion>(c.fracture, impulse_options_.min_gap);
 }
 
 Simulation::~Simulation() = default;
@@ -67,14 +78,17 @@ double Simulation::step(double t_stop) {
   { PhaseTimer _(profile_, Phase::choose_dt); ctx = choose_dt(t_stop); }
   for (bool accepted = false; !accepted;) {
     { PhaseTimer _(profile_, Phase::forcing); sample_forcing(ctx); }
+    { PhaseTimer _(profile_, Phase::penalty); floes_half_kick(ctx); }
     { PhaseTimer _(profile_, Phase::drift);   drift(ctx); }
     { PhaseTimer _(profile_, Phase::collide); collide(ctx); }
+    { PhaseTimer _(profile_, Phase::percussion); percussion(ctx); }
     { PhaseTimer _(profile_, Phase::advance); advance(ctx); }
     { PhaseTimer _(profile_, Phase::detect);  accepted = detect_and_check(ctx); }
   }
+  { PhaseTimer _(profile_, Phase::sea);       sea_flow(ctx); }
+  { PhaseTimer _(profile_, Phase::penalty);   sea_half_kick(ctx); }
   budget_.external += step_budget_.external;
   budget_.collisions += step_budget_.collisions;
-  { PhaseTimer _(profile_, Phase::sea);       sea_flow(ctx); }
   { PhaseTimer _(profile_, Phase::check);     check_state(ctx); }
   // Land exactly on t_stop when the step was cut to reach it.
   t_ = ctx.dt == t_stop - ctx.t ? t_stop : ctx.t + ctx.dt;
@@ -94,8 +108,39 @@ StepContext Simulation::choose_dt(double t_stop) {
   else if (remaining < 1.5 * dt_max) ctx.dt = 0.5 * remaining;
   else ctx.dt = dt_max;
   if (!(ctx.dt > 0.0)) throw RunError("step requested with no time left (t = " + std::to_string(t_) + ")");
+  // The explicit penalty spring's stability limit (coupling/floe_sea.hpp).
+  if (floe_sea_ && floe_sea_->stable_step() < ctx.dt) {
+    if (std::isfinite(remaining)) {
+      const double n = std::ceil(remaining / floe_sea_->stable_step());
+      // Equal steps up to t_stop; the last equal step is kept while it
+      // divides what remains to round-off (the sea's rotations, cached for
+      // one dt, stay valid), and the last step of all lands on t_stop.
+      const bool same = n > 1.0 && equal_dt_ > 0.0 && std::abs(remaining / equal_dt_ - n) < 1e-9 * n;
+      equal_dt_ = same ? equal_dt_ : remaining / n;
+      ctx.dt = std::min(ctx.dt, equal_dt_);
+    } else {
+      ctx.dt = floe_sea_->stable_step();  // no stop in sight (step(inf))
+    }
+  }
   // Collisions do not shorten the step: the floes that may meet within it are
-  // sub-stepped by advance() (contact/substep.hpp).
+  // sub-stepped by advance() (contact/substep.hpp). With fracture on, the
+  // whole step is cut at the first possible impact (contact/step_limit.hpp)
+  // instead, so every impact falls on the start of a step, where percussion
+  // sees its impulses.
+  if (percussion_) {
+    const contact::StepLimit limit = contact::collision_step_limit(
+        scenario_.floes, shapes_, detection_.pairs, detection_.witnesses, detection_options_.collision_distance);
+    if (limit.dt < ctx.dt) {
+      const double floor = kFloorFraction * dt_max;
+      if (limit.dt < floor) {
+        ++substeps_.floor_steps;
+        std::ostringstream m;
+        m << "floes " << limit.a << " and " << limit.b << " at distance " << limit.distance << " m, t = " << t_ << " s";
+        substeps_.floor_pair = m.str();
+      }
+      ctx.dt = std::max(limit.dt, std::min(floor, ctx.dt));
+    }
+  }
   ctx.start = scenario_.floes.state;
   return ctx;
 }
@@ -106,13 +151,33 @@ void Simulation::sample_forcing(StepContext& ctx) const {
   ctx.forcing = scenario_.forcing.at(ctx.t + 0.5 * ctx.dt);
 }
 
+void Simulation::floes_half_kick(const StepContext& ctx) {
+  // The sea's loads at t (evaluated at the end of the previous step when
+  // its half step was the same) kick the floes' vertical and horizontal rates.
+  ctx_momentum_before_ = momentum();
+  if (!floe_sea_) return;
+  // The strong law's loads do not depend on the kick length; the damper's do.
+  const bool depends_on_h = floe_sea_->strong_share() < 1.0;
+  if (loads_h_ < 0.0 || (depends_on_h && loads_h_ != 0.5 * ctx.dt)) evaluate_penalty(0.5 * ctx.dt);
+  if (water_stale_) update_water_velocity();
+  floe_sea_->kick_floes(scenario_.floes, 0.5 * ctx.dt);
+}
+
 void Simulation::drift(StepContext& ctx) {
   const Vec2 current{ctx.forcing.current[0], ctx.forcing.current[1]};
   const Vec2 wind{ctx.forcing.wind[0], ctx.forcing.wind[1]};
-  const Vec2 before = momentum();
-  drift_velocities(scenario_.floes, quadrature_, drift_params_, current, wind, ctx.dt, 0, scenario_.floes.size());
+  std::span<const Vec2> water;
+  if (floe_sea_) {
+    // Drag relative to the current plus the waves' orbital velocity at t.
+    for (Vec2& w : water_velocity_) w += current;
+    water = water_velocity_;
+  }
+  drift_velocities(scenario_.floes, quadrature_, drift_params_, current, wind, ctx.dt, 0, scenario_.floes.size(),
+                   water);
+  if (floe_sea_)
+    for (Vec2& w : water_velocity_) w -= current;
   ctx.momentum = momentum();
-  step_budget_.external = ctx.momentum - before;
+  step_budget_.external = ctx.momentum - ctx_momentum_before_;
 }
 
 void Simulation::collide(StepContext& ctx) {
@@ -120,10 +185,34 @@ void Simulation::collide(StepContext& ctx) {
   // turn W(t-) into W(t+). Contacts the step itself pushed together rest
   // (restitution 0), and pushed points that would close below xi/2 within the
   // step are held by speculative contacts (contact/impulse.hpp).
-  contact::resolve_step_collisions(scenario_.floes, ctx.start, detection_, ctx.dt, impulse_options_, stats_);
+  contact::resolve_step_collisions(scenario_.floes, ctx.start, detection_, ctx.dt, impulse_options_, stats_,
+                                   percussion_ ? &ctx.impulses : nullptr);
   const Vec2 after = momentum();
   step_budget_.collisions = after - ctx.momentum;
   ctx.momentum = after;
+}
+
+void Simulation::percussion(StepContext& ctx) {
+  // Positions are still those of ctx.t, where the contacts were found.
+  if (percussion_ && percussion_->check(scenario_.floes, detection_.contacts, ctx.impulses, ctx.t, ctx.start))
+    on_floes_changed();
+}
+
+void Simulation::on_floes_changed() {
+  quadrature_ = build_footprint_quadrature(scenario_.floes);
+  shapes_ = contact::build_collision_shapes(scenario_.floes);
+  detection_ = contact::detect(scenario_.floes, shapes_, detection_options_);
+  if (floe_sea_) {
+    // A split piece keeps its parent's reference bottom (same thickness);
+    // the loads are evaluated afresh for the new footprints.
+    floe_sea_->floes_changed(scenario_.floes);
+    loads_h_ = -1.0;
+    water_stale_ = true;
+  }
+}
+
+std::vector<FractureEventRow> Simulation::take_fracture_events() {
+  return percussion_ ? percussion_->take_events() : std::vector<FractureEventRow>{};
 }
 
 Vec2 Simulation::momentum() const {
@@ -146,6 +235,7 @@ void Simulation::advance(const StepContext& ctx) {
   const Vec2 before = momentum();
   contact::advance_with_collisions(scenario_.floes, shapes_, detection_, ctx.dt, o, stats_, substeps_);
   step_budget_.collisions += momentum() - before;
+  if (floe_sea_) FloeSeaContact::drift(scenario_.floes, ctx.dt);
   wrap_periodic();
 }
 
@@ -208,9 +298,38 @@ void Simulation::wrap_periodic() {
 }
 
 void Simulation::sea_flow(const StepContext& ctx) {
-  // Free evolution, exact per mode. Floe pressures (half kicks around this
-  // flow, MODEL.md §5) arrive with the floe–sea coupling.
-  if (sea_) sea_->flow(ctx.dt);
+  // The floes' pressures at t (half kick), then the exact modal flow.
+  if (!sea_) return;
+  if (floe_sea_) floe_sea_->kick_sea(*sea_, 0.5 * ctx.dt);
+  sea_->flow(ctx.dt);
+}
+
+void Simulation::sea_half_kick(const StepContext& ctx) {
+  // Loads at t + dt: the second half kick of the sea and of the floes. They
+  // are kept as the first half kick of the next step if its dt is the same.
+  if (!floe_sea_) return;
+  evaluate_penalty(0.5 * ctx.dt);
+  const Vec2 before = momentum();
+  floe_sea_->kick_floes(scenario_.floes, 0.5 * ctx.dt);
+  floe_sea_->kick_sea(*sea_, 0.5 * ctx.dt);
+  step_budget_.external += momentum() - before;
+  // The water under the floes at t + dt, the sea's kick included (its rates
+  // are then synchronous with its elevation, as the floes' are).
+  update_water_velocity();
+  // The damper part depends on the rates the kick just changed: evaluate it
+  // afresh at the next step.
+  if (floe_sea_->strong_share() < 1.0) loads_h_ = -1.0;
+}
+
+void Simulation::evaluate_penalty(double h) {
+  floe_sea_->evaluate(scenario_.floes, *sea_, h);
+  loads_h_ = h;
+}
+
+void Simulation::update_water_velocity() {
+  // Over the footprints of the last evaluate_penalty.
+  floe_sea_->orbital_velocity(scenario_.floes, *sea_, water_velocity_);
+  water_stale_ = false;
 }
 
 void Simulation::check_state(const StepContext& ctx) const {
@@ -236,6 +355,11 @@ Energies Simulation::energies() const {
     horizontal += 0.5 * f.mass[i] * (s.vx * s.vx + s.vy * s.vy) + 0.5 * f.inertia_z[i] * s.yaw_rate * s.yaw_rate;
   }
   Energies e{{"floes_horizontal_kinetic"}, {horizontal}};
+  if (floe_sea_) {
+    e.names.insert(e.names.end(), {"floes_vertical_kinetic", "floes_weight", "penalty"});
+    e.values.insert(e.values.end(), {floe_sea_->floes_vertical_kinetic(f), floe_sea_->floes_weight_energy(f),
+                                     floe_sea_->penalty_energy()});
+  }
   if (sea_) {
     const fluid::SeaEnergy se = sea_->energy();
     e.names.insert(e.names.end(), {"sea_kinetic", "sea_potential"});
@@ -261,9 +385,18 @@ std::vector<std::string> Simulation::warnings() const {
                 substeps_.floor_pair + ")");
   if (stats_.failures)
     w.push_back(std::to_string(stats_.failures) + " collision LCP(s) failed; those floes kept their velocities");
+  if (percussion_ && percussion_->stats().failed_splits)
+    w.push_back(std::to_string(percussion_->stats().failed_splits) +
+                " floe(s) cracked through but were not split (a piece too small, or the pieces would overlap a neighbour)");
   if (stats_.flagged)
     w.push_back(std::to_string(stats_.flagged) + " collision LCP(s) were answered by projected Gauss–Seidel (approximate)");
   return w;
+}
+
+std::vector<std::string> Simulation::notes() const {
+  std::vector<std::string> n = scenario_.notes;
+  if (floe_sea_) n.insert(n.end(), floe_sea_->notes().begin(), floe_sea_->notes().end());
+  return n;
 }
 
 SeaGridInfo Simulation::sea_grid() const {

@@ -1,15 +1,34 @@
 #pragma once
-// The time loop of a run. One call to step() advances the floes (and, as the
-// model grows, the sea) by one step; the step reads as a table of contents,
-// one named and timed phase per line (MODEL.md §5):
+// The time loop of a run. One call to step() advances the floes and the sea
+// by one step; the step reads as a table of contents, one named and timed
+// phase per line (MODEL.md §5, the staggered loop):
 //
-//   choose dt (output schedule, dt_max)
-//   -> sample forcing -> drift velocities (drag, Coriolis) -> collide (LCPs)
-//   -> advance positions (floes that may collide within the step are
-//      sub-stepped event by event, contact/substep.hpp)
+//   choose dt (output schedule, dt_max, penalty limit; collision limit only
+//      with fracture on)
+//   -> sample forcing
+//   -> floes' half kick from the sea (penalty loads at t, coupling/floe_sea.hpp)
+//   -> drift velocities (drag relative to current + orbital velocity, wind,
+//      Coriolis) -> collide (LCPs: W(t-) -> W(t+))
+//   -> percussion (fracture checks on the collision impulses; a split floe
+//      becomes two)
+//   -> advance positions (horizontal: floes that may collide within the step
+//      are sub-stepped event by event, contact/substep.hpp; and the vertical
+//      DOFs)
 //   -> detect (new contacts; an overlap rejects the step, which is redone
-//      with half the dt) -> sea flow -> check state
+//      with half the dt from the floes at t: the sea has not moved yet)
+//   -> sea: half kick with the pressures at t, exact modal flow over dt
+//   -> penalty loads at t + dt: second half kick of the sea and the floes,
+//      then the orbital velocity under the floes (for the next drag)
+//   -> check state
 //
+// The kicks and flows are the Strang splitting of the floe–sea Hamiltonian
+// (second order, energy conserving for the strong law without drag); drag
+// and collisions sit in the middle, where the floes' horizontal drift is.
+// The loads at t + dt serve as the next step's first half kick (the strong
+// law's do not depend on the kick length; the damper's are made afresh), and
+// the sea's two half kicks by that one pressure share its projection
+// (Sea::repeat_kick). Steps cut by the penalty limit are equal and keep one
+// dt, so the sea's rotations are computed once.
 // Step contract: on entry the state is at time() and the contact detection
 // matches the positions; step(t_stop) advances both to time() + dt with
 // 0 < dt <= min(dt_max, t_stop - time()) and returns dt. At the end of every
@@ -24,6 +43,8 @@
 #include <vector>
 
 #include "coupling/drift.hpp"
+#include "coupling/floe_sea.hpp"
+#include "coupling/percussion.hpp"
 #include "contact/detection.hpp"
 #include "contact/impulse.hpp"
 #include "contact/shapes.hpp"
@@ -35,9 +56,9 @@ namespace floesim {
 
 namespace fluid { class Sea; }
 
-enum class Phase { choose_dt, forcing, drift, collide, advance, detect, sea, check, record, count };
+enum class Phase { choose_dt, forcing, drift, collide, percussion, advance, detect, sea, check, record, penalty, count };
 inline constexpr std::array<const char*, static_cast<std::size_t>(Phase::count)> kPhaseNames = {
-    "choose_dt", "forcing", "drift", "collide", "advance", "detect", "sea", "check", "record"};
+    "choose_dt", "forcing", "drift", "collide", "percussion", "advance", "detect", "sea", "check", "record", "penalty"};
 
 // Wall time spent in each phase (s), for `floesim run --profile`.
 struct Profile {
@@ -53,6 +74,7 @@ struct StepContext {
   ForcingSample forcing;
   std::vector<FloeState> start;  // the floes at t, to redo a rejected step
   Vec2 momentum = Vec2::Zero();   // of the dynamic floes, updated by the phases that change it
+  std::vector<contact::ContactImpulse> impulses;  // of the collide phase, one per contact of detection()
 };
 
 // Energies by part (J), named as the columns of /diagnostics/energy; the last
@@ -95,17 +117,30 @@ public:
   // Things a user should hear about once, with a count (e.g. steps cut to the floor).
   std::vector<std::string> warnings() const;
 
+  // Fracture initiations since the last call ([fracture] enabled), and counts.
+  std::vector<FractureEventRow> take_fracture_events();
+  const PercussionStats* percussion_stats() const { return percussion_ ? &percussion_->stats() : nullptr; }
+
   // The sea surface, if the run has one ([sea] model != "none").
   bool has_sea() const { return sea_ != nullptr; }
   SeaGridInfo sea_grid() const;
   std::span<const double> sea_elevation();  // on the grid, x fastest; empty without a sea
+  // The floe–sea contact, if the run has a sea and floes that move.
+  const FloeSeaContact* floe_sea() const { return floe_sea_.get(); }
+  std::vector<std::string> notes() const;  // said once at the start (e.g. calibrated blend)
 
 private:
   StepContext choose_dt(double t_stop);
   void sample_forcing(StepContext& ctx) const;
   void sea_flow(const StepContext& ctx);
+  void floes_half_kick(const StepContext& ctx);
+  void sea_half_kick(const StepContext& ctx);
+  void evaluate_penalty(double h);
+  void update_water_velocity();  // orbital velocity under each floe, for drag
   void drift(StepContext& ctx);
   void collide(StepContext& ctx);
+  void percussion(StepContext& ctx);
+  void on_floes_changed();  // rebuilds every per-floe structure (after a split)
   void advance(const StepContext& ctx);
   bool detect_and_check(StepContext& ctx);  // false: the step overlapped, dt halved
   void wrap_periodic();
@@ -114,6 +149,12 @@ private:
 
   Scenario scenario_;
   std::unique_ptr<fluid::Sea> sea_;
+  std::unique_ptr<FloeSeaContact> floe_sea_;
+  double loads_h_ = -1.0;             // the kick length the floe–sea loads were evaluated for (< 0: stale)
+  double equal_dt_ = -1.0;            // the last of the equal steps the penalty limit asked for
+  std::vector<Vec2> water_velocity_;  // orbital velocity under each floe at t, for drag
+  bool water_stale_ = false;          // the floes changed since water_velocity_ was made
+  Vec2 ctx_momentum_before_ = Vec2::Zero();  // of the floes at the start of the step's try
   DriftParams drift_params_;
   FootprintQuadrature quadrature_;
   contact::CollisionShapes shapes_;
@@ -121,6 +162,7 @@ private:
   contact::ImpulseOptions impulse_options_;
   contact::Detection detection_;  // at the present positions
   contact::CollisionStats stats_;
+  std::unique_ptr<Percussion> percussion_;  // [fracture] enabled
   MomentumBudget budget_, step_budget_;  // run total; this step's (redone steps do not count)
   contact::SubstepReport substeps_;  // collision sub-steps (floors, merges, ...)
   long rejected_steps_ = 0;       // steps redone after an overlap

@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Prints [[floes.floe]] tables: irregular convex floes on a jittered grid.
 
-Used once to write the inline floes of examples/floes_on_waves.toml:
+Used to write the inline floes of examples/pack_drift.toml and floes_on_waves.toml:
     python3 examples/make_floes.py --nx 6 --ny 5 --spacing 40 --seed 3
 """
 import argparse

@@ -198,6 +198,7 @@ SurfaceGrid basin_grid(const SeaParams& p) {
 struct BemSea::Impl {
   std::shared_ptr<const Operators> ops;
   bool hit = false;
+  bool kicked = false;  // work_modes holds the projection of the last kick's pressure
   VectorXd work_modes, work_surface;
 };
 
@@ -225,6 +226,13 @@ void BemSea::kick(std::span<const double> pressure, double h) {
   FLOESIM_ASSERT(pressure.size() == static_cast<std::size_t>(ops.surface));
   const Eigen::Map<const VectorXd> p(pressure.data(), ops.surface);
   impl_->work_modes.noalias() = ops.load * p;
+  impl_->kicked = true;
+  bank_.kick(std::span<const double>(impl_->work_modes.data(), bank_.modes()), h);
+  invalidate_rates();
+}
+
+void BemSea::repeat_kick(double h) {
+  FLOESIM_ASSERT(impl_->kicked);
   bank_.kick(std::span<const double>(impl_->work_modes.data(), bank_.modes()), h);
   invalidate_rates();
 }

@@ -36,6 +36,7 @@ public:
   ~BemSea() override;
 
   void kick(std::span<const double> pressure, double h) override;
+  void repeat_kick(double h) override;
   void flow(double dt) override;
   void set_surface(std::span<const double> eta, std::span<const double> eta_t) override;
 

@@ -78,6 +78,11 @@ public:
   // The step contract is in the comment at the top of this file.
   virtual void kick(std::span<const double> pressure, double h) = 0;
   virtual void flow(double dt) = 0;
+  // kick(p, h) with the pressure p of the last kick(), which the caller
+  // vouches has not changed: the backend reuses its projection of p (the
+  // coupling's half kicks at the end of one step and the start of the next
+  // share their pressure). Needs a kick() before it.
+  virtual void repeat_kick(double h) = 0;
 
   // pressure(sea, t, p) fills p (grid().size() values, Pa) for time t; it may
   // query the sea (called with the state at t, then at t + dt).

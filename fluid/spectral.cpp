@@ -38,13 +38,22 @@ struct SpectralSea::Impl {
   std::vector<double> kx, ky, phi;
   double* real = nullptr;         // n reals, scratch
   fftw_complex* spec = nullptr;   // nc complex, scratch
+  // dims = 2: the y-velocity's spectrum, made in the same pass over the modes
+  // as the x-velocity's (staged_vy) and used by the next velocity_y query.
+  fftw_complex* spec_vy = nullptr;
+  bool staged_vy = false;
   fftw_plan r2c = nullptr, c2r = nullptr;
-  // Deferred kicks: the FFTs of up to two pressures and their h, applied fused
-  // with the next flow. `staged`: spec holds the current q (written by that flow),
-  // so the elevation needs no copy before its c2r.
+  // Deferred kicks: up to two (spectrum, h), applied fused with the next flow,
+  // in order. kick_spec holds the FFTs of up to two pressures; pending kick i
+  // uses kick_spec[kick_buf[i]] (a repeated kick uses the buffer of the last
+  // one again). `staged`: spec holds the current q (written by that flow), so
+  // the elevation needs no copy before its c2r.
   std::array<fftw_complex*, 2> kick_spec{nullptr, nullptr};
+  std::array<int, 2> kick_buf{0, 0};
   std::array<double, 2> kick_h{0.0, 0.0};
   int pending = 0;
+  int last = -1;  // buffer holding the FFT of the last kick's pressure (-1: none yet)
+  const double* kick_data(int i) const { return reinterpret_cast<const double*>(kick_spec[kick_buf[i]]); }
   bool staged = false;
   std::optional<TankZones> tank;
   AlignedVector tank_eta, tank_rate;
@@ -54,6 +63,7 @@ struct SpectralSea::Impl {
     if (c2r) fftw_destroy_plan(c2r);
     fftw_free(real);
     fftw_free(spec);
+    fftw_free(spec_vy);
     for (auto* k : kick_spec) fftw_free(k);
   }
 
@@ -71,27 +81,45 @@ struct SpectralSea::Impl {
       fftw_execute_dft_r2c(r2c, real, to);
     }
   }
-  // out <- IFFT(spec) (unnormalised; spec is destroyed)
-  void backward(std::span<double> out) {
+  // out <- IFFT(from) (unnormalised; `from`, spec or spec_vy, is destroyed)
+  void backward(std::span<double> out, fftw_complex* from) {
     if (aligned(out.data())) {
-      fftw_execute_dft_c2r(c2r, spec, out.data());
+      fftw_execute_dft_c2r(c2r, from, out.data());
     } else {
-      fftw_execute_dft_c2r(c2r, spec, real);
+      fftw_execute_dft_c2r(c2r, from, real);
       std::copy(real, real + n, out.begin());
     }
   }
-  // spec <- (i k)^d factor * a, for a = q or v (d = 0 or 1 via `deriv`).
+  // spec <- (i k)^d factor * a, for a = q or v (d = 0 or 1 via `deriv`); with
+  // `gain`, the deferred kicks are added to a on the way (a = v: the rates as
+  // settle() would leave them, in the same order of operations); with
+  // `deriv_vy`, spec_vy <- i deriv_vy factor * a in the same pass.
   void load(std::span<const double> a, const std::vector<double>* deriv,
-            const std::vector<double>* factor) {
+            const std::vector<double>* factor, std::span<const double> gain = {},
+            const std::vector<double>* deriv_vy = nullptr) {
     staged = false;
-    if (!deriv && !factor) {
+    staged_vy = deriv_vy != nullptr;
+    const int kicks = gain.empty() ? 0 : pending;
+    if (!deriv && !factor && kicks == 0) {
       std::copy(a.begin(), a.end(), reinterpret_cast<double*>(spec));
       return;
     }
     for (std::size_t c = 0; c < nc; ++c) {
+      double a0 = a[2 * c], a1 = a[2 * c + 1];
+      for (int i = 0; i < kicks; ++i) {
+        const double g = kick_h[i] * gain[c];
+        const double* s = kick_data(i);
+        a0 += g * s[2 * c];
+        a1 += g * s[2 * c + 1];
+      }
       double s = 1.0;
       if (factor) s *= (*factor)[c];
-      const double re = a[2 * c] * s, im = a[2 * c + 1] * s;
+      const double re = a0 * s, im = a1 * s;
+      if (deriv_vy) {
+        const double k = (*deriv_vy)[c];
+        spec_vy[c][0] = -k * im;
+        spec_vy[c][1] = k * re;
+      }
       if (deriv) {
         const double k = (*deriv)[c];
         spec[c][0] = -k * im;
@@ -118,6 +146,7 @@ SpectralSea::SpectralSea(const SeaParams& params, const SeaOptions& options)
 
   m.real = fftw_alloc_real(m.n);
   m.spec = fftw_alloc_complex(m.nc);
+  if (m.ny > 1) m.spec_vy = fftw_alloc_complex(m.nc);
   for (auto*& k : m.kick_spec) k = fftw_alloc_complex(m.nc);
   const unsigned flags = options.measure_fft_plans ? FFTW_MEASURE : FFTW_ESTIMATE;
   if (m.ny > 1) {
@@ -186,18 +215,38 @@ void SpectralSea::kick(std::span<const double> pressure, double h) {
   Impl& m = *impl_;
   FLOESIM_ASSERT(pressure.size() == m.n);
   if (m.pending == 2) settle();
-  m.forward(pressure, m.kick_spec[m.pending]);
+  const int buf = m.pending == 1 ? 1 - m.kick_buf[0] : 0;  // one not in use
+  m.forward(pressure, m.kick_spec[buf]);
+  m.kick_buf[m.pending] = buf;
+  m.kick_h[m.pending] = h;
+  m.last = buf;
+  ++m.pending;
+  m.staged_vy = false;
+  invalidate_rates();
+}
+
+void SpectralSea::repeat_kick(double h) {
+  Impl& m = *impl_;
+  FLOESIM_ASSERT(m.last >= 0);
+  // A kick of its own (not h added to a deferred one), so that the
+  // arithmetic, and the result to the bit, does not depend on whether a
+  // query settled the first one in between.
+  if (m.pending == 2) settle();
+  m.kick_buf[m.pending] = m.last;
   m.kick_h[m.pending] = h;
   ++m.pending;
+  m.staged_vy = false;
   invalidate_rates();
 }
 
 void SpectralSea::settle() {
   Impl& m = *impl_;
-  for (int i = 0; i < m.pending; ++i)
-    bank_.kick(std::span<const double>(reinterpret_cast<const double*>(m.kick_spec[i]), 2 * m.nc),
-               m.kick_h[i]);
+  for (int i = 0; i < m.pending; ++i) bank_.kick(std::span<const double>(m.kick_data(i), 2 * m.nc), m.kick_h[i]);
   m.pending = 0;
+  // Base::modes() settles before handing out the state to be changed: the
+  // staged spectra may not outlive that.
+  m.staged = false;
+  m.staged_vy = false;
 }
 
 void SpectralSea::set_surface(std::span<const double> eta, std::span<const double> eta_t) {
@@ -205,6 +254,7 @@ void SpectralSea::set_surface(std::span<const double> eta, std::span<const doubl
   FLOESIM_ASSERT(eta.size() == m.n && eta_t.size() == m.n);
   m.pending = 0;  // the state is replaced: deferred kicks are void
   m.staged = false;
+  m.staged_vy = false;
   auto copy_in = [&](std::span<const double> f, std::span<double> a) {
     m.forward(f, m.spec);
     const double* s = reinterpret_cast<const double*>(m.spec);
@@ -223,7 +273,7 @@ void SpectralSea::flow(double dt) {
     // One pass: deferred kicks, rotation, and q staged in spec for the elevation.
     std::array<ModalBank::Kick, 2> kicks{};
     for (int i = 0; i < m.pending; ++i)
-      kicks[i] = {reinterpret_cast<const double*>(m.kick_spec[i]), m.kick_h[i]};
+      kicks[i] = {m.kick_data(i), m.kick_h[i]};
     bank_.kick_flow(std::span(kicks.data(), static_cast<std::size_t>(m.pending)), dt,
                     reinterpret_cast<double*>(m.spec));
     m.pending = 0;
@@ -233,9 +283,9 @@ void SpectralSea::flow(double dt) {
     // Strang: relax(dt/2) flow(dt) relax(dt/2), relaxing in physical space.
     auto relax = [&](double t0, double h) {
       m.load(bank_.q(), nullptr, nullptr);
-      m.backward(m.tank_eta);
+      m.backward(m.tank_eta, m.spec);
       m.load(bank_.v(), nullptr, nullptr);
-      m.backward(m.tank_rate);
+      m.backward(m.tank_rate, m.spec);
       m.tank->relax(t0, h, m.tank_eta, m.tank_rate);
       set_surface(m.tank_eta, m.tank_rate);
     };
@@ -244,13 +294,16 @@ void SpectralSea::flow(double dt) {
     relax(time_ + 0.5 * dt, 0.5 * dt);
   }
   time_ += dt;
+  m.staged_vy = false;
   invalidate();
 }
 
 void SpectralSea::compute_field(Field f, std::span<double> out) {
   Impl& m = *impl_;
   const bool one_d = m.ny == 1;
-  if (f == Field::velocity_x || f == Field::velocity_y || f == Field::velocity_z) settle();
+  // Rate fields see the deferred kicks without settling them (they stay
+  // fused with the next flow).
+  const std::span<const double> gain = bank_.gain();
   switch (f) {
     case Field::elevation:
       if (!m.staged) m.load(bank_.q(), nullptr, nullptr);
@@ -260,14 +313,21 @@ void SpectralSea::compute_field(Field f, std::span<double> out) {
       if (one_d) return std::fill(out.begin(), out.end(), 0.0);
       m.load(bank_.q(), &m.ky, nullptr);
       break;
-    case Field::velocity_x: m.load(bank_.v(), &m.kx, &m.phi); break;
+    case Field::velocity_x:  // and, in 2-D, the y-velocity's spectrum
+      m.load(bank_.v(), &m.kx, &m.phi, gain, one_d ? nullptr : &m.ky);
+      break;
     case Field::velocity_y:
       if (one_d) return std::fill(out.begin(), out.end(), 0.0);
-      m.load(bank_.v(), &m.ky, &m.phi);
+      if (m.staged_vy) {
+        m.backward(out, m.spec_vy);
+        m.staged_vy = false;
+        return;
+      }
+      m.load(bank_.v(), &m.ky, &m.phi, gain);
       break;
-    case Field::velocity_z: m.load(bank_.v(), nullptr, nullptr); break;
+    case Field::velocity_z: m.load(bank_.v(), nullptr, nullptr, gain); break;
   }
-  m.backward(out);  // destroys spec
+  m.backward(out, m.spec);  // destroys spec
   m.staged = false;
 }
 

@@ -15,8 +15,10 @@
 //
 // The modal work is memory-bound, so kicks are deferred (up to two) and applied
 // in the same pass over the modes as the next flow, which also stages q for the
-// elevation's c2r. Callers see no difference: velocity fields, energy() and
-// modes() settle the deferred kicks first.
+// elevation's c2r. Callers see no difference: velocity fields add the deferred
+// kicks as they load the rates, energy() and modes() settle them first. A
+// repeated kick costs no FFT: it defers the spectrum of the last kick again,
+// as a kick of its own, so a query that settles in between changes no bit.
 
 #include <memory>
 
@@ -31,6 +33,7 @@ public:
   ~SpectralSea() override;
 
   void kick(std::span<const double> pressure, double h) override;
+  void repeat_kick(double h) override;
   void flow(double dt) override;
   void set_surface(std::span<const double> eta, std::span<const double> eta_t) override;
 

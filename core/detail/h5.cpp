@@ -1,5 +1,7 @@
 #include "core/detail/h5.hpp"
 
+#include <algorithm>
+#include <limits>
 #include <mutex>
 
 #include "core/error.hpp"
@@ -133,7 +135,8 @@ void write_bytes(hid_t loc, const std::string& name, const std::vector<hsize_t>&
   write_raw(loc, name, d, H5T_STD_U8LE, H5T_NATIVE_UCHAR, data);
 }
 
-Handle create_extendible(hid_t loc, const std::string& name, const std::vector<hsize_t>& row) {
+Handle create_extendible(hid_t loc, const std::string& name, const std::vector<hsize_t>& row,
+                         hsize_t rows_hint) {
   std::vector<hsize_t> d{0}, maxd{H5S_UNLIMITED}, chunk{1};
   std::size_t row_size = 1;
   for (hsize_t r : row) {
@@ -145,6 +148,7 @@ Handle create_extendible(hid_t loc, const std::string& name, const std::vector<h
   }
   // Aim for chunks of about 64 KiB: several rows per chunk when rows are small.
   chunk[0] = std::max<hsize_t>(1, 8192 / std::max<std::size_t>(row_size, 1));
+  if (rows_hint > 0) chunk[0] = std::min(chunk[0], rows_hint);
   Handle space{H5Screate_simple(static_cast<int>(d.size()), d.data(), maxd.data()), H5Sclose};
   Handle props{H5Pcreate(H5P_DATASET_CREATE), H5Pclose};
   H5Pset_chunk(props, static_cast<int>(chunk.size()), chunk.data());
@@ -166,6 +170,37 @@ void append_row(hid_t dataset, const double* row) {
   Handle mem{H5Screate_simple(static_cast<int>(cnt.size()), cnt.data(), nullptr), H5Sclose};
   if (H5Dwrite(dataset, H5T_NATIVE_DOUBLE, mem, space, H5P_DEFAULT, row) < 0)
     fail("cannot append to a run-file dataset");
+}
+
+Handle create_growable(hid_t loc, const std::string& name, const std::vector<hsize_t>& row,
+                       hsize_t rows_hint) {
+  std::vector<hsize_t> d{0}, maxd{H5S_UNLIMITED}, chunk{1};
+  std::size_t row_size = 1;
+  for (hsize_t r : row) {
+    d.push_back(r);
+    maxd.push_back(H5S_UNLIMITED);
+    chunk.push_back(std::max<hsize_t>(r, 1));
+    row_size *= std::max<hsize_t>(r, 1);
+  }
+  chunk[0] = std::max<hsize_t>(1, 8192 / std::max<std::size_t>(row_size, 1));
+  if (rows_hint > 0) chunk[0] = std::min(chunk[0], rows_hint);
+  Handle space{H5Screate_simple(static_cast<int>(d.size()), d.data(), maxd.data()), H5Sclose};
+  Handle props{H5Pcreate(H5P_DATASET_CREATE), H5Pclose};
+  H5Pset_chunk(props, static_cast<int>(chunk.size()), chunk.data());
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  H5Pset_fill_value(props, H5T_NATIVE_DOUBLE, &nan);
+  hid_t set = H5Dcreate2(loc, name.c_str(), H5T_IEEE_F64LE, space, H5P_DEFAULT, props, H5P_DEFAULT);
+  if (set < 0) fail("cannot create dataset '" + name + "'");
+  return {set, H5Dclose};
+}
+
+void set_extent(hid_t dataset, const std::vector<hsize_t>& d) {
+  if (H5Dset_extent(dataset, d.data()) < 0) fail("cannot resize a run-file dataset");
+}
+
+void remove(hid_t loc, const std::string& name) {
+  if (H5Lexists(loc, name.c_str(), H5P_DEFAULT) > 0 && H5Ldelete(loc, name.c_str(), H5P_DEFAULT) < 0)
+    fail("cannot replace dataset '" + name + "'");
 }
 
 namespace {

@@ -56,9 +56,19 @@ void write_bytes(hid_t loc, const std::string& name, const std::vector<hsize_t>&
                  const unsigned char* data);
 
 // Extendible datasets along the first dimension (chunked): created with 0
-// rows, each append adds one row of the given row shape.
-Handle create_extendible(hid_t loc, const std::string& name, const std::vector<hsize_t>& row);
+// rows, each append adds one row of the given row shape. rows_hint, when not
+// 0, is the number of rows expected: chunks hold no more rows than that, so a
+// short run does not carry a mostly empty 64 KiB chunk per dataset.
+Handle create_extendible(hid_t loc, const std::string& name, const std::vector<hsize_t>& row,
+                         hsize_t rows_hint = 0);
 void append_row(hid_t dataset, const double* row);
+// Like create_extendible, but every dimension may grow (set_extent), and
+// elements never written read as NaN (the fill value).
+Handle create_growable(hid_t loc, const std::string& name, const std::vector<hsize_t>& row,
+                       hsize_t rows_hint = 0);
+void set_extent(hid_t dataset, const std::vector<hsize_t>& dims);
+// Deletes a link (a dataset written whole, before writing it again).
+void remove(hid_t loc, const std::string& name);
 
 // Attributes (on a file, group or dataset).
 void set_attr(hid_t obj, const std::string& name, const std::string& value);

@@ -18,7 +18,7 @@ import h5py
 import numpy as np
 
 FLOESIM, SRC, CASE = sys.argv[1], sys.argv[2], sys.argv[3]
-EXAMPLE = os.path.join(SRC, "examples", "floes_on_waves.toml")
+EXAMPLE = os.path.join(SRC, "examples", "pack_drift.toml")
 WORK = tempfile.mkdtemp(prefix="floesim_cli_")
 
 
@@ -53,7 +53,7 @@ def write(name, text):
 
 def case_run_default():
     # No CONFIG: the default example; the run file goes to the current folder.
-    p = run("run", "-q", "--until", "600")
+    p = run("run", "-q", "--until", "5")
     kv = keyvals(p.stdout)
     check(kv.get("status") == "complete", "status complete")
     out = kv["output"]
@@ -64,12 +64,12 @@ def case_run_default():
         check(f.attrs["format"] == "floesim-1", "format attribute")
         check("[forcing]" in f.attrs["config"], "resolved config echoed")
         t = f["time"][:]
-        check(np.isclose(t[-1], 600.0), "ran until 600 s")
+        check(np.isclose(t[-1], 5.0), "ran until 5 s")
         st = f["floes/state"][:]
-        check(st.shape == (len(t), 30, 12), f"state shape {st.shape}")
-        # The pack drifts: every floe moved, downwind (wind has +x).
-        dx = st[-1, :, 0] - st[0, :, 0]
-        check(np.all(dx > 0), "every floe drifted downwind")
+        check(st.shape == (len(t), 36, 12), f"state shape {st.shape}")
+        # The floes are on waves: every one heaves.
+        check(np.all(np.abs(st[1:, :, 6]).max(axis=0) > 1e-3), "every floe heaves")
+        check("sea/eta" in f and f["sea/eta"].shape[0] == len(t), "the sea is recorded")
         e = f["diagnostics/energy"]
         check(list(e.attrs["columns"])[-1] == "total", "energy columns end with total")
 
@@ -146,36 +146,43 @@ def case_killed_run():
     check("killed" in info, "info says the run has no end mark")
 
 
-def case_xdmf():
-    # Validate the XDMF against the run file: every HDF reference exists, has
-    # the declared dimensions, and every hyperslab selection is in bounds.
-    run("run", EXAMPLE, "-q", "--until", "300", "-o", "x.h5")
-    tree = ET.parse(os.path.join(WORK, "x.xmf"))
+def check_xdmf(name):
+    # Validate NAME.xmf against NAME.h5: every HDF reference exists, has the
+    # declared dimensions, and every hyperslab selection is in bounds.
+    tree = ET.parse(os.path.join(WORK, name + ".xmf"))
     root = tree.getroot()
     check(root.tag == "Xdmf", "root element")
     grids = root.findall("./Domain/Grid")
     check(len(grids) >= 1 and grids[0].get("CollectionType") == "Temporal", "temporal collection")
     steps = grids[0].findall("Grid")
-    with h5py.File(os.path.join(WORK, "x.h5")) as f:
+    with h5py.File(os.path.join(WORK, name + ".h5")) as f:
         check(len(steps) == f["time"].shape[0], "one grid per record")
         for g in steps:
             for item in g.iter("DataItem"):
                 if item.get("Format") != "HDF":
                     continue
-                fname, dset = item.text.strip().split(":")
-                check(fname == "x.h5", "relative file name")
-                dims = tuple(int(d) for d in item.get("Dimensions").split())
+                # "file:/dataset", or a hyperslab "file:/dataset|start:stride:count:dims" (Xdmf3 notation)
+                ref, _, sel = item.text.strip().partition("|")
+                fname, dset = ref.split(":")
+                check(fname == name + ".h5", "relative file name")
+                dims = tuple(int(d) for d in (sel.split(":")[3] if sel else item.get("Dimensions")).split())
                 check(dset in f and f[dset].shape == dims, f"{dset}: {dims} vs {f[dset].shape if dset in f else None}")
-            for slab in g.iter("DataItem"):
-                if slab.get("ItemType") != "HyperSlab":
-                    continue
-                sel, data = list(slab)
-                s = np.array(sel.text.split(), dtype=int).reshape(3, -1)
-                shape = tuple(int(d) for d in data.get("Dimensions").split())
-                end = s[0] + s[1] * (s[2] - 1)
-                check(np.all(end < shape), "hyperslab in bounds")
-                check(int(np.prod(s[2])) == int(np.prod([int(d) for d in slab.get("Dimensions").split()])),
-                      "hyperslab size = declared")
+                if sel:
+                    s = np.array([p.split() for p in sel.split(":")[:3]], dtype=int)
+                    end = s[0] + s[1] * (s[2] - 1)
+                    check(np.all(end < dims), "hyperslab in bounds")
+                    check(int(np.prod(s[2])) == int(np.prod([int(d) for d in item.get("Dimensions").split()])),
+                          "hyperslab size = declared")
+    return steps
+
+
+def case_xdmf():
+    # Validate the XDMF against the run file: every HDF reference exists, has
+    # the declared dimensions, and every hyperslab selection is in bounds.
+    run("run", EXAMPLE, "-q", "--until", "300", "-o", "x.h5")
+    steps = check_xdmf("x")
+    with h5py.File(os.path.join(WORK, "x.h5")) as f:
+        for g in steps:
             topo = g.find("Topology")
             check(topo.get("TopologyType") == "Mixed" and int(topo.get("NumberOfElements")) == 30, "topology")
         # The mixed topology lists 30 polygons (type 3) covering every vertex.
@@ -247,6 +254,89 @@ def case_pack():
         check(not os.path.exists(os.path.join(WORK, "bad.h5")), "no file for bad arguments")
     run("pack", "--floes", "10", "--concentration", "0.5", "-o", "bad.h5", expect=2)  # no --box
     run("pack", "--help")
+
+
+def disc_config(name, p, extra=""):
+    # A disc of diameter 20 m squeezed by P along its vertical diameter (the Brazilian test).
+    pts = [[round(10 * np.cos(-np.pi / 2 + 2 * np.pi * k / 120), 9), round(10 * np.sin(-np.pi / 2 + 2 * np.pi * k / 120), 9)]
+           for k in range(120)]
+    return write(name, f"""[sea]\nmodel = "none"\n[[floes.floe]]\nvertices = {pts}\nthickness = 1.0\n{extra}
+[fracture]\nmesh_size = 1.0\nstrength = 0.5e6
+[[fracture.load]]\npoint = [0.0, 10.0]\nforce = [0.0, {-p}]
+[[fracture.load]]\npoint = [0.0, -10.0]\nforce = [0.0, {p}]\n""")
+
+
+def case_fracture():
+    # floesim fracture: the key: value lines of ARCHITECTURE.md on a Brazilian
+    # disc (tension 2 P / (pi D h) across the loaded diameter, Hertz), the crack
+    # along that diameter just above the load the tool predicts; exit 2 for bad input.
+    p_load = 1.0e6
+    kv = keyvals(run("fracture", disc_config("disc.toml", p_load), "--probe", "0", "0").stdout)
+    for key in ("max_principal_stress", "at", "direction", "initiates", "load_factor", "time_ms"):
+        check(key in kv, f"key {key} printed: {kv}")
+    exact = 2 * p_load / (np.pi * 20.0)
+    check(abs(float(kv["max_principal_stress"]) / exact - 1) < 0.05, f"tension {kv['max_principal_stress']} vs {exact}")
+    check(abs(float(kv["direction"]) - 90) < 5, f"direction {kv['direction']}")
+    check(abs(float(kv["at"].split()[0])) < 2.0, f"on the loaded diameter: {kv['at']}")
+    check(kv["initiates"] == "false" and "crack_from" not in kv, "no initiation below the threshold")
+    sxx = float(kv["probe"].split()[2])
+    check(abs(sxx / exact - 1) < 0.02, f"centre sxx {sxx} vs {exact}")
+    p_c = p_load * float(kv["load_factor"])
+    check(abs(p_c / (np.pi * 20 * 0.5e6 / 2) - 1) < 0.05, f"predicted initiation load {p_c}")
+    kv = keyvals(run("fracture", disc_config("disc2.toml", 1.02 * p_c)).stdout)
+    check(kv["initiates"] == "true", f"initiates above the threshold: {kv}")
+    a, b = (np.array(kv[k].split(), dtype=float) for k in ("crack_from", "crack_to"))
+    check(abs(a[0]) < 2 and abs(b[0]) < 2 and abs(a[1] - b[1]) > 19, f"crack across the loaded diameter: {a} {b}")
+    # An impulse: the dynamic response is integrated.
+    imp = write("imp.toml", open(os.path.join(WORK, "disc.toml")).read().replace("force = [0.0, -1000000.0]",
+                "impulse = [0.0, -1.0e4]").replace("force = [0.0, 1000000.0]", "impulse = [0.0, 1.0e4]"))
+    kv = keyvals(run("fracture", imp).stdout)
+    check(int(kv["steps"]) > 10 and float(kv["time"]) > 0, f"dynamic response: {kv}")
+    # Griffith: its energies are printed.
+    g = write("g.toml", open(os.path.join(WORK, "disc.toml")).read().replace("[fracture]", "[fracture]\ncriterion = \"griffith\""))
+    kv = keyvals(run("fracture", g).stdout)
+    check("energy_released" in kv and kv["criterion"] == "griffith", f"griffith: {kv}")
+    # Bad input: two floes, a load off the floe, no load.
+    two = disc_config("two.toml", p_load, "[[floes.floe]]\nvertices = [[30, 0], [40, 0], [40, 10]]\n")
+    p = run("fracture", two, expect=2)
+    check("one floe" in p.stderr, p.stderr)
+    off = write("off.toml", open(os.path.join(WORK, "disc.toml")).read().replace("point = [0.0, 10.0]", "point = [0.0, 30.0]"))
+    p = run("fracture", off, expect=2)
+    check("not on the floe" in p.stderr and "off.toml" in p.stderr, p.stderr)
+    none = write("none.toml", open(os.path.join(WORK, "disc.toml")).read().split("[[fracture.load]]")[0])
+    p = run("fracture", none, expect=2)
+    check("[[fracture.load]]" in p.stderr, p.stderr)
+    run("fracture", "--help")
+
+
+def case_fracture_run():
+    # examples/percussion.toml: a collision cracks and splits floes; the run file
+    # has the events and the pieces (NaN rows where a floe does not exist).
+    kv = keyvals(run("run", os.path.join(SRC, "examples", "percussion.toml"), "-q", "-o", "perc.h5").stdout)
+    check(kv["status"] == "complete" and int(kv["fracture.splits"]) >= 1, f"splits: {kv}")
+    with h5py.File(os.path.join(WORK, "perc.h5")) as f:
+        ev = f["events/fracture"]
+        cols = list(ev.attrs["columns"])
+        check(cols[:6] == ["time", "floe", "x", "y", "direction", "load"], f"columns {cols}")
+        ev = ev[:]
+        check(len(ev) >= 1, "events recorded")
+        n = f["floes/offsets"].shape[0] - 1
+        st = f["floes/state"][:]
+        m = f["floes/mass"][:]
+        check(st.shape[1] == n and n == 2 + 2 * int(kv["fracture.splits"]), f"floes {n}, state {st.shape}")
+        t = f["time"][:]
+        for e in ev:
+            parent, a, b = int(e[cols.index("floe")]), int(e[cols.index("piece_a")]), int(e[cols.index("piece_b")])
+            check(abs(m[a] + m[b] - m[parent]) < 1e-9 * m[parent], "pieces keep the mass")
+            after = t > e[0] + 1e-9
+            check(np.all(np.isnan(st[after, parent, 0])), "the parent ends")
+            check(np.all(np.isnan(st[t < e[0], a, 0])) and np.all(np.isfinite(st[after, a, 0])), "pieces appear")
+    # The XDMF still describes every record: before the split 2 floes, after it 6 numbers.
+    steps = check_xdmf("perc")
+    counts = [int(g.find("Topology").get("NumberOfElements")) for g in steps]
+    check(counts[0] == 2 and counts[-1] == 6, f"floes per record {counts[0]} -> {counts[-1]}")
+    info = json.loads(run("info", "perc.h5", "--json").stdout)
+    check(info["status"] == "complete", "info reads it")
 
 
 globals()["case_" + CASE]()

@@ -1,0 +1,40 @@
+#include "contact/fracture/floe_fracture.hpp"
+
+namespace floesim::fracture {
+
+MeshOptions mesh_options(const FractureParams& p) {
+  MeshOptions o;
+  o.size = p.mesh_size;
+  return o;
+}
+
+ResponseOptions response_options(const FractureParams& p, double thickness) {
+  ResponseOptions o;
+  o.duration = p.duration;
+  o.load_radius = p.load_radius > 0.0 ? p.load_radius : thickness;
+  return o;
+}
+
+CriterionOptions criterion_options(const FractureParams& p) {
+  CriterionOptions o;
+  o.criterion = p.criterion == FractureCriterion::stress ? Criterion::stress : Criterion::griffith;
+  o.strength = p.strength;
+  o.toughness = p.toughness;
+  return o;
+}
+
+FloeFracture::FloeFracture(std::span<const Vec2> polygon, double thickness, double density,
+                           const FractureParams& params)
+    : polygon_(polygon.begin(), polygon.end()),
+      model_(mesh_polygon(polygon, mesh_options(params)), Material{params.young, params.poisson, density, thickness}),
+      responder_(model_, response_options(params, thickness)),
+      criterion_(criterion_options(params)) {}
+
+FloeFracture::Result FloeFracture::analyse(std::span<const PointLoad> loads, const Observer& observe) {
+  Result r;
+  r.response = responder_.respond(loads, observe);
+  r.initiation = judge(responder_, r.response, polygon_, criterion_);
+  return r;
+}
+
+}  // namespace floesim::fracture

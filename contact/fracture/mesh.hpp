@@ -1,0 +1,44 @@
+#pragma once
+// Triangle meshes of floe polygons for the percussion model (MODEL.md §6).
+//
+// A floe's polygon is meshed once by CGAL's constrained Delaunay refinement
+// (Delaunay_mesher_2, a Ruppert–Shewchuk refinement): the polygon's edges are
+// constraints, every triangle has its edges no longer than `size` and its
+// smallest angle no smaller than about 20.7 degrees (CGAL's shape bound
+// B = sin^2(min angle) = 0.125, the largest for which refinement is
+// guaranteed to end). CGAL types stay in mesh.cpp.
+//
+// A floe much larger than the mesh size would give millions of triangles; the
+// size bound is then raised so that the mesh has about `max_triangles`
+// triangles (Mesh::size says which bound was used).
+
+#include <array>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "core/geometry.hpp"
+
+namespace floesim::fracture {
+
+struct MeshOptions {
+  double size = 2.0;                // m, upper bound on the triangles' edge length
+  double shape_bound = 0.125;       // CGAL's B = sin^2(smallest angle allowed)
+  std::size_t max_triangles = 12000;  // the size bound grows beyond this many (estimated)
+};
+
+struct Mesh {
+  std::vector<Vec2> nodes;                       // m, in the polygon's frame
+  std::vector<std::array<int, 3>> triangles;     // node indices, counter-clockwise
+  std::vector<std::uint8_t> on_boundary;         // per node: 1 if on the polygon's outline
+  double size = 0.0;                             // m, the size bound used
+
+  std::size_t node_count() const { return nodes.size(); }
+  double area(std::size_t t) const;              // m^2 (> 0)
+};
+
+// Meshes a simple counter-clockwise polygon (as make_floe_shape produces).
+// Throws InputError for fewer than 3 vertices, non-finite input, size <= 0.
+Mesh mesh_polygon(std::span<const Vec2> polygon, const MeshOptions& options);
+
+}  // namespace floesim::fracture

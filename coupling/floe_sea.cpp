@@ -1,0 +1,400 @@
+#include "coupling/floe_sea.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include <Eigen/Dense>
+
+#include "core/error.hpp"
+#include "coupling/penalty_law.hpp"
+#include "fluid/sea.hpp"
+
+namespace floesim {
+
+namespace {
+
+// Response eta' at cell `cell` to a pressure impulse (Pa s) from rest: a unit
+// impulse on that cell alone, or (checkerboard) +-1 alternating on every
+// cell, the grid's shortest wave, which the sea answers fastest. Per unit
+// pressure impulse, so an inverse mass per unit area.
+double cell_response(fluid::Sea& sea, std::size_t cell, bool checkerboard) {
+  fluid::ModalBank& bank = sea.modes();
+  const std::vector<double> q(bank.q().begin(), bank.q().end());
+  const std::vector<double> v(bank.v().begin(), bank.v().end());
+  std::fill(bank.q().begin(), bank.q().end(), 0.0);
+  std::fill(bank.v().begin(), bank.v().end(), 0.0);
+  const fluid::SurfaceGrid& g = sea.grid();
+  std::vector<double> p(g.size(), 0.0);
+  if (checkerboard) {
+    for (std::size_t c = 0; c < g.size(); ++c)
+      p[c] = ((c % static_cast<std::size_t>(g.nx)) + c / static_cast<std::size_t>(g.nx)) % 2 ? -1.0 : 1.0;
+  } else {
+    p[cell] = 1.0;
+  }
+  sea.kick(p, 1.0);
+  const double r = std::abs(sea.field(fluid::Field::velocity_z)[cell]);
+  fluid::ModalBank& back = sea.modes();
+  std::copy(q.begin(), q.end(), back.q().begin());
+  std::copy(v.begin(), v.end(), back.v().begin());
+  return r;
+}
+
+// Solves A x = b for (heave, pitch, roll) with only the slopes that `tilt`
+// allows (0: none, 1: pitch, 2: both); the others are 0.
+Eigen::Vector3d solve_tilted(const Eigen::Matrix3d& A, const Eigen::Vector3d& b, std::uint8_t tilt) {
+  if (tilt == 2) return A.ldlt().solve(b);
+  if (tilt == 1) {
+    const Eigen::Vector2d x = A.topLeftCorner<2, 2>().ldlt().solve(b.head<2>());
+    return {x[0], x[1], 0.0};
+  }
+  return {b[0] / A(0, 0), 0.0, 0.0};
+}
+
+}  // namespace
+
+FloeSeaContact::FloeSeaContact(const CouplingParams& params, const SeaParams& sea_params, const Floes& floes,
+                               fluid::Sea& sea)
+    : rho_(sea_params.rho), g_(sea_params.g), sigma_(sea_params.sigma), K_(params.stiffness), grid_(sea.grid()) {
+  kappa_ = K_ * rho_ * g_;
+  switch (params.law) {
+    case PenaltyLaw::strong: s_ = 1.0; break;
+    case PenaltyLaw::weak: s_ = 0.0; break;
+    case PenaltyLaw::blend:
+      if (params.restitution >= 0.0) {
+        const BlendCalibration cal = calibrate_blend(K_);
+        s_ = cal.share_for(params.restitution);
+        std::ostringstream m;
+        m << "[coupling] restitution = " << params.restitution << " at stiffness K = " << K_
+          << ": blend s = " << s_ << " (obstacle-problem calibration)";
+        notes_.push_back(m.str());
+      } else {
+        s_ = params.blend;
+      }
+      break;
+  }
+  const fluid::SurfaceGrid& grid = sea.grid();
+  cell_area_ = grid.dx() * (grid.dims == 2 ? grid.dy() : grid.ly);
+  // The sea under the floes, as fast as it can answer: one cell, or the
+  // grid's shortest wave, at a few places (a walled basin answers faster near
+  // its walls).
+  for (std::size_t c : {std::size_t{0}, grid.size() / 4, grid.size() / 2, grid.size() - 1})
+    for (bool checkerboard : {false, true})
+      sea_inverse_mass_ = std::max(sea_inverse_mass_, cell_response(sea, c, checkerboard));
+  floes_changed(floes);
+}
+
+void FloeSeaContact::floes_changed(const Floes& floes) {
+  const std::size_t n = floes.size(), old = bottom0_.size();
+  dynamic_.assign(n, 0);
+  tilt_.assign(n, 0);
+  body_moments_.resize(n);
+  bottom0_.resize(n);
+  loads_.assign(n, {});
+  double min_mass_per_area = INFINITY;
+  for (std::size_t i = 0; i < n; ++i) {
+    dynamic_[i] = floes.is_static[i] ? 0 : 1;
+    const PolygonMoments m = polygon_moments(floes.vertices(i));
+    const double rh = floes.density[i] * floes.thickness[i];
+    body_moments_[i] << rh * m.sxx, rh * m.sxy, rh * m.sxy, rh * m.syy;
+    // A slope is resisted when the floe spans about two cells along it: its
+    // smallest radius of gyration is at least half a cell. A long-crested sea
+    // (dims = 1) is uniform across, so it never resists roll.
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(body_moments_[i] / std::max(floes.mass[i], 1e-300));
+    const double gyration = std::sqrt(std::max(eig.eigenvalues()[0], 0.0));
+    if (gyration >= 0.5 * std::max(grid_.dx(), grid_.dims == 2 ? grid_.dy() : 0.0))
+      tilt_[i] = grid_.dims == 2 ? 2 : 1;
+    if (i >= old) bottom0_[i] = -floes.draft(i, rho_) * (1.0 + 1.0 / K_);
+    if (dynamic_[i]) min_mass_per_area = std::min(min_mass_per_area, rh);
+  }
+  stable_step_ = INFINITY;
+  if (s_ > 0.0 && std::isfinite(min_mass_per_area))
+    stable_step_ = 1.0 / std::sqrt(s_ * kappa_ * (1.0 / min_mass_per_area + sea_inverse_mass_));
+}
+
+double FloeSeaContact::weak_coefficient(const Floes& floes, std::size_t i) const {
+  return K_ * rho_ * std::sqrt(g_ * floes.draft(i, rho_));
+}
+
+Eigen::Matrix2d FloeSeaContact::tilt_inertia(const Floes& floes, std::size_t i) const {
+  const double c = std::cos(floes.state[i].yaw), s = std::sin(floes.state[i].yaw);
+  Eigen::Matrix2d R;
+  R << c, -s, s, c;
+  const double h = floes.thickness[i];
+  return R * body_moments_[i] * R.transpose() + floes.mass[i] * h * h / 12.0 * Eigen::Matrix2d::Identity();
+}
+
+void FloeSeaContact::start(Floes& floes, fluid::Sea& sea, bool given) {
+  const fluid::SurfaceGrid& grid = sea.grid();
+  const std::size_t n = floes.size();
+  pressure_.assign(grid.size(), 0.0);  // evaluate() clears only the footprints' cells
+  pressure_kicked_ = false;
+  build_footprints(floes, dynamic_, grid, footprints_);
+  if (given) {
+    for (std::size_t i = 0; i < n; ++i) bottom0_[i] = -floes.draft(i, rho_) * (1.0 + 1.0 / K_);
+    return;
+  }
+  // The static problem (see the header): on the calm sea first, which fixes
+  // each floe's reference bottom (heave 0), then on the sea's waves.
+  const Footprints& fp = footprints_;
+  std::vector<double> F(grid.size(), 0.0), S(grid.size(), 0.0), eta(grid.size());
+  std::vector<double> z(n, 0.0);
+  std::vector<Vec2> a(n, Vec2::Zero());
+  auto zb = [&](std::size_t i, std::size_t k) { return z[i] + a[i].dot(fp.centroid[k]); };
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!dynamic_[i]) continue;
+    z[i] = -floes.draft(i, rho_) * (1.0 + 1.0 / K_);
+    for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k) F[fp.cell[k]] += std::pow(fp.area[k] / cell_area_, 2);
+  }
+  // Gauss–Seidel over the floes from the present z, a, with the free level W
+  // (+ L); fills eta (zero mean) and returns the L that makes it so.
+  auto weight = [&](std::size_t k) { return std::pow(fp.area[k] / cell_area_, 2); };
+  auto solve = [&](std::span<const double> W) {
+    std::fill(S.begin(), S.end(), 0.0);
+    for (std::size_t i = 0; i < n; ++i)
+      if (dynamic_[i])
+        for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k) S[fp.cell[k]] += weight(k) * zb(i, k);
+    double change = INFINITY;
+    int sweeps = 0;
+    for (; sweeps < 200 && change > 1e-13; ++sweeps) {
+      change = 0.0;
+      for (std::size_t i = 0; i < n; ++i) {
+        if (!dynamic_[i] || fp.offsets[i] == fp.offsets[i + 1]) continue;
+        Eigen::Matrix3d A = Eigen::Matrix3d::Zero();
+        Eigen::Vector3d b(-floes.mass[i] * g_ / kappa_, 0.0, 0.0);
+        for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k) {
+          const std::uint32_t c = fp.cell[k];
+          const double f = fp.area[k] / cell_area_;
+          const double Fo = F[c] - f * f, So = S[c] - f * f * zb(i, k);
+          const double alpha = (W[c] + K_ * So) / (1.0 + K_ * F[c]), beta = (1.0 + K_ * Fo) / (1.0 + K_ * F[c]);
+          const Eigen::Vector3d phi(1.0, fp.centroid[k].x(), fp.centroid[k].y());
+          A += f * fp.area[k] * beta * phi * phi.transpose();
+          b += f * fp.area[k] * alpha * phi;
+        }
+        // Slopes the discrete footprint cannot resist stay 0 (a floe within a
+        // few cells; roll in a long-crested sea).
+        const Eigen::Vector3d x = solve_tilted(A, b, tilt_[i]);
+        for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k) S[fp.cell[k]] -= weight(k) * zb(i, k);
+        change = std::max(change, std::abs(x[0] - z[i]) / floes.draft(i, rho_));
+        z[i] = x[0];
+        a[i] = {x[1], x[2]};
+        for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k) S[fp.cell[k]] += weight(k) * zb(i, k);
+      }
+    }
+    if (change > 1e-9) {
+      std::ostringstream m;
+      m << "the floes' static equilibrium on the sea did not converge in " << sweeps
+        << " sweeps (last relative change " << change << ")";
+      throw RunError(m.str());
+    }
+    double mean = 0.0;
+    for (std::size_t c = 0; c < grid.size(); ++c) {
+      eta[c] = (W[c] + K_ * S[c]) / (1.0 + K_ * F[c]);
+      mean += eta[c];
+    }
+    mean /= static_cast<double>(grid.size());
+    for (double& e : eta) e -= mean;
+    return mean;
+  };
+  const double calm_level = solve(std::vector<double>(grid.size(), 0.0));
+  for (std::size_t i = 0; i < n; ++i)
+    if (dynamic_[i]) bottom0_[i] = z[i] - calm_level;
+  // The waves in the sea: the floes start from the least-squares plane of the
+  // waves under them (and take the plane of the waves' rates as theirs),
+  // then settle on the waves.
+  const std::span<const double> wave = sea.elevation();
+  const std::vector<double> wave_eta(wave.begin(), wave.end());
+  const std::span<const double> wave_w = sea.field(fluid::Field::velocity_z);
+  const std::vector<double> eta_t(wave_w.begin(), wave_w.end());
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!dynamic_[i]) continue;
+    FloeState& st = floes.state[i];
+    Eigen::Matrix3d A = Eigen::Matrix3d::Zero();
+    Eigen::Vector3d be = Eigen::Vector3d::Zero(), bw = Eigen::Vector3d::Zero();
+    for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k) {
+      const Eigen::Vector3d phi(1.0, fp.centroid[k].x(), fp.centroid[k].y());
+      A += fp.area[k] * phi * phi.transpose();
+      be += fp.area[k] * wave_eta[fp.cell[k]] * phi;
+      bw += fp.area[k] * eta_t[fp.cell[k]] * phi;
+    }
+    if (!(A(0, 0) > 0.0)) continue;
+    const Eigen::Vector3d xe = solve_tilted(A, be, tilt_[i]), xw = solve_tilted(A, bw, tilt_[i]);
+    z[i] += xe[0];
+    a[i] += Vec2{xe[1], xe[2]};
+    st.heave_rate = xw[0];
+    st.pitch_rate = xw[1];
+    st.roll_rate = xw[2];
+  }
+  const double wave_level = solve(wave_eta);
+  sea.set_surface(eta, eta_t);
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!dynamic_[i]) continue;
+    FloeState& st = floes.state[i];
+    st.heave = z[i] - wave_level - bottom0_[i];
+    st.pitch = a[i].x();
+    st.roll = a[i].y();
+  }
+  const double capillary =
+      sigma_ * (std::pow(M_PI / grid.dx(), 2) + (grid.dims == 2 ? std::pow(M_PI / grid.dy(), 2) : 0.0)) / (rho_ * g_);
+  if (capillary > 1e-3) {
+    std::ostringstream m;
+    m << "the static start neglects capillarity, whose relative size on this grid is up to " << capillary;
+    notes_.push_back(m.str());
+  }
+}
+
+void FloeSeaContact::evaluate(const Floes& floes, fluid::Sea& sea, double h) {
+  const fluid::SurfaceGrid& grid = sea.grid();
+  // The pressure is zero outside the footprints: clear the cells of the last
+  // ones rather than the whole grid.
+  if (pressure_.size() != grid.size()) pressure_.assign(grid.size(), 0.0);
+  else for (std::uint32_t c : footprints_.cell) pressure_[c] = 0.0;
+  pressure_kicked_ = false;
+  build_footprints(floes, dynamic_, grid, footprints_);
+  const Footprints& fp = footprints_;
+  const std::span<const double> eta = sea.elevation();
+  std::span<const double> w;
+  if (s_ < 1.0) w = sea.field(fluid::Field::velocity_z);
+  const double ks = s_ * kappa_, inv_cell_area = 1.0 / cell_area_;
+  double energy = 0.0;
+  thread_local std::vector<double> u;  // [delta]^+ of each area piece
+  u.resize(fp.cell.size());
+  for (std::size_t i = 0; i < floes.size(); ++i) {
+    FloeSeaLoad& load = loads_[i];
+    load = {};
+    if (!dynamic_[i]) continue;
+    const FloeState& st = floes.state[i];
+    const double z = st.heave + bottom0_[i];
+    const Vec2 a{st.pitch, st.roll}, ar{st.pitch_rate, st.roll_rate};
+    const double c = (1.0 - s_) * weak_coefficient(floes, i);
+    const double damper = c / (1.0 + h * c * (1.0 / (floes.density[i] * floes.thickness[i]) + sea_inverse_mass_));
+    double fz = 0.0, wetted = 0.0;  // wetted: sum phi_c a_c u_c
+    Vec2 moment = Vec2::Zero(), fh = Vec2::Zero();
+    double torque = 0.0;
+    for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k) {
+      const Vec2& r = fp.centroid[k];
+      const std::uint32_t cell = fp.cell[k];
+      const double delta = eta[cell] - z - a.dot(r);
+      if (delta <= 0.0) {
+        u[k] = 0.0;
+        continue;
+      }
+      u[k] = delta;
+      const double area = fp.area[k], cover = area * inv_cell_area;  // phi_c
+      double f = ks * cover * area * delta;
+      energy += 0.5 * ks * cover * area * delta * delta;
+      wetted += cover * area * delta;
+      if (c > 0.0) {
+        const double rate = w[cell] - st.heave_rate - ar.dot(r);
+        f += cover * area * damper * rate;
+      }
+      pressure_[cell] += f * inv_cell_area;
+      fz += f;
+      moment += f * r;
+    }
+    // Strong part, horizontal: -dV/dG and -dV/dyaw through the edge pieces.
+    if (ks > 0.0) {
+      for (std::size_t k = fp.edge_offsets[i]; k < fp.edge_offsets[i + 1]; ++k) {
+        const std::ptrdiff_t piece = fp.edge_piece[k];
+        if (piece < 0 || u[piece] <= 0.0) continue;
+        const double up = u[piece];
+        const Vec2& A = fp.edge_a[k];
+        const Vec2& B = fp.edge_b[k];
+        const Vec2 e = B - A;
+        const Vec2 N{e.y(), -e.x()};                     // ∮ n ds
+        const Vec2 mid = 0.5 * (A + B);
+        // Q^T a = ∮ (r . a) n ds;  T = ∮ r x n ds = -mid . e
+        const double ra = mid.dot(a);
+        const double T = -mid.dot(e);
+        // S = ∮ r (r x n) ds = -[A (A.e) + (A (e.e) + e (A.e)) / 2 + e (e.e) / 3]
+        const double ae = A.dot(e), ee = e.dot(e);
+        const Vec2 S = -(A * ae + 0.5 * (A * ee + e * ae) + e * (ee / 3.0));
+        const Vec2& rc = fp.centroid[piece];
+        const double kf = ks * fp.area[piece] / cell_area_;
+        const Vec2 dVdG = kf * (up * up * N - up * (ra * N - a.dot(rc) * N));
+        const double dVdyaw = kf * (up * up * T - up * a.dot(S - rc * T));
+        fh -= dVdG;
+        torque -= dVdyaw;
+      }
+      // The explicit-G term of dV/dG: -phi_c a_c u a, summed over the area pieces.
+      fh -= ks * wetted * a;
+    }
+    load.vertical = {fz - floes.mass[i] * g_, moment.x(), moment.y()};
+    load.horizontal = {fh.x(), fh.y(), torque};
+  }
+  penalty_energy_ = energy;
+}
+
+void FloeSeaContact::kick_sea(fluid::Sea& sea, double h) {
+  if (pressure_kicked_) {
+    sea.repeat_kick(h);
+  } else {
+    sea.kick(pressure_, h);
+    pressure_kicked_ = true;
+  }
+}
+
+void FloeSeaContact::kick_floes(Floes& floes, double h) const {
+  for (std::size_t i = 0; i < floes.size(); ++i) {
+    if (!dynamic_[i]) continue;
+    FloeState& st = floes.state[i];
+    const FloeSeaLoad& load = loads_[i];
+    st.heave_rate += h * load.vertical[0] / floes.mass[i];
+    if (tilt_[i] == 2) {
+      const Eigen::Vector2d da = tilt_inertia(floes, i).ldlt().solve(load.vertical.tail<2>());
+      st.pitch_rate += h * da[0];
+      st.roll_rate += h * da[1];
+    } else if (tilt_[i] == 1) {
+      st.pitch_rate += h * load.vertical[1] / tilt_inertia(floes, i)(0, 0);
+    }
+    st.vx += h * load.horizontal[0] / floes.mass[i];
+    st.vy += h * load.horizontal[1] / floes.mass[i];
+    st.yaw_rate += h * load.horizontal[2] / floes.inertia_z[i];
+  }
+}
+
+void FloeSeaContact::drift(Floes& floes, double h) {
+  for (std::size_t i = 0; i < floes.size(); ++i) {
+    if (floes.is_static[i]) continue;
+    FloeState& st = floes.state[i];
+    st.heave += h * st.heave_rate;
+    st.pitch += h * st.pitch_rate;
+    st.roll += h * st.roll_rate;
+  }
+}
+
+void FloeSeaContact::orbital_velocity(const Floes& floes, fluid::Sea& sea, std::vector<Vec2>& out) const {
+  out.assign(floes.size(), Vec2::Zero());
+  const std::span<const double> u = sea.field(fluid::Field::velocity_x);
+  const std::span<const double> v = sea.field(fluid::Field::velocity_y);
+  const Footprints& fp = footprints_;
+  for (std::size_t i = 0; i < std::min(floes.size(), fp.floes()); ++i) {
+    double area = 0.0;
+    Vec2 sum = Vec2::Zero();
+    for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k) {
+      area += fp.area[k];
+      sum += fp.area[k] * Vec2{u[fp.cell[k]], v[fp.cell[k]]};
+    }
+    if (area > 0.0) out[i] = sum / area;
+  }
+}
+
+double FloeSeaContact::floes_vertical_kinetic(const Floes& floes) const {
+  double e = 0.0;
+  for (std::size_t i = 0; i < floes.size(); ++i) {
+    if (!dynamic_[i]) continue;
+    const FloeState& st = floes.state[i];
+    const Eigen::Vector2d ar(st.pitch_rate, st.roll_rate);
+    e += 0.5 * floes.mass[i] * st.heave_rate * st.heave_rate + 0.5 * ar.dot(tilt_inertia(floes, i) * ar);
+  }
+  return e;
+}
+
+double FloeSeaContact::floes_weight_energy(const Floes& floes) const {
+  double e = 0.0;
+  for (std::size_t i = 0; i < floes.size(); ++i)
+    if (dynamic_[i]) e += floes.mass[i] * g_ * floes.state[i].heave;
+  return e;
+}
+
+}  // namespace floesim

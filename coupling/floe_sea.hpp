@@ -1,0 +1,156 @@
+#pragma once
+// Floe–sea contact by penalty (MODEL.md §4): the vertical motion of the floes
+// (heave zeta, bottom slopes a = (pitch, roll)), the pressure they put on the
+// sea, and the forces the sea puts back on them, vertical and horizontal.
+//
+// Floe i's bottom is the plane z_b(x) = zeta_i + z0_i + a_i . (x - G_i), with
+// z0_i its height at floating equilibrium (so zeta = 0 at rest). On each area
+// piece c of its footprint (coupling/footprint.hpp: cell c of the sea grid,
+// area a_c, centroid r_c) the penetration is delta_c = eta_c - z_b(G + r_c)
+// and the law (coupling/penalty_law.hpp) gives the force
+//     f_c = phi_c a_c (s kappa [delta_c]^+ + (1 - s) c_i delta_c' 1[delta_c > 0]),
+// up on the floe, down on the water (pressure f_c / cell area on cell c), with
+// phi_c = a_c / cell area the piece's share of its cell.
+//
+// Why phi_c: the sea knows one elevation per cell. A floe edge that covers a
+// sliver of a cell sees that cell's mean water level, which at rest sits
+// close to the free level, not to the floe's bottom, so an unweighted law
+// would push there with the full draft as penetration: a force that jumps as
+// the edge enters a cell. Weighted by phi_c the penalty energy of a piece
+// grows as a_c^2 from zero and the forces are continuous (C^1 energy). The
+// grid still resolves the edge only to a cell: a partly covered cell's water
+// is held down nearly as a whole, so the floating depth converges as O(dx / L)
+// (docs/coupling.md gives the measured figures).
+//
+// Energy (strong part). With V = s kappa / 2 sum_c phi_c a_c [delta_c]^+^2, the
+// vertical forces are exactly -dV/d(zeta, a) and -dV/d eta_c, so floes + sea
+// + V + the floes' weight M g zeta is a Hamiltonian that the Strang splitting
+// (half kick, exact sea flow and floe drift, half kick) conserves to O(dt^2).
+// The horizontal force and torque of the strong part are -dV/dG and
+// -dV/dyaw of the same discrete V (not a quadrature of -∫ p grad eta): a_c and
+// the first moment of piece c change with G through the floe's boundary in
+// cell c (Reynolds' transport theorem), so with the edge pieces A -> B in the
+// cell, N_c = ∮ n ds, Q_c = ∮ r n^T ds, T_c = ∮ r x n ds, S_c = ∮ r (r x n) ds,
+// and u = [delta_c]^+,
+//     dV/dG   = sum_c kappa s phi_c [u^2 N_c - u (Q_c^T a - (a . r_c) N_c - a_c a)],
+//     dV/dyaw = sum_c kappa s phi_c [u^2 T_c - u a . (S_c - r_c T_c)]
+// (the bottom slope a is held in the world frame). In the continuum limit this
+// is the pressure-slope force -∫ p grad eta. The damping (weak) part has no
+// potential and no horizontal share.
+//
+// KNOWN PROBLEM (docs/coupling.md): through the partly covered edge cells the
+// floe feels its own static depression, a cogging potential of period dx
+// that holds slow floes in place (a 10 m floe on 1.6 m cells at 0.5 m/s is
+// trapped). Tried and rejected: -a ∫ p (the continuum limit under a stiff
+// penalty) and the grid slope: neither is the gradient of V, and both pump
+// energy into heave as floes cross cells.
+// The damper is integrated implicitly per piece over a kick of length h,
+// using the inverse mass per unit area of the floe (1 / rho_i h) and of the
+// sea under one cell (measured once from the sea's response to a unit
+// impulse on one cell):  f_c = a_c c delta' / (1 + h c (1/m_floe + 1/m_sea)).
+// As c -> inf this removes the relative normal velocity in one kick
+// (restitution 0) and never destabilises.
+//
+// Start (MODEL.md §1): the static problem is solved first. The sea's static
+// response to a pressure is local, eta = W - p / (rho_w g) + const, W the
+// surface without floes, up to capillarity (relative size sigma k^2 /
+// (rho_w g) <= sigma (pi / dx)^2 / (rho_w g), reported), so on each cell
+// eta_c (1 + K sum_i f_ci^2) = W_c + L + K sum_i f_ci^2 z_b,i(r_ci) with
+// f_ci = a_ci / cell area (the phi_c weights: f_ci enters squared); each
+// floe's heave and slopes solve the 3x3 equilibrium of its weight
+// (Gauss–Seidel over floes sharing cells), and L is set by the zero mean of
+// eta. Solved on the calm sea (W = 0) it gives each floe's reference bottom
+// z0_i; solved again with W = the initial waves it puts the floes at rest on
+// them: a rigid bottom cannot follow the waves' curvature, so the water under
+// it is displaced instead of the floe being lifted by the penetration (which,
+// at K = 1000, would hold many times the floe's weight). The sea keeps the
+// waves' rates; each floe takes their least-squares plane.
+
+#include <span>
+#include <string>
+#include <vector>
+
+#include "core/floes.hpp"
+#include "core/params.hpp"
+#include "coupling/footprint.hpp"
+
+namespace floesim {
+
+namespace fluid { class Sea; }
+
+// Loads of the sea on floe i, world frame.
+struct FloeSeaLoad {
+  Eigen::Vector3d vertical = Eigen::Vector3d::Zero();    // Fz (N, weight included), moments about G (N m)
+  Eigen::Vector3d horizontal = Eigen::Vector3d::Zero();  // Fx, Fy (N), torque about z (N m)
+};
+
+class FloeSeaContact {
+public:
+  // Resolves the law (blend from a requested restitution through the
+  // calibration table), measures the sea's local inverse mass, and prepares
+  // the floes' vertical inertia.
+  FloeSeaContact(const CouplingParams& params, const SeaParams& sea_params, const Floes& floes, fluid::Sea& sea);
+
+  // Puts the floes at rest on the sea (the static problem above), then adds
+  // the sea's present waves; or (start = "given") keeps the floes' heave as given.
+  void start(Floes& floes, fluid::Sea& sea, bool given);
+
+  // Evaluates the contact at the present state for a kick of length h: the
+  // pressure on the sea grid and the loads on the floes.
+  void evaluate(const Floes& floes, fluid::Sea& sea, double h);
+  // Apply the last evaluation over h: to the floes' vertical and horizontal
+  // rates; to the sea's modal velocities (a second kick_sea with the same
+  // evaluation repeats the sea's last kick, without projecting the pressure
+  // again: nothing else may kick the sea in between).
+  void kick_floes(Floes& floes, double h) const;
+  void kick_sea(fluid::Sea& sea, double h);
+  // Vertical drift of the floes: zeta += h zeta', a += h a'.
+  static void drift(Floes& floes, double h);
+
+  // Mean orbital velocity of the sea under each floe (m/s, world), for drag.
+  void orbital_velocity(const Floes& floes, fluid::Sea& sea, std::vector<Vec2>& out) const;
+
+  // Stable kick length of the explicit spring part (s > 0): 1 / omega_pen,
+  // omega_pen^2 = s kappa (1 / m_floe + 1 / m_sea) (leapfrog needs < 2 / omega).
+  double stable_step() const { return stable_step_; }
+
+  // Energies (J) at the last evaluate(): the penalty spring's, and the floes'
+  // vertical kinetic and weight (M g zeta) energies at the present state.
+  double penalty_energy() const { return penalty_energy_; }
+  double floes_vertical_kinetic(const Floes& floes) const;
+  double floes_weight_energy(const Floes& floes) const;
+
+  // Height of floe i's bottom at its centroid, z_b(G) = zeta + z0 (m).
+  double bottom(const Floes& floes, std::size_t i) const { return floes.state[i].heave + bottom0_[i]; }
+  const Footprints& footprints() const { return footprints_; }
+  std::span<const FloeSeaLoad> loads() const { return loads_; }
+  std::span<const double> pressure() const { return pressure_; }
+  double strong_share() const { return s_; }
+  double kappa() const { return kappa_; }
+  // Notes for the user (calibrated share, capillarity neglected at the start).
+  const std::vector<std::string>& notes() const { return notes_; }
+  // Floes whose contact rebuilt data must be redone (after a split).
+  void floes_changed(const Floes& floes);
+
+private:
+  double weak_coefficient(const Floes& floes, std::size_t i) const;
+  Eigen::Matrix2d tilt_inertia(const Floes& floes, std::size_t i) const;
+
+  double rho_ = 1025.0, g_ = 9.81, sigma_ = 0.0, K_ = 1000.0, s_ = 1.0, kappa_ = 0.0;
+  fluid::SurfaceGrid grid_;
+  double sea_inverse_mass_ = 0.0;  // 1 / m_sea: eta' per unit pressure impulse on one cell (m^2 s / kg... per Pa s)
+  double stable_step_ = 0.0;
+  double cell_area_ = 1.0;
+  std::vector<std::uint8_t> dynamic_;
+  std::vector<std::uint8_t> tilt_;           // slopes resisted: 0 none, 1 pitch, 2 pitch and roll
+  std::vector<double> bottom0_;             // z0_i, m
+  std::vector<Eigen::Matrix2d> body_moments_;  // rho h ∫ r r^T in the body frame
+  Footprints footprints_;
+  std::vector<FloeSeaLoad> loads_;
+  std::vector<double> pressure_;
+  bool pressure_kicked_ = false;  // the sea's last kick was with pressure_ as it is
+  double penalty_energy_ = 0.0;
+  std::vector<std::string> notes_;
+};
+
+}  // namespace floesim

@@ -1,0 +1,116 @@
+#include "coupling/penalty_law.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+namespace floesim {
+
+// The obstacle problem in units of the draft d, the time sqrt(d / g) and the
+// mass per unit area rho_w d: the mass sits at height x above the obstacle,
+// its spring pulls it toward x = 1/2 with unit frequency, and it is released
+// from x = 3/2, so it reaches the obstacle with speed v0 = sqrt(3) / 2. While
+// x < 0 (delta = -x > 0) the law adds p = s K delta + (1 - s) K delta':
+//     x'' + c x' + w2 x = 1/2,   c = (1 - s) K,   w2 = 1 + s K,
+// linear with constant coefficients, so the contact phase is solved in closed
+// form. The mass leaves when x returns to 0; e = |x'| there / v0.
+double obstacle_restitution(double s, double K) {
+  const double v0 = std::sqrt(0.75);
+  const double c = (1.0 - s) * K, w2 = 1.0 + s * K;
+  const double xp = 0.5 / w2;
+  const double beta = 0.5 * c;
+  const double disc = beta * beta - w2;
+  // x(t) and x'(t) of the contact phase, x(0) = 0, x'(0) = -v0.
+  auto motion = [&](double t, double& x, double& v) {
+    if (disc < -1e-12 * w2) {  // underdamped
+      const double wd = std::sqrt(-disc);
+      const double c1 = -xp, c2 = (-v0 + beta * c1) / wd;
+      const double ex = std::exp(-beta * t), co = std::cos(wd * t), si = std::sin(wd * t);
+      x = xp + ex * (c1 * co + c2 * si);
+      v = ex * ((-beta * c1 + wd * c2) * co + (-beta * c2 - wd * c1) * si);
+    } else if (disc > 1e-12 * w2) {  // overdamped: r_fast < r_slow < 0
+      const double sq = std::sqrt(disc);
+      const double r_fast = -beta - sq, r_slow = -w2 / (beta + sq);
+      // A + B = -xp, r_slow A + r_fast B = -v0.
+      const double b = (-v0 + r_slow * xp) / (r_fast - r_slow);
+      const double a = -xp - b;
+      x = xp + a * std::exp(r_slow * t) + b * std::exp(r_fast * t);
+      v = a * r_slow * std::exp(r_slow * t) + b * r_fast * std::exp(r_fast * t);
+    } else {  // critical
+      const double c1 = -xp, c2 = -v0 + beta * c1;
+      const double ex = std::exp(-beta * t);
+      x = xp + (c1 + c2 * t) * ex;
+      v = (c2 - beta * (c1 + c2 * t)) * ex;
+    }
+  };
+  // First return to x = 0: scan on a geometric grid in t (the contact may
+  // last from 1/K to K time units), then bisect.
+  const double t_fast = 1.0 / (std::sqrt(w2) + c);
+  double t_prev = 0.0;
+  for (double t = 1e-3 * t_fast; t < 1e9; t *= 1.002) {
+    double x, v;
+    motion(t, x, v);
+    if (x >= 0.0) {
+      double lo = t_prev, hi = t;
+      for (int k = 0; k < 200 && hi - lo > 1e-15 * hi; ++k) {
+        const double mid = 0.5 * (lo + hi);
+        motion(mid, x, v);
+        (x >= 0.0 ? hi : lo) = mid;
+      }
+      motion(hi, x, v);
+      return std::abs(v) / v0;
+    }
+    t_prev = t;
+  }
+  return 0.0;  // never leaves within 10^9 time units: absorbed
+}
+
+BlendCalibration calibrate_blend(double K, int points) {
+  // Tabulated along the damping ratio zeta = (1 - s) sqrt(K / s) / 2, where e
+  // varies (for large K all of it happens within 1 - s ~ 1 / sqrt(K)):
+  // s = q^2 with q^2 + b q - 1 = 0, b = 2 zeta / sqrt(K); zeta from 0 (s = 1)
+  // log-spaced over 10^-3 .. 10^3, then s = 0.
+  BlendCalibration cal;
+  cal.stiffness = K;
+  std::vector<double> zetas{0.0};
+  for (int k = 0; k < points - 2; ++k) zetas.push_back(std::pow(10.0, -3.0 + 6.0 * k / (points - 3)));
+  for (double zeta : zetas) {
+    const double b = 2.0 * zeta / std::sqrt(K);
+    const double q = 2.0 / (b + std::sqrt(b * b + 4.0));  // the root of q^2 + b q - 1, cancellation-free
+    cal.share.push_back(q * q);
+  }
+  cal.share.push_back(0.0);
+  std::reverse(cal.share.begin(), cal.share.end());  // increasing s
+  for (double s : cal.share) cal.restitution.push_back(obstacle_restitution(s, K));
+  // Round-off may leave the table flat at its ends; keep it non-decreasing.
+  for (std::size_t k = 1; k < cal.restitution.size(); ++k)
+    cal.restitution[k] = std::max(cal.restitution[k], cal.restitution[k - 1]);
+  return cal;
+}
+
+double BlendCalibration::share_for(double e) const {
+  const auto& x = restitution;
+  const auto& y = share;
+  if (x.empty()) throw std::logic_error("BlendCalibration::share_for on an empty table");
+  if (e <= x.front()) return y.front();
+  if (e >= x.back()) return y.back();
+  std::size_t k = static_cast<std::size_t>(std::upper_bound(x.begin(), x.end(), e) - x.begin()) - 1;
+  while (k + 1 < x.size() && x[k + 1] == x[k]) ++k;
+  // Monotone cubic (Fritsch–Carlson) through the table points.
+  auto slope = [&](std::size_t i) {
+    const std::size_t n = x.size();
+    auto secant = [&](std::size_t a) { return (y[a + 1] - y[a]) / (x[a + 1] - x[a]); };
+    if (i == 0) return secant(0);
+    if (i == n - 1) return secant(n - 2);
+    const double l = secant(i - 1), r = secant(i);
+    if (l * r <= 0.0 || !std::isfinite(l) || !std::isfinite(r)) return 0.0;
+    return 2.0 / (1.0 / l + 1.0 / r);  // harmonic mean keeps monotonicity
+  };
+  const double h = x[k + 1] - x[k];
+  const double t = (e - x[k]) / h;
+  const double h00 = (1 + 2 * t) * (1 - t) * (1 - t), h10 = t * (1 - t) * (1 - t);
+  const double h01 = t * t * (3 - 2 * t), h11 = t * t * (t - 1);
+  return h00 * y[k] + h10 * h * slope(k) + h01 * y[k + 1] + h11 * h * slope(k + 1);
+}
+
+}  // namespace floesim

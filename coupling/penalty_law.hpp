@@ -1,0 +1,48 @@
+#pragma once
+// The floe–sea penalty laws (MODEL.md §4; Destuynder & Fabre, seed 000 eq. 12,
+// 13 and 17) as functions of the penetration delta = eta - z_b (m) and its
+// rate delta' (m/s), per unit area:
+//
+//   strong  p = kappa [delta]^+,                kappa = K rho_w g
+//           (a spring: conserves energy; as K -> inf, an elastic contact, e -> 1)
+//   weak    Lambda = c [delta]^+, p = dLambda/dt = c delta' 1[delta > 0],
+//           c = K rho_w sqrt(g d)
+//           (the penalty on the first integral in time, seed eq. 17: a damper
+//           while in contact; as K -> inf it absorbs the impact, e -> 0. Lambda
+//           >= 0 always; p may pull while delta decreases, as in eq. 17)
+//   blend   p = s strong + (1 - s) weak, s in [0, 1].
+//
+// The seed's model is dimensionless: eq. 13 penalises a time integral of
+// delta, eq. 17 delta itself, with the same 1/epsilon. Our weak coefficient c
+// uses the time scale sqrt(d / g) of the floe's heave (d = its draft), so that
+// one K serves both laws: on a floe of draft d the damping ratio of the blend
+// is zeta = (1 - s) sqrt(K / s) / 2, independent of d.
+//
+// Calibration (MODEL.md §4): a rigid mass on a spring (natural frequency
+// sqrt(g / d), at rest a height d above the obstacle, released from 2 d) hits
+// the penalised obstacle; e = exit speed / entry speed. The map s -> e at a
+// given K is tabulated, increasing in s (s = 1 gives e = 1: the strong law
+// conserves energy), and inverted for a requested e.
+
+#include <vector>
+
+namespace floesim {
+
+struct PenaltyLawParams {
+  double stiffness = 1000.0;  // K
+  double strong_share = 1.0;  // s
+};
+
+// Restitution of the obstacle problem above for a share s and stiffness K
+// (integrated accurately: RK4 with 400 steps per contact time scale).
+double obstacle_restitution(double strong_share, double stiffness);
+
+struct BlendCalibration {
+  double stiffness = 0.0;
+  std::vector<double> share, restitution;  // increasing in both
+  // The share s that gives restitution e (monotone cubic interpolation).
+  double share_for(double e) const;
+};
+BlendCalibration calibrate_blend(double stiffness, int points = 61);
+
+}  // namespace floesim
