@@ -83,21 +83,29 @@ struct Candidate {
 // listed in the cells it covers (cell side: the mean box size, so a box
 // covers about four), the (cell, entry) list is sorted by cell, and within a
 // cell a pair is reported only if the cell holds the lower-left corner of the
-// two boxes' intersection, so once. The cells are hashed by sorting, so an
-// open domain with floes far apart costs no empty cells. O(n log n) with a
+// two boxes' intersection, so once. O(n) for a pack (counting sort), O(n log n)
+// for floes spread over an open domain (cells hashed by sorting), with a
 // bounded number of boxes per cell (a sweep along one axis grows as n^1.5).
 std::vector<Candidate> broad_phase(const std::vector<Entry>& entries, const std::vector<std::uint8_t>& is_static) {
   std::vector<Candidate> out;
   if (entries.empty()) return out;
-  double size = 0.0, x0 = entries[0].box.xmin, y0 = entries[0].box.ymin;
+  double size = 0.0, x0 = entries[0].box.xmin, y0 = entries[0].box.ymin, x1 = x0, y1 = y0;
   for (const Entry& e : entries) {
     size += std::max(e.box.xmax - e.box.xmin, e.box.ymax - e.box.ymin);
     x0 = std::min(x0, e.box.xmin);
     y0 = std::min(y0, e.box.ymin);
+    x1 = std::max(x1, e.box.xmax);
+    y1 = std::max(y1, e.box.ymax);
   }
   const double h = std::max(size / static_cast<double>(entries.size()), 1e-9);
   auto cell = [&](double v, double v0) { return static_cast<std::int64_t>(std::floor((v - v0) / h)); };
-  constexpr std::int64_t kRow = std::int64_t{1} << 31;
+  // A pack's grid has about as many cells as floes: its cells are numbered
+  // row by row and the items ordered by a counting sort, O(n). A grid with
+  // many more cells than items (floes far apart in an open domain) is hashed
+  // by sorting instead, so empty cells cost nothing. Both give the same order.
+  const double cells = (static_cast<double>(cell(x1, x0)) + 1.0) * (static_cast<double>(cell(y1, y0)) + 1.0);
+  const bool dense = cells <= 8.0 * static_cast<double>(entries.size());
+  const std::int64_t row = dense ? cell(x1, x0) + 1 : std::int64_t{1} << 31;
   struct Item {
     std::int64_t key;
     std::uint32_t entry;
@@ -107,11 +115,21 @@ std::vector<Candidate> broad_phase(const std::vector<Entry>& entries, const std:
   for (std::uint32_t e = 0; e < entries.size(); ++e) {
     const Box& b = entries[e].box;
     for (std::int64_t cy = cell(b.ymin, y0); cy <= cell(b.ymax, y0); ++cy)
-      for (std::int64_t cx = cell(b.xmin, x0); cx <= cell(b.xmax, x0); ++cx) items.push_back({cy * kRow + cx, e});
+      for (std::int64_t cx = cell(b.xmin, x0); cx <= cell(b.xmax, x0); ++cx) items.push_back({cy * row + cx, e});
   }
-  std::sort(items.begin(), items.end(), [](const Item& p, const Item& q) {
-    return p.key != q.key ? p.key < q.key : p.entry < q.entry;
-  });
+  if (dense) {
+    // Items were made in entry order, so each cell's stay in entry order.
+    std::vector<std::uint32_t> first(static_cast<std::size_t>(cells) + 1, 0);
+    for (const Item& it : items) ++first[static_cast<std::size_t>(it.key) + 1];
+    for (std::size_t c = 1; c < first.size(); ++c) first[c] += first[c - 1];
+    std::vector<Item> sorted(items.size());
+    for (const Item& it : items) sorted[first[static_cast<std::size_t>(it.key)]++] = it;
+    items.swap(sorted);
+  } else {
+    std::sort(items.begin(), items.end(), [](const Item& p, const Item& q) {
+      return p.key != q.key ? p.key < q.key : p.entry < q.entry;
+    });
+  }
   for (std::size_t first = 0; first < items.size();) {
     std::size_t last = first;
     while (last < items.size() && items[last].key == items[first].key) ++last;
@@ -122,7 +140,7 @@ std::vector<Candidate> broad_phase(const std::vector<Entry>& entries, const std:
         const Entry& q = entries[items[j].entry];
         if (p.floe == q.floe || !p.box.overlaps(q.box)) continue;
         if (is_static[p.floe] && is_static[q.floe]) continue;
-        const std::int64_t owner = cell(std::max(p.box.ymin, q.box.ymin), y0) * kRow +
+        const std::int64_t owner = cell(std::max(p.box.ymin, q.box.ymin), y0) * row +
                                    cell(std::max(p.box.xmin, q.box.xmin), x0);
         if (owner != key) continue;
         // Canonical order a < b, with b shifted relative to a.

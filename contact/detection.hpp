@@ -2,8 +2,8 @@
 // Which floes are near each other, how far apart, and where they touch.
 //
 // Broad phase: world bounding boxes, floe i's inflated by a pad
-// p_i = reach_i + xi/2, sorted along x and swept (sweep and prune):
-// O(n log n + pairs). Two floes become a candidate pair when their padded
+// p_i = reach_i + xi/2, listed in the cells of a uniform grid (cell side the
+// mean box size; cells hashed by sorting): O(n log n + pairs). Two floes become a candidate pair when their padded
 // boxes overlap; so a pair that is not a candidate is more than
 // reach_a + reach_b + xi apart, and stays out of contact as long as each floe
 // moves less than its reach (the time loop checks that, contact/substep.hpp).

@@ -227,9 +227,9 @@ Result Lemke::run() {
         double best = residual(lcp_, end.z);
         Result refined = finish_solved(basis);
         if (refined.status == Status::solved) {
-          const double r = residual(lcp_, refined.z);
-          if (r < best) {
-            best = r;
+          const double refined_residual = residual(lcp_, refined.z);
+          if (refined_residual < best) {
+            best = refined_residual;
             end.z = refined.z;
           }
         }

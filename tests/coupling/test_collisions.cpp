@@ -309,6 +309,8 @@ TEST_CASE("FloeDyn's 100-floe example stays close to FloeDyn's own output") {
     for (std::size_t i = 0; i < sim.floes().size(); ++i)
       c += sim.floes().mass[i] * Vec2{sim.floes().state[i].x, sim.floes().state[i].y};
     c /= mass;
+    MESSAGE("t " << v[0] << " s: energy " << e.values[0] << " J (FloeDyn " << v[1] << "), mass centre " << c.transpose()
+                 << " m (FloeDyn " << v[2] << " " << v[3] << "), " << (c - Vec2{v[2], v[3]}).norm() << " m apart");
     CHECK(e.values[0] == doctest::Approx(v[1]).epsilon(0.03));
     CHECK((c - Vec2{v[2], v[3]}).norm() < 3.0);
     ++compared;
