@@ -201,6 +201,48 @@ std::string pack_file(const std::string& name, std::size_t n, double conc, doubl
 }
 }  // namespace
 
+TEST_CASE("multirate: a collision within a step happens at its instant, the step is not cut, a far floe moves in one go") {
+  // Two equal 10 m squares close at 1 m/s across a 5 m gap, so they meet about 5 s into one
+  // 10 s step; a third floe 1 km away drifts at 0.1 m/s. No drag, wind or Coriolis: velocities
+  // are constant between impacts. Poisson's law, head-on (e = 0.4): they leave at -+0.2 m/s.
+  // The sub-step limit (contact/step_limit.hpp) lets the gap close to keep = xi/2 and the impact
+  // is resolved there, at t_c = 5 - xi/2 (any instant with the gap in [xi/2, xi] would be a
+  // valid event: t_c in [5 - xi, 5 - xi/2]). Analytic end positions: A's centre (at 0 at t = 0)
+  // x_A = 0.5 t_c - 0.2 (10 - t_c), the gap xi/2 + 0.4 (10 - t_c), and the far floe moved
+  // exactly 0.1 * 10 m.
+  std::ostringstream t;
+  t << "[run]\ndt_max = 10\n[contact]\nrestitution = 0.4\nfriction = 0.7\ncollision_distance = 0.01\n"
+    << "[forcing]\nocean_drag = 0\nair_drag = 0\n"
+    << "[[floes.floe]]\nvertices = [[-5.0, -5.0], [5.0, -5.0], [5.0, 5.0], [-5.0, 5.0]]\nvelocity = [0.5, 0.0]\n"
+    << "[[floes.floe]]\nvertices = [[10.0, -5.0], [20.0, -5.0], [20.0, 5.0], [10.0, 5.0]]\nvelocity = [-0.5, 0.0]\n"
+    << "[[floes.floe]]\nvertices = [[1000.0, 0.0], [1010.0, 0.0], [1010.0, 10.0], [1000.0, 10.0]]\n"
+    << "velocity = [0.1, 0.0]\n";
+  Simulation sim(build_scenario(parse_config(t.str(), "multirate.toml", ".")));
+  const Vec2 p0 = sim.momentum();
+  const double far_x0 = sim.floes().state[2].x;
+  const double dt = sim.step(10.0);
+  CHECK(dt == 10.0);  // one step: the collision did not cut it
+  const auto& st = sim.floes().state;
+  CHECK(st[0].vx == doctest::Approx(-0.2).epsilon(1e-9));
+  CHECK(st[1].vx == doctest::Approx(0.2).epsilon(1e-9));
+  CHECK((sim.momentum() - p0).norm() < 1e-9 * sim.floes().mass[0]);
+  const double xi = 0.01;
+  const double earliest = 0.5 * (5 - xi) - 0.2 * (10 - (5 - xi));
+  const double latest = 0.5 * (5 - 0.5 * xi) - 0.2 * (10 - (5 - 0.5 * xi));
+  MESSAGE("A's centre at 10 s: " << st[0].x << " m (analytic " << earliest << " to " << latest << " m)");
+  CHECK(st[0].x >= earliest - 1e-9);
+  CHECK(st[0].x <= latest + 1e-9);
+  CHECK(st[1].x - st[0].x == doctest::Approx(10.0 + 0.5 * xi + 0.4 * (10 - (5 - 0.5 * xi))).epsilon(1e-9));
+  CHECK(st[2].x - far_x0 == doctest::Approx(1.0).epsilon(1e-12));  // the far floe: one linear move
+  const contact::SubstepReport& r = sim.substep_report();
+  CHECK(r.clusters == 1);      // only the colliding pair was sub-stepped
+  CHECK(r.largest_cluster == 2);
+  CHECK(r.substeps >= 2);      // up to the impact, then on to the end of the step
+  CHECK(sim.collision_stats().failures == 0);
+  CHECK(sim.warnings().empty());
+  for (const auto& p : sim.detection().pairs) CHECK_FALSE(p.overlap);
+}
+
 TEST_CASE("a dense periodic pack: collisions conserve momentum, floes never overlap") {
   // Newton's third law: impulses between floes cancel, so with no forcing and no obstacle the
   // pack's momentum stays as it was while hundreds of collisions happen across the seams too.
