@@ -55,7 +55,10 @@ void add_info_command(CLI::App& app, Registry& registry) {
         else o << "null";
       }
       o << "},\n  \"lcp\": {\"solves\": " << r.lcp_last[0] << ", \"pivots\": " << r.lcp_last[1]
-        << ", \"failures\": " << r.lcp_last[2] << ", \"fallbacks\": " << r.lcp_last[3] << "},\n  \"datasets\": {";
+        << ", \"failures\": " << r.lcp_last[2] << ", \"fallbacks\": " << r.lcp_last[3] << "},\n  \"substeps\": {";
+      for (int k = 0; k < kSubstepColumns; ++k)
+        o << (k ? ", " : "") << json_string(kSubstepColumnNames[k]) << ": " << r.substeps_last[static_cast<std::size_t>(k)];
+      o << "},\n  \"datasets\": {";
       for (std::size_t k = 0; k < r.datasets.size(); ++k)
         o << (k ? ", " : "") << json_string(r.datasets[k].first) << ": " << shape(r.datasets[k].second);
       o << "}";
@@ -71,6 +74,8 @@ void add_info_command(CLI::App& app, Registry& registry) {
       o << "energy." << r.energy_columns[k] << ": " << r.energy_last[k] << " J\n";
     o << "lcp.solves: " << r.lcp_last[0] << "\nlcp.pivots: " << r.lcp_last[1] << "\nlcp.failures: " << r.lcp_last[2]
       << "\nlcp.fallbacks: " << r.lcp_last[3] << "\n";
+    for (int k = 0; k < kSubstepColumns; ++k)
+      o << "substeps." << kSubstepColumnNames[k] << ": " << r.substeps_last[static_cast<std::size_t>(k)] << "\n";
     for (const auto& [p, d] : r.datasets) o << "dataset: " << p << " " << shape(d) << "\n";
     if (args->config) o << "config:\n" << r.config << "\n";
     return 0;

@@ -124,6 +124,11 @@ void add_run_command(CLI::App& app, Registry& registry) {
     o << "collisions.lcps: " << c.lcps << "\ncollisions.contacts: " << c.contacts << "\ncollisions.pivots: " << c.pivots
       << "\ncollisions.largest_lcp: " << c.largest << "\ncollisions.failures: " << c.failures
       << "\ncollisions.fallbacks: " << c.fallbacks << "\n";
+    {
+      const LcpCounters counters = sim.lcp_counters();  // the sub-stepper's counts, as in /diagnostics/substeps
+      for (int k = 0; k < kSubstepColumns; ++k)
+        o << "substeps." << kSubstepColumnNames[k] << ": " << counters.substeps[static_cast<std::size_t>(k)] << "\n";
+    }
     if (const PercussionStats* f = sim.percussion_stats())
       o << "fracture.checks: " << f->checks << "\nfracture.screened: " << f->screened
         << "\nfracture.initiations: " << f->initiations << "\nfracture.splits: " << f->splits << "\n";

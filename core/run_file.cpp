@@ -17,7 +17,7 @@ namespace fs = std::filesystem;
 
 struct RunWriter::Impl {
   std::string path;
-  h5::Handle file, floes_group, xdmf_group, time, state, energy, lcp, verts, eta, events;
+  h5::Handle file, floes_group, xdmf_group, time, state, energy, lcp, substeps, verts, eta, events;
   std::size_t n = 0, nverts = 0, records = 0;  // floes (numbers) and vertices in the /floes tables
   // The /floes tables, one row per floe number, and the XDMF topology.
   std::vector<long long> offsets{0}, topology;
@@ -90,6 +90,9 @@ RunWriter::RunWriter(const std::string& path, const Floes& floes, const std::str
   h5::set_attr(w.energy, "units", std::string("J"));
   w.lcp = h5::create_extendible(d, "lcp", {4}, rows);
   h5::set_attr(w.lcp, "columns", std::vector<std::string>{"solves", "pivots", "failures", "fallbacks"});
+  w.substeps = h5::create_extendible(d, "substeps", {kSubstepColumns}, rows);
+  h5::set_attr(w.substeps, "columns",
+               std::vector<std::string>(std::begin(kSubstepColumnNames), std::end(kSubstepColumnNames)));
 
   h5::Handle ev = h5::create_group(w.file, "/events");
   w.events = h5::create_extendible(ev, "fracture", {kFractureEventColumns});
@@ -171,6 +174,7 @@ void RunWriter::record(double t, const Floes& floes, std::span<const double> ene
   h5::append_row(w.energy, energy.data());
   const double l[4] = {lcp.solves, lcp.pivots, lcp.failures, lcp.fallbacks};
   h5::append_row(w.lcp, l);
+  h5::append_row(w.substeps, lcp.substeps.data());
   w.scratch.assign(3 * w.nverts, std::nan(""));
   for (std::size_t i = 0; i < floes.size(); ++i) {
     std::size_t k = static_cast<std::size_t>(w.offsets[id_of(floes, i)]);
@@ -335,6 +339,11 @@ RunInfo read_run_info(const std::string& path) {
   if (r.records && k && ev.size() >= k) r.energy_last.assign(ev.end() - static_cast<long>(k), ev.end());
   const auto lv = h5::read_doubles(h5::open_dataset(f, "/diagnostics/lcp", path), path + ": /diagnostics/lcp");
   if (lv.size() >= 4) for (int c = 0; c < 4; ++c) r.lcp_last[static_cast<std::size_t>(c)] = lv[lv.size() - 4 + static_cast<std::size_t>(c)];
+  if (h5::exists(f, "/diagnostics/substeps")) {  // absent in files written before it existed
+    const auto sv = h5::read_doubles(h5::open_dataset(f, "/diagnostics/substeps", path), path + ": /diagnostics/substeps");
+    if (sv.size() >= kSubstepColumns)
+      std::copy(sv.end() - kSubstepColumns, sv.end(), r.substeps_last.begin());
+  }
   for (const std::string& p : dataset_paths(f)) {
     auto d = h5::dims(h5::open_dataset(f, p, path));
     r.datasets.emplace_back(p, std::vector<unsigned long long>(d.begin(), d.end()));

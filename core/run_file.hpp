@@ -21,6 +21,9 @@
 //   /sea/x [nx], /sea/y [ny], /sea/eta [T, ny, nx] (dims 2) or [T, nx] (dims 1)
 //   /diagnostics/energy [T, k] (columns attribute; the last column is "total")
 //   /diagnostics/lcp [T, 4]: solves, pivots, failures, fallbacks (cumulative)
+//   /diagnostics/substeps [T, 9] (columns attribute, kSubstepColumnNames):
+//     the collision sub-stepper's counts (contact/substep.hpp), cumulative
+//     except largest_cluster (the largest so far)
 //   /xdmf/vertices [T, V, 3]: world vertex positions (x, y, heave) for ParaView
 //   /xdmf/topology [E]: XDMF mixed-polygon connectivity
 
@@ -63,8 +66,14 @@ inline constexpr const char* kFractureEventColumnNames[kFractureEventColumns] = 
     "time", "floe", "x", "y", "direction", "load", "stress", "x0", "y0", "x1", "y1",
     "criterion", "energy_released", "energy_needed", "delay", "piece_a", "piece_b"};
 
+inline constexpr int kSubstepColumns = 9;
+inline constexpr const char* kSubstepColumnNames[kSubstepColumns] = {
+    "clusters", "substeps", "time_steps", "largest_cluster", "joined", "merges", "rejected", "floor_steps",
+    "rebuilt"};
+
 struct LcpCounters {
   double solves = 0, pivots = 0, failures = 0, fallbacks = 0;  // cumulative
+  std::array<double, kSubstepColumns> substeps{};  // /diagnostics/substeps, kSubstepColumnNames
 };
 
 class RunWriter {
@@ -111,6 +120,7 @@ struct RunInfo {
   std::vector<std::string> energy_columns;
   std::vector<double> energy_last;      // last record
   std::array<double, 4> lcp_last{};     // solves, pivots, failures, fallbacks
+  std::array<double, kSubstepColumns> substeps_last{};  // kSubstepColumnNames (0 for files without them)
   std::vector<std::pair<std::string, std::vector<unsigned long long>>> datasets;  // path, shape
 };
 RunInfo read_run_info(const std::string& path);

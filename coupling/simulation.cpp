@@ -373,8 +373,15 @@ Energies Simulation::energies() const {
 }
 
 LcpCounters Simulation::lcp_counters() const {
-  return {static_cast<double>(stats_.lcps), static_cast<double>(stats_.pivots),
-          static_cast<double>(stats_.failures), static_cast<double>(stats_.fallbacks)};
+  LcpCounters c{static_cast<double>(stats_.lcps), static_cast<double>(stats_.pivots),
+                static_cast<double>(stats_.failures), static_cast<double>(stats_.fallbacks), {}};
+  const contact::SubstepReport& s = substeps_;  // in the order of kSubstepColumnNames
+  c.substeps = {static_cast<double>(s.clusters),        static_cast<double>(s.substeps),
+                static_cast<double>(s.time_steps),      static_cast<double>(s.largest_cluster),
+                static_cast<double>(s.joined),          static_cast<double>(s.merges),
+                static_cast<double>(s.rejected),        static_cast<double>(s.floor_steps),
+                static_cast<double>(s.rebuilt)};
+  return c;
 }
 
 std::vector<std::string> Simulation::warnings() const {

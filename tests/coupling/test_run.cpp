@@ -3,6 +3,7 @@
 
 #include <hdf5.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -152,3 +153,46 @@ TEST_CASE("a wave-only run writes the sea elevation and keeps the sea's energy")
 }
 
 TEST_SUITE_END();
+
+TEST_CASE("the run file and floesim info hold the collision sub-stepper's counts") {
+  // Two 10 m squares close at 1 m/s across a 5 m gap and meet within the first 10 s step (the
+  // multirate case of test_collisions.cpp): one cluster of 2 floes, sub-stepped up to the impact
+  // and on to the end of the step; the second step has no collision. /diagnostics/substeps must
+  // hold, at each record, the counts Simulation::substep_report() had then.
+  const std::string out = (fs::temp_directory_path() / "floesim_substeps.h5").string();
+  const std::string text =
+      "[run]\nt_end = 20\ndt_max = 10\noutput_interval = 10\n"
+      "[contact]\nrestitution = 0.4\nfriction = 0.7\ncollision_distance = 0.01\n"
+      "[forcing]\nocean_drag = 0\nair_drag = 0\n"
+      "[[floes.floe]]\nvertices = [[-5.0, -5.0], [5.0, -5.0], [5.0, 5.0], [-5.0, 5.0]]\nvelocity = [0.5, 0.0]\n"
+      "[[floes.floe]]\nvertices = [[10.0, -5.0], [20.0, -5.0], [20.0, 5.0], [10.0, 5.0]]\nvelocity = [-0.5, 0.0]\n";
+  Simulation sim(build_scenario(parse_config(text, "substeps.toml", ".")));
+  const RunSummary s = run_simulation(sim, {out, -1.0, {}, {}});
+  REQUIRE(s.status == "complete");
+  const contact::SubstepReport& r = sim.substep_report();
+  REQUIRE(r.clusters == 1);
+  REQUIRE(r.substeps >= 2);
+
+  const RunDataset d = read_run_dataset(out, "/diagnostics/substeps");
+  REQUIRE(d.shape == std::vector<unsigned long long>{3, kSubstepColumns});  // t = 0, 10, 20
+  REQUIRE(d.columns == std::vector<std::string>(std::begin(kSubstepColumnNames), std::end(kSubstepColumnNames)));
+  auto at = [&](std::size_t record, const std::string& column) {
+    const auto c = std::find(d.columns.begin(), d.columns.end(), column) - d.columns.begin();
+    return d.values[record * kSubstepColumns + static_cast<std::size_t>(c)];
+  };
+  for (const std::string& c : d.columns) CHECK(at(0, c) == 0.0);  // nothing before the first step
+  CHECK(at(1, "clusters") == 1.0);
+  CHECK(at(1, "largest_cluster") == 2.0);
+  CHECK(at(1, "substeps") == static_cast<double>(r.substeps));
+  CHECK(at(2, "clusters") == static_cast<double>(r.clusters));  // the second step added none
+  CHECK(at(2, "substeps") == static_cast<double>(r.substeps));
+  CHECK(at(2, "time_steps") == static_cast<double>(r.time_steps));
+  CHECK(at(2, "merges") == static_cast<double>(r.merges));
+  CHECK(at(2, "floor_steps") == 0.0);
+
+  // floesim info reads the last record.
+  const RunInfo info = read_run_info(out);
+  CHECK(info.substeps_last[0] == 1.0);
+  CHECK(info.substeps_last[1] == static_cast<double>(r.substeps));
+  CHECK(info.substeps_last[3] == 2.0);
+}
