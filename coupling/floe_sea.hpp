@@ -134,6 +134,9 @@ public:
 
 private:
   double weak_coefficient(const Floes& floes, std::size_t i) const;
+  // psi(Phi) = 1 / (1 + K (1 - Phi)): the sub-cell weight of a cell covered
+  // to the share Phi (the header's "Partly covered cells").
+  double subcell_weight(double coverage) const;
   Eigen::Matrix2d tilt_inertia(const Floes& floes, std::size_t i) const;
 
   double rho_ = 1025.0, g_ = 9.81, sigma_ = 0.0, K_ = 1000.0, s_ = 1.0, kappa_ = 0.0;
@@ -148,6 +151,8 @@ private:
   Footprints footprints_;
   std::vector<FloeSeaLoad> loads_;
   std::vector<double> pressure_;
+  std::vector<double> coverage_;  // Phi_c: the share of cell c under floes
+  std::vector<double> cell_sum_;  // sum over the pieces in cell c of a_k [delta_k]^+^2
   bool pressure_kicked_ = false;  // the sea's last kick was with pressure_ as it is
   double penalty_energy_ = 0.0;
   std::vector<std::string> notes_;
