@@ -108,7 +108,9 @@ void FloeSeaContact::floes_changed(const Floes& floes) {
     const double gyration = std::sqrt(std::max(eig.eigenvalues()[0], 0.0));
     if (gyration >= 0.5 * std::max(grid_.dx(), grid_.dims == 2 ? grid_.dy() : 0.0))
       tilt_[i] = grid_.dims == 2 ? 2 : 1;
-    if (i >= old) bottom0_[i] = -floes.draft(i, rho_) * (1.0 + 1.0 / K_);
+    // A new floe (a piece of a split) floats at its draft (and compliance)
+    // below the calm sea's free level, as its parent did.
+    if (i >= old) bottom0_[i] = free_level_ - floes.draft(i, rho_) * (1.0 + 1.0 / K_);
     if (dynamic_[i]) min_mass_per_area = std::min(min_mass_per_area, rh);
   }
   stable_step_ = INFINITY;
@@ -137,6 +139,7 @@ void FloeSeaContact::start(Floes& floes, fluid::Sea& sea, bool given) {
   pressure_kicked_ = false;
   build_footprints(floes, dynamic_, grid, footprints_);
   if (given) {
+    free_level_ = 0.0;
     for (std::size_t i = 0; i < n; ++i) bottom0_[i] = -floes.draft(i, rho_) * (1.0 + 1.0 / K_);
     return;
   }
@@ -208,6 +211,7 @@ void FloeSeaContact::start(Floes& floes, fluid::Sea& sea, bool given) {
     return mean;
   };
   const double calm_level = solve(std::vector<double>(grid.size(), 0.0));
+  free_level_ = -calm_level;  // the free water's level once eta has zero mean
   for (std::size_t i = 0; i < n; ++i)
     if (dynamic_[i]) bottom0_[i] = z[i] - calm_level;
   // The waves in the sea: the floes start from the least-squares plane of the

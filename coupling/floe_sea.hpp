@@ -146,6 +146,7 @@ private:
   std::vector<std::uint8_t> dynamic_;
   std::vector<std::uint8_t> tilt_;           // slopes resisted: 0 none, 1 pitch, 2 pitch and roll
   std::vector<double> bottom0_;             // z0_i, m
+  double free_level_ = 0.0;                 // the calm sea's free level (m; eta has zero mean)
   std::vector<Eigen::Matrix2d> body_moments_;  // rho h ∫ r r^T in the body frame
   Footprints footprints_;
   std::vector<FloeSeaLoad> loads_;
