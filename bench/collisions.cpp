@@ -14,6 +14,11 @@
 //                C_w 5e-3, C_a 1.7e-3, rho_a 1.341), to 10^3 s. The pack is
 //                written once to a temporary pack file and read through the
 //                [floes] pack key, like a user's run.
+//   jam_N        N = 100, 500 floes at rest covering 50% of a 1 km box walled
+//                on all sides, wind 15 m/s along x (the jam test of
+//                tests/coupling: the pack drifts ~500 m, jams against the
+//                downwind wall and stays there), to 10^4 s (100) / 3 10^3 s
+//                (500). Not part of the cost-vs-N fit.
 //
 // Per scenario: a warm-up run (to 10% of the simulated time), then R timed
 // runs (each a fresh Simulation; the minimum wall time is kept, the median is
@@ -66,6 +71,7 @@ struct BenchScenario {
   std::size_t floes = 0;      // 0: FloeDyn's example
   double t_end = 0.0;         // s simulated
   double floedyn_s = -1.0;    // FloeDyn, one core of this machine kind (issue 4); < 0: unknown
+  bool jam = false;           // a walled pack pushed by the wind against the downwind wall
 };
 
 const std::vector<BenchScenario> kScenarios = {
@@ -73,6 +79,8 @@ const std::vector<BenchScenario> kScenarios = {
     {"pack_500", 500, 1.0e3, 24.6},
     {"pack_2000", 2000, 1.0e3, 204.0},
     {"pack_10000", 10000, 1.0e3, -1.0},
+    {"jam_100", 100, 1.0e4, -1.0, true},
+    {"jam_500", 500, 3.0e3, -1.0, true},
 };
 
 constexpr double kMeanDiameter = 100.0;  // m
@@ -90,8 +98,27 @@ double box_side(std::size_t n) {
   return std::sqrt(static_cast<double>(n) * mean_area / kConcentration);
 }
 
+// The pack of a jam_N scenario: N floes at rest covering 50% of a 1 km box
+// walled on all sides (20 m walls), default sizes and thickness (1 m) as in
+// the jam test of tests/coupling/test_collisions.cpp.
+std::string write_jam_pack(const BenchScenario& s, const std::string& dir) {
+  PackOptions o;
+  o.floes = s.floes;
+  o.concentration = kConcentration;
+  o.width = o.height = 1000.0;
+  o.seed = 11;
+  o.wall_width = 20.0;
+  GeneratedPack pack = generate_pack(o);
+  write_pack(pack_file(dir, s), pack.floes, pack.window);
+  std::ostringstream m;
+  m << s.name << ": walled box " << o.width << " m, mean diameter " << pack.mean_size << " m, cover "
+    << pack.concentration << ", min gap " << pack.min_gap << " m";
+  return m.str();
+}
+
 // Generates the pack of a pack_N scenario and writes it; returns a one-line description.
 std::string write_scenario_pack(const BenchScenario& s, const std::string& dir) {
+  if (s.jam) return write_jam_pack(s, dir);
   PackOptions o;
   o.floes = s.floes;
   o.concentration = kConcentration;
@@ -123,6 +150,12 @@ std::string write_scenario_pack(const BenchScenario& s, const std::string& dir) 
 Config scenario_config(const BenchScenario& s, const std::string& pack_dir) {
   if (s.floes == 0) return load_config(std::string(FLOESIM_BENCH_SOURCE_DIR) + "/examples/floedyn_100.toml");
   std::ostringstream t;
+  if (s.jam) {
+    t << "[run]\nt_end = " << s.t_end << "\ndt_max = 10.0\noutput_interval = 60.0\n"
+      << "[floes]\npack = \"" << pack_file(pack_dir, s) << "\"\n"
+      << "[contact]\nrestitution = 0.4\nfriction = 0.7\n[forcing]\nwind = [15.0, 0.0]\n";
+    return parse_config(t.str(), s.name, pack_dir);
+  }
   t << "[run]\nt_end = " << s.t_end << "\ndt_max = 10.0\noutput_interval = 60.0\n"
     << "[sea]\nmodel = \"none\"\nrho = 1024.071\n"
     << "[floes]\npack = \"" << pack_file(pack_dir, s) << "\"\ndensity = 917.0\n"
@@ -140,6 +173,8 @@ struct RunResult {
   double setup = 0.0;      // s: Simulation construction (shapes, quadrature, first detection)
   std::size_t steps = 0;
   contact::CollisionStats stats;
+  contact::SubstepReport substeps;
+  long rejected_steps = 0;
   Profile profile;
   std::vector<std::string> warnings;
 };
@@ -182,6 +217,8 @@ RunResult run_once(const Config& config, double t_end, double time_limit) {
     r.simulated = sim.time();
     r.steps = sim.steps();
     r.stats = sim.collision_stats();
+    r.substeps = sim.substep_report();
+    r.rejected_steps = sim.rejected_steps();
     r.profile = sim.profile();
     r.warnings = sim.warnings();
   } catch (const std::exception& e) {  // construction (e.g. floes overlapping at t = 0)
@@ -272,7 +309,7 @@ int main(int argc, char** argv) {
   std::string csv, child, pack_dir_arg;
   app.add_option("--repeats", repeats, "timed runs per scenario after the warm-up (minimum kept)")
       ->check(CLI::PositiveNumber);
-  app.add_option("--repeats-large", repeats_large, "timed runs for scenarios of 10^4 floes or more")
+  app.add_option("--repeats-large", repeats_large, "timed runs for scenarios of 10^4 floes or more, and jam_500")
       ->check(CLI::PositiveNumber);
   app.add_option("--only", only, "scenarios to run (default: all)");
   app.add_option("--csv", csv, "write the results as CSV to this file");
@@ -329,7 +366,7 @@ int main(int argc, char** argv) {
     const Config config = scenario_config(s, pack_dir);
     Row row;
     row.scenario = &s;
-    row.repeats = s.floes >= 10000 ? repeats_large : repeats;
+    row.repeats = s.floes >= 10000 || (s.jam && s.floes >= 500) ? repeats_large : repeats;
     const RunResult warm = run_once(config, 0.1 * s.t_end, time_limit);
     std::vector<double> walls;
     if (warm.status != "ok") {
@@ -349,9 +386,13 @@ int main(int argc, char** argv) {
     row.peak_rss_mb = child_peak_rss_mb({self, "--child", s.name, "--pack-dir", pack_dir, "--time-limit",
                                          std::to_string(time_limit)});
     const RunResult& b = row.best;
-    std::printf("# %s: %s, %zu floes, t = %g s, wall %.3f s (min of %d), %zu steps, %ld LCPs, peak %.1f MiB\n",
-                s.name.c_str(), b.status.c_str(), b.floes, b.simulated, b.wall, row.repeats, b.steps, b.stats.lcps,
-                row.peak_rss_mb);
+    std::printf("# %s: %s, %zu floes, t = %g s, wall %.3f s (min of %d), %zu steps (%ld redone), %ld LCPs, peak %.1f MiB\n"
+                "#   %ld clusters, %ld sub-steps, largest %ld floes, %ld joined, %ld merges, %ld sub-steps redone, "
+                "%ld at the floor, %ld pair lists rebuilt\n",
+                s.name.c_str(), b.status.c_str(), b.floes, b.simulated, b.wall, row.repeats, b.steps, b.rejected_steps,
+                b.stats.lcps, row.peak_rss_mb, b.substeps.clusters, b.substeps.substeps, b.substeps.largest_cluster,
+                b.substeps.joined, b.substeps.merges, b.substeps.rejected, b.substeps.floor_steps,
+                b.substeps.rebuilt);
     for (const std::string& w : b.warnings) std::printf("#   warning: %s\n", w.c_str());
     std::fflush(stdout);
     rows.push_back(std::move(row));
@@ -361,16 +402,19 @@ int main(int argc, char** argv) {
   // Table and CSV.
   std::ostringstream out;
   out << "scenario,status,floes,simulated_s,repeats,wall_s,wall_s_median,setup_s,steps,lcps,pivots,failures,"
-         "fallbacks,contacts,largest_lcp,peak_rss_mb,floedyn_s,speedup";
+         "fallbacks,contacts,largest_lcp,rejected_steps,clusters,substeps,largest_cluster,joined,merges,"
+         "rejected_substeps,floor_substeps,pairs_rebuilt,peak_rss_mb,floedyn_s,speedup";
   for (const char* p : kPhaseNames) out << "," << p << "_s";
   out << "\n";
   for (const Row& row : rows) {
     const RunResult& b = row.best;
     char buf[512];
-    std::snprintf(buf, sizeof buf, "%s,%s,%zu,%g,%d,%.3f,%.3f,%.4f,%zu,%ld,%ld,%ld,%ld,%ld,%ld,%.1f,", row.scenario->name.c_str(),
-                  csv_field(b.status).c_str(), b.floes, b.simulated, row.repeats, b.wall, row.wall_median, b.setup,
-                  b.steps, b.stats.lcps, b.stats.pivots, b.stats.failures, b.stats.fallbacks, b.stats.contacts,
-                  b.stats.largest, row.peak_rss_mb);
+    const contact::SubstepReport& sr = b.substeps;
+    std::snprintf(buf, sizeof buf, "%s,%s,%zu,%g,%d,%.3f,%.3f,%.4f,%zu,%ld,%ld,%ld,%ld,%ld,%ld,%ld,%ld,%ld,%ld,%ld,%ld,%ld,%ld,%ld,%.1f,",
+                  row.scenario->name.c_str(), csv_field(b.status).c_str(), b.floes, b.simulated, row.repeats, b.wall,
+                  row.wall_median, b.setup, b.steps, b.stats.lcps, b.stats.pivots, b.stats.failures, b.stats.fallbacks,
+                  b.stats.contacts, b.stats.largest, b.rejected_steps, sr.clusters, sr.substeps, sr.largest_cluster,
+                  sr.joined, sr.merges, sr.rejected, sr.floor_steps, sr.rebuilt, row.peak_rss_mb);
     out << buf;
     if (row.scenario->floedyn_s > 0 && b.status == "ok") {
       std::snprintf(buf, sizeof buf, "%.1f,%.1f", row.scenario->floedyn_s, row.scenario->floedyn_s / b.wall);
@@ -414,7 +458,7 @@ int main(int argc, char** argv) {
   // Scaling of the cost per simulated second with N, from the pack cases that completed.
   std::vector<double> n, cost;
   for (const Row& row : rows)
-    if (row.scenario->floes > 0 && row.best.status == "ok" && row.best.simulated > 0) {
+    if (row.scenario->floes > 0 && !row.scenario->jam && row.best.status == "ok" && row.best.simulated > 0) {
       n.push_back(static_cast<double>(row.best.floes));
       cost.push_back(row.best.wall / row.best.simulated);
     }

@@ -8,13 +8,6 @@ namespace floesim::contact {
 
 namespace {
 
-struct Box {
-  double xmin, xmax, ymin, ymax;
-  bool overlaps(const Box& o) const {
-    return xmin <= o.xmax && o.xmin <= xmax && ymin <= o.ymax && o.ymin <= ymax;
-  }
-};
-
 Box box_of(std::span<const Vec2> v, double pad) {
   Box b{std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity(),
         std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity()};
@@ -75,77 +68,251 @@ Separation separation(std::span<const Vec2> a, std::span<const Vec2> b) {
   return best;
 }
 
-// Distance between two convex polygons with the closest points; 0 and
-// overlap = true when they intersect.
-struct ConvexDistance {
-  double distance = 0.0;
-  Vec2 pa = Vec2::Zero(), pb = Vec2::Zero();
-  bool overlap = false;
-};
-
-ConvexDistance distance_of(std::span<const Vec2> a, std::span<const Vec2> b) {
-  ConvexDistance r;
-  if (!(separation(a, b).gap > 0.0)) {
-    r.overlap = true;
-    r.pa = r.pb = a[0];
-    return r;
-  }
-  r.distance = std::numeric_limits<double>::infinity();
-  for (const Vec2& v : a) {
-    const Vec2 c = closest_on_boundary(b, v);
-    const double d = (c - v).norm();
-    if (d < r.distance) { r.distance = d; r.pa = v; r.pb = c; }
-  }
-  for (const Vec2& v : b) {
-    const Vec2 c = closest_on_boundary(a, v);
-    const double d = (c - v).norm();
-    if (d < r.distance) { r.distance = d; r.pa = c; r.pb = v; }
-  }
-  return r;
-}
-
 struct Entry {
   Box box;
   std::uint32_t floe;
   Vec2 shift;
 };
 
+struct Candidate {
+  std::uint32_t a, b;  // a < b
+  Vec2 shift;          // of b
+};
+
+// Pairs of entries whose boxes overlap, through a uniform grid: each box is
+// listed in the cells it covers (cell side: the mean box size, so a box
+// covers about four), the (cell, entry) list is sorted by cell, and within a
+// cell a pair is reported only if the cell holds the lower-left corner of the
+// two boxes' intersection, so once. O(n) for a pack (counting sort), O(n log n)
+// for floes spread over an open domain (cells hashed by sorting), with a
+// bounded number of boxes per cell (a sweep along one axis grows as n^1.5).
+std::vector<Candidate> broad_phase(const std::vector<Entry>& entries, const std::vector<std::uint8_t>& is_static) {
+  std::vector<Candidate> out;
+  if (entries.empty()) return out;
+  double size = 0.0, x0 = entries[0].box.xmin, y0 = entries[0].box.ymin, x1 = x0, y1 = y0;
+  for (const Entry& e : entries) {
+    size += std::max(e.box.xmax - e.box.xmin, e.box.ymax - e.box.ymin);
+    x0 = std::min(x0, e.box.xmin);
+    y0 = std::min(y0, e.box.ymin);
+    x1 = std::max(x1, e.box.xmax);
+    y1 = std::max(y1, e.box.ymax);
+  }
+  const double h = std::max(size / static_cast<double>(entries.size()), 1e-9);
+  auto cell = [&](double v, double v0) { return static_cast<std::int64_t>(std::floor((v - v0) / h)); };
+  // A pack's grid has about as many cells as floes: its cells are numbered
+  // row by row and the items ordered by a counting sort, O(n). A grid with
+  // many more cells than items (floes far apart in an open domain) is hashed
+  // by sorting instead, so empty cells cost nothing. Both give the same order.
+  const double cells = (static_cast<double>(cell(x1, x0)) + 1.0) * (static_cast<double>(cell(y1, y0)) + 1.0);
+  const bool dense = cells <= 8.0 * static_cast<double>(entries.size());
+  const std::int64_t row = dense ? cell(x1, x0) + 1 : std::int64_t{1} << 31;
+  struct Item {
+    std::int64_t key;
+    std::uint32_t entry;
+  };
+  std::vector<Item> items;
+  items.reserve(4 * entries.size());
+  for (std::uint32_t e = 0; e < entries.size(); ++e) {
+    const Box& b = entries[e].box;
+    for (std::int64_t cy = cell(b.ymin, y0); cy <= cell(b.ymax, y0); ++cy)
+      for (std::int64_t cx = cell(b.xmin, x0); cx <= cell(b.xmax, x0); ++cx) items.push_back({cy * row + cx, e});
+  }
+  if (dense) {
+    // Items were made in entry order, so each cell's stay in entry order.
+    std::vector<std::uint32_t> first(static_cast<std::size_t>(cells) + 1, 0);
+    for (const Item& it : items) ++first[static_cast<std::size_t>(it.key) + 1];
+    for (std::size_t c = 1; c < first.size(); ++c) first[c] += first[c - 1];
+    std::vector<Item> sorted(items.size());
+    for (const Item& it : items) sorted[first[static_cast<std::size_t>(it.key)]++] = it;
+    items.swap(sorted);
+  } else {
+    std::sort(items.begin(), items.end(), [](const Item& p, const Item& q) {
+      return p.key != q.key ? p.key < q.key : p.entry < q.entry;
+    });
+  }
+  for (std::size_t first = 0; first < items.size();) {
+    std::size_t last = first;
+    while (last < items.size() && items[last].key == items[first].key) ++last;
+    const std::int64_t key = items[first].key;
+    for (std::size_t i = first; i < last; ++i) {
+      const Entry& p = entries[items[i].entry];
+      for (std::size_t j = i + 1; j < last; ++j) {
+        const Entry& q = entries[items[j].entry];
+        if (p.floe == q.floe || !p.box.overlaps(q.box)) continue;
+        if (is_static[p.floe] && is_static[q.floe]) continue;
+        const std::int64_t owner = cell(std::max(p.box.ymin, q.box.ymin), y0) * row +
+                                   cell(std::max(p.box.xmin, q.box.xmin), x0);
+        if (owner != key) continue;
+        // Canonical order a < b, with b shifted relative to a.
+        if (p.floe < q.floe) out.push_back({p.floe, q.floe, q.shift - p.shift});
+        else out.push_back({q.floe, p.floe, p.shift - q.shift});
+      }
+    }
+    first = last;
+  }
+  return out;
+}
+
+Box shifted_box(Box b, const Vec2& s) {
+  b.xmin += s.x(); b.xmax += s.x(); b.ymin += s.y(); b.ymax += s.y();
+  return b;
+}
+
 }  // namespace
+
+PosedShapes::PosedShapes(const Floes& floes, const CollisionShapes& shapes)
+    : shapes_(&shapes), world_(shapes.vertices.size()), part_box_(shapes.vertex_offsets.size() - 1),
+      floe_box_(floes.size()) {
+  for (std::size_t i = 0; i < floes.size(); ++i) update(floes, i);
+}
+
+void PosedShapes::update(const Floes& floes, std::size_t i) {
+  const CollisionShapes& shapes = *shapes_;
+  const FloeState& s = floes.state[i];
+  const double c = std::cos(s.yaw), sn = std::sin(s.yaw);
+  Box fb = box_of({}, 0.0);
+  for (std::size_t p = shapes.part_offsets[i]; p < shapes.part_offsets[i + 1]; ++p) {
+    for (std::size_t k = shapes.vertex_offsets[p]; k < shapes.vertex_offsets[p + 1]; ++k) {
+      const Vec2& b = shapes.vertices[k];
+      world_[k] = {s.x + c * b.x() - sn * b.y(), s.y + sn * b.x() + c * b.y()};
+    }
+    part_box_[p] = box_of(part(p), 0.0);
+    fb.xmin = std::min(fb.xmin, part_box_[p].xmin);
+    fb.xmax = std::max(fb.xmax, part_box_[p].xmax);
+    fb.ymin = std::min(fb.ymin, part_box_[p].ymin);
+    fb.ymax = std::max(fb.ymax, part_box_[p].ymax);
+  }
+  floe_box_[i] = fb;
+}
+
+double exact_range(const Floes& floes, const CollisionShapes& shapes, std::uint32_t a, std::uint32_t b,
+                   double horizon, double xi) {
+  const FloeState &sa = floes.state[a], &sb = floes.state[b];
+  const double speed = std::hypot(sb.vx - sa.vx, sb.vy - sa.vy) + std::abs(sa.yaw_rate) * shapes.radius[a] +
+                       std::abs(sb.yaw_rate) * shapes.radius[b];
+  return xi + speed * horizon;
+}
+
+NearPair measure_pair(const PosedShapes& posed, std::uint32_t a, std::uint32_t b, const Vec2& shift, double xi,
+                      double range, std::vector<ContactPoint>& contacts, std::vector<Witness>& witnesses) {
+  const CollisionShapes& shapes = posed.shapes();
+  range = std::max(range, xi);
+  NearPair pair;
+  pair.a = a;
+  pair.b = b;
+  pair.shift = shift;
+  pair.first_contact = static_cast<std::uint32_t>(contacts.size());
+  pair.first_witness = static_cast<std::uint32_t>(witnesses.size());
+  const Vec2 axes[4] = {Vec2::UnitX(), -Vec2::UnitX(), Vec2::UnitY(), -Vec2::UnitY()};
+  // A separation along an axis, from boxes or separating axes: a lower bound.
+  auto axis_bound = [&](double gap, const Vec2& normal) {
+    if (pair.axis_distance < std::numeric_limits<double>::infinity()) pair.axis_any = true;
+    if (gap < pair.axis_distance) {
+      pair.axis_distance = gap;
+      pair.axis_normal = normal;
+    }
+  };
+  auto box_gap = [&](const Box& A, const Box& B, Vec2& normal) {
+    const double g[4] = {B.xmin - A.xmax, A.xmin - B.xmax, B.ymin - A.ymax, A.ymin - B.ymax};
+    const int widest = static_cast<int>(std::max_element(g, g + 4) - g);
+    normal = axes[widest];
+    return g[widest];
+  };
+  Vec2 n;
+  double closest = std::numeric_limits<double>::infinity();  // least vertex distance
+  bool touching = false;
+  const double floe_gap = box_gap(posed.floe_box(a), shifted_box(posed.floe_box(b), shift), n);
+  if (floe_gap > range) {
+    axis_bound(floe_gap, n);
+  } else {
+    // Vertices of b's part, shifted (small: a few dozen at most).
+    thread_local std::vector<Vec2> shifted;
+    for (std::size_t pa = shapes.part_offsets[a]; pa < shapes.part_offsets[a + 1]; ++pa) {
+      const std::span<const Vec2> A = posed.part(pa);
+      for (std::size_t pb = shapes.part_offsets[b]; pb < shapes.part_offsets[b + 1]; ++pb) {
+        const double part_gap = box_gap(posed.part_box(pa), shifted_box(posed.part_box(pb), shift), n);
+        if (part_gap > range) {
+          axis_bound(part_gap, n);
+          continue;
+        }
+        shifted.clear();
+        for (const Vec2& v : posed.part(pb)) shifted.push_back(v + shift);
+        const Separation sep = separation(A, shifted);
+        if (sep.gap > range) {
+          axis_bound(sep.gap, sep.normal);
+          continue;
+        }
+        if (!(sep.gap > 0.0)) {
+          pair.overlap = true;
+          continue;
+        }
+        // Vertex by vertex: witnesses, contact points, the distance.
+        auto vertex = [&](const Vec2& v, const Vec2& q, bool from_a) {
+          const double d = (q - v).norm();
+          if (d == 0.0) {  // touching: no normal
+            touching = true;
+            return;
+          }
+          const Vec2 on_a = from_a ? v : q, on_b = from_a ? q : v;
+          const Vec2 normal = (on_b - on_a) / d;
+          if (d < closest) {
+            closest = d;
+            pair.pa = on_a;
+            pair.pb = on_b;
+            pair.normal = normal;
+          }
+          if (d >= range) {
+            pair.far_distance = std::min(pair.far_distance, d);
+            return;
+          }
+          witnesses.push_back({on_a, on_b, normal, d});
+          if (d >= xi) return;
+          const Vec2 point = 0.5 * (v + q);
+          for (std::size_t k = pair.first_contact; k < contacts.size(); ++k) {
+            const ContactPoint& o = contacts[k];
+            if ((o.point - point).norm() <= 1e-3 * xi && o.normal.dot(normal) > 1.0 - 1e-6) return;
+          }
+          contacts.push_back({a, b, point, normal, d, shift});
+        };
+        for (const Vec2& v : A) vertex(v, closest_on_boundary(shifted, v), true);
+        for (const Vec2& v : shifted) vertex(v, closest_on_boundary(A, v), false);
+      }
+    }
+  }
+  // The pair's distance: the least over its parts, exact or a bound.
+  if (pair.overlap || touching) {
+    pair.distance = 0.0;
+  } else if (closest <= pair.axis_distance) {
+    pair.distance = closest;
+    pair.exact = true;
+  } else {
+    pair.distance = pair.axis_distance;
+    pair.normal = pair.axis_normal;
+  }
+  pair.contact_count = static_cast<std::uint32_t>(contacts.size()) - pair.first_contact;
+  pair.witness_count = static_cast<std::uint32_t>(witnesses.size()) - pair.first_witness;
+  return pair;
+}
 
 Detection detect(const Floes& floes, const CollisionShapes& shapes, const DetectionOptions& opt) {
   Detection out;
   const std::size_t n = floes.size();
   const double xi = opt.collision_distance;
+  const PosedShapes posed(floes, shapes);
 
-  // World vertices of every part, same layout as shapes.vertices.
-  std::vector<Vec2> world(shapes.vertices.size());
-  std::vector<Box> part_box(shapes.vertex_offsets.size() - 1);
-  std::vector<Box> floe_box(n);  // padded by half the search margin
-  for (std::size_t i = 0; i < n; ++i) {
-    const FloeState& s = floes.state[i];
-    const double c = std::cos(s.yaw), sn = std::sin(s.yaw);
-    Box fb = box_of({}, 0.0);
-    for (std::size_t p = shapes.part_offsets[i]; p < shapes.part_offsets[i + 1]; ++p) {
-      for (std::size_t k = shapes.vertex_offsets[p]; k < shapes.vertex_offsets[p + 1]; ++k) {
-        const Vec2& b = shapes.vertices[k];
-        world[k] = {s.x + c * b.x() - sn * b.y(), s.y + sn * b.x() + c * b.y()};
-      }
-      part_box[p] = box_of({world.data() + shapes.vertex_offsets[p], shapes.vertex_offsets[p + 1] - shapes.vertex_offsets[p]},
-                           0.5 * opt.search_margin);
-      fb.xmin = std::min(fb.xmin, part_box[p].xmin);
-      fb.xmax = std::max(fb.xmax, part_box[p].xmax);
-      fb.ymin = std::min(fb.ymin, part_box[p].ymin);
-      fb.ymax = std::max(fb.ymax, part_box[p].ymax);
-    }
-    floe_box[i] = fb;
-  }
+  out.reach.resize(n);
+  for (std::size_t i = 0; i < n; ++i)
+    out.reach[i] = opt.reach.empty() ? std::max(0.0, 0.5 * opt.search_margin - 0.5 * xi) : opt.reach[i];
 
-  // Broad phase entries (with periodic images of floes that cross an edge).
+  // Broad phase entries, boxes padded by reach + xi/2 (with periodic images of
+  // floes that cross an edge).
   std::vector<Entry> entries;
   entries.reserve(n + n / 4);
   const Domain& d = opt.domain;
   for (std::uint32_t i = 0; i < n; ++i) {
-    const Box& b = floe_box[i];
+    const double pad = out.reach[i] + 0.5 * xi;
+    const Box& f = posed.floe_box(i);
+    const Box b{f.xmin - pad, f.xmax + pad, f.ymin - pad, f.ymax + pad};
     entries.push_back({b, i, Vec2::Zero()});
     if (!d.periodic) continue;
     // Shifts of the images: 0 and, where the box crosses an edge, one period.
@@ -155,30 +322,10 @@ Detection detect(const Floes& floes, const CollisionShapes& shapes, const Detect
       for (int ky = 0; ky < 2; ++ky) {
         const double ox = sx[kx], oy = sy[ky];
         if ((kx == 1 && ox == 0.0) || (ky == 1 && oy == 0.0) || (kx == 0 && ky == 0)) continue;
-        entries.push_back({{b.xmin + ox, b.xmax + ox, b.ymin + oy, b.ymax + oy}, i, Vec2{ox, oy}});
+        entries.push_back({shifted_box(b, Vec2{ox, oy}), i, Vec2{ox, oy}});
       }
   }
-  std::sort(entries.begin(), entries.end(), [](const Entry& x, const Entry& y) { return x.box.xmin < y.box.xmin; });
-
-  struct Candidate { std::uint32_t a, b; Vec2 shift; };
-  std::vector<Candidate> candidates;
-  std::vector<std::size_t> active;
-  for (std::size_t e = 0; e < entries.size(); ++e) {
-    const Entry& cur = entries[e];
-    std::size_t keep = 0;
-    for (std::size_t k = 0; k < active.size(); ++k)
-      if (entries[active[k]].box.xmax >= cur.box.xmin) active[keep++] = active[k];
-    active.resize(keep);
-    for (std::size_t k : active) {
-      const Entry& o = entries[k];
-      if (o.floe == cur.floe || !o.box.overlaps(cur.box)) continue;
-      if (floes.is_static[o.floe] && floes.is_static[cur.floe]) continue;
-      // Canonical order a < b, with b shifted relative to a.
-      if (o.floe < cur.floe) candidates.push_back({o.floe, cur.floe, cur.shift - o.shift});
-      else candidates.push_back({cur.floe, o.floe, o.shift - cur.shift});
-    }
-    active.push_back(e);
-  }
+  std::vector<Candidate> candidates = broad_phase(entries, floes.is_static);
   // A pair may be found through several images: keep each (a, b, shift) once.
   auto key_less = [](const Candidate& x, const Candidate& y) {
     if (x.a != y.a) return x.a < y.a;
@@ -193,79 +340,11 @@ Detection detect(const Floes& floes, const CollisionShapes& shapes, const Detect
                                }),
                    candidates.end());
 
-  // Narrow phase.
-  std::vector<Vec2> shifted;
-  const double pad = 0.5 * opt.search_margin;
-  for (const Candidate& c : candidates) {
-    NearPair pair;
-    pair.a = c.a;
-    pair.b = c.b;
-    pair.shift = c.shift;
-    // Box gap (unpadded boxes): a cheap lower bound for pairs well apart.
-    const Box& A0 = floe_box[c.a];
-    const Box& B0 = floe_box[c.b];
-    const double gaps[4] = {B0.xmin + c.shift.x() - A0.xmax + 2 * pad, A0.xmin - B0.xmax - c.shift.x() + 2 * pad,
-                            B0.ymin + c.shift.y() - A0.ymax + 2 * pad, A0.ymin - B0.ymax - c.shift.y() + 2 * pad};
-    const Vec2 axes[4] = {Vec2::UnitX(), -Vec2::UnitX(), Vec2::UnitY(), -Vec2::UnitY()};
-    const int widest = static_cast<int>(std::max_element(gaps, gaps + 4) - gaps);
-    if (gaps[widest] > xi) {
-      pair.distance = gaps[widest];
-      pair.normal = axes[widest];
-      out.pairs.push_back(pair);
-      continue;
-    }
-    pair.distance = std::numeric_limits<double>::infinity();
-    const std::size_t first_contact = out.contacts.size();
-    for (std::size_t pa = shapes.part_offsets[c.a]; pa < shapes.part_offsets[c.a + 1]; ++pa) {
-      const std::span<const Vec2> A{world.data() + shapes.vertex_offsets[pa],
-                                    shapes.vertex_offsets[pa + 1] - shapes.vertex_offsets[pa]};
-      for (std::size_t pb = shapes.part_offsets[c.b]; pb < shapes.part_offsets[c.b + 1]; ++pb) {
-        Box bb = part_box[pb];
-        bb.xmin += c.shift.x(); bb.xmax += c.shift.x(); bb.ymin += c.shift.y(); bb.ymax += c.shift.y();
-        if (!part_box[pa].overlaps(bb)) continue;
-        shifted.clear();
-        for (std::size_t k = shapes.vertex_offsets[pb]; k < shapes.vertex_offsets[pb + 1]; ++k)
-          shifted.push_back(world[k] + c.shift);
-        // Parts separated by more than xi along an edge normal: that separation
-        // is a lower bound (no contact points to find).
-        const Separation sep = separation(A, shifted);
-        if (sep.gap > xi) {
-          if (sep.gap < pair.distance) {
-            pair.distance = sep.gap;
-            pair.normal = sep.normal;
-            pair.exact = false;
-          }
-          continue;
-        }
-        const ConvexDistance dist = distance_of(A, shifted);
-        if (dist.overlap) pair.overlap = true;
-        if (dist.distance < pair.distance) {
-          pair.distance = dist.distance;
-          pair.pa = dist.pa;
-          pair.pb = dist.pb;
-          pair.exact = true;
-          if (dist.distance > 0.0) pair.normal = (dist.pb - dist.pa) / dist.distance;
-        }
-        if (dist.overlap || dist.distance >= xi) continue;
-        // Contact points: vertices of one part within xi of the other part.
-        auto add = [&](const Vec2& v, const Vec2& q, bool from_a) {
-          const double gap = (q - v).norm();
-          if (gap >= xi || gap == 0.0) return;
-          const Vec2 normal = from_a ? Vec2((q - v) / gap) : Vec2((v - q) / gap);
-          const Vec2 point = 0.5 * (v + q);
-          for (std::size_t k = first_contact; k < out.contacts.size(); ++k) {
-            const ContactPoint& o = out.contacts[k];
-            if ((o.point - point).norm() <= 1e-3 * xi && o.normal.dot(normal) > 1.0 - 1e-6) return;
-          }
-          out.contacts.push_back({c.a, c.b, point, normal, gap, c.shift});
-        };
-        for (const Vec2& v : A) add(v, closest_on_boundary(shifted, v), true);
-        for (const Vec2& v : shifted) add(v, closest_on_boundary(A, v), false);
-      }
-    }
-    if (pair.overlap) pair.distance = 0.0;
-    out.pairs.push_back(pair);
-  }
+  out.pairs.reserve(candidates.size());
+  for (const Candidate& c : candidates)
+    out.pairs.push_back(measure_pair(posed, c.a, c.b, c.shift, xi,
+                                     exact_range(floes, shapes, c.a, c.b, opt.horizon, xi), out.contacts,
+                                     out.witnesses));
   return out;
 }
 

@@ -1,26 +1,40 @@
 #pragma once
 // Which floes are near each other, how far apart, and where they touch.
 //
-// Broad phase: world bounding boxes, each inflated by half a search margin,
-// sorted along x and swept (sweep and prune): O(n log n + pairs). In a periodic
-// domain a floe whose box crosses the domain's edge is also entered shifted by
-// the period, so pairs across the seam are found with the shift to apply.
+// Broad phase: world bounding boxes, floe i's inflated by a pad
+// p_i = reach_i + xi/2, listed in the cells of a uniform grid (cell side the
+// mean box size; cells hashed by sorting): O(n log n + pairs). Two floes become a candidate pair when their padded
+// boxes overlap; so a pair that is not a candidate is more than
+// reach_a + reach_b + xi apart, and stays out of contact as long as each floe
+// moves less than its reach (the time loop checks that, contact/substep.hpp).
+// In a periodic domain a floe whose box crosses the domain's edge is also
+// entered shifted by the period, so pairs across the seam are found with the
+// shift to apply.
 //
-// Pairs whose (unpadded) boxes are more than xi apart get the box gap as a
-// lower bound on their distance. Closer pairs get the narrow phase, per pair of
-// convex parts:
-//   * separation test (separating axes of both parts); overlapping parts give
-//     distance 0 and `overlap = true`;
-//   * distance = min over the vertices of each part of the distance to the
-//     other part's boundary (for disjoint convex polygons the minimum is
-//     reached at a vertex of one of them);
-//   * contact points: every vertex v of one floe whose closest boundary point q
-//     of the other is nearer than the collision distance xi gives one point
+// Narrow phase (measure_pair), per candidate pair, with a range r_ab within
+// which it is measured vertex by vertex (exact_range: xi plus how far the two
+// floes' points can close on each other within the horizon, so a pair beyond
+// it cannot come within xi during the horizon).
+//   * Pairs whose (unpadded) boxes, or whose convex parts, are further apart
+//     than r_ab along an axis get that separation as a lower bound ("axis").
+//   * Closer parts: separation test (separating axes of both parts);
+//     overlapping parts give distance 0 and `overlap = true`. Otherwise every
+//     vertex v of one part and its closest point q on the other part's
+//     boundary: the distance is the least |q - v| (for disjoint convex
+//     polygons the minimum is reached at a vertex of one of them). A vertex
+//     nearer than r_ab is a witness (v, q, N = (q - v)/|q - v|): the other
+//     part lies behind the line through q normal to N, so v's distance to
+//     that line, moving with the other floe, bounds v's distance from below
+//     (step_limit.hpp). Vertices beyond r_ab only give their least distance
+//     ("far").
+//   * Contact points: every vertex v of one floe whose closest boundary point
+//     q of the other is nearer than the collision distance xi gives one point
 //     P = (v + q)/2 with the unit normal N along q - v (pointing from floe a to
 //     floe b). An edge–edge contact thus gives its two end points; a
 //     vertex–vertex contact found from both sides is kept once.
 
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 #include "contact/shapes.hpp"
@@ -37,23 +51,44 @@ struct Domain {
 
 struct DetectionOptions {
   double collision_distance = 0.01;  // xi, m: contact points below this gap
-  double search_margin = 0.01;       // m: pairs whose boxes are within this are measured
+  // How far each floe may move before the pair list must be rebuilt (m): per
+  // floe when `reach` is given (one entry per floe), else search_margin/2 - xi/2
+  // for all.
+  double search_margin = 0.01;       // m
+  std::vector<double> reach;         // m, per floe (optional)
+  double horizon = 0.0;              // s: pairs are measured vertex by vertex within exact_range(horizon)
   Domain domain;
 };
 
-// A pair of floes whose boxes came within the search margin.
+// A vertex of one floe and its closest point on the other (world; b's shifted).
+struct Witness {
+  Vec2 pa = Vec2::Zero(), pb = Vec2::Zero();  // on a, on b (one of them is the vertex)
+  Vec2 normal = Vec2::UnitX();                // unit, (pb - pa)/distance
+  double distance = 0.0;                      // m
+};
+
+// A pair of floes whose padded boxes overlap.
 struct NearPair {
   std::uint32_t a = 0, b = 0;  // floe indices, a < b
   Vec2 shift = Vec2::Zero();   // periodic shift added to floe b's positions
-  // Distance between the floes (0 if they overlap). When `exact` is false it is
-  // a lower bound: the gap between their bounding boxes along `normal` (pairs
-  // whose boxes are further apart than the collision distance are not measured
-  // in detail).
+  // Distance between the floes (0 if they overlap): exact when `exact`, else a
+  // lower bound (the axis separation).
   double distance = 0.0;       // m
-  Vec2 normal = Vec2::UnitX(); // unit, from a towards b: the gap closes at -normal . (V_b - V_a)
+  Vec2 normal = Vec2::UnitX(); // unit, from a towards b (closest points, or the axis)
   Vec2 pa = Vec2::Zero(), pb = Vec2::Zero();  // closest points when exact (world; pb shifted)
   bool exact = false;
   bool overlap = false;
+  // Lower bounds: the least axis separation (infinite if none; when several
+  // parts gave one, along different axes, `axis_any` says the axis is not
+  // known), and the least distance of the vertices that are not witnesses.
+  double axis_distance = std::numeric_limits<double>::infinity();
+  Vec2 axis_normal = Vec2::UnitX();
+  bool axis_any = false;
+  double far_distance = std::numeric_limits<double>::infinity();
+  // Its witnesses and contact points: [first, first + count) of the lists it
+  // was measured into.
+  std::uint32_t first_witness = 0, witness_count = 0;
+  std::uint32_t first_contact = 0, contact_count = 0;
 };
 
 struct ContactPoint {
@@ -62,12 +97,56 @@ struct ContactPoint {
   Vec2 normal = Vec2::UnitX(); // unit
   double gap = 0.0;            // m, >= 0
   Vec2 shift = Vec2::Zero();   // periodic shift of floe b for this contact
+  bool speculative = false;    // gap >= xi: may close, but not below xi/2 within the step (impulse.hpp)
 };
 
 struct Detection {
-  std::vector<NearPair> pairs;        // every pair measured
+  std::vector<NearPair> pairs;        // every candidate pair, measured
   std::vector<ContactPoint> contacts; // contact points of pairs closer than xi
+  std::vector<Witness> witnesses;     // of the pairs measured vertex by vertex
+  std::vector<double> reach;          // m, per floe: the reach the pair list was built for
 };
+
+struct Box {
+  double xmin, xmax, ymin, ymax;
+  bool overlaps(const Box& o) const {
+    return xmin <= o.xmax && o.xmin <= xmax && ymin <= o.ymax && o.ymin <= ymax;
+  }
+};
+
+// The floes' convex parts in world coordinates at their present poses (same
+// layout as CollisionShapes::vertices), with part and floe bounding boxes.
+// update() re-poses one floe, so a few moving floes cost only themselves.
+class PosedShapes {
+public:
+  PosedShapes() = default;
+  PosedShapes(const Floes& floes, const CollisionShapes& shapes);  // all floes posed
+  void update(const Floes& floes, std::size_t floe);
+  std::span<const Vec2> part(std::size_t p) const {
+    return {world_.data() + shapes_->vertex_offsets[p], shapes_->vertex_offsets[p + 1] - shapes_->vertex_offsets[p]};
+  }
+  const Box& part_box(std::size_t p) const { return part_box_[p]; }
+  const Box& floe_box(std::size_t i) const { return floe_box_[i]; }
+  const CollisionShapes& shapes() const { return *shapes_; }
+
+private:
+  const CollisionShapes* shapes_ = nullptr;
+  std::vector<Vec2> world_;
+  std::vector<Box> part_box_, floe_box_;
+};
+
+// xi plus the distance floes a and b can close within `horizon` at their
+// present velocities: |V_b - V_a| + |omega_a| R_a + |omega_b| R_b bounds the
+// relative speed of any two of their points.
+double exact_range(const Floes& floes, const CollisionShapes& shapes, std::uint32_t a, std::uint32_t b,
+                   double horizon, double collision_distance);
+
+// Measures the pair (a, b) with b shifted by `shift` at the poses of `posed`
+// (narrow phase above, vertex by vertex within `range`); appends its contact
+// points and witnesses to the lists.
+NearPair measure_pair(const PosedShapes& posed, std::uint32_t a, std::uint32_t b, const Vec2& shift,
+                      double collision_distance, double range, std::vector<ContactPoint>& contacts,
+                      std::vector<Witness>& witnesses);
 
 Detection detect(const Floes& floes, const CollisionShapes& shapes, const DetectionOptions& options);
 

@@ -2,17 +2,23 @@
 
 #include <Eigen/Sparse>
 #include <algorithm>
+#include <cmath>
 #include <numeric>
+#include <cstdlib>
 #include <unordered_map>
 
 namespace floesim::contact {
 
 namespace {
 
-// Union–find over floe indices.
+// Union–find over the floes that have contacts (local indices), so a call
+// costs the size of its contact list, not of the pack.
 struct Components {
   std::vector<std::uint32_t> parent;
-  explicit Components(std::size_t n) : parent(n) { std::iota(parent.begin(), parent.end(), 0u); }
+  std::uint32_t add() {
+    parent.push_back(static_cast<std::uint32_t>(parent.size()));
+    return parent.back();
+  }
   std::uint32_t find(std::uint32_t i) {
     while (parent[i] != i) i = parent[i] = parent[parent[i]];
     return i;
@@ -39,20 +45,53 @@ Row make_row(const ContactPoint& c, const Vec2& u, const FloeState& sa, const Fl
 
 }  // namespace
 
+namespace {
+// Velocity of floe f's point p (world, in f's own image), and its change since `before`.
+Vec2 point_velocity(const FloeState& s, const Vec2& p) {
+  const Vec2 r = p - Vec2{s.x, s.y};
+  return Vec2{s.vx, s.vy} + s.yaw_rate * Vec2{-r.y(), r.x()};
+}
+// The normal approach speed of a contact's two points (> 0: approaching),
+// with the floes' velocities taken from `s` (the positions are the present
+// ones: velocities from the start of the step are compared at the same points).
+double approach(const Floes& floes, std::span<const FloeState> s, std::uint32_t a, std::uint32_t b,
+                const Vec2& pa, const Vec2& pb_own, const Vec2& normal) {
+  FloeState va = s[a], vb = s[b];
+  va.x = floes.state[a].x; va.y = floes.state[a].y;
+  vb.x = floes.state[b].x; vb.y = floes.state[b].y;
+  return -normal.dot(point_velocity(vb, pb_own) - point_velocity(va, pa));
+}
+// Pushed (impulse.hpp): approaching now at least three times as fast as at
+// the start of the step.
+bool pushed(double now, double at_start) { return now > 0.0 && at_start <= now / 3.0; }
+}  // namespace
+
 std::vector<ContactImpulse> resolve_collisions(Floes& floes, const std::vector<ContactPoint>& contacts,
-                                               const ImpulseOptions& opt, CollisionStats& stats) {
+                                               const ImpulseOptions& opt, CollisionStats& stats,
+                                               std::span<const std::uint8_t> resting) {
   std::vector<ContactImpulse> impulses(contacts.size());
   if (contacts.empty()) return impulses;
 
   // Contact graph over dynamic floes.
-  Components comp(floes.size());
-  for (const ContactPoint& c : contacts)
-    if (!floes.is_static[c.a] && !floes.is_static[c.b]) comp.join(c.a, c.b);
+  Components comp;
+  std::unordered_map<std::uint32_t, std::uint32_t> node;  // floe -> local index
+  auto node_of = [&](std::uint32_t f) {
+    auto [it, fresh] = node.emplace(f, 0u);
+    if (fresh) it->second = comp.add();
+    return it->second;
+  };
+  for (const ContactPoint& c : contacts) {
+    if (floes.is_static[c.a] && floes.is_static[c.b]) continue;
+    if (floes.is_static[c.a]) node_of(c.b);
+    else if (floes.is_static[c.b]) node_of(c.a);
+    else comp.join(node_of(c.a), node_of(c.b));
+  }
   std::unordered_map<std::uint32_t, std::vector<std::size_t>> groups;  // root -> contacts
   for (std::size_t j = 0; j < contacts.size(); ++j) {
     const ContactPoint& c = contacts[j];
+    if (floes.is_static[c.a] && floes.is_static[c.b]) continue;
     const std::uint32_t owner = floes.is_static[c.a] ? c.b : c.a;
-    groups[comp.find(owner)].push_back(j);
+    groups[comp.find(node.at(owner))].push_back(j);
   }
   std::vector<std::vector<std::size_t>> ordered;
   ordered.reserve(groups.size());
@@ -98,22 +137,53 @@ std::vector<ContactImpulse> resolve_collisions(Floes& floes, const std::vector<C
     std::vector<double> target(m, 0.0);
     for (std::size_t k = 0; k < m; ++k) {
       const double g = contacts[list[k]].gap;
-      if (g < opt.min_gap) target[k] = (opt.min_gap - g) / opt.relaxation_time;
+      if (contacts[list[k]].speculative) target[k] = -0.9 * (g - 0.5 * opt.collision_distance) / opt.speculative_step;
+      else if (g < opt.min_gap) target[k] = (opt.min_gap - g) / opt.relaxation_time;
     }
-    // q = (Gn W - target, Gt W, 0); returns its most negative normal entry
-    // (the fastest approach, once the targets are met: nothing to do if >= 0).
+    // Scaling (symmetric, so the LCP keeps the structure Lemke relies on):
+    // with s_k = 1 / sqrt(D_kk), D = Gn A^-1 Gn^T (s_k^2 is the effective
+    // mass at contact k), the unknowns are lambda_k = s_k lambda'_k,
+    // beta_k = s_k beta'_k, alpha_k = alpha'_k / s_k, and the rows of contact k
+    // are multiplied by s_k (normal, tangent) and 1/s_k (friction): M' = S M S,
+    // q' = S q. The normal diagonal becomes 1, the E, mu and -E^T entries are
+    // unchanged, and M' is copositive as M is (z'^T M' z' = (S z')^T M (S z')).
+    // Unscaled, inverse masses of 1e-7 next to the O(1) friction rows defeat
+    // the pivoting tolerances; scaled on one side only (M S), the Delassus
+    // block loses its symmetry and Lemke ends on secondary rays in jams.
+    auto contact_of = [m](std::size_t r) { return r < m ? r : (r - m) / 2; };
+    std::vector<double> scale(m, 1.0);
+    for (std::size_t k = 0; k < m; ++k) {
+      double dkk = 0.0;
+      const Row& r = rows[k];
+      if (r.fa >= 0) dkk += r.ga.cwiseProduct(Ainv.segment<3>(3 * r.fa)).dot(r.ga);
+      if (r.fb >= 0) dkk += r.gb.cwiseProduct(Ainv.segment<3>(3 * r.fb)).dot(r.gb);
+      if (dkk > 0.0) scale[k] = 1.0 / std::sqrt(dkk);
+    }
+    // q' = S (Gn W - target, Gt W, 0); returns the most negative unscaled
+    // normal entry (the fastest approach, once the targets are met: nothing to
+    // do if >= 0).
     lcp::Lcp problem;
     auto fill_q = [&] {
       problem.q = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(4 * m));
-      for (std::size_t r = 0; r < 3 * m; ++r) problem.q[static_cast<Eigen::Index>(r)] = apply(rows[r], W);
       double worst = 0.0;
-      for (std::size_t k = 0; k < m; ++k) {
-        problem.q[static_cast<Eigen::Index>(k)] -= target[k];
-        worst = std::min(worst, problem.q[static_cast<Eigen::Index>(k)]);
+      for (std::size_t r = 0; r < 3 * m; ++r) {
+        double q = apply(rows[r], W);
+        if (r < m) {
+          q -= target[r];
+          worst = std::min(worst, q);
+        }
+        problem.q[static_cast<Eigen::Index>(r)] = scale[contact_of(r)] * q;
       }
       return worst;
     };
     if (!(fill_q() < -opt.approach_tolerance)) continue;
+    // Restitution per contact: 0 for resting contacts (see the header).
+    std::vector<double> restitution(m, opt.restitution);
+    for (std::size_t k = 0; k < m; ++k)
+      if (contacts[list[k]].speculative) restitution[k] = 0.0;
+    if (!resting.empty())
+      for (std::size_t k = 0; k < m; ++k)
+        if (resting[list[k]]) restitution[k] = 0.0;
 
     // Delassus blocks G A^-1 G^T: rows interact through shared floes.
     std::vector<std::vector<std::size_t>> rows_of(nf);
@@ -126,21 +196,6 @@ std::vector<ContactImpulse> resolve_collisions(Floes& floes, const std::vector<C
       if (r.fb == f) return &r.gb;
       return nullptr;
     };
-    // Scaling: impulses of contact k are solved for in units of s_k = 1 / D_kk
-    // (D = Gn A^-1 Gn^T, so s_k is the effective mass at the contact): the
-    // columns of lambda_k and beta_k are multiplied by s_k, and the friction
-    // row of contact k, mu lambda_k - beta_k+ - beta_k-, is divided by s_k,
-    // which leaves it unchanged. Without this, inverse masses of 1e-7 next to
-    // the O(1) friction rows defeat the pivoting tolerances.
-    std::vector<double> scale(m, 1.0);
-    for (std::size_t k = 0; k < m; ++k) {
-      double dkk = 0.0;
-      const Row& r = rows[k];
-      if (r.fa >= 0) dkk += r.ga.cwiseProduct(Ainv.segment<3>(3 * r.fa)).dot(r.ga);
-      if (r.fb >= 0) dkk += r.gb.cwiseProduct(Ainv.segment<3>(3 * r.fb)).dot(r.gb);
-      if (dkk > 0.0) scale[k] = 1.0 / dkk;
-    }
-    auto contact_of = [m](std::size_t r) { return r < m ? r : (r - m) / 2; };
     const std::size_t n = 4 * m;
     std::vector<Eigen::Triplet<double>> trip;
     trip.reserve(n * 8);
@@ -151,7 +206,7 @@ std::vector<ContactImpulse> resolve_collisions(Floes& floes, const std::vector<C
           const Eigen::Vector3d& g1 = *block(rows[r1], static_cast<int>(f));
           const Eigen::Vector3d& g2 = *block(rows[r2], static_cast<int>(f));
           trip.emplace_back(static_cast<int>(r1), static_cast<int>(r2),
-                            g1.cwiseProduct(ai).dot(g2) * scale[contact_of(r2)]);
+                            scale[contact_of(r1)] * g1.cwiseProduct(ai).dot(g2) * scale[contact_of(r2)]);
         }
     }
     for (std::size_t k = 0; k < m; ++k) {
@@ -174,7 +229,8 @@ std::vector<ContactImpulse> resolve_collisions(Floes& floes, const std::vector<C
     // ends approaching.
     Eigen::VectorXd total = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(3 * m));  // impulses applied
     for (int pass = 0; pass < 2; ++pass) {
-      const double e = pass == 0 ? opt.restitution : 0.0;
+      // Pass 1 only where Poisson's law acted (no restitution: nothing to undo).
+      if (pass == 1 && std::all_of(restitution.begin(), restitution.end(), [](double e) { return e == 0.0; })) break;
       if (pass == 1 && !(fill_q() < -opt.approach_tolerance)) break;  // pass 0 uses the q above
       const lcp::FallbackResult res = lcp::solve_with_fallbacks(problem, opt.solver);
       ++stats.lcps;
@@ -188,9 +244,12 @@ std::vector<ContactImpulse> resolve_collisions(Floes& floes, const std::vector<C
         ++stats.failures;
         break;  // leave these velocities as they are: counted and reported
       }
-      // W += (1 + e) A^-1 G^T z.
-      Eigen::VectorXd z = (1.0 + e) * res.result.z.head(static_cast<Eigen::Index>(3 * m));
-      for (std::size_t r = 0; r < 3 * m; ++r) z[static_cast<Eigen::Index>(r)] *= scale[contact_of(r)];
+      // W += A^-1 G^T diag(1 + e_k) z (pass 1: restitution 0).
+      Eigen::VectorXd z = res.result.z.head(static_cast<Eigen::Index>(3 * m));
+      for (std::size_t r = 0; r < 3 * m; ++r) {
+        const std::size_t k = contact_of(r);
+        z[static_cast<Eigen::Index>(r)] *= scale[k] * (pass == 0 ? 1.0 + restitution[k] : 1.0);
+      }
       total += z;
       Eigen::VectorXd p = Eigen::VectorXd::Zero(3 * static_cast<Eigen::Index>(nf));
       for (std::size_t r = 0; r < 3 * m; ++r) {
@@ -217,6 +276,119 @@ std::vector<ContactImpulse> resolve_collisions(Floes& floes, const std::vector<C
     }
   }
   return impulses;
+}
+
+std::size_t resolve_step_collisions(Floes& floes, std::span<const FloeState> start, const Detection& detection,
+                                    double step, const ImpulseOptions& options, CollisionStats& stats,
+                                    std::vector<ContactImpulse>* impulses) {
+  const double xi = options.collision_distance;
+  ImpulseOptions opt = options;
+  opt.speculative_step = step;
+  std::vector<ContactPoint> contacts = detection.contacts;
+  // Jams: contact components (dynamic floes joined by contact points) of at
+  // least opt.jam_floes floes.
+  Components jam;
+  std::unordered_map<std::uint32_t, std::uint32_t> jam_node;
+  auto jam_node_of = [&](std::uint32_t f) {
+    auto [it, fresh] = jam_node.emplace(f, 0u);
+    if (fresh) it->second = jam.add();
+    return it->second;
+  };
+  for (const ContactPoint& c : contacts)
+    if (!floes.is_static[c.a] && !floes.is_static[c.b]) jam.join(jam_node_of(c.a), jam_node_of(c.b));
+  std::vector<std::uint32_t> jam_size(jam.parent.size(), 0);
+  for (const auto& [f, local] : jam_node) ++jam_size[jam.find(local)];
+  auto in_jam = [&](std::uint32_t f) {
+    if (floes.is_static[f]) return false;
+    const auto it = jam_node.find(f);
+    return it != jam_node.end() && jam_size[jam.find(it->second)] >= opt.jam_floes;
+  };
+  auto jammed = [&](std::uint32_t a, std::uint32_t b) { return in_jam(a) || in_jam(b); };
+  std::vector<std::uint8_t> resting(contacts.size(), 0);
+  for (std::size_t k = 0; k < contacts.size(); ++k) {
+    const ContactPoint& c = contacts[k];
+    const Vec2 pb = c.point - c.shift;  // in b's own image
+    resting[k] = jammed(c.a, c.b) || pushed(approach(floes, floes.state, c.a, c.b, c.point, pb, c.normal),
+                                            approach(floes, start, c.a, c.b, c.point, pb, c.normal));
+  }
+  // In a jam every point beyond xi is speculative from the start.
+  std::vector<std::uint8_t> taken(detection.witnesses.size(), 0);
+  std::size_t added = 0;
+  for (const NearPair& p : detection.pairs) {
+    if (p.overlap || !jammed(p.a, p.b)) continue;
+    for (std::uint32_t k = p.first_witness; k < p.first_witness + p.witness_count; ++k) {
+      const Witness& w = detection.witnesses[k];
+      if (w.distance < xi) continue;
+      taken[k] = 1;
+      contacts.push_back({p.a, p.b, 0.5 * (w.pa + w.pb), w.normal, w.distance, p.shift, true});
+      resting.push_back(1);
+      ++added;
+    }
+  }
+  const std::vector<FloeState> before = floes.state;  // W^-
+  std::vector<ContactPoint> again;  // the contacts to solve again: components that gained speculative ones
+  std::vector<std::uint8_t> again_resting;
+  std::vector<std::size_t> again_index;  // their places in contacts
+  std::vector<ContactImpulse> total = resolve_collisions(floes, contacts, opt, stats, resting);
+  for (int round = 1; round <= 2; ++round) {
+    // Pushed points beyond xi that would now close below xi/2 within the step.
+    const std::size_t first_new = contacts.size();
+    for (const NearPair& p : detection.pairs) {
+      if (p.overlap) continue;
+      for (std::uint32_t k = p.first_witness; k < p.first_witness + p.witness_count; ++k) {
+        const Witness& w = detection.witnesses[k];
+        if (taken[k] || w.distance < xi) continue;
+        const Vec2 pb = w.pb - p.shift;
+        const double now = approach(floes, floes.state, p.a, p.b, w.pa, pb, w.normal);
+        if (!(now * step > w.distance - 0.5 * xi)) continue;
+        if (!pushed(now, approach(floes, start, p.a, p.b, w.pa, pb, w.normal))) continue;
+        taken[k] = 1;
+        contacts.push_back({p.a, p.b, 0.5 * (w.pa + w.pb), w.normal, w.distance, p.shift, true});
+        resting.push_back(1);
+        ++added;
+      }
+    }
+    if (contacts.size() == first_new) break;
+    // The components (over all contacts) that gained speculative contacts are
+    // solved again from W^-; the others keep their solution.
+    Components comp;
+    std::unordered_map<std::uint32_t, std::uint32_t> node;
+    auto node_of = [&](std::uint32_t f) {
+      auto [it, fresh] = node.emplace(f, 0u);
+      if (fresh) it->second = comp.add();
+      return it->second;
+    };
+    auto dynamic_end = [&](const ContactPoint& c) { return floes.is_static[c.a] ? c.b : c.a; };
+    for (const ContactPoint& c : contacts) {
+      if (floes.is_static[c.a] || floes.is_static[c.b]) node_of(dynamic_end(c));
+      else comp.join(node_of(c.a), node_of(c.b));
+    }
+    std::vector<std::uint8_t> redo(comp.parent.size(), 0);
+    for (std::size_t k = first_new; k < contacts.size(); ++k) redo[comp.find(node.at(dynamic_end(contacts[k])))] = 1;
+    again.clear();
+    again_resting.clear();
+    again_index.clear();
+    for (std::size_t k = 0; k < contacts.size(); ++k)
+      if (redo[comp.find(node.at(dynamic_end(contacts[k])))]) {
+        again.push_back(contacts[k]);
+        again_resting.push_back(resting[k]);
+        again_index.push_back(k);
+      }
+    for (const auto& [f, local] : node)
+      if (redo[comp.find(local)]) {
+        floes.state[f].vx = before[f].vx;
+        floes.state[f].vy = before[f].vy;
+        floes.state[f].yaw_rate = before[f].yaw_rate;
+      }
+    const std::vector<ContactImpulse> redone = resolve_collisions(floes, again, opt, stats, again_resting);
+    total.resize(contacts.size());
+    for (std::size_t j = 0; j < again.size(); ++j) total[again_index[j]] = redone[j];
+  }
+  if (impulses) {
+    total.resize(detection.contacts.size());
+    *impulses = std::move(total);
+  }
+  return added;
 }
 
 }  // namespace floesim::contact

@@ -32,10 +32,47 @@
 // at or above min_gap keep the exact Signorini condition (and the exact
 // restitution law).
 //
+// Collisions at the start of a step (resolve_step_collisions): resting and
+// speculative contacts. Poisson's law is a law of impacts. A contact is
+// "pushed" when it approaches now at least three times faster than it did at
+// the start of the step, i.e. the approach was made by this step (its smooth
+// forces, and the impulses of the contacts around it: in a jam, neighbours get
+// the same push from the wind and approach because the floe ahead is held).
+//  * A pushed contact point is resting: restitution 0 (Poisson's law per
+//    contact, e_k = 0: W^+ = W^c + A^-1 G^T diag(e_k) z^c, which is
+//    (1 + e) W^c - e W^- when every e_k = e). Bouncing it by e times a speed
+//    the step itself created would make a jammed pack rattle at a rate set by
+//    the step.
+//  * Speculative contacts (after Catto's): a pushed point of two floes at a
+//    gap g >= xi (a witness of the detection, detection.hpp) that would come
+//    closer than xi/2 within the step h may close by at most (g - xi/2)/2: it
+//    asks for v_n >= -(g - xi/2)/(2 h), i.e. q_j += (g - xi/2)/(2 h), with
+//    restitution 0. It applies an impulse only if the pair would otherwise
+//    end the step closer than xi/2 + (g - xi/2)/2; the pair then arrives at
+//    the end of the step instead of colliding within it, with room to spare
+//    for the turning of the floes (step_limit.hpp). As the approach may come
+//    from the impulses of the step, the speculative points are found after a
+//    solve, and the components that gained some are solved again from W^-
+//    (at most two more times). Impacts (approaches that are not pushed) keep
+//    their instant and restitution: the step's sub-steps resolve them
+//    (substep.hpp).
+//  * Jams: a contact component of at least jam_floes floes is a jam. Every
+//    contact of a jam floe rests and every point beyond xi of its pairs (with
+//    other jam floes, obstacles, or floes coming at it) is speculative from
+//    the first solve: the jam is time-stepped (one LCP per step, as in dense
+//    granular flows, where event-driven collisions collapse into ever shorter
+//    sub-steps). Floes jammed by the wind against an obstacle touch each other
+//    all the time, and would otherwise need an event, and an LCP of the whole
+//    jam, each time one pair among hundreds closed a gap; a floe that drifts
+//    into a jam is stopped within the last step before it touches (at most
+//    its speed times the step early), without rebound (a jam of tens of floes
+//    takes the blow as a body, not as a single elastic partner).
+//
 // Components are built from dynamic floes joined by contacts; an obstacle
 // (static floe) does not join components since it transmits no impulse.
 
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "contact/detection.hpp"
@@ -46,10 +83,17 @@ namespace floesim::contact {
 struct ImpulseOptions {
   double restitution = 0.4;  // e in [0, 1]
   double friction = 0.7;     // mu >= 0
-  // A component is solved only if some contact approaches faster than this (m/s).
-  double approach_tolerance = 1e-12;
+  // A component is solved only if some contact approaches faster than this
+  // (m/s). Re-measured resting contacts approach at round-off speeds (1e-9
+  // m/s, from the change of their points and normals as floes turn); at 1e-6
+  // m/s a contact closes 10 um in a 10 s step, a thousandth of xi, which the
+  // step limit and the gap stabilisation handle.
+  double approach_tolerance = 1e-6;
   double min_gap = 0.0;      // m, see "gap stabilisation" above
   double relaxation_time = 10.0;  // s, tau of the gap stabilisation
+  double collision_distance = 0.01;  // xi, m (speculative contacts)
+  double speculative_step = 0.0;     // s, the step speculative contacts are for (set by resolve_step_collisions)
+  std::size_t jam_floes = 20;        // a contact component of this many floes is a jam (resolve_step_collisions)
   std::size_t dense_max = 400;  // LCPs up to this size are assembled dense, larger sparse
   lcp::FallbackOptions solver;
 };
@@ -76,8 +120,20 @@ struct ContactImpulse {
 };
 
 // Changes the velocities of the floes in contact (W^- -> W^+). Returns the
-// impulses, one per contact, in the order of `contacts`.
+// impulses, one per contact, in the order of `contacts`. `resting` (optional,
+// one flag per contact): restitution 0 for those (above).
 std::vector<ContactImpulse> resolve_collisions(Floes& floes, const std::vector<ContactPoint>& contacts,
-                                               const ImpulseOptions& options, CollisionStats& stats);
+                                               const ImpulseOptions& options, CollisionStats& stats,
+                                               std::span<const std::uint8_t> resting = {});
+
+// The collisions at the start of a step of length `step`: the contacts of
+// `detection` (measured at the present positions) with their resting flags,
+// and the speculative contacts (above). `start`: the floes at the start of the
+// step, before its smooth forces. Returns how many speculative contacts took
+// part. `impulses` (optional) receives the impulses of detection.contacts, in
+// their order (percussion).
+std::size_t resolve_step_collisions(Floes& floes, std::span<const FloeState> start, const Detection& detection,
+                                    double step, const ImpulseOptions& options, CollisionStats& stats,
+                                    std::vector<ContactImpulse>* impulses = nullptr);
 
 }  // namespace floesim::contact

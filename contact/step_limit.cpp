@@ -1,44 +1,86 @@
 #include "contact/step_limit.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 namespace floesim::contact {
 
-StepLimit collision_step_limit(const Floes& floes, const CollisionShapes& shapes,
-                               const std::vector<NearPair>& pairs, double xi) {
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+// d_f(t) >= d + r t - kappa t^2 / 2 (step_limit.hpp).
+struct Feature {
+  double d, r, kappa;
+};
+
+// First t > 0 at which d + r t - kappa t^2/2 reaches keep (infinite if never).
+double time_to(const Feature& f, double keep) {
+  const double room = f.d - keep;
+  if (!(room > 0.0)) return 0.0;
+  if (f.kappa > 0.0) {
+    const double root = std::sqrt(f.r * f.r + 2.0 * f.kappa * room);
+    return f.r < 0.0 ? 2.0 * room / (root - f.r) : (f.r + root) / f.kappa;
+  }
+  return f.r < 0.0 ? room / -f.r : kInf;
+}
+
+// Lowest value of d + r s - kappa s^2/2 - keep over s in [0, t].
+double room_over(const Feature& f, double keep, double t) {
+  return f.d - keep + std::min(0.0, f.r * t - 0.5 * f.kappa * t * t);
+}
+
+Vec2 point_velocity(const FloeState& s, const Vec2& r) { return Vec2{s.vx, s.vy} + s.yaw_rate * Vec2{-r.y(), r.x()}; }
+
+// Calls f(feature) for each feature of the pair (step_limit.hpp).
+template <class F>
+void for_each_feature(const Floes& floes, const CollisionShapes& shapes, const NearPair& p,
+                      std::span<const Witness> witnesses, F&& f) {
+  const FloeState &a = floes.state[p.a], &b = floes.state[p.b];
+  const Vec2 ga{a.x, a.y}, gb = Vec2{b.x, b.y} + p.shift;
+  const double ra = shapes.radius[p.a], rb = shapes.radius[p.b];
+  const double wa = std::abs(a.yaw_rate), wb = std::abs(b.yaw_rate);
+  const Vec2 dv{b.vx - a.vx, b.vy - a.vy};
+  const double spin = wa * ra + wb * rb;
+  const double s = dv.norm() + spin;
+  if (p.axis_distance < kInf) f(Feature{p.axis_distance, p.axis_any ? -s : p.axis_normal.dot(dv) - spin, 0.0});
+  if (p.far_distance < kInf) f(Feature{p.far_distance, -s, 0.0});
+  if (witnesses.empty()) return;
+  const double w = std::max(wa, wb);
+  const double kappa = 2.0 * w * dv.norm() + w * w * (ra + rb + p.distance) + (wa + wb) * (wa + wb) * std::max(ra, rb);
+  for (const Witness& x : witnesses)
+    f(Feature{x.distance, x.normal.dot(point_velocity(b, x.pb - gb) - point_velocity(a, x.pa - ga)), kappa});
+}
+
+}  // namespace
+
+double pair_step_limit(const Floes& floes, const CollisionShapes& shapes, const NearPair& p,
+                       std::span<const Witness> witnesses, double xi) {
+  // Overlaps are the caller's to report; floes exactly touching (no normal)
+  // are left to the overlap check, as no bound applies.
+  if (p.overlap || !(p.distance > 0.0)) return kInf;
+  const double keep = 0.5 * std::min(p.distance, xi);
+  double t = kInf;
+  for_each_feature(floes, shapes, p, witnesses, [&](const Feature& f) { t = std::min(t, time_to(f, keep)); });
+  return t;
+}
+
+double pair_room(const Floes& floes, const CollisionShapes& shapes, const NearPair& p,
+                 std::span<const Witness> witnesses, double xi, double t) {
+  if (p.overlap || !(p.distance > 0.0)) return 0.0;
+  const double keep = 0.5 * std::min(p.distance, xi);
+  double room = kInf;
+  for_each_feature(floes, shapes, p, witnesses, [&](const Feature& f) { room = std::min(room, room_over(f, keep, t)); });
+  return room;
+}
+
+StepLimit collision_step_limit(const Floes& floes, const CollisionShapes& shapes, const std::vector<NearPair>& pairs,
+                               const std::vector<Witness>& witnesses, double xi) {
   StepLimit limit;
   for (const NearPair& p : pairs) {
     if (p.overlap) continue;  // reported by the caller's overlap check
-    const FloeState &a = floes.state[p.a], &b = floes.state[p.b];
-    const double d = p.distance;
-    if (!(d > 0.0)) continue;
-    const Vec2& n = p.normal;
-    const double keep = 0.5 * std::min(d, xi);
-    double dt;
-    if (p.exact) {
-      // Closest points known: d'(0) = n . (v_b(p_b) - v_a(p_a)) exactly, and the
-      // second derivative is bounded by how fast rotation turns the relative
-      // velocity: |d''| <= kappa = (|w_a| + |w_b|) (|V_b - V_a| + |w_a| R_a + |w_b| R_b).
-      // Solve d - s1 t - kappa t^2 / 2 = keep for t.
-      const Vec2 ra = p.pa - Vec2{a.x, a.y}, rb = p.pb - Vec2{b.x, b.y} - p.shift;
-      const Vec2 va = Vec2{a.vx, a.vy} + a.yaw_rate * Vec2{-ra.y(), ra.x()};
-      const Vec2 vb = Vec2{b.vx, b.vy} + b.yaw_rate * Vec2{-rb.y(), rb.x()};
-      const double s1 = std::max(0.0, -n.dot(vb - va));
-      const double kappa = (std::abs(a.yaw_rate) + std::abs(b.yaw_rate)) *
-                           (Vec2{b.vx - a.vx, b.vy - a.vy}.norm() + std::abs(a.yaw_rate) * shapes.radius[p.a] +
-                            std::abs(b.yaw_rate) * shapes.radius[p.b]);
-      const double room = d - keep;
-      if (kappa > 0.0) dt = 2.0 * room / (s1 + std::sqrt(s1 * s1 + 2.0 * kappa * room));
-      else if (s1 > 0.0) dt = room / s1;
-      else continue;
-    } else {
-      const double approach = -n.dot(Vec2{b.vx - a.vx, b.vy - a.vy});
-      const double s = std::max(0.0, approach) + std::abs(a.yaw_rate) * shapes.radius[p.a] +
-                       std::abs(b.yaw_rate) * shapes.radius[p.b];
-      if (!(s > 0.0)) continue;
-      dt = (d - keep) / s;
-    }
-    if (dt < limit.dt) limit = {dt, p.a, p.b, d};
+    const double dt = pair_step_limit(floes, shapes, p, witnesses_of(p, witnesses), xi);
+    if (dt < limit.dt) limit = {dt, p.a, p.b, p.distance};
   }
   return limit;
 }

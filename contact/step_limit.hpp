@@ -2,26 +2,40 @@
 // Event-driven step control (MODEL.md §2): how long floes may move with their
 // present velocities before a near pair could close its gap.
 //
-// For two floes translating with constant velocities, the distance d(t)
-// between them is a convex function of t (the distance from a point moving on
-// a line to a fixed convex set — their Minkowski difference — is convex), so
-// d(t) >= d(0) + t n.(V_b - V_a), n the unit vector between the closest points.
-// The same bound holds for the separation of the two floes along any fixed axis
-// n, which is how pairs far apart are handled (their box gap, detection.hpp).
-// Rotation moves a point at radius r from its centroid by at most |omega| r t.
-// Hence, with R_a, R_b the floes' radii,
-//   d(t) >= d(0) - t s,   s = max(0, -n.(V_b - V_a)) + |omega_a| R_a + |omega_b| R_b,
-// and a pair keeps at least `keep` of its gap over dt <= (d - keep)/s. We keep
-// half of the gap below the collision distance xi and let pairs further away
-// come to xi/2:  keep = min(d, xi)/2. That bound is rigorous but pessimistic
-// for floes in contact that turn slowly; for pairs whose closest points are
-// known, the step uses d'(0) = n.(v_b(p_b) - v_a(p_a)) (exact, rotation
-// included) and a bound kappa on d'' from the rotation rates (step_limit.cpp).
-// The step itself re-detects after moving and redoes a step that overlapped,
-// so no estimate here can let floes overlap.
+// A pair's distance is bounded below, over a time t during which both floes
+// keep their velocities, by a few "features", each
+//   d_f(t) >= d_f + r_f t - kappa_f t^2 / 2,
+// and the step keeps every feature above keep = min(d, xi)/2 (half of a gap
+// below the collision distance xi; pairs further apart may come to xi/2).
+// With w_a = |omega_a|, w_b = |omega_b| and R the floes' radii about their
+// centroids, no two points of the floes approach faster than
+// s = |V_b - V_a| + w_a R_a + w_b R_b. The features (detection.hpp):
+//  * axis: a separation along a fixed axis n (box gap or separating axis):
+//    every point moves along n at n.V -+ w R at most, so
+//    r = n.(V_b - V_a) - w_a R_a - w_b R_b (or -s when the axis is not
+//    known), kappa = 0;
+//  * far: the least distance of the vertices that are not witnesses,
+//    r = -s, kappa = 0;
+//  * witness (vertex v, closest point q on the other floe, N = (q - v)/|q - v|):
+//    the other floe lies behind the line through q normal to N, which moves
+//    with it, so v's distance to that line bounds v's distance to the other
+//    floe from below. Its rate is exactly N.(v_q - v_v), the normal relative
+//    velocity of the two points (rotation included; positive when
+//    separating), and in the line owner's frame the other floe's centroid
+//    accelerates by at most w^2 |G_b - G_a| + 2 w |V_b - V_a| while its
+//    vertices turn at w_a + w_b, so
+//      kappa = 2 w |V_b - V_a| + w^2 (R_a + R_b + d) + (w_a + w_b)^2 max(R_a, R_b),
+//    w = max(w_a, w_b) (either floe may own the line).
+// Two convex parts first touch at a vertex of one of them, so while every
+// feature stays positive they do not overlap: the limit is a bound, not an
+// estimate. The time loop still re-measures after moving and redoes a step
+// that overlapped (round-off, a floe outrunning its reach).
+// Crediting separating witnesses (r > 0) is what lets a resting contact, which
+// the collision LCP has just left separating or sliding, not limit the step.
 
 #include <cstdint>
 #include <limits>
+#include <span>
 #include <vector>
 
 #include "contact/detection.hpp"
@@ -34,7 +48,27 @@ struct StepLimit {
   double distance = 0.0;       // m, that pair's distance
 };
 
+// The longest time over which the pair stays above keep (infinite if it
+// never closes). `witnesses` are the pair's own.
+double pair_step_limit(const Floes& floes, const CollisionShapes& shapes, const NearPair& pair,
+                       std::span<const Witness> witnesses, double collision_distance);
+
+// How far above keep the pair's distance stays at least over [0, t]
+// (negative: it may close below keep within t).
+double pair_room(const Floes& floes, const CollisionShapes& shapes, const NearPair& pair,
+                 std::span<const Witness> witnesses, double collision_distance, double t);
+
+// The smallest pair_step_limit over `pairs` (their witnesses in `witnesses`).
 StepLimit collision_step_limit(const Floes& floes, const CollisionShapes& shapes,
-                               const std::vector<NearPair>& pairs, double collision_distance);
+                               const std::vector<NearPair>& pairs, const std::vector<Witness>& witnesses,
+                               double collision_distance);
+
+// A pair's own contact points and witnesses, in the lists it was measured into.
+inline std::span<const ContactPoint> contacts_of(const NearPair& p, const std::vector<ContactPoint>& contacts) {
+  return {contacts.data() + p.first_contact, p.contact_count};
+}
+inline std::span<const Witness> witnesses_of(const NearPair& p, const std::vector<Witness>& witnesses) {
+  return {witnesses.data() + p.first_witness, p.witness_count};
+}
 
 }  // namespace floesim::contact

@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "contact/step_limit.hpp"
+#include "contact/substep.hpp"
 #include "core/error.hpp"
 #include "fluid/sea.hpp"
 
@@ -40,12 +41,14 @@ Simulation::Simulation(Scenario scenario) : scenario_(std::move(scenario)) {
   shapes_ = contact::build_collision_shapes(scenario_.floes);
   detection_options_.collision_distance = c.contact.collision_distance;
   detection_options_.domain = make_domain(scenario_);
+  detection_options_.horizon = c.run.dt_max;
   impulse_options_.restitution = c.contact.restitution;
   impulse_options_.friction = c.contact.friction;
   impulse_options_.min_gap = 0.1 * c.contact.collision_distance;
   impulse_options_.relaxation_time = c.run.dt_max;
+  impulse_options_.collision_distance = c.contact.collision_distance;
   wrap_periodic();
-  detection_options_.search_margin = c.contact.collision_distance;
+  set_reach();
   detection_ = contact::detect(scenario_.floes, shapes_, detection_options_);
   for (const contact::NearPair& p : detection_.pairs)
     if (p.overlap)
@@ -119,18 +122,24 @@ StepContext Simulation::choose_dt(double t_stop) {
       ctx.dt = floe_sea_->stable_step();  // no stop in sight (step(inf))
     }
   }
-  // Event-driven limit from the near pairs (contact/step_limit.hpp).
-  const contact::StepLimit limit = contact::collision_step_limit(
-      scenario_.floes, shapes_, detection_.pairs, detection_options_.collision_distance);
-  if (limit.dt < ctx.dt) {
-    const double floor = kFloorFraction * dt_max;
-    if (limit.dt < floor) {
-      ++floor_steps_;
-      std::ostringstream m;
-      m << "floes " << limit.a << " and " << limit.b << " at distance " << limit.distance << " m, t = " << t_ << " s";
-      floor_pair_ = m.str();
+  // Collisions do not shorten the step: the floes that may meet within it are
+  // sub-stepped by advance() (contact/substep.hpp). With fracture on, the
+  // whole step is cut at the first possible impact (contact/step_limit.hpp)
+  // instead, so every impact falls on the start of a step, where percussion
+  // sees its impulses.
+  if (percussion_) {
+    const contact::StepLimit limit = contact::collision_step_limit(
+        scenario_.floes, shapes_, detection_.pairs, detection_.witnesses, detection_options_.collision_distance);
+    if (limit.dt < ctx.dt) {
+      const double floor = kFloorFraction * dt_max;
+      if (limit.dt < floor) {
+        ++substeps_.floor_steps;
+        std::ostringstream m;
+        m << "floes " << limit.a << " and " << limit.b << " at distance " << limit.distance << " m, t = " << t_ << " s";
+        substeps_.floor_pair = m.str();
+      }
+      ctx.dt = std::max(limit.dt, std::min(floor, ctx.dt));
     }
-    ctx.dt = std::max(limit.dt, std::min(floor, ctx.dt));
   }
   ctx.start = scenario_.floes.state;
   return ctx;
@@ -173,8 +182,11 @@ void Simulation::drift(StepContext& ctx) {
 
 void Simulation::collide(StepContext& ctx) {
   // Contacts were found at the positions of the start of the step; the LCPs
-  // turn W(t-) into W(t+) (contact/impulse.hpp).
-  ctx.impulses = contact::resolve_collisions(scenario_.floes, detection_.contacts, impulse_options_, stats_);
+  // turn W(t-) into W(t+). Contacts the step itself pushed together rest
+  // (restitution 0), and pushed points that would close below xi/2 within the
+  // step are held by speculative contacts (contact/impulse.hpp).
+  contact::resolve_step_collisions(scenario_.floes, ctx.start, detection_, ctx.dt, impulse_options_, stats_,
+                                   percussion_ ? &ctx.impulses : nullptr);
   const Vec2 after = momentum();
   step_budget_.collisions = after - ctx.momentum;
   ctx.momentum = after;
@@ -212,20 +224,48 @@ Vec2 Simulation::momentum() const {
 }
 
 void Simulation::advance(const StepContext& ctx) {
-  advance_positions(scenario_.floes, ctx.dt, 0, scenario_.floes.size());
+  // Free floes move in one go; those that may collide within the step are
+  // sub-stepped event by event, cluster by cluster (contact/substep.hpp). All
+  // the momentum this changes is collisions'.
+  contact::SubstepOptions o;
+  o.collision_distance = detection_options_.collision_distance;
+  o.floor = kFloorFraction * scenario_.config.run.dt_max;
+  o.domain = detection_options_.domain;
+  o.impulse = impulse_options_;
+  const Vec2 before = momentum();
+  contact::advance_with_collisions(scenario_.floes, shapes_, detection_, ctx.dt, o, stats_, substeps_);
+  step_budget_.collisions += momentum() - before;
   if (floe_sea_) FloeSeaContact::drift(scenario_.floes, ctx.dt);
   wrap_periodic();
 }
 
-bool Simulation::detect_and_check(StepContext& ctx) {
-  // Search far enough to see every pair that could meet within the next step.
-  double vmax = 0.0;
-  for (std::size_t i = 0; i < scenario_.floes.size(); ++i) {
-    const FloeState& s = scenario_.floes.state[i];
-    vmax = std::max(vmax, std::hypot(s.vx, s.vy) + std::abs(s.yaw_rate) * shapes_.radius[i]);
+void Simulation::set_reach() {
+  // The pair list must hold every pair that can meet within the next step:
+  // each floe's reach is what it may travel in dt_max at 1.5 times its
+  // present speed (rotation included), plus half the pack's rms speed for
+  // what collisions at the start of the step may give it. A floe that would
+  // still outrun its reach makes the sub-stepper rebuild the list.
+  const Floes& f = scenario_.floes;
+  const double dt_max = scenario_.config.run.dt_max;
+  std::vector<double> speed(f.size(), 0.0);
+  double sum2 = 0.0;
+  std::size_t dynamic = 0;
+  for (std::size_t i = 0; i < f.size(); ++i) {
+    if (f.is_static[i]) continue;
+    const FloeState& s = f.state[i];
+    speed[i] = std::hypot(s.vx, s.vy) + std::abs(s.yaw_rate) * shapes_.radius[i];
+    sum2 += speed[i] * speed[i];
+    ++dynamic;
   }
-  detection_options_.search_margin =
-      std::max(detection_options_.collision_distance, 2.0 * vmax * scenario_.config.run.dt_max);
+  const double rms = dynamic ? std::sqrt(sum2 / static_cast<double>(dynamic)) : 0.0;
+  detection_options_.reach.resize(f.size());
+  for (std::size_t i = 0; i < f.size(); ++i)
+    detection_options_.reach[i] =
+        f.is_static[i] ? 0.0 : dt_max * (1.5 * speed[i] + 0.5 * rms) + detection_options_.collision_distance;
+}
+
+bool Simulation::detect_and_check(StepContext& ctx) {
+  set_reach();
   contact::Detection next = contact::detect(scenario_.floes, shapes_, detection_options_);
   for (const contact::NearPair& p : next.pairs) {
     if (!p.overlap) continue;
@@ -339,10 +379,10 @@ LcpCounters Simulation::lcp_counters() const {
 
 std::vector<std::string> Simulation::warnings() const {
   std::vector<std::string> w;
-  if (floor_steps_)
-    w.push_back(std::to_string(floor_steps_) + " step(s) were held at the floor " +
+  if (substeps_.floor_steps)
+    w.push_back(std::to_string(substeps_.floor_steps) + " sub-step(s) were held at the floor " +
                 std::to_string(kFloorFraction) + " dt_max although the collision limit asked for less (last: " +
-                floor_pair_ + ")");
+                substeps_.floor_pair + ")");
   if (stats_.failures)
     w.push_back(std::to_string(stats_.failures) + " collision LCP(s) failed; those floes kept their velocities");
   if (percussion_ && percussion_->stats().failed_splits)

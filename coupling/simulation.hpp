@@ -3,14 +3,17 @@
 // by one step; the step reads as a table of contents, one named and timed
 // phase per line (MODEL.md §5, the staggered loop):
 //
-//   choose dt (output schedule, dt_max, collision limit, penalty limit)
+//   choose dt (output schedule, dt_max, penalty limit; collision limit only
+//      with fracture on)
 //   -> sample forcing
 //   -> floes' half kick from the sea (penalty loads at t, coupling/floe_sea.hpp)
 //   -> drift velocities (drag relative to current + orbital velocity, wind,
 //      Coriolis) -> collide (LCPs: W(t-) -> W(t+))
 //   -> percussion (fracture checks on the collision impulses; a split floe
 //      becomes two)
-//   -> advance positions (horizontal with W(t+), and the vertical DOFs)
+//   -> advance positions (horizontal: floes that may collide within the step
+//      are sub-stepped event by event, contact/substep.hpp; and the vertical
+//      DOFs)
 //   -> detect (new contacts; an overlap rejects the step, which is redone
 //      with half the dt from the floes at t: the sea has not moved yet)
 //   -> sea: half kick with the pressures at t, exact modal flow over dt
@@ -45,6 +48,7 @@
 #include "contact/detection.hpp"
 #include "contact/impulse.hpp"
 #include "contact/shapes.hpp"
+#include "contact/substep.hpp"
 #include "core/run_file.hpp"
 #include "coupling/scenario.hpp"
 
@@ -108,6 +112,8 @@ public:
   Vec2 momentum() const;  // of the dynamic floes now
   LcpCounters lcp_counters() const;
   const contact::Detection& detection() const { return detection_; }
+  const contact::SubstepReport& substep_report() const { return substeps_; }
+  long rejected_steps() const { return rejected_steps_; }
   // Things a user should hear about once, with a count (e.g. steps cut to the floor).
   std::vector<std::string> warnings() const;
 
@@ -138,6 +144,7 @@ private:
   void advance(const StepContext& ctx);
   bool detect_and_check(StepContext& ctx);  // false: the step overlapped, dt halved
   void wrap_periodic();
+  void set_reach();  // detection reach of each floe for the next step
   void check_state(const StepContext& ctx) const;
 
   Scenario scenario_;
@@ -157,9 +164,8 @@ private:
   contact::CollisionStats stats_;
   std::unique_ptr<Percussion> percussion_;  // [fracture] enabled
   MomentumBudget budget_, step_budget_;  // run total; this step's (redone steps do not count)
-  long floor_steps_ = 0;          // steps the collision limit wanted below the floor
+  contact::SubstepReport substeps_;  // collision sub-steps (floors, merges, ...)
   long rejected_steps_ = 0;       // steps redone after an overlap
-  std::string floor_pair_;        // the last pair that did it
   Profile profile_;
   double t_ = 0.0;
   std::size_t steps_ = 0;

@@ -211,7 +211,33 @@ Result Lemke::run() {
     basis.solve(u);
     const Index p = ratio_test(u);
     if (p < 0) {
+      // A degenerate end: z0 is still basic but (nearly) at zero, so the
+      // almost-complementary point reached, with z0 dropped, solves the LCP
+      // (w = M z + q + d z0). Rounding in the lexicographic ties can leave z0
+      // in the basis at value ~0 on the Stewart–Trinkle LCPs of jammed packs.
+      // Accepted only if that point's residual (lcp.hpp) is within
+      // ray_accept_residual.
       result.status = Status::ray;
+      result.z = read_z(basis, x_);  // the point reached (z0 > 0 there unless accepted below)
+      if (basis.position_of(basis.z0_var()) >= 0 && opt_.ray_accept_residual > 0.0) {
+        // The point as reached, and refined from a fresh factorisation (which
+        // may fail on a nearly singular basis): the better one is kept.
+        Result end;
+        end.z = result.z;
+        double best = residual(lcp_, end.z);
+        Result refined = finish_solved(basis);
+        if (refined.status == Status::solved) {
+          const double refined_residual = residual(lcp_, refined.z);
+          if (refined_residual < best) {
+            best = refined_residual;
+            end.z = refined.z;
+          }
+        }
+        if (best <= opt_.ray_accept_residual) {
+          end.status = Status::solved;
+          result = end;
+        }
+      }
       break;
     }
     const int leaving = basis.variable_at(p);
@@ -235,7 +261,7 @@ Result Lemke::run() {
     entering = basis.complement(leaving);
   }
   if (!ok) result.status = Status::failed;
-  if (result.status != Status::solved) {
+  if (result.status != Status::solved && result.status != Status::ray) {
     // Report the point reached (z0 > 0 there, so it does not solve the LCP).
     result.z = read_z(basis, x_);
   }

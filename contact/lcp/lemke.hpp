@@ -6,7 +6,10 @@
 //   * Status::solved      z >= 0 with w = M z + q; the residual says how well
 //                         (residual() in lcp.hpp; typically 1e-15 .. 1e-12);
 //   * Status::ray         the method ended on a secondary ray: no entering column
-//                         has a positive pivot. For a copositive-plus M (PSD, P,
+//                         has a positive pivot (unless the point reached, z0
+//                         dropped, solves the LCP within ray_accept_residual: a
+//                         degenerate end where z0 sat at ~0 without leaving;
+//                         that is reported solved). For a copositive-plus M (PSD, P,
 //                         non-negative, ...) this proves the LCP infeasible;
 //                         otherwise Lemke simply could not reach a solution;
 //   * Status::pivot_limit more than options.max_pivots pivots;
@@ -61,6 +64,10 @@ struct LemkeOptions {
   double pivot_tolerance = 1e-9;   // relative to ||u||_inf
   double zero_tolerance = 1e-12;   // relative to ||x_B||_inf (and ||B^-1 e_j||_inf)
   double tie_tolerance = 1e-9;     // relative difference of tied ratios
+  // At a secondary ray, the point reached with z0 dropped is reported solved
+  // if its residual is at most this (a degenerate end: z0 at ~0 did not
+  // leave); 0: never.
+  double ray_accept_residual = 1e-9;
   Factorization factorization = Factorization::automatic;
   // automatic: at each refactorisation, the reduced basis C (k x k, k = number
   // of basic z's) goes to UMFPACK when k >= sparse_min_size and C has at most

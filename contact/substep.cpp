@@ -1,0 +1,528 @@
+#include "contact/substep.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numeric>
+#include <queue>
+#include <sstream>
+
+#include "contact/step_limit.hpp"
+#include "core/error.hpp"
+
+namespace floesim::contact {
+
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr int kFree = -1;
+// A sub-step is halved after an overlap down to this fraction of the floor.
+constexpr double kHalvingFloor = 0x1.0p-20;
+
+// Pairs measured with their contact points and witnesses.
+struct Measured {
+  std::vector<NearPair> pairs;
+  std::vector<ContactPoint> contacts;
+  std::vector<Witness> witnesses;
+};
+
+// A cluster being sub-stepped. Its floes move on straight lines between its
+// sub-step ends (tau_snap -> tau), where its collisions are resolved.
+struct Cluster {
+  std::vector<std::uint32_t> members;  // dynamic floes
+  double tau = 0.0;                    // s into the step: where the cluster is
+  double tau_snap = 0.0;               // start of its last sub-step
+  std::vector<FloeState> snap;         // members' states at tau_snap (velocities of that sub-step)
+  std::vector<std::uint32_t> internal; // pairs: members with members, and with obstacles
+  Measured cur;                        // the internal pairs measured at tau
+  bool alive = true;                   // false once merged into another cluster
+  bool events_only = false;            // its time step overlapped: events for the rest of the step
+};
+
+// One call of advance_with_collisions (the steps of substep.hpp). Clusters
+// are advanced in time order, one sub-step at a time (the cluster furthest
+// behind goes next), so when one must merge with another, that one has a
+// sub-step in progress that started no later than now: its floes are put
+// where their straight paths take them now, and the two go on together.
+class Stepper {
+public:
+  Stepper(Floes& floes, const CollisionShapes& shapes, const Detection& detection, double dt,
+          const SubstepOptions& options, CollisionStats& stats, SubstepReport& report)
+      : floes_(floes), shapes_(shapes), det_(&detection), dt_(dt), opt_(options), stats_(stats), report_(report) {}
+
+  void run() {
+    const std::size_t n = floes_.size();
+    start_ = floes_.state;
+    lin_.assign(n, 0.0);
+    bool outrun = false;
+    for (std::size_t i = 0; i < n; ++i) {
+      if (floes_.is_static[i]) continue;
+      const FloeState& s = start_[i];
+      lin_[i] = (std::hypot(s.vx, s.vy) + std::abs(s.yaw_rate) * shapes_.radius[i]) * dt_;
+      outrun = outrun || lin_[i] > det_->reach[i];
+    }
+    if (outrun) rebuild_pairs();
+    build_pair_index();
+    room_.resize(det_->pairs.size());
+    for (std::size_t p = 0; p < det_->pairs.size(); ++p) {
+      const NearPair& q = det_->pairs[p];
+      room_[p] = pair_room(floes_, shapes_, q, witnesses_of(q, det_->witnesses), opt_.collision_distance, dt_);
+    }
+    make_clusters();
+    reach_left_.assign(n, kInf);
+    budget_.assign(n, kInf);
+    outran_.assign(n, 0);
+    for (std::size_t i = 0; i < n; ++i)
+      if (!floes_.is_static[i]) reach_left_[i] = det_->reach[i] - lin_[i];
+    if (clusters_.empty()) {
+      for (std::size_t i = 0; i < n; ++i)
+        if (!floes_.is_static[i]) floes_.state[i] = linear(static_cast<std::uint32_t>(i), dt_);
+      return;
+    }
+    posed_ = PosedShapes(floes_, shapes_);
+    // Free floes go to the end of the step now: nobody reads them before, and
+    // a floe that joins a cluster is put back on its straight path.
+    for (std::size_t i = 0; i < n; ++i)
+      if (!floes_.is_static[i] && cluster_of_[i] == kFree) floes_.state[i] = linear(static_cast<std::uint32_t>(i), dt_);
+    // Time order: a min-heap of (tau, cluster); stale entries are skipped.
+    using Entry = std::pair<double, int>;
+    std::priority_queue<Entry, std::vector<Entry>, std::greater<Entry>> queue;
+    for (std::size_t k = 0; k < clusters_.size(); ++k) {
+      Cluster& c = clusters_[k];
+      compute_budgets(static_cast<int>(k));
+      collect_internal(static_cast<int>(k));
+      measure_internal(c);
+      snapshot(c);
+      queue.push({0.0, static_cast<int>(k)});
+    }
+    while (!queue.empty()) {
+      const auto [tau, k] = queue.top();
+      queue.pop();
+      Cluster& c = clusters_[static_cast<std::size_t>(k)];
+      if (!c.alive || tau != c.tau || !(c.tau < dt_)) continue;
+      advance_cluster(k);
+      if (c.alive && c.tau < dt_) queue.push({c.tau, k});
+    }
+    for (const Cluster& c : clusters_)
+      if (c.alive) {
+        ++report_.clusters;
+        report_.largest_cluster = std::max(report_.largest_cluster, static_cast<long>(c.members.size()));
+      }
+  }
+
+private:
+  std::uint32_t other(std::uint32_t p, std::uint32_t i) const {
+    const NearPair& q = det_->pairs[p];
+    return q.a == i ? q.b : q.a;
+  }
+
+  // The floe on its straight path, tau after the start of the step.
+  FloeState linear(std::uint32_t i, double tau) const {
+    FloeState s = start_[i];
+    s.x += tau * s.vx;
+    s.y += tau * s.vy;
+    s.yaw += tau * s.yaw_rate;
+    return s;
+  }
+
+  // How far any point of floe i is from where its straight path would put it.
+  double deviation(std::uint32_t i, double tau) const {
+    const FloeState l = linear(i, tau);
+    const FloeState& s = floes_.state[i];
+    return std::hypot(s.x - l.x, s.y - l.y) + shapes_.radius[i] * std::abs(s.yaw - l.yaw);
+  }
+
+  void rebuild_pairs() {
+    DetectionOptions o;
+    o.collision_distance = opt_.collision_distance;
+    o.domain = opt_.domain;
+    o.reach = det_->reach;
+    o.horizon = dt_;
+    for (std::size_t i = 0; i < o.reach.size(); ++i) o.reach[i] = std::max(o.reach[i], 1.5 * lin_[i]);
+    rebuilt_ = detect(floes_, shapes_, o);
+    det_ = &rebuilt_;
+    ++report_.rebuilt;
+  }
+
+  // pairs_of(i): indices of the candidate pairs of floe i (compressed rows).
+  void build_pair_index() {
+    const std::size_t n = floes_.size();
+    pair_offsets_.assign(n + 1, 0);
+    for (const NearPair& q : det_->pairs) {
+      ++pair_offsets_[q.a + 1];
+      ++pair_offsets_[q.b + 1];
+    }
+    std::partial_sum(pair_offsets_.begin(), pair_offsets_.end(), pair_offsets_.begin());
+    pair_list_.resize(pair_offsets_[n]);
+    std::vector<std::size_t> fill(pair_offsets_.begin(), pair_offsets_.end() - 1);
+    for (std::size_t p = 0; p < det_->pairs.size(); ++p) {
+      pair_list_[fill[det_->pairs[p].a]++] = static_cast<std::uint32_t>(p);
+      pair_list_[fill[det_->pairs[p].b]++] = static_cast<std::uint32_t>(p);
+    }
+    stamp_.assign(det_->pairs.size(), 0);
+  }
+  std::span<const std::uint32_t> pairs_of(std::uint32_t i) const {
+    return {pair_list_.data() + pair_offsets_[i], pair_offsets_[i + 1] - pair_offsets_[i]};
+  }
+
+  // Clusters: connected components of the hot pairs between dynamic floes,
+  // grown through tight pairs (room below xi: a floe of the cluster that
+  // collides would soon bring the other in anyway, one at a time), numbered
+  // by their lowest floe.
+  void make_clusters() {
+    const std::size_t n = floes_.size();
+    std::vector<std::uint32_t> parent(n);
+    std::iota(parent.begin(), parent.end(), 0u);
+    auto find = [&](std::uint32_t i) {
+      while (parent[i] != i) i = parent[i] = parent[parent[i]];
+      return i;
+    };
+    std::vector<std::uint8_t> hot(n, 0);
+    const double tight = opt_.collision_distance;
+    for (std::size_t p = 0; p < det_->pairs.size(); ++p) {
+      if (!(room_[p] < tight)) continue;
+      const NearPair& q = det_->pairs[p];
+      const bool da = !floes_.is_static[q.a], db = !floes_.is_static[q.b];
+      if (room_[p] < 0.0) {
+        if (da) hot[q.a] = 1;
+        if (db) hot[q.b] = 1;
+      }
+      if (da && db) parent[find(q.a)] = find(q.b);
+    }
+    // A jam (a contact component of jam_floes floes or more, impulse.hpp)
+    // joins a cluster whole: its floes would come in one by one anyway, each
+    // time with an LCP of the part that came in so far.
+    find_jams();
+    for (std::uint32_t i = 0; i < n; ++i)
+      if (jam_of_[i] >= 0) parent[find(i)] = find(jams_[static_cast<std::size_t>(jam_of_[i])].front());
+    std::vector<std::uint8_t> active_root(n, 0);
+    for (std::uint32_t i = 0; i < n; ++i)
+      if (hot[i]) active_root[find(i)] = 1;
+    cluster_of_.assign(n, kFree);
+    std::vector<int> of_root(n, kFree);
+    for (std::uint32_t i = 0; i < n; ++i) {
+      if (floes_.is_static[i] || !active_root[find(i)]) continue;
+      const std::uint32_t r = find(i);
+      if (of_root[r] == kFree) {
+        of_root[r] = static_cast<int>(clusters_.size());
+        clusters_.emplace_back();
+      }
+      cluster_of_[i] = of_root[r];
+      clusters_[static_cast<std::size_t>(of_root[r])].members.push_back(i);
+    }
+  }
+
+  // jam_of_[i]: the jam of floe i (-1: none), jams_: their floes.
+  void find_jams() {
+    const std::size_t n = floes_.size();
+    std::vector<std::uint32_t> parent(n);
+    std::iota(parent.begin(), parent.end(), 0u);
+    auto find = [&](std::uint32_t i) {
+      while (parent[i] != i) i = parent[i] = parent[parent[i]];
+      return i;
+    };
+    for (const ContactPoint& c : det_->contacts)
+      if (!floes_.is_static[c.a] && !floes_.is_static[c.b]) parent[find(c.a)] = find(c.b);
+    std::vector<std::uint32_t> size(n, 0);
+    for (std::uint32_t i = 0; i < n; ++i)
+      if (!floes_.is_static[i]) ++size[find(i)];
+    jam_of_.assign(n, -1);
+    std::vector<int> of_root(n, -1);
+    for (std::uint32_t i = 0; i < n; ++i) {
+      const std::uint32_t r = find(i);
+      if (floes_.is_static[i] || size[r] < opt_.impulse.jam_floes) continue;
+      if (of_root[r] < 0) {
+        of_root[r] = static_cast<int>(jams_.size());
+        jams_.emplace_back();
+      }
+      jam_of_[i] = of_root[r];
+      jams_[static_cast<std::size_t>(of_root[r])].push_back(i);
+    }
+  }
+
+  // Budget of each member: half the room of each pair with a floe outside
+  // the cluster (obstacles do not move: their pairs are internal).
+  void compute_budgets(int k) {
+    for (std::uint32_t i : clusters_[static_cast<std::size_t>(k)].members) {
+      double b = kInf;
+      for (std::uint32_t p : pairs_of(i)) {
+        const std::uint32_t j = other(p, i);
+        if (floes_.is_static[j] || cluster_of_[j] == k) continue;
+        b = std::min(b, 0.5 * room_[p]);
+      }
+      budget_[i] = b;
+    }
+  }
+
+  void collect_internal(int k) {
+    Cluster& c = clusters_[static_cast<std::size_t>(k)];
+    c.internal.clear();
+    ++epoch_;
+    for (std::uint32_t i : c.members)
+      for (std::uint32_t p : pairs_of(i)) {
+        if (stamp_[p] == epoch_) continue;
+        const std::uint32_t j = other(p, i);
+        if (!floes_.is_static[j] && cluster_of_[j] != k) continue;
+        stamp_[p] = epoch_;
+        c.internal.push_back(p);
+      }
+  }
+
+  // Measures a cluster's internal pairs at the present poses into m; true if
+  // one overlaps.
+  bool measure(const Cluster& c, Measured& m) const {
+    m.pairs.clear();
+    m.contacts.clear();
+    m.witnesses.clear();
+    bool overlap = false;
+    for (std::uint32_t p : c.internal) {
+      const NearPair& q = det_->pairs[p];
+      const double range = exact_range(floes_, shapes_, q.a, q.b, dt_, opt_.collision_distance);
+      m.pairs.push_back(measure_pair(posed_, q.a, q.b, q.shift, opt_.collision_distance, range, m.contacts, m.witnesses));
+      overlap = overlap || m.pairs.back().overlap;
+    }
+    return overlap;
+  }
+  void measure_internal(Cluster& c) {
+    for (std::uint32_t i : c.members) posed_.update(floes_, i);
+    measure(c, c.cur);
+  }
+
+  void snapshot(Cluster& c) {
+    c.snap.clear();
+    for (std::uint32_t i : c.members) c.snap.push_back(floes_.state[i]);
+    c.tau_snap = c.tau;
+  }
+  void restore(Cluster& c) {
+    for (std::size_t m = 0; m < c.snap.size(); ++m) floes_.state[c.members[m]] = c.snap[m];
+  }
+
+  // One event of cluster k: a sub-step, or floes joining it at its time.
+  void advance_cluster(int k) {
+    Cluster& c = clusters_[static_cast<std::size_t>(k)];
+    if (c.members.size() >= opt_.impulse.jam_floes && !c.events_only) {
+      time_step(k);
+      return;
+    }
+    const double xi = opt_.collision_distance;
+    double limit = kInf;
+    const NearPair* by = nullptr;
+    for (const NearPair& q : c.cur.pairs) {
+      const double l = pair_step_limit(floes_, shapes_, q, witnesses_of(q, c.cur.witnesses), xi);
+      if (l < limit) {
+        limit = l;
+        by = &q;
+      }
+    }
+    double h = std::min(limit, dt_ - c.tau);
+    if (h < opt_.floor && dt_ - c.tau > opt_.floor) {
+      h = opt_.floor;
+      ++report_.floor_steps;
+      std::ostringstream m;
+      m << "floes " << by->a << " and " << by->b << " at distance " << by->distance << " m, " << c.tau
+        << " s into the step";
+      report_.floor_pair = m.str();
+    }
+    snapshot(c);
+    for (;;) {
+      const bool last = h >= dt_ - c.tau;
+      const double t1 = last ? dt_ : c.tau + h;
+      for (std::size_t m = 0; m < c.members.size(); ++m) {
+        FloeState& s = floes_.state[c.members[m]];
+        s = c.snap[m];
+        s.x += h * s.vx;
+        s.y += h * s.vy;
+        s.yaw += h * s.yaw_rate;
+      }
+      // Budgets: the pairs with floes outside that this sub-step would break
+      // bring those floes in, at the cluster's time.
+      joining_.clear();
+      merging_.clear();
+      collect_breaks(k, t1);
+      if (!joining_.empty() || !merging_.empty()) {
+        restore(c);
+        bring_in(k);
+        return;
+      }
+      for (std::uint32_t i : c.members) posed_.update(floes_, i);
+      if (!measure(c, next_)) {
+        c.tau = t1;
+        std::swap(c.cur, next_);
+        ++report_.substeps;
+        // Collisions at the end of the sub-step (at the end of the step they
+        // are left to the next step, which starts with them).
+        if (c.tau < dt_ && !c.cur.contacts.empty()) resolve_collisions(floes_, c.cur.contacts, opt_.impulse, stats_);
+        return;
+      }
+      // Overlap: redo with half the length.
+      ++report_.rejected;
+      restore(c);
+      h *= 0.5;
+      if (h < kHalvingFloor * opt_.floor) {
+        const NearPair* bad = nullptr;
+        for (const NearPair& q : next_.pairs)
+          if (q.overlap) bad = &q;
+        std::ostringstream m;
+        m << "floes " << bad->a << " and " << bad->b << " overlap however short the sub-step, " << c.tau
+          << " s into the step";
+        throw RunError(m.str());
+      }
+    }
+  }
+
+  // The floes outside cluster k whose pairs with its members, now at time t1,
+  // are past the members' budgets: free ones to joining_, clusters to merging_.
+  void collect_breaks(int k, double t1) {
+    for (std::uint32_t i : clusters_[static_cast<std::size_t>(k)].members) {
+      const double dev = deviation(i, t1);
+      if (dev > reach_left_[i] && !outran_[i]) {
+        outran_[i] = 1;
+        ++report_.reach_exceeded;
+      }
+      if (!(dev > budget_[i])) continue;
+      for (std::uint32_t p : pairs_of(i)) {
+        const std::uint32_t j = other(p, i);
+        if (floes_.is_static[j] || cluster_of_[j] == k || !(0.5 * room_[p] < dev)) continue;
+        if (cluster_of_[j] == kFree) joining_.push_back(j);
+        else merging_.push_back(cluster_of_[j]);
+      }
+    }
+  }
+
+  // A dense cluster (jam_floes floes or more) takes the rest of the step in
+  // one go: its contacts rest and every point of its pairs beyond xi is a
+  // speculative contact for that time (impulse.hpp), one LCP instead of an
+  // event, and an LCP of the whole cluster, each time one of its many pairs
+  // meets. If that overlaps after all (a pair turning faster than its
+  // witnesses tell), the cluster goes back to events for the rest of the step.
+  void time_step(int k) {
+    Cluster& c = clusters_[static_cast<std::size_t>(k)];
+    const double xi = opt_.collision_distance;
+    const double h = dt_ - c.tau;
+    std::vector<ContactPoint> contacts = c.cur.contacts;
+    for (const NearPair& q : c.cur.pairs)
+      for (const Witness& w : witnesses_of(q, c.cur.witnesses))
+        if (w.distance >= xi) contacts.push_back({q.a, q.b, 0.5 * (w.pa + w.pb), w.normal, w.distance, q.shift, true});
+    const std::vector<std::uint8_t> resting(contacts.size(), 1);
+    ImpulseOptions impulse = opt_.impulse;
+    impulse.speculative_step = h;
+    snapshot(c);
+    const std::vector<FloeState> before = c.snap;
+    resolve_collisions(floes_, contacts, impulse, stats_, resting);
+    snapshot(c);  // the velocities of the time step, for merges that look back into it
+    auto undo = [&] {
+      for (std::size_t m = 0; m < before.size(); ++m) floes_.state[c.members[m]] = before[m];
+      c.snap = before;
+    };
+    for (std::size_t m = 0; m < c.members.size(); ++m) {
+      FloeState& s = floes_.state[c.members[m]];
+      s.x += h * s.vx;
+      s.y += h * s.vy;
+      s.yaw += h * s.yaw_rate;
+    }
+    joining_.clear();
+    merging_.clear();
+    collect_breaks(k, dt_);
+    if (!joining_.empty() || !merging_.empty()) {
+      undo();
+      bring_in(k);
+      return;
+    }
+    for (std::uint32_t i : c.members) posed_.update(floes_, i);
+    if (measure(c, next_)) {
+      undo();
+      for (std::uint32_t i : c.members) posed_.update(floes_, i);
+      c.events_only = true;
+      ++report_.rejected;
+      return;
+    }
+    c.tau = dt_;
+    std::swap(c.cur, next_);
+    ++report_.substeps;
+    ++report_.time_steps;
+  }
+
+  // The floes in joining_ (free) and the clusters in merging_ join cluster k
+  // at its time: a free floe where its straight path puts it, a cluster's
+  // floes where its sub-step in progress puts them (it started no later than
+  // now: time order). Then the collisions at that time are resolved.
+  void bring_in(int k) {
+    Cluster& c = clusters_[static_cast<std::size_t>(k)];
+    // A jam comes in whole (make_clusters).
+    for (std::size_t m = 0, n = joining_.size(); m < n; ++m) {
+      const int jam = jam_of_[joining_[m]];
+      if (jam < 0) continue;
+      for (std::uint32_t f : jams_[static_cast<std::size_t>(jam)]) {
+        if (cluster_of_[f] == kFree) joining_.push_back(f);
+        else if (cluster_of_[f] != k) merging_.push_back(cluster_of_[f]);
+      }
+    }
+    std::sort(joining_.begin(), joining_.end());
+    joining_.erase(std::unique(joining_.begin(), joining_.end()), joining_.end());
+    for (std::uint32_t j : joining_) {
+      cluster_of_[j] = k;
+      c.members.push_back(j);
+      floes_.state[j] = linear(j, c.tau);
+      ++report_.joined;
+    }
+    std::sort(merging_.begin(), merging_.end());
+    merging_.erase(std::unique(merging_.begin(), merging_.end()), merging_.end());
+    for (int l : merging_) {
+      Cluster& o = clusters_[static_cast<std::size_t>(l)];
+      const double since = c.tau - o.tau_snap;  // >= 0 by the time order
+      for (std::size_t m = 0; m < o.members.size(); ++m) {
+        FloeState s = o.snap[m];
+        s.x += since * s.vx;
+        s.y += since * s.vy;
+        s.yaw += since * s.yaw_rate;
+        floes_.state[o.members[m]] = s;
+        cluster_of_[o.members[m]] = k;
+        c.members.push_back(o.members[m]);
+      }
+      o.members.clear();
+      o.alive = false;
+      ++report_.merges;
+    }
+    compute_budgets(k);
+    collect_internal(k);
+    measure_internal(c);
+    if (!c.cur.contacts.empty()) resolve_collisions(floes_, c.cur.contacts, opt_.impulse, stats_);
+    snapshot(c);
+  }
+
+  Floes& floes_;
+  const CollisionShapes& shapes_;
+  const Detection* det_;
+  Detection rebuilt_;  // when the pair list had to be rebuilt
+  double dt_;
+  const SubstepOptions& opt_;
+  CollisionStats& stats_;
+  SubstepReport& report_;
+
+  std::vector<FloeState> start_;       // at the start of the step: the straight paths
+  std::vector<double> lin_;            // m, linear travel of each floe over the step
+  std::vector<double> room_;           // m, per pair, over the step on straight paths
+  std::vector<std::size_t> pair_offsets_;
+  std::vector<std::uint32_t> pair_list_;
+  std::vector<int> cluster_of_;        // kFree or a cluster
+  std::vector<Cluster> clusters_;
+  std::vector<double> budget_, reach_left_;  // m, per floe
+  std::vector<std::uint8_t> outran_;
+  PosedShapes posed_;
+  std::vector<std::uint32_t> stamp_;
+  std::uint32_t epoch_ = 0;
+  Measured next_;                      // a cluster's pairs after the sub-step being tried
+  std::vector<std::uint32_t> joining_;
+  std::vector<int> merging_;
+  std::vector<int> jam_of_;                      // per floe: its jam, or -1
+  std::vector<std::vector<std::uint32_t>> jams_; // the floes of each jam
+};
+
+}  // namespace
+
+void advance_with_collisions(Floes& floes, const CollisionShapes& shapes, const Detection& detection, double dt,
+                             const SubstepOptions& options, CollisionStats& stats, SubstepReport& report) {
+  Stepper(floes, shapes, detection, dt, options, stats, report).run();
+}
+
+}  // namespace floesim::contact

@@ -1,0 +1,80 @@
+#pragma once
+// Multirate advance of the floes over one step of the run: only the floes
+// that may collide within the step are sub-stepped, cluster by cluster; every
+// other floe moves in one go.
+//
+// Contract. On entry the floes are at time t with the velocities they keep
+// over the step (drift done, and the collisions of the contacts found at t
+// resolved: W(t+)); `detection` was measured at these positions, with the
+// reach of each floe (detection.hpp). On exit the positions are at t + dt (not
+// wrapped into a periodic box) and velocities carry the collisions of the
+// step; every pair the sub-steps measured ended each sub-step apart, and
+// every other pair kept at least keep = min(d, xi)/2 of its gap by the bounds
+// below. The caller still re-detects at t + dt and redoes the step if anything
+// overlaps (estimates in step_limit.hpp are not all rigorous).
+//
+// How (one step of length dt):
+//  1. Each candidate pair gets its room over dt (step_limit.hpp) with the
+//     present velocities, as if both floes moved on straight paths ("linear"
+//     below; rotation at a constant rate). A pair whose room is negative may
+//     meet within the step: it is hot. Clusters are the connected components
+//     of hot pairs between dynamic floes (obstacles join no cluster; a hot
+//     pair with an obstacle puts its floe in a cluster of its own).
+//  2. Floes in no cluster are free: they move linearly over dt. Two free floes
+//     keep their room; so does every pair as long as each floe stays close to
+//     its linear path.
+//  3. Each cluster runs event-driven sub-steps of its own: limit from its
+//     internal pairs (members with members, and with obstacles), move,
+//     re-measure those pairs (an overlap halves the sub-step), collide
+//     (impulse.hpp). Its floes' deviation from their linear paths,
+//        dev_i = |X_i - X_i^lin| + R_i |theta_i - theta_i^lin|,
+//     bounds how much closer they got to any floe outside than the linear
+//     bounds said. Each pair with one floe outside splits its room in two
+//     halves, one per floe, so clusters can run one after another: floe i's
+//     budget is the least half-room of its pairs with floes outside, and the
+//     reach it has left (reach_i - its linear travel). A sub-step that would
+//     take a floe past its budget is not taken; instead the pairs it would
+//     break join the cluster: a free floe joins at once (at its linear
+//     position, which is where it is at that time), a floe of another cluster
+//     merges the two clusters, which rerun from the start of the step.
+//  4. A floe whose linear travel exceeds its reach before the step makes the
+//     pair list be rebuilt (once) with a larger reach.
+// With no collision in sight this is one step for every floe; the cost of a
+// collision is the cost of its cluster's sub-steps, not of the whole pack's.
+
+#include <string>
+
+#include "contact/detection.hpp"
+#include "contact/impulse.hpp"
+
+namespace floesim::contact {
+
+struct SubstepOptions {
+  double collision_distance = 0.01;  // xi, m
+  double floor = 1e-5;               // s: a sub-step the limit wants shorter is taken at this length and counted
+  int max_halvings = 40;             // an overlapping sub-step is halved at most this many times
+  Domain domain;                     // to rebuild the pair list
+  ImpulseOptions impulse;
+};
+
+// Running totals of a run.
+struct SubstepReport {
+  long clusters = 0;        // clusters sub-stepped
+  long substeps = 0;        // their sub-steps
+  long time_steps = 0;      // of those, dense clusters' time steps (the rest of a step in one LCP)
+  long largest_cluster = 0; // floes
+  long joined = 0;          // free floes that joined a running cluster
+  long merges = 0;          // cluster merges (the merged cluster reruns the step)
+  long rejected = 0;        // sub-steps redone with half the length after an overlap
+  long floor_steps = 0;     // sub-steps held at the floor
+  long rebuilt = 0;         // pair lists rebuilt for a floe that would outrun its reach
+  long reach_exceeded = 0;  // cluster floes that went past their reach (left to the caller's check)
+  std::string floor_pair;   // the last pair that held a sub-step at the floor
+};
+
+// Advances the floes over dt as stated above. Throws RunError when a sub-step
+// overlaps however short it is made.
+void advance_with_collisions(Floes& floes, const CollisionShapes& shapes, const Detection& detection, double dt,
+                             const SubstepOptions& options, CollisionStats& stats, SubstepReport& report);
+
+}  // namespace floesim::contact
