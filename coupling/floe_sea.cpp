@@ -53,6 +53,10 @@ Eigen::Vector3d solve_tilted(const Eigen::Matrix3d& A, const Eigen::Vector3d& b,
 
 }  // namespace
 
+double FloeSeaContact::subcell_weight(double coverage) const {
+  return 1.0 / (1.0 + K_ * (1.0 - std::clamp(coverage, 0.0, 1.0)));
+}
+
 FloeSeaContact::FloeSeaContact(const CouplingParams& params, const SeaParams& sea_params, const Floes& floes,
                                fluid::Sea& sea)
     : rho_(sea_params.rho), g_(sea_params.g), sigma_(sea_params.sigma), K_(params.stiffness), grid_(sea.grid()) {
@@ -104,7 +108,9 @@ void FloeSeaContact::floes_changed(const Floes& floes) {
     const double gyration = std::sqrt(std::max(eig.eigenvalues()[0], 0.0));
     if (gyration >= 0.5 * std::max(grid_.dx(), grid_.dims == 2 ? grid_.dy() : 0.0))
       tilt_[i] = grid_.dims == 2 ? 2 : 1;
-    if (i >= old) bottom0_[i] = -floes.draft(i, rho_) * (1.0 + 1.0 / K_);
+    // A new floe (a piece of a split) floats at its draft (and compliance)
+    // below the calm sea's free level, as its parent did.
+    if (i >= old) bottom0_[i] = free_level_ - floes.draft(i, rho_) * (1.0 + 1.0 / K_);
     if (dynamic_[i]) min_mass_per_area = std::min(min_mass_per_area, rh);
   }
   stable_step_ = INFINITY;
@@ -128,9 +134,12 @@ void FloeSeaContact::start(Floes& floes, fluid::Sea& sea, bool given) {
   const fluid::SurfaceGrid& grid = sea.grid();
   const std::size_t n = floes.size();
   pressure_.assign(grid.size(), 0.0);  // evaluate() clears only the footprints' cells
+  coverage_.assign(grid.size(), 0.0);
+  cell_sum_.assign(grid.size(), 0.0);
   pressure_kicked_ = false;
   build_footprints(floes, dynamic_, grid, footprints_);
   if (given) {
+    free_level_ = 0.0;
     for (std::size_t i = 0; i < n; ++i) bottom0_[i] = -floes.draft(i, rho_) * (1.0 + 1.0 / K_);
     return;
   }
@@ -141,14 +150,19 @@ void FloeSeaContact::start(Floes& floes, fluid::Sea& sea, bool given) {
   std::vector<double> z(n, 0.0);
   std::vector<Vec2> a(n, Vec2::Zero());
   auto zb = [&](std::size_t i, std::size_t k) { return z[i] + a[i].dot(fp.centroid[k]); };
+  // psi of each piece (the sub-cell weight of its cell's coverage) and its
+  // weight phi psi in the cell's balance.
+  std::vector<double> coverage(grid.size(), 0.0), psi(fp.cell.size());
+  for (std::size_t k = 0; k < fp.cell.size(); ++k) coverage[fp.cell[k]] += fp.area[k] / cell_area_;
+  for (std::size_t k = 0; k < fp.cell.size(); ++k) psi[k] = subcell_weight(coverage[fp.cell[k]]);
+  auto weight = [&](std::size_t k) { return fp.area[k] / cell_area_ * psi[k]; };
   for (std::size_t i = 0; i < n; ++i) {
     if (!dynamic_[i]) continue;
     z[i] = -floes.draft(i, rho_) * (1.0 + 1.0 / K_);
-    for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k) F[fp.cell[k]] += std::pow(fp.area[k] / cell_area_, 2);
+    for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k) F[fp.cell[k]] += weight(k);
   }
   // Gauss–Seidel over the floes from the present z, a, with the free level W
   // (+ L); fills eta (zero mean) and returns the L that makes it so.
-  auto weight = [&](std::size_t k) { return std::pow(fp.area[k] / cell_area_, 2); };
   auto solve = [&](std::span<const double> W) {
     std::fill(S.begin(), S.end(), 0.0);
     for (std::size_t i = 0; i < n; ++i)
@@ -164,8 +178,8 @@ void FloeSeaContact::start(Floes& floes, fluid::Sea& sea, bool given) {
         Eigen::Vector3d b(-floes.mass[i] * g_ / kappa_, 0.0, 0.0);
         for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k) {
           const std::uint32_t c = fp.cell[k];
-          const double f = fp.area[k] / cell_area_;
-          const double Fo = F[c] - f * f, So = S[c] - f * f * zb(i, k);
+          const double f = psi[k], w = weight(k);
+          const double Fo = F[c] - w, So = S[c] - w * zb(i, k);
           const double alpha = (W[c] + K_ * So) / (1.0 + K_ * F[c]), beta = (1.0 + K_ * Fo) / (1.0 + K_ * F[c]);
           const Eigen::Vector3d phi(1.0, fp.centroid[k].x(), fp.centroid[k].y());
           A += f * fp.area[k] * beta * phi * phi.transpose();
@@ -197,6 +211,7 @@ void FloeSeaContact::start(Floes& floes, fluid::Sea& sea, bool given) {
     return mean;
   };
   const double calm_level = solve(std::vector<double>(grid.size(), 0.0));
+  free_level_ = -calm_level;  // the free water's level once eta has zero mean
   for (std::size_t i = 0; i < n; ++i)
     if (dynamic_[i]) bottom0_[i] = z[i] - calm_level;
   // The waves in the sea: the floes start from the least-squares plane of the
@@ -246,9 +261,14 @@ void FloeSeaContact::start(Floes& floes, fluid::Sea& sea, bool given) {
 void FloeSeaContact::evaluate(const Floes& floes, fluid::Sea& sea, double h) {
   const fluid::SurfaceGrid& grid = sea.grid();
   // The pressure is zero outside the footprints: clear the cells of the last
-  // ones rather than the whole grid.
-  if (pressure_.size() != grid.size()) pressure_.assign(grid.size(), 0.0);
-  else for (std::uint32_t c : footprints_.cell) pressure_[c] = 0.0;
+  // ones rather than the whole grid (and the cells' coverage and sums).
+  if (pressure_.size() != grid.size()) {
+    pressure_.assign(grid.size(), 0.0);
+    coverage_.assign(grid.size(), 0.0);
+    cell_sum_.assign(grid.size(), 0.0);
+  } else {
+    for (std::uint32_t c : footprints_.cell) pressure_[c] = coverage_[c] = cell_sum_[c] = 0.0;
+  }
   pressure_kicked_ = false;
   build_footprints(floes, dynamic_, grid, footprints_);
   const Footprints& fp = footprints_;
@@ -256,9 +276,13 @@ void FloeSeaContact::evaluate(const Floes& floes, fluid::Sea& sea, double h) {
   std::span<const double> w;
   if (s_ < 1.0) w = sea.field(fluid::Field::velocity_z);
   const double ks = s_ * kappa_, inv_cell_area = 1.0 / cell_area_;
+  for (std::size_t k = 0; k < fp.cell.size(); ++k) coverage_[fp.cell[k]] += fp.area[k] * inv_cell_area;
   double energy = 0.0;
   thread_local std::vector<double> u;  // [delta]^+ of each area piece
+  thread_local std::vector<double> wetted;  // per floe: sum psi_c a_c u_c
   u.resize(fp.cell.size());
+  wetted.assign(floes.size(), 0.0);
+  // Vertical: the law on each area piece.
   for (std::size_t i = 0; i < floes.size(); ++i) {
     FloeSeaLoad& load = loads_[i];
     load = {};
@@ -267,10 +291,9 @@ void FloeSeaContact::evaluate(const Floes& floes, fluid::Sea& sea, double h) {
     const double z = st.heave + bottom0_[i];
     const Vec2 a{st.pitch, st.roll}, ar{st.pitch_rate, st.roll_rate};
     const double c = (1.0 - s_) * weak_coefficient(floes, i);
-    const double damper = c / (1.0 + h * c * (1.0 / (floes.density[i] * floes.thickness[i]) + sea_inverse_mass_));
-    double fz = 0.0, wetted = 0.0;  // wetted: sum phi_c a_c u_c
-    Vec2 moment = Vec2::Zero(), fh = Vec2::Zero();
-    double torque = 0.0;
+    const double inv_mass = 1.0 / (floes.density[i] * floes.thickness[i]) + sea_inverse_mass_;
+    double fz = 0.0, wet = 0.0;
+    Vec2 moment = Vec2::Zero();
     for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k) {
       const Vec2& r = fp.centroid[k];
       const std::uint32_t cell = fp.cell[k];
@@ -280,47 +303,63 @@ void FloeSeaContact::evaluate(const Floes& floes, fluid::Sea& sea, double h) {
         continue;
       }
       u[k] = delta;
-      const double area = fp.area[k], cover = area * inv_cell_area;  // phi_c
-      double f = ks * cover * area * delta;
-      energy += 0.5 * ks * cover * area * delta * delta;
-      wetted += cover * area * delta;
+      const double area = fp.area[k], psi = subcell_weight(coverage_[cell]);
+      double f = ks * psi * area * delta;
+      energy += 0.5 * ks * psi * area * delta * delta;
+      wet += psi * area * delta;
+      cell_sum_[cell] += area * delta * delta;
       if (c > 0.0) {
         const double rate = w[cell] - st.heave_rate - ar.dot(r);
-        f += cover * area * damper * rate;
+        f += area * psi * c / (1.0 + h * psi * c * inv_mass) * rate;
       }
       pressure_[cell] += f * inv_cell_area;
       fz += f;
       moment += f * r;
     }
-    // Strong part, horizontal: -dV/dG and -dV/dyaw through the edge pieces.
-    if (ks > 0.0) {
+    wetted[i] = wet;
+    load.vertical = {fz - floes.mass[i] * g_, moment.x(), moment.y()};
+  }
+  // Strong part, horizontal: -dV/dG and -dV/dyaw through the edge pieces. The
+  // coverage Phi_c moves with every floe's edge in cell c, so an edge also
+  // carries psi'(Phi_c) / (2 A) sum_k a_k u_k^2 of the cell's pieces.
+  if (ks > 0.0) {
+    for (std::size_t i = 0; i < floes.size(); ++i) {
+      if (!dynamic_[i]) continue;
+      const FloeState& st = floes.state[i];
+      const Vec2 a{st.pitch, st.roll};
+      Vec2 fh = Vec2::Zero();
+      double torque = 0.0;
       for (std::size_t k = fp.edge_offsets[i]; k < fp.edge_offsets[i + 1]; ++k) {
         const std::ptrdiff_t piece = fp.edge_piece[k];
-        if (piece < 0 || u[piece] <= 0.0) continue;
-        const double up = u[piece];
+        if (piece < 0) continue;
+        const std::uint32_t cell = fp.edge_cell[k];
+        const double up = u[piece], sum = cell_sum_[cell];
+        if (up <= 0.0 && sum <= 0.0) continue;
+        const double psi = subcell_weight(coverage_[cell]);
+        const double dpsi = K_ * psi * psi;  // d psi / d Phi
         const Vec2& A = fp.edge_a[k];
         const Vec2& B = fp.edge_b[k];
         const Vec2 e = B - A;
-        const Vec2 N{e.y(), -e.x()};                     // ∮ n ds
+        const Vec2 N{e.y(), -e.x()};                     // ∮ n ds = d a_c / dG
         const Vec2 mid = 0.5 * (A + B);
-        // Q^T a = ∮ (r . a) n ds;  T = ∮ r x n ds = -mid . e
+        // Q^T a = ∮ (r . a) n ds;  T = ∮ r x n ds = -mid . e = d a_c / dyaw
         const double ra = mid.dot(a);
         const double T = -mid.dot(e);
         // S = ∮ r (r x n) ds = -[A (A.e) + (A (e.e) + e (A.e)) / 2 + e (e.e) / 3]
         const double ae = A.dot(e), ee = e.dot(e);
         const Vec2 S = -(A * ae + 0.5 * (A * ee + e * ae) + e * (ee / 3.0));
         const Vec2& rc = fp.centroid[piece];
-        const double kf = ks * fp.area[piece] / cell_area_;
-        const Vec2 dVdG = kf * (up * up * N - up * (ra * N - a.dot(rc) * N));
-        const double dVdyaw = kf * (up * up * T - up * a.dot(S - rc * T));
+        const double area_term = 0.5 * ks * (psi * up * up + dpsi * sum * inv_cell_area);  // dV / d a_c
+        const double kf = ks * psi;
+        const Vec2 dVdG = area_term * N - kf * up * (ra * N - a.dot(rc) * N);
+        const double dVdyaw = area_term * T - kf * up * a.dot(S - rc * T);
         fh -= dVdG;
         torque -= dVdyaw;
       }
-      // The explicit-G term of dV/dG: -phi_c a_c u a, summed over the area pieces.
-      fh -= ks * wetted * a;
+      // The explicit-G term of dV/dG: -psi_c a_c u a, summed over the area pieces.
+      fh -= ks * wetted[i] * a;
+      loads_[i].horizontal = {fh.x(), fh.y(), torque};
     }
-    load.vertical = {fz - floes.mass[i] * g_, moment.x(), moment.y()};
-    load.horizontal = {fh.x(), fh.y(), torque};
   }
   penalty_energy_ = energy;
 }

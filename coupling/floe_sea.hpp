@@ -8,46 +8,45 @@
 // piece c of its footprint (coupling/footprint.hpp: cell c of the sea grid,
 // area a_c, centroid r_c) the penetration is delta_c = eta_c - z_b(G + r_c)
 // and the law (coupling/penalty_law.hpp) gives the force
-//     f_c = phi_c a_c (s kappa [delta_c]^+ + (1 - s) c_i delta_c' 1[delta_c > 0]),
-// up on the floe, down on the water (pressure f_c / cell area on cell c), with
-// phi_c = a_c / cell area the piece's share of its cell.
+//     f_c = psi_c a_c (s kappa [delta_c]^+ + (1 - s) c_i delta_c' 1[delta_c > 0]),
+// up on the floe, down on the water (pressure f_c / cell area on cell c).
 //
-// Why phi_c: the sea knows one elevation per cell. A floe edge that covers a
-// sliver of a cell sees that cell's mean water level, which at rest sits
-// close to the free level, not to the floe's bottom, so an unweighted law
-// would push there with the full draft as penetration: a force that jumps as
-// the edge enters a cell. Weighted by phi_c the penalty energy of a piece
-// grows as a_c^2 from zero and the forces are continuous (C^1 energy). The
-// grid still resolves the edge only to a cell: a partly covered cell's water
-// is held down nearly as a whole, so the floating depth converges as O(dx / L)
-// (docs/coupling.md gives the measured figures).
+// Partly covered cells: psi_c = 1 / (1 + K (1 - Phi_c)), Phi_c the share of
+// cell c covered by floes (all pieces in the cell). The sea knows one level
+// per cell, eta_c; in a cell covered to the share Phi the water under the
+// floe (level w_u) and the free water (w_f) share it, Phi w_u + (1 - Phi) w_f
+// = eta_c. Splitting the cell's water into two levels costs the hydrostatic
+// energy rho g A Phi (1 - Phi) (w_u - w_f)^2 / 2 beyond that of the mean,
+// and the penalty acts on the water under the floe, kappa/2 a [w_u - z_b]^+^2.
+// Minimising over the split (it is instantaneous at the grid's scale) leaves
+//     V_c = kappa / 2 psi_c a_c [eta_c - z_b]^+^2,  psi = 1 / (1 + K (1 - Phi)),
+// the law above. At rest on a calm sea (local static response eta = -p / (rho
+// g)) every piece then carries rho g a_c d K / (1 + K) whatever its share of
+// the cell, and the cell's level is Phi times the floe's depth: the floating
+// depth is d (1 + 1/K) at any resolution, and the static energy of a floe
+// does not depend on where it sits in the cells (no cogging; tests in
+// tests/coupling/test_subcell.cpp). The energy is C^0 where an edge enters a
+// cell (psi(0) = 1 / (1 + K) > 0: the hydrostatic force on a floe's side).
 //
-// Energy (strong part). With V = s kappa / 2 sum_c phi_c a_c [delta_c]^+^2, the
+// Energy (strong part). With V = s kappa / 2 sum_c psi_c a_c [delta_c]^+^2, the
 // vertical forces are exactly -dV/d(zeta, a) and -dV/d eta_c, so floes + sea
 // + V + the floes' weight M g zeta is a Hamiltonian that the Strang splitting
 // (half kick, exact sea flow and floe drift, half kick) conserves to O(dt^2).
 // The horizontal force and torque of the strong part are -dV/dG and
-// -dV/dyaw of the same discrete V (not a quadrature of -∫ p grad eta): a_c and
-// the first moment of piece c change with G through the floe's boundary in
-// cell c (Reynolds' transport theorem), so with the edge pieces A -> B in the
-// cell, N_c = ∮ n ds, Q_c = ∮ r n^T ds, T_c = ∮ r x n ds, S_c = ∮ r (r x n) ds,
-// and u = [delta_c]^+,
-//     dV/dG   = sum_c kappa s phi_c [u^2 N_c - u (Q_c^T a - (a . r_c) N_c - a_c a)],
-//     dV/dyaw = sum_c kappa s phi_c [u^2 T_c - u a . (S_c - r_c T_c)]
-// (the bottom slope a is held in the world frame). In the continuum limit this
-// is the pressure-slope force -∫ p grad eta. The damping (weak) part has no
-// potential and no horizontal share.
+// -dV/dyaw of the same discrete V: a_c, Phi_c and the first moment of piece c
+// change with G through the floe's boundary in cell c (Reynolds' transport
+// theorem), so with the edge pieces A -> B in the cell, N_c = ∮ n ds,
+// Q_c = ∮ r n^T ds, T_c = ∮ r x n ds, S_c = ∮ r (r x n) ds, u = [delta_c]^+,
+// U_c = sum over all pieces k in cell c of a_k u_k^2 and psi' = K psi^2,
+//     dV/dG   = sum_c s kappa [(psi u^2 + psi' U_c / A) N_c / 2 - psi u (Q_c^T a - (a . r_c) N_c - a_c a)],
+//     dV/dyaw = sum_c s kappa [(psi u^2 + psi' U_c / A) T_c / 2 - psi u a . (S_c - r_c T_c)]
+// (the bottom slope a is held in the world frame). The damping (weak) part
+// has no potential and no horizontal share.
 //
-// KNOWN PROBLEM (docs/coupling.md): through the partly covered edge cells the
-// floe feels its own static depression, a cogging potential of period dx
-// that holds slow floes in place (a 10 m floe on 1.6 m cells at 0.5 m/s is
-// trapped). Tried and rejected: -a ∫ p (the continuum limit under a stiff
-// penalty) and the grid slope: neither is the gradient of V, and both pump
-// energy into heave as floes cross cells.
 // The damper is integrated implicitly per piece over a kick of length h,
 // using the inverse mass per unit area of the floe (1 / rho_i h) and of the
 // sea under one cell (measured once from the sea's response to a unit
-// impulse on one cell):  f_c = a_c c delta' / (1 + h c (1/m_floe + 1/m_sea)).
+// impulse on one cell):  f_c = a_c psi c delta' / (1 + h psi c (1/m_floe + 1/m_sea)).
 // As c -> inf this removes the relative normal velocity in one kick
 // (restitution 0) and never destabilises.
 //
@@ -55,8 +54,8 @@
 // response to a pressure is local, eta = W - p / (rho_w g) + const, W the
 // surface without floes, up to capillarity (relative size sigma k^2 /
 // (rho_w g) <= sigma (pi / dx)^2 / (rho_w g), reported), so on each cell
-// eta_c (1 + K sum_i f_ci^2) = W_c + L + K sum_i f_ci^2 z_b,i(r_ci) with
-// f_ci = a_ci / cell area (the phi_c weights: f_ci enters squared); each
+// eta_c (1 + K sum_i w_ci) = W_c + L + K sum_i w_ci z_b,i(r_ci) with
+// w_ci = psi_c a_ci / cell area; each
 // floe's heave and slopes solve the 3x3 equilibrium of its weight
 // (Gauss–Seidel over floes sharing cells), and L is set by the zero mean of
 // eta. Solved on the calm sea (W = 0) it gives each floe's reference bottom
@@ -134,6 +133,9 @@ public:
 
 private:
   double weak_coefficient(const Floes& floes, std::size_t i) const;
+  // psi(Phi) = 1 / (1 + K (1 - Phi)): the sub-cell weight of a cell covered
+  // to the share Phi (the header's "Partly covered cells").
+  double subcell_weight(double coverage) const;
   Eigen::Matrix2d tilt_inertia(const Floes& floes, std::size_t i) const;
 
   double rho_ = 1025.0, g_ = 9.81, sigma_ = 0.0, K_ = 1000.0, s_ = 1.0, kappa_ = 0.0;
@@ -144,10 +146,13 @@ private:
   std::vector<std::uint8_t> dynamic_;
   std::vector<std::uint8_t> tilt_;           // slopes resisted: 0 none, 1 pitch, 2 pitch and roll
   std::vector<double> bottom0_;             // z0_i, m
+  double free_level_ = 0.0;                 // the calm sea's free level (m; eta has zero mean)
   std::vector<Eigen::Matrix2d> body_moments_;  // rho h ∫ r r^T in the body frame
   Footprints footprints_;
   std::vector<FloeSeaLoad> loads_;
   std::vector<double> pressure_;
+  std::vector<double> coverage_;  // Phi_c: the share of cell c under floes
+  std::vector<double> cell_sum_;  // sum over the pieces in cell c of a_k [delta_k]^+^2
   bool pressure_kicked_ = false;  // the sea's last kick was with pressure_ as it is
   double penalty_energy_ = 0.0;
   std::vector<std::string> notes_;

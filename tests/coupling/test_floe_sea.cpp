@@ -135,10 +135,9 @@ TEST_CASE("floating equilibrium: the static start is at rest, displaces its weig
     for (double e : eta) volume += (level - e) * cell;
     CHECK(volume == doctest::Approx(sim.floes().mass[0] / 1025.0).epsilon(0.005));
   }
-  // The bottom's depth below the water level. The grid resolves the floe's
-  // edge to a cell: a partly covered cell's water is held down as a whole, so
-  // the depth converges as O(dx / L) (docs/coupling.md). In a flume (dims = 1,
-  // the floe spanning its width) with L / dx = 400 it is within 0.5 %. Pure
+  // The bottom's depth below the water level: exact at any resolution with
+  // the sub-cell law (tests/coupling/test_subcell.cpp); here in a flume
+  // (dims = 1, the floe spanning its width) with L / dx = 400, within 0.5 %. Pure
   // gravity (sigma = 0): at dx = 5 cm capillarity would stiffen the shortest
   // waves by 3 %, which the hydrostatic static start neglects.
   for (double K : {100.0, 1000.0}) {
@@ -266,8 +265,7 @@ TEST_CASE("two floes in waves collide: LCP impulses and the penalty coexist with
   // Energy: without drag or wind the only work is the collisions' (e = 0.4,
   // dissipative) so the total energy may fall but not grow beyond the
   // splitting error. No overlap is the loop's invariant (it throws otherwise).
-  // The floes start 0.2 m apart: farther, the grid's cogging (docs/coupling.md,
-  // known problems) would hold them before they meet.
+  // The floes start 0.2 m apart (test_subcell.cpp sends two from 20 m apart).
   std::ostringstream t;
   t << "[run]\nt_end = 40.0\ndt_max = 0.01\noutput_interval = 1.0\n" << kSea2d
     << "[sea.waves]\nkind = \"regular\"\namplitude = 0.2\nwavelength = 50.0\n"
