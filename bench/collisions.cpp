@@ -389,11 +389,11 @@ int main(int argc, char** argv) {
     std::printf("# %s: %s, %zu floes, t = %g s, wall %.3f s (min of %d), %zu steps (%ld redone), %ld LCPs, peak %.1f MiB\n"
                 "#   %ld clusters, %ld sub-steps, largest %ld floes, %ld joined, %ld merges, %ld sub-steps redone, "
                 "%ld at the floor, %ld pair lists rebuilt, %ld jam time steps\n"
-                "#   %ld pivots, %ld failures\n",
+                "#   %ld LCPs solved from a warm start, %ld warm starts redone from scratch, %ld pivots, %ld failures\n",
                 s.name.c_str(), b.status.c_str(), b.floes, b.simulated, b.wall, row.repeats, b.steps, b.rejected_steps,
                 b.stats.lcps, row.peak_rss_mb, b.substeps.clusters, b.substeps.substeps, b.substeps.largest_cluster,
                 b.substeps.joined, b.substeps.merges, b.substeps.rejected, b.substeps.floor_steps,
-                b.substeps.rebuilt, b.substeps.time_steps, b.stats.pivots,
+                b.substeps.rebuilt, b.substeps.time_steps, b.stats.warm, b.stats.warm_missed, b.stats.pivots,
                 b.stats.failures);
     for (const std::string& w : b.warnings) std::printf("#   warning: %s\n", w.c_str());
     std::fflush(stdout);

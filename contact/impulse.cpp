@@ -1,5 +1,6 @@
 #include "contact/impulse.hpp"
 
+
 #include <Eigen/Sparse>
 #include <algorithm>
 #include <cmath>
@@ -64,6 +65,58 @@ double approach(const Floes& floes, std::span<const FloeState> s, std::uint32_t 
 // Pushed (impulse.hpp): approaching now at least three times as fast as at
 // the start of the step.
 bool pushed(double now, double at_start) { return now > 0.0 && at_start <= now / 3.0; }
+std::uint64_t pair_key(std::uint32_t a, std::uint32_t b) { return (std::uint64_t{a} << 32) | b; }
+Vec2 body_point(const Floes& floes, std::uint32_t a, const Vec2& p) {
+  const FloeState& s = floes.state[a];
+  return rotate(p - Vec2{s.x, s.y}, -s.yaw);
+}
+
+// The guess for the LCP of the contacts `list` (unknowns ordered as in
+// impulse.hpp: lambda [m], beta [2m], alpha [m]).
+std::vector<std::uint8_t> warm_guess(const WarmStart& warm, const Floes& floes,
+                                     const std::vector<ContactPoint>& contacts, const std::vector<std::size_t>& list) {
+  const std::size_t m = list.size();
+  std::vector<std::uint8_t> basic(4 * m, 0);
+  for (std::size_t k = 0; k < m; ++k) {
+    const ContactPoint& c = contacts[list[k]];
+    const auto it = warm.pairs.find(pair_key(c.a, c.b));
+    if (it == warm.pairs.end()) continue;
+    const Vec2 p = body_point(floes, c.a, c.point);
+    const WarmStart::Entry* best = nullptr;
+    double best_d = warm.match_distance;
+    for (const WarmStart::Entry& e : it->second) {
+      const double d = (e.body_point - p).norm();
+      if (d <= best_d) {
+        best_d = d;
+        best = &e;
+      }
+    }
+    if (!best) continue;
+    basic[k] = best->basic[0];
+    basic[m + 2 * k] = best->basic[1];
+    basic[m + 2 * k + 1] = best->basic[2];
+    basic[3 * m + k] = best->basic[3];
+  }
+  return basic;
+}
+
+// Stores the final basis of the LCP of `list` (which z's were basic),
+// replacing what its pairs had.
+void warm_store(WarmStart& warm, const Floes& floes, const std::vector<ContactPoint>& contacts,
+                const std::vector<std::size_t>& list, const std::vector<std::uint8_t>& z_basic) {
+  const std::size_t m = list.size();
+  for (std::size_t k = 0; k < m; ++k) {
+    const ContactPoint& c = contacts[list[k]];
+    warm.pairs[pair_key(c.a, c.b)].clear();
+  }
+  auto on = [&](std::size_t i) -> std::uint8_t { return z_basic[i]; };
+  for (std::size_t k = 0; k < m; ++k) {
+    const ContactPoint& c = contacts[list[k]];
+    warm.pairs[pair_key(c.a, c.b)].push_back(
+        {body_point(floes, c.a, c.point), {on(k), on(m + 2 * k), on(m + 2 * k + 1), on(3 * m + k)}});
+  }
+}
+
 }  // namespace
 
 std::vector<ContactImpulse> resolve_collisions(Floes& floes, const std::vector<ContactPoint>& contacts,
@@ -232,7 +285,29 @@ std::vector<ContactImpulse> resolve_collisions(Floes& floes, const std::vector<C
       // Pass 1 only where Poisson's law acted (no restitution: nothing to undo).
       if (pass == 1 && std::all_of(restitution.begin(), restitution.end(), [](double e) { return e == 0.0; })) break;
       if (pass == 1 && !(fill_q() < -opt.approach_tolerance)) break;  // pass 0 uses the q above
-      const lcp::FallbackResult res = lcp::solve_with_fallbacks(problem, opt.solver);
+      // Large LCPs: first Lemke from the last basis of their contacts (WarmStart).
+      lcp::FallbackResult res;
+      const bool use_warm = opt.warm != nullptr && n >= opt.warm_min;
+      bool warm_solved = false;
+      if (use_warm) {
+        std::vector<std::uint8_t> guess = warm_guess(*opt.warm, floes, contacts, list);
+        if (std::find(guess.begin(), guess.end(), 1) != guess.end()) {
+          lcp::LemkeOptions lo = opt.solver.lemke;
+          lo.start = &guess;
+          lcp::Result r = lcp::solve_lemke(problem, lo);
+          if (r.status == lcp::Status::solved && r.residual <= opt.solver.accept_residual) {
+            res.result = std::move(r);
+            warm_solved = true;
+            ++stats.warm;
+          } else {
+            ++stats.warm_missed;
+            stats.pivots += r.pivots;  // the warm attempt's pivots count too
+          }
+        }
+      }
+      if (!warm_solved) res = lcp::solve_with_fallbacks(problem, opt.solver);
+      if (use_warm && res.solved() && !res.result.z_basic.empty())
+        warm_store(*opt.warm, floes, contacts, list, res.result.z_basic);
       ++stats.lcps;
       stats.contacts += static_cast<long>(m);
       stats.pivots += res.result.pivots;

@@ -71,14 +71,35 @@
 // Components are built from dynamic floes joined by contacts; an obstacle
 // (static floe) does not join components since it transmits no impulse.
 
+#include <array>
 #include <cstdint>
 #include <span>
+#include <unordered_map>
 #include <vector>
 
 #include "contact/detection.hpp"
 #include "contact/lcp/fallback.hpp"
 
 namespace floesim::contact {
+
+// Warm starts of large LCPs (LemkeOptions::start, lemke.hpp): Lemke's final
+// complementary basis for each large component, per contact point (which of
+// lambda, beta+, beta-, alpha were basic), keyed by its pair of floes and the
+// point in floe a's body frame (jammed floes hardly move, so a point keeps
+// its place from one step to the next). A contact of a large LCP takes the
+// flags of the nearest stored point of its pair within `match_distance`; a
+// point with none starts with its w's basic. Lemke then starts from that
+// basis. A wrong guess costs only time: the answer is accepted only with a
+// residual within the fallback chain's accept_residual, and otherwise the
+// LCP is solved from scratch by the chain (counted in warm_missed).
+struct WarmStart {
+  struct Entry {
+    Vec2 body_point = Vec2::Zero();
+    std::array<std::uint8_t, 4> basic{};  // lambda, beta+, beta-, alpha basic
+  };
+  std::unordered_map<std::uint64_t, std::vector<Entry>> pairs;
+  double match_distance = 1.0;  // m
+};
 
 struct ImpulseOptions {
   double restitution = 0.4;  // e in [0, 1]
@@ -96,6 +117,10 @@ struct ImpulseOptions {
   std::size_t jam_floes = 20;        // a contact component of this many floes is a jam (resolve_step_collisions)
   std::size_t dense_max = 400;  // LCPs up to this size are assembled dense, larger sparse
   lcp::FallbackOptions solver;
+  // LCPs of at least warm_min unknowns are first solved by Lemke from the
+  // basis in `warm` (null: never); the caller owns it and keeps it across steps.
+  WarmStart* warm = nullptr;
+  std::size_t warm_min = 200;
 };
 
 // Running totals of a run (written to /diagnostics/lcp and the summary).
@@ -108,6 +133,8 @@ struct CollisionStats {
   long flagged = 0;       // of those, answered by projected Gauss–Seidel
   long largest = 0;       // largest LCP size
   long total_size = 0;    // sum of LCP sizes
+  long warm = 0;          // of lcps, solved by Lemke warm-started from the last basis
+  long warm_missed = 0;   // warm starts that ended without an accepted solution (then solved from scratch)
 };
 
 // Per contact: the total impulse applied (compression + decompression), N s.

@@ -160,6 +160,7 @@ private:
   contact::CollisionShapes shapes_;
   contact::DetectionOptions detection_options_;
   contact::ImpulseOptions impulse_options_;
+  std::unique_ptr<contact::WarmStart> warm_ = std::make_unique<contact::WarmStart>();  // jam LCPs' last bases
   contact::Detection detection_;  // at the present positions
   contact::CollisionStats stats_;
   std::unique_ptr<Percussion> percussion_;  // [fracture] enabled

@@ -10,7 +10,9 @@
 
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
+#include <cstdint>
 #include <string_view>
+#include <vector>
 #include <variant>
 
 namespace floesim::lcp {
@@ -58,6 +60,9 @@ struct Result {
   long pivots = 0;          // Lemke: pivots, counting the one where z0 enters
   long iterations = 0;      // iterative solvers: sweeps
   double residual = 0.0;    // residual(lcp, z), see below
+  // Lemke: which z_j were basic at the end (a complementary basis when
+  // solved; empty otherwise and for iterative solvers), for warm starts.
+  std::vector<std::uint8_t> z_basic;
 };
 
 // The scaled complementarity residual, the same for every solver:

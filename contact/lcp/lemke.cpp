@@ -28,7 +28,16 @@ class Lemke {
 public:
   Lemke(const Lcp& lcp, const LemkeOptions& options, LemkeStats& stats)
       : lcp_(lcp), opt_(options), stats_(stats), n_(lcp.size()), M_(sparse_copy(lcp)),
-        d_(options.covering.size() ? options.covering : Vector::Ones(n_)) {}
+        d_(options.covering.size() ? options.covering : Vector::Ones(n_)) {
+    if (opt_.start) {
+      // d = B 1 for the start basis B: columns e_i (w_i basic) and -M e_j (z_j basic).
+      const std::vector<std::uint8_t>& s = *opt_.start;
+      for (Index i = 0; i < n_; ++i) d_(i) = s[static_cast<std::size_t>(i)] ? 0.0 : 1.0;
+      for (Index j = 0; j < n_; ++j)
+        if (s[static_cast<std::size_t>(j)])
+          for (SparseMatrix::InnerIterator it(M_, j); it; ++it) d_(it.index()) -= it.value();
+    }
+  }
 
   Result run();
 
@@ -163,6 +172,8 @@ Result Lemke::finish_solved(LemkeBasis& basis) {
   basis.solve(r);
   x += r;
   result.z = read_z(basis, x);
+  result.z_basic.assign(static_cast<std::size_t>(n_), 0);
+  for (Index j = 0; j < n_; ++j) result.z_basic[static_cast<std::size_t>(j)] = basis.position_of(basis.z_var(j)) >= 0;
   return result;
 }
 
@@ -190,10 +201,26 @@ Result Lemke::run() {
   stats_.refactorisations = basis.refactorisations();
 
   // First pivot: z0 enters at row r; with B = I, u = B^-1 (-d) = -d.
-  const Index r = first_leaving();
+  Index r = -1;
   Vector u = -d_;
   x_ = lcp_.q;
-  int entering = basis.complement(basis.w_var(r));
+  if (opt_.start) {
+    // Warm start: B is the given basis, B^-1 (-d) = -1; z0 enters where B^-1 q is least.
+    if (!basis.start_from(*opt_.start)) {
+      result.status = Status::failed;
+      return result;
+    }
+    basis.solve(x_);
+    u = -Vector::Ones(n_);
+    x_.minCoeff(&r);
+    if (x_(r) >= 0.0) {
+      result = finish_solved(basis);
+      return result;
+    }
+  } else {
+    r = first_leaving();
+  }
+  int entering = basis.complement(basis.variable_at(r));
   bool ok = basis.replace(r, basis.z0_var(), u);
   const double theta0 = x_(r) / u(r);
   x_ -= theta0 * u;
@@ -280,6 +307,8 @@ Result solve_lemke(const Lcp& lcp, const LemkeOptions& options, LemkeStats* stat
       (options.covering.size() != lcp.size() || !(options.covering.array() > 0.0).all() ||
        !options.covering.allFinite()))
     throw InputError("Lemke: the covering vector must have n positive finite entries");
+  if (options.start && options.start->size() != static_cast<std::size_t>(lcp.size()))
+    throw InputError("Lemke: the start basis must have n entries");
   LemkeStats local;
   Lemke lemke(lcp, options, stats ? *stats : local);
   if (stats) *stats = {};

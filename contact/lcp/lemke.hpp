@@ -77,6 +77,14 @@ struct LemkeOptions {
   double sparse_max_density = 0.1;
   // Etas (pivots) between refactorisations of the basis.
   int refactor_interval = 100;
+  // Warm start (null: none): the complementary basis to start from, z_j
+  // basic where (*start)[j] (Result::z_basic of an earlier, similar LCP).
+  // The covering vector is then d = B 1, so that z0 entering at
+  // -min(B^-1 q) makes the start feasible; if B^-1 q >= 0 the start solves
+  // the LCP with no pivot. d need not be positive, so Lemke's guarantees do
+  // not hold: a warm start that ends on a ray or a singular basis is for the
+  // caller to redo from scratch. `covering` is ignored.
+  const std::vector<std::uint8_t>* start = nullptr;
 };
 
 // What the revised method did, for benchmarks and diagnostics.

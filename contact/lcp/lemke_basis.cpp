@@ -123,6 +123,15 @@ LemkeBasis::LemkeBasis(const SparseMatrix& M, const Vector& d, FactorPolicy poli
   refactor();  // B = I: nothing to factorise, but it sets up the bookkeeping
 }
 
+bool LemkeBasis::start_from(const std::vector<std::uint8_t>& z_basic) {
+  std::fill(position_.begin(), position_.end(), -1);
+  for (Index i = 0; i < n_; ++i) {
+    basis_[i] = z_basic[static_cast<std::size_t>(i)] ? z_var(i) : w_var(i);
+    position_[basis_[i]] = i;
+  }
+  return refactor();
+}
+
 int LemkeBasis::complement(int var) const {
   if (var == z0_var()) return -1;
   return is_w(var) ? var + static_cast<int>(n_) : var - static_cast<int>(n_);

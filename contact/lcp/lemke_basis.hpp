@@ -29,6 +29,7 @@
 // current basis is factorised afresh (bounds both the work per solve and the
 // growth of rounding errors).
 
+#include <cstdint>
 #include <memory>
 #include <vector>
 
@@ -90,6 +91,9 @@ public:
   bool replace(Index pos, int var, const Vector& u);
   // Factorises the current basis afresh, dropping the etas.
   bool refactor();
+  // Starts over from the complementary basis with z_j at position j where
+  // z_basic[j], w_j elsewhere; false if it is singular.
+  bool start_from(const std::vector<std::uint8_t>& z_basic);
 
   long solves() const { return solves_; }
   long refactorisations() const { return refactorisations_; }

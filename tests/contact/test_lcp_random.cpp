@@ -182,6 +182,49 @@ TEST_CASE("lcp: the pivot limit is reported and a malformed LCP is refused") {
   CHECK_THROWS_AS(solve_lemke(lcp, options), InputError);
 }
 
+TEST_CASE("lcp warm start: Lemke from an earlier basis solves a nearby LCP in few pivots, or says it did not") {
+  // For a P-matrix (here symmetric positive definite) the LCP has one solution, so the warm
+  // start must find the same z as a cold solve. From the basis of the LCP's own solution it
+  // needs no pivot; from the basis of a nearby q (a step of a jam later) it needs fewer
+  // than the cold solve. A start from a singular basis is refused (failed), never "solved".
+  std::mt19937_64 rng(20261201);
+  const Index n = 200;
+  const DenseMatrix A = gaussian(rng, n, n);
+  const DenseMatrix M = A * A.transpose() / static_cast<double>(n) + 0.05 * DenseMatrix::Identity(n, n);
+  const Lcp first{M, gaussian(rng, n)};
+  const Result cold = solve_lemke(first);
+  REQUIRE(cold.status == Status::solved);
+  REQUIRE(cold.z_basic.size() == static_cast<std::size_t>(n));
+  LemkeOptions warm;
+  warm.start = &cold.z_basic;
+  const Result again = solve_lemke(first, warm);
+  REQUIRE(again.status == Status::solved);
+  CHECK(again.pivots == 0);
+  CHECK((again.z - cold.z).norm() <= 1e-9 * (1.0 + cold.z.norm()));
+
+  const Lcp nearby{M, first.q + 0.05 * gaussian(rng, n)};
+  const Result nearby_cold = solve_lemke(nearby);
+  const Result nearby_warm = solve_lemke(nearby, warm);
+  REQUIRE(nearby_cold.status == Status::solved);
+  REQUIRE(nearby_warm.status == Status::solved);
+  MESSAGE("pivots: cold " << nearby_cold.pivots << ", warm " << nearby_warm.pivots);
+  CHECK(nearby_warm.pivots < nearby_cold.pivots);
+  check_complementary(nearby, nearby_warm.z, 1e-9);
+  CHECK((nearby_warm.z - nearby_cold.z).norm() <= 1e-8 * (1.0 + nearby_cold.z.norm()));
+
+  // A singular start: z_0 and z_1 basic with identical columns.
+  DenseMatrix S = M;
+  S.col(1) = S.col(0);
+  S.row(1) = S.row(0);
+  std::vector<std::uint8_t> singular(static_cast<std::size_t>(n), 0);
+  singular[0] = singular[1] = 1;
+  warm.start = &singular;
+  CHECK(solve_lemke(Lcp{S, first.q}, warm).status == Status::failed);
+  std::vector<std::uint8_t> short_start(3, 0);
+  warm.start = &short_start;
+  CHECK_THROWS_AS(solve_lemke(first, warm), InputError);
+}
+
 TEST_SUITE_END();
 
 }  // namespace
