@@ -109,8 +109,9 @@ public:
   // Mean orbital velocity of the sea under each floe (m/s, world), for drag.
   void orbital_velocity(const Floes& floes, fluid::Sea& sea, std::vector<Vec2>& out) const;
 
-  // Stable kick length of the explicit spring part (s > 0): 1 / omega_pen,
-  // omega_pen^2 = s kappa (1 / m_floe + 1 / m_sea) (leapfrog needs < 2 / omega).
+  // Stable kick length of the explicit spring part (s > 0): 0.5 / omega_pen,
+  // omega_pen^2 = s kappa (1 / m_floe + 1 / m_sea) (a quarter of leapfrog's
+  // linear limit 2 / omega; the contact is not linear, see floe_sea.cpp).
   double stable_step() const { return stable_step_; }
 
   // Energies (J) at the last evaluate(): the penalty spring's, and the floes'

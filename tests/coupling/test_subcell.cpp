@@ -113,7 +113,7 @@ TEST_CASE("two floes sent at each other from 20 m apart at 0.5 m/s meet on 1.56 
   // would meet after 20 s. On the grid they first lose about a quarter of
   // their speed (the depression under each floe has to be set moving), then
   // slow a little more (known problem: grid wave resistance,
-  // docs/coupling.md); measured: first contact at t = 30.6 s. Before the
+  // docs/coupling.md); measured: first contact at t = 31.9 s. Before the
   // sub-cell law they stayed trapped within 0.6 m of their start. Collisions
   // (e = 0.4) are the only dissipation: the total energy may not grow beyond
   // the splitting error (measured 1.3e-4 of it).
@@ -141,7 +141,7 @@ TEST_CASE("a floe in a steady wind on a calm sea reaches the free-drift speed") 
   // not depend on the ice velocity; the ocean drag is relative to the water
   // under the floe). Reached from rest as u tanh(t / tau), tau = m / (rho_w
   // C_w u A) = 137 s here (about 170 s with the water the floe sets moving).
-  // KNOWN PROBLEM (docs/coupling.md): on the sea the floe drifts at 0.8 u, not
+  // KNOWN PROBLEM (docs/coupling.md): on the sea the floe drifts at 0.76 u, not
   // u: a residual grid wave resistance of about 30 N at 0.1 m/s (it does not
   // fall with the cell size: 0.70 u on 0.78 m cells). Before the sub-cell law
   // the floe was held by the grid (mean speed about 0). This test pins what is
