@@ -18,6 +18,9 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr int kFree = -1;
 // A sub-step is halved after an overlap down to this fraction of the floor.
 constexpr double kHalvingFloor = 0x1.0p-20;
+// A jam whose time step overlaps halves it (the linearised gaps miss the
+// floes' turning by a term in h^2); below this fraction of dt it goes to events.
+constexpr double kJamStepFloor = 1.0 / 16.0;
 
 // Pairs measured with their contact points and witnesses.
 struct Measured {
@@ -37,6 +40,7 @@ struct Cluster {
   Measured cur;                        // the internal pairs measured at tau
   bool alive = true;                   // false once merged into another cluster
   bool events_only = false;            // its time step overlapped: events for the rest of the step
+  double jam_h = std::numeric_limits<double>::infinity();  // s, its time step (halved when one overlaps)
 };
 
 // One call of advance_with_collisions (the steps of substep.hpp). Clusters
@@ -394,21 +398,62 @@ private:
   // speculative contact for that time (impulse.hpp), one LCP instead of an
   // event, and an LCP of the whole cluster, each time one of its many pairs
   // meets. If that overlaps after all (a pair turning faster than its
-  // witnesses tell), the cluster goes back to events for the rest of the step.
+  // linearised witness gaps tell: an error in h^2), the time step is redone
+  // with half the length; below kJamStepFloor dt the cluster goes back to
+  // events for the rest of the step.
   void time_step(int k) {
     Cluster& c = clusters_[static_cast<std::size_t>(k)];
     const double xi = opt_.collision_distance;
-    const double h = dt_ - c.tau;
-    std::vector<ContactPoint> contacts = c.cur.contacts;
-    for (const NearPair& q : c.cur.pairs)
-      for (const Witness& w : witnesses_of(q, c.cur.witnesses))
-        if (w.distance >= xi) contacts.push_back({q.a, q.b, 0.5 * (w.pa + w.pb), w.normal, w.distance, q.shift, true});
-    const std::vector<std::uint8_t> resting(contacts.size(), 1);
+    const double h = std::min(dt_ - c.tau, c.jam_h);
+    const double t1 = h >= dt_ - c.tau ? dt_ : c.tau + h;
     ImpulseOptions impulse = opt_.impulse;
     impulse.speculative_step = h;
     snapshot(c);
     const std::vector<FloeState> before = c.snap;
-    resolve_collisions(floes_, contacts, impulse, stats_, resting);
+    // The witnesses were found within the range the floes' velocities before
+    // the LCP gave. The LCP may speed floes up (a jam passes the push on), so
+    // vertices beyond that range could close within h, unseen. The pairs are
+    // then measured again, at the same poses, within the range the new
+    // velocities give; if that finds more witnesses, the LCP is solved again
+    // from the velocities before it with them (a few rounds at most).
+    for (std::uint32_t i : c.members) posed_.update(floes_, i);
+    const Measured* wit = &c.cur;
+    std::vector<double> ranges(c.cur.pairs.size(), 0.0);
+    for (int round = 0;; ++round) {
+      std::vector<ContactPoint> contacts = c.cur.contacts;
+      for (const NearPair& q : wit->pairs)
+        for (const Witness& w : witnesses_of(q, wit->witnesses))
+          if (w.distance >= xi) contacts.push_back({q.a, q.b, 0.5 * (w.pa + w.pb), w.normal, w.distance, q.shift, true});
+      const std::vector<std::uint8_t> resting(contacts.size(), 1);
+      resolve_collisions(floes_, contacts, impulse, stats_, resting);
+      if (round == 3) break;
+      bool wider = false;
+      for (std::size_t i = 0; i < c.internal.size(); ++i) {
+        const NearPair& q = det_->pairs[c.internal[i]];
+        const double r = exact_range(floes_, shapes_, q.a, q.b, h, xi);
+        if (r > ranges[i]) {
+          ranges[i] = 1.5 * r;
+          wider = true;
+        }
+      }
+      if (!wider && round > 0) break;
+      wide_.pairs.clear();
+      wide_.contacts.clear();
+      wide_.witnesses.clear();
+      std::size_t spec = 0;
+      for (std::size_t i = 0; i < c.internal.size(); ++i) {
+        const NearPair& q = det_->pairs[c.internal[i]];
+        const double r = std::max(ranges[i], exact_range(floes_, shapes_, q.a, q.b, dt_, xi));
+        wide_.pairs.push_back(measure_pair(posed_, q.a, q.b, q.shift, xi, r, wide_.contacts, wide_.witnesses));
+      }
+      for (const Witness& w : wide_.witnesses) spec += (w.distance >= xi);
+      std::size_t had = 0;
+      for (const Witness& w : wit->witnesses) had += (w.distance >= xi);
+      if (spec <= had) break;
+      wit = &wide_;
+      for (std::size_t m = 0; m < before.size(); ++m) floes_.state[c.members[m]] = before[m];
+      ++report_.rejected;
+    }
     snapshot(c);  // the velocities of the time step, for merges that look back into it
     auto undo = [&] {
       for (std::size_t m = 0; m < before.size(); ++m) floes_.state[c.members[m]] = before[m];
@@ -422,7 +467,7 @@ private:
     }
     joining_.clear();
     merging_.clear();
-    collect_breaks(k, dt_);
+    collect_breaks(k, t1);
     if (!joining_.empty() || !merging_.empty()) {
       undo();
       bring_in(k);
@@ -432,11 +477,12 @@ private:
     if (measure(c, next_)) {
       undo();
       for (std::uint32_t i : c.members) posed_.update(floes_, i);
-      c.events_only = true;
+      c.jam_h = 0.5 * h;
+      if (c.jam_h < kJamStepFloor * dt_) c.events_only = true;
       ++report_.rejected;
       return;
     }
-    c.tau = dt_;
+    c.tau = t1;
     std::swap(c.cur, next_);
     ++report_.substeps;
     ++report_.time_steps;
@@ -514,6 +560,7 @@ private:
   Measured next_;                      // a cluster's pairs after the sub-step being tried
   std::vector<std::uint32_t> joining_;
   std::vector<int> merging_;
+  Measured wide_;                                // time_step: the pairs measured within a wider range
   std::vector<int> jam_of_;                      // per floe: its jam, or -1
   std::vector<std::vector<std::uint32_t>> jams_; // the floes of each jam
 };
