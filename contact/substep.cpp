@@ -21,6 +21,11 @@ constexpr double kHalvingFloor = 0x1.0p-20;
 // A jam whose time step overlaps halves it (the linearised gaps miss the
 // floes' turning by a term in h^2); below this fraction of dt it goes to events.
 constexpr double kJamStepFloor = 1.0 / 16.0;
+// Dynamic floes whose room to a jam-sized cluster is below this many xi
+// (10 m at xi = 1 cm) join it at the start of the step (make_clusters): the
+// jam's time steps move its floes 0.5 to 3 m off their straight paths
+// (jam_500), beyond the budgets of nearer pads.
+constexpr double kJamPad = 1000.0;
 
 // Pairs measured with their contact points and witnesses.
 struct Measured {
@@ -199,6 +204,32 @@ private:
     find_jams();
     for (std::uint32_t i = 0; i < n; ++i)
       if (jam_of_[i] >= 0) parent[find(i)] = find(jams_[static_cast<std::size_t>(jam_of_[i])].front());
+    // A cluster of jam_floes floes or more takes time steps, whose LCP turns
+    // and speeds up its floes: their deviations from the straight paths
+    // outgrow small budgets. The dynamic floes close to such a cluster (room
+    // below kJamPad xi) join it now rather than during its time step, where
+    // each join reruns its LCP.
+    {
+      std::vector<std::uint32_t> size(n, 0), hot_root(n, 0);
+      for (std::uint32_t i = 0; i < n; ++i)
+        if (!floes_.is_static[i]) {
+          ++size[find(i)];
+          if (hot[i]) hot_root[find(i)] = 1;
+        }
+      std::vector<std::uint8_t> big(n, 0);
+      for (std::uint32_t i = 0; i < n; ++i) {
+        const std::uint32_t r = find(i);
+        big[i] = !floes_.is_static[i] && hot_root[r] && size[r] >= opt_.impulse.jam_floes;
+      }
+      const double pad = kJamPad * tight;
+      for (std::size_t p = 0; p < det_->pairs.size(); ++p) {
+        const NearPair& q = det_->pairs[p];
+        if (!(room_[p] < pad) || floes_.is_static[q.a] || floes_.is_static[q.b] || !(big[q.a] || big[q.b])) continue;
+        hot[q.a] = hot[q.a] || big[q.a];
+        hot[q.b] = hot[q.b] || big[q.b];
+        parent[find(q.a)] = find(q.b);
+      }
+    }
     std::vector<std::uint8_t> active_root(n, 0);
     for (std::uint32_t i = 0; i < n; ++i)
       if (hot[i]) active_root[find(i)] = 1;
