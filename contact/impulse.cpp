@@ -16,10 +16,19 @@ namespace {
 // costs the size of its contact list, not of the pack.
 struct Components {
   std::vector<std::uint32_t> parent;
+  std::unordered_map<std::uint32_t, std::uint32_t> local;  // floe -> local index
   std::uint32_t add() {
     parent.push_back(static_cast<std::uint32_t>(parent.size()));
     return parent.back();
   }
+  // The local index of floe f, added on first sight.
+  std::uint32_t node(std::uint32_t f) {
+    auto [it, fresh] = local.emplace(f, 0u);
+    if (fresh) it->second = add();
+    return it->second;
+  }
+  // The root of floe f's component; f must have been seen.
+  std::uint32_t root_of(std::uint32_t f) { return find(local.at(f)); }
   std::uint32_t find(std::uint32_t i) {
     while (parent[i] != i) i = parent[i] = parent[parent[i]];
     return i;
@@ -127,24 +136,18 @@ std::vector<ContactImpulse> resolve_collisions(Floes& floes, const std::vector<C
 
   // Contact graph over dynamic floes.
   Components comp;
-  std::unordered_map<std::uint32_t, std::uint32_t> node;  // floe -> local index
-  auto node_of = [&](std::uint32_t f) {
-    auto [it, fresh] = node.emplace(f, 0u);
-    if (fresh) it->second = comp.add();
-    return it->second;
-  };
   for (const ContactPoint& c : contacts) {
     if (floes.is_static[c.a] && floes.is_static[c.b]) continue;
-    if (floes.is_static[c.a]) node_of(c.b);
-    else if (floes.is_static[c.b]) node_of(c.a);
-    else comp.join(node_of(c.a), node_of(c.b));
+    if (floes.is_static[c.a]) comp.node(c.b);
+    else if (floes.is_static[c.b]) comp.node(c.a);
+    else comp.join(comp.node(c.a), comp.node(c.b));
   }
   std::unordered_map<std::uint32_t, std::vector<std::size_t>> groups;  // root -> contacts
   for (std::size_t j = 0; j < contacts.size(); ++j) {
     const ContactPoint& c = contacts[j];
     if (floes.is_static[c.a] && floes.is_static[c.b]) continue;
     const std::uint32_t owner = floes.is_static[c.a] ? c.b : c.a;
-    groups[comp.find(node.at(owner))].push_back(j);
+    groups[comp.root_of(owner)].push_back(j);
   }
   std::vector<std::vector<std::size_t>> ordered;
   ordered.reserve(groups.size());
@@ -363,20 +366,14 @@ std::size_t resolve_step_collisions(Floes& floes, std::span<const FloeState> sta
   // Jams: contact components (dynamic floes joined by contact points) of at
   // least opt.jam_floes floes.
   Components jam;
-  std::unordered_map<std::uint32_t, std::uint32_t> jam_node;
-  auto jam_node_of = [&](std::uint32_t f) {
-    auto [it, fresh] = jam_node.emplace(f, 0u);
-    if (fresh) it->second = jam.add();
-    return it->second;
-  };
   for (const ContactPoint& c : contacts)
-    if (!floes.is_static[c.a] && !floes.is_static[c.b]) jam.join(jam_node_of(c.a), jam_node_of(c.b));
+    if (!floes.is_static[c.a] && !floes.is_static[c.b]) jam.join(jam.node(c.a), jam.node(c.b));
   std::vector<std::uint32_t> jam_size(jam.parent.size(), 0);
-  for (const auto& [f, local] : jam_node) ++jam_size[jam.find(local)];
+  for (const auto& [f, local] : jam.local) ++jam_size[jam.find(local)];
   auto in_jam = [&](std::uint32_t f) {
     if (floes.is_static[f]) return false;
-    const auto it = jam_node.find(f);
-    return it != jam_node.end() && jam_size[jam.find(it->second)] >= opt.jam_floes;
+    const auto it = jam.local.find(f);
+    return it != jam.local.end() && jam_size[jam.find(it->second)] >= opt.jam_floes;
   };
   auto jammed = [&](std::uint32_t a, std::uint32_t b) { return in_jam(a) || in_jam(b); };
   std::vector<std::uint8_t> resting(contacts.size(), 0);
@@ -427,29 +424,23 @@ std::size_t resolve_step_collisions(Floes& floes, std::span<const FloeState> sta
     // The components (over all contacts) that gained speculative contacts are
     // solved again from W^-; the others keep their solution.
     Components comp;
-    std::unordered_map<std::uint32_t, std::uint32_t> node;
-    auto node_of = [&](std::uint32_t f) {
-      auto [it, fresh] = node.emplace(f, 0u);
-      if (fresh) it->second = comp.add();
-      return it->second;
-    };
     auto dynamic_end = [&](const ContactPoint& c) { return floes.is_static[c.a] ? c.b : c.a; };
     for (const ContactPoint& c : contacts) {
-      if (floes.is_static[c.a] || floes.is_static[c.b]) node_of(dynamic_end(c));
-      else comp.join(node_of(c.a), node_of(c.b));
+      if (floes.is_static[c.a] || floes.is_static[c.b]) comp.node(dynamic_end(c));
+      else comp.join(comp.node(c.a), comp.node(c.b));
     }
     std::vector<std::uint8_t> redo(comp.parent.size(), 0);
-    for (std::size_t k = first_new; k < contacts.size(); ++k) redo[comp.find(node.at(dynamic_end(contacts[k])))] = 1;
+    for (std::size_t k = first_new; k < contacts.size(); ++k) redo[comp.root_of(dynamic_end(contacts[k]))] = 1;
     again.clear();
     again_resting.clear();
     again_index.clear();
     for (std::size_t k = 0; k < contacts.size(); ++k)
-      if (redo[comp.find(node.at(dynamic_end(contacts[k])))]) {
+      if (redo[comp.root_of(dynamic_end(contacts[k]))]) {
         again.push_back(contacts[k]);
         again_resting.push_back(resting[k]);
         again_index.push_back(k);
       }
-    for (const auto& [f, local] : node)
+    for (const auto& [f, local] : comp.local)
       if (redo[comp.find(local)]) {
         floes.state[f].vx = before[f].vx;
         floes.state[f].vy = before[f].vy;

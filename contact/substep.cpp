@@ -127,11 +127,7 @@ private:
 
   // The floe on its straight path, tau after the start of the step.
   FloeState linear(std::uint32_t i, double tau) const {
-    FloeState s = start_[i];
-    s.x += tau * s.vx;
-    s.y += tau * s.vy;
-    s.yaw += tau * s.yaw_rate;
-    return s;
+    return drifted(start_[i], tau);
   }
 
   // How far any point of floe i is from where its straight path would put it.
@@ -363,11 +359,7 @@ private:
       const bool last = h >= dt_ - c.tau;
       const double t1 = last ? dt_ : c.tau + h;
       for (std::size_t m = 0; m < c.members.size(); ++m) {
-        FloeState& s = floes_.state[c.members[m]];
-        s = c.snap[m];
-        s.x += h * s.vx;
-        s.y += h * s.vy;
-        s.yaw += h * s.yaw_rate;
+        floes_.state[c.members[m]] = drifted(c.snap[m], h);
       }
       // Budgets: the pairs with floes outside that this sub-step would break
       // bring those floes in, at the cluster's time.
@@ -491,10 +483,7 @@ private:
       c.snap = before;
     };
     for (std::size_t m = 0; m < c.members.size(); ++m) {
-      FloeState& s = floes_.state[c.members[m]];
-      s.x += h * s.vx;
-      s.y += h * s.vy;
-      s.yaw += h * s.yaw_rate;
+      floes_.state[c.members[m]] = drifted(floes_.state[c.members[m]], h);
     }
     joining_.clear();
     merging_.clear();
@@ -548,11 +537,7 @@ private:
       Cluster& o = clusters_[static_cast<std::size_t>(l)];
       const double since = c.tau - o.tau_snap;  // >= 0 by the time order
       for (std::size_t m = 0; m < o.members.size(); ++m) {
-        FloeState s = o.snap[m];
-        s.x += since * s.vx;
-        s.y += since * s.vy;
-        s.yaw += since * s.yaw_rate;
-        floes_.state[o.members[m]] = s;
+        floes_.state[o.members[m]] = drifted(o.snap[m], since);
         cluster_of_[o.members[m]] = k;
         c.members.push_back(o.members[m]);
       }

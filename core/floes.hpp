@@ -23,6 +23,15 @@ struct FloeState {
   double pitch = 0.0, roll = 0.0; // rad (small): bottom slope a = (pitch, roll)
   double heave_rate = 0.0, pitch_rate = 0.0, roll_rate = 0.0;
 };
+// The horizontal pose after a free flight of h seconds: straight path at
+// (vx, vy), yaw turning at yaw_rate. The vertical DOFs are left as they are.
+inline FloeState drifted(FloeState s, double h) {
+  s.x += h * s.vx;
+  s.y += h * s.vy;
+  s.yaw += h * s.yaw_rate;
+  return s;
+}
+
 inline constexpr int kStateColumns = 12;
 static_assert(sizeof(FloeState) == kStateColumns * sizeof(double));
 inline constexpr const char* kStateColumnNames[kStateColumns] = {

@@ -122,10 +122,7 @@ void drift_velocities(Floes& floes, const FootprintQuadrature& q, const DriftPar
 void advance_positions(Floes& floes, double dt, std::size_t begin, std::size_t end) {
   for (std::size_t i = begin; i < end; ++i) {
     if (floes.is_static[i]) continue;
-    FloeState& s = floes.state[i];
-    s.x += dt * s.vx;
-    s.y += dt * s.vy;
-    s.yaw += dt * s.yaw_rate;
+    floes.state[i] = drifted(floes.state[i], dt);
   }
 }
 
