@@ -326,6 +326,9 @@ void read_coupling(Section s, CouplingParams& c) {
   if (start != "equilibrium" && start != "given")
     s.fail("start", "expected \"equilibrium\" (floes at rest on the sea, then the waves) or \"given\" (the floes' heave as given), got \"" + start + "\"");
   c.start_given = start == "given";
+  c.footprint = s.choice<FootprintChoice>("footprint", c.footprint, {{"automatic", FootprintChoice::automatic},
+                                                                     {"cell", FootprintChoice::cell},
+                                                                     {"tent", FootprintChoice::tent}});
   s.finish();
 }
 
@@ -482,7 +485,11 @@ std::string resolved_toml(const Config& c) {
                                                                    {"weak", PenaltyLaw::weak},
                                                                    {"blend", PenaltyLaw::blend}})},
                        {"stiffness", c.coupling.stiffness},
-                       {"start", c.coupling.start_given ? "given" : "equilibrium"}};
+                       {"start", c.coupling.start_given ? "given" : "equilibrium"},
+                       {"footprint", name_of<FootprintChoice>(c.coupling.footprint,
+                                                              {{"automatic", FootprintChoice::automatic},
+                                                               {"cell", FootprintChoice::cell},
+                                                               {"tent", FootprintChoice::tent}})}};
   if (c.coupling.law == PenaltyLaw::blend) {
     if (c.coupling.restitution >= 0.0) coupling.insert("restitution", c.coupling.restitution);
     else coupling.insert("blend", c.coupling.blend);

@@ -67,6 +67,9 @@ struct ContactParams {
 };
 
 enum class PenaltyLaw { strong, weak, blend };
+// How floes' footprints are weighed on the sea grid (coupling/footprint.hpp):
+// automatic = tent on periodic grids, cell in walled basins.
+enum class FootprintChoice { automatic, cell, tent };
 
 struct CouplingParams {
   PenaltyLaw law = PenaltyLaw::strong;
@@ -77,6 +80,7 @@ struct CouplingParams {
   // on the initial waves); true: the floes' heave and heave rate
   // are as given ([[floes.floe]] heave, heave_rate), e.g. for a drop test.
   bool start_given = false;
+  FootprintChoice footprint = FootprintChoice::automatic;
 };
 
 enum class SeriesInterpolation { linear, previous };

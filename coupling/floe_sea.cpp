@@ -78,6 +78,10 @@ FloeSeaContact::FloeSeaContact(const CouplingParams& params, const SeaParams& se
       break;
   }
   const fluid::SurfaceGrid& grid = sea.grid();
+  const bool periodic = grid.edge == fluid::GridEdge::periodic;
+  if (params.footprint == FootprintChoice::tent && !periodic)
+    throw RunError("[coupling] footprint = \"tent\" needs a periodic sea (a spectral sea); this sea has walls: use \"cell\" or \"automatic\"");
+  kernel_ = params.footprint == FootprintChoice::cell || !periodic ? FootprintKernel::cell : FootprintKernel::tent;
   cell_area_ = grid.dx() * (grid.dims == 2 ? grid.dy() : grid.ly);
   // The sea under the floes, as fast as it can answer: one cell, or the
   // grid's shortest wave, at a few places (a walled basin answers faster near
@@ -143,7 +147,7 @@ void FloeSeaContact::start(Floes& floes, fluid::Sea& sea, bool given) {
   coverage_.assign(grid.size(), 0.0);
   cell_sum_.assign(grid.size(), 0.0);
   pressure_kicked_ = false;
-  build_footprints(floes, dynamic_, grid, footprints_);
+  build_footprints(floes, dynamic_, grid, footprints_, kernel_);
   if (given) {
     free_level_ = 0.0;
     for (std::size_t i = 0; i < n; ++i) bottom0_[i] = -floes.draft(i, rho_) * (1.0 + 1.0 / K_);
@@ -276,7 +280,7 @@ void FloeSeaContact::evaluate(const Floes& floes, fluid::Sea& sea, double h) {
     for (std::uint32_t c : footprints_.cell) pressure_[c] = coverage_[c] = cell_sum_[c] = 0.0;
   }
   pressure_kicked_ = false;
-  build_footprints(floes, dynamic_, grid, footprints_);
+  build_footprints(floes, dynamic_, grid, footprints_, kernel_);
   const Footprints& fp = footprints_;
   const std::span<const double> eta = sea.elevation();
   std::span<const double> w;
@@ -343,21 +347,14 @@ void FloeSeaContact::evaluate(const Floes& floes, fluid::Sea& sea, double h) {
         if (up <= 0.0 && sum <= 0.0) continue;
         const double psi = subcell_weight(coverage_[cell]);
         const double dpsi = K_ * psi * psi;  // d psi / d Phi
-        const Vec2& A = fp.edge_a[k];
-        const Vec2& B = fp.edge_b[k];
-        const Vec2 e = B - A;
-        const Vec2 N{e.y(), -e.x()};                     // ∮ n ds = d a_c / dG
-        const Vec2 mid = 0.5 * (A + B);
-        // Q^T a = ∮ (r . a) n ds;  T = ∮ r x n ds = -mid . e = d a_c / dyaw
-        const double ra = mid.dot(a);
-        const double T = -mid.dot(e);
-        // S = ∮ r (r x n) ds = -[A (A.e) + (A (e.e) + e (A.e)) / 2 + e (e.e) / 3]
-        const double ae = A.dot(e), ee = e.dot(e);
-        const Vec2 S = -(A * ae + 0.5 * (A * ee + e * ae) + e * (ee / 3.0));
+        const Vec2& N = fp.edge_normal[k];  // d w_c / dG
+        const double T = fp.edge_twist[k];  // d w_c / dyaw
+        const Vec2 Qa = fp.edge_first[k].transpose() * a;  // ∮ B (r . a) n ds
+        const Vec2& S = fp.edge_swept[k];
         const Vec2& rc = fp.centroid[piece];
         const double area_term = 0.5 * ks * (psi * up * up + dpsi * sum * inv_cell_area);  // dV / d a_c
         const double kf = ks * psi;
-        const Vec2 dVdG = area_term * N - kf * up * (ra * N - a.dot(rc) * N);
+        const Vec2 dVdG = area_term * N - kf * up * (Qa - a.dot(rc) * N);
         const double dVdyaw = area_term * T - kf * up * a.dot(S - rc * T);
         fh -= dVdG;
         torque -= dVdyaw;

@@ -139,6 +139,7 @@ private:
   double subcell_weight(double coverage) const;
   Eigen::Matrix2d tilt_inertia(const Floes& floes, std::size_t i) const;
 
+  FootprintKernel kernel_ = FootprintKernel::cell;
   double rho_ = 1025.0, g_ = 9.81, sigma_ = 0.0, K_ = 1000.0, s_ = 1.0, kappa_ = 0.0;
   fluid::SurfaceGrid grid_;
   double sea_inverse_mass_ = 0.0;  // 1 / m_sea: eta' per unit pressure impulse on one cell (m^2 s / kg... per Pa s)

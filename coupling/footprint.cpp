@@ -1,7 +1,9 @@
 #include "coupling/footprint.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <stdexcept>
 
 namespace floesim {
 
@@ -30,6 +32,60 @@ int wrap(int i, int n) { return ((i % n) + n) % n; }
 
 constexpr double kSixth = 1.0 / 6.0;
 
+// Gauss–Legendre with 3 points on [0, 1]: exact for polynomials of degree 5.
+constexpr double kGaussT[3] = {0.5 - 0.3872983346207417, 0.5, 0.5 + 0.3872983346207417};
+constexpr double kGaussW[3] = {5.0 / 18.0, 8.0 / 18.0, 5.0 / 18.0};
+constexpr double kUnit[3] = {1.0, 1.0, 1.0};
+
+// Appends an edge piece A -> B (relative to G) weighted by a kernel B that is
+// linear in each coordinate along the segment, given by its values at the
+// three Gauss points (1 for the cell kernel). The integrands are at most of
+// degree 4 along the segment, so the rule is exact. With n ds = (e_y, -e_x) dt
+// and r x n ds = -(r . e) dt:
+//     length = ∫ B |e| dt,  N = ∫ B n ds,  T = ∫ B (r x n) ds,
+//     Q = ∫ B r n^T ds,     S = ∫ B r (r x n) ds.
+void push_edge_piece(Footprints& out, std::uint32_t cell, const Vec2& a, const Vec2& b, const double (&weight)[3]) {
+  const Vec2 e = b - a, n{e.y(), -e.x()};
+  double length = 0.0, twist = 0.0, wsum = 0.0;
+  Vec2 first = Vec2::Zero(), swept = Vec2::Zero();
+  for (int g = 0; g < 3; ++g) {
+    const double w = kGaussW[g] * weight[g];
+    const Vec2 r = a + kGaussT[g] * e;
+    const double rxn = -r.dot(e);
+    wsum += w;
+    first += w * r;
+    twist += w * rxn;
+    swept += w * rxn * r;
+  }
+  length = wsum * e.norm();
+  out.edge_cell.push_back(cell);
+  out.edge_length.push_back(length);
+  out.edge_normal.push_back(wsum * n);
+  out.edge_twist.push_back(twist);
+  out.edge_first.push_back(first * n.transpose());
+  out.edge_swept.push_back(swept);
+}
+
+// Splits the segment a -> b (relative to G) at the grid lines x = (k + shift)
+// dx (and y likewise when two_d); returns the parameters, sorted, from 0 to 1.
+void split_at_lines(const Vec2& a, const Vec2& b, const Vec2& g, double dx, double dy, double shift, bool two_d,
+                    std::vector<double>& ts) {
+  const Vec2 e = b - a;
+  ts.assign({0.0, 1.0});
+  for (int axis = 0; axis < (two_d ? 2 : 1); ++axis) {
+    if (e[axis] == 0.0) continue;
+    const double step = axis == 0 ? dx : dy;
+    const double o = axis == 0 ? g.x() : g.y();
+    const double u0 = std::min(a[axis], b[axis]) + o, u1 = std::max(a[axis], b[axis]) + o;
+    const double inv = 1.0 / e[axis];
+    for (double line = (std::ceil(u0 / step - shift) + shift) * step; line < u1; line += step) {
+      const double t = (line - o - a[axis]) * inv;
+      if (t > 0.0 && t < 1.0) ts.push_back(t);
+    }
+  }
+  std::sort(ts.begin(), ts.end());
+}
+
 struct Scratch {
   std::vector<Vec2> poly;
   std::vector<double> ts;
@@ -42,7 +98,217 @@ struct Scratch {
   std::vector<std::uint32_t> cells;
   std::vector<double> areas;
   std::vector<Vec2> firsts;
+  // Tent kernel: per dual cell the moments m[p][q] = ∫∫ s^p t^q ds dt of the
+  // floe's part (local coordinates s, t in [0, 1]) and the carries ∫ s^p ds.
+  std::vector<std::array<double, 9>> moments;
+  std::vector<std::array<double, 3>> carries;
+  std::vector<std::uint32_t> edge_node;  // local node of each tent edge piece
+  std::vector<double> node_area;
+  std::vector<Vec2> node_first;
 };
+
+// Sorts the pieces of the last floe (from first_piece) by cell and merges
+// pieces of one cell: a floe whose box wraps around a periodic edge, or is
+// larger than the box and covers a cell twice.
+void merge_wrapped(Footprints& out, std::size_t first_piece, Scratch& s) {
+  const std::size_t n = out.cell.size() - first_piece;
+  std::vector<std::size_t>& order = s.order;
+  order.resize(n);
+  for (std::size_t k = 0; k < n; ++k) order[k] = first_piece + k;
+  std::sort(order.begin(), order.end(), [&](std::size_t x, std::size_t y) { return out.cell[x] < out.cell[y]; });
+  s.cells.clear();
+  s.areas.clear();
+  s.firsts.clear();
+  for (std::size_t k : order) {
+    if (!s.cells.empty() && s.cells.back() == out.cell[k]) {
+      s.areas.back() += out.area[k];
+      s.firsts.back() += out.area[k] * out.centroid[k];
+    } else {
+      s.cells.push_back(out.cell[k]);
+      s.areas.push_back(out.area[k]);
+      s.firsts.push_back(out.area[k] * out.centroid[k]);
+    }
+  }
+  out.cell.resize(first_piece);
+  out.area.resize(first_piece);
+  out.centroid.resize(first_piece);
+  for (std::size_t k = 0; k < s.cells.size(); ++k) {
+    out.cell.push_back(s.cells[k]);
+    out.area.push_back(s.areas[k]);
+    out.centroid.push_back(s.firsts[k] / s.areas[k]);
+  }
+}
+
+
+// Tent kernel (see the header): the same edge accumulation on the dual grid,
+// whose lines x = (I + 1/2) dx run through the cells' centres. In dual cell
+// (I, J), with s = (x - x_I) / dx and t = (y - y_J) / dy in [0, 1], the four
+// tents of its corners (the nodes I, I + 1 and J, J + 1, i.e. sea cells) are
+// (1 - s)(1 - t), s (1 - t), (1 - s) t and s t. Every integral of a tent times
+// 1, x or y over the floe's part of the dual cell is a combination of the
+// moments m_pq = ∫∫ s^p t^q ds dt, p, q <= 2 (not p = q = 2). By Green's
+// theorem, as for the areas (F_q(s, t) = t^(q+1) / (q+1) the t-antiderivative),
+//     m_pq(own row) = -sum over sub-segments ∫ s^p F_q(s, t(s)) ds,
+//     m_pq(row below) = -sum over the sub-segments above ∫ s^p ds / (q + 1),
+// integrated exactly by 3-point Gauss–Legendre (degree <= 4). With dims = 1
+// there is one row and no t in the tents: t is y relative to G (dy = 1).
+void build_tent(const Floes& floes, std::span<const std::uint8_t> include, const fluid::SurfaceGrid& grid,
+                Footprints& out, Scratch& s) {
+  if (grid.edge != fluid::GridEdge::periodic)
+    throw std::invalid_argument("the tent footprint kernel needs a periodic grid");
+  const bool two_d = grid.dims == 2;
+  const double dx = grid.dx(), dy = two_d ? grid.dy() : 1.0;
+  const double area_element = dx * (two_d ? dy : 1.0);
+  const double tiny = 1e-12 * dx * (two_d ? grid.dy() : grid.ly);
+  auto wrap_cell = [&](int i, int j) {
+    return static_cast<std::uint32_t>((two_d ? wrap(j, grid.ny) : 0) * grid.nx + wrap(i, grid.nx));
+  };
+  for (std::size_t f = 0; f < floes.size(); ++f) {
+    if (!include[f]) {
+      out.offsets.push_back(out.cell.size());
+      out.edge_offsets.push_back(out.edge_cell.size());
+      continue;
+    }
+    const FloeState& st = floes.state[f];
+    const Vec2 g{st.x, st.y};
+    s.poly.clear();
+    Vec2 lo = Vec2::Constant(INFINITY), hi = Vec2::Constant(-INFINITY);
+    for (const Vec2& p : floes.vertices(f)) {
+      s.poly.push_back(rotate(p, st.yaw));
+      lo = lo.cwiseMin(s.poly.back());
+      hi = hi.cwiseMax(s.poly.back());
+    }
+    // Dual cells of the bounding box, and their corner nodes ((w + 1) x (h + 1); one row with dims = 1).
+    const int i0 = static_cast<int>(std::floor((g.x() + lo.x()) / dx - 0.5));
+    const int i1 = static_cast<int>(std::floor((g.x() + hi.x()) / dx - 0.5));
+    const int j0 = two_d ? static_cast<int>(std::floor((g.y() + lo.y()) / dy - 0.5)) : 0;
+    const int j1 = two_d ? static_cast<int>(std::floor((g.y() + hi.y()) / dy - 0.5)) : 0;
+    const int w = i1 - i0 + 1, h = j1 - j0 + 1;
+    const int nw = w + 1, nh = two_d ? h + 1 : 1;
+    const std::size_t nloc = static_cast<std::size_t>(w) * static_cast<std::size_t>(h);
+    s.moments.assign(nloc, {});
+    s.carries.assign(nloc, {});
+    // Origin of dual cell (li, lj) relative to G (dims = 1: t = y, origin 0).
+    auto origin = [&](int li, int lj) {
+      return Vec2{(i0 + li + 0.5) * dx - g.x(), two_d ? (j0 + lj + 0.5) * dy - g.y() : 0.0};
+    };
+
+    const std::size_t first_edge = out.edge_cell.size();
+    s.edge_node.clear();
+    const std::size_t nv = s.poly.size();
+    for (std::size_t k = 0; k < nv; ++k) {
+      const Vec2 a = s.poly[k], b = s.poly[(k + 1) % nv];
+      const Vec2 e = b - a;
+      split_at_lines(a, b, g, dx, dy, 0.5, two_d, s.ts);
+      for (std::size_t m = 0; m + 1 < s.ts.size(); ++m) {
+        if (s.ts[m + 1] - s.ts[m] <= 1e-14) continue;
+        const Vec2 pa = a + s.ts[m] * e, pb = a + s.ts[m + 1] * e;
+        const Vec2 mid = g + 0.5 * (pa + pb);
+        const int ci = static_cast<int>(std::floor(mid.x() / dx - 0.5));
+        const int cj = two_d ? static_cast<int>(std::floor(mid.y() / dy - 0.5)) : 0;
+        const int li = std::clamp(ci - i0, 0, w - 1), lj = std::clamp(cj - j0, 0, h - 1);
+        const std::size_t local = static_cast<std::size_t>(lj) * w + li;
+        const Vec2 o = origin(li, lj);
+        const double sa = (pa.x() - o.x()) / dx, sb = (pb.x() - o.x()) / dx;
+        const double ta = (pa.y() - o.y()) / dy, tb = (pb.y() - o.y()) / dy;
+        double ss[3], tt[3];
+        for (int q = 0; q < 3; ++q) {
+          ss[q] = sa + kGaussT[q] * (sb - sa);
+          tt[q] = ta + kGaussT[q] * (tb - ta);
+        }
+        const double run = sb - sa;
+        if (run != 0.0) {
+          std::array<double, 9>& mom = s.moments[local];
+          std::array<double, 3>& carry = s.carries[local];
+          for (int q = 0; q < 3; ++q) {
+            const double wq = kGaussW[q] * run;
+            const double s1 = ss[q], s2 = s1 * s1, t1 = tt[q], t2 = t1 * t1, t3 = t2 * t1;
+            // m_pq -= ∫ s^p t^(q+1) / (q+1) ds
+            mom[0] -= wq * t1;
+            mom[1] -= wq * s1 * t1;
+            mom[2] -= wq * s2 * t1;
+            mom[3] -= wq * t2 * 0.5;
+            mom[4] -= wq * s1 * t2 * 0.5;
+            mom[5] -= wq * s2 * t2 * 0.5;
+            mom[6] -= wq * t3 / 3.0;
+            mom[7] -= wq * s1 * t3 / 3.0;
+            if (lj > 0) {
+              carry[0] -= wq;
+              carry[1] -= wq * s1;
+              carry[2] -= wq * s2;
+            }
+          }
+        }
+        // Edge pieces, one per corner node of the dual cell.
+        for (int beta = 0; beta < (two_d ? 2 : 1); ++beta)
+          for (int alpha = 0; alpha < 2; ++alpha) {
+            double weight[3];
+            for (int q = 0; q < 3; ++q)
+              weight[q] = (alpha ? ss[q] : 1.0 - ss[q]) * (two_d ? (beta ? tt[q] : 1.0 - tt[q]) : 1.0);
+            if (weight[0] == 0.0 && weight[1] == 0.0 && weight[2] == 0.0) continue;
+            push_edge_piece(out, wrap_cell(i0 + li + alpha, j0 + lj + beta), pa, pb, weight);
+            s.edge_node.push_back(static_cast<std::uint32_t>((lj + beta) * nw + li + alpha));
+          }
+      }
+    }
+    // The carries, summed down each column: a full row below has m_pq =
+    // (sum of the carries above)_p / (q + 1).
+    if (h > 1) {
+      for (int li = 0; li < w; ++li) {
+        std::array<double, 3> above{};
+        for (int lj = h - 1; lj >= 0; --lj) {
+          const std::size_t local = static_cast<std::size_t>(lj) * w + li;
+          std::array<double, 9>& mom = s.moments[local];
+          for (int p = 0; p < 3; ++p)
+            for (int q = 0; q < 3; ++q)
+              if (p + q < 4) mom[static_cast<std::size_t>(3 * q + p)] += above[static_cast<std::size_t>(p)] / (q + 1);
+          for (int p = 0; p < 3; ++p) above[static_cast<std::size_t>(p)] += s.carries[local][static_cast<std::size_t>(p)];
+        }
+      }
+    }
+    // Nodes: each dual cell adds its four tents' integrals to its corners.
+    // With the tent (c0 + c1 s)(d0 + d1 t), ∫∫ tent s^i t^j = sum of c d m.
+    const std::size_t nnodes = static_cast<std::size_t>(nw) * static_cast<std::size_t>(nh);
+    s.node_area.assign(nnodes, 0.0);
+    s.node_first.assign(nnodes, Vec2::Zero());
+    for (int lj = 0; lj < h; ++lj)
+      for (int li = 0; li < w; ++li) {
+        const std::array<double, 9>& mom = s.moments[static_cast<std::size_t>(lj) * w + li];
+        auto m = [&](int p, int q) { return mom[static_cast<std::size_t>(3 * q + p)]; };
+        const Vec2 o = origin(li, lj);
+        for (int beta = 0; beta < (two_d ? 2 : 1); ++beta)
+          for (int alpha = 0; alpha < 2; ++alpha) {
+            const double c0 = alpha ? 0.0 : 1.0, c1 = alpha ? 1.0 : -1.0;
+            const double d0 = two_d ? (beta ? 0.0 : 1.0) : 1.0, d1 = two_d ? (beta ? 1.0 : -1.0) : 0.0;
+            auto I = [&](int i, int j) {
+              return c0 * d0 * m(i, j) + c1 * d0 * m(i + 1, j) + c0 * d1 * m(i, j + 1) + c1 * d1 * m(i + 1, j + 1);
+            };
+            const double i00 = I(0, 0), i10 = I(1, 0), i01 = I(0, 1);
+            const std::size_t node = static_cast<std::size_t>((lj + beta) * nw + li + alpha);
+            s.node_area[node] += area_element * i00;
+            s.node_first[node] += area_element * Vec2{o.x() * i00 + dx * i10, o.y() * i00 + dy * i01};
+          }
+      }
+    const std::size_t first_piece = out.cell.size();
+    s.piece.assign(nnodes, -1);
+    for (int nj = 0; nj < nh; ++nj)
+      for (int ni = 0; ni < nw; ++ni) {
+        const std::size_t node = static_cast<std::size_t>(nj) * nw + ni;
+        const double a = s.node_area[node];
+        if (a <= tiny) continue;
+        s.piece[node] = static_cast<std::ptrdiff_t>(out.cell.size());
+        out.cell.push_back(wrap_cell(i0 + ni, j0 + nj));
+        out.area.push_back(a);
+        out.centroid.push_back(s.node_first[node] / a);
+      }
+    const bool wraps = i0 < 0 || i1 + 1 >= grid.nx || (two_d && (j0 < 0 || j1 + 1 >= grid.ny));
+    if (wraps) merge_wrapped(out, first_piece, s);
+    out.offsets.push_back(out.cell.size());
+    for (std::size_t k = 0; k < s.edge_node.size(); ++k)
+      out.edge_piece.push_back(wraps ? out.find(f, out.edge_cell[first_edge + k]) : s.piece[s.edge_node[k]]);
+    out.edge_offsets.push_back(out.edge_cell.size());
+  }
+}
 
 }  // namespace
 
@@ -54,23 +320,31 @@ std::ptrdiff_t Footprints::find(std::size_t i, std::uint32_t c) const {
 }
 
 void build_footprints(const Floes& floes, std::span<const std::uint8_t> include,
-                      const fluid::SurfaceGrid& grid, Footprints& out) {
+                      const fluid::SurfaceGrid& grid, Footprints& out, FootprintKernel kernel) {
   out.offsets.assign(1, 0);
   out.cell.clear();
   out.area.clear();
   out.centroid.clear();
   out.edge_offsets.assign(1, 0);
   out.edge_cell.clear();
-  out.edge_a.clear();
-  out.edge_b.clear();
   out.edge_piece.clear();
+  out.edge_length.clear();
+  out.edge_normal.clear();
+  out.edge_twist.clear();
+  out.edge_first.clear();
+  out.edge_swept.clear();
+  out.kernel = kernel;
+  static thread_local Scratch scratch;
+  if (kernel == FootprintKernel::tent) {
+    build_tent(floes, include, grid, out, scratch);
+    return;
+  }
   const double dx = grid.dx(), dy = grid.dy(), inv_dx = 1.0 / dx, inv_dy = 1.0 / dy;
   const bool periodic = grid.edge == fluid::GridEdge::periodic;
   const bool two_d = grid.dims == 2;
   // A piece thinner than this (relative to a cell) is round-off from a vertex
   // lying on a grid line.
   const double tiny = 1e-12 * dx * (two_d ? dy : grid.ly);
-  static thread_local Scratch scratch;
   Scratch& s = scratch;
 
   // Cell of column i, row j, or -1 outside a walled basin.
@@ -116,19 +390,7 @@ void build_footprints(const Floes& floes, std::span<const std::uint8_t> include,
       for (std::size_t k = 0; k < nv; ++k) {
         const Vec2 a = s.poly[k], b = s.poly[(k + 1) % nv];
         const Vec2 e = b - a;
-        s.ts.assign({0.0, 1.0});
-        for (int axis = 0; axis < (two_d ? 2 : 1); ++axis) {
-          if (e[axis] == 0.0) continue;
-          const double step = axis == 0 ? dx : dy;
-          const double o = axis == 0 ? g.x() : g.y();
-          const double u0 = std::min(a[axis], b[axis]) + o, u1 = std::max(a[axis], b[axis]) + o;
-          const double inv = 1.0 / e[axis];
-          for (double line = std::ceil(u0 / step) * step; line < u1; line += step) {
-            const double t = (line - o - a[axis]) * inv;
-            if (t > 0.0 && t < 1.0) s.ts.push_back(t);
-          }
-        }
-        std::sort(s.ts.begin(), s.ts.end());
+        split_at_lines(a, b, g, dx, dy, 0.0, two_d, s.ts);
         for (std::size_t m = 0; m + 1 < s.ts.size(); ++m) {
           if (s.ts[m + 1] - s.ts[m] <= 1e-14) continue;
           const Vec2 pa = a + s.ts[m] * e, pb = a + s.ts[m + 1] * e;
@@ -152,9 +414,7 @@ void build_footprints(const Floes& floes, std::span<const std::uint8_t> include,
           }
           const std::int64_t c = cell_of(ci, cj);
           if (c < 0) continue;
-          out.edge_cell.push_back(static_cast<std::uint32_t>(c));
-          out.edge_a.push_back(pa);
-          out.edge_b.push_back(pb);
+          push_edge_piece(out, static_cast<std::uint32_t>(c), pa, pb, kUnit);
           s.edge_local.push_back(static_cast<std::uint32_t>(local));
         }
       }
@@ -191,34 +451,7 @@ void build_footprints(const Floes& floes, std::span<const std::uint8_t> include,
         }
       const bool wraps = periodic && (i0 < 0 || i1 >= grid.nx || (two_d && (j0 < 0 || j1 >= grid.ny)));
       if (wraps) {
-        // Sort this floe's pieces by cell (a floe larger than the periodic box
-        // covers a cell twice: merge those).
-        const std::size_t n = out.cell.size() - first_piece;
-        std::vector<std::size_t>& order = s.order;
-        order.resize(n);
-        for (std::size_t k = 0; k < n; ++k) order[k] = first_piece + k;
-        std::sort(order.begin(), order.end(), [&](std::size_t x, std::size_t y) { return out.cell[x] < out.cell[y]; });
-        s.cells.clear();
-        s.areas.clear();
-        s.firsts.clear();
-        for (std::size_t k : order) {
-          if (!s.cells.empty() && s.cells.back() == out.cell[k]) {
-            s.areas.back() += out.area[k];
-            s.firsts.back() += out.area[k] * out.centroid[k];
-          } else {
-            s.cells.push_back(out.cell[k]);
-            s.areas.push_back(out.area[k]);
-            s.firsts.push_back(out.area[k] * out.centroid[k]);
-          }
-        }
-        out.cell.resize(first_piece);
-        out.area.resize(first_piece);
-        out.centroid.resize(first_piece);
-        for (std::size_t k = 0; k < s.cells.size(); ++k) {
-          out.cell.push_back(s.cells[k]);
-          out.area.push_back(s.areas[k]);
-          out.centroid.push_back(s.firsts[k] / s.areas[k]);
-        }
+        merge_wrapped(out, first_piece, s);
       }
       out.offsets.push_back(out.cell.size());
       // Each edge piece's area piece: through the local map, or by search

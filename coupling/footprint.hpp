@@ -30,26 +30,51 @@
 
 namespace floesim {
 
+// How a floe's footprint is weighed on the grid (docs/coupling.md, "Footprints"):
+//   cell: the indicator of each cell, B_c = 1 on cell c: pieces are the exact
+//         areas omega ∩ cell_c. A cell's load is continuous as an edge crosses
+//         the cell, but its rate jumps at the cell's lines.
+//   tent: the bilinear tent of each node (a cell's centre), B_c(x) = (1 -
+//         |x - x_c| / dx)^+ (1 - |y - y_c| / dy)^+: pieces are w_c = ∫_omega B_c,
+//         first moments ∫_omega B_c r. The tents are a partition of unity, so
+//         the pieces still sum to the floe's area, and a node's load is C^1 in
+//         the floe's position: its rate no longer jumps as a floe drifts.
+//         Computed by the same edge accumulation on the dual grid (lines
+//         through the cells' centres), where each dual cell holds four
+//         bilinear tents. Periodic grids only (a tent would reach past a wall).
+enum class FootprintKernel { cell, tent };
+
 struct Footprints {
+  FootprintKernel kernel = FootprintKernel::cell;
   // Area pieces of floe i: [offsets[i], offsets[i + 1]), sorted by cell.
+  // With the tent kernel, "area" is the tent-weighted area w_c and "centroid"
+  // the tent-weighted centroid.
   std::vector<std::size_t> offsets{0};
   std::vector<std::uint32_t> cell;
   std::vector<double> area;       // m^2
   std::vector<Vec2> centroid;     // m, relative to G
-  // Edge pieces of floe i: [edge_offsets[i], edge_offsets[i + 1]); the polygon
-  // is counter-clockwise, so the outward normal of A -> B is (e_y, -e_x) / |e|.
+  // Edge pieces of floe i: [edge_offsets[i], edge_offsets[i + 1]): a part of
+  // the outline in one cell (tent: one dual cell, weighted by one node's
+  // tent B; cell: B = 1), with its integrals along the outline (n the outward
+  // normal, r relative to G; the polygon is counter-clockwise):
   std::vector<std::size_t> edge_offsets{0};
   std::vector<std::uint32_t> edge_cell;
-  std::vector<Vec2> edge_a, edge_b;  // m, relative to G
-  std::vector<std::ptrdiff_t> edge_piece;  // index of the area piece in the same cell, or -1
+  std::vector<std::ptrdiff_t> edge_piece;  // index of the area piece of that cell, or -1
+  std::vector<double> edge_length;         // ∫ B ds (m)
+  std::vector<Vec2> edge_normal;           // N = ∫ B n ds = d w_c / dG
+  std::vector<double> edge_twist;          // T = ∫ B (r x n) ds = d w_c / dyaw
+  std::vector<Eigen::Matrix2d> edge_first; // Q = ∫ B r n^T ds: d (∫ B r) / dG = Q - w_c I
+  std::vector<Vec2> edge_swept;            // S = ∫ B r (r x n) ds = d (∫ B r) / dyaw
 
   std::size_t floes() const { return offsets.size() - 1; }
   // Index of the area piece of floe i in `cell_index`, or -1.
   std::ptrdiff_t find(std::size_t i, std::uint32_t cell_index) const;
 };
 
-// Pieces of every floe for which include[i] is true (others get none).
+// Pieces of every floe for which include[i] is true (others get none). The
+// tent kernel needs a periodic grid (a walled one gets std::invalid_argument).
 void build_footprints(const Floes& floes, std::span<const std::uint8_t> include,
-                      const fluid::SurfaceGrid& grid, Footprints& out);
+                      const fluid::SurfaceGrid& grid, Footprints& out,
+                      FootprintKernel kernel = FootprintKernel::cell);
 
 }  // namespace floesim

@@ -63,6 +63,8 @@ Simulation::Simulation(Scenario scenario) : scenario_(std::move(scenario)) {
   const bool any_dynamic = std::any_of(f.is_static.begin(), f.is_static.end(), [](std::uint8_t s) { return !s; });
   if (sea_ && any_dynamic) {
     floe_sea_ = std::make_unique<FloeSeaContact>(c.coupling, c.sea, scenario_.floes, *sea_);
+    if (c.sea.waves.kind != WaveKind::none || c.sea.tank.enabled)
+      incident_ = fluid::make_sea(c.sea, c.run.seed, sea_options);
     floe_sea_->start(scenario_.floes, *sea_, c.coupling.start_given);
     evaluate_penalty(0.5 * c.run.dt_max);
     update_water_velocity();
@@ -169,7 +171,7 @@ void Simulation::drift(StepContext& ctx) {
   const Vec2 wind{ctx.forcing.wind[0], ctx.forcing.wind[1]};
   std::span<const Vec2> water;
   if (floe_sea_) {
-    // Drag relative to the current plus the waves' orbital velocity at t.
+    // Drag relative to the current plus the incident waves' orbital velocity at t.
     for (Vec2& w : water_velocity_) w += current;
     water = water_velocity_;
   }
@@ -303,6 +305,7 @@ void Simulation::sea_flow(const StepContext& ctx) {
   if (!sea_) return;
   if (floe_sea_) floe_sea_->kick_sea(*sea_, 0.5 * ctx.dt);
   sea_->flow(ctx.dt);
+  if (incident_) incident_->flow(ctx.dt);
 }
 
 void Simulation::sea_half_kick(const StepContext& ctx) {
@@ -328,8 +331,11 @@ void Simulation::evaluate_penalty(double h) {
 }
 
 void Simulation::update_water_velocity() {
-  // Over the footprints of the last evaluate_penalty.
-  floe_sea_->orbital_velocity(scenario_.floes, *sea_, water_velocity_);
+  // The incident waves' velocity over the footprints of the last evaluate_penalty.
+  if (incident_)
+    floe_sea_->orbital_velocity(scenario_.floes, *incident_, water_velocity_);
+  else
+    water_velocity_.assign(scenario_.floes.size(), Vec2::Zero());
   water_stale_ = false;
 }
 

@@ -7,8 +7,8 @@
 //      with fracture on)
 //   -> sample forcing
 //   -> floes' half kick from the sea (penalty loads at t, coupling/floe_sea.hpp)
-//   -> drift velocities (drag relative to current + orbital velocity, wind,
-//      Coriolis) -> collide (LCPs: W(t-) -> W(t+))
+//   -> drift velocities (drag relative to current + the incident waves'
+//      orbital velocity, wind, Coriolis) -> collide (LCPs: W(t-) -> W(t+))
 //   -> percussion (fracture checks on the collision impulses; a split floe
 //      becomes two)
 //   -> advance positions (horizontal: floes that may collide within the step
@@ -16,7 +16,8 @@
 //      DOFs)
 //   -> detect (new contacts; an overlap rejects the step, which is redone
 //      with half the dt from the floes at t: the sea has not moved yet)
-//   -> sea: half kick with the pressures at t, exact modal flow over dt
+//   -> sea: half kick with the pressures at t, exact modal flow over dt (and
+//      the incident sea's flow)
 //   -> penalty loads at t + dt: second half kick of the sea and the floes,
 //      then the orbital velocity under the floes (for the next drag)
 //   -> check state
@@ -136,7 +137,7 @@ private:
   void floes_half_kick(const StepContext& ctx);
   void sea_half_kick(const StepContext& ctx);
   void evaluate_penalty(double h);
-  void update_water_velocity();  // orbital velocity under each floe, for drag
+  void update_water_velocity();  // incident orbital velocity under each floe, for drag
   void drift(StepContext& ctx);
   void collide(StepContext& ctx);
   void percussion(StepContext& ctx);
@@ -150,9 +151,16 @@ private:
   Scenario scenario_;
   std::unique_ptr<fluid::Sea> sea_;
   std::unique_ptr<FloeSeaContact> floe_sea_;
+  // The waves without the floes: the same sea, never kicked. The sea is
+  // linear, so this is the incident part of sea_ (sea_ minus what the floes
+  // radiate and displace). Drag is relative to its orbital velocity: the flow
+  // a floe sets up by pushing its own depression along is not the ambient
+  // water its drag coefficient is measured against (docs/coupling.md). None
+  // on a calm sea without wave generation (its velocity is 0).
+  std::unique_ptr<fluid::Sea> incident_;
   double loads_h_ = -1.0;             // the kick length the floe–sea loads were evaluated for (< 0: stale)
   double equal_dt_ = -1.0;            // the last of the equal steps the penalty limit asked for
-  std::vector<Vec2> water_velocity_;  // orbital velocity under each floe at t, for drag
+  std::vector<Vec2> water_velocity_;  // incident orbital velocity under each floe at t, for drag
   bool water_stale_ = false;          // the floes changed since water_velocity_ was made
   Vec2 ctx_momentum_before_ = Vec2::Zero();  // of the floes at the start of the step's try
   DriftParams drift_params_;

@@ -73,7 +73,7 @@ TEST_CASE("footprint pieces tile the floe exactly, wherever it sits on the grid"
         area += fp.area[k];
         first += fp.area[k] * fp.centroid[k];
       }
-      for (std::size_t k = 0; k < fp.edge_cell.size(); ++k) length += (fp.edge_b[k] - fp.edge_a[k]).norm();
+      for (std::size_t k = 0; k < fp.edge_cell.size(); ++k) length += fp.edge_length[k];
       CHECK(area == doctest::Approx(floes.area[0]).epsilon(1e-12));
       CHECK(first.norm() < 1e-10 * floes.area[0]);  // centroid at G
       CHECK(length == doctest::Approx(perimeter).epsilon(1e-12));
