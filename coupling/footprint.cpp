@@ -37,16 +37,25 @@ constexpr double kGaussT[3] = {0.5 - 0.3872983346207417, 0.5, 0.5 + 0.3872983346
 constexpr double kGaussW[3] = {5.0 / 18.0, 8.0 / 18.0, 5.0 / 18.0};
 constexpr double kUnit[3] = {1.0, 1.0, 1.0};
 
-// Appends an edge piece A -> B (relative to G) weighted by a kernel B that is
-// linear in each coordinate along the segment, given by its values at the
-// three Gauss points (1 for the cell kernel). The integrands are at most of
-// degree 4 along the segment, so the rule is exact. With n ds = (e_y, -e_x) dt
-// and r x n ds = -(r . e) dt:
+// The integrals along a floe's outline that go with one node (or cell): its
+// edge piece, summed over the sub-segments in the cells around it.
+struct EdgeSum {
+  double length = 0.0, twist = 0.0;
+  Vec2 normal = Vec2::Zero(), swept = Vec2::Zero();
+  Eigen::Matrix2d first = Eigen::Matrix2d::Zero();
+  bool any = false;
+};
+
+// Adds the sub-segment A -> B (relative to G) weighted by a kernel B that is
+// linear in each coordinate along it, given by its values at the three Gauss
+// points (1 for the cell kernel). The integrands are at most of degree 4
+// along the segment, so the rule is exact. With n ds = (e_y, -e_x) dt and
+// r x n ds = -(r . e) dt:
 //     length = ∫ B |e| dt,  N = ∫ B n ds,  T = ∫ B (r x n) ds,
 //     Q = ∫ B r n^T ds,     S = ∫ B r (r x n) ds.
-void push_edge_piece(Footprints& out, std::uint32_t cell, const Vec2& a, const Vec2& b, const double (&weight)[3]) {
+void add_edge(EdgeSum& sum, const Vec2& a, const Vec2& b, const double (&weight)[3]) {
   const Vec2 e = b - a, n{e.y(), -e.x()};
-  double length = 0.0, twist = 0.0, wsum = 0.0;
+  double twist = 0.0, wsum = 0.0;
   Vec2 first = Vec2::Zero(), swept = Vec2::Zero();
   for (int g = 0; g < 3; ++g) {
     const double w = kGaussW[g] * weight[g];
@@ -57,13 +66,22 @@ void push_edge_piece(Footprints& out, std::uint32_t cell, const Vec2& a, const V
     twist += w * rxn;
     swept += w * rxn * r;
   }
-  length = wsum * e.norm();
+  sum.length += wsum * e.norm();
+  sum.normal += wsum * n;
+  sum.twist += twist;
+  sum.first += first * n.transpose();
+  sum.swept += swept;
+  sum.any = true;
+}
+
+void push_edge_piece(Footprints& out, std::uint32_t cell, std::ptrdiff_t piece, const EdgeSum& sum) {
   out.edge_cell.push_back(cell);
-  out.edge_length.push_back(length);
-  out.edge_normal.push_back(wsum * n);
-  out.edge_twist.push_back(twist);
-  out.edge_first.push_back(first * n.transpose());
-  out.edge_swept.push_back(swept);
+  out.edge_piece.push_back(piece);
+  out.edge_length.push_back(sum.length);
+  out.edge_normal.push_back(sum.normal);
+  out.edge_twist.push_back(sum.twist);
+  out.edge_first.push_back(sum.first);
+  out.edge_swept.push_back(sum.swept);
 }
 
 // Splits the segment a -> b (relative to G) at the grid lines x = (k + shift)
@@ -93,7 +111,7 @@ struct Scratch {
   // direct sums, the carries to the rows below, and the piece made there.
   std::vector<double> area, mx, my, carry_area, carry_mx;
   std::vector<std::ptrdiff_t> piece;
-  std::vector<std::uint32_t> edge_local;  // local cell of each of this floe's edge pieces
+  std::vector<EdgeSum> edges;  // per local cell or node
   std::vector<std::size_t> order;
   std::vector<std::uint32_t> cells;
   std::vector<double> areas;
@@ -102,9 +120,7 @@ struct Scratch {
   // floe's part (local coordinates s, t in [0, 1]) and the carries ∫ s^p ds.
   std::vector<std::array<double, 9>> moments;
   std::vector<std::array<double, 3>> carries;
-  std::vector<std::uint32_t> edge_node;  // local node of each tent edge piece
-  std::vector<double> node_area;
-  std::vector<Vec2> node_first;
+  std::vector<double> node_area, node_fx, node_fy;
 };
 
 // Sorts the pieces of the last floe (from first_piece) by cell and merges
@@ -193,8 +209,8 @@ void build_tent(const Floes& floes, std::span<const std::uint8_t> include, const
       return Vec2{(i0 + li + 0.5) * dx - g.x(), two_d ? (j0 + lj + 0.5) * dy - g.y() : 0.0};
     };
 
-    const std::size_t first_edge = out.edge_cell.size();
-    s.edge_node.clear();
+    const std::size_t nnodes = static_cast<std::size_t>(nw) * static_cast<std::size_t>(nh);
+    s.edges.assign(nnodes, {});
     const std::size_t nv = s.poly.size();
     for (std::size_t k = 0; k < nv; ++k) {
       const Vec2 a = s.poly[k], b = s.poly[(k + 1) % nv];
@@ -239,15 +255,14 @@ void build_tent(const Floes& floes, std::span<const std::uint8_t> include, const
             }
           }
         }
-        // Edge pieces, one per corner node of the dual cell.
+        // The outline's integrals, to each corner node of the dual cell.
         for (int beta = 0; beta < (two_d ? 2 : 1); ++beta)
           for (int alpha = 0; alpha < 2; ++alpha) {
             double weight[3];
             for (int q = 0; q < 3; ++q)
               weight[q] = (alpha ? ss[q] : 1.0 - ss[q]) * (two_d ? (beta ? tt[q] : 1.0 - tt[q]) : 1.0);
             if (weight[0] == 0.0 && weight[1] == 0.0 && weight[2] == 0.0) continue;
-            push_edge_piece(out, wrap_cell(i0 + li + alpha, j0 + lj + beta), pa, pb, weight);
-            s.edge_node.push_back(static_cast<std::uint32_t>((lj + beta) * nw + li + alpha));
+            add_edge(s.edges[static_cast<std::size_t>((lj + beta) * nw + li + alpha)], pa, pb, weight);
           }
       }
     }
@@ -268,9 +283,9 @@ void build_tent(const Floes& floes, std::span<const std::uint8_t> include, const
     }
     // Nodes: each dual cell adds its four tents' integrals to its corners.
     // With the tent (c0 + c1 s)(d0 + d1 t), ∫∫ tent s^i t^j = sum of c d m.
-    const std::size_t nnodes = static_cast<std::size_t>(nw) * static_cast<std::size_t>(nh);
     s.node_area.assign(nnodes, 0.0);
-    s.node_first.assign(nnodes, Vec2::Zero());
+    s.node_fx.assign(nnodes, 0.0);
+    s.node_fy.assign(nnodes, 0.0);
     for (int lj = 0; lj < h; ++lj)
       for (int li = 0; li < w; ++li) {
         const std::array<double, 9>& mom = s.moments[static_cast<std::size_t>(lj) * w + li];
@@ -286,7 +301,8 @@ void build_tent(const Floes& floes, std::span<const std::uint8_t> include, const
             const double i00 = I(0, 0), i10 = I(1, 0), i01 = I(0, 1);
             const std::size_t node = static_cast<std::size_t>((lj + beta) * nw + li + alpha);
             s.node_area[node] += area_element * i00;
-            s.node_first[node] += area_element * Vec2{o.x() * i00 + dx * i10, o.y() * i00 + dy * i01};
+            s.node_fx[node] += area_element * (o.x() * i00 + dx * i10);
+            s.node_fy[node] += area_element * (o.y() * i00 + dy * i01);
           }
       }
     const std::size_t first_piece = out.cell.size();
@@ -299,13 +315,18 @@ void build_tent(const Floes& floes, std::span<const std::uint8_t> include, const
         s.piece[node] = static_cast<std::ptrdiff_t>(out.cell.size());
         out.cell.push_back(wrap_cell(i0 + ni, j0 + nj));
         out.area.push_back(a);
-        out.centroid.push_back(s.node_first[node] / a);
+        out.centroid.push_back(Vec2{s.node_fx[node], s.node_fy[node]} / a);
       }
     const bool wraps = i0 < 0 || i1 + 1 >= grid.nx || (two_d && (j0 < 0 || j1 + 1 >= grid.ny));
     if (wraps) merge_wrapped(out, first_piece, s);
     out.offsets.push_back(out.cell.size());
-    for (std::size_t k = 0; k < s.edge_node.size(); ++k)
-      out.edge_piece.push_back(wraps ? out.find(f, out.edge_cell[first_edge + k]) : s.piece[s.edge_node[k]]);
+    for (int nj = 0; nj < nh; ++nj)
+      for (int ni = 0; ni < nw; ++ni) {
+        const std::size_t node = static_cast<std::size_t>(nj) * nw + ni;
+        if (!s.edges[node].any) continue;
+        const std::uint32_t c = wrap_cell(i0 + ni, j0 + nj);
+        push_edge_piece(out, c, wraps ? out.find(f, c) : s.piece[node], s.edges[node]);
+      }
     out.edge_offsets.push_back(out.edge_cell.size());
   }
 }
@@ -384,8 +405,7 @@ void build_footprints(const Floes& floes, std::span<const std::uint8_t> include,
 
       // Edges: split at grid lines; each sub-segment is an edge piece and adds
       // its integrals to its cell (direct) and to the rows below (carry).
-      const std::size_t first_edge = out.edge_cell.size();
-      s.edge_local.clear();
+      s.edges.assign(nloc, {});
       const std::size_t nv = s.poly.size();
       for (std::size_t k = 0; k < nv; ++k) {
         const Vec2 a = s.poly[k], b = s.poly[(k + 1) % nv];
@@ -412,10 +432,7 @@ void build_footprints(const Floes& floes, std::span<const std::uint8_t> include,
               s.carry_mx[local] -= run * dy * 0.5 * (x0 + x1);
             }
           }
-          const std::int64_t c = cell_of(ci, cj);
-          if (c < 0) continue;
-          push_edge_piece(out, static_cast<std::uint32_t>(c), pa, pb, kUnit);
-          s.edge_local.push_back(static_cast<std::uint32_t>(local));
+          add_edge(s.edges[local], pa, pb, kUnit);
         }
       }
       // The carries, summed down each column: a full row j below the
@@ -454,10 +471,18 @@ void build_footprints(const Floes& floes, std::span<const std::uint8_t> include,
         merge_wrapped(out, first_piece, s);
       }
       out.offsets.push_back(out.cell.size());
-      // Each edge piece's area piece: through the local map, or by search
-      // among the floe's pieces once they were sorted and merged.
-      for (std::size_t k = 0; k < s.edge_local.size(); ++k)
-        out.edge_piece.push_back(wraps ? out.find(f, out.edge_cell[first_edge + k]) : s.piece[s.edge_local[k]]);
+      // One edge piece per cell the outline crosses. Its area piece: through
+      // the local map, or by search among the floe's pieces once they were
+      // sorted and merged.
+      for (int lj = 0; lj < h; ++lj)
+        for (int li = 0; li < w; ++li) {
+          const std::size_t local = static_cast<std::size_t>(lj) * w + li;
+          if (!s.edges[local].any) continue;
+          const std::int64_t c = cell_of(i0 + li, j0 + lj);
+          if (c < 0) continue;
+          const auto cell = static_cast<std::uint32_t>(c);
+          push_edge_piece(out, cell, wraps ? out.find(f, cell) : s.piece[local], s.edges[local]);
+        }
     } else {
       out.offsets.push_back(out.cell.size());
     }

@@ -1,10 +1,11 @@
 #pragma once
-// Where each floe covers the sea's surface grid (MODEL.md §4): the exact
-// pieces of its footprint in every cell it touches, and the pieces of its
-// boundary in every cell its edges cross.
+// Where each floe covers the sea's surface grid (MODEL.md §4): its pieces,
+// one per cell (or node) it touches, and the integrals along its outline that
+// go with them, for the cell kernel (B = the cell's indicator) or the tent
+// kernel (B = a node's bilinear tent; below):
 //
-//   area piece  (cell c, area a_c, centroid r_c):   omega_i ∩ cell_c
-//   edge piece  (cell c, segment A -> B):           ∂omega_i ∩ cell_c
+//   area piece  (cell c, weight a_c = ∫_omega B_c, centroid r_c = ∫_omega B_c r / a_c)
+//   edge piece  (cell c, ∮ B_c over the outline: length, N, T, Q, S)
 //
 // Positions are relative to the floe's centroid G, in world orientation (so a
 // floe far from the origin keeps full precision). Area pieces come from the
@@ -14,8 +15,8 @@
 // Exact up to round-off for convex and non-convex polygons, in time
 // proportional to the sub-segments plus the cells of the floe's bounding box.
 // Pieces are sorted by cell; each edge piece knows its area piece. Forces built
-// on these areas change continuously as a floe crosses cell boundaries
-// (MODEL.md §4: smooth forces).
+// on these weights change continuously as a floe crosses cell boundaries
+// (MODEL.md §4: smooth forces), and with the tent kernel their rates too.
 //
 // Periodic grids (spectral sea) wrap cell indices; a walled basin (bem) has no
 // water outside [0, lx], so pieces there are dropped. With dims = 1 cells are
@@ -53,10 +54,11 @@ struct Footprints {
   std::vector<std::uint32_t> cell;
   std::vector<double> area;       // m^2
   std::vector<Vec2> centroid;     // m, relative to G
-  // Edge pieces of floe i: [edge_offsets[i], edge_offsets[i + 1]): a part of
-  // the outline in one cell (tent: one dual cell, weighted by one node's
-  // tent B; cell: B = 1), with its integrals along the outline (n the outward
-  // normal, r relative to G; the polygon is counter-clockwise):
+  // Edge pieces of floe i: [edge_offsets[i], edge_offsets[i + 1]), one per
+  // cell (cell kernel) or node (tent kernel) whose kernel B meets the floe's
+  // outline: the integrals along all of the outline there (n the outward
+  // normal, r relative to G; the polygon is counter-clockwise). The contact's
+  // horizontal forces are linear in them, node by node.
   std::vector<std::size_t> edge_offsets{0};
   std::vector<std::uint32_t> edge_cell;
   std::vector<std::ptrdiff_t> edge_piece;  // index of the area piece of that cell, or -1
