@@ -144,8 +144,7 @@ void FloeSeaContact::start(Floes& floes, fluid::Sea& sea, bool given) {
   const fluid::SurfaceGrid& grid = sea.grid();
   const std::size_t n = floes.size();
   pressure_.assign(grid.size(), 0.0);  // evaluate() clears only the footprints' cells
-  coverage_.assign(grid.size(), 0.0);
-  cell_sum_.assign(grid.size(), 0.0);
+  cells_.assign(grid.size(), {});
   pressure_kicked_ = false;
   build_footprints(floes, dynamic_, grid, footprints_, kernel_);
   if (given) {
@@ -274,10 +273,12 @@ void FloeSeaContact::evaluate(const Floes& floes, fluid::Sea& sea, double h) {
   // ones rather than the whole grid (and the cells' coverage and sums).
   if (pressure_.size() != grid.size()) {
     pressure_.assign(grid.size(), 0.0);
-    coverage_.assign(grid.size(), 0.0);
-    cell_sum_.assign(grid.size(), 0.0);
+    cells_.assign(grid.size(), {});
   } else {
-    for (std::uint32_t c : footprints_.cell) pressure_[c] = coverage_[c] = cell_sum_[c] = 0.0;
+    for (std::uint32_t c : footprints_.cell) {
+      pressure_[c] = 0.0;
+      cells_[c] = {};
+    }
   }
   pressure_kicked_ = false;
   build_footprints(floes, dynamic_, grid, footprints_, kernel_);
@@ -286,17 +287,27 @@ void FloeSeaContact::evaluate(const Floes& floes, fluid::Sea& sea, double h) {
   std::span<const double> w;
   if (s_ < 1.0) w = sea.field(fluid::Field::velocity_z);
   const double ks = s_ * kappa_, inv_cell_area = 1.0 / cell_area_;
-  for (std::size_t k = 0; k < fp.cell.size(); ++k) coverage_[fp.cell[k]] += fp.area[k] * inv_cell_area;
+  // Floes in the order of their first cell, so that floes next to each
+  // other on the grid come one after the other (the grid's arrays are
+  // read and written where each floe lies: this keeps them in cache).
+  order_.clear();
+  for (std::size_t i = 0; i < floes.size(); ++i)
+    if (dynamic_[i] && fp.offsets[i] < fp.offsets[i + 1]) order_.push_back(static_cast<std::uint32_t>(i));
+  std::sort(order_.begin(), order_.end(),
+            [&](std::uint32_t x, std::uint32_t y) { return fp.cell[fp.offsets[x]] < fp.cell[fp.offsets[y]]; });
+  for (std::uint32_t i : order_)
+    for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k) cells_[fp.cell[k]].coverage += fp.area[k] * inv_cell_area;
   double energy = 0.0;
-  thread_local std::vector<double> u;  // [delta]^+ of each area piece
+  thread_local std::vector<double> u;    // [delta]^+ of each area piece
+  thread_local std::vector<double> psi;  // psi of each area piece's cell
   thread_local std::vector<double> wetted;  // per floe: sum psi_c a_c u_c
-  u.resize(fp.cell.size());
+  u.assign(fp.cell.size(), 0.0);
+  psi.resize(fp.cell.size());
   wetted.assign(floes.size(), 0.0);
+  for (FloeSeaLoad& load : loads_) load = {};
   // Vertical: the law on each area piece.
-  for (std::size_t i = 0; i < floes.size(); ++i) {
+  for (std::uint32_t i : order_) {
     FloeSeaLoad& load = loads_[i];
-    load = {};
-    if (!dynamic_[i]) continue;
     const FloeState& st = floes.state[i];
     const double z = st.heave + bottom0_[i];
     const Vec2 a{st.pitch, st.roll}, ar{st.pitch_rate, st.roll_rate};
@@ -308,19 +319,18 @@ void FloeSeaContact::evaluate(const Floes& floes, fluid::Sea& sea, double h) {
       const Vec2& r = fp.centroid[k];
       const std::uint32_t cell = fp.cell[k];
       const double delta = eta[cell] - z - a.dot(r);
-      if (delta <= 0.0) {
-        u[k] = 0.0;
-        continue;
-      }
+      const double ps = subcell_weight(cells_[cell].coverage);
+      psi[k] = ps;
+      if (delta <= 0.0) continue;
       u[k] = delta;
-      const double area = fp.area[k], psi = subcell_weight(coverage_[cell]);
-      double f = ks * psi * area * delta;
-      energy += 0.5 * ks * psi * area * delta * delta;
-      wet += psi * area * delta;
-      cell_sum_[cell] += area * delta * delta;
+      const double area = fp.area[k];
+      double f = ks * ps * area * delta;
+      energy += 0.5 * ks * ps * area * delta * delta;
+      wet += ps * area * delta;
+      cells_[cell].sum += area * delta * delta;
       if (c > 0.0) {
         const double rate = w[cell] - st.heave_rate - ar.dot(r);
-        f += area * psi * c / (1.0 + h * psi * c * inv_mass) * rate;
+        f += area * ps * c / (1.0 + h * ps * c * inv_mass) * rate;
       }
       pressure_[cell] += f * inv_cell_area;
       fz += f;
@@ -333,8 +343,7 @@ void FloeSeaContact::evaluate(const Floes& floes, fluid::Sea& sea, double h) {
   // coverage Phi_c moves with every floe's edge in cell c, so an edge also
   // carries psi'(Phi_c) / (2 A) sum_k a_k u_k^2 of the cell's pieces.
   if (ks > 0.0) {
-    for (std::size_t i = 0; i < floes.size(); ++i) {
-      if (!dynamic_[i]) continue;
+    for (std::uint32_t i : order_) {
       const FloeState& st = floes.state[i];
       const Vec2 a{st.pitch, st.roll};
       Vec2 fh = Vec2::Zero();
@@ -342,18 +351,17 @@ void FloeSeaContact::evaluate(const Floes& floes, fluid::Sea& sea, double h) {
       for (std::size_t k = fp.edge_offsets[i]; k < fp.edge_offsets[i + 1]; ++k) {
         const std::ptrdiff_t piece = fp.edge_piece[k];
         if (piece < 0) continue;
-        const std::uint32_t cell = fp.edge_cell[k];
-        const double up = u[piece], sum = cell_sum_[cell];
+        const double up = u[piece], sum = cells_[fp.edge_cell[k]].sum;
         if (up <= 0.0 && sum <= 0.0) continue;
-        const double psi = subcell_weight(coverage_[cell]);
-        const double dpsi = K_ * psi * psi;  // d psi / d Phi
+        const double ps = psi[piece];
+        const double dpsi = K_ * ps * ps;  // d psi / d Phi
         const Vec2& N = fp.edge_normal[k];  // d w_c / dG
         const double T = fp.edge_twist[k];  // d w_c / dyaw
         const Vec2 Qa = fp.edge_first[k].transpose() * a;  // ∮ B (r . a) n ds
         const Vec2& S = fp.edge_swept[k];
         const Vec2& rc = fp.centroid[piece];
-        const double area_term = 0.5 * ks * (psi * up * up + dpsi * sum * inv_cell_area);  // dV / d a_c
-        const double kf = ks * psi;
+        const double area_term = 0.5 * ks * (ps * up * up + dpsi * sum * inv_cell_area);  // dV / d a_c
+        const double kf = ks * ps;
         const Vec2 dVdG = area_term * N - kf * up * (Qa - a.dot(rc) * N);
         const double dVdyaw = area_term * T - kf * up * a.dot(S - rc * T);
         fh -= dVdG;

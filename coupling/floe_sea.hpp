@@ -153,8 +153,12 @@ private:
   Footprints footprints_;
   std::vector<FloeSeaLoad> loads_;
   std::vector<double> pressure_;
-  std::vector<double> coverage_;  // Phi_c: the share of cell c under floes
-  std::vector<double> cell_sum_;  // sum over the pieces in cell c of a_k [delta_k]^+^2
+  struct CellSums {
+    double coverage = 0.0;  // Phi_c: the share of cell c under floes
+    double sum = 0.0;       // sum over the pieces in cell c of a_k [delta_k]^+^2
+  };
+  std::vector<CellSums> cells_;
+  std::vector<std::uint32_t> order_;  // dynamic floes with pieces, by their first cell
   bool pressure_kicked_ = false;  // the sea's last kick was with pressure_ as it is
   double penalty_energy_ = 0.0;
   std::vector<std::string> notes_;

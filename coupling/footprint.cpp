@@ -53,23 +53,35 @@ struct EdgeSum {
 // r x n ds = -(r . e) dt:
 //     length = ∫ B |e| dt,  N = ∫ B n ds,  T = ∫ B (r x n) ds,
 //     Q = ∫ B r n^T ds,     S = ∫ B r (r x n) ds.
-void add_edge(EdgeSum& sum, const Vec2& a, const Vec2& b, const double (&weight)[3]) {
-  const Vec2 e = b - a, n{e.y(), -e.x()};
+// The sub-segment's Gauss points: positions r_g and r_g x n ds / dt.
+struct SegmentPoints {
+  Vec2 n, r[3];
+  double rxn[3], length;
+  SegmentPoints(const Vec2& a, const Vec2& b) {
+    const Vec2 e = b - a;
+    n = {e.y(), -e.x()};
+    length = e.norm();
+    for (int g = 0; g < 3; ++g) {
+      r[g] = a + kGaussT[g] * e;
+      rxn[g] = -r[g].dot(e);
+    }
+  }
+};
+
+void add_edge(EdgeSum& sum, const SegmentPoints& p, const double (&weight)[3]) {
   double twist = 0.0, wsum = 0.0;
   Vec2 first = Vec2::Zero(), swept = Vec2::Zero();
   for (int g = 0; g < 3; ++g) {
     const double w = kGaussW[g] * weight[g];
-    const Vec2 r = a + kGaussT[g] * e;
-    const double rxn = -r.dot(e);
     wsum += w;
-    first += w * r;
-    twist += w * rxn;
-    swept += w * rxn * r;
+    first += w * p.r[g];
+    twist += w * p.rxn[g];
+    swept += (w * p.rxn[g]) * p.r[g];
   }
-  sum.length += wsum * e.norm();
-  sum.normal += wsum * n;
+  sum.length += wsum * p.length;
+  sum.normal += wsum * p.n;
   sum.twist += twist;
-  sum.first += first * n.transpose();
+  sum.first += first * p.n.transpose();
   sum.swept += swept;
   sum.any = true;
 }
@@ -121,6 +133,7 @@ struct Scratch {
   std::vector<std::array<double, 9>> moments;
   std::vector<std::array<double, 3>> carries;
   std::vector<double> node_area, node_fx, node_fy;
+  std::vector<std::uint8_t> touched;  // dual cells the outline crosses
 };
 
 // Sorts the pieces of the last floe (from first_piece) by cell and merges
@@ -173,7 +186,7 @@ void build_tent(const Floes& floes, std::span<const std::uint8_t> include, const
   if (grid.edge != fluid::GridEdge::periodic)
     throw std::invalid_argument("the tent footprint kernel needs a periodic grid");
   const bool two_d = grid.dims == 2;
-  const double dx = grid.dx(), dy = two_d ? grid.dy() : 1.0;
+  const double dx = grid.dx(), dy = two_d ? grid.dy() : 1.0, inv_dx = 1.0 / dx, inv_dy = 1.0 / dy;
   const double area_element = dx * (two_d ? dy : 1.0);
   const double tiny = 1e-12 * dx * (two_d ? grid.dy() : grid.ly);
   auto wrap_cell = [&](int i, int j) {
@@ -203,6 +216,7 @@ void build_tent(const Floes& floes, std::span<const std::uint8_t> include, const
     const int nw = w + 1, nh = two_d ? h + 1 : 1;
     const std::size_t nloc = static_cast<std::size_t>(w) * static_cast<std::size_t>(h);
     s.moments.assign(nloc, {});
+    s.touched.assign(nloc, 0);
     s.carries.assign(nloc, {});
     // Origin of dual cell (li, lj) relative to G (dims = 1: t = y, origin 0).
     auto origin = [&](int li, int lj) {
@@ -225,14 +239,15 @@ void build_tent(const Floes& floes, std::span<const std::uint8_t> include, const
         const int li = std::clamp(ci - i0, 0, w - 1), lj = std::clamp(cj - j0, 0, h - 1);
         const std::size_t local = static_cast<std::size_t>(lj) * w + li;
         const Vec2 o = origin(li, lj);
-        const double sa = (pa.x() - o.x()) / dx, sb = (pb.x() - o.x()) / dx;
-        const double ta = (pa.y() - o.y()) / dy, tb = (pb.y() - o.y()) / dy;
+        const double sa = (pa.x() - o.x()) * inv_dx, sb = (pb.x() - o.x()) * inv_dx;
+        const double ta = (pa.y() - o.y()) * inv_dy, tb = (pb.y() - o.y()) * inv_dy;
         double ss[3], tt[3];
         for (int q = 0; q < 3; ++q) {
           ss[q] = sa + kGaussT[q] * (sb - sa);
           tt[q] = ta + kGaussT[q] * (tb - ta);
         }
         const double run = sb - sa;
+        s.touched[local] = 1;  // vertical sub-segments too: they split the cell
         if (run != 0.0) {
           std::array<double, 9>& mom = s.moments[local];
           std::array<double, 3>& carry = s.carries[local];
@@ -256,13 +271,14 @@ void build_tent(const Floes& floes, std::span<const std::uint8_t> include, const
           }
         }
         // The outline's integrals, to each corner node of the dual cell.
+        const SegmentPoints points(pa, pb);
         for (int beta = 0; beta < (two_d ? 2 : 1); ++beta)
           for (int alpha = 0; alpha < 2; ++alpha) {
             double weight[3];
             for (int q = 0; q < 3; ++q)
               weight[q] = (alpha ? ss[q] : 1.0 - ss[q]) * (two_d ? (beta ? tt[q] : 1.0 - tt[q]) : 1.0);
             if (weight[0] == 0.0 && weight[1] == 0.0 && weight[2] == 0.0) continue;
-            add_edge(s.edges[static_cast<std::size_t>((lj + beta) * nw + li + alpha)], pa, pb, weight);
+            add_edge(s.edges[static_cast<std::size_t>((lj + beta) * nw + li + alpha)], points, weight);
           }
       }
     }
@@ -288,9 +304,24 @@ void build_tent(const Floes& floes, std::span<const std::uint8_t> include, const
     s.node_fy.assign(nnodes, 0.0);
     for (int lj = 0; lj < h; ++lj)
       for (int li = 0; li < w; ++li) {
-        const std::array<double, 9>& mom = s.moments[static_cast<std::size_t>(lj) * w + li];
-        auto m = [&](int p, int q) { return mom[static_cast<std::size_t>(3 * q + p)]; };
+        const std::size_t local = static_cast<std::size_t>(lj) * w + li;
+        const std::array<double, 9>& mom = s.moments[local];
         const Vec2 o = origin(li, lj);
+        if (two_d && !s.touched[local]) {
+          // No outline here: the dual cell is empty (m00 = 0) or full
+          // (m_pq = 1 / ((p + 1)(q + 1))), where each corner's tent has
+          // ∫∫ tent = 1/4 and ∫∫ tent s = 1/6 at s = 1, 1/12 at s = 0.
+          if (mom[0] < 0.5) continue;
+          for (int beta = 0; beta < 2; ++beta)
+            for (int alpha = 0; alpha < 2; ++alpha) {
+              const std::size_t node = static_cast<std::size_t>((lj + beta) * nw + li + alpha);
+              s.node_area[node] += 0.25 * area_element;
+              s.node_fx[node] += area_element * (0.25 * o.x() + dx * (alpha ? 1.0 / 6.0 : 1.0 / 12.0));
+              s.node_fy[node] += area_element * (0.25 * o.y() + dy * (beta ? 1.0 / 6.0 : 1.0 / 12.0));
+            }
+          continue;
+        }
+        auto m = [&](int p, int q) { return mom[static_cast<std::size_t>(3 * q + p)]; };
         for (int beta = 0; beta < (two_d ? 2 : 1); ++beta)
           for (int alpha = 0; alpha < 2; ++alpha) {
             const double c0 = alpha ? 0.0 : 1.0, c1 = alpha ? 1.0 : -1.0;
@@ -432,7 +463,7 @@ void build_footprints(const Floes& floes, std::span<const std::uint8_t> include,
               s.carry_mx[local] -= run * dy * 0.5 * (x0 + x1);
             }
           }
-          add_edge(s.edges[local], pa, pb, kUnit);
+          add_edge(s.edges[local], SegmentPoints(pa, pb), kUnit);
         }
       }
       // The carries, summed down each column: a full row j below the
