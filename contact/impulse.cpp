@@ -93,7 +93,7 @@ std::vector<std::uint8_t> warm_guess(const WarmStart& warm, const Floes& floes,
     const Vec2 p = body_point(floes, c.a, c.point);
     const WarmStart::Entry* best = nullptr;
     double best_d = warm.match_distance;
-    for (const WarmStart::Entry& e : it->second) {
+    for (const WarmStart::Entry& e : it->second.entries) {
       const double d = (e.body_point - p).norm();
       if (d <= best_d) {
         best_d = d;
@@ -116,12 +116,14 @@ void warm_store(WarmStart& warm, const Floes& floes, const std::vector<ContactPo
   const std::size_t m = list.size();
   for (std::size_t k = 0; k < m; ++k) {
     const ContactPoint& c = contacts[list[k]];
-    warm.pairs[pair_key(c.a, c.b)].clear();
+    WarmStart::Pair& pair = warm.pairs[pair_key(c.a, c.b)];
+    pair.entries.clear();
+    pair.stored = warm.clock;
   }
   auto on = [&](std::size_t i) -> std::uint8_t { return z_basic[i]; };
   for (std::size_t k = 0; k < m; ++k) {
     const ContactPoint& c = contacts[list[k]];
-    warm.pairs[pair_key(c.a, c.b)].push_back(
+    warm.pairs[pair_key(c.a, c.b)].entries.push_back(
         {body_point(floes, c.a, c.point), {on(k), on(m + 2 * k), on(m + 2 * k + 1), on(3 * m + k)}});
   }
 }

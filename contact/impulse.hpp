@@ -92,13 +92,26 @@ namespace floesim::contact {
 // basis. A wrong guess costs only time: the answer is accepted only with a
 // residual within the fallback chain's accept_residual, and otherwise the
 // LCP is solved from scratch by the chain (counted in warm_missed).
+// The store is pruned by age: `tick()` (once per step of the run) drops,
+// every `max_age` ticks, the pairs not stored for max_age ticks, so pairs that
+// drifted apart and the floes a split retired do not pile up.
 struct WarmStart {
   struct Entry {
     Vec2 body_point = Vec2::Zero();
     std::array<std::uint8_t, 4> basic{};  // lambda, beta+, beta-, alpha basic
   };
-  std::unordered_map<std::uint64_t, std::vector<Entry>> pairs;
+  struct Pair {
+    std::vector<Entry> entries;
+    long stored = 0;  // the clock when they were stored
+  };
+  std::unordered_map<std::uint64_t, Pair> pairs;
   double match_distance = 1.0;  // m
+  long clock = 0;
+  long max_age = 256;
+
+  void tick() {
+    if (++clock % max_age == 0) std::erase_if(pairs, [&](const auto& p) { return clock - p.second.stored > max_age; });
+  }
 };
 
 struct ImpulseOptions {

@@ -187,7 +187,9 @@ void Simulation::collide(StepContext& ctx) {
   // Contacts were found at the positions of the start of the step; the LCPs
   // turn W(t-) into W(t+). Contacts the step itself pushed together rest
   // (restitution 0), and pushed points that would close below xi/2 within the
-  // step are held by speculative contacts (contact/impulse.hpp).
+  // step are held by speculative contacts (contact/impulse.hpp). The warm
+  // starts of jam LCPs age by one step (pruned by age).
+  warm_->tick();
   contact::resolve_step_collisions(scenario_.floes, ctx.start, detection_, ctx.dt, impulse_options_, stats_,
                                    percussion_ ? &ctx.impulses : nullptr);
   const Vec2 after = momentum();

@@ -327,6 +327,24 @@ TEST_CASE("a pack pushed by wind against a wall: jammed, no overlap, the wall ta
   CHECK(gap_low > 0.0);
 }
 
+TEST_CASE("the warm-start store of jam LCPs forgets the pairs not stored for max_age steps") {
+  // contact/impulse.hpp: every max_age ticks the pairs older than max_age go; the pairs a jam
+  // stores again each step stay (the wall-jam test above runs 600 steps with warm starts).
+  contact::WarmStart w;
+  w.max_age = 4;
+  w.pairs[1].stored = w.clock;  // 0: never stored again
+  w.pairs[2].stored = w.clock;  // 0: stored again at 3 and 7
+  for (int k = 0; k < 3; ++k) w.tick();
+  w.pairs[2].stored = w.clock;
+  w.tick();  // clock 4: a pruning tick, both are 4 or less old
+  CHECK(w.pairs.size() == 2);
+  for (int k = 0; k < 3; ++k) w.tick();
+  w.pairs[2].stored = w.clock;  // 7
+  w.tick();  // clock 8: pair 1 is 8 old, pair 2 is 1
+  CHECK(w.pairs.count(1) == 0);
+  CHECK(w.pairs.count(2) == 1);
+}
+
 TEST_CASE("FloeDyn's 100-floe example stays close to FloeDyn's own output") {
   // Reference: ../shared/data/floedyn/reference_100_floes.csv (FloeDyn's output for its example).
   // Two FloeDyn runs agree to 0.5% in energy; ours differs by its integrator (semi-implicit drag),
