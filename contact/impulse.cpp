@@ -56,11 +56,8 @@ Row make_row(const ContactPoint& c, const Vec2& u, const FloeState& sa, const Fl
 }  // namespace
 
 namespace {
-// Velocity of floe f's point p (world, in f's own image), and its change since `before`.
-Vec2 point_velocity(const FloeState& s, const Vec2& p) {
-  const Vec2 r = p - Vec2{s.x, s.y};
-  return Vec2{s.vx, s.vy} + s.yaw_rate * Vec2{-r.y(), r.x()};
-}
+// Velocity of floe f's point p (world, in f's own image).
+Vec2 point_velocity(const FloeState& s, const Vec2& p) { return arm_velocity(s, p - Vec2{s.x, s.y}); }
 // The normal approach speed of a contact's two points (> 0: approaching),
 // with the floes' velocities taken from `s` (the positions are the present
 // ones: velocities from the start of the step are compared at the same points).

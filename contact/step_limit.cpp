@@ -30,8 +30,6 @@ double room_over(const Feature& f, double keep, double t) {
   return f.d - keep + std::min(0.0, f.r * t - 0.5 * f.kappa * t * t);
 }
 
-Vec2 point_velocity(const FloeState& s, const Vec2& r) { return Vec2{s.vx, s.vy} + s.yaw_rate * Vec2{-r.y(), r.x()}; }
-
 // Calls f(feature) for each feature of the pair (step_limit.hpp).
 template <class F>
 void for_each_feature(const Floes& floes, const CollisionShapes& shapes, const NearPair& p,
@@ -49,7 +47,7 @@ void for_each_feature(const Floes& floes, const CollisionShapes& shapes, const N
   const double w = std::max(wa, wb);
   const double kappa = 2.0 * w * dv.norm() + w * w * (ra + rb + p.distance) + (wa + wb) * (wa + wb) * std::max(ra, rb);
   for (const Witness& x : witnesses)
-    f(Feature{x.distance, x.normal.dot(point_velocity(b, x.pb - gb) - point_velocity(a, x.pa - ga)), kappa});
+    f(Feature{x.distance, x.normal.dot(arm_velocity(b, x.pb - gb) - arm_velocity(a, x.pa - ga)), kappa});
 }
 
 }  // namespace

@@ -32,6 +32,12 @@ inline FloeState drifted(FloeState s, double h) {
   return s;
 }
 
+// Horizontal velocity of the floe's point at arm r from its centroid (world
+// frame): v + omega e_z x r.
+inline Vec2 arm_velocity(const FloeState& s, const Vec2& r) {
+  return Vec2{s.vx, s.vy} + s.yaw_rate * Vec2{-r.y(), r.x()};
+}
+
 inline constexpr int kStateColumns = 12;
 static_assert(sizeof(FloeState) == kStateColumns * sizeof(double));
 inline constexpr const char* kStateColumnNames[kStateColumns] = {

@@ -12,21 +12,15 @@
 #include "coupling/penalty_law.hpp"
 #include "coupling/scenario.hpp"
 #include "coupling/simulation.hpp"
+#include "sim_energy.hpp"
 #include "fluid/sea.hpp"
 
 using namespace floesim;
+using floesim::test::energy;
 
 namespace {
 
 Simulation make(const std::string& text) { return Simulation(build_scenario(parse_config(text, "floe_sea.toml", "."))); }
-
-double energy(const Simulation& sim, const std::string& name) {
-  const Energies e = sim.energies();
-  for (std::size_t k = 0; k < e.names.size(); ++k)
-    if (e.names[k] == name) return e.values[k];
-  FAIL("no energy column " << name);
-  return 0.0;
-}
 
 // One square floe of side L, thickness 1 m, in a periodic spectral box.
 std::string one_floe(double L, const std::string& sea, const std::string& extra, double x0 = 50.0, double y0 = 50.0) {
@@ -274,16 +268,11 @@ TEST_CASE("two floes in waves collide: LCP impulses and the penalty coexist with
     << "[[floes.floe]]\nvertices = [[39.0, 45.0], [49.0, 45.0], [49.0, 55.0], [39.0, 55.0]]\nvelocity = [0.5, 0.0]\n"
     << "[[floes.floe]]\nvertices = [[49.2, 46.0], [59.2, 46.0], [59.2, 56.0], [49.2, 56.0]]\nvelocity = [-0.5, 0.0]\n";
   Simulation sim = make(t.str());
-  const double e0 = energy(sim, "total");
-  double top = e0;
-  while (sim.time() < 40.0) {
-    sim.step(40.0);
-    top = std::max(top, energy(sim, "total"));
-  }
+  const test::EnergyRun run = test::run_tracking_energy(sim, 40.0);
   CHECK(sim.collision_stats().lcps > 0);
   CHECK(sim.collision_stats().failures == 0);
-  CHECK(top < e0 * (1.0 + 1e-4));
-  CHECK(energy(sim, "total") < e0);
+  CHECK(run.top < run.start * (1.0 + 1e-4));
+  CHECK(energy(sim, "total") < run.start);
 }
 
 }  // TEST_SUITE

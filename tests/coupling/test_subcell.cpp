@@ -10,8 +10,10 @@
 #include <string>
 
 #include "coupling/simulation.hpp"
+#include "sim_energy.hpp"
 
 using namespace floesim;
+using floesim::test::energy;
 
 TEST_SUITE_BEGIN("coupling");
 
@@ -20,14 +22,6 @@ namespace {
 constexpr double kDraft = 917.0 / 1025.0;  // rho_i h / rho_w for h = 1 m
 
 Simulation make(const std::string& text) { return Simulation(build_scenario(parse_config(text, "subcell.toml", "."))); }
-
-double energy(const Simulation& sim, const std::string& name) {
-  const Energies e = sim.energies();
-  for (std::size_t k = 0; k < e.names.size(); ++k)
-    if (e.names[k] == name) return e.values[k];
-  FAIL("no energy column " << name);
-  return 0.0;
-}
 
 std::string square(double x0, double y0, double L, const std::string& extra = "") {
   std::ostringstream t;
@@ -121,20 +115,16 @@ TEST_CASE("two floes sent at each other from 20 m apart at 0.5 m/s meet on 1.56 
   Simulation sim = make(box(64, 100.0) + "[forcing]\nocean_drag = 0.0\nair_drag = 0.0\n" +
                         square(20.0, 45.0, 10.0, "velocity = [0.5, 0.0]\n") +
                         square(50.0, 45.5, 10.0, "velocity = [-0.5, 0.0]\n"));
-  const double e0 = energy(sim, "total");
-  double top = e0;
   double first = -1.0;
-  while (sim.time() < 40.0) {
-    sim.step(40.0);
-    top = std::max(top, energy(sim, "total"));
-    if (first < 0.0 && sim.collision_stats().lcps > 0) first = sim.time();
-  }
+  const test::EnergyRun run = test::run_tracking_energy(sim, 40.0, [&](const Simulation& s) {
+    if (first < 0.0 && s.collision_stats().lcps > 0) first = s.time();
+  });
   MESSAGE("first collision at t = " << first << " s (free flight: 20 s); x = " << sim.floes().state[0].x << ", "
                                     << sim.floes().state[1].x);
   CHECK(sim.collision_stats().lcps > 0);
   CHECK(first > 20.0);
   CHECK(first < 25.0);
-  CHECK(top < e0 * (1.0 + 5e-4));
+  CHECK(run.top < run.start * (1.0 + 5e-4));
 }
 
 TEST_CASE("a floe in a steady wind reaches the free-drift speed, on a calm sea and in a swell") {
@@ -189,17 +179,12 @@ TEST_CASE("percussion on a sea: the pieces of a split float where their parent d
     << "[fracture]\nenabled = true\ncriterion = \"stress\"\nstrength = 0.5e6\nyoung = 6.0e9\npoisson = 0.3\n"
     << "split = true\nmesh_size = 1.5\nduration = 0.01\n";
   Simulation sim = make(t.str());
-  const double e0 = energy(sim, "total");
-  double top = e0;
-  while (sim.time() < 8.0) {
-    sim.step(8.0);
-    top = std::max(top, energy(sim, "total"));
-  }
+  const test::EnergyRun run = test::run_tracking_energy(sim, 8.0);
   std::size_t alive = 0;
   for (std::size_t i = 0; i < sim.floes().size(); ++i) alive += std::isfinite(sim.floes().state[i].x) ? 1 : 0;
-  MESSAGE("floes at the end: " << alive << ", largest total energy / initial - 1: " << top / e0 - 1.0);
+  MESSAGE("floes at the end: " << alive << ", largest total energy / initial - 1: " << run.top / run.start - 1.0);
   CHECK(alive == 4);  // each floe split once
-  CHECK(top < e0 * (1.0 + 1e-4));
+  CHECK(run.top < run.start * (1.0 + 1e-4));
 }
 
 TEST_SUITE_END();
