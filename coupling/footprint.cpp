@@ -133,6 +133,7 @@ struct Scratch {
   std::vector<std::array<double, 9>> moments;
   std::vector<std::array<double, 3>> carries;
   std::vector<double> node_area, node_fx, node_fy;
+  std::vector<std::uint32_t> column, row_start;  // nodes' wrapped columns, rows' first cells
   std::vector<std::uint8_t> touched;  // dual cells the outline crosses
 };
 
@@ -189,9 +190,6 @@ void build_tent(const Floes& floes, std::span<const std::uint8_t> include, const
   const double dx = grid.dx(), dy = two_d ? grid.dy() : 1.0, inv_dx = 1.0 / dx, inv_dy = 1.0 / dy;
   const double area_element = dx * (two_d ? dy : 1.0);
   const double tiny = 1e-12 * dx * (two_d ? grid.dy() : grid.ly);
-  auto wrap_cell = [&](int i, int j) {
-    return static_cast<std::uint32_t>((two_d ? wrap(j, grid.ny) : 0) * grid.nx + wrap(i, grid.nx));
-  };
   for (std::size_t f = 0; f < floes.size(); ++f) {
     if (!include[f]) {
       out.offsets.push_back(out.cell.size());
@@ -225,6 +223,15 @@ void build_tent(const Floes& floes, std::span<const std::uint8_t> include, const
 
     const std::size_t nnodes = static_cast<std::size_t>(nw) * static_cast<std::size_t>(nh);
     s.edges.assign(nnodes, {});
+    // The sea cell of node (ni, nj): row_start[nj] + column[ni] (wrapped).
+    s.column.resize(static_cast<std::size_t>(nw));
+    s.row_start.resize(static_cast<std::size_t>(nh));
+    for (int ni = 0; ni < nw; ++ni) s.column[static_cast<std::size_t>(ni)] = static_cast<std::uint32_t>(wrap(i0 + ni, grid.nx));
+    for (int nj = 0; nj < nh; ++nj)
+      s.row_start[static_cast<std::size_t>(nj)] = static_cast<std::uint32_t>((two_d ? wrap(j0 + nj, grid.ny) : 0) * grid.nx);
+    auto cell_of_node = [&](int ni, int nj) {
+      return s.row_start[static_cast<std::size_t>(nj)] + s.column[static_cast<std::size_t>(ni)];
+    };
     const std::size_t nv = s.poly.size();
     for (std::size_t k = 0; k < nv; ++k) {
       const Vec2 a = s.poly[k], b = s.poly[(k + 1) % nv];
@@ -344,7 +351,7 @@ void build_tent(const Floes& floes, std::span<const std::uint8_t> include, const
         const double a = s.node_area[node];
         if (a <= tiny) continue;
         s.piece[node] = static_cast<std::ptrdiff_t>(out.cell.size());
-        out.cell.push_back(wrap_cell(i0 + ni, j0 + nj));
+        out.cell.push_back(cell_of_node(ni, nj));
         out.area.push_back(a);
         out.centroid.push_back(Vec2{s.node_fx[node], s.node_fy[node]} / a);
       }
@@ -355,7 +362,7 @@ void build_tent(const Floes& floes, std::span<const std::uint8_t> include, const
       for (int ni = 0; ni < nw; ++ni) {
         const std::size_t node = static_cast<std::size_t>(nj) * nw + ni;
         if (!s.edges[node].any) continue;
-        const std::uint32_t c = wrap_cell(i0 + ni, j0 + nj);
+        const std::uint32_t c = cell_of_node(ni, nj);
         push_edge_piece(out, c, wraps ? out.find(f, c) : s.piece[node], s.edges[node]);
       }
     out.edge_offsets.push_back(out.edge_cell.size());
