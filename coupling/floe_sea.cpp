@@ -413,19 +413,21 @@ void FloeSeaContact::drift(Floes& floes, double h) {
   }
 }
 
-void FloeSeaContact::orbital_velocity(const Floes& floes, fluid::Sea& sea, std::vector<Vec2>& out) const {
+void FloeSeaContact::mean_velocity(const Floes& floes, std::span<const double> u0, std::span<const double> v0,
+                                   std::span<const double> u1, std::span<const double> v1, double w,
+                                   std::vector<Vec2>& out) const {
   out.assign(floes.size(), Vec2::Zero());
-  const std::span<const double> u = sea.field(fluid::Field::velocity_x);
-  const std::span<const double> v = sea.field(fluid::Field::velocity_y);
   const Footprints& fp = footprints_;
   for (std::size_t i = 0; i < std::min(floes.size(), fp.floes()); ++i) {
     double area = 0.0;
-    Vec2 sum = Vec2::Zero();
+    Vec2 sum0 = Vec2::Zero(), sum1 = Vec2::Zero();
     for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k) {
+      const std::uint32_t c = fp.cell[k];
       area += fp.area[k];
-      sum += fp.area[k] * Vec2{u[fp.cell[k]], v[fp.cell[k]]};
+      sum0 += fp.area[k] * Vec2{u0[c], v0[c]};
+      sum1 += fp.area[k] * Vec2{u1[c], v1[c]};
     }
-    if (area > 0.0) out[i] = sum / area;
+    if (area > 0.0) out[i] = ((1.0 - w) * sum0 + w * sum1) / area;
   }
 }
 

@@ -106,8 +106,12 @@ public:
   // Vertical drift of the floes: zeta += h zeta', a += h a'.
   static void drift(Floes& floes, double h);
 
-  // Mean orbital velocity of the sea under each floe (m/s, world), for drag.
-  void orbital_velocity(const Floes& floes, fluid::Sea& sea, std::vector<Vec2>& out) const;
+  // Mean over each floe's footprint (weights a_c) of the velocity field
+  // (1 - w) (u0, v0) + w (u1, v1) (m/s, world): the incident waves' orbital
+  // velocity for drag (coupling/incident.hpp).
+  void mean_velocity(const Floes& floes, std::span<const double> u0, std::span<const double> v0,
+                     std::span<const double> u1, std::span<const double> v1, double w,
+                     std::vector<Vec2>& out) const;
 
   // Stable kick length of the explicit spring part (s > 0): 0.5 / omega_pen,
   // omega_pen^2 = s kappa (1 / m_floe + 1 / m_sea) (a quarter of leapfrog's

@@ -64,7 +64,8 @@ Simulation::Simulation(Scenario scenario) : scenario_(std::move(scenario)) {
   if (sea_ && any_dynamic) {
     floe_sea_ = std::make_unique<FloeSeaContact>(c.coupling, c.sea, scenario_.floes, *sea_);
     if (c.sea.waves.kind != WaveKind::none || c.sea.tank.enabled)
-      incident_ = fluid::make_sea(c.sea, c.run.seed, sea_options);
+      incident_ = std::make_unique<IncidentSea>(fluid::make_sea(c.sea, c.run.seed, sea_options),
+                                                IncidentSea::interval_for(c.sea));
     floe_sea_->start(scenario_.floes, *sea_, c.coupling.start_given);
     evaluate_penalty(0.5 * c.run.dt_max);
     update_water_velocity();
@@ -307,7 +308,6 @@ void Simulation::sea_flow(const StepContext& ctx) {
   if (!sea_) return;
   if (floe_sea_) floe_sea_->kick_sea(*sea_, 0.5 * ctx.dt);
   sea_->flow(ctx.dt);
-  if (incident_) incident_->flow(ctx.dt);
 }
 
 void Simulation::sea_half_kick(const StepContext& ctx) {
@@ -334,10 +334,13 @@ void Simulation::evaluate_penalty(double h) {
 
 void Simulation::update_water_velocity() {
   // The incident waves' velocity over the footprints of the last evaluate_penalty.
-  if (incident_)
-    floe_sea_->orbital_velocity(scenario_.floes, *incident_, water_velocity_);
-  else
+  if (incident_) {
+    incident_->advance_to(sea_->time());
+    floe_sea_->mean_velocity(scenario_.floes, incident_->u0(), incident_->v0(), incident_->u1(), incident_->v1(),
+                             incident_->weight(sea_->time()), water_velocity_);
+  } else {
     water_velocity_.assign(scenario_.floes.size(), Vec2::Zero());
+  }
   water_stale_ = false;
 }
 

@@ -16,8 +16,7 @@
 //      DOFs)
 //   -> detect (new contacts; an overlap rejects the step, which is redone
 //      with half the dt from the floes at t: the sea has not moved yet)
-//   -> sea: half kick with the pressures at t, exact modal flow over dt (and
-//      the incident sea's flow)
+//   -> sea: half kick with the pressures at t, exact modal flow over dt
 //   -> penalty loads at t + dt: second half kick of the sea and the floes,
 //      then the orbital velocity under the floes (for the next drag)
 //   -> check state
@@ -45,6 +44,7 @@
 
 #include "coupling/drift.hpp"
 #include "coupling/floe_sea.hpp"
+#include "coupling/incident.hpp"
 #include "coupling/percussion.hpp"
 #include "contact/detection.hpp"
 #include "contact/impulse.hpp"
@@ -151,13 +151,9 @@ private:
   Scenario scenario_;
   std::unique_ptr<fluid::Sea> sea_;
   std::unique_ptr<FloeSeaContact> floe_sea_;
-  // The waves without the floes: the same sea, never kicked. The sea is
-  // linear, so this is the incident part of sea_ (sea_ minus what the floes
-  // radiate and displace). Drag is relative to its orbital velocity: the flow
-  // a floe sets up by pushing its own depression along is not the ambient
-  // water its drag coefficient is measured against (docs/coupling.md). None
-  // on a calm sea without wave generation (its velocity is 0).
-  std::unique_ptr<fluid::Sea> incident_;
+  // The incident waves (coupling/incident.hpp), for drag; none on a calm sea
+  // without wave generation (its velocity is 0).
+  std::unique_ptr<IncidentSea> incident_;
   double loads_h_ = -1.0;             // the kick length the floe–sea loads were evaluated for (< 0: stale)
   double equal_dt_ = -1.0;            // the last of the equal steps the penalty limit asked for
   std::vector<Vec2> water_velocity_;  // incident orbital velocity under each floe at t, for drag

@@ -1,0 +1,54 @@
+#pragma once
+// The incident waves, for the floes' drag (docs/coupling.md, "Drag is
+// relative to the incident waves"): the same sea as the run's (same [sea]
+// and seed), never kicked by the floes. The sea is linear, so this is the
+// run's sea minus what the floes displace and radiate.
+//
+// Its orbital velocity is kept as two snapshots, at t0 and t1 = t0 + tau, and
+// read in between as (1 - w) u(t0) + w u(t1), w = (t - t0) / tau. Linear
+// interpolation of a wave of frequency omega errs by at most
+// (omega tau)^2 / 8 of its amplitude, so tau = T / 40 for the waves' period
+// T (the peak period of a JONSWAP sea) gives 0.3% at omega = 2 pi / T. The
+// incident sea then moves once per tau instead of once per step. A tau of 0
+// takes the fields at every time asked.
+
+#include <memory>
+#include <span>
+#include <vector>
+
+#include "core/params.hpp"
+#include "fluid/sea.hpp"
+
+namespace floesim {
+
+class IncidentSea {
+public:
+  // tau in seconds (0: no interpolation).
+  IncidentSea(std::unique_ptr<fluid::Sea> sea, double tau);
+
+  // The interval for the waves of `params`: a fortieth of their period (the
+  // regular or standing wave's, from its wavelength if need be, or JONSWAP's
+  // peak period); 0 when there is none.
+  static double interval_for(const SeaParams& params);
+
+  // Brings the snapshots to t0 <= t <= t1. t may not decrease from one call
+  // to the next.
+  void advance_to(double t);
+  // The weight w of the t1 snapshot at time t.
+  double weight(double t) const;
+  std::span<const double> u0() const { return u0_; }
+  std::span<const double> v0() const { return v0_; }
+  std::span<const double> u1() const { return u1_; }
+  std::span<const double> v1() const { return v1_; }
+  double interval() const { return tau_; }
+
+private:
+  void take(std::vector<double>& u, std::vector<double>& v);
+
+  std::unique_ptr<fluid::Sea> sea_;
+  double tau_ = 0.0;
+  double t0_ = 0.0, t1_ = 0.0;
+  std::vector<double> u0_, v0_, u1_, v1_;
+};
+
+}  // namespace floesim
