@@ -241,8 +241,8 @@ void build_tent(const Floes& floes, std::span<const std::uint8_t> include, const
         if (s.ts[m + 1] - s.ts[m] <= 1e-14) continue;
         const Vec2 pa = a + s.ts[m] * e, pb = a + s.ts[m + 1] * e;
         const Vec2 mid = g + 0.5 * (pa + pb);
-        const int ci = static_cast<int>(std::floor(mid.x() / dx - 0.5));
-        const int cj = two_d ? static_cast<int>(std::floor(mid.y() / dy - 0.5)) : 0;
+        const int ci = static_cast<int>(std::floor(mid.x() * inv_dx - 0.5));
+        const int cj = two_d ? static_cast<int>(std::floor(mid.y() * inv_dy - 0.5)) : 0;
         const int li = std::clamp(ci - i0, 0, w - 1), lj = std::clamp(cj - j0, 0, h - 1);
         const std::size_t local = static_cast<std::size_t>(lj) * w + li;
         const Vec2 o = origin(li, lj);
@@ -297,10 +297,19 @@ void build_tent(const Floes& floes, std::span<const std::uint8_t> include, const
         for (int lj = h - 1; lj >= 0; --lj) {
           const std::size_t local = static_cast<std::size_t>(lj) * w + li;
           std::array<double, 9>& mom = s.moments[local];
-          for (int p = 0; p < 3; ++p)
-            for (int q = 0; q < 3; ++q)
-              if (p + q < 4) mom[static_cast<std::size_t>(3 * q + p)] += above[static_cast<std::size_t>(p)] / (q + 1);
-          for (int p = 0; p < 3; ++p) above[static_cast<std::size_t>(p)] += s.carries[local][static_cast<std::size_t>(p)];
+          if (s.touched[local]) {
+            mom[0] += above[0];  // m_pq += above_p / (q + 1)
+            mom[1] += above[1];
+            mom[2] += above[2];
+            mom[3] += 0.5 * above[0];
+            mom[4] += 0.5 * above[1];
+            mom[5] += 0.5 * above[2];
+            mom[6] += above[0] / 3.0;
+            mom[7] += above[1] / 3.0;
+            for (int p = 0; p < 3; ++p) above[static_cast<std::size_t>(p)] += s.carries[local][static_cast<std::size_t>(p)];
+          } else {
+            mom[0] += above[0];  // full or empty: only m00 is read (below)
+          }
         }
       }
     }
