@@ -312,7 +312,7 @@ void read_contact(Section s, ContactParams& c) {
   s.finish();
 }
 
-void read_coupling(Section s, CouplingParams& c) {
+void read_coupling(Section s, CouplingParams& c, SeaModel sea_model) {
   c.law = s.choice<PenaltyLaw>("law", c.law, {{"strong", PenaltyLaw::strong}, {"weak", PenaltyLaw::weak},
                                               {"blend", PenaltyLaw::blend}});
   c.stiffness = s.number("stiffness", c.stiffness, positive, "a relative stiffness K > 0");
@@ -329,6 +329,9 @@ void read_coupling(Section s, CouplingParams& c) {
   c.footprint = s.choice<FootprintChoice>("footprint", c.footprint, {{"automatic", FootprintChoice::automatic},
                                                                      {"cell", FootprintChoice::cell},
                                                                      {"tent", FootprintChoice::tent}});
+  if (c.footprint == FootprintChoice::tent && sea_model == SeaModel::bem)
+    s.fail("footprint", "\"tent\" needs a periodic sea ([sea] model = \"spectral\"): a tent would reach past a bem "
+                        "basin's walls; use \"cell\" or \"automatic\"");
   s.finish();
 }
 
@@ -405,7 +408,7 @@ Config parse_config(std::string_view text, const std::string& name, const std::s
   read_sea(Section(top.table("sea"), "sea", name), c.sea, name);
   read_floes(Section(top.table("floes"), "floes", name), c.floes, name, base_dir);
   read_contact(Section(top.table("contact"), "contact", name), c.contact);
-  read_coupling(Section(top.table("coupling"), "coupling", name), c.coupling);
+  read_coupling(Section(top.table("coupling"), "coupling", name), c.coupling, c.sea.model);
   read_forcing(Section(top.table("forcing"), "forcing", name), c.forcing, base_dir);
   read_fracture(Section(top.table("fracture"), "fracture", name), c.fracture, name);
   top.finish();

@@ -99,6 +99,8 @@ TEST_CASE("unknown keys, wrong types and out-of-range values name file, line and
   refused("[[floes.floe]]\nvertices = [[0,0],[1,0],[1,1]]\nstatic = true\nvelocity = [1, 0]\n",
           {"[floes.floe] static", "cannot have a velocity"});
   refused("[coupling]\nblend = 0.5\n", {"[coupling] blend", "blend"});
+  refused("[coupling]\nfootprint = \"round\"\n", {"[coupling] footprint", "\"tent\""});
+  refused("[sea]\nmodel = \"bem\"\n[coupling]\nfootprint = \"tent\"\n", {"case.toml:4", "[coupling] footprint", "periodic"});
   refused("[sea.waves]\nkind = \"regular\"\n", {"[sea.waves] kind", "wavelength or a period"});
   refused("[run\n", {"case.toml:1", "not valid TOML"});
 }
