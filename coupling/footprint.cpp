@@ -137,6 +137,57 @@ struct Scratch {
   std::vector<std::uint8_t> touched;  // dual cells the outline crosses
 };
 
+// Floe f posed in world orientation relative to its centroid G (into poly),
+// and the cells of its bounding box on the grid whose lines lie at
+// (k + shift) dx, (k + shift) dy: columns i0..i1, rows j0..j1 (one row, 0,
+// when dims = 1).
+struct PosedBox {
+  Vec2 g = Vec2::Zero();
+  int i0 = 0, i1 = 0, j0 = 0, j1 = 0;
+  int w() const { return i1 - i0 + 1; }
+  int h() const { return j1 - j0 + 1; }
+};
+PosedBox pose(const Floes& floes, std::size_t f, double dx, double dy, double shift, bool two_d,
+              std::vector<Vec2>& poly) {
+  const FloeState& st = floes.state[f];
+  PosedBox b;
+  b.g = {st.x, st.y};
+  poly.clear();
+  Vec2 lo = Vec2::Constant(INFINITY), hi = Vec2::Constant(-INFINITY);
+  for (const Vec2& p : floes.vertices(f)) {
+    poly.push_back(rotate(p, st.yaw));
+    lo = lo.cwiseMin(poly.back());
+    hi = hi.cwiseMax(poly.back());
+  }
+  b.i0 = static_cast<int>(std::floor((b.g.x() + lo.x()) / dx - shift));
+  b.i1 = static_cast<int>(std::floor((b.g.x() + hi.x()) / dx - shift));
+  b.j0 = two_d ? static_cast<int>(std::floor((b.g.y() + lo.y()) / dy - shift)) : 0;
+  b.j1 = two_d ? static_cast<int>(std::floor((b.g.y() + hi.y()) / dy - shift)) : 0;
+  return b;
+}
+
+// Calls fn(pa, pb, li, lj) for each sub-segment of the outline poly cut at
+// the grid lines of pose(): its ends (relative to G) and the local column and
+// row of its cell in the box.
+template <class Fn>
+void for_each_subsegment(const std::vector<Vec2>& poly, const PosedBox& b, double dx, double dy, double shift,
+                         bool two_d, std::vector<double>& ts, Fn&& fn) {
+  const double inv_dx = 1.0 / dx, inv_dy = 1.0 / dy;
+  const std::size_t nv = poly.size();
+  for (std::size_t k = 0; k < nv; ++k) {
+    const Vec2 a = poly[k], e = poly[(k + 1) % nv] - a;
+    split_at_lines(a, a + e, b.g, dx, dy, shift, two_d, ts);
+    for (std::size_t m = 0; m + 1 < ts.size(); ++m) {
+      if (ts[m + 1] - ts[m] <= 1e-14) continue;
+      const Vec2 pa = a + ts[m] * e, pb = a + ts[m + 1] * e;
+      const Vec2 mid = b.g + 0.5 * (pa + pb);
+      const int ci = static_cast<int>(std::floor(mid.x() * inv_dx - shift));
+      const int cj = two_d ? static_cast<int>(std::floor(mid.y() * inv_dy - shift)) : 0;
+      fn(pa, pb, std::clamp(ci - b.i0, 0, b.w() - 1), std::clamp(cj - b.j0, 0, b.h() - 1));
+    }
+  }
+}
+
 // Sorts the pieces of the last floe (from first_piece) by cell and merges
 // pieces of one cell: a floe whose box wraps around a periodic edge, or is
 // larger than the box and covers a cell twice.
@@ -196,21 +247,10 @@ void build_tent(const Floes& floes, std::span<const std::uint8_t> include, const
       out.edge_offsets.push_back(out.edge_cell.size());
       continue;
     }
-    const FloeState& st = floes.state[f];
-    const Vec2 g{st.x, st.y};
-    s.poly.clear();
-    Vec2 lo = Vec2::Constant(INFINITY), hi = Vec2::Constant(-INFINITY);
-    for (const Vec2& p : floes.vertices(f)) {
-      s.poly.push_back(rotate(p, st.yaw));
-      lo = lo.cwiseMin(s.poly.back());
-      hi = hi.cwiseMax(s.poly.back());
-    }
     // Dual cells of the bounding box, and their corner nodes ((w + 1) x (h + 1); one row with dims = 1).
-    const int i0 = static_cast<int>(std::floor((g.x() + lo.x()) / dx - 0.5));
-    const int i1 = static_cast<int>(std::floor((g.x() + hi.x()) / dx - 0.5));
-    const int j0 = two_d ? static_cast<int>(std::floor((g.y() + lo.y()) / dy - 0.5)) : 0;
-    const int j1 = two_d ? static_cast<int>(std::floor((g.y() + hi.y()) / dy - 0.5)) : 0;
-    const int w = i1 - i0 + 1, h = j1 - j0 + 1;
+    const PosedBox box = pose(floes, f, dx, dy, 0.5, two_d, s.poly);
+    const Vec2 g = box.g;
+    const int i0 = box.i0, i1 = box.i1, j0 = box.j0, j1 = box.j1, w = box.w(), h = box.h();
     const int nw = w + 1, nh = two_d ? h + 1 : 1;
     const std::size_t nloc = static_cast<std::size_t>(w) * static_cast<std::size_t>(h);
     s.moments.assign(nloc, {});
@@ -232,18 +272,7 @@ void build_tent(const Floes& floes, std::span<const std::uint8_t> include, const
     auto cell_of_node = [&](int ni, int nj) {
       return s.row_start[static_cast<std::size_t>(nj)] + s.column[static_cast<std::size_t>(ni)];
     };
-    const std::size_t nv = s.poly.size();
-    for (std::size_t k = 0; k < nv; ++k) {
-      const Vec2 a = s.poly[k], b = s.poly[(k + 1) % nv];
-      const Vec2 e = b - a;
-      split_at_lines(a, b, g, dx, dy, 0.5, two_d, s.ts);
-      for (std::size_t m = 0; m + 1 < s.ts.size(); ++m) {
-        if (s.ts[m + 1] - s.ts[m] <= 1e-14) continue;
-        const Vec2 pa = a + s.ts[m] * e, pb = a + s.ts[m + 1] * e;
-        const Vec2 mid = g + 0.5 * (pa + pb);
-        const int ci = static_cast<int>(std::floor(mid.x() * inv_dx - 0.5));
-        const int cj = two_d ? static_cast<int>(std::floor(mid.y() * inv_dy - 0.5)) : 0;
-        const int li = std::clamp(ci - i0, 0, w - 1), lj = std::clamp(cj - j0, 0, h - 1);
+    for_each_subsegment(s.poly, box, dx, dy, 0.5, two_d, s.ts, [&](const Vec2& pa, const Vec2& pb, int li, int lj) {
         const std::size_t local = static_cast<std::size_t>(lj) * w + li;
         const Vec2 o = origin(li, lj);
         const double sa = (pa.x() - o.x()) * inv_dx, sb = (pb.x() - o.x()) * inv_dx;
@@ -287,8 +316,7 @@ void build_tent(const Floes& floes, std::span<const std::uint8_t> include, const
             if (weight[0] == 0.0 && weight[1] == 0.0 && weight[2] == 0.0) continue;
             add_edge(s.edges[static_cast<std::size_t>((lj + beta) * nw + li + alpha)], points, weight);
           }
-      }
-    }
+    });
     // The carries, summed down each column: a full row below has m_pq =
     // (sum of the carries above)_p / (q + 1).
     if (h > 1) {
@@ -401,13 +429,12 @@ void build_footprints(const Floes& floes, std::span<const std::uint8_t> include,
   out.edge_twist.clear();
   out.edge_first.clear();
   out.edge_swept.clear();
-  out.kernel = kernel;
   static thread_local Scratch scratch;
   if (kernel == FootprintKernel::tent) {
     build_tent(floes, include, grid, out, scratch);
     return;
   }
-  const double dx = grid.dx(), dy = grid.dy(), inv_dx = 1.0 / dx, inv_dy = 1.0 / dy;
+  const double dx = grid.dx(), dy = grid.dy();
   const bool periodic = grid.edge == fluid::GridEdge::periodic;
   const bool two_d = grid.dims == 2;
   // A piece thinner than this (relative to a cell) is round-off from a vertex
@@ -429,21 +456,10 @@ void build_footprints(const Floes& floes, std::span<const std::uint8_t> include,
 
   for (std::size_t f = 0; f < floes.size(); ++f) {
     if (include[f]) {
-      const FloeState& st = floes.state[f];
-      const Vec2 g{st.x, st.y};
-      s.poly.clear();
-      Vec2 lo = Vec2::Constant(INFINITY), hi = Vec2::Constant(-INFINITY);
-      for (const Vec2& p : floes.vertices(f)) {
-        s.poly.push_back(rotate(p, st.yaw));
-        lo = lo.cwiseMin(s.poly.back());
-        hi = hi.cwiseMax(s.poly.back());
-      }
       // The bounding box in cells (all of the width when dims = 1: one row).
-      const int i0 = static_cast<int>(std::floor((g.x() + lo.x()) / dx));
-      const int i1 = static_cast<int>(std::floor((g.x() + hi.x()) / dx));
-      const int j0 = two_d ? static_cast<int>(std::floor((g.y() + lo.y()) / dy)) : 0;
-      const int j1 = two_d ? static_cast<int>(std::floor((g.y() + hi.y()) / dy)) : 0;
-      const int w = i1 - i0 + 1, h = j1 - j0 + 1;
+      const PosedBox box = pose(floes, f, dx, dy, 0.0, two_d, s.poly);
+      const Vec2 g = box.g;
+      const int i0 = box.i0, i1 = box.i1, j0 = box.j0, j1 = box.j1, w = box.w(), h = box.h();
       const std::size_t nloc = static_cast<std::size_t>(w) * static_cast<std::size_t>(h);
       for (auto* v : {&s.area, &s.mx, &s.my, &s.carry_area, &s.carry_mx}) v->assign(nloc, 0.0);
       // Bottom of local row lj, relative to G (dims = 1: y = 0, any base works
@@ -453,18 +469,7 @@ void build_footprints(const Floes& floes, std::span<const std::uint8_t> include,
       // Edges: split at grid lines; each sub-segment is an edge piece and adds
       // its integrals to its cell (direct) and to the rows below (carry).
       s.edges.assign(nloc, {});
-      const std::size_t nv = s.poly.size();
-      for (std::size_t k = 0; k < nv; ++k) {
-        const Vec2 a = s.poly[k], b = s.poly[(k + 1) % nv];
-        const Vec2 e = b - a;
-        split_at_lines(a, b, g, dx, dy, 0.0, two_d, s.ts);
-        for (std::size_t m = 0; m + 1 < s.ts.size(); ++m) {
-          if (s.ts[m + 1] - s.ts[m] <= 1e-14) continue;
-          const Vec2 pa = a + s.ts[m] * e, pb = a + s.ts[m + 1] * e;
-          const Vec2 mid = g + 0.5 * (pa + pb);
-          const int ci = static_cast<int>(std::floor(mid.x() * inv_dx));
-          const int cj = two_d ? static_cast<int>(std::floor(mid.y() * inv_dy)) : 0;
-          const int li = std::clamp(ci - i0, 0, w - 1), lj = std::clamp(cj - j0, 0, h - 1);
+      for_each_subsegment(s.poly, box, dx, dy, 0.0, two_d, s.ts, [&](const Vec2& pa, const Vec2& pb, int li, int lj) {
           const std::size_t local = static_cast<std::size_t>(lj) * w + li;
           const double run = pb.x() - pa.x();
           if (run != 0.0) {
@@ -480,8 +485,7 @@ void build_footprints(const Floes& floes, std::span<const std::uint8_t> include,
             }
           }
           add_edge(s.edges[local], SegmentPoints(pa, pb), kUnit);
-        }
-      }
+      });
       // The carries, summed down each column: a full row j below the
       // sub-segments has area sum carry and y-moment that times its mid-height.
       if (h > 1) {

@@ -46,7 +46,6 @@ namespace floesim {
 enum class FootprintKernel { cell, tent };
 
 struct Footprints {
-  FootprintKernel kernel = FootprintKernel::cell;
   // Area pieces of floe i: [offsets[i], offsets[i + 1]), sorted by cell.
   // With the tent kernel, "area" is the tent-weighted area w_c and "centroid"
   // the tent-weighted centroid.

@@ -40,7 +40,6 @@ public:
   std::span<const double> v0() const { return v0_; }
   std::span<const double> u1() const { return u1_; }
   std::span<const double> v1() const { return v1_; }
-  double interval() const { return tau_; }
 
 private:
   void take(std::vector<double>& u, std::vector<double>& v);

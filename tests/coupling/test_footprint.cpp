@@ -50,18 +50,32 @@ Piece green(const std::vector<Vec2>& v) {
   return m;
 }
 
+// Floe f's outline in world orientation relative to its centroid g, and its
+// world bounding box.
+struct Posed {
+  Vec2 g = Vec2::Zero();
+  std::vector<Vec2> poly;
+  double lo[2] = {INFINITY, INFINITY}, hi[2] = {-INFINITY, -INFINITY};
+};
+Posed pose(const Floes& floes, std::size_t f) {
+  const FloeState& st = floes.state[f];
+  Posed out;
+  out.g = {st.x, st.y};
+  for (const Vec2& p : floes.vertices(f)) out.poly.push_back(rotate(p, st.yaw));
+  for (const Vec2& p : out.poly)
+    for (int a = 0; a < 2; ++a) {
+      out.lo[a] = std::min(out.lo[a], p[a] + out.g[a]);
+      out.hi[a] = std::max(out.hi[a], p[a] + out.g[a]);
+    }
+  return out;
+}
+
 // Reference pieces of floe f by clipping, keyed by (wrapped) cell.
 std::map<std::uint32_t, Piece> clipped_pieces(const Floes& floes, std::size_t f, const fluid::SurfaceGrid& grid) {
-  const FloeState& st = floes.state[f];
-  const Vec2 g{st.x, st.y};
-  std::vector<Vec2> poly;
-  for (const Vec2& p : floes.vertices(f)) poly.push_back(rotate(p, st.yaw));
-  double lo[2] = {INFINITY, INFINITY}, hi[2] = {-INFINITY, -INFINITY};
-  for (const Vec2& p : poly)
-    for (int a = 0; a < 2; ++a) {
-      lo[a] = std::min(lo[a], p[a] + g[a]);
-      hi[a] = std::max(hi[a], p[a] + g[a]);
-    }
+  const Posed posed = pose(floes, f);
+  const Vec2& g = posed.g;
+  const std::vector<Vec2>& poly = posed.poly;
+  const double *lo = posed.lo, *hi = posed.hi;
   const bool two_d = grid.dims == 2;
   const double dx = grid.dx(), dy = grid.dy();
   std::map<std::uint32_t, Piece> out;
@@ -107,6 +121,42 @@ std::vector<Vec2> star(int n, double r_in, double r_out, double phase) {
   return v;
 }
 
+// The periodic test grid: 40 x 30 cells of 2 m x 1.5 m.
+fluid::SurfaceGrid box_grid() {
+  fluid::SurfaceGrid grid;
+  grid.dims = 2;
+  grid.nx = 40;
+  grid.ny = 30;
+  grid.lx = 80.0;
+  grid.ly = 45.0;
+  return grid;
+}
+
+// n floes of 3 to 15 m, in turn a non-convex star, an L and a regular
+// 12-gon, and last a floe longer than the box (cells covered twice).
+Floes mixed_floes(std::mt19937_64& rng, int n) {
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  std::vector<std::vector<Vec2>> outlines;
+  for (int k = 0; k < n; ++k) {
+    const double r = 3.0 + 12.0 * u(rng);
+    if (k % 3 == 0) outlines.push_back(star(5, 0.4 * r, r, u(rng)));
+    else if (k % 3 == 1) outlines.push_back({{0, 0}, {r, 0}, {r, 0.3 * r}, {0.3 * r, 0.3 * r}, {0.3 * r, r}, {0, r}});
+    else outlines.push_back(star(6, r, r, u(rng)));
+  }
+  outlines.push_back({{0, 0}, {100, 0}, {100, 10}, {0, 10}});
+  return make_floes(outlines);
+}
+
+// Every floe at a random place and yaw in the grid's box.
+void scatter(Floes& floes, const fluid::SurfaceGrid& grid, std::mt19937_64& rng) {
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  for (FloeState& s : floes.state) {
+    s.x = grid.lx * u(rng);
+    s.y = grid.ly * u(rng);
+    s.yaw = 2.0 * std::numbers::pi * u(rng);
+  }
+}
+
 void check_against_clipping(const Floes& floes, const fluid::SurfaceGrid& grid) {
   Footprints fp;
   const std::vector<std::uint8_t> include(floes.size(), 1);
@@ -143,30 +193,11 @@ void check_against_clipping(const Floes& floes, const fluid::SurfaceGrid& grid) 
 }  // namespace
 
 TEST_CASE("footprint pieces equal the polygon clipped by each cell, convex or not, across periodic edges") {
-  fluid::SurfaceGrid grid;
-  grid.dims = 2;
-  grid.nx = 40;
-  grid.ny = 30;
-  grid.lx = 80.0;
-  grid.ly = 45.0;  // dx = 2, dy = 1.5
+  const fluid::SurfaceGrid grid = box_grid();
   std::mt19937_64 rng(7);
-  std::uniform_real_distribution<double> u(0.0, 1.0);
-  std::vector<std::vector<Vec2>> outlines;
-  for (int k = 0; k < 12; ++k) {
-    const double r = 3.0 + 12.0 * u(rng);
-    if (k % 3 == 0) outlines.push_back(star(5, 0.4 * r, r, u(rng)));  // non-convex
-    else if (k % 3 == 1) outlines.push_back({{0, 0}, {r, 0}, {r, 0.3 * r}, {0.3 * r, 0.3 * r}, {0.3 * r, r}, {0, r}});  // L
-    else outlines.push_back(star(6, r, r, u(rng)));  // a regular 12-gon
-  }
-  outlines.push_back({{0, 0}, {100, 0}, {100, 10}, {0, 10}});  // longer than the box: cells covered twice
-  Floes floes = make_floes(outlines);
+  Floes floes = mixed_floes(rng, 12);
   for (int trial = 0; trial < 6; ++trial) {
-    for (std::size_t f = 0; f < floes.size(); ++f) {
-      FloeState& s = floes.state[f];
-      s.x = grid.lx * u(rng);  // near the edges too: pieces wrap
-      s.y = grid.ly * u(rng);
-      s.yaw = 2.0 * std::numbers::pi * u(rng);
-    }
+    scatter(floes, grid, rng);  // near the edges too: pieces wrap
     if (trial == 0) {  // vertices exactly on grid lines
       floes.state[1].x = floes.state[1].y = 0.0;
       floes.state[1].yaw = 0.0;
@@ -214,16 +245,10 @@ double triangle_integral(const Vec2& a, const Vec2& b, const Vec2& c, const F& f
 }
 
 std::map<std::uint32_t, Piece> tent_pieces(const Floes& floes, std::size_t f, const fluid::SurfaceGrid& grid) {
-  const FloeState& st = floes.state[f];
-  const Vec2 g{st.x, st.y};
-  std::vector<Vec2> poly;
-  for (const Vec2& p : floes.vertices(f)) poly.push_back(rotate(p, st.yaw));
-  double lo[2] = {INFINITY, INFINITY}, hi[2] = {-INFINITY, -INFINITY};
-  for (const Vec2& p : poly)
-    for (int a = 0; a < 2; ++a) {
-      lo[a] = std::min(lo[a], p[a] + g[a]);
-      hi[a] = std::max(hi[a], p[a] + g[a]);
-    }
+  const Posed posed = pose(floes, f);
+  const Vec2& g = posed.g;
+  const std::vector<Vec2>& poly = posed.poly;
+  const double *lo = posed.lo, *hi = posed.hi;
   const bool two_d = grid.dims == 2;
   const double dx = grid.dx(), dy = grid.dy();
   std::map<std::uint32_t, Piece> out;
@@ -297,30 +322,11 @@ void check_tent(const Floes& floes, const fluid::SurfaceGrid& grid) {
 }  // namespace
 
 TEST_CASE("tent footprint: node weights and moments equal the tents integrated over the clipped floe") {
-  fluid::SurfaceGrid grid;
-  grid.dims = 2;
-  grid.nx = 40;
-  grid.ny = 30;
-  grid.lx = 80.0;
-  grid.ly = 45.0;  // dx = 2, dy = 1.5
+  const fluid::SurfaceGrid grid = box_grid();
   std::mt19937_64 rng(11);
-  std::uniform_real_distribution<double> u(0.0, 1.0);
-  std::vector<std::vector<Vec2>> outlines;
-  for (int k = 0; k < 9; ++k) {
-    const double r = 3.0 + 12.0 * u(rng);
-    if (k % 3 == 0) outlines.push_back(star(5, 0.4 * r, r, u(rng)));
-    else if (k % 3 == 1) outlines.push_back({{0, 0}, {r, 0}, {r, 0.3 * r}, {0.3 * r, 0.3 * r}, {0.3 * r, r}, {0, r}});
-    else outlines.push_back(star(6, r, r, u(rng)));
-  }
-  outlines.push_back({{0, 0}, {100, 0}, {100, 10}, {0, 10}});  // longer than the box: nodes covered twice
-  Floes floes = make_floes(outlines);
+  Floes floes = mixed_floes(rng, 9);
   for (int trial = 0; trial < 4; ++trial) {
-    for (std::size_t f = 0; f < floes.size(); ++f) {
-      FloeState& s = floes.state[f];
-      s.x = grid.lx * u(rng);
-      s.y = grid.ly * u(rng);
-      s.yaw = 2.0 * std::numbers::pi * u(rng);
-    }
+    scatter(floes, grid, rng);
     if (trial == 0) {  // vertices exactly on dual grid lines (cell centres)
       floes.state[1].x = 1.0;
       floes.state[1].y = 0.75;
