@@ -97,6 +97,7 @@ double Simulation::step(double t_stop) {
   // Land exactly on t_stop when the step was cut to reach it.
   t_ = ctx.dt == t_stop - ctx.t ? t_stop : ctx.t + ctx.dt;
   ++steps_;
+  warm_->tick();  // the jam LCPs' warm starts age by one step
   return ctx.dt;
 }
 
@@ -188,9 +189,7 @@ void Simulation::collide(StepContext& ctx) {
   // Contacts were found at the positions of the start of the step; the LCPs
   // turn W(t-) into W(t+). Contacts the step itself pushed together rest
   // (restitution 0), and pushed points that would close below xi/2 within the
-  // step are held by speculative contacts (contact/impulse.hpp). The warm
-  // starts of jam LCPs age by one step (pruned by age).
-  warm_->tick();
+  // step are held by speculative contacts (contact/impulse.hpp).
   contact::resolve_step_collisions(scenario_.floes, ctx.start, detection_, ctx.dt, impulse_options_, stats_,
                                    percussion_ ? &ctx.impulses : nullptr);
   const Vec2 after = momentum();
