@@ -68,9 +68,23 @@ double approach(const Floes& floes, std::span<const FloeState> s, std::uint32_t 
   vb.x = floes.state[b].x; vb.y = floes.state[b].y;
   return -normal.dot(point_velocity(vb, pb_own) - point_velocity(va, pa));
 }
-// Pushed (impulse.hpp): approaching now at least three times as fast as at
-// the start of the step.
-bool pushed(double now, double at_start) { return now > 0.0 && at_start <= now / 3.0; }
+// The speed the step's smooth forces gave the two floes' points (the larger
+// of the two): |v_f(p)| of W^- minus that of the step's start, at the present
+// positions.
+double smooth_kick(const Floes& floes, std::span<const FloeState> start, std::span<const FloeState> w_minus,
+                   std::uint32_t a, std::uint32_t b, const Vec2& pa, const Vec2& pb_own) {
+  auto kick = [&](std::uint32_t f, const Vec2& p) {
+    FloeState s0 = start[f], s1 = w_minus[f];
+    s0.x = s1.x = floes.state[f].x;
+    s0.y = s1.y = floes.state[f].y;
+    return (point_velocity(s1, p) - point_velocity(s0, p)).norm();
+  };
+  return std::max(kick(a, pa), kick(b, pb_own));
+}
+// Made by the step (impulse.hpp): the contact approached at the start of the
+// step at most a third as fast as now, or no faster than the step's smooth
+// forces move either floe's point (or not at all).
+bool made_by_step(double now, double at_start, double kick) { return at_start <= std::max(kick, now / 3.0); }
 std::uint64_t pair_key(std::uint32_t a, std::uint32_t b) { return (std::uint64_t{a} << 32) | b; }
 Vec2 body_point(const Floes& floes, std::uint32_t a, const Vec2& p) {
   const FloeState& s = floes.state[a];
@@ -379,8 +393,9 @@ std::size_t resolve_step_collisions(Floes& floes, std::span<const FloeState> sta
   for (std::size_t k = 0; k < contacts.size(); ++k) {
     const ContactPoint& c = contacts[k];
     const Vec2 pb = c.point - c.shift;  // in b's own image
-    resting[k] = jammed(c.a, c.b) || pushed(approach(floes, floes.state, c.a, c.b, c.point, pb, c.normal),
-                                            approach(floes, start, c.a, c.b, c.point, pb, c.normal));
+    resting[k] = jammed(c.a, c.b) || made_by_step(approach(floes, floes.state, c.a, c.b, c.point, pb, c.normal),
+                                                  approach(floes, start, c.a, c.b, c.point, pb, c.normal),
+                                                  smooth_kick(floes, start, floes.state, c.a, c.b, c.point, pb));
   }
   // In a jam every point beyond xi is speculative from the start.
   std::vector<std::uint8_t> taken(detection.witnesses.size(), 0);
@@ -412,7 +427,9 @@ std::size_t resolve_step_collisions(Floes& floes, std::span<const FloeState> sta
         const Vec2 pb = w.pb - p.shift;
         const double now = approach(floes, floes.state, p.a, p.b, w.pa, pb, w.normal);
         if (!(now * step > w.distance - 0.5 * xi)) continue;
-        if (!pushed(now, approach(floes, start, p.a, p.b, w.pa, pb, w.normal))) continue;
+        if (!made_by_step(now, approach(floes, start, p.a, p.b, w.pa, pb, w.normal),
+                          smooth_kick(floes, start, before, p.a, p.b, w.pa, pb)))
+          continue;
         taken[k] = 1;
         contacts.push_back({p.a, p.b, 0.5 * (w.pa + w.pb), w.normal, w.distance, p.shift, true});
         resting.push_back(1);

@@ -34,15 +34,24 @@
 //
 // Collisions at the start of a step (resolve_step_collisions): resting and
 // speculative contacts. Poisson's law is a law of impacts. A contact is
-// "pushed" when it approaches now at least three times faster than it did at
-// the start of the step, i.e. the approach was made by this step (its smooth
-// forces, and the impulses of the contacts around it: in a jam, neighbours get
-// the same push from the wind and approach because the floe ahead is held).
+// "pushed" when its approach was made by this step: at the start of the step
+// it approached no faster than a third of its approach now, and no faster
+// than the step's smooth forces move either floe's point there (|dv(P)| of
+// either floe between the start of the step and W^-), or not at all. The
+// approach then comes from the step's forces, and from the impulses of the
+// contacts around it: in a jam, neighbours get the same push from the wind
+// and approach because the floe ahead is held.
 //  * A pushed contact point is resting: restitution 0 (Poisson's law per
 //    contact, e_k = 0: W^+ = W^c + A^-1 G^T diag(e_k) z^c, which is
 //    (1 + e) W^c - e W^- when every e_k = e). Bouncing it by e times a speed
 //    the step itself created would make a jammed pack rattle at a rate set by
-//    the step.
+//    the step. The second and third conditions matter in chains: a floe
+//    pushed by the wind against a floe the wall holds has no relative
+//    approach of its own, yet its contact takes the impulse that stops the
+//    wind's push; bounced by e, that floe chattered at a few mm/s for ever
+//    (tests/coupling/test_collisions.cpp, the row against a wall). An approach
+//    slower than one step's push is re-made within the step anyway: a bounce
+//    that slow would land again before the step ends.
 //  * Speculative contacts (after Catto's): a pushed point of two floes at a
 //    gap g >= xi (a witness of the detection, detection.hpp) that would come
 //    closer than xi/2 within the step h may close by at most (g - xi/2)/2: it
