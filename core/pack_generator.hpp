@@ -35,6 +35,11 @@
 //     at least min_gap apart, and every floe at least min_gap / 2 from the box.
 //  4. Optional walls: four static rectangular floes (obstacles) outside the
 //     box, min_gap / 2 beyond its sides, their corners min_gap apart.
+//  5. Numbering: the floes are numbered along a Z-order (Morton) curve of
+//     their centroids, walls last, so floes near each other in the box are
+//     near each other in the floe arrays. Detection and the multirate advance
+//     read floes neighbour by neighbour: at 10^4 floes this took the bench's
+//     pack run from 1.48-1.51 s to 1.36-1.38 s (same pack, renumbered).
 //
 // Determinism: the random numbers come from std::mt19937_64 (whose sequence the
 // C++ standard fixes) through our own uniform-double mapping (53 high bits), not

@@ -269,6 +269,32 @@ TEST_CASE("pack: static walls around the box keep the gap") {
   CHECK(floe_area(pack) / 1e6 == doctest::Approx(0.85).epsilon(0.02));  // walls not counted
 }
 
+TEST_CASE("pack: floes are numbered along a space-filling curve, neighbours near each other") {
+  // Z-order numbering (pack_generator.hpp, step 5): in a random order the mean distance
+  // between floes i and i + 1 would be about 0.52 of the box side (two uniform points in a
+  // unit square); along a Z curve of N cells it is a few floe sizes, and half the first
+  // floes lie in the box's lower-left quarter.
+  PackOptions o = options(2000, 0.5, 4);
+  o.wall_width = 10.0;
+  const GeneratedPack pack = generate_pack(o);
+  REQUIRE(pack.floes.size() == 2004);
+  const std::size_t n = 2000;
+  const double size = std::sqrt(o.width * o.height / static_cast<double>(n));  // box per floe
+  double step = 0.0;
+  std::size_t lower_left = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const FloeState& s = pack.floes.state[i];
+    if (i + 1 < n) step += std::hypot(pack.floes.state[i + 1].x - s.x, pack.floes.state[i + 1].y - s.y);
+    if (i < n / 4 && s.x < 0.5 * o.width && s.y < 0.5 * o.height) ++lower_left;
+  }
+  step /= static_cast<double>(n - 1);
+  MESSAGE("mean distance of consecutive floes " << step / size << " floe spacings, " << lower_left
+                                                << " of the first " << n / 4 << " in the lower-left quarter");
+  CHECK(step < 3.0 * size);
+  CHECK(lower_left > 0.9 * static_cast<double>(n / 4));
+  for (std::size_t i = n; i < pack.floes.size(); ++i) CHECK(pack.floes.is_static[i]);  // walls last
+}
+
 TEST_CASE("pack: a larger requested gap is honoured, an impossible one refused") {
   PackOptions o = options(200, 0.5, 4);
   o.min_gap = 2.0;  // m; mean size ~ 56 m
