@@ -22,10 +22,11 @@
 //
 // Per scenario: a warm-up run (to 10% of the simulated time), then R timed
 // runs (each a fresh Simulation; the minimum wall time is kept, the median is
-// shown); the steps follow `floesim run` (steps land on the output times) but
-// nothing is written. Peak memory is measured in a separate process (this
-// binary re-executed with --child NAME) that runs the scenario once:
-// ru_maxrss from wait4, so pack generation and the timing runs do not count.
+// shown), taken round-robin over the scenarios; the steps follow `floesim run`
+// (steps land on the output times) but nothing is written. Peak memory is
+// measured in a separate process (this binary re-executed with --child NAME)
+// that runs the scenario once and reports its own VmHWM, so pack generation
+// and the timing runs do not count.
 // A scenario that throws, or runs past --time-limit, is reported with its
 // status and the simulated time it reached.
 //
@@ -33,7 +34,6 @@
 //                                 [--csv FILE] [--time-limit S] [--note TEXT...] [--pack-dir DIR]
 // To profile one scenario: run once with --pack-dir DIR --only NAME, then
 //   perf record -g floesim_bench_collisions --child NAME --pack-dir DIR
-#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -228,24 +228,49 @@ RunResult run_once(const Config& config, double t_end, double time_limit) {
   return r;
 }
 
-// Runs this binary with --child NAME; returns its peak resident set (MiB) from
-// wait4, or -1 when it could not run or failed.
+// Runs this binary with --child NAME; returns its peak resident set (MiB),
+// or -1 when it could not run or failed. The child reads it from its own
+// /proc/self/status (VmHWM) and writes it to its stdout, a pipe. (wait4's
+// ru_maxrss would not do: exec records the
+// hiwater mark of the memory it replaces, the forked copy of this process, so
+// a child forked after a large scenario would report that scenario's memory.)
 double child_peak_rss_mb(const std::vector<std::string>& args) {
   std::vector<char*> argv;
   for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
   argv.push_back(nullptr);
   std::fflush(stdout);
+  int fd[2];
+  if (pipe(fd) != 0) return -1.0;
   const pid_t pid = fork();
   if (pid < 0) return -1.0;
   if (pid == 0) {
+    dup2(fd[1], STDOUT_FILENO);
+    close(fd[0]);
+    close(fd[1]);
     execv("/proc/self/exe", argv.data());
     _exit(127);
   }
+  close(fd[1]);
+  std::string text;
+  char buf[256];
+  for (ssize_t n; (n = read(fd[0], buf, sizeof buf)) > 0;) text.append(buf, static_cast<std::size_t>(n));
+  close(fd[0]);
   int status = 0;
-  rusage usage{};
-  if (wait4(pid, &status, 0, &usage) != pid) return -1.0;
+  if (waitpid(pid, &status, 0) != pid) return -1.0;
   if (!WIFEXITED(status) || WEXITSTATUS(status) == 127) return -1.0;
-  return static_cast<double>(usage.ru_maxrss) / 1024.0;  // ru_maxrss is in KiB on Linux
+  const std::size_t at = text.find("vmhwm_kib ");
+  if (at == std::string::npos) return -1.0;
+  return std::stod(text.substr(at + 10)) / 1024.0;
+}
+
+// The child's answer: its peak resident set (VmHWM of /proc/self/status, KiB).
+void print_own_peak_rss() {
+  std::ifstream status("/proc/self/status");
+  for (std::string line; std::getline(status, line);)
+    if (line.rfind("VmHWM:", 0) == 0) {
+      std::printf("vmhwm_kib %s\n", line.substr(6).c_str());
+      return;
+    }
 }
 
 std::string csv_field(const std::string& s) {
@@ -319,11 +344,15 @@ int main(int argc, char** argv) {
   app.add_option("--pack-dir", pack_dir_arg, "keep the generated packs in this folder (default: a temporary one)");
   CLI11_PARSE(app, argc, argv);
 
-  if (child == "none") return 0;  // the baseline: a process that only starts
+  if (child == "none") {  // the baseline: a process that only starts
+    print_own_peak_rss();
+    return 0;
+  }
   if (!child.empty()) {
     const BenchScenario* s = find_scenario(child);
     if (!s) return 3;
     const RunResult r = run_once(scenario_config(*s, pack_dir_arg), s->t_end, time_limit);
+    print_own_peak_rss();
     return r.status == "ok" ? 0 : 2;
   }
 
@@ -355,7 +384,14 @@ int main(int argc, char** argv) {
   std::printf("# machine: %s\n# process baseline (start and exit, no scenario): %.1f MiB\n", machine.c_str(),
               base_rss);
 
+  // Set-up and warm-up of every scenario, then the timed runs round-robin
+  // (repeat k of every scenario before repeat k + 1 of any), so a change in the
+  // machine's speed during the bench (other jobs, clock) falls on all the
+  // scenarios alike instead of on the ones that ran while it lasted: the cost
+  // exponent compares their times.
   std::vector<Row> rows;
+  std::vector<Config> configs;
+  std::vector<std::vector<double>> walls;
   for (const BenchScenario& s : kScenarios) {
     if (!only.empty() && std::find(only.begin(), only.end(), s.name) == only.end()) continue;
     if (s.floes > 0) {
@@ -363,25 +399,35 @@ int main(int argc, char** argv) {
       const std::string d = write_scenario_pack(s, pack_dir);
       std::printf("# %s (generated and written in %.2f s)\n", d.c_str(), seconds_since(t0));
     }
-    const Config config = scenario_config(s, pack_dir);
+    configs.push_back(scenario_config(s, pack_dir));
     Row row;
     row.scenario = &s;
     row.repeats = s.floes >= 10000 || (s.jam && s.floes >= 500) ? repeats_large : repeats;
-    const RunResult warm = run_once(config, 0.1 * s.t_end, time_limit);
-    std::vector<double> walls;
+    const RunResult warm = run_once(configs.back(), 0.1 * s.t_end, time_limit);
     if (warm.status != "ok") {
       row.best = warm;  // failed already in the warm-up: report that
       row.repeats = 0;
-    } else {
-      for (int k = 0; k < row.repeats; ++k) {
-        RunResult r = run_once(config, s.t_end, time_limit);
-        walls.push_back(r.wall);
-        const bool better = k == 0 || (r.status == "ok" && (row.best.status != "ok" || r.wall < row.best.wall));
-        if (better) row.best = std::move(r);
-        if (row.best.status != "ok") break;  // do not repeat a failure or a timeout
-      }
-      std::sort(walls.begin(), walls.end());
-      row.wall_median = walls[walls.size() / 2];
+    }
+    rows.push_back(std::move(row));
+    walls.emplace_back();
+  }
+  const int most = std::max(repeats, repeats_large);
+  for (int k = 0; k < most; ++k)
+    for (std::size_t i = 0; i < rows.size(); ++i) {
+      Row& row = rows[i];
+      if (k >= row.repeats || (k > 0 && row.best.status != "ok")) continue;  // a failure or a timeout is not repeated
+      RunResult r = run_once(configs[i], row.scenario->t_end, time_limit);
+      walls[i].push_back(r.wall);
+      const bool better = k == 0 || (r.status == "ok" && (row.best.status != "ok" || r.wall < row.best.wall));
+      if (better) row.best = std::move(r);
+    }
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    Row& row = rows[i];
+    const BenchScenario& s = *row.scenario;
+    if (!walls[i].empty()) {
+      std::sort(walls[i].begin(), walls[i].end());
+      row.wall_median = walls[i][walls[i].size() / 2];
+      row.repeats = static_cast<int>(walls[i].size());
     }
     row.peak_rss_mb = child_peak_rss_mb({self, "--child", s.name, "--pack-dir", pack_dir, "--time-limit",
                                          std::to_string(time_limit)});
@@ -397,7 +443,6 @@ int main(int argc, char** argv) {
                 b.stats.failures);
     for (const std::string& w : b.warnings) std::printf("#   warning: %s\n", w.c_str());
     std::fflush(stdout);
-    rows.push_back(std::move(row));
   }
   if (pack_dir_arg.empty()) fs::remove_all(pack_dir);
 
@@ -483,8 +528,8 @@ int main(int argc, char** argv) {
     f << "# command: " << command << "\n# machine: " << machine << "\n";
     for (const std::string& note : notes) f << "# " << note << "\n";
     f << "# wall_s: minimum over `repeats` runs after a warm-up run to 10% of simulated_s (Simulation construction + "
-         "steps, no output); phases from Simulation::profile() of that run\n"
-      << "# peak_rss_mb: MiB, ru_maxrss of a separate process running the scenario once (baseline of a process "
+         "steps, no output; the repeats round-robin over the scenarios); phases from Simulation::profile() of that run\n"
+      << "# peak_rss_mb: MiB, VmHWM of a separate process running the scenario once (baseline of a process "
          "that only starts: "
       << std::fixed << std::setprecision(1) << base_rss << " MiB)\n"
       << "# floedyn_s: FloeDyn on one core of this machine kind (issue 4); speedup = floedyn_s / wall_s\n"
