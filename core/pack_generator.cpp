@@ -369,6 +369,8 @@ void validate(const PackOptions& o) {
   if (!(std::isfinite(o.wall_width) && o.wall_width >= 0.0)) fail("wall width must be a finite number >= 0 (m)");
 }
 
+namespace {
+
 // The floes numbered along a Z-order (Morton) curve of their centroids on a
 // 2^16 x 2^16 grid of the box, walls last: floes near each other in space are
 // then near each other in the floe arrays, which the detection and the contact
@@ -397,6 +399,7 @@ std::vector<std::size_t> z_order(const std::vector<std::vector<Vec2>>& polys, st
   return order;
 }
 
+}  // namespace
 
 GeneratedPack generate_pack(const PackOptions& o) {
   validate(o);
@@ -498,7 +501,8 @@ GeneratedPack generate_pack(const PackOptions& o) {
                        ? o.thickness_max
                        : rng.uniform(o.thickness_min, o.thickness_max);
     in.density = o.density;
-    in.origin = in.is_static ? "generated wall " + std::to_string(i - n) : "generated floe " + std::to_string(out.floes.size());
+    in.origin = in.is_static ? "generated wall " + std::to_string(i - n)
+                             : "generated floe " + std::to_string(out.floes.size());
     out.floes.add(make_floe_shape(in), in);
   }
   return out;
