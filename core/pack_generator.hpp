@@ -38,8 +38,9 @@
 //  5. Numbering: the floes are numbered along a Z-order (Morton) curve of
 //     their centroids, walls last, so floes near each other in the box are
 //     near each other in the floe arrays. Detection and the multirate advance
-//     read floes neighbour by neighbour: at 10^4 floes this took the bench's
-//     pack run from 1.48-1.51 s to 1.36-1.38 s (same pack, renumbered).
+//     read floes neighbour by neighbour: the bench's 10^4-floe pack, run
+//     renumbered and not, alternating, took 1.66, 1.36, 1.38 s against 1.66,
+//     1.48, 1.51 s (docs/contact.md).
 //
 // Determinism: the random numbers come from std::mt19937_64 (whose sequence the
 // C++ standard fixes) through our own uniform-double mapping (53 high bits), not
