@@ -231,9 +231,9 @@ RunResult run_once(const Config& config, double t_end, double time_limit) {
 // Runs this binary with --child NAME; returns its peak resident set (MiB),
 // or -1 when it could not run or failed. The child reads it from its own
 // /proc/self/status (VmHWM) and writes it to its stdout, a pipe. (wait4's
-// ru_maxrss would not do: exec records the
-// hiwater mark of the memory it replaces, the forked copy of this process, so
-// a child forked after a large scenario would report that scenario's memory.)
+// ru_maxrss would not do: exec records the hiwater mark of the memory it
+// replaces, the forked copy of this process, so a child forked after a large
+// scenario would report that scenario's memory.)
 double child_peak_rss_mb(const std::vector<std::string>& args) {
   std::vector<char*> argv;
   for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));

@@ -74,10 +74,8 @@ double approach(const Floes& floes, std::span<const FloeState> s, std::uint32_t 
 double smooth_kick(const Floes& floes, std::span<const FloeState> start, std::span<const FloeState> w_minus,
                    std::uint32_t a, std::uint32_t b, const Vec2& pa, const Vec2& pb_own) {
   auto kick = [&](std::uint32_t f, const Vec2& p) {
-    FloeState s0 = start[f], s1 = w_minus[f];
-    s0.x = s1.x = floes.state[f].x;
-    s0.y = s1.y = floes.state[f].y;
-    return (point_velocity(s1, p) - point_velocity(s0, p)).norm();
+    const Vec2 arm = p - Vec2{floes.state[f].x, floes.state[f].y};
+    return (arm_velocity(w_minus[f], arm) - arm_velocity(start[f], arm)).norm();
   };
   return std::max(kick(a, pa), kick(b, pb_own));
 }

@@ -35,7 +35,7 @@
 // Collisions at the start of a step (resolve_step_collisions): resting and
 // speculative contacts. Poisson's law is a law of impacts. A contact is
 // "pushed" when its approach was made by this step: at the start of the step
-// it approached no faster than a third of its approach now, and no faster
+// it approached no faster than a third of its approach now, or no faster
 // than the step's smooth forces move either floe's point there (|dv(P)| of
 // either floe between the start of the step and W^-), or not at all. The
 // approach then comes from the step's forces, and from the impulses of the

@@ -371,11 +371,12 @@ void validate(const PackOptions& o) {
 
 namespace {
 
-// The floes numbered along a Z-order (Morton) curve of their centroids on a
-// 2^16 x 2^16 grid of the box, walls last: floes near each other in space are
-// then near each other in the floe arrays, which the detection and the contact
-// sweeps read neighbour by neighbour.
-std::vector<std::size_t> z_order(const std::vector<std::vector<Vec2>>& polys, std::size_t n, double W, double H) {
+// The floes numbered along a Z-order (Morton) curve of their centroids
+// (`centres`, n of them) on a 2^16 x 2^16 grid of the box, the `total - n`
+// walls last: floes near each other in space are then near each other in the
+// floe arrays, which the detection and the contact sweeps read neighbour by
+// neighbour.
+std::vector<std::size_t> z_order(const std::vector<Vec2>& centres, std::size_t total, double W, double H) {
   auto spread = [](std::uint64_t v) {  // the 16 bits of v to the even bits
     v &= 0xFFFF;
     v = (v | (v << 8)) & 0x00FF00FF;
@@ -387,12 +388,10 @@ std::vector<std::size_t> z_order(const std::vector<std::vector<Vec2>>& polys, st
   auto cell = [](double x, double L) {
     return static_cast<std::uint64_t>(std::clamp(x / L, 0.0, 1.0) * 65535.0);
   };
+  const std::size_t n = centres.size();
   std::vector<std::uint64_t> key(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    const Vec2 c = polygon_moments(polys[i]).centroid();
-    key[i] = spread(cell(c.x(), W)) | (spread(cell(c.y(), H)) << 1);
-  }
-  std::vector<std::size_t> order(polys.size());
+  for (std::size_t i = 0; i < n; ++i) key[i] = spread(cell(centres[i].x(), W)) | (spread(cell(centres[i].y(), H)) << 1);
+  std::vector<std::size_t> order(total);
   std::iota(order.begin(), order.end(), std::size_t{0});
   std::stable_sort(order.begin(), order.begin() + static_cast<std::ptrdiff_t>(n),
                    [&](std::size_t a, std::size_t b) { return key[a] < key[b]; });
@@ -448,11 +447,12 @@ GeneratedPack generate_pack(const PackOptions& o) {
   out.required_gap = gap;
   const double s = std::sqrt(C);
   std::vector<std::vector<Vec2>> polys(n);
+  std::vector<Vec2> centres(n);  // shrinking about the centroid keeps it
   double floe_area = 0.0, size_sum = 0.0;
   for (std::size_t i = 0; i < n; ++i) {
     std::vector<Vec2> v = solve.cells[i].v;
     drop_short_edges(v, 1e-6 * mean_size_target);
-    const Vec2 c = polygon_moments(v).centroid();
+    const Vec2 c = centres[i] = polygon_moments(v).centroid();
     const double h = inner_distance(v, c);
     const double si = std::min(s, 1.0 - 0.5 * gap / h);
     if (!(si > 0.0))
@@ -492,7 +492,7 @@ GeneratedPack generate_pack(const PackOptions& o) {
   std::fill(is_static.begin() + static_cast<std::ptrdiff_t>(n), is_static.end(), 1);
   out.min_gap = smallest_gap(polys, is_static, neighbours);
 
-  const std::vector<std::size_t> order = z_order(polys, n, W, H);
+  const std::vector<std::size_t> order = z_order(centres, polys.size(), W, H);
   for (std::size_t i : order) {
     FloeInput in;
     in.vertices = std::move(polys[i]);
