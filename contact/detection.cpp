@@ -265,14 +265,14 @@ NearPair measure_pair(const PosedShapes& posed, std::uint32_t a, std::uint32_t b
             pair.far_distance = std::min(pair.far_distance, d);
             return;
           }
-          witnesses.push_back({on_a, on_b, normal, d});
+          witnesses.push_back({on_a, on_b, normal, d, !from_a});
           if (d >= xi) return;
           const Vec2 point = 0.5 * (v + q);
           for (std::size_t k = pair.first_contact; k < contacts.size(); ++k) {
             const ContactPoint& o = contacts[k];
             if ((o.point - point).norm() <= 1e-3 * xi && o.normal.dot(normal) > 1.0 - 1e-6) return;
           }
-          contacts.push_back({a, b, point, normal, d, shift});
+          contacts.push_back({a, b, point, normal, d, shift, false, !from_a});
         };
         for (const Vec2& v : A) vertex(v, closest_on_boundary(shifted, v), true);
         for (const Vec2& v : shifted) vertex(v, closest_on_boundary(A, v), false);

@@ -65,6 +65,7 @@ struct Witness {
   Vec2 pa = Vec2::Zero(), pb = Vec2::Zero();  // on a, on b (one of them is the vertex)
   Vec2 normal = Vec2::UnitX();                // unit, (pb - pa)/distance
   double distance = 0.0;                      // m
+  bool vertex_of_b = false;                   // the vertex is b's (pb), the closest point on a's boundary
 };
 
 // A pair of floes whose padded boxes overlap.
@@ -98,6 +99,8 @@ struct ContactPoint {
   double gap = 0.0;            // m, >= 0
   Vec2 shift = Vec2::Zero();   // periodic shift of floe b for this contact
   bool speculative = false;    // gap >= xi: may close, but not below xi/2 within the step (impulse.hpp)
+  bool vertex_of_b = false;    // the point pairs b's vertex with a's boundary (else a's vertex, b's boundary)
+  double turning = 0.0;        // m: closing over the speculative step beyond the linearised gap (step_limit.hpp)
 };
 
 struct Detection {

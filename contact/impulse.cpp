@@ -88,6 +88,7 @@ Vec2 body_point(const Floes& floes, std::uint32_t a, const Vec2& p) {
   const FloeState& s = floes.state[a];
   return rotate(p - Vec2{s.x, s.y}, -s.yaw);
 }
+Vec2 body_direction(const Floes& floes, std::uint32_t a, const Vec2& v) { return rotate(v, -floes.state[a].yaw); }
 
 // The guess for the LCP of the contacts `list` (unknowns ordered as in
 // impulse.hpp: lambda [m], beta [2m], alpha [m]).
@@ -95,21 +96,28 @@ std::vector<std::uint8_t> warm_guess(const WarmStart& warm, const Floes& floes,
                                      const std::vector<ContactPoint>& contacts, const std::vector<std::size_t>& list) {
   const std::size_t m = list.size();
   std::vector<std::uint8_t> basic(4 * m, 0);
+  // One entry per contact at most: two contacts at one point (a corner against a corner
+  // gives two normals there) must not both take the flags of one, or their two lambdas
+  // could both be basic on nearly equal rows, a singular start.
+  std::unordered_map<const WarmStart::Entry*, std::uint8_t> taken;
   for (std::size_t k = 0; k < m; ++k) {
     const ContactPoint& c = contacts[list[k]];
     const auto it = warm.pairs.find(pair_key(c.a, c.b));
     if (it == warm.pairs.end()) continue;
     const Vec2 p = body_point(floes, c.a, c.point);
+    const Vec2 n = body_direction(floes, c.a, c.normal);
     const WarmStart::Entry* best = nullptr;
     double best_d = warm.match_distance;
     for (const WarmStart::Entry& e : it->second.entries) {
-      const double d = (e.body_point - p).norm();
-      if (d <= best_d) {
+      // Points within match_distance, normals within about 0.1 rad.
+      const double d = (e.body_point - p).norm() + 10.0 * warm.match_distance * (e.body_normal - n).norm();
+      if (d <= best_d && !taken.contains(&e)) {
         best_d = d;
         best = &e;
       }
     }
     if (!best) continue;
+    taken.emplace(best, 1);
     basic[k] = best->basic[0];
     basic[m + 2 * k] = best->basic[1];
     basic[m + 2 * k + 1] = best->basic[2];
@@ -133,7 +141,8 @@ void warm_store(WarmStart& warm, const Floes& floes, const std::vector<ContactPo
   for (std::size_t k = 0; k < m; ++k) {
     const ContactPoint& c = contacts[list[k]];
     warm.pairs[pair_key(c.a, c.b)].entries.push_back(
-        {body_point(floes, c.a, c.point), {on(k), on(m + 2 * k), on(m + 2 * k + 1), on(3 * m + k)}});
+        {body_point(floes, c.a, c.point), body_direction(floes, c.a, c.normal),
+         {on(k), on(m + 2 * k), on(m + 2 * k + 1), on(3 * m + k)}});
   }
 }
 
@@ -206,6 +215,8 @@ std::vector<ContactImpulse> resolve_collisions(Floes& floes, const std::vector<C
       const double g = contacts[list[k]].gap;
       if (contacts[list[k]].speculative) target[k] = -0.9 * (g - 0.5 * opt.collision_distance) / opt.speculative_step;
       else if (g < opt.min_gap) target[k] = (opt.min_gap - g) / opt.relaxation_time;
+      // What the floes' turning closes beyond the linear gap (jam time steps).
+      if (opt.speculative_step > 0.0) target[k] += contacts[list[k]].turning / opt.speculative_step;
     }
     // Scaling (symmetric, so the LCP keeps the structure Lemke relies on):
     // with s_k = 1 / sqrt(D_kk), D = Gn A^-1 Gn^T (s_k^2 is the effective
@@ -295,6 +306,8 @@ std::vector<ContactImpulse> resolve_collisions(Floes& floes, const std::vector<C
     // solves a compression LCP (restitution 0) from W^+ so that no contact
     // ends approaching.
     Eigen::VectorXd total = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(3 * m));  // impulses applied
+    lcp::FallbackOptions solver = opt.solver;  // with the layout, for the contact-wise Gauss–Seidel
+    solver.friction = {m, opt.friction};
     for (int pass = 0; pass < 2; ++pass) {
       // Pass 1 only where Poisson's law acted (no restitution: nothing to undo).
       if (pass == 1 && std::all_of(restitution.begin(), restitution.end(), [](double e) { return e == 0.0; })) break;
@@ -319,7 +332,7 @@ std::vector<ContactImpulse> resolve_collisions(Floes& floes, const std::vector<C
           }
         }
       }
-      if (!warm_solved) res = lcp::solve_with_fallbacks(problem, opt.solver);
+      if (!warm_solved) res = lcp::solve_with_fallbacks(problem, solver);
       if (use_warm && res.solved() && !res.result.z_basic.empty())
         warm_store(*opt.warm, floes, contacts, list, res.result.z_basic);
       ++stats.lcps;
@@ -329,6 +342,7 @@ std::vector<ContactImpulse> resolve_collisions(Floes& floes, const std::vector<C
       stats.total_size += static_cast<long>(n);
       if (res.attempts.size() > 1) ++stats.fallbacks;
       if (res.flagged) ++stats.flagged;
+      if (res.solved() && res.method == lcp::Method::coulomb_gs) ++stats.gauss_seidel;
       if (!res.solved()) {
         ++stats.failures;
         break;  // leave these velocities as they are: counted and reported
@@ -404,7 +418,7 @@ std::size_t resolve_step_collisions(Floes& floes, std::span<const FloeState> sta
       const Witness& w = detection.witnesses[k];
       if (w.distance < xi) continue;
       taken[k] = 1;
-      contacts.push_back({p.a, p.b, 0.5 * (w.pa + w.pb), w.normal, w.distance, p.shift, true});
+      contacts.push_back({p.a, p.b, 0.5 * (w.pa + w.pb), w.normal, w.distance, p.shift, true, w.vertex_of_b});
       resting.push_back(1);
       ++added;
     }
@@ -429,7 +443,7 @@ std::size_t resolve_step_collisions(Floes& floes, std::span<const FloeState> sta
                           smooth_kick(floes, start, before, p.a, p.b, w.pa, pb)))
           continue;
         taken[k] = 1;
-        contacts.push_back({p.a, p.b, 0.5 * (w.pa + w.pb), w.normal, w.distance, p.shift, true});
+        contacts.push_back({p.a, p.b, 0.5 * (w.pa + w.pb), w.normal, w.distance, p.shift, true, w.vertex_of_b});
         resting.push_back(1);
         ++added;
       }

@@ -107,6 +107,7 @@ namespace floesim::contact {
 struct WarmStart {
   struct Entry {
     Vec2 body_point = Vec2::Zero();
+    Vec2 body_normal = Vec2::UnitX();
     std::array<std::uint8_t, 4> basic{};  // lambda, beta+, beta-, alpha basic
   };
   struct Pair {
@@ -114,7 +115,7 @@ struct WarmStart {
     long stored = 0;  // the clock when they were stored
   };
   std::unordered_map<std::uint64_t, Pair> pairs;
-  double match_distance = 1.0;  // m
+  double match_distance = 0.05;  // m
   long clock = 0;
   long max_age = 256;
 
@@ -153,6 +154,7 @@ struct CollisionStats {
   long failures = 0;      // solves that ended without an accepted solution
   long fallbacks = 0;     // solves that needed a fallback step
   long flagged = 0;       // of those, answered by projected Gauss–Seidel
+  long gauss_seidel = 0;  // of those, answered by the contact-wise Gauss–Seidel (lcp/coulomb_gs.hpp)
   long largest = 0;       // largest LCP size
   long total_size = 0;    // sum of LCP sizes
   long warm = 0;          // of lcps, solved by Lemke warm-started from the last basis

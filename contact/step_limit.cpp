@@ -83,4 +83,23 @@ StepLimit collision_step_limit(const Floes& floes, const CollisionShapes& shapes
   return limit;
 }
 
+double turning_closing(const Floes& floes, const ContactPoint& c, double h) {
+  const FloeState& sa = floes.state[c.a];
+  const FloeState& sb = floes.state[c.b];
+  const Vec2 ga{sa.x, sa.y};
+  const Vec2 gb = Vec2{sb.x, sb.y} + c.shift;  // b's image next to a
+  const Vec2 pa = c.point - 0.5 * c.gap * c.normal;
+  const Vec2 pb = c.point + 0.5 * c.gap * c.normal;
+  // Straight-line and turned positions of a material point at P, arm r = P - G.
+  // (Vec2 returns: an Eigen expression would outlive its temporaries.)
+  auto linear = [h](const FloeState& s, const Vec2& g, const Vec2& p) -> Vec2 { return p + h * arm_velocity(s, p - g); };
+  auto turned = [h](const FloeState& s, const Vec2& g, const Vec2& p) -> Vec2 {
+    return g + h * Vec2{s.vx, s.vy} + rotate(p - g, h * s.yaw_rate);
+  };
+  const double g_linear = c.normal.dot(linear(sb, gb, pb) - linear(sa, ga, pa));
+  const double edge_turn = h * (c.vertex_of_b ? sa.yaw_rate : sb.yaw_rate);
+  const double g_turned = rotate(c.normal, edge_turn).dot(turned(sb, gb, pb) - turned(sa, ga, pa));
+  return std::max(0.0, g_linear - g_turned);
+}
+
 }  // namespace floesim::contact

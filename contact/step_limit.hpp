@@ -63,6 +63,25 @@ StepLimit collision_step_limit(const Floes& floes, const CollisionShapes& shapes
                                const std::vector<NearPair>& pairs, const std::vector<Witness>& witnesses,
                                double collision_distance);
 
+// The closing of a contact over a step of length h that its linearised gap
+// misses, from the turning of the floes (m, >= 0; 0 when the turning opens
+// it). The collision LCP asks for a normal velocity at the contact point, so
+// it sees the gap after h as linear, g + h v_n. With the floes' velocities
+// kept over h (translation, yaw at a constant rate), the contact's two
+// material points, A = P - N g/2 on a and B = P + N g/2 on b, and the line of
+// the edge (through the point on the edge's floe e, normal N turning with e
+// by omega_e h) give the gap after h as
+//   g(h) = (R(omega_e h) N) . (B(h) - A(h)),
+// exact while the vertex stays in front of the edge. Its second-order part is
+// what matters: an edge at distance rho from its floe's centroid, turned by
+// theta, moves a point in front of it by -(rho + g) theta^2/2 against the
+// linear gap, while the vertex's own turning only opens it (its path curves
+// towards its centroid). A 20 m arm turned by 0.05 rad in one step closes
+// 2.5 cm: the creeping 500-floe jam (docs/contact.md) turned floes at up to
+// 0.005 rad/s, and its 10 s time steps overlapped at gaps of 0.01 to 9 mm.
+// Returns max(0, g_lin(h) - g(h)).
+double turning_closing(const Floes& floes, const ContactPoint& contact, double h);
+
 // A pair's own contact points and witnesses, in the lists it was measured into.
 inline std::span<const ContactPoint> contacts_of(const NearPair& p, const std::vector<ContactPoint>& contacts) {
   return {contacts.data() + p.first_contact, p.contact_count};

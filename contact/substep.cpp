@@ -1,6 +1,7 @@
 #include "contact/substep.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <numeric>
@@ -21,6 +22,11 @@ constexpr double kHalvingFloor = 0x1.0p-20;
 // A jam whose time step overlaps halves it (the linearised gaps miss the
 // floes' turning by a term in h^2); below this fraction of dt it goes to events.
 constexpr double kJamStepFloor = 1.0 / 16.0;
+// A jam's time step solves its LCP again while the turning of its floes
+// closes a contact by more than kTurningSlack xi beyond what it asked for
+// (time_step), at most kTurningRounds more times.
+constexpr double kTurningSlack = 0.01;
+constexpr int kTurningRounds = 3;
 // Dynamic floes whose room to a jam-sized cluster is below this many xi
 // (10 m at xi = 1 cm) join it at the start of the step (make_clusters): the
 // jam's time steps move its floes 0.5 to 3 m off their straight paths
@@ -441,39 +447,65 @@ private:
     // from the velocities before it with them (a few rounds at most).
     for (std::uint32_t i : c.members) posed_.update(floes_, i);
     const Measured* wit = &c.cur;
-    std::vector<double> ranges(c.cur.pairs.size(), 0.0);
+    // The range each pair was measured within (c.cur: the velocities before the LCP, over dt).
+    std::vector<double> ranges(c.internal.size());
+    for (std::size_t i = 0; i < c.internal.size(); ++i) {
+      const NearPair& q = det_->pairs[c.internal[i]];
+      ranges[i] = exact_range(floes_, shapes_, q.a, q.b, dt_, xi);
+    }
     for (int round = 0;; ++round) {
       std::vector<ContactPoint> contacts = c.cur.contacts;
       for (const NearPair& q : wit->pairs)
         for (const Witness& w : witnesses_of(q, wit->witnesses))
-          if (w.distance >= xi) contacts.push_back({q.a, q.b, 0.5 * (w.pa + w.pb), w.normal, w.distance, q.shift, true});
+          if (w.distance >= xi) contacts.push_back({q.a, q.b, 0.5 * (w.pa + w.pb), w.normal, w.distance, q.shift, true, w.vertex_of_b});
       const std::vector<std::uint8_t> resting(contacts.size(), 1);
-      resolve_collisions(floes_, contacts, impulse, stats_, resting);
+      // The LCP sees each contact's gap after h as linear; the floes' turning
+      // closes some further (turning_closing, step_limit.hpp), which depends
+      // on the velocities the LCP gives. So the LCP is solved again from the
+      // velocities before it, each contact asking for what its turning
+      // closed with the last answer on top, until no contact's turning grows
+      // by more than kTurningSlack xi (a few rounds at most: the turning
+      // hardly changes with the small velocity changes it asks for). The
+      // turning kept is the largest seen, so the rounds end.
+      for (int turn = 0;; ++turn) {
+        resolve_collisions(floes_, contacts, impulse, stats_, resting);
+        if (turn == kTurningRounds) break;
+        bool grew = false;
+        for (ContactPoint& cp : contacts) {
+          const double closing = turning_closing(floes_, cp, h);
+          if (closing > cp.turning + kTurningSlack * xi) {
+            cp.turning = closing;
+            grew = true;
+          }
+        }
+        if (!grew) break;
+        for (std::size_t m = 0; m < before.size(); ++m) floes_.state[c.members[m]] = before[m];
+      }
       if (round == 3) break;
+      // Ranges only grow, so a measure finds every witness the last one found.
       bool wider = false;
       for (std::size_t i = 0; i < c.internal.size(); ++i) {
         const NearPair& q = det_->pairs[c.internal[i]];
-        const double r = exact_range(floes_, shapes_, q.a, q.b, h, xi);
+        const double r = 1.5 * exact_range(floes_, shapes_, q.a, q.b, h, xi);
         if (r > ranges[i]) {
-          ranges[i] = 1.5 * r;
+          ranges[i] = r;
           wider = true;
         }
       }
-      if (!wider && round > 0) break;
-      wide_.pairs.clear();
-      wide_.contacts.clear();
-      wide_.witnesses.clear();
-      std::size_t spec = 0;
+      if (!wider) break;
+      // Into the buffer the last round did not use: `wit` may point at the other.
+      Measured& into = wit == &wide_[0] ? wide_[1] : wide_[0];
+      into.pairs.clear();
+      into.contacts.clear();
+      into.witnesses.clear();
+      bool more = false;
       for (std::size_t i = 0; i < c.internal.size(); ++i) {
         const NearPair& q = det_->pairs[c.internal[i]];
-        const double r = std::max(ranges[i], exact_range(floes_, shapes_, q.a, q.b, dt_, xi));
-        wide_.pairs.push_back(measure_pair(posed_, q.a, q.b, q.shift, xi, r, wide_.contacts, wide_.witnesses));
+        into.pairs.push_back(measure_pair(posed_, q.a, q.b, q.shift, xi, ranges[i], into.contacts, into.witnesses));
+        more = more || i >= wit->pairs.size() || into.pairs.back().witness_count > wit->pairs[i].witness_count;
       }
-      for (const Witness& w : wide_.witnesses) spec += (w.distance >= xi);
-      std::size_t had = 0;
-      for (const Witness& w : wit->witnesses) had += (w.distance >= xi);
-      if (spec <= had) break;
-      wit = &wide_;
+      if (!more) break;
+      wit = &into;
       for (std::size_t m = 0; m < before.size(); ++m) floes_.state[c.members[m]] = before[m];
       ++report_.rejected;
     }
@@ -576,7 +608,7 @@ private:
   Measured next_;                      // a cluster's pairs after the sub-step being tried
   std::vector<std::uint32_t> joining_;
   std::vector<int> merging_;
-  Measured wide_;                                // time_step: the pairs measured within a wider range
+  std::array<Measured, 2> wide_;                 // time_step: the pairs measured within wider ranges (two rounds)
   std::vector<int> jam_of_;                      // per floe: its jam, or -1
   std::vector<std::vector<std::uint32_t>> jams_; // the floes of each jam
 };

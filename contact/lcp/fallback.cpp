@@ -10,6 +10,7 @@ std::string_view to_string(Method method) {
     case Method::lemke: return "lemke";
     case Method::lemke_other_covering: return "lemke_other_covering";
     case Method::lemke_regularised: return "lemke_regularised";
+    case Method::coulomb_gs: return "coulomb_gs";
     case Method::pgs: return "pgs";
   }
   return "lemke";
@@ -57,6 +58,12 @@ FallbackResult solve_with_fallbacks(const Lcp& lcp, const FallbackOptions& optio
 
   const Lcp shifted = regularised(lcp, options.regularisation);
   if (record(Method::lemke_regularised, solve_lemke(shifted, options.lemke))) return out;
+
+  if (options.friction.contacts > 0) {
+    CoulombGsOptions gs = options.coulomb_gs;
+    gs.tolerance = std::min(gs.tolerance, options.accept_residual);
+    if (record(Method::coulomb_gs, solve_coulomb_gs(lcp, options.friction, out.result.z, gs))) return out;
+  }
 
   if (options.allow_pgs) {
     PgsOptions pgs = options.pgs;

@@ -8,7 +8,10 @@
 //   3. Lemke on the regularised LCP(M + delta I, q), delta = regularisation *
 //      max(1, max_i |M_ii|); accepted if its z solves the ORIGINAL LCP within
 //      `accept_residual` (the residual is always computed with the original M);
-//   4. projected Gauss–Seidel (pgs.hpp), flagged: its answer is approximate.
+//   4. for the Stewart–Trinkle LCPs of frictional contact (`friction` set):
+//      contact-wise Gauss–Seidel (coulomb_gs.hpp) from the best attempt so
+//      far, accepted on the same residual as Lemke's answers;
+//   5. projected Gauss–Seidel (pgs.hpp), flagged: its answer is approximate.
 //
 // A step succeeds when its status is solved and its residual (on the original
 // LCP) is at most accept_residual; a "solved" above that counts as failed. The
@@ -19,17 +22,20 @@
 #include <string>
 #include <vector>
 
+#include "contact/lcp/coulomb_gs.hpp"
 #include "contact/lcp/lemke.hpp"
 #include "contact/lcp/pgs.hpp"
 
 namespace floesim::lcp {
 
-enum class Method { lemke, lemke_other_covering, lemke_regularised, pgs };
+enum class Method { lemke, lemke_other_covering, lemke_regularised, coulomb_gs, pgs };
 std::string_view to_string(Method method);
 
 struct FallbackOptions {
   LemkeOptions lemke;
   PgsOptions pgs;
+  FrictionLayout friction;  // contacts = 0: not a Stewart–Trinkle LCP (no step 4)
+  CoulombGsOptions coulomb_gs;
   double accept_residual = 1e-9;
   double regularisation = 1e-10;  // relative diagonal shift of step 3
   bool allow_pgs = true;

@@ -7,6 +7,7 @@
 
 #include "contact/detection.hpp"
 #include "contact/impulse.hpp"
+#include "contact/step_limit.hpp"
 #include "coupling/simulation.hpp"
 
 using namespace floesim;
@@ -227,6 +228,39 @@ std::string pack_file(const std::string& name, std::size_t n, double conc, doubl
   return path;
 }
 }  // namespace
+
+TEST_CASE("turning closing: a vertex sliding on a turning edge closes by what the linear gap misses") {
+  // A diamond's vertex rests at gap g on the top edge (y = rho) of a square turning at omega
+  // about its centroid (the origin), the diamond sliding along the edge. Over h, the edge's
+  // line is {p : n(theta) . p = rho}, n(theta) = (-sin theta, cos theta), theta = omega h, and
+  // the vertex, translating only, is at B0 + h v: the exact gap is
+  //   n(theta) . (B0 + h v) - rho,
+  // while the LCP sees g + h v_n, v_n = v_y - omega s (the square's point under the vertex
+  // moves at omega e_z x (s, rho)). Their difference is the second-order term
+  // -(rho + g + h v_y) theta^2/2 - theta h v_x + ... of the rigid motion (step_limit.hpp).
+  const double rho = 20.0, g = 0.004, s = -5.0, omega = 0.004, h = 9.0;
+  const Vec2 v{0.08, 0.0};
+  Floes f = make({polygon({{-rho, -rho}, {rho, -rho}, {rho, rho}, {-rho, rho}}, Vec2::Zero(), omega),
+                  polygon({{s, rho + g}, {s + 10, rho + g + 10}, {s, rho + g + 20}, {s - 10, rho + g + 10}}, v)});
+  const CollisionShapes shapes = build_collision_shapes(f);
+  DetectionOptions d;
+  d.collision_distance = 0.01;
+  d.search_margin = 0.01;
+  const Detection det = detect(f, shapes, d);
+  REQUIRE(det.contacts.size() == 1);
+  const ContactPoint& c = det.contacts[0];
+  CHECK(c.vertex_of_b);  // the diamond's vertex on the square's edge
+  const double theta = omega * h;
+  const double exact = -std::sin(theta) * (s + h * v.x()) + std::cos(theta) * (rho + g + h * v.y()) - rho;
+  const double linear = g + h * (v.y() - omega * s);
+  REQUIRE(linear - exact > 0.03);  // the vertex slides towards the edge's rising end: 3.9 cm here
+  CHECK(turning_closing(f, c, h) == doctest::Approx(linear - exact).epsilon(1e-6));
+  // Sliding the other way, the turned edge falls away under the vertex faster than the
+  // linear gap says: nothing to make up.
+  f.state[1].vx = -v.x();
+  CHECK(-std::sin(theta) * (s - h * v.x()) + std::cos(theta) * (rho + g) - rho > linear);
+  CHECK(turning_closing(f, c, h) == 0.0);
+}
 
 TEST_CASE("multirate: a collision within a step happens at its instant, the step is not cut, a far floe moves in one go") {
   // Two equal 10 m squares close at 1 m/s across a 5 m gap, so they meet about 5 s into one
