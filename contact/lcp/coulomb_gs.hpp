@@ -1,7 +1,7 @@
 #pragma once
 // Contact-wise Gauss–Seidel for the Stewart–Trinkle LCP of 2D frictional
 // contact (the nonsmooth Gauss–Seidel of Jean and Moreau): the fallback chain's
-// last step for the collision LCPs (fallback.hpp), whose friction rows have a
+// step after Lemke for the collision LCPs (fallback.hpp), whose friction rows have a
 // zero diagonal, so that the plain projected Gauss–Seidel (pgs.hpp) cannot
 // run on them.
 //
@@ -45,7 +45,7 @@ struct FrictionLayout {
 };
 
 struct CoulombGsOptions {
-  long max_sweeps = 5000;
+  long max_sweeps = 20000;
   int check_every = 10;
   double tolerance = 1e-9;  // on the LCP's residual (lcp.hpp)
 };

@@ -51,6 +51,12 @@ FallbackResult solve_with_fallbacks(const Lcp& lcp, const FallbackOptions& optio
 
   if (record(Method::lemke, solve_lemke(lcp, options.lemke))) return out;
 
+  if (options.friction.contacts > 0) {
+    CoulombGsOptions gs = options.coulomb_gs;
+    gs.tolerance = std::min(gs.tolerance, options.accept_residual);
+    if (record(Method::coulomb_gs, solve_coulomb_gs(lcp, options.friction, out.result.z, gs))) return out;
+  }
+
   LemkeOptions other = options.lemke;
   other.covering.resize(lcp.size());
   for (Index i = 0; i < lcp.size(); ++i) other.covering(i) = 1.0 + static_cast<double>(i % 7) / 7.0;
@@ -58,12 +64,6 @@ FallbackResult solve_with_fallbacks(const Lcp& lcp, const FallbackOptions& optio
 
   const Lcp shifted = regularised(lcp, options.regularisation);
   if (record(Method::lemke_regularised, solve_lemke(shifted, options.lemke))) return out;
-
-  if (options.friction.contacts > 0) {
-    CoulombGsOptions gs = options.coulomb_gs;
-    gs.tolerance = std::min(gs.tolerance, options.accept_residual);
-    if (record(Method::coulomb_gs, solve_coulomb_gs(lcp, options.friction, out.result.z, gs))) return out;
-  }
 
   if (options.allow_pgs) {
     PgsOptions pgs = options.pgs;
