@@ -123,7 +123,8 @@ void add_run_command(CLI::App& app, Registry& registry) {
     const contact::CollisionStats& c = s.collisions;
     o << "collisions.lcps: " << c.lcps << "\ncollisions.contacts: " << c.contacts << "\ncollisions.pivots: " << c.pivots
       << "\ncollisions.largest_lcp: " << c.largest << "\ncollisions.failures: " << c.failures
-      << "\ncollisions.fallbacks: " << c.fallbacks << "\n";
+      << "\ncollisions.fallbacks: " << c.fallbacks << "\ncollisions.gauss_seidel: " << c.gauss_seidel
+      << "\ncollisions.tolerated: " << c.tolerated << "\n";
     {
       const LcpCounters counters = sim.lcp_counters();  // the sub-stepper's counts, as in /diagnostics/substeps
       for (int k = 0; k < kSubstepColumns; ++k)

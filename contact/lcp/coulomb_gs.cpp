@@ -117,6 +117,7 @@ Result solve_coulomb_gs(const Lcp& lcp, const FrictionLayout& layout, const Vect
     }
   };
   const int check_every = std::max(1, options.check_every);
+  to_z();  // the start, should no sweep run
   result.status = Status::pivot_limit;
   for (long sweep = 1; sweep <= options.max_sweeps; ++sweep) {
     for (Index k = 0; k < mi; ++k) {

@@ -76,6 +76,39 @@ TEST_CASE("head-on collision of two equal floes: momentum conserved, relative ve
   }
 }
 
+TEST_CASE("an LCP answer the fallback chain rejects is taken only within the velocity tolerance") {
+  // Two squares meet edge to edge (two contacts, restitution 0). With the chain cut short (one
+  // Lemke pivot, one Gauss–Seidel sweep, no PGS) nothing reaches the LCP's residual tolerance.
+  // The best attempt (the sweep's) is then taken only if its complementarity error, as a
+  // velocity, is within ImpulseOptions::velocity_tolerance (contact/impulse.hpp); otherwise
+  // the floes keep their velocities and a failure is counted.
+  auto run = [](double tolerance, CollisionStats& stats) {
+    Floes f = make({square(0, 0, 10, {0.5, 0}), square(10.005, 0, 10, {-0.3, 0})});
+    const CollisionShapes shapes = build_collision_shapes(f);
+    DetectionOptions d;
+    d.collision_distance = 0.01;
+    d.search_margin = 0.01;
+    const Detection det = detect(f, shapes, d);
+    ImpulseOptions o;
+    o.restitution = 0.0;
+    o.solver.lemke.max_pivots = 1;
+    o.solver.coulomb_gs.max_sweeps = 1;
+    o.solver.allow_pgs = false;
+    o.velocity_tolerance = tolerance;
+    resolve_collisions(f, det.contacts, o, stats);
+    return f.state[1].vx - f.state[0].vx;
+  };
+  CollisionStats strict, loose;
+  CHECK(run(1e-12, strict) == doctest::Approx(-0.8));  // untouched: the floes keep approaching
+  CHECK(strict.failures == 1);
+  CHECK(strict.tolerated == 0);
+  const double taken = run(1.0, loose);  // one sweep's answer, taken
+  CHECK(std::abs(taken) < 0.8);
+  CHECK(loose.failures == 0);
+  CHECK(loose.tolerated == 1);
+  MESSAGE("relative velocity after one sweep: " << taken << " m/s (0 when solved)");
+}
+
 TEST_CASE("off-centre impact: velocities equal the rigid-body impulse formulas") {
   // A diamond's vertex (on its own centroid line) hits the left edge of a square at height h
   // above the square's centre. Frictionless single contact, normal n = +x, r_B = P - G_B:
@@ -396,6 +429,55 @@ TEST_CASE("a pack pushed by wind against a wall: jammed, no overlap, the wall ta
     CHECK(gap_low >= 0.9 * gap1);                 // held, not creeping
     CHECK(gap_low > 0.0);
   }
+}
+
+TEST_CASE("500 floes pushed by wind against a wall: no overlap, no step at the floor, no failed LCP, the wall takes the wind") {
+  // The issue's long jam at 500 floes. 70% of a 1 km box walled on all sides (seed 11), wind
+  // 15 m/s: the floes drift ~150 m and are one contact cluster of all 500 floes by ~1000 s.
+  // Momentum balance of the pack over [T1, T2], once jammed: P2 - P1 = (F_wind + F_wall)
+  // (T2 - T1) + the water drag's impulse, with F_wind = rho_a C_a |U_a| U_a x ice area (the
+  // floes move at mm/s against U_a = 15 m/s) and the drag of floes creeping at cm/s at most,
+  // under 1% of the wind. Every step must end with no two floes overlapping, no sub-step held
+  // at the floor, and every LCP answered (on the chain's residual, or within the velocity
+  // tolerance: contact/impulse.hpp). A jammed step costs about a second here (LCPs of ~900
+  // contacts), so the jam is followed for 300 s; the bench runs it longer (scenario jam_500,
+  // the 50% pack, 3000 s).
+  const std::string pack = pack_file("floesim_wall_pack_500.h5", 500, 0.7, 1000.0, 0.0, 20.0, 11);
+  std::ostringstream t;
+  t << "[run]\ndt_max = 10\n[floes]\npack = \"" << pack << "\"\n"
+    << "[contact]\nrestitution = 0.4\nfriction = 0.7\n[forcing]\nwind = [15.0, 0.0]\n";
+  Simulation sim(build_scenario(parse_config(t.str(), "wall500.toml", ".")));
+  double area = 0;
+  for (std::size_t i = 0; i < sim.floes().size(); ++i)
+    if (!sim.floes().is_static[i]) area += sim.floes().area[i];
+  const double wind_force = 1.341 * 1.7e-3 * 15.0 * 15.0 * area;
+  long overlapping_steps = 0;
+  auto step_to = [&](double t_end) {
+    while (sim.time() < t_end) {
+      sim.step(t_end);
+      bool overlap = false;
+      for (const auto& p : sim.detection().pairs) overlap = overlap || p.overlap;
+      overlapping_steps += overlap;
+    }
+  };
+  const double T1 = 1100.0, T2 = 1400.0;
+  step_to(T1);
+  CHECK(sim.substep_report().largest_cluster == 500);  // jammed: one cluster of every floe
+  const Vec2 wall1 = sim.momentum_budget().collisions;
+  const Vec2 P1 = sim.momentum();
+  step_to(T2);
+  const Vec2 wall_rate = (sim.momentum_budget().collisions - wall1) / (T2 - T1);
+  const Vec2 dPdt = (sim.momentum() - P1) / (T2 - T1);
+  const contact::CollisionStats& stats = sim.collision_stats();
+  MESSAGE("steps " << sim.steps() << ", LCPs " << stats.lcps << " (largest " << stats.largest << " unknowns), pivots "
+                   << stats.pivots << ", Gauss-Seidel answers " << stats.gauss_seidel << ", within the velocity tolerance "
+                   << stats.tolerated << "; wall force " << wall_rate.transpose() << " N, wind force " << wind_force
+                   << " N, dP/dt " << dPdt.transpose() << " N");
+  CHECK(overlapping_steps == 0);
+  CHECK(stats.failures == 0);
+  CHECK(sim.warnings().empty());  // no sub-step held at the floor, no failed or approximate LCP
+  CHECK(std::abs(wall_rate.x() + wind_force - dPdt.x()) < 0.01 * wind_force);
+  CHECK(std::abs(wall_rate.y() - dPdt.y()) < 0.01 * wind_force);
 }
 
 TEST_CASE("the warm-start store of jam LCPs forgets the pairs not stored for max_age steps") {
