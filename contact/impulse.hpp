@@ -54,12 +54,14 @@
 //    that slow would land again before the step ends.
 //  * Speculative contacts (after Catto's): a pushed point of two floes at a
 //    gap g >= xi (a witness of the detection, detection.hpp) that would come
-//    closer than xi/2 within the step h may close by at most (g - xi/2)/2: it
-//    asks for v_n >= -(g - xi/2)/(2 h), i.e. q_j += (g - xi/2)/(2 h), with
+//    closer than xi/2 within the step h may close by at most 0.9 (g - xi/2):
+//    it asks for v_n >= -0.9 (g - xi/2)/h, i.e. q_j += 0.9 (g - xi/2)/h, with
 //    restitution 0. It applies an impulse only if the pair would otherwise
-//    end the step closer than xi/2 + (g - xi/2)/2; the pair then arrives at
-//    the end of the step instead of colliding within it, with room to spare
-//    for the turning of the floes (step_limit.hpp). As the approach may come
+//    end the step closer than xi/2 + 0.1 (g - xi/2); the pair then arrives at
+//    the end of the step instead of colliding within it. (Until 2026-12-02
+//    this comment said (g - xi/2)/2; the code has always used 0.9.) The
+//    turning of the floes over h is added to the target in a jam's time step
+//    (turning_closing, step_limit.hpp; substep.hpp). As the approach may come
 //    from the impulses of the step, the speculative points are found after a
 //    solve, and the components that gained some are solved again from W^-
 //    (at most two more times). Impacts (approaches that are not pushed) keep
