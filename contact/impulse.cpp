@@ -97,6 +97,14 @@ double velocity_error(const lcp::Lcp& problem, const Eigen::VectorXd& z, const s
   return worst;
 }
 
+// Lemke's pivot limit on collision LCPs, per unknown (the solver's own
+// default is 50 per unknown). Solved from scratch, the LCPs of a 500-floe jam
+// (3700 to 4600 unknowns) took 1 to 3 pivots per unknown, where one solve of
+// the 70% jam (t = 1140 s) was still inside Lemke after 14 minutes, under the
+// default limit (about 200,000 pivots a step of the chain). Beyond this limit
+// the chain's contact-wise Gauss–Seidel takes over (lcp/fallback.hpp).
+constexpr long kLemkePivotsPerUnknown = 5;
+
 // Made by the step (impulse.hpp): the contact approached at the start of the
 // step at most a third as fast as now, or no faster than the step's smooth
 // forces move either floe's point (or not at all).
@@ -326,6 +334,7 @@ std::vector<ContactImpulse> resolve_collisions(Floes& floes, const std::vector<C
     Eigen::VectorXd total = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(3 * m));  // impulses applied
     lcp::FallbackOptions solver = opt.solver;  // with the layout, for the contact-wise Gauss–Seidel
     solver.friction = {m, opt.friction};
+    if (solver.lemke.max_pivots == 0) solver.lemke.max_pivots = kLemkePivotsPerUnknown * static_cast<long>(n) + 1000;
     for (int pass = 0; pass < 2; ++pass) {
       // Pass 1 only where Poisson's law acted (no restitution: nothing to undo).
       if (pass == 1 && std::all_of(restitution.begin(), restitution.end(), [](double e) { return e == 0.0; })) break;
@@ -337,7 +346,7 @@ std::vector<ContactImpulse> resolve_collisions(Floes& floes, const std::vector<C
       if (use_warm) {
         std::vector<std::uint8_t> guess = warm_guess(*opt.warm, floes, contacts, list);
         if (std::find(guess.begin(), guess.end(), 1) != guess.end()) {
-          lcp::LemkeOptions lo = opt.solver.lemke;
+          lcp::LemkeOptions lo = solver.lemke;
           lo.start = &guess;
           lcp::Result r = lcp::solve_lemke(problem, lo);
           if (r.status == lcp::Status::solved && r.residual <= opt.solver.accept_residual) {
