@@ -101,9 +101,12 @@ double velocity_error(const lcp::Lcp& problem, const Eigen::VectorXd& z, const s
 // default is 50 per unknown). Solved from scratch, the LCPs of a 500-floe jam
 // (3700 to 4600 unknowns) took 1 to 3 pivots per unknown, where one solve of
 // the 70% jam (t = 1140 s) was still inside Lemke after 14 minutes, under the
-// default limit (about 200,000 pivots a step of the chain). Beyond this limit
-// the chain's contact-wise Gauss–Seidel takes over (lcp/fallback.hpp).
-constexpr long kLemkePivotsPerUnknown = 5;
+// default limit (about 200,000 pivots a step of the chain). At 5 per unknown,
+// 5 LCPs of the 50% jam failed (t = 1920 to 1980 s: Lemke stopped far from
+// the solution and the Gauss–Seidel stalled from there); at 15 none did to
+// t = 2100 s. Beyond this limit the chain's contact-wise Gauss–Seidel takes
+// over (lcp/fallback.hpp).
+constexpr long kLemkePivotsPerUnknown = 15;
 
 // Made by the step (impulse.hpp): the contact approached at the start of the
 // step at most a third as fast as now, or no faster than the step's smooth
