@@ -133,6 +133,12 @@ void add_run_command(CLI::App& app, Registry& registry) {
     if (const PercussionStats* f = sim.percussion_stats())
       o << "fracture.checks: " << f->checks << "\nfracture.screened: " << f->screened
         << "\nfracture.initiations: " << f->initiations << "\nfracture.splits: " << f->splits << "\n";
+    if (const FloeSeaContact* fs = sim.floe_sea(); fs && fs->implicit()) {
+      const FloeSeaContact::ImplicitStats& st = fs->implicit_stats();
+      const double steps = std::max<double>(1.0, static_cast<double>(st.steps));
+      o << "implicit.newton_per_step: " << st.newton / steps << "\nimplicit.cg_per_step: " << st.cg / steps
+        << "\nimplicit.sea_responses_per_step: " << st.g_products / steps << "\n";
+    }
     o << "warnings: " << s.warnings.size() << "\n";
     for (const auto& w : s.warnings) o << "  " << w << "\n";
     if (args->profile) {

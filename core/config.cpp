@@ -332,6 +332,11 @@ void read_coupling(Section s, CouplingParams& c, SeaModel sea_model) {
   if (c.footprint == FootprintChoice::tent && sea_model == SeaModel::bem)
     s.fail("footprint", "\"tent\" needs a periodic sea ([sea] model = \"spectral\"): a tent would reach past a bem "
                         "basin's walls; use \"cell\" or \"automatic\"");
+  c.integrator = s.choice<CouplingIntegrator>("integrator", c.integrator,
+                                              {{"explicit", CouplingIntegrator::explicit_kicks},
+                                               {"implicit", CouplingIntegrator::implicit}});
+  c.newton_tolerance = s.number("newton_tolerance", c.newton_tolerance, positive, "a relative tolerance > 0");
+  c.cg_tolerance = s.number("cg_tolerance", c.cg_tolerance, positive, "a relative tolerance > 0");
   s.finish();
 }
 
@@ -492,7 +497,10 @@ std::string resolved_toml(const Config& c) {
                        {"footprint", name_of<FootprintChoice>(c.coupling.footprint,
                                                               {{"automatic", FootprintChoice::automatic},
                                                                {"cell", FootprintChoice::cell},
-                                                               {"tent", FootprintChoice::tent}})}};
+                                                               {"tent", FootprintChoice::tent}})},
+                       {"integrator", c.coupling.integrator == CouplingIntegrator::implicit ? "implicit" : "explicit"},
+                       {"newton_tolerance", c.coupling.newton_tolerance},
+                       {"cg_tolerance", c.coupling.cg_tolerance}};
   if (c.coupling.law == PenaltyLaw::blend) {
     if (c.coupling.restitution >= 0.0) coupling.insert("restitution", c.coupling.restitution);
     else coupling.insert("blend", c.coupling.blend);

@@ -70,6 +70,11 @@ enum class PenaltyLaw { strong, weak, blend };
 // How floes' footprints are weighed on the sea grid (coupling/footprint.hpp):
 // automatic = tent on periodic grids, cell in walled basins.
 enum class FootprintChoice { automatic, cell, tent };
+// How the penalty spring between floes and sea is integrated in time
+// (docs/coupling.md, "The implicit step"): explicit kicks limited to
+// 0.5 / omega_pen, or the implicit midpoint with the discrete gradient of the
+// penalty energy, whose step is limited by dt_max alone.
+enum class CouplingIntegrator { explicit_kicks, implicit };
 
 struct CouplingParams {
   PenaltyLaw law = PenaltyLaw::strong;
@@ -81,6 +86,15 @@ struct CouplingParams {
   // are as given ([[floes.floe]] heave, heave_rate), e.g. for a drop test.
   bool start_given = false;
   FootprintChoice footprint = FootprintChoice::automatic;
+  CouplingIntegrator integrator = CouplingIntegrator::explicit_kicks;
+  // Implicit integrator: the Newton iteration on the end-of-step penetrations
+  // stops when every piece's residual is below newton_tolerance times the
+  // thickest floe's draft; each Newton step's conjugate gradients stop at the
+  // relative residual cg_tolerance.
+  double newton_tolerance = 1e-10;
+  double cg_tolerance = 1e-10;
+  int max_newton = 40;
+  int max_cg = 500;
 };
 
 enum class SeriesInterpolation { linear, previous };

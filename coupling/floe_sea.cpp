@@ -59,7 +59,9 @@ double FloeSeaContact::subcell_weight(double coverage) const {
 
 FloeSeaContact::FloeSeaContact(const CouplingParams& params, const SeaParams& sea_params, const Floes& floes,
                                fluid::Sea& sea)
-    : rho_(sea_params.rho), g_(sea_params.g), sigma_(sea_params.sigma), K_(params.stiffness), grid_(sea.grid()) {
+    : rho_(sea_params.rho), g_(sea_params.g), sigma_(sea_params.sigma), K_(params.stiffness), grid_(sea.grid()),
+      implicit_(params.integrator == CouplingIntegrator::implicit), newton_tolerance_(params.newton_tolerance),
+      cg_tolerance_(params.cg_tolerance), max_newton_(params.max_newton), max_cg_(params.max_cg) {
   kappa_ = K_ * rho_ * g_;
   switch (params.law) {
     case PenaltyLaw::strong: s_ = 1.0; break;
@@ -124,7 +126,8 @@ void FloeSeaContact::floes_changed(const Floes& floes) {
   // and below agree with each other (docs/coupling.md, Known problems). We
   // take a quarter of the linear limit.
   stable_step_ = INFINITY;
-  if (s_ > 0.0 && std::isfinite(min_mass_per_area))
+  footprints_fresh_ = false;
+  if (!implicit_ && s_ > 0.0 && std::isfinite(min_mass_per_area))
     stable_step_ = 0.5 / std::sqrt(s_ * kappa_ * (1.0 / min_mass_per_area + sea_inverse_mass_));
 }
 
@@ -267,26 +270,20 @@ void FloeSeaContact::start(Floes& floes, fluid::Sea& sea, bool given) {
   }
 }
 
-void FloeSeaContact::evaluate(const Floes& floes, fluid::Sea& sea, double h) {
-  const fluid::SurfaceGrid& grid = sea.grid();
+void FloeSeaContact::rebuild_footprints(const Floes& floes) {
   // The pressure is zero outside the footprints: clear the cells of the last
   // ones rather than the whole grid (and the cells' coverage and sums).
-  if (pressure_.size() != grid.size()) {
-    pressure_.assign(grid.size(), 0.0);
-    cells_.assign(grid.size(), {});
+  if (pressure_.size() != grid_.size()) {
+    pressure_.assign(grid_.size(), 0.0);
+    cells_.assign(grid_.size(), {});
   } else {
     for (std::uint32_t c : footprints_.cell) {
       pressure_[c] = 0.0;
       cells_[c] = {};
     }
   }
-  pressure_kicked_ = false;
-  build_footprints(floes, dynamic_, grid, footprints_, kernel_);
+  build_footprints(floes, dynamic_, grid_, footprints_, kernel_);
   const Footprints& fp = footprints_;
-  const std::span<const double> eta = sea.elevation();
-  std::span<const double> w;
-  if (s_ < 1.0) w = sea.field(fluid::Field::velocity_z);
-  const double ks = s_ * kappa_, inv_cell_area = 1.0 / cell_area_;
   // Floes in the order of their first cell, so that floes next to each
   // other on the grid come one after the other (the grid's arrays are
   // read and written where each floe lies: this keeps them in cache).
@@ -295,8 +292,31 @@ void FloeSeaContact::evaluate(const Floes& floes, fluid::Sea& sea, double h) {
     if (dynamic_[i] && fp.offsets[i] < fp.offsets[i + 1]) order_.push_back(static_cast<std::uint32_t>(i));
   std::sort(order_.begin(), order_.end(),
             [&](std::uint32_t x, std::uint32_t y) { return fp.cell[fp.offsets[x]] < fp.cell[fp.offsets[y]]; });
+  const double inv_cell_area = 1.0 / cell_area_;
   for (std::uint32_t i : order_)
     for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k) cells_[fp.cell[k]].coverage += fp.area[k] * inv_cell_area;
+}
+
+void FloeSeaContact::evaluate(const Floes& floes, fluid::Sea& sea, double h) {
+  pressure_kicked_ = false;
+  if (footprints_fresh_) {
+    // The implicit step built them at these positions: keep them and their
+    // coverage, clear what the last evaluation summed.
+    for (std::uint32_t c : footprints_.cell) {
+      pressure_[c] = 0.0;
+      cells_[c].sum = 0.0;
+    }
+    footprints_fresh_ = false;
+  } else {
+    rebuild_footprints(floes);
+  }
+  const Footprints& fp = footprints_;
+  const std::span<const double> eta = sea.elevation();
+  std::span<const double> w;
+  if (s_ < 1.0) w = sea.field(fluid::Field::velocity_z);
+  const double ks = s_ * kappa_, inv_cell_area = 1.0 / cell_area_;
+  // The implicit integrator applies the spring's vertical part and the weight itself.
+  const double spring_kick = implicit_ ? 0.0 : 1.0, weight = implicit_ ? 0.0 : g_;
   double energy = 0.0;
   thread_local std::vector<double> u;    // [delta]^+ of each area piece
   thread_local std::vector<double> psi;  // psi of each area piece's cell
@@ -324,7 +344,7 @@ void FloeSeaContact::evaluate(const Floes& floes, fluid::Sea& sea, double h) {
       if (delta <= 0.0) continue;
       u[k] = delta;
       const double area = fp.area[k];
-      double f = ks * ps * area * delta;
+      double f = spring_kick * ks * ps * area * delta;
       energy += 0.5 * ks * ps * area * delta * delta;
       wet += ps * area * delta;
       cells_[cell].sum += area * delta * delta;
@@ -337,7 +357,7 @@ void FloeSeaContact::evaluate(const Floes& floes, fluid::Sea& sea, double h) {
       moment += f * r;
     }
     wetted[i] = wet;
-    load.vertical = {fz - floes.mass[i] * g_, moment.x(), moment.y()};
+    load.vertical = {fz - floes.mass[i] * weight, moment.x(), moment.y()};
   }
   // Strong part, horizontal: -dV/dG and -dV/dyaw through the edge pieces. The
   // coverage Phi_c moves with every floe's edge in cell c, so an edge also
@@ -376,6 +396,7 @@ void FloeSeaContact::evaluate(const Floes& floes, fluid::Sea& sea, double h) {
 }
 
 void FloeSeaContact::kick_sea(fluid::Sea& sea, double h) {
+  if (implicit_ && s_ >= 1.0) return;  // no damper: the pressure is all the implicit step's
   if (pressure_kicked_) {
     sea.repeat_kick(h);
   } else {
@@ -403,7 +424,8 @@ void FloeSeaContact::kick_floes(Floes& floes, double h) const {
   }
 }
 
-void FloeSeaContact::drift(Floes& floes, double h) {
+void FloeSeaContact::advance_vertical(Floes& floes, fluid::Sea& sea, double h) {
+  if (implicit_) return implicit_step(floes, sea, h);
   for (std::size_t i = 0; i < floes.size(); ++i) {
     if (floes.is_static[i]) continue;
     FloeState& st = floes.state[i];
@@ -411,6 +433,251 @@ void FloeSeaContact::drift(Floes& floes, double h) {
     st.pitch += h * st.pitch_rate;
     st.roll += h * st.roll_rate;
   }
+  sea.flow(h);
+}
+
+namespace {
+
+// The discrete gradient of V(d) = c / 2 [d]^+^2 between d0 and d1 (the force
+// held over the step; docs/coupling.md, "The implicit step") and its
+// derivative in d1. f (d1 - d0) = V(d1) - V(d0) exactly; the cases avoid the
+// cancellation of the quotient where both ends are in the water.
+struct SecantForce {
+  double f, df;
+};
+SecantForce secant_force(double c, double d0, double d1) {
+  if (d0 > 0.0 && d1 > 0.0) return {0.5 * c * (d0 + d1), 0.5 * c};
+  if (d0 <= 0.0 && d1 <= 0.0) return {0.0, 0.0};
+  if (d0 > 0.0) {  // leaves the water within the step: d1 <= 0 < d0
+    const double f = 0.5 * c * d0 * d0 / (d0 - d1);
+    return {f, f / (d0 - d1)};
+  }
+  // enters it: d0 <= 0 < d1
+  const double e = d1 - d0;
+  return {0.5 * c * d1 * d1 / e, 0.5 * c * d1 * (d1 - 2.0 * d0) / (e * e)};
+}
+
+double max_abs(std::span<const double> x) {
+  double m = 0.0;
+  for (double v : x) m = std::max(m, std::abs(v));
+  return m;
+}
+
+double dot(std::span<const double> a, std::span<const double> b) {
+  double s = 0.0;
+  for (std::size_t k = 0; k < a.size(); ++k) s += a[k] * b[k];
+  return s;
+}
+
+}  // namespace
+
+void FloeSeaContact::apply_response(const Floes& floes, fluid::Sea& sea, double h, std::span<const double> u,
+                                    std::span<double> out) {
+  const Footprints& fp = footprints_;
+  const double inv_cell_area = 1.0 / cell_area_;
+  // The sea: the pressure of the forces u, held over h, lowers the nodes by
+  // the midpoint response (G_sea u is minus that change).
+  for (std::size_t k = 0; k < fp.cell.size(); ++k) grid_work_[fp.cell[k]] += u[k] * inv_cell_area;
+  sea.midpoint_response(grid_work_, h, grid_eta_);
+  for (std::size_t k = 0; k < fp.cell.size(); ++k) {
+    out[k] = -grid_eta_[fp.cell[k]];
+    grid_work_[fp.cell[k]] = 0.0;
+  }
+  // The floes: each one's bottom rises by h^2 / 2 M^-1 of the forces' resultant.
+  const double hh = 0.5 * h * h;
+  for (std::uint32_t i : order_) {
+    Eigen::Vector3d F = Eigen::Vector3d::Zero();
+    for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k)
+      F += u[k] * Eigen::Vector3d(1.0, fp.centroid[k].x(), fp.centroid[k].y());
+    Eigen::Vector3d x(hh * F[0] / floes.mass[i], 0.0, 0.0);
+    if (tilt_[i] == 2) x.tail<2>() = hh * tilt_inertia(floes, i).ldlt().solve(F.tail<2>());
+    else if (tilt_[i] == 1) x[1] = hh * F[1] / tilt_inertia(floes, i)(0, 0);
+    for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k)
+      out[k] += x[0] + x[1] * fp.centroid[k].x() + x[2] * fp.centroid[k].y();
+  }
+  ++implicit_stats_.g_products;
+}
+
+void FloeSeaContact::implicit_step(Floes& floes, fluid::Sea& sea, double h) {
+  rebuild_footprints(floes);
+  footprints_fresh_ = true;
+  const Footprints& fp = footprints_;
+  const std::size_t n = fp.cell.size();
+  grid_work_.assign(grid_.size(), 0.0);
+  grid_eta_.resize(grid_.size());
+  const double ks = s_ * kappa_;
+  // Per piece: the spring coefficient c = s kappa psi a, the penetrations at
+  // t (d0) and with no penalty at t + h (dfree), both on this footprint.
+  std::vector<double> c(n, 0.0), d0(n, 0.0), dfree(n, 0.0);
+  std::vector<Eigen::Vector3d> free_bottom(floes.size(), Eigen::Vector3d::Zero());  // z, a at t + h with no penalty
+  double scale = 0.0;  // the thickest draft: the residual's unit
+  {
+    const std::span<const double> eta0 = sea.elevation();
+    for (std::uint32_t i : order_) {
+      const FloeState& st = floes.state[i];
+      const double z = st.heave + bottom0_[i];
+      const Vec2 a{st.pitch, st.roll};
+      free_bottom[i] = {z + h * st.heave_rate - 0.5 * h * h * g_, st.pitch + h * st.pitch_rate,
+                        st.roll + h * st.roll_rate};
+      scale = std::max(scale, floes.draft(i, rho_));
+      for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k) {
+        c[k] = ks * subcell_weight(cells_[fp.cell[k]].coverage) * fp.area[k];
+        d0[k] = eta0[fp.cell[k]] - z - a.dot(fp.centroid[k]);
+      }
+    }
+  }
+  sea.midpoint_free_elevation(h, grid_eta_);
+  for (std::uint32_t i : order_) {
+    const Eigen::Vector3d& b = free_bottom[i];
+    for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k)
+      dfree[k] = grid_eta_[fp.cell[k]] - b[0] - b[1] * fp.centroid[k].x() - b[2] * fp.centroid[k].y();
+  }
+  // The sea's response on a node to its own pressure over h: the diagonal of
+  // G_sea, for the preconditioner (a periodic sea's is the same on every node).
+  if (self_response_h_ != h) {
+    const std::size_t node = grid_.edge == fluid::GridEdge::periodic ? 0 : grid_.size() / 2;
+    grid_work_[node] = 1.0;
+    sea.midpoint_response(grid_work_, h, grid_eta_);
+    grid_work_[node] = 0.0;
+    self_response_ = std::max(-grid_eta_[node], 0.0);
+    self_response_h_ = h;
+  }
+  const double self = self_response_ / cell_area_;
+
+  // Newton on R(d1) = d1 - dfree + G f(d0, d1), from d1 = d0.
+  std::vector<double> d1 = d0, f(n), df(n), R(n), Gf(n), sq(n), w(n), r(n), z(n), p(n), Ap(n), tmp(n), step(n),
+      trial(n), ftrial(n);
+  auto residual = [&](std::span<const double> d, std::vector<double>& force, std::vector<double>& out) {
+    for (std::size_t k = 0; k < n; ++k) force[k] = secant_force(c[k], d0[k], d[k]).f;
+    apply_response(floes, sea, h, force, out);
+    for (std::size_t k = 0; k < n; ++k) out[k] += d[k] - dfree[k];
+  };
+  residual(d1, f, R);
+  const double tolerance = newton_tolerance_ * std::max(scale, 1e-300);
+  // Per floe, the preconditioner's small system (C^-1 + U^T D^-1 U) with
+  // U = S Phi, C = h^2 / 2 M^-1, D = I + S self S (Woodbury).
+  std::vector<Eigen::Matrix3d> small(floes.size());
+  const double hh = 0.5 * h * h;
+  auto precondition = [&](std::span<const double> in, std::span<double> out) {
+    for (std::uint32_t i : order_) {
+      Eigen::Vector3d t = Eigen::Vector3d::Zero();
+      for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k) {
+        const double dinv = 1.0 / (1.0 + sq[k] * sq[k] * self);
+        out[k] = dinv * in[k];
+        t += sq[k] * out[k] * Eigen::Vector3d(1.0, fp.centroid[k].x(), fp.centroid[k].y());
+      }
+      if (tilt_[i] < 2) t[2] = 0.0;  // slopes the floe does not have
+      if (tilt_[i] < 1) t[1] = 0.0;
+      const Eigen::Vector3d y = small[i].ldlt().solve(t);
+      for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k) {
+        const double dinv = 1.0 / (1.0 + sq[k] * sq[k] * self);
+        out[k] -= dinv * sq[k] * (y[0] + y[1] * fp.centroid[k].x() + y[2] * fp.centroid[k].y());
+      }
+    }
+  };
+  int newton = 0;
+  double norm = max_abs(R);
+  for (; norm > tolerance; ++newton) {
+    if (newton == max_newton_) {
+      std::ostringstream m;
+      m << "the implicit floe–sea step did not converge in " << max_newton_ << " Newton iterations (largest residual "
+        << norm << " m, tolerance " << tolerance << " m; dt = " << h << " s)";
+      throw RunError(m.str());
+    }
+    for (std::size_t k = 0; k < n; ++k) {
+      df[k] = secant_force(c[k], d0[k], d1[k]).df;
+      sq[k] = std::sqrt(df[k]);
+    }
+    for (std::uint32_t i : order_) {
+      Eigen::Matrix3d m = Eigen::Matrix3d::Identity();
+      m(0, 0) = floes.mass[i] / hh;
+      if (tilt_[i] == 2) m.bottomRightCorner<2, 2>() = tilt_inertia(floes, i) / hh;
+      else if (tilt_[i] == 1) m(1, 1) = tilt_inertia(floes, i)(0, 0) / hh;
+      Eigen::Matrix3d utu = Eigen::Matrix3d::Zero();
+      for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k) {
+        Eigen::Vector3d u = sq[k] * Eigen::Vector3d(1.0, fp.centroid[k].x(), fp.centroid[k].y());
+        if (tilt_[i] < 2) u[2] = 0.0;
+        if (tilt_[i] < 1) u[1] = 0.0;
+        utu += u * u.transpose() / (1.0 + sq[k] * sq[k] * self);
+      }
+      small[i] = m + utu;
+    }
+    // Conjugate gradients on (I + S G S) w = -S R.
+    for (std::size_t k = 0; k < n; ++k) {
+      w[k] = 0.0;
+      r[k] = -sq[k] * R[k];
+    }
+    const double bnorm = std::sqrt(dot(r, r));
+    precondition(r, z);
+    p = z;
+    double rz = dot(r, z);
+    for (int it = 0; it < max_cg_ && std::sqrt(dot(r, r)) > cg_tolerance_ * bnorm; ++it) {
+      for (std::size_t k = 0; k < n; ++k) tmp[k] = sq[k] * p[k];
+      apply_response(floes, sea, h, tmp, Ap);
+      for (std::size_t k = 0; k < n; ++k) Ap[k] = p[k] + sq[k] * Ap[k];
+      const double alpha = rz / dot(p, Ap);
+      for (std::size_t k = 0; k < n; ++k) {
+        w[k] += alpha * p[k];
+        r[k] -= alpha * Ap[k];
+      }
+      precondition(r, z);
+      const double rz_new = dot(r, z);
+      for (std::size_t k = 0; k < n; ++k) p[k] = z[k] + rz_new / rz * p[k];
+      rz = rz_new;
+      ++implicit_stats_.cg;
+    }
+    // The Newton step: (I + G F') step = -R, step = -R - G S w.
+    for (std::size_t k = 0; k < n; ++k) tmp[k] = sq[k] * w[k];
+    apply_response(floes, sea, h, tmp, step);
+    for (std::size_t k = 0; k < n; ++k) step[k] = -R[k] - step[k];
+    // Backtracking on the residual's norm.
+    const double norm2 = std::sqrt(dot(R, R));
+    double t = 1.0;
+    for (;;) {
+      for (std::size_t k = 0; k < n; ++k) trial[k] = d1[k] + t * step[k];
+      residual(trial, ftrial, tmp);
+      if (std::sqrt(dot(tmp, tmp)) < (1.0 - 1e-4 * t) * norm2 || t < 1e-6) break;
+      t *= 0.5;
+    }
+    d1.swap(trial);
+    f.swap(ftrial);
+    R.swap(tmp);
+    norm = max_abs(R);
+  }
+  ++implicit_stats_.steps;
+  implicit_stats_.newton += newton;
+  implicit_stats_.last_residual = norm;
+
+  // The step with the forces f held over it: the floes...
+  for (std::uint32_t i : order_) {
+    FloeState& st = floes.state[i];
+    Eigen::Vector3d F(-floes.mass[i] * g_, 0.0, 0.0);
+    for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k)
+      F += f[k] * Eigen::Vector3d(1.0, fp.centroid[k].x(), fp.centroid[k].y());
+    const double az = F[0] / floes.mass[i];
+    st.heave += h * st.heave_rate + 0.5 * h * h * az;
+    st.heave_rate += h * az;
+    Vec2 aa = Vec2::Zero();
+    if (tilt_[i] == 2) aa = tilt_inertia(floes, i).ldlt().solve(F.tail<2>());
+    else if (tilt_[i] == 1) aa.x() = F[1] / tilt_inertia(floes, i)(0, 0);
+    st.pitch += h * st.pitch_rate + 0.5 * h * h * aa.x();
+    st.roll += h * st.roll_rate + 0.5 * h * h * aa.y();
+    st.pitch_rate += h * aa.x();
+    st.roll_rate += h * aa.y();
+  }
+  // Floes with no pieces (outside the sea) drift, as with the explicit kicks.
+  for (std::size_t i = 0; i < floes.size(); ++i) {
+    if (!dynamic_[i] || fp.offsets[i] < fp.offsets[i + 1]) continue;
+    FloeState& st = floes.state[i];
+    st.heave += h * st.heave_rate;
+    st.pitch += h * st.pitch_rate;
+    st.roll += h * st.roll_rate;
+  }
+  // ... and the sea.
+  const double inv_cell_area = 1.0 / cell_area_;
+  for (std::size_t k = 0; k < n; ++k) grid_work_[fp.cell[k]] += f[k] * inv_cell_area;
+  sea.midpoint_step(grid_work_, h);
+  for (std::size_t k = 0; k < n; ++k) grid_work_[fp.cell[k]] = 0.0;
 }
 
 void FloeSeaContact::mean_velocity(const Floes& floes, std::span<const double> u0, std::span<const double> v0,

@@ -50,6 +50,35 @@
 // As c -> inf this removes the relative normal velocity in one kick
 // (restitution 0) and never destabilises.
 //
+// Implicit step ([coupling] integrator = "implicit"; docs/coupling.md, "The
+// implicit step"). The explicit kicks above are stable only below
+// 0.5 / omega_pen, a step set by K. The implicit step instead integrates the
+// floes' vertical DOFs x_i = (zeta, a) and the sea's modes together by the
+// implicit midpoint rule, with the discrete gradient of the penalty energy in
+// place of its force (Gonzalez 1996; Hairer, Lubich & Wanner, Geometric
+// Numerical Integration, §V.5):
+//     x1 - x0 = h (x0' + x1') / 2,  M (x1' - x0') = h (sum_c Phi_c f_c - M g e_z),
+//     the sea: ModalBank::midpoint with the pressure f_c / A on node c,
+//     f_c = c_c ([d1]^+^2 - [d0]^+^2) / (2 (d1 - d0)),  c_c = s kappa psi_c a_c,
+// with d0, d1 the penetrations of piece c at t and t + h (both on the
+// footprint at t + h, after the horizontal drift). Since f_c (d1 - d0) is
+// exactly the change of c_c / 2 [d]^+^2, the step conserves the floes'
+// vertical energy + the weight + the sea's + V exactly, for any h and K
+// (up to the solver's tolerance), opening and closing contacts included;
+// it is second order where the contact is smooth. Eliminating x1 and the
+// sea leaves one equation for d1 on the pieces:
+//     R(d1) = d1 - d_free + G f(d0, d1) = 0,
+// d_free the penetrations the step reaches with no penalty, G = G_sea + G_floe
+// the penetration response to forces held over the step: G_sea applies the
+// sea's midpoint response (two FFTs), G_floe = h^2 / 2 Phi M^-1 Phi^T per
+// floe. Both are symmetric positive semi-definite and f is non-decreasing
+// in d1, so Newton's method, J = I + G diag(f'), converges with a line
+// search; each Newton step solves the symmetrised system
+// (I + S G S) w = -S R, S = diag(f'^1/2), by conjugate gradients,
+// preconditioned per floe by its own rigid response plus the sea's response
+// on the piece's own node (Sherman–Morrison–Woodbury on the floe's 1 to 3
+// DOFs). The damper (weak) part and the horizontal forces keep their kicks.
+//
 // Start (MODEL.md §1): the static problem is solved first. The sea's static
 // response to a pressure is local, eta = W - p / (rho_w g) + const, W the
 // surface without floes, up to capillarity (relative size sigma k^2 /
@@ -95,7 +124,10 @@ public:
   void start(Floes& floes, fluid::Sea& sea, bool given);
 
   // Evaluates the contact at the present state for a kick of length h: the
-  // pressure on the sea grid and the loads on the floes.
+  // pressure on the sea grid and the loads on the floes. With the implicit
+  // integrator the spring's vertical part and the weight are left out of the
+  // pressure and the vertical loads (advance_vertical applies them); the
+  // horizontal forces and the penalty energy are the same.
   void evaluate(const Floes& floes, fluid::Sea& sea, double h);
   // Apply the last evaluation over h: to the floes' vertical and horizontal
   // rates; to the sea's modal velocities (a second kick_sea with the same
@@ -103,8 +135,6 @@ public:
   // again: nothing else may kick the sea in between).
   void kick_floes(Floes& floes, double h) const;
   void kick_sea(fluid::Sea& sea, double h);
-  // Vertical drift of the floes: zeta += h zeta', a += h a'.
-  static void drift(Floes& floes, double h);
 
   // Mean over each floe's footprint (weights a_c) of the velocity field
   // (1 - w) (u0, v0) + w (u1, v1) (m/s, world): the incident waves' orbital
@@ -112,6 +142,18 @@ public:
   void mean_velocity(const Floes& floes, std::span<const double> u0, std::span<const double> v0,
                      std::span<const double> u1, std::span<const double> v1, double w,
                      std::vector<Vec2>& out) const;
+
+  // Implicit integrator: advances the floes' vertical DOFs and the sea over h
+  // (the floes' horizontal positions already at t + h, their vertical DOFs
+  // and the sea at t). Explicit: the floes' vertical drift and the sea's free
+  // flow. Throws RunError if the Newton iteration does not converge.
+  void advance_vertical(Floes& floes, fluid::Sea& sea, double h);
+  bool implicit() const { return implicit_; }
+  struct ImplicitStats {
+    long steps = 0, newton = 0, cg = 0, g_products = 0;  // totals over the run
+    double last_residual = 0.0;  // m, the last step's largest piece residual
+  };
+  const ImplicitStats& implicit_stats() const { return implicit_stats_; }
 
   // Stable kick length of the explicit spring part (s > 0): 0.5 / omega_pen,
   // omega_pen^2 = s kappa (1 / m_floe + 1 / m_sea) (a quarter of leapfrog's
@@ -142,6 +184,12 @@ private:
   // to the share Phi (the header's "Partly covered cells").
   double subcell_weight(double coverage) const;
   Eigen::Matrix2d tilt_inertia(const Floes& floes, std::size_t i) const;
+  // Clears the cells of the present footprints, builds them at the floes'
+  // positions and sums the cells' coverage (cells_[c].coverage).
+  void rebuild_footprints(const Floes& floes);
+  void implicit_step(Floes& floes, fluid::Sea& sea, double h);
+  // The implicit step's operator: out = G u on the pieces (see the header).
+  void apply_response(const Floes& floes, fluid::Sea& sea, double h, std::span<const double> u, std::span<double> out);
 
   FootprintKernel kernel_ = FootprintKernel::cell;
   double rho_ = 1025.0, g_ = 9.81, sigma_ = 0.0, K_ = 1000.0, s_ = 1.0, kappa_ = 0.0;
@@ -164,6 +212,13 @@ private:
   std::vector<CellSums> cells_;
   std::vector<std::uint32_t> order_;  // dynamic floes with pieces, by their first cell
   bool pressure_kicked_ = false;  // the sea's last kick was with pressure_ as it is
+  bool implicit_ = false;
+  bool footprints_fresh_ = false;  // built by the implicit step at the present positions
+  double newton_tolerance_ = 1e-10, cg_tolerance_ = 1e-10;
+  int max_newton_ = 40, max_cg_ = 500;
+  ImplicitStats implicit_stats_;
+  double self_response_h_ = -1.0, self_response_ = 0.0;  // sea's node response to its own pressure over h
+  std::vector<double> grid_work_, grid_eta_;  // grid-sized scratch of the implicit step
   double penalty_energy_ = 0.0;
   std::vector<std::string> notes_;
 };

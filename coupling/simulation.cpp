@@ -240,7 +240,6 @@ void Simulation::advance(const StepContext& ctx) {
   const Vec2 before = momentum();
   contact::advance_with_collisions(scenario_.floes, shapes_, detection_, ctx.dt, o, stats_, substeps_);
   step_budget_.collisions += momentum() - before;
-  if (floe_sea_) FloeSeaContact::drift(scenario_.floes, ctx.dt);
   wrap_periodic();
 }
 
@@ -303,10 +302,13 @@ void Simulation::wrap_periodic() {
 }
 
 void Simulation::sea_flow(const StepContext& ctx) {
-  // The floes' pressures at t (half kick), then the exact modal flow.
+  // The floes' pressures at t (half kick), then the floes' vertical DOFs and
+  // the sea over dt: their free flows (explicit kicks), or the implicit step
+  // of the penalty spring (coupling/floe_sea.hpp).
   if (!sea_) return;
-  if (floe_sea_) floe_sea_->kick_sea(*sea_, 0.5 * ctx.dt);
-  sea_->flow(ctx.dt);
+  if (!floe_sea_) return sea_->flow(ctx.dt);
+  floe_sea_->kick_sea(*sea_, 0.5 * ctx.dt);
+  floe_sea_->advance_vertical(scenario_.floes, *sea_, ctx.dt);
 }
 
 void Simulation::sea_half_kick(const StepContext& ctx) {

@@ -11,12 +11,13 @@
 //      orbital velocity, wind, Coriolis) -> collide (LCPs: W(t-) -> W(t+))
 //   -> percussion (fracture checks on the collision impulses; a split floe
 //      becomes two)
-//   -> advance positions (horizontal: floes that may collide within the step
-//      are sub-stepped event by event, contact/substep.hpp; and the vertical
-//      DOFs)
+//   -> advance horizontal positions (floes that may collide within the step
+//      are sub-stepped event by event, contact/substep.hpp)
 //   -> detect (new contacts; an overlap rejects the step, which is redone
 //      with half the dt from the floes at t: the sea has not moved yet)
-//   -> sea: half kick with the pressures at t, exact modal flow over dt
+//   -> sea: half kick with the pressures at t, then the floes' vertical DOFs
+//      and the sea over dt (explicit: their free flows, the sea's exact;
+//      implicit: the midpoint step of the penalty spring, floe_sea.hpp)
 //   -> penalty loads at t + dt: second half kick of the sea and the floes,
 //      then the orbital velocity under the floes (for the next drag)
 //   -> check state
@@ -27,8 +28,10 @@
 // The loads at t + dt serve as the next step's first half kick (the strong
 // law's do not depend on the kick length; the damper's are made afresh), and
 // the sea's two half kicks by that one pressure share its projection
-// (Sea::repeat_kick). Steps cut by the penalty limit are equal and keep one
-// dt, so the sea's rotations are computed once.
+// (Sea::repeat_kick). Steps cut by the explicit penalty limit are equal and
+// keep one dt, so the sea's rotations are computed once. With the implicit
+// integrator there is no penalty limit: the kicks carry the damper and the
+// horizontal forces only.
 // Step contract: on entry the state is at time() and the contact detection
 // matches the positions; step(t_stop) advances both to time() + dt with
 // 0 < dt <= min(dt_max, t_stop - time()) and returns dt. At the end of every

@@ -256,6 +256,18 @@ void BemSea::set_surface(std::span<const double> eta, std::span<const double> et
   invalidate();
 }
 
+void BemSea::project(std::span<const double> pressure, std::span<double> s) {
+  const auto& ops = *impl_->ops;
+  const Eigen::Map<const VectorXd> p(pressure.data(), ops.surface);
+  Eigen::Map<VectorXd>(s.data(), static_cast<Eigen::Index>(s.size())).noalias() = ops.load * p;
+}
+
+void BemSea::synthesize(std::span<const double> q, std::span<double> eta) {
+  const auto& ops = *impl_->ops;
+  const Eigen::Map<const VectorXd> a(q.data(), static_cast<Eigen::Index>(q.size()));
+  Eigen::Map<VectorXd>(eta.data(), ops.surface).noalias() = ops.x * a;
+}
+
 void BemSea::compute_field(Field f, std::span<double> out) {
   const auto& ops = *impl_->ops;
   const Eigen::Index nm = static_cast<Eigen::Index>(bank_.modes());

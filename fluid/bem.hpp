@@ -47,6 +47,8 @@ public:
 
 protected:
   void compute_field(Field f, std::span<double> out) override;
+  void project(std::span<const double> pressure, std::span<double> s) override;
+  void synthesize(std::span<const double> q, std::span<double> eta) override;
 
 private:
   struct Impl;

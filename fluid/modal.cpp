@@ -138,6 +138,43 @@ void ModalBank::kick(std::span<const double> s, double h) {
   }
 }
 
+void ModalBank::midpoint(std::span<const double> s, double h) {
+  FLOESIM_ASSERT(s.empty() || s.size() == v_.size());
+  const auto m = static_cast<std::size_t>(components_);
+  for (std::size_t j = 0; j < omega_.size(); ++j) {
+    const double w2 = omega_[j] * omega_[j], den = 1.0 + 0.25 * h * h * w2;
+    for (std::size_t c = 0; c < m; ++c) {
+      const std::size_t i = j * m + c;
+      const double a = s.empty() ? 0.0 : gain_[j] * s[i];
+      const double q0 = q_[i];
+      const double q1 = ((1.0 - 0.25 * h * h * w2) * q0 + h * v_[i] + 0.5 * h * h * a) / den;
+      v_[i] += h * (a - 0.5 * w2 * (q0 + q1));
+      q_[i] = q1;
+    }
+  }
+}
+
+void ModalBank::midpoint_free(double h, std::span<double> q_out) const {
+  FLOESIM_ASSERT(q_out.size() == q_.size());
+  const auto m = static_cast<std::size_t>(components_);
+  for (std::size_t j = 0; j < omega_.size(); ++j) {
+    const double w2 = omega_[j] * omega_[j], den = 1.0 + 0.25 * h * h * w2;
+    for (std::size_t c = 0; c < m; ++c) {
+      const std::size_t i = j * m + c;
+      q_out[i] = ((1.0 - 0.25 * h * h * w2) * q_[i] + h * v_[i]) / den;
+    }
+  }
+}
+
+void ModalBank::midpoint_response(std::span<const double> s, double h, std::span<double> q_out) const {
+  FLOESIM_ASSERT(s.size() == q_.size() && q_out.size() == q_.size());
+  const auto m = static_cast<std::size_t>(components_);
+  for (std::size_t j = 0; j < omega_.size(); ++j) {
+    const double r = 0.5 * h * h * gain_[j] / (1.0 + 0.25 * h * h * omega_[j] * omega_[j]);
+    for (std::size_t c = 0; c < m; ++c) q_out[j * m + c] = r * s[j * m + c];
+  }
+}
+
 namespace {
 
 // 1/2 sum_j weight_j |a_j|^2 over the components of each mode.

@@ -66,6 +66,21 @@ public:
   };
   void kick_flow(std::span<const Kick> kicks, double dt, double* q_out = nullptr);
 
+  // The implicit midpoint rule (for this linear bank, the trapezoidal rule)
+  // over h with the load s held over the step (laid out like v; empty: none):
+  //     q1 = ((1 - h^2 w^2 / 4) q0 + h v0 + h^2 / 2 g s) / (1 + h^2 w^2 / 4),
+  //     v1 = v0 - h w^2 (q0 + q1) / 2 + h g s,
+  // the solution of q1 - q0 = h (v0 + v1) / 2, v1 - v0 = h (-w^2 (q0 + q1) / 2 + g s).
+  // Stable for every h, it conserves 1/2 mass (v^2 + w^2 q^2) exactly when
+  // s = 0, and the work of s is s . (q1 - q0) exactly: the sea's share of the
+  // coupled energy balance of the implicit floe–sea step (docs/coupling.md).
+  // Its frequency is 2 atan(w h / 2) / h: a phase error (w h)^2 / 12.
+  void midpoint(std::span<const double> s, double h);
+  // q1 of midpoint() without changing the state: with no load (free), or the
+  // part due to the load alone from rest, h^2 / 2 g s / (1 + h^2 w^2 / 4).
+  void midpoint_free(double h, std::span<double> q_out) const;
+  void midpoint_response(std::span<const double> s, double h, std::span<double> q_out) const;
+
   double kinetic() const;
   double potential() const;
 

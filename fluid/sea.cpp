@@ -23,6 +23,30 @@ void Sea::step(double dt, const PressureFn& pressure) {
   kick(p_scratch_, 0.5 * dt);
 }
 
+void Sea::midpoint_free_elevation(double h, std::span<double> eta) {
+  settle();
+  modal_a_.resize(bank_.q().size());
+  bank_.midpoint_free(h, modal_a_);
+  synthesize(modal_a_, eta);
+}
+
+void Sea::midpoint_response(std::span<const double> p, double h, std::span<double> eta) {
+  modal_a_.resize(bank_.q().size());
+  modal_b_.resize(bank_.q().size());
+  project(p, modal_a_);
+  bank_.midpoint_response(modal_a_, h, modal_b_);
+  synthesize(modal_b_, eta);
+}
+
+void Sea::midpoint_step(std::span<const double> p, double h) {
+  settle();
+  modal_a_.resize(bank_.q().size());
+  project(p, modal_a_);
+  bank_.midpoint(modal_a_, h);
+  time_ += h;
+  invalidate();
+}
+
 void Sea::invalidate_rates() {
   for (Field f : {Field::velocity_x, Field::velocity_y, Field::velocity_z})
     valid_[static_cast<std::size_t>(f)] = false;

@@ -84,6 +84,18 @@ public:
   // share their pressure). Needs a kick() before it.
   virtual void repeat_kick(double h) = 0;
 
+  // The implicit step of the floe–sea coupling (coupling/floe_sea.hpp): a
+  // pressure held over h, integrated by the implicit midpoint rule of the
+  // modes (ModalBank::midpoint). The elevation the step would reach with no
+  // pressure, and the change of elevation a pressure p alone causes (linear
+  // and symmetric in p: ∫ p' midpoint_response(p) = ∫ p midpoint_response(p'));
+  // neither changes the state.
+  void midpoint_free_elevation(double h, std::span<double> eta);
+  void midpoint_response(std::span<const double> p, double h, std::span<double> eta);
+  // Advances the state over h with p held over the step; t += h. A tank's
+  // relaxation zones act over h / 2 before and after (as in flow()).
+  virtual void midpoint_step(std::span<const double> p, double h);
+
   // pressure(sea, t, p) fills p (grid().size() values, Pa) for time t; it may
   // query the sea (called with the state at t, then at t + dt).
   using PressureFn = std::function<void(Sea& sea, double t, std::span<double> p)>;
@@ -114,6 +126,10 @@ protected:
   // applies the deferred ones. The state seen through the public API is always
   // the settled one.
   virtual void settle() {}
+  // The modal load s of a pressure (kick(p, h) is v += h gain s), and the
+  // elevation on the grid of modal amplitudes q.
+  virtual void project(std::span<const double> pressure, std::span<double> s) = 0;
+  virtual void synthesize(std::span<const double> q, std::span<double> eta) = 0;
   void invalidate() { valid_.fill(false); }
   void invalidate_rates();  // only the fields that depend on eta' (after a kick)
 
@@ -125,6 +141,7 @@ private:
   std::array<AlignedVector, field_count> fields_;
   std::array<bool, field_count> valid_{};
   AlignedVector p_scratch_;
+  AlignedVector modal_a_, modal_b_;  // scratch for the midpoint operations
 };
 
 // Checks a [sea] section; throws InputError naming the key ("[sea] cells: ...").

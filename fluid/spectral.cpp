@@ -280,22 +280,54 @@ void SpectralSea::flow(double dt) {
     m.staged = true;
   } else {
     settle();
-    // Strang: relax(dt/2) flow(dt) relax(dt/2), relaxing in physical space.
-    auto relax = [&](double t0, double h) {
-      m.load(bank_.q(), nullptr, nullptr);
-      m.backward(m.tank_eta, m.spec);
-      m.load(bank_.v(), nullptr, nullptr);
-      m.backward(m.tank_rate, m.spec);
-      m.tank->relax(t0, h, m.tank_eta, m.tank_rate);
-      set_surface(m.tank_eta, m.tank_rate);
-    };
-    relax(time_, 0.5 * dt);
+    // Strang: relax(dt/2) flow(dt) relax(dt/2).
+    relax_tank(time_, 0.5 * dt);
     bank_.flow(dt);
-    relax(time_ + 0.5 * dt, 0.5 * dt);
+    relax_tank(time_ + 0.5 * dt, 0.5 * dt);
   }
   time_ += dt;
   m.staged_vy = false;
   invalidate();
+}
+
+void SpectralSea::relax_tank(double t0, double h) {
+  Impl& m = *impl_;
+  m.load(bank_.q(), nullptr, nullptr);
+  m.backward(m.tank_eta, m.spec);
+  m.load(bank_.v(), nullptr, nullptr);
+  m.backward(m.tank_rate, m.spec);
+  m.tank->relax(t0, h, m.tank_eta, m.tank_rate);
+  set_surface(m.tank_eta, m.tank_rate);
+}
+
+void SpectralSea::midpoint_step(std::span<const double> p, double h) {
+  Impl& m = *impl_;
+  if (!m.tank) return Sea::midpoint_step(p, h);
+  settle();
+  // Strang, as flow(): relax(h/2), the midpoint step, relax(h/2).
+  relax_tank(time_, 0.5 * h);
+  Sea::midpoint_step(p, h);  // advances time_ by h
+  relax_tank(time_ - 0.5 * h, 0.5 * h);
+  m.staged = false;
+  m.staged_vy = false;
+  invalidate();
+}
+
+void SpectralSea::project(std::span<const double> pressure, std::span<double> s) {
+  Impl& m = *impl_;
+  FLOESIM_ASSERT(pressure.size() == m.n && s.size() == 2 * m.nc);
+  m.forward(pressure, m.spec);
+  m.staged = false;
+  const double* f = reinterpret_cast<const double*>(m.spec);
+  std::copy(f, f + 2 * m.nc, s.begin());
+}
+
+void SpectralSea::synthesize(std::span<const double> q, std::span<double> eta) {
+  Impl& m = *impl_;
+  FLOESIM_ASSERT(q.size() == 2 * m.nc && eta.size() == m.n);
+  std::copy(q.begin(), q.end(), reinterpret_cast<double*>(m.spec));
+  m.staged = false;
+  m.backward(eta, m.spec);
 }
 
 void SpectralSea::compute_field(Field f, std::span<double> out) {

@@ -36,6 +36,7 @@ public:
   void repeat_kick(double h) override;
   void flow(double dt) override;
   void set_surface(std::span<const double> eta, std::span<const double> eta_t) override;
+  void midpoint_step(std::span<const double> p, double h) override;
 
   // omega of the Fourier mode with wave vector 2 pi (mx / lx, my / ly).
   double omega(int mx, int my = 0) const;
@@ -45,8 +46,12 @@ public:
 protected:
   void compute_field(Field f, std::span<double> out) override;
   void settle() override;
+  void project(std::span<const double> pressure, std::span<double> s) override;
+  void synthesize(std::span<const double> q, std::span<double> eta) override;
 
 private:
+  // The tank's relaxation zones over [t0, t0 + h], in physical space.
+  void relax_tank(double t0, double h);
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };

@@ -12,7 +12,12 @@
 # (`--profile`, ms per step). The CSV starts with comment lines: the command,
 # the commit, the machine and its load (uptime) before and after.
 #
+# With --integrator implicit the floe–sea spring is integrated implicitly
+# ([coupling] integrator, docs/coupling.md) and the rows also give the Newton
+# and conjugate-gradient iterations per step.
+#
 # usage: bench/ocean/run.sh [--until T=60] [--repeats R=1] [--stiffness "K..."="100"]
+#                           [--integrator explicit|implicit=explicit]
 #                           [--build DIR=build] [--csv FILE=bench/results/ocean_epyc-2core.csv | -]
 #                           [--work DIR] [--note TEXT]
 set -euo pipefail
@@ -22,6 +27,7 @@ root="$(cd "$here/../.." && pwd)"
 until_s=60
 repeats=1
 stiffness="100"
+integrator="explicit"
 build="$root/build"
 csv="$root/bench/results/ocean_epyc-2core.csv"
 work=""
@@ -36,7 +42,8 @@ while [ $# -gt 0 ]; do
     --csv) csv="$2"; shift 2 ;;
     --work) work="$2"; shift 2 ;;
     --note) note="$2"; shift 2 ;;
-    -h|--help) sed -n '2,19p' "$0"; exit 0 ;;
+    --integrator) integrator="$2"; shift 2 ;;
+    -h|--help) sed -n '2,24p' "$0"; exit 0 ;;
     *) echo "run.sh: unknown option $1 (see --help)" >&2; exit 2 ;;
   esac
 done
@@ -60,7 +67,8 @@ rows="$work/rows.csv"
 phases=""
 for K in $stiffness; do
   toml="$work/ocean_K$K.toml"
-  sed -e "s|^pack = .*|pack = \"$pack\"|" -e "s|^stiffness = .*|stiffness = $K|" "$here/ocean.toml" > "$toml"
+  sed -e "s|^pack = .*|pack = \"$pack\"|" -e "s|^stiffness = .*|stiffness = $K\nintegrator = \"$integrator\"|" \
+    "$here/ocean.toml" > "$toml"
   # The set-up alone (sea, waves, floes, static start): its CPU time is taken
   # from the whole run's to give the loop's.
   /usr/bin/time -v "$floesim" run "$toml" --until 0 -q -o "$work/setup.h5" > /dev/null 2> "$work/setup.time"
@@ -78,7 +86,7 @@ for K in $stiffness; do
     fi
   done
   [ -n "$phases" ] || phases="$(awk -F': ' '$1 ~ /^profile\./ { sub(/^profile\./, "", $1); printf "%s%s", sep, $1; sep = " " }' "$best.txt")"
-  awk -F': ' -v K="$K" -v repeats="$repeats" -v phases="$phases" -v setup_cpu="$setup_cpu" '
+  awk -F': ' -v K="$K" -v integrator="$integrator" -v repeats="$repeats" -v phases="$phases" -v setup_cpu="$setup_cpu" '
     FNR == 1 { file++ }
     file == 1 { v[$1] = $2 }
     file == 2 {
@@ -95,13 +103,13 @@ for K in $stiffness; do
       steps = v["steps"] + 0; sim = v["simulated"] + 0; wall = v["wall_time"] + 0
       split(v["energy.total"], e, " ")
       loop_cpu = user + sys - setup_cpu
-      printf "%s,%s,%d,%g,%d,%.5f,%.3f,%.1f,%.3f,%.3f,%.3f,%.3f,%.3f,%.1f,%.1f,%.2f,%d,%d,%.3g",
-        v["status"], K, v["floes"], sim, steps, sim / steps, wall, steps / wall, sim / wall,
+      printf "%s,%s,%s,%d,%g,%d,%.5f,%.3f,%.1f,%.3f,%.3f,%.3f,%.3f,%.3f,%.1f,%.1f,%.2f,%d,%d,%.3g",
+        v["status"], integrator, K, v["floes"], sim, steps, sim / steps, wall, steps / wall, sim / wall,
         elapsed - wall, loop_cpu, sim / loop_cpu, setup_cpu, rss, 1000 * wall / steps, 1000 * loop_cpu / steps,
         v["collisions.lcps"], v["collisions.contacts"], (e[3] - e[1]) / e[1]
       np = split(phases, ph, " ")
       for (i = 1; i <= np; i++) { split(v["profile." ph[i]], t, " "); printf ",%.3f", 1000 * t[1] / steps }
-      printf ",%d\n", repeats
+      printf ",%s,%s,%d\n", v["implicit.newton_per_step"] + 0, v["implicit.cg_per_step"] + 0, repeats
     }' "$best.txt" "$best.time" >> "$rows"
 done
 load_after="$(uptime | sed 's/.*load average: //')"
@@ -119,9 +127,9 @@ cpu="$(awk -F': ' '/^model name/ { print $2; exit }' /proc/cpuinfo)"
   echo "#   other processes on a shared machine disturb less than its wall time; sim_s_per_cpu_s = simulated_s / loop_cpu_s;"
   echo "#   peak_rss_mb: maximum resident set of the run (MiB, /usr/bin/time -v); ms_per_step: loop_s / steps, cpu_ms_per_step likewise;"
   echo "#   energy_drift: (total at the end - total at t = 0) / total at t = 0; phase columns: wall ms per step (floesim run --profile)"
-  printf "status,stiffness,floes,simulated_s,steps,mean_dt_s,loop_s,steps_per_s,sim_s_per_wall_s,setup_s,loop_cpu_s,sim_s_per_cpu_s,setup_cpu_s,peak_rss_mb,ms_per_step,cpu_ms_per_step,lcps,contacts,energy_drift"
+  printf "status,integrator,stiffness,floes,simulated_s,steps,mean_dt_s,loop_s,steps_per_s,sim_s_per_wall_s,setup_s,loop_cpu_s,sim_s_per_cpu_s,setup_cpu_s,peak_rss_mb,ms_per_step,cpu_ms_per_step,lcps,contacts,energy_drift"
   for p in $phases; do printf ",%s_ms" "$p"; done
-  printf ",repeats\n"
+  printf ",newton_per_step,cg_per_step,repeats\n"
   cat "$rows"
 } > "$work/result.csv"
 if [ "$csv" = "-" ]; then cat "$work/result.csv"; else cp "$work/result.csv" "$csv"; cat "$csv"; fi
