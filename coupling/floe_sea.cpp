@@ -126,7 +126,6 @@ void FloeSeaContact::floes_changed(const Floes& floes) {
   // and below agree with each other (docs/coupling.md, Known problems). We
   // take a quarter of the linear limit.
   stable_step_ = INFINITY;
-  footprints_fresh_ = false;
   if (!implicit_ && s_ > 0.0 && std::isfinite(min_mass_per_area))
     stable_step_ = 0.5 / std::sqrt(s_ * kappa_ * (1.0 / min_mass_per_area + sea_inverse_mass_));
 }
@@ -299,17 +298,7 @@ void FloeSeaContact::rebuild_footprints(const Floes& floes) {
 
 void FloeSeaContact::evaluate(const Floes& floes, fluid::Sea& sea, double h) {
   pressure_kicked_ = false;
-  if (footprints_fresh_) {
-    // The implicit step built them at these positions: keep them and their
-    // coverage, clear what the last evaluation summed.
-    for (std::uint32_t c : footprints_.cell) {
-      pressure_[c] = 0.0;
-      cells_[c].sum = 0.0;
-    }
-    footprints_fresh_ = false;
-  } else {
-    rebuild_footprints(floes);
-  }
+  rebuild_footprints(floes);
   const Footprints& fp = footprints_;
   const std::span<const double> eta = sea.elevation();
   std::span<const double> w;
@@ -424,8 +413,8 @@ void FloeSeaContact::kick_floes(Floes& floes, double h) const {
   }
 }
 
-void FloeSeaContact::advance_vertical(Floes& floes, fluid::Sea& sea, double h) {
-  if (implicit_) return implicit_step(floes, sea, h);
+void FloeSeaContact::advance_vertical(Floes& floes, std::span<const FloeState> start, fluid::Sea& sea, double h) {
+  if (implicit_) return implicit_step(floes, start, sea, h);
   for (std::size_t i = 0; i < floes.size(); ++i) {
     if (floes.is_static[i]) continue;
     FloeState& st = floes.state[i];
@@ -498,9 +487,35 @@ void FloeSeaContact::apply_response(const Floes& floes, fluid::Sea& sea, double 
   ++implicit_stats_.g_products;
 }
 
-void FloeSeaContact::implicit_step(Floes& floes, fluid::Sea& sea, double h) {
-  rebuild_footprints(floes);
-  footprints_fresh_ = true;
+void FloeSeaContact::implicit_step(Floes& floes, std::span<const FloeState> start, fluid::Sea& sea, double h) {
+  // The footprint at the midpoint of the floes' horizontal motion over the
+  // step (at its end, the vertical forces would lag the drift by h / 2: a
+  // first-order error). Positions are restored once it is built; a
+  // periodic grid's seam is crossed by the shorter way.
+  {
+    std::vector<std::array<double, 3>> end(floes.size());
+    const bool periodic = grid_.edge == fluid::GridEdge::periodic;
+    for (std::size_t i = 0; i < floes.size(); ++i) {
+      FloeState& st = floes.state[i];
+      end[i] = {st.x, st.y, st.yaw};
+      if (!dynamic_[i] || i >= start.size()) continue;
+      double dx = st.x - start[i].x, dy = st.y - start[i].y;
+      if (periodic) {
+        dx -= grid_.lx * std::round(dx / grid_.lx);
+        if (grid_.dims == 2) dy -= grid_.ly * std::round(dy / grid_.ly);
+      }
+      st.x -= 0.5 * dx;
+      st.y -= 0.5 * dy;
+      st.yaw = 0.5 * (st.yaw + start[i].yaw);
+    }
+    rebuild_footprints(floes);
+    for (std::size_t i = 0; i < floes.size(); ++i) {
+      FloeState& st = floes.state[i];
+      st.x = end[i][0];
+      st.y = end[i][1];
+      st.yaw = end[i][2];
+    }
+  }
   const Footprints& fp = footprints_;
   const std::size_t n = fp.cell.size();
   grid_work_.assign(grid_.size(), 0.0);

@@ -61,7 +61,7 @@
 //     the sea: ModalBank::midpoint with the pressure f_c / A on node c,
 //     f_c = c_c ([d1]^+^2 - [d0]^+^2) / (2 (d1 - d0)),  c_c = s kappa psi_c a_c,
 // with d0, d1 the penetrations of piece c at t and t + h (both on the
-// footprint at t + h, after the horizontal drift). Since f_c (d1 - d0) is
+// footprint at the midpoint of the step's horizontal drift). Since f_c (d1 - d0) is
 // exactly the change of c_c / 2 [d]^+^2, the step conserves the floes'
 // vertical energy + the weight + the sea's + V exactly, for any h and K
 // (up to the solver's tolerance), opening and closing contacts included;
@@ -144,10 +144,12 @@ public:
                      std::vector<Vec2>& out) const;
 
   // Implicit integrator: advances the floes' vertical DOFs and the sea over h
-  // (the floes' horizontal positions already at t + h, their vertical DOFs
-  // and the sea at t). Explicit: the floes' vertical drift and the sea's free
-  // flow. Throws RunError if the Newton iteration does not converge.
-  void advance_vertical(Floes& floes, fluid::Sea& sea, double h);
+  // (the floes' horizontal positions already at t + h, `start` the floes at
+  // t, their vertical DOFs and the sea at t), on the footprint at the
+  // midpoint of the horizontal motion. Explicit: the floes' vertical drift
+  // and the sea's free flow. Throws RunError if the Newton iteration does not
+  // converge.
+  void advance_vertical(Floes& floes, std::span<const FloeState> start, fluid::Sea& sea, double h);
   bool implicit() const { return implicit_; }
   struct ImplicitStats {
     long steps = 0, newton = 0, cg = 0, g_products = 0;  // totals over the run
@@ -187,7 +189,7 @@ private:
   // Clears the cells of the present footprints, builds them at the floes'
   // positions and sums the cells' coverage (cells_[c].coverage).
   void rebuild_footprints(const Floes& floes);
-  void implicit_step(Floes& floes, fluid::Sea& sea, double h);
+  void implicit_step(Floes& floes, std::span<const FloeState> start, fluid::Sea& sea, double h);
   // The implicit step's operator: out = G u on the pieces (see the header).
   void apply_response(const Floes& floes, fluid::Sea& sea, double h, std::span<const double> u, std::span<double> out);
 
@@ -213,7 +215,6 @@ private:
   std::vector<std::uint32_t> order_;  // dynamic floes with pieces, by their first cell
   bool pressure_kicked_ = false;  // the sea's last kick was with pressure_ as it is
   bool implicit_ = false;
-  bool footprints_fresh_ = false;  // built by the implicit step at the present positions
   double newton_tolerance_ = 1e-10, cg_tolerance_ = 1e-10;
   int max_newton_ = 40, max_cg_ = 500;
   ImplicitStats implicit_stats_;

@@ -308,7 +308,7 @@ void Simulation::sea_flow(const StepContext& ctx) {
   if (!sea_) return;
   if (!floe_sea_) return sea_->flow(ctx.dt);
   floe_sea_->kick_sea(*sea_, 0.5 * ctx.dt);
-  floe_sea_->advance_vertical(scenario_.floes, *sea_, ctx.dt);
+  floe_sea_->advance_vertical(scenario_.floes, ctx.start, *sea_, ctx.dt);
 }
 
 void Simulation::sea_half_kick(const StepContext& ctx) {
