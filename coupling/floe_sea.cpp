@@ -58,7 +58,7 @@ double FloeSeaContact::subcell_weight(double coverage) const {
 }
 
 FloeSeaContact::FloeSeaContact(const CouplingParams& params, const SeaParams& sea_params, const Floes& floes,
-                               fluid::Sea& sea)
+                               fluid::Sea& sea, double dt_max)
     : rho_(sea_params.rho), g_(sea_params.g), sigma_(sea_params.sigma), K_(params.stiffness), grid_(sea.grid()),
       implicit_(params.integrator == CouplingIntegrator::implicit), newton_tolerance_(params.newton_tolerance),
       cg_tolerance_(params.cg_tolerance), max_newton_(params.max_newton), max_cg_(params.max_cg) {
@@ -68,11 +68,25 @@ FloeSeaContact::FloeSeaContact(const CouplingParams& params, const SeaParams& se
     case PenaltyLaw::weak: s_ = 0.0; break;
     case PenaltyLaw::blend:
       if (params.restitution >= 0.0) {
-        const BlendCalibration cal = calibrate_blend(K_);
+        // The implicit step's restitution depends on the step in units of
+        // the floes' heave time sqrt(d / g): calibrated on the median draft.
+        double step = 0.0;
+        if (implicit_) {
+          std::vector<double> drafts;
+          for (std::size_t i = 0; i < floes.size(); ++i)
+            if (!floes.is_static[i]) drafts.push_back(floes.draft(i, rho_));
+          if (!drafts.empty()) {
+            std::nth_element(drafts.begin(), drafts.begin() + drafts.size() / 2, drafts.end());
+            step = dt_max / std::sqrt(drafts[drafts.size() / 2] / g_);
+          }
+        }
+        const BlendCalibration cal = calibrate_blend(K_, 61, step);
         s_ = cal.share_for(params.restitution);
         std::ostringstream m;
         m << "[coupling] restitution = " << params.restitution << " at stiffness K = " << K_
-          << ": blend s = " << s_ << " (obstacle-problem calibration)";
+          << ": blend s = " << s_ << " (obstacle-problem calibration";
+        if (step > 0.0) m << ", stepped as the implicit integrator at dt_max = " << step << " sqrt(d / g)";
+        m << ")";
         notes_.push_back(m.str());
       } else {
         s_ = params.blend;
@@ -304,8 +318,9 @@ void FloeSeaContact::evaluate(const Floes& floes, fluid::Sea& sea, double h) {
   std::span<const double> w;
   if (s_ < 1.0) w = sea.field(fluid::Field::velocity_z);
   const double ks = s_ * kappa_, inv_cell_area = 1.0 / cell_area_;
-  // The implicit integrator applies the spring's vertical part and the weight itself.
+  // The implicit integrator applies the vertical law and the weight itself.
   const double spring_kick = implicit_ ? 0.0 : 1.0, weight = implicit_ ? 0.0 : g_;
+  const double damper_kick = implicit_ ? 0.0 : 1.0 - s_;
   double energy = 0.0;
   thread_local std::vector<double> u;    // [delta]^+ of each area piece
   thread_local std::vector<double> psi;  // psi of each area piece's cell
@@ -320,7 +335,7 @@ void FloeSeaContact::evaluate(const Floes& floes, fluid::Sea& sea, double h) {
     const FloeState& st = floes.state[i];
     const double z = st.heave + bottom0_[i];
     const Vec2 a{st.pitch, st.roll}, ar{st.pitch_rate, st.roll_rate};
-    const double c = (1.0 - s_) * weak_coefficient(floes, i);
+    const double c = damper_kick * weak_coefficient(floes, i);
     const double inv_mass = 1.0 / (floes.density[i] * floes.thickness[i]) + sea_inverse_mass_;
     double fz = 0.0, wet = 0.0;
     Vec2 moment = Vec2::Zero();
@@ -385,7 +400,7 @@ void FloeSeaContact::evaluate(const Floes& floes, fluid::Sea& sea, double h) {
 }
 
 void FloeSeaContact::kick_sea(fluid::Sea& sea, double h) {
-  if (implicit_ && s_ >= 1.0) return;  // no damper: the pressure is all the implicit step's
+  if (implicit_) return;  // the implicit step applies the whole vertical law
   if (pressure_kicked_) {
     sea.repeat_kick(h);
   } else {
@@ -446,6 +461,19 @@ SecantForce secant_force(double c, double d0, double d1) {
   return {0.5 * c * d1 * d1 / e, 0.5 * c * d1 * (d1 - 2.0 * d0) / (e * e)};
 }
 
+// The law's force held over the step: the spring's discrete gradient and
+// the damper's impulse over the step, cd h = c psi a: Lambda = c [delta]^+
+// (seed 000 eq. 17) changes by c ([d1]^+ - [d0]^+), and
+// f (d1 - d0) >= 0 for that part (it only absorbs).
+SecantForce law_force(double c, double cd, double d0, double d1) {
+  SecantForce f = secant_force(c, d0, d1);
+  if (cd > 0.0) {
+    f.f += cd * (std::max(d1, 0.0) - std::max(d0, 0.0));
+    if (d1 > 0.0) f.df += cd;
+  }
+  return f;
+}
+
 double max_abs(std::span<const double> x) {
   double m = 0.0;
   for (double v : x) m = std::max(m, std::abs(v));
@@ -460,8 +488,7 @@ double dot(std::span<const double> a, std::span<const double> b) {
 
 }  // namespace
 
-void FloeSeaContact::apply_response(const Floes& floes, fluid::Sea& sea, double h, std::span<const double> u,
-                                    std::span<double> out) {
+void FloeSeaContact::apply_response(fluid::Sea& sea, double h, std::span<const double> u, std::span<double> out) {
   const Footprints& fp = footprints_;
   const double inv_cell_area = 1.0 / cell_area_;
   // The sea: the pressure of the forces u, held over h, lowers the nodes by
@@ -478,9 +505,7 @@ void FloeSeaContact::apply_response(const Floes& floes, fluid::Sea& sea, double 
     Eigen::Vector3d F = Eigen::Vector3d::Zero();
     for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k)
       F += u[k] * Eigen::Vector3d(1.0, fp.centroid[k].x(), fp.centroid[k].y());
-    Eigen::Vector3d x(hh * F[0] / floes.mass[i], 0.0, 0.0);
-    if (tilt_[i] == 2) x.tail<2>() = hh * tilt_inertia(floes, i).ldlt().solve(F.tail<2>());
-    else if (tilt_[i] == 1) x[1] = hh * F[1] / tilt_inertia(floes, i)(0, 0);
+    const Eigen::Vector3d x = hh * (inv_mass_[i] * F);
     for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k)
       out[k] += x[0] + x[1] * fp.centroid[k].x() + x[2] * fp.centroid[k].y();
   }
@@ -518,16 +543,34 @@ void FloeSeaContact::implicit_step(Floes& floes, std::span<const FloeState> star
   }
   const Footprints& fp = footprints_;
   const std::size_t n = fp.cell.size();
+  // Each floe's vertical mass matrix diag(M, J) and its inverse on the DOFs
+  // it has (slopes it does not have: identity mass, zero inverse).
+  std::vector<Eigen::Matrix3d> mass(floes.size(), Eigen::Matrix3d::Identity());
+  inv_mass_.assign(floes.size(), Eigen::Matrix3d::Zero());
+  for (std::uint32_t i : order_) {
+    mass[i](0, 0) = floes.mass[i];
+    inv_mass_[i](0, 0) = 1.0 / floes.mass[i];
+    if (tilt_[i] == 2) {
+      const Eigen::Matrix2d J = tilt_inertia(floes, i);
+      mass[i].bottomRightCorner<2, 2>() = J;
+      inv_mass_[i].bottomRightCorner<2, 2>() = J.inverse();
+    } else if (tilt_[i] == 1) {
+      mass[i](1, 1) = tilt_inertia(floes, i)(0, 0);
+      inv_mass_[i](1, 1) = 1.0 / mass[i](1, 1);
+    }
+  }
   grid_work_.assign(grid_.size(), 0.0);
   grid_eta_.resize(grid_.size());
   const double ks = s_ * kappa_;
   // Per piece: the spring coefficient c = s kappa psi a, the penetrations at
   // t (d0) and with no penalty at t + h (dfree), both on this footprint.
-  std::vector<double> c(n, 0.0), d0(n, 0.0), dfree(n, 0.0);
+  std::vector<double> c(n, 0.0), cd(n, 0.0), d0(n, 0.0), dfree(n, 0.0);
   std::vector<Eigen::Vector3d> free_bottom(floes.size(), Eigen::Vector3d::Zero());  // z, a at t + h with no penalty
   double scale = 0.0;  // the thickest draft: the residual's unit
+  std::vector<double> guess(n, 0.0);  // Newton's start: d0 + h d0' (first order)
   {
     const std::span<const double> eta0 = sea.elevation();
+    const std::span<const double> w0 = sea.field(fluid::Field::velocity_z);
     for (std::uint32_t i : order_) {
       const FloeState& st = floes.state[i];
       const double z = st.heave + bottom0_[i];
@@ -535,9 +578,13 @@ void FloeSeaContact::implicit_step(Floes& floes, std::span<const FloeState> star
       free_bottom[i] = {z + h * st.heave_rate - 0.5 * h * h * g_, st.pitch + h * st.pitch_rate,
                         st.roll + h * st.roll_rate};
       scale = std::max(scale, floes.draft(i, rho_));
+      const double damper = (1.0 - s_) * weak_coefficient(floes, i) / h;
       for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k) {
-        c[k] = ks * subcell_weight(cells_[fp.cell[k]].coverage) * fp.area[k];
+        const double psi_area = subcell_weight(cells_[fp.cell[k]].coverage) * fp.area[k];
+        c[k] = ks * psi_area;
+        cd[k] = damper * psi_area;
         d0[k] = eta0[fp.cell[k]] - z - a.dot(fp.centroid[k]);
+        guess[k] = d0[k] + h * (w0[fp.cell[k]] - st.heave_rate - Vec2{st.pitch_rate, st.roll_rate}.dot(fp.centroid[k]));
       }
     }
   }
@@ -559,35 +606,33 @@ void FloeSeaContact::implicit_step(Floes& floes, std::span<const FloeState> star
   }
   const double self = self_response_ / cell_area_;
 
-  // Newton on R(d1) = d1 - dfree + G f(d0, d1), from d1 = d0.
-  std::vector<double> d1 = d0, f(n), df(n), R(n), Gf(n), sq(n), w(n), r(n), z(n), p(n), Ap(n), tmp(n), step(n),
+  // Newton on R(d1) = d1 - dfree + G f(d0, d1), from the guess.
+  std::vector<double> d1 = guess, f(n), df(n), R(n), Gf(n), sq(n), w(n), r(n), z(n), p(n), Ap(n), tmp(n), step(n),
       trial(n), ftrial(n);
   auto residual = [&](std::span<const double> d, std::vector<double>& force, std::vector<double>& out) {
-    for (std::size_t k = 0; k < n; ++k) force[k] = secant_force(c[k], d0[k], d[k]).f;
-    apply_response(floes, sea, h, force, out);
+    for (std::size_t k = 0; k < n; ++k) force[k] = law_force(c[k], cd[k], d0[k], d[k]).f;
+    apply_response(sea, h, force, out);
     for (std::size_t k = 0; k < n; ++k) out[k] += d[k] - dfree[k];
   };
   residual(d1, f, R);
   const double tolerance = newton_tolerance_ * std::max(scale, 1e-300);
   // Per floe, the preconditioner's small system (C^-1 + U^T D^-1 U) with
   // U = S Phi, C = h^2 / 2 M^-1, D = I + S self S (Woodbury).
-  std::vector<Eigen::Matrix3d> small(floes.size());
+  std::vector<Eigen::LDLT<Eigen::Matrix3d>> small(floes.size());
+  std::vector<double> dinv(n);  // 1 / (1 + f' self): the sea's diagonal part
   const double hh = 0.5 * h * h;
   auto precondition = [&](std::span<const double> in, std::span<double> out) {
     for (std::uint32_t i : order_) {
       Eigen::Vector3d t = Eigen::Vector3d::Zero();
       for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k) {
-        const double dinv = 1.0 / (1.0 + sq[k] * sq[k] * self);
-        out[k] = dinv * in[k];
+        out[k] = dinv[k] * in[k];
         t += sq[k] * out[k] * Eigen::Vector3d(1.0, fp.centroid[k].x(), fp.centroid[k].y());
       }
       if (tilt_[i] < 2) t[2] = 0.0;  // slopes the floe does not have
       if (tilt_[i] < 1) t[1] = 0.0;
-      const Eigen::Vector3d y = small[i].ldlt().solve(t);
-      for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k) {
-        const double dinv = 1.0 / (1.0 + sq[k] * sq[k] * self);
-        out[k] -= dinv * sq[k] * (y[0] + y[1] * fp.centroid[k].x() + y[2] * fp.centroid[k].y());
-      }
+      const Eigen::Vector3d y = small[i].solve(t);
+      for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k)
+        out[k] -= dinv[k] * sq[k] * (y[0] + y[1] * fp.centroid[k].x() + y[2] * fp.centroid[k].y());
     }
   };
   int newton = 0;
@@ -600,22 +645,19 @@ void FloeSeaContact::implicit_step(Floes& floes, std::span<const FloeState> star
       throw RunError(m.str());
     }
     for (std::size_t k = 0; k < n; ++k) {
-      df[k] = secant_force(c[k], d0[k], d1[k]).df;
+      df[k] = law_force(c[k], cd[k], d0[k], d1[k]).df;
       sq[k] = std::sqrt(df[k]);
+      dinv[k] = 1.0 / (1.0 + df[k] * self);
     }
     for (std::uint32_t i : order_) {
-      Eigen::Matrix3d m = Eigen::Matrix3d::Identity();
-      m(0, 0) = floes.mass[i] / hh;
-      if (tilt_[i] == 2) m.bottomRightCorner<2, 2>() = tilt_inertia(floes, i) / hh;
-      else if (tilt_[i] == 1) m(1, 1) = tilt_inertia(floes, i)(0, 0) / hh;
       Eigen::Matrix3d utu = Eigen::Matrix3d::Zero();
       for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k) {
         Eigen::Vector3d u = sq[k] * Eigen::Vector3d(1.0, fp.centroid[k].x(), fp.centroid[k].y());
         if (tilt_[i] < 2) u[2] = 0.0;
         if (tilt_[i] < 1) u[1] = 0.0;
-        utu += u * u.transpose() / (1.0 + sq[k] * sq[k] * self);
+        utu += dinv[k] * u * u.transpose();
       }
-      small[i] = m + utu;
+      small[i].compute(mass[i] / hh + utu);
     }
     // Conjugate gradients on (I + S G S) w = -S R.
     for (std::size_t k = 0; k < n; ++k) {
@@ -623,12 +665,16 @@ void FloeSeaContact::implicit_step(Floes& floes, std::span<const FloeState> star
       r[k] = -sq[k] * R[k];
     }
     const double bnorm = std::sqrt(dot(r, r));
+    // Inexact Newton: the linear solve need only bring the residual to a
+    // tenth of the tolerance (linear regime: one Newton step suffices), and
+    // no further than cg_tolerance.
+    const double cg_rel = std::clamp(0.1 * tolerance / norm, cg_tolerance_, 0.1);
     precondition(r, z);
     p = z;
     double rz = dot(r, z);
-    for (int it = 0; it < max_cg_ && std::sqrt(dot(r, r)) > cg_tolerance_ * bnorm; ++it) {
+    for (int it = 0; it < max_cg_ && std::sqrt(dot(r, r)) > cg_rel * bnorm; ++it) {
       for (std::size_t k = 0; k < n; ++k) tmp[k] = sq[k] * p[k];
-      apply_response(floes, sea, h, tmp, Ap);
+      apply_response(sea, h, tmp, Ap);
       for (std::size_t k = 0; k < n; ++k) Ap[k] = p[k] + sq[k] * Ap[k];
       const double alpha = rz / dot(p, Ap);
       for (std::size_t k = 0; k < n; ++k) {
@@ -643,7 +689,7 @@ void FloeSeaContact::implicit_step(Floes& floes, std::span<const FloeState> star
     }
     // The Newton step: (I + G F') step = -R, step = -R - G S w.
     for (std::size_t k = 0; k < n; ++k) tmp[k] = sq[k] * w[k];
-    apply_response(floes, sea, h, tmp, step);
+    apply_response(sea, h, tmp, step);
     for (std::size_t k = 0; k < n; ++k) step[k] = -R[k] - step[k];
     // Backtracking on the residual's norm.
     const double norm2 = std::sqrt(dot(R, R));
@@ -669,16 +715,13 @@ void FloeSeaContact::implicit_step(Floes& floes, std::span<const FloeState> star
     Eigen::Vector3d F(-floes.mass[i] * g_, 0.0, 0.0);
     for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k)
       F += f[k] * Eigen::Vector3d(1.0, fp.centroid[k].x(), fp.centroid[k].y());
-    const double az = F[0] / floes.mass[i];
-    st.heave += h * st.heave_rate + 0.5 * h * h * az;
-    st.heave_rate += h * az;
-    Vec2 aa = Vec2::Zero();
-    if (tilt_[i] == 2) aa = tilt_inertia(floes, i).ldlt().solve(F.tail<2>());
-    else if (tilt_[i] == 1) aa.x() = F[1] / tilt_inertia(floes, i)(0, 0);
-    st.pitch += h * st.pitch_rate + 0.5 * h * h * aa.x();
-    st.roll += h * st.roll_rate + 0.5 * h * h * aa.y();
-    st.pitch_rate += h * aa.x();
-    st.roll_rate += h * aa.y();
+    const Eigen::Vector3d acc = inv_mass_[i] * F;
+    st.heave += h * st.heave_rate + hh * acc[0];
+    st.pitch += h * st.pitch_rate + hh * acc[1];
+    st.roll += h * st.roll_rate + hh * acc[2];
+    st.heave_rate += h * acc[0];
+    st.pitch_rate += h * acc[1];
+    st.roll_rate += h * acc[2];
   }
   // Floes with no pieces (outside the sea) drift, as with the explicit kicks.
   for (std::size_t i = 0; i < floes.size(); ++i) {

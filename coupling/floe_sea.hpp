@@ -59,7 +59,8 @@
 // Numerical Integration, §V.5):
 //     x1 - x0 = h (x0' + x1') / 2,  M (x1' - x0') = h (sum_c Phi_c f_c - M g e_z),
 //     the sea: ModalBank::midpoint with the pressure f_c / A on node c,
-//     f_c = c_c ([d1]^+^2 - [d0]^+^2) / (2 (d1 - d0)),  c_c = s kappa psi_c a_c,
+//     f_c = c_c ([d1]^+^2 - [d0]^+^2) / (2 (d1 - d0)),  c_c = s kappa psi_c a_c
+//     (the strong part; the damper's below),
 // with d0, d1 the penetrations of piece c at t and t + h (both on the
 // footprint at the midpoint of the step's horizontal drift). Since f_c (d1 - d0) is
 // exactly the change of c_c / 2 [d]^+^2, the step conserves the floes'
@@ -77,7 +78,10 @@
 // (I + S G S) w = -S R, S = diag(f'^1/2), by conjugate gradients,
 // preconditioned per floe by its own rigid response plus the sea's response
 // on the piece's own node (Sherman–Morrison–Woodbury on the floe's 1 to 3
-// DOFs). The damper (weak) part and the horizontal forces keep their kicks.
+// DOFs). The damper (weak) part is in the same step as the impulse of
+// Lambda = c [delta]^+ over it, f_c += c psi_c a_c ([d1]^+ - [d0]^+) / h (seed
+// eq. 17 on the step: it only absorbs, f (d1 - d0) >= 0, and keeps f
+// non-decreasing in d1); the horizontal forces keep their half kicks.
 //
 // Start (MODEL.md §1): the static problem is solved first. The sea's static
 // response to a pressure is local, eta = W - p / (rho_w g) + const, W the
@@ -115,9 +119,11 @@ struct FloeSeaLoad {
 class FloeSeaContact {
 public:
   // Resolves the law (blend from a requested restitution through the
-  // calibration table), measures the sea's local inverse mass, and prepares
-  // the floes' vertical inertia.
-  FloeSeaContact(const CouplingParams& params, const SeaParams& sea_params, const Floes& floes, fluid::Sea& sea);
+  // calibration table: with the implicit integrator, of the obstacle problem
+  // stepped at dt_max on the floes' median draft), measures the sea's local
+  // inverse mass, and prepares the floes' vertical inertia.
+  FloeSeaContact(const CouplingParams& params, const SeaParams& sea_params, const Floes& floes, fluid::Sea& sea,
+                 double dt_max);
 
   // Puts the floes at rest on the sea (the static problem above), then adds
   // the sea's present waves; or (start = "given") keeps the floes' heave as given.
@@ -191,7 +197,7 @@ private:
   void rebuild_footprints(const Floes& floes);
   void implicit_step(Floes& floes, std::span<const FloeState> start, fluid::Sea& sea, double h);
   // The implicit step's operator: out = G u on the pieces (see the header).
-  void apply_response(const Floes& floes, fluid::Sea& sea, double h, std::span<const double> u, std::span<double> out);
+  void apply_response(fluid::Sea& sea, double h, std::span<const double> u, std::span<double> out);
 
   FootprintKernel kernel_ = FootprintKernel::cell;
   double rho_ = 1025.0, g_ = 9.81, sigma_ = 0.0, K_ = 1000.0, s_ = 1.0, kappa_ = 0.0;
@@ -220,6 +226,7 @@ private:
   ImplicitStats implicit_stats_;
   double self_response_h_ = -1.0, self_response_ = 0.0;  // sea's node response to its own pressure over h
   std::vector<double> grid_work_, grid_eta_;  // grid-sized scratch of the implicit step
+  std::vector<Eigen::Matrix3d> inv_mass_;     // per floe, the implicit step's (zeta, a) inverse mass
   double penalty_energy_ = 0.0;
   std::vector<std::string> notes_;
 };

@@ -65,13 +65,64 @@ double obstacle_restitution(double s, double K) {
   return 0.0;  // never leaves within 10^9 time units: absorbed
 }
 
-BlendCalibration calibrate_blend(double K, int points) {
+double stepped_obstacle_restitution(double s, double K, double h) {
+  const double v0 = std::sqrt(0.75);
+  const double ks = s * K, c = (1.0 - s) * K;
+  // Over the step from x0 to x1 (penetration delta = -x), the penalty's
+  // force held over it and its x1-derivative: the spring's discrete gradient
+  // of ks / 2 [delta]^+^2 and the damper's impulse c ([delta1]^+ - [delta0]^+) / h.
+  auto penalty = [&](double x0, double x1, double& df) {
+    const double d0 = -x0, d1 = -x1;
+    double f = 0.0;
+    df = 0.0;
+    if (d0 > 0.0 && d1 > 0.0) {
+      f = 0.5 * ks * (d0 + d1);
+      df = -0.5 * ks;
+    } else if (d0 > 0.0) {
+      f = 0.5 * ks * d0 * d0 / (d0 - d1);
+      df = -f / (d0 - d1);
+    } else if (d1 > 0.0) {
+      const double e = d1 - d0;
+      f = 0.5 * ks * d1 * d1 / e;
+      df = -0.5 * ks * d1 * (d1 - 2.0 * d0) / (e * e);
+    }
+    f += c * (std::max(d1, 0.0) - std::max(d0, 0.0)) / h;
+    if (d1 > 0.0) df -= c / h;
+    return f;
+  };
+  double x = 0.0, v = -v0;  // at the surface, going down
+  bool touched = false;
+  for (long n = 0; n < 10'000'000 && static_cast<double>(n) * h < 1e5; ++n) {
+    // x1 - x - h v - h^2 / 2 F(x1) = 0, F = 1/2 - (x + x1) / 2 + penalty:
+    // increasing in x1, solved by Newton from x + h v.
+    const double x0 = x;
+    double x1 = x + h * v, df = 0.0;
+    for (int it = 0; it < 100; ++it) {
+      const double F = 0.5 - 0.5 * (x0 + x1) + penalty(x0, x1, df);
+      const double step = (x1 - x0 - h * v - 0.5 * h * h * F) / (1.0 - 0.5 * h * h * (df - 0.5));
+      x1 -= step;
+      if (std::abs(step) <= 1e-15 * (1.0 + std::abs(x1))) break;
+    }
+    v += h * (0.5 - 0.5 * (x0 + x1) + penalty(x0, x1, df));
+    x = x1;
+    if (x < 0.0) touched = true;
+    if (touched && x >= 0.0) {
+      // Out of contact: free oscillation about 1/2 with unit frequency.
+      const double energy = 0.5 * v * v + 0.5 * (x - 0.5) * (x - 0.5);
+      return std::sqrt(std::max(2.0 * energy - 0.25, 0.0)) / v0;
+    }
+  }
+  return 0.0;  // still in contact after 10^5 time units: absorbed
+}
+
+BlendCalibration calibrate_blend(double K, int points, double step) {
   // Tabulated along the damping ratio zeta = (1 - s) sqrt(K / s) / 2, where e
   // varies (for large K all of it happens within 1 - s ~ 1 / sqrt(K)):
   // s = q^2 with q^2 + b q - 1 = 0, b = 2 zeta / sqrt(K); zeta from 0 (s = 1)
   // log-spaced over 10^-3 .. 10^3, then s = 0.
   BlendCalibration cal;
   cal.stiffness = K;
+  cal.step = step;
   std::vector<double> zetas{0.0};
   for (int k = 0; k < points - 2; ++k) zetas.push_back(std::pow(10.0, -3.0 + 6.0 * k / (points - 3)));
   for (double zeta : zetas) {
@@ -81,7 +132,33 @@ BlendCalibration calibrate_blend(double K, int points) {
   }
   cal.share.push_back(0.0);
   std::reverse(cal.share.begin(), cal.share.end());  // increasing s
-  for (double s : cal.share) cal.restitution.push_back(obstacle_restitution(s, K));
+  for (double s : cal.share)
+    cal.restitution.push_back(step > 0.0 ? stepped_obstacle_restitution(s, K, step) : obstacle_restitution(s, K));
+  // Stepped at a coarse step, e(s) is steep where the contact shortens to a
+  // step: refine the table (s halved between neighbours) where e jumps by
+  // more than 0.01, so that interpolation meets a requested e within 0.02.
+  if (step > 0.0) {
+    for (std::size_t k = 0; k + 1 < cal.share.size() && cal.share.size() < 4000;) {
+      const double ds = cal.share[k + 1] - cal.share[k];
+      if (std::abs(cal.restitution[k + 1] - cal.restitution[k]) > 0.01 && ds > 1e-9 * cal.share[k + 1]) {
+        const double s = cal.share[k] + 0.5 * ds;
+        cal.share.insert(cal.share.begin() + static_cast<std::ptrdiff_t>(k + 1), s);
+        cal.restitution.insert(cal.restitution.begin() + static_cast<std::ptrdiff_t>(k + 1),
+                               stepped_obstacle_restitution(s, K, step));
+      } else {
+        ++k;
+      }
+    }
+  }
+  // Stepped, e(s) is monotone only from s = 1 down to where it first
+  // reaches its lowest: below that the contact lasts less than a step and e
+  // is the step's artefact. The table keeps that branch.
+  if (step > 0.0) {
+    std::size_t first = cal.restitution.size() - 1;
+    while (first > 0 && cal.restitution[first - 1] <= cal.restitution[first] + 1e-12) --first;
+    cal.share.erase(cal.share.begin(), cal.share.begin() + static_cast<std::ptrdiff_t>(first));
+    cal.restitution.erase(cal.restitution.begin(), cal.restitution.begin() + static_cast<std::ptrdiff_t>(first));
+  }
   // Round-off may leave the table flat at its ends; keep it non-decreasing.
   for (std::size_t k = 1; k < cal.restitution.size(); ++k)
     cal.restitution[k] = std::max(cal.restitution[k], cal.restitution[k - 1]);

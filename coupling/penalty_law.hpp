@@ -34,15 +34,30 @@ struct PenaltyLawParams {
 };
 
 // Restitution of the obstacle problem above for a share s and stiffness K
-// (integrated accurately: RK4 with 400 steps per contact time scale).
+// (the contact phase in closed form: the continuous law).
 double obstacle_restitution(double strong_share, double stiffness);
+
+// The same obstacle problem stepped as the implicit floe–sea integrator steps
+// a floe ([coupling] integrator = "implicit", coupling/floe_sea.hpp), with
+// the step `dt` in units of sqrt(d / g): the implicit midpoint rule with the
+// spring's discrete gradient and the damper's impulse over the step,
+// c ([delta1]^+ - [delta0]^+) (the seed's eq. 17 on the step). Entering at
+// the surface with the speed of the continuous problem, e is the speed the
+// mass would have on returning to the surface, from its energy once it is
+// out of contact. Monotone in s only down to where the contact lasts about
+// a step (calibrate_blend keeps that branch).
+double stepped_obstacle_restitution(double strong_share, double stiffness, double dt);
 
 struct BlendCalibration {
   double stiffness = 0.0;
+  double step = 0.0;  // the stepped problem's dt (units of sqrt(d / g)); 0: the continuous law
   std::vector<double> share, restitution;  // increasing in both
   // The share s that gives restitution e (monotone cubic interpolation).
   double share_for(double e) const;
 };
-BlendCalibration calibrate_blend(double stiffness, int points = 61);
+// The table s -> e of the continuous law (step = 0) or of the stepped one
+// (its monotone branch from s = 1 down: lower e are out of reach at that step,
+// and share_for gives the branch's end).
+BlendCalibration calibrate_blend(double stiffness, int points = 61, double step = 0.0);
 
 }  // namespace floesim

@@ -62,7 +62,7 @@ Simulation::Simulation(Scenario scenario) : scenario_(std::move(scenario)) {
   const Floes& f = scenario_.floes;
   const bool any_dynamic = std::any_of(f.is_static.begin(), f.is_static.end(), [](std::uint8_t s) { return !s; });
   if (sea_ && any_dynamic) {
-    floe_sea_ = std::make_unique<FloeSeaContact>(c.coupling, c.sea, scenario_.floes, *sea_);
+    floe_sea_ = std::make_unique<FloeSeaContact>(c.coupling, c.sea, scenario_.floes, *sea_, c.run.dt_max);
     if (c.sea.waves.kind != WaveKind::none || c.sea.tank.enabled)
       incident_ = std::make_unique<IncidentSea>(fluid::make_sea(c.sea, c.run.seed, sea_options),
                                                 IncidentSea::interval_for(c.sea));
