@@ -665,14 +665,11 @@ void FloeSeaContact::implicit_step(Floes& floes, std::span<const FloeState> star
       r[k] = -sq[k] * R[k];
     }
     const double bnorm = std::sqrt(dot(r, r));
-    // Inexact Newton: the linear solve need only bring the residual to a
-    // tenth of the tolerance (linear regime: one Newton step suffices), and
-    // no further than cg_tolerance.
-    const double cg_rel = std::clamp(0.1 * tolerance / norm, cg_tolerance_, 0.1);
+
     precondition(r, z);
     p = z;
     double rz = dot(r, z);
-    for (int it = 0; it < max_cg_ && std::sqrt(dot(r, r)) > cg_rel * bnorm; ++it) {
+    for (int it = 0; it < max_cg_ && std::sqrt(dot(r, r)) > cg_tolerance_ * bnorm; ++it) {
       for (std::size_t k = 0; k < n; ++k) tmp[k] = sq[k] * p[k];
       apply_response(sea, h, tmp, Ap);
       for (std::size_t k = 0; k < n; ++k) Ap[k] = p[k] + sq[k] * Ap[k];
