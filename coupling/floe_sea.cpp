@@ -7,6 +7,7 @@
 #include <Eigen/Dense>
 
 #include "core/error.hpp"
+#include "coupling/incident.hpp"
 #include "coupling/penalty_law.hpp"
 #include "fluid/sea.hpp"
 
@@ -109,6 +110,7 @@ FloeSeaContact::FloeSeaContact(const CouplingParams& params, const SeaParams& se
 }
 
 void FloeSeaContact::floes_changed(const Floes& floes) {
+  loads_h_ = -1.0;  // the loads and the water velocity are the old floes'
   const std::size_t n = floes.size(), old = bottom0_.size();
   dynamic_.assign(n, 0);
   tilt_.assign(n, 0);
@@ -312,6 +314,7 @@ void FloeSeaContact::rebuild_footprints(const Floes& floes) {
 
 void FloeSeaContact::evaluate(const Floes& floes, fluid::Sea& sea, double h) {
   pressure_kicked_ = false;
+  loads_h_ = h;
   rebuild_footprints(floes);
   const Footprints& fp = footprints_;
   const std::span<const double> eta = sea.elevation();
@@ -399,6 +402,37 @@ void FloeSeaContact::evaluate(const Floes& floes, fluid::Sea& sea, double h) {
   penalty_energy_ = energy;
 }
 
+void FloeSeaContact::evaluate_loads(const Floes& floes, fluid::Sea& sea, IncidentSea* incident, double h) {
+  evaluate(floes, sea, h);
+  update_water(floes, sea, incident);
+}
+
+void FloeSeaContact::ready_loads(const Floes& floes, fluid::Sea& sea, IncidentSea* incident, double h) {
+  // Only the explicit damper's loads depend on the kick length.
+  const bool explicit_damper = !implicit_ && s_ < 1.0;
+  if (loads_h_ < 0.0 || (explicit_damper && loads_h_ != h)) evaluate_loads(floes, sea, incident, h);
+}
+
+void FloeSeaContact::update_water(const Floes& floes, const fluid::Sea& sea, IncidentSea* incident) {
+  water_.assign(floes.size(), Vec2::Zero());
+  if (!incident) return;
+  incident->advance_to(sea.time());
+  const double w = incident->weight(sea.time());
+  const std::span<const double> u0 = incident->u0(), v0 = incident->v0(), u1 = incident->u1(), v1 = incident->v1();
+  const Footprints& fp = footprints_;
+  for (std::size_t i = 0; i < std::min(floes.size(), fp.floes()); ++i) {
+    double area = 0.0;
+    Vec2 sum0 = Vec2::Zero(), sum1 = Vec2::Zero();
+    for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k) {
+      const std::uint32_t c = fp.cell[k];
+      area += fp.area[k];
+      sum0 += fp.area[k] * Vec2{u0[c], v0[c]};
+      sum1 += fp.area[k] * Vec2{u1[c], v1[c]};
+    }
+    if (area > 0.0) water_[i] = ((1.0 - w) * sum0 + w * sum1) / area;
+  }
+}
+
 void FloeSeaContact::kick_sea(fluid::Sea& sea, double h) {
   if (implicit_) return;  // the implicit step applies the whole vertical law
   if (pressure_kicked_) {
@@ -409,7 +443,9 @@ void FloeSeaContact::kick_sea(fluid::Sea& sea, double h) {
   }
 }
 
-void FloeSeaContact::kick_floes(Floes& floes, double h) const {
+void FloeSeaContact::kick_floes(Floes& floes, double h) {
+  // The explicit damper's loads depend on the rates this kick changes.
+  if (!implicit_ && s_ < 1.0) loads_h_ = -1.0;
   for (std::size_t i = 0; i < floes.size(); ++i) {
     if (!dynamic_[i]) continue;
     FloeState& st = floes.state[i];
@@ -733,24 +769,6 @@ void FloeSeaContact::implicit_step(Floes& floes, std::span<const FloeState> star
   for (std::size_t k = 0; k < n; ++k) grid_work_[fp.cell[k]] += f[k] * inv_cell_area;
   sea.midpoint_step(grid_work_, h);
   for (std::size_t k = 0; k < n; ++k) grid_work_[fp.cell[k]] = 0.0;
-}
-
-void FloeSeaContact::mean_velocity(const Floes& floes, std::span<const double> u0, std::span<const double> v0,
-                                   std::span<const double> u1, std::span<const double> v1, double w,
-                                   std::vector<Vec2>& out) const {
-  out.assign(floes.size(), Vec2::Zero());
-  const Footprints& fp = footprints_;
-  for (std::size_t i = 0; i < std::min(floes.size(), fp.floes()); ++i) {
-    double area = 0.0;
-    Vec2 sum0 = Vec2::Zero(), sum1 = Vec2::Zero();
-    for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k) {
-      const std::uint32_t c = fp.cell[k];
-      area += fp.area[k];
-      sum0 += fp.area[k] * Vec2{u0[c], v0[c]};
-      sum1 += fp.area[k] * Vec2{u1[c], v1[c]};
-    }
-    if (area > 0.0) out[i] = ((1.0 - w) * sum0 + w * sum1) / area;
-  }
 }
 
 double FloeSeaContact::floes_vertical_kinetic(const Floes& floes) const {

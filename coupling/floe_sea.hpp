@@ -109,6 +109,7 @@
 namespace floesim {
 
 namespace fluid { class Sea; }
+class IncidentSea;
 
 // Loads of the sea on floe i, world frame.
 struct FloeSeaLoad {
@@ -129,25 +130,30 @@ public:
   // the sea's present waves; or (start = "given") keeps the floes' heave as given.
   void start(Floes& floes, fluid::Sea& sea, bool given);
 
-  // Evaluates the contact at the present state for a kick of length h: the
-  // pressure on the sea grid and the loads on the floes. With the implicit
-  // integrator the spring's vertical part and the weight are left out of the
-  // pressure and the vertical loads (advance_vertical applies them); the
-  // horizontal forces and the penalty energy are the same.
-  void evaluate(const Floes& floes, fluid::Sea& sea, double h);
-  // Apply the last evaluation over h: to the floes' vertical and horizontal
-  // rates; to the sea's modal velocities (a second kick_sea with the same
-  // evaluation repeats the sea's last kick, without projecting the pressure
-  // again: nothing else may kick the sea in between).
-  void kick_floes(Floes& floes, double h) const;
+  // The loads cache: this class alone knows whether its loads still hold.
+  // One evaluation of the contact gives the loads on the floes, the pressure
+  // on the sea (and whether the sea was already kicked with it) and the
+  // incident waves' velocity under each floe (for drag). An evaluation at
+  // the end of a step (evaluate_loads) serves its second half kicks and,
+  // unless it went stale, the first half kick of the next step (ready_loads).
+  // It goes stale when the floes change (a split: floes_changed), when the
+  // kick it served changed the rates it depends on (the explicit damper),
+  // or, for the explicit damper, when the kick length changes.
+  //
+  // With the implicit integrator the vertical law and the weight are left out
+  // of the pressure and the vertical loads (advance_vertical applies them);
+  // the horizontal forces and the penalty energy are the same.
+  void evaluate_loads(const Floes& floes, fluid::Sea& sea, IncidentSea* incident, double h);
+  void ready_loads(const Floes& floes, fluid::Sea& sea, IncidentSea* incident, double h);
+  // Apply the loads over h: to the floes' vertical and horizontal rates; to
+  // the sea's modal velocities (a second kick_sea with the same evaluation
+  // repeats the sea's last kick, without projecting the pressure again:
+  // nothing else may kick the sea in between).
+  void kick_floes(Floes& floes, double h);
   void kick_sea(fluid::Sea& sea, double h);
-
-  // Mean over each floe's footprint (weights a_c) of the velocity field
-  // (1 - w) (u0, v0) + w (u1, v1) (m/s, world): the incident waves' orbital
-  // velocity for drag (coupling/incident.hpp).
-  void mean_velocity(const Floes& floes, std::span<const double> u0, std::span<const double> v0,
-                     std::span<const double> u1, std::span<const double> v1, double w,
-                     std::vector<Vec2>& out) const;
+  // The incident waves' orbital velocity under each floe (m/s, world), the
+  // mean over its footprint, at the time of the loads' evaluation.
+  std::span<const Vec2> water_velocity() const { return water_; }
 
   // Implicit integrator: advances the floes' vertical DOFs and the sea over h
   // (the floes' horizontal positions already at t + h, `start` the floes at
@@ -195,6 +201,11 @@ private:
   // Clears the cells of the present footprints, builds them at the floes'
   // positions and sums the cells' coverage (cells_[c].coverage).
   void rebuild_footprints(const Floes& floes);
+  // The contact at the present state for a kick of length h (see evaluate_loads).
+  void evaluate(const Floes& floes, fluid::Sea& sea, double h);
+  // Mean over each floe's footprint (weights a_c) of the incident waves'
+  // velocity at the sea's time (zero without incident waves).
+  void update_water(const Floes& floes, const fluid::Sea& sea, IncidentSea* incident);
   void implicit_step(Floes& floes, std::span<const FloeState> start, fluid::Sea& sea, double h);
   // The implicit step's operator: out = G u on the pieces (see the header).
   void apply_response(fluid::Sea& sea, double h, std::span<const double> u, std::span<double> out);
@@ -220,6 +231,8 @@ private:
   std::vector<CellSums> cells_;
   std::vector<std::uint32_t> order_;  // dynamic floes with pieces, by their first cell
   bool pressure_kicked_ = false;  // the sea's last kick was with pressure_ as it is
+  double loads_h_ = -1.0;         // the kick length of the last evaluation (< 0: stale)
+  std::vector<Vec2> water_;       // incident velocity under each floe, with the loads
   bool implicit_ = false;
   double newton_tolerance_ = 1e-10, cg_tolerance_ = 1e-10;
   int max_newton_ = 40, max_cg_ = 500;

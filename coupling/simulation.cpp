@@ -67,8 +67,7 @@ Simulation::Simulation(Scenario scenario) : scenario_(std::move(scenario)) {
       incident_ = std::make_unique<IncidentSea>(fluid::make_sea(c.sea, c.run.seed, sea_options),
                                                 IncidentSea::interval_for(c.sea));
     floe_sea_->start(scenario_.floes, *sea_, c.coupling.start_given);
-    evaluate_penalty(0.5 * c.run.dt_max);
-    update_water_velocity();
+    floe_sea_->ready_loads(scenario_.floes, *sea_, incident_.get(), 0.5 * c.run.dt_max);
   }
   // Pieces of a split are opened by the gap that collisions keep between floes.
   if (c.fracture.enabled) percussion_ = std::make_unique<Percussion>(c.fracture, impulse_options_.min_gap);
@@ -161,26 +160,22 @@ void Simulation::floes_half_kick(const StepContext& ctx) {
   // its half step was the same) kick the floes' vertical and horizontal rates.
   ctx_momentum_before_ = momentum();
   if (!floe_sea_) return;
-  // The strong law's loads do not depend on the kick length; the damper's do.
-  const bool depends_on_h = floe_sea_->strong_share() < 1.0;
-  if (loads_h_ < 0.0 || (depends_on_h && loads_h_ != 0.5 * ctx.dt)) evaluate_penalty(0.5 * ctx.dt);
-  if (water_stale_) update_water_velocity();
+  floe_sea_->ready_loads(scenario_.floes, *sea_, incident_.get(), 0.5 * ctx.dt);
   floe_sea_->kick_floes(scenario_.floes, 0.5 * ctx.dt);
 }
 
 void Simulation::drift(StepContext& ctx) {
   const Vec2 current{ctx.forcing.current[0], ctx.forcing.current[1]};
   const Vec2 wind{ctx.forcing.wind[0], ctx.forcing.wind[1]};
-  std::span<const Vec2> water;
+  std::vector<Vec2> water;
   if (floe_sea_) {
     // Drag relative to the current plus the incident waves' orbital velocity at t.
-    for (Vec2& w : water_velocity_) w += current;
-    water = water_velocity_;
+    const std::span<const Vec2> orbital = floe_sea_->water_velocity();
+    water.assign(orbital.begin(), orbital.end());
+    for (Vec2& w : water) w += current;
   }
   drift_velocities(scenario_.floes, quadrature_, drift_params_, current, wind, ctx.dt, 0, scenario_.floes.size(),
                    water);
-  if (floe_sea_)
-    for (Vec2& w : water_velocity_) w -= current;
   ctx.momentum = momentum();
   step_budget_.external = ctx.momentum - ctx_momentum_before_;
 }
@@ -211,8 +206,6 @@ void Simulation::on_floes_changed() {
     // A split piece keeps its parent's reference bottom (same thickness);
     // the loads are evaluated afresh for the new footprints.
     floe_sea_->floes_changed(scenario_.floes);
-    loads_h_ = -1.0;
-    water_stale_ = true;
   }
 }
 
@@ -312,37 +305,15 @@ void Simulation::sea_flow(const StepContext& ctx) {
 }
 
 void Simulation::sea_half_kick(const StepContext& ctx) {
-  // Loads at t + dt: the second half kick of the sea and of the floes. They
-  // are kept as the first half kick of the next step if its dt is the same.
+  // Loads at t + dt (and the incident waves' velocity under the floes, for
+  // the next drag): the second half kick of the sea and of the floes, and,
+  // while they hold, the first of the next step (FloeSeaContact's loads cache).
   if (!floe_sea_) return;
-  evaluate_penalty(0.5 * ctx.dt);
+  floe_sea_->evaluate_loads(scenario_.floes, *sea_, incident_.get(), 0.5 * ctx.dt);
   const Vec2 before = momentum();
   floe_sea_->kick_floes(scenario_.floes, 0.5 * ctx.dt);
   floe_sea_->kick_sea(*sea_, 0.5 * ctx.dt);
   step_budget_.external += momentum() - before;
-  // The water under the floes at t + dt, the sea's kick included (its rates
-  // are then synchronous with its elevation, as the floes' are).
-  update_water_velocity();
-  // The damper part depends on the rates the kick just changed: evaluate it
-  // afresh at the next step.
-  if (floe_sea_->strong_share() < 1.0) loads_h_ = -1.0;
-}
-
-void Simulation::evaluate_penalty(double h) {
-  floe_sea_->evaluate(scenario_.floes, *sea_, h);
-  loads_h_ = h;
-}
-
-void Simulation::update_water_velocity() {
-  // The incident waves' velocity over the footprints of the last evaluate_penalty.
-  if (incident_) {
-    incident_->advance_to(sea_->time());
-    floe_sea_->mean_velocity(scenario_.floes, incident_->u0(), incident_->v0(), incident_->u1(), incident_->v1(),
-                             incident_->weight(sea_->time()), water_velocity_);
-  } else {
-    water_velocity_.assign(scenario_.floes.size(), Vec2::Zero());
-  }
-  water_stale_ = false;
 }
 
 void Simulation::check_state(const StepContext& ctx) const {

@@ -139,8 +139,6 @@ private:
   void sea_flow(const StepContext& ctx);
   void floes_half_kick(const StepContext& ctx);
   void sea_half_kick(const StepContext& ctx);
-  void evaluate_penalty(double h);
-  void update_water_velocity();  // incident orbital velocity under each floe, for drag
   void drift(StepContext& ctx);
   void collide(StepContext& ctx);
   void percussion(StepContext& ctx);
@@ -157,10 +155,7 @@ private:
   // The incident waves (coupling/incident.hpp), for drag; none on a calm sea
   // without wave generation (its velocity is 0).
   std::unique_ptr<IncidentSea> incident_;
-  double loads_h_ = -1.0;             // the kick length the floe–sea loads were evaluated for (< 0: stale)
   double equal_dt_ = -1.0;            // the last of the equal steps the penalty limit asked for
-  std::vector<Vec2> water_velocity_;  // incident orbital velocity under each floe at t, for drag
-  bool water_stale_ = false;          // the floes changed since water_velocity_ was made
   Vec2 ctx_momentum_before_ = Vec2::Zero();  // of the floes at the start of the step's try
   DriftParams drift_params_;
   FootprintQuadrature quadrature_;
