@@ -68,6 +68,7 @@ void add_run_command(CLI::App& app, Registry& registry) {
   struct Args {
     std::string config, output;
     double until = -1.0;
+    int threads = -1;
     bool quiet = false, profile = false;
   };
   auto args = std::make_shared<Args>();
@@ -76,6 +77,8 @@ void add_run_command(CLI::App& app, Registry& registry) {
   sub->add_option("-o,--output", args->output, "Run file to write (default: CONFIG's name with .h5, here)");
   sub->add_option("--until", args->until, "Stop at this time (s) instead of [run] t_end")
       ->check(CLI::NonNegativeNumber);
+  sub->add_option("--threads", args->threads, "Threads for the per-floe phases (default: [run] threads; 0: one per core)")
+      ->check(CLI::Range(0, 1024));
   sub->add_flag("-q,--quiet", args->quiet, "No progress line");
   sub->add_flag("--profile", args->profile, "Print the time spent in each phase of the step");
   registry[sub] = [args] {
@@ -86,7 +89,9 @@ void add_run_command(CLI::App& app, Registry& registry) {
     if (fs::exists(output) && fs::equivalent(output, config_path))
       throw InputError(output + ": the output would overwrite the configuration");
 
-    Simulation sim(build_scenario(load_config(config_path)));
+    Config config = load_config(config_path);
+    if (args->threads >= 0) config.run.threads = args->threads;
+    Simulation sim(build_scenario(std::move(config)));
     for (const std::string& note : sim.notes()) std::cerr << "floesim: note: " << note << "\n";
 
     ProgressLine progress(!args->quiet && isatty(STDERR_FILENO));
@@ -136,8 +141,9 @@ void add_run_command(CLI::App& app, Registry& registry) {
     if (const FloeSeaContact* fs = sim.floe_sea(); fs && fs->implicit()) {
       const FloeSeaContact::ImplicitStats& st = fs->implicit_stats();
       const double steps = std::max<double>(1.0, static_cast<double>(st.steps));
-      o << "implicit.newton_per_step: " << st.newton / steps << "\nimplicit.cg_per_step: " << st.cg / steps
-        << "\nimplicit.sea_responses_per_step: " << st.g_products / steps << "\n";
+      o << "implicit.newton_per_step: " << static_cast<double>(st.newton) / steps
+        << "\nimplicit.cg_per_step: " << static_cast<double>(st.cg) / steps
+        << "\nimplicit.sea_responses_per_step: " << static_cast<double>(st.g_products) / steps << "\n";
     }
     o << "warnings: " << s.warnings.size() << "\n";
     for (const auto& w : s.warnings) o << "  " << w << "\n";

@@ -195,6 +195,8 @@ void read_run(Section s, RunParams& r) {
   r.output_interval = s.number("output_interval", r.output_interval, positive, "an interval > 0 (s)");
   r.seed = static_cast<unsigned long>(
       s.integer("seed", static_cast<long long>(r.seed), [](long long v) { return v >= 0; }, "a seed >= 0"));
+  r.threads = static_cast<int>(s.integer("threads", r.threads, [](long long v) { return v >= 0 && v <= 1024; },
+                                         "a thread count in [0, 1024] (0: one per core)"));
   s.finish();
 }
 

@@ -17,6 +17,9 @@ struct RunParams {
   double dt_max = 0.05;           // s, upper bound on the step (the loop may take smaller)
   double output_interval = 1.0;   // s, time between records in the run file
   unsigned long seed = 1;         // seed of every random choice of the run
+  // Threads for the per-floe and per-piece phases (0: one per core). The
+  // results do not depend on it: an execution setting, not written to run files.
+  int threads = 0;
 };
 
 enum class SeaModel { none, spectral, bem };

@@ -297,7 +297,7 @@ void FloeSeaContact::rebuild_footprints(const Floes& floes) {
       cells_[c] = {};
     }
   }
-  build_footprints(floes, dynamic_, grid_, footprints_, kernel_);
+  build_footprints(floes, dynamic_, grid_, footprints_, kernel_, threads_);
   const Footprints& fp = footprints_;
   // Floes in the order of their first cell, so that floes next to each
   // other on the grid come one after the other (the grid's arrays are
@@ -324,16 +324,23 @@ void FloeSeaContact::evaluate(const Floes& floes, fluid::Sea& sea, double h) {
   // The implicit integrator applies the vertical law and the weight itself.
   const double spring_kick = implicit_ ? 0.0 : 1.0, weight = implicit_ ? 0.0 : g_;
   const double damper_kick = implicit_ ? 0.0 : 1.0 - s_;
-  double energy = 0.0;
-  thread_local std::vector<double> u;    // [delta]^+ of each area piece
-  thread_local std::vector<double> psi;  // psi of each area piece's cell
-  thread_local std::vector<double> wetted;  // per floe: sum psi_c a_c u_c
+  // Scratch shared by the threads (each writes its own floes' entries).
+  std::vector<double>& u = eval_.penetration;
+  std::vector<double>& psi = eval_.psi;
+  std::vector<double>& force = eval_.force;
+  std::vector<double>& wetted = eval_.wetted;
   u.assign(fp.cell.size(), 0.0);
   psi.resize(fp.cell.size());
+  force.assign(fp.cell.size(), 0.0);
   wetted.assign(floes.size(), 0.0);
   for (FloeSeaLoad& load : loads_) load = {};
-  // Vertical: the law on each area piece.
-  for (std::uint32_t i : order_) {
+  // Vertical: the law on each area piece, floe by floe (on threads); then
+  // the pieces' sums into the cells, in order (the same sums whatever the
+  // thread count).
+  const std::ptrdiff_t floes_in_order = static_cast<std::ptrdiff_t>(order_.size());
+#pragma omp parallel for num_threads(threads_) schedule(dynamic, 16)
+  for (std::ptrdiff_t j = 0; j < floes_in_order; ++j) {
+    const std::uint32_t i = order_[static_cast<std::size_t>(j)];
     FloeSeaLoad& load = loads_[i];
     const FloeState& st = floes.state[i];
     const double z = st.heave + bottom0_[i];
@@ -352,25 +359,34 @@ void FloeSeaContact::evaluate(const Floes& floes, fluid::Sea& sea, double h) {
       u[k] = delta;
       const double area = fp.area[k];
       double f = spring_kick * ks * ps * area * delta;
-      energy += 0.5 * ks * ps * area * delta * delta;
       wet += ps * area * delta;
-      cells_[cell].sum += area * delta * delta;
       if (c > 0.0) {
         const double rate = w[cell] - st.heave_rate - ar.dot(r);
         f += area * ps * c / (1.0 + h * ps * c * inv_mass) * rate;
       }
-      pressure_[cell] += f * inv_cell_area;
+      force[k] = f;
       fz += f;
       moment += f * r;
     }
     wetted[i] = wet;
     load.vertical = {fz - floes.mass[i] * weight, moment.x(), moment.y()};
   }
+  double energy = 0.0;
+  for (std::uint32_t i : order_)
+    for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k) {
+      if (u[k] <= 0.0) continue;
+      const double area = fp.area[k], delta = u[k];
+      energy += 0.5 * ks * psi[k] * area * delta * delta;
+      cells_[fp.cell[k]].sum += area * delta * delta;
+      pressure_[fp.cell[k]] += force[k] * inv_cell_area;
+    }
   // Strong part, horizontal: -dV/dG and -dV/dyaw through the edge pieces. The
   // coverage Phi_c moves with every floe's edge in cell c, so an edge also
   // carries psi'(Phi_c) / (2 A) sum_k a_k u_k^2 of the cell's pieces.
   if (ks > 0.0) {
-    for (std::uint32_t i : order_) {
+#pragma omp parallel for num_threads(threads_) schedule(dynamic, 16)
+    for (std::ptrdiff_t j = 0; j < floes_in_order; ++j) {
+      const std::uint32_t i = order_[static_cast<std::size_t>(j)];
       const FloeState& st = floes.state[i];
       const Vec2 a{st.pitch, st.roll};
       Vec2 fh = Vec2::Zero();
@@ -420,7 +436,9 @@ void FloeSeaContact::update_water(const Floes& floes, const fluid::Sea& sea, Inc
   const double w = incident->weight(sea.time());
   const std::span<const double> u0 = incident->u0(), v0 = incident->v0(), u1 = incident->u1(), v1 = incident->v1();
   const Footprints& fp = footprints_;
-  for (std::size_t i = 0; i < std::min(floes.size(), fp.floes()); ++i) {
+  const std::ptrdiff_t count = static_cast<std::ptrdiff_t>(std::min(floes.size(), fp.floes()));
+#pragma omp parallel for num_threads(threads_) schedule(static)
+  for (std::ptrdiff_t i = 0; i < count; ++i) {
     double area = 0.0;
     Vec2 sum0 = Vec2::Zero(), sum1 = Vec2::Zero();
     for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k) {
@@ -516,9 +534,36 @@ double max_abs(std::span<const double> x) {
   return m;
 }
 
-double dot(std::span<const double> a, std::span<const double> b) {
+// f(k) for k < n on `threads` threads (each k's work independent of the
+// others); on one thread when n is at most `grain` (not worth a fork).
+template <class F>
+void for_each_index(std::size_t n, int threads, F&& f, std::size_t grain = 4096) {
+  const auto count = static_cast<std::ptrdiff_t>(n);
+#pragma omp parallel for num_threads(threads) schedule(static) if (n > grain)
+  for (std::ptrdiff_t k = 0; k < count; ++k) f(static_cast<std::size_t>(k));
+}
+
+// f(i) for the floes of `order` on threads.
+template <class F>
+void for_each_floe(const std::vector<std::uint32_t>& order, int threads, F&& f) {
+  const auto count = static_cast<std::ptrdiff_t>(order.size());
+#pragma omp parallel for num_threads(threads) schedule(dynamic, 16) if (count > 32)
+  for (std::ptrdiff_t j = 0; j < count; ++j) f(order[static_cast<std::size_t>(j)]);
+}
+
+// a . b summed in fixed blocks, then the blocks in order: the same bits
+// whatever the thread count.
+double dot(std::span<const double> a, std::span<const double> b, int threads) {
+  constexpr std::size_t kBlock = 2048;
+  const std::size_t blocks = (a.size() + kBlock - 1) / kBlock;
+  std::vector<double> partial(blocks, 0.0);
+  for_each_index(blocks, threads, [&](std::size_t block) {
+    double s = 0.0;
+    for (std::size_t k = block * kBlock; k < std::min(a.size(), (block + 1) * kBlock); ++k) s += a[k] * b[k];
+    partial[block] = s;
+  }, 2);
   double s = 0.0;
-  for (std::size_t k = 0; k < a.size(); ++k) s += a[k] * b[k];
+  for (double x : partial) s += x;
   return s;
 }
 
@@ -529,22 +574,21 @@ void FloeSeaContact::apply_response(fluid::Sea& sea, double h, std::span<const d
   const double inv_cell_area = 1.0 / cell_area_;
   // The sea: the pressure of the forces u, held over h, lowers the nodes by
   // the midpoint response (G_sea u is minus that change).
+  // (The scatter is in order: pieces of several floes share nodes.)
   for (std::size_t k = 0; k < fp.cell.size(); ++k) grid_work_[fp.cell[k]] += u[k] * inv_cell_area;
   sea.midpoint_response(grid_work_, h, grid_eta_);
-  for (std::size_t k = 0; k < fp.cell.size(); ++k) {
-    out[k] = -grid_eta_[fp.cell[k]];
-    grid_work_[fp.cell[k]] = 0.0;
-  }
+  for_each_index(fp.cell.size(), threads_, [&](std::size_t k) { out[k] = -grid_eta_[fp.cell[k]]; });
+  for (std::uint32_t c : fp.cell) grid_work_[c] = 0.0;
   // The floes: each one's bottom rises by h^2 / 2 M^-1 of the forces' resultant.
   const double hh = 0.5 * h * h;
-  for (std::uint32_t i : order_) {
+  for_each_floe(order_, threads_, [&](std::uint32_t i) {
     Eigen::Vector3d F = Eigen::Vector3d::Zero();
     for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k)
       F += u[k] * Eigen::Vector3d(1.0, fp.centroid[k].x(), fp.centroid[k].y());
     const Eigen::Vector3d x = hh * (inv_mass_[i] * F);
     for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k)
       out[k] += x[0] + x[1] * fp.centroid[k].x() + x[2] * fp.centroid[k].y();
-  }
+  });
   ++implicit_stats_.g_products;
 }
 
@@ -607,13 +651,13 @@ void FloeSeaContact::implicit_step(Floes& floes, std::span<const FloeState> star
   {
     const std::span<const double> eta0 = sea.elevation();
     const std::span<const double> w0 = sea.field(fluid::Field::velocity_z);
-    for (std::uint32_t i : order_) {
+    for (std::uint32_t i : order_) scale = std::max(scale, floes.draft(i, rho_));
+    for_each_floe(order_, threads_, [&](std::uint32_t i) {
       const FloeState& st = floes.state[i];
       const double z = st.heave + bottom0_[i];
       const Vec2 a{st.pitch, st.roll};
       free_bottom[i] = {z + h * st.heave_rate - 0.5 * h * h * g_, st.pitch + h * st.pitch_rate,
                         st.roll + h * st.roll_rate};
-      scale = std::max(scale, floes.draft(i, rho_));
       const double damper = (1.0 - s_) * weak_coefficient(floes, i) / h;
       for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k) {
         const double psi_area = subcell_weight(cells_[fp.cell[k]].coverage) * fp.area[k];
@@ -622,14 +666,14 @@ void FloeSeaContact::implicit_step(Floes& floes, std::span<const FloeState> star
         d0[k] = eta0[fp.cell[k]] - z - a.dot(fp.centroid[k]);
         guess[k] = d0[k] + h * (w0[fp.cell[k]] - st.heave_rate - Vec2{st.pitch_rate, st.roll_rate}.dot(fp.centroid[k]));
       }
-    }
+    });
   }
   sea.midpoint_free_elevation(h, grid_eta_);
-  for (std::uint32_t i : order_) {
+  for_each_floe(order_, threads_, [&](std::uint32_t i) {
     const Eigen::Vector3d& b = free_bottom[i];
     for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k)
       dfree[k] = grid_eta_[fp.cell[k]] - b[0] - b[1] * fp.centroid[k].x() - b[2] * fp.centroid[k].y();
-  }
+  });
   // The sea's response on a node to its own pressure over h: the diagonal of
   // G_sea, for the preconditioner (a periodic sea's is the same on every node).
   if (self_response_h_ != h) {
@@ -646,9 +690,9 @@ void FloeSeaContact::implicit_step(Floes& floes, std::span<const FloeState> star
   std::vector<double> d1 = guess, f(n), df(n), R(n), Gf(n), sq(n), w(n), r(n), z(n), p(n), Ap(n), tmp(n), step(n),
       trial(n), ftrial(n);
   auto residual = [&](std::span<const double> d, std::vector<double>& force, std::vector<double>& out) {
-    for (std::size_t k = 0; k < n; ++k) force[k] = law_force(c[k], cd[k], d0[k], d[k]).f;
+    for_each_index(n, threads_, [&](std::size_t k) { force[k] = law_force(c[k], cd[k], d0[k], d[k]).f; });
     apply_response(sea, h, force, out);
-    for (std::size_t k = 0; k < n; ++k) out[k] += d[k] - dfree[k];
+    for_each_index(n, threads_, [&](std::size_t k) { out[k] += d[k] - dfree[k]; });
   };
   residual(d1, f, R);
   const double tolerance = newton_tolerance_ * std::max(scale, 1e-300);
@@ -658,7 +702,7 @@ void FloeSeaContact::implicit_step(Floes& floes, std::span<const FloeState> star
   std::vector<double> dinv(n);  // 1 / (1 + f' self): the sea's diagonal part
   const double hh = 0.5 * h * h;
   auto precondition = [&](std::span<const double> in, std::span<double> out) {
-    for (std::uint32_t i : order_) {
+    for_each_floe(order_, threads_, [&](std::uint32_t i) {
       Eigen::Vector3d t = Eigen::Vector3d::Zero();
       for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k) {
         out[k] = dinv[k] * in[k];
@@ -669,7 +713,7 @@ void FloeSeaContact::implicit_step(Floes& floes, std::span<const FloeState> star
       const Eigen::Vector3d y = small[i].solve(t);
       for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k)
         out[k] -= dinv[k] * sq[k] * (y[0] + y[1] * fp.centroid[k].x() + y[2] * fp.centroid[k].y());
-    }
+    });
   };
   int newton = 0;
   double norm = max_abs(R);
@@ -680,12 +724,12 @@ void FloeSeaContact::implicit_step(Floes& floes, std::span<const FloeState> star
         << norm << " m, tolerance " << tolerance << " m; dt = " << h << " s)";
       throw RunError(m.str());
     }
-    for (std::size_t k = 0; k < n; ++k) {
+    for_each_index(n, threads_, [&](std::size_t k) {
       df[k] = law_force(c[k], cd[k], d0[k], d1[k]).df;
       sq[k] = std::sqrt(df[k]);
       dinv[k] = 1.0 / (1.0 + df[k] * self);
-    }
-    for (std::uint32_t i : order_) {
+    });
+    for_each_floe(order_, threads_, [&](std::uint32_t i) {
       Eigen::Matrix3d utu = Eigen::Matrix3d::Zero();
       for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k) {
         Eigen::Vector3d u = sq[k] * Eigen::Vector3d(1.0, fp.centroid[k].x(), fp.centroid[k].y());
@@ -694,43 +738,44 @@ void FloeSeaContact::implicit_step(Floes& floes, std::span<const FloeState> star
         utu += dinv[k] * u * u.transpose();
       }
       small[i].compute(mass[i] / hh + utu);
-    }
+    });
     // Conjugate gradients on (I + S G S) w = -S R.
-    for (std::size_t k = 0; k < n; ++k) {
+    for_each_index(n, threads_, [&](std::size_t k) {
       w[k] = 0.0;
       r[k] = -sq[k] * R[k];
-    }
-    const double bnorm = std::sqrt(dot(r, r));
+    });
+    const double bnorm = std::sqrt(dot(r, r, threads_));
 
     precondition(r, z);
     p = z;
-    double rz = dot(r, z);
-    for (int it = 0; it < max_cg_ && std::sqrt(dot(r, r)) > cg_tolerance_ * bnorm; ++it) {
-      for (std::size_t k = 0; k < n; ++k) tmp[k] = sq[k] * p[k];
+    double rz = dot(r, z, threads_);
+    for (int it = 0; it < max_cg_ && std::sqrt(dot(r, r, threads_)) > cg_tolerance_ * bnorm; ++it) {
+      for_each_index(n, threads_, [&](std::size_t k) { tmp[k] = sq[k] * p[k]; });
       apply_response(sea, h, tmp, Ap);
-      for (std::size_t k = 0; k < n; ++k) Ap[k] = p[k] + sq[k] * Ap[k];
-      const double alpha = rz / dot(p, Ap);
-      for (std::size_t k = 0; k < n; ++k) {
+      for_each_index(n, threads_, [&](std::size_t k) { Ap[k] = p[k] + sq[k] * Ap[k]; });
+      const double alpha = rz / dot(p, Ap, threads_);
+      for_each_index(n, threads_, [&](std::size_t k) {
         w[k] += alpha * p[k];
         r[k] -= alpha * Ap[k];
-      }
+      });
       precondition(r, z);
-      const double rz_new = dot(r, z);
-      for (std::size_t k = 0; k < n; ++k) p[k] = z[k] + rz_new / rz * p[k];
+      const double rz_new = dot(r, z, threads_);
+      const double beta = rz_new / rz;
+      for_each_index(n, threads_, [&](std::size_t k) { p[k] = z[k] + beta * p[k]; });
       rz = rz_new;
       ++implicit_stats_.cg;
     }
     // The Newton step: (I + G F') step = -R, step = -R - G S w.
-    for (std::size_t k = 0; k < n; ++k) tmp[k] = sq[k] * w[k];
+    for_each_index(n, threads_, [&](std::size_t k) { tmp[k] = sq[k] * w[k]; });
     apply_response(sea, h, tmp, step);
-    for (std::size_t k = 0; k < n; ++k) step[k] = -R[k] - step[k];
+    for_each_index(n, threads_, [&](std::size_t k) { step[k] = -R[k] - step[k]; });
     // Backtracking on the residual's norm.
-    const double norm2 = std::sqrt(dot(R, R));
+    const double norm2 = std::sqrt(dot(R, R, threads_));
     double t = 1.0;
     for (;;) {
-      for (std::size_t k = 0; k < n; ++k) trial[k] = d1[k] + t * step[k];
+      for_each_index(n, threads_, [&](std::size_t k) { trial[k] = d1[k] + t * step[k]; });
       residual(trial, ftrial, tmp);
-      if (std::sqrt(dot(tmp, tmp)) < (1.0 - 1e-4 * t) * norm2 || t < 1e-6) break;
+      if (std::sqrt(dot(tmp, tmp, threads_)) < (1.0 - 1e-4 * t) * norm2 || t < 1e-6) break;
       t *= 0.5;
     }
     d1.swap(trial);

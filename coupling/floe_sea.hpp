@@ -98,6 +98,7 @@
 // at K = 1000, would hold many times the floe's weight). The sea keeps the
 // waves' rates; each floe takes their least-squares plane.
 
+#include <algorithm>
 #include <span>
 #include <string>
 #include <vector>
@@ -163,6 +164,8 @@ public:
   // converge.
   void advance_vertical(Floes& floes, std::span<const FloeState> start, fluid::Sea& sea, double h);
   bool implicit() const { return implicit_; }
+  // Threads for the per-floe and per-piece work (results do not depend on it).
+  void set_threads(int threads) { threads_ = std::max(threads, 1); }
   struct ImplicitStats {
     long steps = 0, newton = 0, cg = 0, g_products = 0;  // totals over the run
     double last_residual = 0.0;  // m, the last step's largest piece residual
@@ -234,12 +237,19 @@ private:
   double loads_h_ = -1.0;         // the kick length of the last evaluation (< 0: stale)
   std::vector<Vec2> water_;       // incident velocity under each floe, with the loads
   bool implicit_ = false;
+  int threads_ = 1;
   double newton_tolerance_ = 1e-10, cg_tolerance_ = 1e-10;
   int max_newton_ = 40, max_cg_ = 500;
   ImplicitStats implicit_stats_;
   double self_response_h_ = -1.0, self_response_ = 0.0;  // sea's node response to its own pressure over h
   std::vector<double> grid_work_, grid_eta_;  // grid-sized scratch of the implicit step
   std::vector<Eigen::Matrix3d> inv_mass_;     // per floe, the implicit step's (zeta, a) inverse mass
+  struct EvaluationScratch {
+    std::vector<double> penetration;  // [delta]^+ of each area piece
+    std::vector<double> psi;          // psi of each area piece's cell
+    std::vector<double> force;        // of each area piece on the sea (N)
+    std::vector<double> wetted;       // per floe: sum psi_c a_c [delta_c]^+
+  } eval_;
   double penalty_energy_ = 0.0;
   std::vector<std::string> notes_;
 };

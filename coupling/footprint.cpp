@@ -234,14 +234,12 @@ void merge_wrapped(Footprints& out, std::size_t first_piece, Scratch& s) {
 // integrated exactly by 3-point Gauss–Legendre (degree <= 4). With dims = 1
 // there is one row and no t in the tents: t is y relative to G (dy = 1).
 void build_tent(const Floes& floes, std::span<const std::uint8_t> include, const fluid::SurfaceGrid& grid,
-                Footprints& out, Scratch& s) {
-  if (grid.edge != fluid::GridEdge::periodic)
-    throw std::invalid_argument("the tent footprint kernel needs a periodic grid");
+                Footprints& out, Scratch& s, std::size_t first, std::size_t last) {
   const bool two_d = grid.dims == 2;
   const double dx = grid.dx(), dy = two_d ? grid.dy() : 1.0, inv_dx = 1.0 / dx, inv_dy = 1.0 / dy;
   const double area_element = dx * (two_d ? dy : 1.0);
   const double tiny = 1e-12 * dx * (two_d ? grid.dy() : grid.ly);
-  for (std::size_t f = 0; f < floes.size(); ++f) {
+  for (std::size_t f = first; f < last; ++f) {
     if (!include[f]) {
       out.offsets.push_back(out.cell.size());
       out.edge_offsets.push_back(out.edge_cell.size());
@@ -400,7 +398,7 @@ void build_tent(const Floes& floes, std::span<const std::uint8_t> include, const
         const std::size_t node = static_cast<std::size_t>(nj) * nw + ni;
         if (!s.edges[node].any) continue;
         const std::uint32_t c = cell_of_node(ni, nj);
-        push_edge_piece(out, c, wraps ? out.find(f, c) : s.piece[node], s.edges[node]);
+        push_edge_piece(out, c, wraps ? out.find(f - first, c) : s.piece[node], s.edges[node]);
       }
     out.edge_offsets.push_back(out.edge_cell.size());
   }
@@ -415,8 +413,9 @@ std::ptrdiff_t Footprints::find(std::size_t i, std::uint32_t c) const {
   return it != last && *it == c ? it - cell.begin() : -1;
 }
 
-void build_footprints(const Floes& floes, std::span<const std::uint8_t> include,
-                      const fluid::SurfaceGrid& grid, Footprints& out, FootprintKernel kernel) {
+namespace {
+
+void clear(Footprints& out) {
   out.offsets.assign(1, 0);
   out.cell.clear();
   out.area.clear();
@@ -429,18 +428,72 @@ void build_footprints(const Floes& floes, std::span<const std::uint8_t> include,
   out.edge_twist.clear();
   out.edge_first.clear();
   out.edge_swept.clear();
-  static thread_local Scratch scratch;
-  if (kernel == FootprintKernel::tent) {
-    build_tent(floes, include, grid, out, scratch);
-    return;
+}
+
+// Appends the footprints of part (floes after those already in out).
+void append(Footprints& out, const Footprints& part) {
+  const std::size_t pieces = out.cell.size(), edges = out.edge_cell.size();
+  for (std::size_t k = 1; k < part.offsets.size(); ++k) out.offsets.push_back(pieces + part.offsets[k]);
+  for (std::size_t k = 1; k < part.edge_offsets.size(); ++k) out.edge_offsets.push_back(edges + part.edge_offsets[k]);
+  out.cell.insert(out.cell.end(), part.cell.begin(), part.cell.end());
+  out.area.insert(out.area.end(), part.area.begin(), part.area.end());
+  out.centroid.insert(out.centroid.end(), part.centroid.begin(), part.centroid.end());
+  out.edge_cell.insert(out.edge_cell.end(), part.edge_cell.begin(), part.edge_cell.end());
+  for (std::ptrdiff_t p : part.edge_piece)
+    out.edge_piece.push_back(p < 0 ? p : p + static_cast<std::ptrdiff_t>(pieces));
+  out.edge_length.insert(out.edge_length.end(), part.edge_length.begin(), part.edge_length.end());
+  out.edge_normal.insert(out.edge_normal.end(), part.edge_normal.begin(), part.edge_normal.end());
+  out.edge_twist.insert(out.edge_twist.end(), part.edge_twist.begin(), part.edge_twist.end());
+  out.edge_first.insert(out.edge_first.end(), part.edge_first.begin(), part.edge_first.end());
+  out.edge_swept.insert(out.edge_swept.end(), part.edge_swept.begin(), part.edge_swept.end());
+}
+
+void build_cells(const Floes& floes, std::span<const std::uint8_t> include, const fluid::SurfaceGrid& grid,
+                 Footprints& out, Scratch& s, std::size_t first, std::size_t last);
+
+}  // namespace
+
+void build_footprints(const Floes& floes, std::span<const std::uint8_t> include,
+                      const fluid::SurfaceGrid& grid, Footprints& out, FootprintKernel kernel, int threads) {
+  if (kernel == FootprintKernel::tent && grid.edge != fluid::GridEdge::periodic)
+    throw std::invalid_argument("the tent footprint kernel needs a periodic grid");
+  auto build = [&](Footprints& part, std::size_t first, std::size_t last) {
+    static thread_local Scratch scratch;
+    clear(part);
+    if (kernel == FootprintKernel::tent) build_tent(floes, include, grid, part, scratch, first, last);
+    else build_cells(floes, include, grid, part, scratch, first, last);
+  };
+  // Each floe's pieces depend on that floe alone: ranges of floes are built
+  // on threads and joined in order, the same arrays whatever the thread count.
+  const std::size_t n = floes.size();
+  const std::size_t chunks = threads > 1 ? std::min<std::size_t>(n, 4 * static_cast<std::size_t>(threads)) : 1;
+  if (chunks <= 1) return build(out, 0, n);
+  // The caller's thread owns the parts (a thread_local seen from the workers
+  // would be theirs).
+  thread_local std::vector<Footprints> owned;
+  owned.resize(chunks);
+  std::vector<Footprints>& parts = owned;
+  const std::ptrdiff_t count = static_cast<std::ptrdiff_t>(chunks);
+#pragma omp parallel for num_threads(threads) schedule(dynamic, 1)
+  for (std::ptrdiff_t c = 0; c < count; ++c) {
+    const auto k = static_cast<std::size_t>(c);
+    build(parts[k], n * k / chunks, n * (k + 1) / chunks);
   }
+  clear(out);
+  for (const Footprints& part : parts) append(out, part);
+}
+
+namespace {
+
+// The cell kernel: the exact areas floe ∩ cell, for floes first..last-1.
+void build_cells(const Floes& floes, std::span<const std::uint8_t> include, const fluid::SurfaceGrid& grid,
+                 Footprints& out, Scratch& s, std::size_t first, std::size_t last) {
   const double dx = grid.dx(), dy = grid.dy();
   const bool periodic = grid.edge == fluid::GridEdge::periodic;
   const bool two_d = grid.dims == 2;
   // A piece thinner than this (relative to a cell) is round-off from a vertex
   // lying on a grid line.
   const double tiny = 1e-12 * dx * (two_d ? dy : grid.ly);
-  Scratch& s = scratch;
 
   // Cell of column i, row j, or -1 outside a walled basin.
   auto cell_of = [&](int i, int j) -> std::int64_t {
@@ -454,7 +507,7 @@ void build_footprints(const Floes& floes, std::span<const std::uint8_t> include,
     return static_cast<std::int64_t>(j) * grid.nx + i;
   };
 
-  for (std::size_t f = 0; f < floes.size(); ++f) {
+  for (std::size_t f = first; f < last; ++f) {
     if (include[f]) {
       // The bounding box in cells (all of the width when dims = 1: one row).
       const PosedBox box = pose(floes, f, dx, dy, 0.0, two_d, s.poly);
@@ -532,7 +585,7 @@ void build_footprints(const Floes& floes, std::span<const std::uint8_t> include,
           const std::int64_t c = cell_of(i0 + li, j0 + lj);
           if (c < 0) continue;
           const auto cell = static_cast<std::uint32_t>(c);
-          push_edge_piece(out, cell, wraps ? out.find(f, cell) : s.piece[local], s.edges[local]);
+          push_edge_piece(out, cell, wraps ? out.find(f - first, cell) : s.piece[local], s.edges[local]);
         }
     } else {
       out.offsets.push_back(out.cell.size());
@@ -540,5 +593,7 @@ void build_footprints(const Floes& floes, std::span<const std::uint8_t> include,
     out.edge_offsets.push_back(out.edge_cell.size());
   }
 }
+
+}  // namespace
 
 }  // namespace floesim

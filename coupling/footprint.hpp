@@ -74,8 +74,10 @@ struct Footprints {
 
 // Pieces of every floe for which include[i] is true (others get none). The
 // tent kernel needs a periodic grid (a walled one gets std::invalid_argument).
+// With threads > 1 ranges of floes are built on that many threads; the
+// result does not depend on the thread count.
 void build_footprints(const Floes& floes, std::span<const std::uint8_t> include,
                       const fluid::SurfaceGrid& grid, Footprints& out,
-                      FootprintKernel kernel = FootprintKernel::cell);
+                      FootprintKernel kernel = FootprintKernel::cell, int threads = 1);
 
 }  // namespace floesim

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <sstream>
+#include <thread>
 
 #include "contact/step_limit.hpp"
 #include "contact/substep.hpp"
@@ -63,6 +64,8 @@ Simulation::Simulation(Scenario scenario) : scenario_(std::move(scenario)) {
   const bool any_dynamic = std::any_of(f.is_static.begin(), f.is_static.end(), [](std::uint8_t s) { return !s; });
   if (sea_ && any_dynamic) {
     floe_sea_ = std::make_unique<FloeSeaContact>(c.coupling, c.sea, scenario_.floes, *sea_, c.run.dt_max);
+    floe_sea_->set_threads(c.run.threads > 0 ? c.run.threads
+                                             : static_cast<int>(std::max(1u, std::thread::hardware_concurrency())));
     if (c.sea.waves.kind != WaveKind::none || c.sea.tank.enabled)
       incident_ = std::make_unique<IncidentSea>(fluid::make_sea(c.sea, c.run.seed, sea_options),
                                                 IncidentSea::interval_for(c.sea));
