@@ -15,8 +15,9 @@ void add_compare_command(CLI::App& app, Registry& registry) {
                                                  "equal when |a - b| <= atol + rtol |b| everywhere");
   sub->add_option("A", args->a, "Run file A")->required();
   sub->add_option("B", args->b, "Run file B (the reference)")->required();
-  sub->add_option("--rtol", args->opt.rtol, "Relative tolerance")->capture_default_str()->check(CLI::NonNegativeNumber);
-  sub->add_option("--atol", args->opt.atol, "Absolute tolerance")->capture_default_str()->check(CLI::NonNegativeNumber);
+  // The tolerances' rule (finite, >= 0) is validate(CompareOptions), called by compare_runs.
+  sub->add_option("--rtol", args->opt.rtol, "Relative tolerance (>= 0)")->capture_default_str();
+  sub->add_option("--atol", args->opt.atol, "Absolute tolerance (>= 0)")->capture_default_str();
   registry[sub] = [args] {
     const CompareResult r = compare_runs(args->a, args->b, args->opt);
     std::cout << "datasets_compared: " << r.datasets_compared << "\n";

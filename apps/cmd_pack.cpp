@@ -56,7 +56,7 @@ void add_pack_command(CLI::App& app, Registry& registry) {
   auto args = std::make_shared<Args>();
   CLI::App* sub = app.add_subcommand(
       "pack", "Write a random pack of non-overlapping floes (power diagram, shrunk cells)");
-  sub->add_option("--floes", args->options.floes, "Number of floes N")->required();
+  sub->add_option("--floes", args->options.floes, "Number of floes N")->required()->check(unsigned_count());
   sub->add_option("--concentration", args->options.concentration,
                   "Ice concentration C in (0, 0.95]: floe area / box area")->required();
   sub->add_option("--box", args->box, "Box width and height W H (m); the box is [0, W] x [0, H]")

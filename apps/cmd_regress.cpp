@@ -178,11 +178,13 @@ void add_regress_command(CLI::App& app, Registry& registry) {
       "regress", "Run every DIR/*.toml and compare each run with its reference DIR/<case>.ref.h5 "
                  "(exit 0 all pass, 1 any differs, 2 bad input)");
   sub->add_option("DIR", args->dir, "Folder of regression cases")->required();
-  sub->add_option("--rtol", args->opt.rtol, "Relative tolerance")->capture_default_str()->check(CLI::NonNegativeNumber);
-  sub->add_option("--atol", args->opt.atol, "Absolute tolerance")->capture_default_str()->check(CLI::NonNegativeNumber);
+  // The tolerances' rule (finite, >= 0) is validate(CompareOptions), checked first below.
+  sub->add_option("--rtol", args->opt.rtol, "Relative tolerance (>= 0)")->capture_default_str();
+  sub->add_option("--atol", args->opt.atol, "Absolute tolerance (>= 0)")->capture_default_str();
   sub->add_flag("--update", args->update, "Rewrite the references from fresh runs (after an intended change of results)");
   sub->add_option("--keep", args->keep, "Keep the fresh runs in this folder (default: a temporary folder, removed)");
   registry[sub] = [args] {
+    validate(args->opt);
     const fs::path dir(args->dir);
     const std::vector<Case> cases = find_cases(dir);
     if (!args->update) {

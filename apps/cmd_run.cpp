@@ -12,6 +12,7 @@
 #include <sstream>
 
 #include "apps/commands.hpp"
+#include "core/config.hpp"
 #include "core/error.hpp"
 #include "coupling/run.hpp"
 
@@ -76,7 +77,7 @@ void add_run_command(CLI::App& app, Registry& registry) {
   sub->add_option("CONFIG", args->config, "Configuration file (.toml)");
   sub->add_option("-o,--output", args->output, "Run file to write (default: CONFIG's name with .h5, here)");
   sub->add_option("--until", args->until, "Stop at this time (s) instead of [run] t_end")
-      ->check(CLI::NonNegativeNumber);
+      ->check(finite_non_negative());
   sub->add_option("--threads", args->threads, "Threads for the per-floe phases (default: [run] threads; 0: one per core)")
       ->check(CLI::Range(0, 1024));
   sub->add_flag("-q,--quiet", args->quiet, "No progress line");
@@ -91,7 +92,15 @@ void add_run_command(CLI::App& app, Registry& registry) {
 
     Config config = load_config(config_path);
     if (args->threads >= 0) config.run.threads = args->threads;
-    Simulation sim(build_scenario(std::move(config)));
+    // --until replaces t_end: the bound on the records of [run] t_end holds for it too.
+    const std::string problem =
+        args->until >= 0.0 ? record_count_problem(args->until, config.run.output_interval) : std::string{};
+    if (!problem.empty()) {
+      std::ostringstream m;
+      m << "--until " << args->until << ": " << problem << " (" << config_path << ": [run] output_interval)";
+      throw InputError(m.str());
+    }
+    Simulation sim(build_scenario(config));
     for (const std::string& note : sim.notes()) std::cerr << "floesim: note: " << note << "\n";
 
     ProgressLine progress(!args->quiet && isatty(STDERR_FILENO));

@@ -1,6 +1,7 @@
 // floesim command line: dispatches to one subcommand per apps/cmd_*.cpp.
 #include <iostream>
 #include <map>
+#include <string>
 
 #include "apps/commands.hpp"
 #include "core/error.hpp"
@@ -23,6 +24,22 @@ int main(int argc, char** argv) {
   floesim::apps::add_render_command(app, handlers);
   floesim::apps::add_run_command(app, handlers);
 
+  // CLI11 answers an unknown word (or none) with "A subcommand is required": name it and list ours.
+  if (argc == 1 || argv[1][0] != '-') {
+    std::string names;
+    bool known = false;
+    for (const CLI::App* sub : app.get_subcommands([](CLI::App*) { return true; })) {
+      names += (names.empty() ? "" : ", ") + sub->get_name();
+      known = known || (argc > 1 && sub->check_name(argv[1]));
+    }
+    if (!known) {
+      std::cerr << "floesim: error: "
+                << (argc == 1 ? std::string("a subcommand is required")
+                              : "unknown subcommand '" + std::string(argv[1]) + "'")
+                << "; expected one of: " << names << " (floesim --help)\n";
+      return 2;
+    }
+  }
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

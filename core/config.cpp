@@ -6,11 +6,13 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <iomanip>
 #include <numbers>
 #include <set>
 #include <sstream>
 
 #include "core/error.hpp"
+#include "core/forcing.hpp"
 
 namespace floesim {
 
@@ -193,6 +195,8 @@ void read_run(Section s, RunParams& r) {
   r.t_end = s.number("t_end", r.t_end, non_negative, "a time >= 0 (s)");
   r.dt_max = s.number("dt_max", r.dt_max, positive, "a time step > 0 (s)");
   r.output_interval = s.number("output_interval", r.output_interval, positive, "an interval > 0 (s)");
+  if (const std::string problem = record_count_problem(r.t_end, r.output_interval); !problem.empty())
+    s.fail("output_interval", problem);
   r.seed = static_cast<unsigned long>(
       s.integer("seed", static_cast<long long>(r.seed), [](long long v) { return v >= 0; }, "a seed >= 0"));
   r.threads = static_cast<int>(s.integer("threads", r.threads, [](long long v) { return v >= 0 && v <= 1024; },
@@ -350,6 +354,15 @@ void read_forcing(Section s, ForcingParams& f, const std::string& base_dir) {
   f.series_interpolation = s.choice<SeriesInterpolation>(
       "series_interpolation", f.series_interpolation,
       {{"linear", SeriesInterpolation::linear}, {"previous", SeriesInterpolation::previous}});
+  // The series is checked here, at load, by its reader (the one place of its rules), so that
+  // a bad file is refused before any scenario is built; make_forcing reads it again.
+  if (!f.series.empty()) {
+    try {
+      ForcingSeries::from_csv(f.series, f.series_interpolation);
+    } catch (const InputError& e) {
+      s.fail("series", e.what());
+    }
+  }
   f.coriolis = s.number("coriolis", f.coriolis, finite, "a Coriolis parameter f (1/s)");
   if (s.has("latitude")) {
     if (s.has("coriolis")) s.fail("latitude", "give coriolis (f) or latitude, not both");
@@ -400,6 +413,17 @@ void read_fracture(Section s, FractureParams& f, const std::string& file) {
 
 }  // namespace
 
+std::string record_count_problem(double t_end, double output_interval) {
+  const double records = std::floor(t_end / output_interval) + 2.0;
+  if (records <= kMaxRecords) return "";
+  std::ostringstream m;
+  m << "expected an output_interval >= " << t_end / (kMaxRecords - 2.0) << " s (at most "
+    << static_cast<long>(kMaxRecords) << " records up to t_end = " << t_end << " s), got " << output_interval << " s: ";
+  if (std::isfinite(records)) m << std::setprecision(15) << records << " records";
+  else m << "more records than a double can count";
+  return m.str();
+}
+
 Config parse_config(std::string_view text, const std::string& name, const std::string& base_dir) {
   toml::table root;
   try {
@@ -428,10 +452,15 @@ Config parse_config(std::string_view text, const std::string& name, const std::s
 }
 
 Config load_config(const std::string& path) {
+  // A folder opens as an empty stream on Linux and would parse as the default scenario.
+  std::error_code ec;
+  if (fs::is_directory(path, ec))
+    throw InputError(path + ": is a folder; expected a configuration file (.toml)");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(path + ": cannot open the configuration file");
   std::stringstream ss;
   ss << in.rdbuf();
+  if (in.bad()) throw InputError(path + ": cannot read the configuration file");
   const fs::path dir = fs::absolute(fs::path(path)).parent_path();
   return parse_config(ss.str(), path, dir.string());
 }

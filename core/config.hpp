@@ -33,6 +33,16 @@ struct Config {
   FractureParams fracture;
 };
 
+// At most this many records in a run file (t = 0, one every output_interval, t_end):
+// it bounds the file's size and the steps shortened to land on output times
+// (output_interval = 1e-320 would write records without end).
+inline constexpr double kMaxRecords = 1e7;
+
+// The rule on the number of records, in one place for [run] t_end and for
+// `floesim run --until`: "" if a run to t_end writes at most kMaxRecords records
+// at output_interval (both > 0 and finite), else what was expected.
+std::string record_count_problem(double t_end, double output_interval);
+
 // Reads and checks a configuration file.
 Config load_config(const std::string& path);
 

@@ -45,6 +45,14 @@ inline constexpr const char* kStateColumnNames[kStateColumns] = {
     "heave", "pitch", "roll", "heave_rate", "pitch_rate", "roll_rate"};
 
 struct Floes {
+  // Declared so that Floes is not an aggregate. GCC 12 destroys twice a member that
+  // is an aggregate with default member initializers (offsets{0}) when it is
+  // brace-initialised with `{}` inside an enclosing aggregate whose later
+  // initialiser throws: `Scenario s{config, {}, make_forcing(...)}` aborted with
+  // "double free" on every bad forcing file (issue 17). A constructor makes `{}`
+  // a constructor call, which GCC cleans up correctly.
+  Floes() = default;
+
   std::vector<std::size_t> offsets{0};  // floe i owns body[offsets[i] .. offsets[i+1])
   std::vector<Vec2> body;               // m, body-frame vertices, counter-clockwise
 

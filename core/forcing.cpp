@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 
 #include "core/error.hpp"
@@ -15,6 +16,10 @@ ForcingSeries::ForcingSeries(const ForcingParams& p) {
 }
 
 namespace {
+
+constexpr const char* kHeader = "t_s,wind_u,wind_v,current_u,current_v";
+constexpr const char* kColumns[5] = {"t_s", "wind_u", "wind_v", "current_u", "current_v"};
+
 std::vector<std::string> split_csv(const std::string& line) {
   std::vector<std::string> out;
   std::size_t start = 0;
@@ -28,44 +33,74 @@ std::vector<std::string> split_csv(const std::string& line) {
   }
   return out;
 }
+
+// A field as it can be shown in a message: binary bytes as '?', at most 40 characters.
+std::string shown(const std::string& f) {
+  std::string s;
+  for (char c : f.substr(0, 40)) s += (c >= 0x20 && c < 0x7f) ? c : '?';
+  return "'" + s + (f.size() > 40 ? "...'" : "'");
+}
+
+bool is_number(const std::string& f, double& v) {
+  const auto [p, ec] = std::from_chars(f.data(), f.data() + f.size(), v);
+  return ec == std::errc{} && p == f.data() + f.size() && !f.empty();
+}
+
 }  // namespace
 
+// Every rule of the series file is here. The configuration loader calls this to
+// check [forcing] series at load (core/config.cpp); make_forcing reads it again.
 ForcingSeries ForcingSeries::from_csv(const std::string& path, SeriesInterpolation interpolation) {
-  std::ifstream in(path);
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec))
+    throw InputError(path + ": the forcing series is a folder; expected a CSV file (" + std::string(kHeader) + ")");
+  std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(path + ": cannot open the forcing series");
   ForcingSeries s;
   s.interpolation_ = interpolation;
   std::string line;
   long lineno = 0;
-  bool header_seen = false;
+  bool first = true;  // the first line that is not blank or a comment: the header, if it is not numeric
+  std::string last_t;  // the previous row's time as written, and its line
+  long last_line = 0;
   auto bad = [&](const std::string& what) { throw InputError(where(path, lineno, "", what)); };
   while (std::getline(in, line)) {
     ++lineno;
-    if (line.empty() || line.find_first_not_of(" \t\r") == std::string::npos || line[0] == '#') continue;
+    if (line.find_first_not_of(" \t\r") == std::string::npos || line[0] == '#') continue;
     const auto fields = split_csv(line);
-    if (!header_seen) {
-      header_seen = true;
-      if (!fields.empty() && fields[0] == "t_s") {
-        if (fields.size() != 5 || fields[1] != "wind_u" || fields[2] != "wind_v" ||
-            fields[3] != "current_u" || fields[4] != "current_v")
-          bad("expected the header t_s,wind_u,wind_v,current_u,current_v");
+    double v[5];
+    if (first) {
+      first = false;
+      // A header is a line whose first field is not a number; it must be exactly ours,
+      // so that a file with other columns (or other units) is not read by position.
+      if (!is_number(fields[0], v[0])) {
+        std::string got;
+        for (const std::string& f : fields) got += (got.empty() ? "" : ",") + f;
+        if (!std::equal(fields.begin(), fields.end(), std::begin(kColumns), std::end(kColumns)))
+          bad("expected the header " + std::string(kHeader) + ", got " + shown(got));
         continue;
       }
     }
-    if (fields.size() != 5) bad("expected 5 columns (t_s,wind_u,wind_v,current_u,current_v), got " +
-                                std::to_string(fields.size()));
-    double v[5];
-    for (int k = 0; k < 5; ++k) {
-      const std::string& f = fields[static_cast<std::size_t>(k)];
-      auto [p, ec] = std::from_chars(f.data(), f.data() + f.size(), v[k]);
-      if (ec != std::errc{} || p != f.data() + f.size()) bad("column " + std::to_string(k + 1) + " is not a number: '" + f + "'");
-      if (!std::isfinite(v[k])) bad("column " + std::to_string(k + 1) + " is not finite");
+    if (fields.size() != 5)
+      bad("expected 5 columns (" + std::string(kHeader) + "), got " + std::to_string(fields.size()));
+    for (std::size_t k = 0; k < 5; ++k) {
+      const std::string& f = fields[k];
+      const std::string column = "column " + std::to_string(k + 1) + " (" + kColumns[k] + ")";
+      if (!is_number(f, v[k])) bad(column + ": expected a number, got " + shown(f));
+      if (!std::isfinite(v[k])) bad(column + ": expected a finite number, got " + shown(f));
     }
-    if (!s.t_.empty() && !(v[0] > s.t_.back())) bad("times must increase strictly");
+    if (!s.t_.empty() && !(v[0] > s.t_.back()))
+      bad("expected times increasing strictly, got t_s = " + fields[0] + " after " + last_t + " (line " +
+          std::to_string(last_line) + ")");
+    last_t = fields[0];
+    last_line = lineno;
     s.t_.push_back(v[0]);
     s.v_.push_back(ForcingSample{{v[1], v[2]}, {v[3], v[4]}});
   }
-  if (s.t_.empty()) throw InputError(path + ": the forcing series has no data row");
+  if (in.bad()) throw InputError(path + ": cannot read the forcing series");
+  if (s.t_.empty())
+    throw InputError(path + ": the forcing series has no data row (expected the header " + std::string(kHeader) +
+                     " then one row per time)");
   return s;
 }
 

@@ -1,7 +1,8 @@
 #pragma once
 // Wind and ocean current as functions of time: constant, or a time series read
-// from CSV with the columns t_s,wind_u,wind_v,current_u,current_v (m/s; lines
-// starting with '#' are comments; one header line). Uniform in space.
+// from CSV with the columns t_s,wind_u,wind_v,current_u,current_v (s, m/s; lines
+// starting with '#' and blank lines are skipped; the header line, if any, must be
+// exactly those names). Uniform in space.
 
 #include <array>
 #include <string>
@@ -20,8 +21,9 @@ class ForcingSeries {
 public:
   // Constant forcing from [forcing] current and wind.
   explicit ForcingSeries(const ForcingParams& p);
-  // Time series; throws InputError naming the file and the line for a bad row
-  // (wrong column count, non-number, non-finite value, times not increasing).
+  // Time series; throws InputError naming the file, the line and what was expected
+  // for a bad file: a folder, unreadable, a wrong header, a wrong column count, a
+  // non-number or non-finite value, times not increasing strictly, no data row.
   static ForcingSeries from_csv(const std::string& path, SeriesInterpolation interpolation);
 
   // The forcing at time t: linear interpolation between rows, or the value of

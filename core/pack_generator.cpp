@@ -344,7 +344,7 @@ void validate(const PackOptions& o) {
     if (!(std::isfinite(x) && x > 0.0))
       fail(std::string(name) + " must be a finite number > 0 (" + unit + "), got " + number(x));
   };
-  if (o.floes < 1) fail("floes must be at least 1");
+  if (o.floes < 1) fail("floes must be at least 1, got 0");
   if (o.floes > 10'000'000) fail("floes must be at most 10^7, got " + std::to_string(o.floes));
   if (!(o.concentration > 0.0 && o.concentration <= kMaxConcentration))
     fail("concentration must be in (0, " + number(kMaxConcentration) + "], got " + number(o.concentration));

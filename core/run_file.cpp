@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <sstream>
 
 #include "core/detail/h5.hpp"
 #include "core/error.hpp"
@@ -365,7 +366,17 @@ RunDataset read_run_dataset(const std::string& path, const std::string& dataset)
   return r;
 }
 
+void validate(const CompareOptions& o) {
+  for (auto [name, v] : {std::pair{"rtol", o.rtol}, std::pair{"atol", o.atol}})
+    if (!(std::isfinite(v) && v >= 0.0)) {
+      std::ostringstream m;
+      m << "compare: " << name << " (tolerance): expected a finite number >= 0, got " << v;
+      throw InputError(m.str());
+    }
+}
+
 CompareResult compare_runs(const std::string& a, const std::string& b, const CompareOptions& opt) {
+  validate(opt);
   h5::Handle fa = h5::open_file(a), fb = h5::open_file(b);
   for (auto [f, p] : {std::pair{fa.get(), a}, std::pair{fb.get(), b}})
     if (!h5::has_attr(f, "format") || h5::get_attr_string(f, "format") != kRunFormat)

@@ -143,6 +143,10 @@ struct CompareOptions {
   double rtol = 1e-6;
   double atol = 1e-9;
 };
+// Throws InputError unless rtol and atol are finite and >= 0: a NaN tolerance
+// makes every element differ, a negative one every element but exact equals.
+// compare_runs calls it; `floesim regress` too, before any run.
+void validate(const CompareOptions& options);
 struct DatasetDifference {
   std::string dataset, what;   // what: "missing in B", "shape", or "values"
   std::size_t count = 0;       // elements out of tolerance

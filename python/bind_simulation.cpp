@@ -58,6 +58,14 @@ void run_until(Simulation& sim, double t) {
 }
 
 py::dict run_to_file(Simulation& sim, const std::string& output, double until) {
+  // until < 0 (the default): to [run] t_end, already bounded at load. Otherwise the
+  // checks of `floesim run --until` (apps/cmd_run.cpp): finite, and the records bound.
+  if (std::isnan(until) || std::isinf(until))
+    throw InputError("run: until: expected a finite time >= 0 (s), or -1 for [run] t_end, got " + std::to_string(until));
+  if (until >= 0.0)
+    if (const std::string problem = record_count_problem(until, sim.scenario().config.run.output_interval);
+        !problem.empty())
+      throw InputError("run: until = " + std::to_string(until) + ": " + problem);
   RunOptions options;
   options.output = output;
   options.until = until;

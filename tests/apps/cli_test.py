@@ -116,9 +116,108 @@ def case_bad_input():
         check("Usage" in p.stdout or "usage" in p.stdout.lower(), f"{sub} --help")
 
 
+# A small valid scenario: one floe, no sea, 2 s.
+SMALL = ('[run]\nt_end = 2.0\ndt_max = 0.5\noutput_interval = 1.0\n\n[sea]\nmodel = "none"\n\n'
+         '[[floes.floe]]\nvertices = [[0, 0], [20, 0], [20, 20], [0, 20]]\n\n[forcing]\nwind = [5.0, 0.0]\n')
+HEADER = "t_s,wind_u,wind_v,current_u,current_v\n"
+
+# Malformed forcing series (issue 17: each aborted with a double free, exit 134):
+# name, CSV bytes, the line blamed, words of the message.
+BAD_SERIES = [
+    ("missing_column", HEADER + "0,1,2,3\n", 2, ["expected 5 columns", "got 4"]),
+    ("long_row", HEADER + "0,1,2,3,4\n10,1,2,3,4,5\n", 3, ["expected 5 columns", "got 6"]),
+    ("short_row", HEADER + "0,1,2,3,4\n10,1\n", 3, ["expected 5 columns", "got 2"]),
+    ("decreasing", HEADER + "0,1,2,3,4\n60,1,2,3,4\n30,1,2,3,4\n", 4,
+     ["expected times increasing strictly", "t_s = 30 after 60"]),
+    ("duplicate", HEADER + "0,1,2,3,4\n60,1,2,3,4\n60,1,2,3,4\n", 4, ["expected times increasing strictly"]),
+    ("text", HEADER + "0,1,2,three,4\n", 2, ["column 4 (current_u): expected a number, got 'three'"]),
+    ("nan", HEADER + "0,nan,2,3,4\n", 2, ["column 2 (wind_u): expected a finite number, got 'nan'"]),
+    ("inf", HEADER + "0,1,2,3,-inf\n", 2, ["column 5 (current_v): expected a finite number"]),
+    ("empty", "", 0, ["no data row", "expected the header t_s,wind_u,wind_v,current_u,current_v"]),
+    ("header_only", HEADER, 0, ["no data row"]),
+    ("wrong_header", "time,u,v,cu,cv\n0,1,2,3,4\n", 1,
+     ["expected the header t_s,wind_u,wind_v,current_u,current_v", "got 'time,u,v,cu,cv'"]),
+    ("binary", "\x89PNG\r\n\x1a\n\x00\x00\x00\rIHDR\x00\xff", 1, ["expected the header", "'?PNG'"]),
+]
+
+
+def case_bad_inputs():
+    # A catalogue of malformed inputs: each exits 2 (not a signal, not 0) with a
+    # message naming the file or option, and what was expected; no run file is written.
+    def series(name, data):
+        with open(os.path.join(WORK, name + ".csv"), "wb") as f:
+            f.write(data.encode("latin-1"))
+        return write(name + ".toml", SMALL + f'series = "{name}.csv"\n')
+
+    cases = []  # (name, args, words)
+    for name, data, line, words in BAD_SERIES:
+        csv = os.path.join(WORK, name + ".csv")
+        blamed = f"{csv}:{line}: " if line else f"{csv}: "
+        cases.append((f"series {name}", ["run", series(name, data), "-o", "out.h5"],
+                      [f"{name}.toml:", "key '[forcing] series'", blamed] + words))
+    # The same reader error through the other commands that load a configuration.
+    frac = disc_config("frac_series.toml", 1.0e6, '[forcing]\nseries = "decreasing.csv"\n')
+    cases.append(("fracture series", ["fracture", frac], ["[forcing] series", "decreasing.csv:4:", "increasing"]))
+    os.makedirs(os.path.join(WORK, "regress_bad"), exist_ok=True)
+    with open(os.path.join(WORK, "regress_bad", "c.toml"), "w") as f:
+        f.write(SMALL + 'series = "../nan.csv"\n')
+    open(os.path.join(WORK, "regress_bad", "c.ref.h5"), "w").close()
+    cases.append(("regress series", ["regress", os.path.join(WORK, "regress_bad")],
+                  ["[forcing] series", "nan.csv:2:", "expected a finite number"]))
+    # A folder as CONFIG.
+    os.makedirs(os.path.join(WORK, "a_folder"), exist_ok=True)
+    cases.append(("folder config", ["run", "a_folder", "-o", "out.h5"],
+                  ["a_folder: is a folder", "expected a configuration file"]))
+    # --until: finite and >= 0, and no more records than the bound.
+    small = write("small.toml", SMALL)
+    for value in ("nan", "inf", "-inf", "-3"):
+        cases.append((f"--until {value}", ["run", small, "--until", value, "-o", "out.h5"],
+                      ["--until", "expected a finite number >= 0", f"got '{value}'"]))
+    cases.append(("--until 1e12", ["run", small, "--until", "1e12", "-o", "out.h5"],
+                  ["--until 1e+12", "expected an output_interval >= 100000 s", "at most 10000000 records",
+                   "[run] output_interval"]))
+    # [run] output_interval that would write records without end.
+    tiny = write("tiny_interval.toml", SMALL.replace("output_interval = 1.0", "output_interval = 1e-320"))
+    cases.append(("output_interval 1e-320", ["run", tiny, "-o", "out.h5"],
+                  ["tiny_interval.toml:4:", "key '[run] output_interval'", "at most 10000000 records"]))
+    many = write("many_records.toml", SMALL.replace("t_end = 2.0", "t_end = 1.0e9"))
+    cases.append(("output_interval 1 to 1e9 s", ["run", many, "-o", "out.h5"],
+                  ["many_records.toml:4:", "[run] output_interval", ">= 100 s", "1000000002 records"]))
+    # compare / regress tolerances: finite and >= 0.
+    run("run", small, "-q", "-o", "ref.h5")
+    for opt in ("--rtol", "--atol"):
+        for value in ("nan", "-1", "inf"):
+            cases.append((f"compare {opt} {value}", ["compare", "ref.h5", "ref.h5", opt, value],
+                          [f"{opt[2:]} (tolerance): expected a finite number >= 0", f"got {value}"]))
+    cases.append(("regress --rtol nan", ["regress", os.path.join(WORK, "regress_bad"), "--rtol", "nan"],
+                  ["rtol (tolerance): expected a finite number >= 0"]))
+    # pack --floes: a negative count is refused as written, not wrapped to 2^64 - 5.
+    pack = ["pack", "--concentration", "0.5", "--box", "100", "100", "-o", "out.h5"]
+    cases.append(("pack --floes -5", pack + ["--floes", "-5"], ["--floes", "expected a whole number >= 0", "'-5'"]))
+    cases.append(("pack --floes 2.5", pack + ["--floes", "2.5"], ["--floes", "'2.5'"]))
+    cases.append(("pack --floes 0", pack + ["--floes", "0"], ["floes must be at least 1"]))
+    # Subcommands: an unknown word is named and ours are listed.
+    listed = ["compare", "fracture", "info", "pack", "regress", "render", "run"]
+    cases.append(("unknown subcommand", ["frobnicate", "x.toml"], ["unknown subcommand 'frobnicate'"] + listed))
+    cases.append(("no subcommand", [], ["a subcommand is required"] + listed))
+
+    failures = []
+    for name, args, words in cases:
+        p = subprocess.run([FLOESIM, *args], cwd=WORK, capture_output=True, text=True, errors="replace", timeout=60)
+        text = p.stdout + p.stderr
+        missing = [w for w in words if w not in text]
+        if p.returncode != 2 or missing:
+            failures.append(f"{name}: exit {p.returncode} (expected 2), missing {missing}\n  {text.strip()}")
+        if os.path.exists(os.path.join(WORK, "out.h5")):
+            failures.append(f"{name}: wrote out.h5")
+            os.remove(os.path.join(WORK, "out.h5"))
+    check(not failures, f"{len(failures)} of {len(cases)} cases:\n" + "\n".join(failures))
+    print(f"{len(cases)} malformed inputs refused with exit 2")
+
+
 def case_killed_run():
     # A long run killed midway leaves a readable file with the records so far.
-    cfg = open(EXAMPLE).read().replace("t_end = 3600.0", "t_end = 1.0e9").replace(
+    cfg = open(EXAMPLE).read().replace("t_end = 3600.0", "t_end = 1.0e7").replace(
         "output_interval = 60.0", "output_interval = 5.0").replace("dt_max = 5.0", "dt_max = 0.5")
     path = write("long.toml", cfg)
     p = subprocess.Popen([FLOESIM, "run", path, "-q", "-o", "long.h5"], cwd=WORK,

@@ -103,6 +103,18 @@ TEST_CASE("unknown keys, wrong types and out-of-range values name file, line and
   refused("[sea]\nmodel = \"bem\"\n[coupling]\nfootprint = \"tent\"\n", {"case.toml:4", "[coupling] footprint", "periodic"});
   refused("[sea.waves]\nkind = \"regular\"\n", {"[sea.waves] kind", "wavelength or a period"});
   refused("[run\n", {"case.toml:1", "not valid TOML"});
+  // At most kMaxRecords records: output_interval = 1e-320 would write records without end.
+  refused("[run]\nt_end = 10\noutput_interval = 1e-320\n", {"case.toml:3", "[run] output_interval", ">= 1e-06 s",
+                                                                "at most 10000000 records"});
+  refused("[run]\nt_end = 1e9\noutput_interval = 1\n", {"case.toml:3", "[run] output_interval", "1000000002 records"});
+}
+
+TEST_CASE("the bound on records: kMaxRecords records up to t_end") {
+  CHECK(record_count_problem(1e7 - 2, 1.0).empty());  // t = 0, 1, ..., 1e7 - 2 and t_end: kMaxRecords
+  CHECK(!record_count_problem(1e7 - 1, 1.0).empty());
+  CHECK(record_count_problem(1e7 - 1, 1.0).find("got 1 s: 10000001 records") != std::string::npos);
+  CHECK(record_count_problem(0, 1e-300).empty());     // t_end = 0: two records
+  CHECK(parse("[run]\nt_end = 3600\noutput_interval = 0.001\n").run.output_interval == 0.001);
 }
 
 TEST_CASE("the resolved configuration parses back to the same values") {

@@ -3,6 +3,8 @@
 
 #include <cmath>
 #include <limits>
+#include <string>
+#include <vector>
 
 #include "core/error.hpp"
 #include "core/floes.hpp"
@@ -106,6 +108,19 @@ TEST_CASE("Floes: contiguous storage, static floes have zero inverse mass") {
   const auto w = floes.world_vertices(0);
   CHECK(w[0].x() == doctest::Approx(10.0));
   CHECK(w[0].y() == doctest::Approx(20.0));
+}
+
+// Issue 17: `Scenario s{config, {}, make_forcing(...)}` aborted with a double free
+// when the forcing reader threw, GCC 12 destroying the `{}`-initialised Floes twice
+// (an aggregate with default member initialisers). Floes has a constructor now.
+TEST_CASE("an aggregate holding Floes{} is cleaned up once when a later member throws") {
+  struct Holder {
+    std::string name;
+    Floes floes;
+    std::vector<double> after;
+  };
+  auto throws = []() -> std::vector<double> { throw InputError("bad input"); };
+  CHECK_THROWS_AS((Holder{std::string(100, 'a'), {}, throws()}), InputError);
 }
 
 TEST_SUITE_END();

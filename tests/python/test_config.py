@@ -138,5 +138,44 @@ class Write(unittest.TestCase):
             self.assertIn("file not found", str(e.exception))
 
 
+class BadInputAtLoad(unittest.TestCase):
+    """Issue 17: a malformed forcing series killed the interpreter (a double free in
+    floesim.Simulation); it is an InputError at load now, naming the CSV line."""
+
+    def setUp(self):
+        self.dir = tempfile.mkdtemp(prefix="floesim_badload_")
+        self.csv = os.path.join(self.dir, "wind.csv")
+        with open(self.csv, "w") as f:
+            f.write("t_s,wind_u,wind_v,current_u,current_v\n0,1,0,0,0\n60,2,0,0,0\n30,3,0,0,0\n")
+
+    def test_bad_series_in_a_file(self):
+        path = os.path.join(self.dir, "case.toml")
+        with open(path, "w") as f:
+            f.write('[forcing]\nseries = "wind.csv"\n')
+        with self.assertRaises(floesim.InputError) as e:
+            floesim.Config.load(path)
+        self.assertIn("key '[forcing] series': " + self.csv + ":4: expected times increasing strictly",
+                      str(e.exception))
+
+    def test_bad_series_set_from_python(self):
+        cfg = floesim.Config("")
+        with self.assertRaises(floesim.InputError) as e:
+            cfg["forcing"]["series"] = self.csv
+        self.assertIn(self.csv + ":4:", str(e.exception))
+        floesim.Simulation(cfg)  # unchanged: constant forcing
+
+    def test_records_bound(self):
+        with self.assertRaises(floesim.InputError) as e:
+            floesim.Config("[run]\noutput_interval = 1e-320\n")
+        self.assertIn("at most 10000000 records", str(e.exception))
+        sim = floesim.Simulation(floesim.Config("[run]\nt_end = 1\n"))
+        with self.assertRaises(floesim.InputError) as e:
+            sim.run(os.path.join(self.dir, "out.h5"), until=1e12)
+        self.assertIn("at most 10000000 records", str(e.exception))
+        with self.assertRaises(floesim.InputError):
+            sim.run(os.path.join(self.dir, "out.h5"), until=math.nan)
+        self.assertFalse(os.path.exists(os.path.join(self.dir, "out.h5")))
+
+
 if __name__ == "__main__":
     unittest.main()
