@@ -15,6 +15,11 @@ namespace floesim {
 
 namespace {
 
+// Loops over fewer floes (or pieces, for_each_index) than this stay on one
+// thread: a parallel region costs a fork and a barrier, ruinous for short
+// loops when the cores are shared (each barrier may wait a scheduler slice).
+constexpr std::ptrdiff_t kFloesPerThread = 64;
+
 // Response eta' at cell `cell` to a pressure impulse (Pa s) from rest: a unit
 // impulse on that cell alone, or (checkerboard) +-1 alternating on every
 // cell, the grid's shortest wave, which the sea answers fastest. Per unit
@@ -338,7 +343,7 @@ void FloeSeaContact::evaluate(const Floes& floes, fluid::Sea& sea, double h) {
   // the pieces' sums into the cells, in order (the same sums whatever the
   // thread count).
   const std::ptrdiff_t floes_in_order = static_cast<std::ptrdiff_t>(order_.size());
-#pragma omp parallel for num_threads(threads_) schedule(dynamic, 16)
+#pragma omp parallel for num_threads(threads_) schedule(dynamic, 16) if (floes_in_order > kFloesPerThread)
   for (std::ptrdiff_t j = 0; j < floes_in_order; ++j) {
     const std::uint32_t i = order_[static_cast<std::size_t>(j)];
     FloeSeaLoad& load = loads_[i];
@@ -384,7 +389,7 @@ void FloeSeaContact::evaluate(const Floes& floes, fluid::Sea& sea, double h) {
   // coverage Phi_c moves with every floe's edge in cell c, so an edge also
   // carries psi'(Phi_c) / (2 A) sum_k a_k u_k^2 of the cell's pieces.
   if (ks > 0.0) {
-#pragma omp parallel for num_threads(threads_) schedule(dynamic, 16)
+#pragma omp parallel for num_threads(threads_) schedule(dynamic, 16) if (floes_in_order > kFloesPerThread)
     for (std::ptrdiff_t j = 0; j < floes_in_order; ++j) {
       const std::uint32_t i = order_[static_cast<std::size_t>(j)];
       const FloeState& st = floes.state[i];
@@ -437,7 +442,7 @@ void FloeSeaContact::update_water(const Floes& floes, const fluid::Sea& sea, Inc
   const std::span<const double> u0 = incident->u0(), v0 = incident->v0(), u1 = incident->u1(), v1 = incident->v1();
   const Footprints& fp = footprints_;
   const std::ptrdiff_t count = static_cast<std::ptrdiff_t>(std::min(floes.size(), fp.floes()));
-#pragma omp parallel for num_threads(threads_) schedule(static)
+#pragma omp parallel for num_threads(threads_) schedule(static) if (count > kFloesPerThread)
   for (std::ptrdiff_t i = 0; i < count; ++i) {
     double area = 0.0;
     Vec2 sum0 = Vec2::Zero(), sum1 = Vec2::Zero();
@@ -547,7 +552,7 @@ void for_each_index(std::size_t n, int threads, F&& f, std::size_t grain = 4096)
 template <class F>
 void for_each_floe(const std::vector<std::uint32_t>& order, int threads, F&& f) {
   const auto count = static_cast<std::ptrdiff_t>(order.size());
-#pragma omp parallel for num_threads(threads) schedule(dynamic, 16) if (count > 32)
+#pragma omp parallel for num_threads(threads) schedule(dynamic, 16) if (count > kFloesPerThread)
   for (std::ptrdiff_t j = 0; j < count; ++j) f(order[static_cast<std::size_t>(j)]);
 }
 

@@ -466,7 +466,8 @@ void build_footprints(const Floes& floes, std::span<const std::uint8_t> include,
   // Each floe's pieces depend on that floe alone: ranges of floes are built
   // on threads and joined in order, the same arrays whatever the thread count.
   const std::size_t n = floes.size();
-  const std::size_t chunks = threads > 1 ? std::min<std::size_t>(n, 4 * static_cast<std::size_t>(threads)) : 1;
+  // (Fewer than 64 floes stay on one thread: not worth a parallel region.)
+  const std::size_t chunks = threads > 1 && n >= 64 ? 4 * static_cast<std::size_t>(threads) : 1;
   if (chunks <= 1) return build(out, 0, n);
   // The caller's thread owns the parts (a thread_local seen from the workers
   // would be theirs).

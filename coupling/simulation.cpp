@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <sstream>
 #include <thread>
 
@@ -18,6 +19,17 @@ namespace {
 constexpr double kFloorFraction = 1e-6;
 // A step that overlaps is halved at most this many times before the run fails.
 constexpr int kMaxHalvings = 40;
+
+// [run] threads = 0: OMP_NUM_THREADS when it is set (so that a test runner
+// with several processes can ask for one thread each), else one per core.
+int resolve_threads(int requested) {
+  if (requested > 0) return requested;
+  if (const char* env = std::getenv("OMP_NUM_THREADS")) {
+    const int n = std::atoi(env);
+    if (n > 0) return n;
+  }
+  return static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+}
 
 contact::Domain make_domain(const Scenario& s) {
   contact::Domain d;
@@ -64,8 +76,7 @@ Simulation::Simulation(Scenario scenario) : scenario_(std::move(scenario)) {
   const bool any_dynamic = std::any_of(f.is_static.begin(), f.is_static.end(), [](std::uint8_t s) { return !s; });
   if (sea_ && any_dynamic) {
     floe_sea_ = std::make_unique<FloeSeaContact>(c.coupling, c.sea, scenario_.floes, *sea_, c.run.dt_max);
-    floe_sea_->set_threads(c.run.threads > 0 ? c.run.threads
-                                             : static_cast<int>(std::max(1u, std::thread::hardware_concurrency())));
+    floe_sea_->set_threads(resolve_threads(c.run.threads));
     if (c.sea.waves.kind != WaveKind::none || c.sea.tank.enabled)
       incident_ = std::make_unique<IncidentSea>(fluid::make_sea(c.sea, c.run.seed, sea_options),
                                                 IncidentSea::interval_for(c.sea));
