@@ -94,7 +94,7 @@ struct CouplingParams {
   // stops when every piece's residual is below newton_tolerance times the
   // thickest floe's draft; each Newton step's conjugate gradients stop at the
   // relative residual cg_tolerance.
-  double newton_tolerance = 1e-10;
+  double newton_tolerance = 1e-8;
   double cg_tolerance = 1e-10;
   int max_newton = 40;
   int max_cg = 500;

@@ -238,7 +238,7 @@ private:
   std::vector<Vec2> water_;       // incident velocity under each floe, with the loads
   bool implicit_ = false;
   int threads_ = 1;
-  double newton_tolerance_ = 1e-10, cg_tolerance_ = 1e-10;
+  double newton_tolerance_ = 1e-8, cg_tolerance_ = 1e-10;
   int max_newton_ = 40, max_cg_ = 500;
   ImplicitStats implicit_stats_;
   double self_response_h_ = -1.0, self_response_ = 0.0;  // sea's node response to its own pressure over h
