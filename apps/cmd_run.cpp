@@ -78,7 +78,7 @@ void add_run_command(CLI::App& app, Registry& registry) {
   sub->add_option("-o,--output", args->output, "Run file to write (default: CONFIG's name with .h5, here)");
   sub->add_option("--until", args->until, "Stop at this time (s) instead of [run] t_end")
       ->check(finite_non_negative());
-  sub->add_option("--threads", args->threads, "Threads for the per-floe phases (default: [run] threads; 0: one per core)")
+  sub->add_option("--threads", args->threads, "Threads for the per-floe phases (default: [run] threads; 0: OMP_NUM_THREADS if set, else one per core)")
       ->check(CLI::Range(0, 1024));
   sub->add_flag("-q,--quiet", args->quiet, "No progress line");
   sub->add_flag("--profile", args->profile, "Print the time spent in each phase of the step");

@@ -200,7 +200,7 @@ void read_run(Section s, RunParams& r) {
   r.seed = static_cast<unsigned long>(
       s.integer("seed", static_cast<long long>(r.seed), [](long long v) { return v >= 0; }, "a seed >= 0"));
   r.threads = static_cast<int>(s.integer("threads", r.threads, [](long long v) { return v >= 0 && v <= 1024; },
-                                         "a thread count in [0, 1024] (0: one per core)"));
+                                         "a thread count in [0, 1024] (0: OMP_NUM_THREADS if set, else one per core)"));
   s.finish();
 }
 

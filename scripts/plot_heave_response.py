@@ -6,7 +6,9 @@ floe 10 m long and 0.5 m thick spanning the flume's 10 m width, strong law,
 K = 100) for a range of wavelengths, takes the heave's Fourier component at
 the wave frequency over wave periods 2..6, and plots heave / wave amplitude
 against wavelength / floe length, with the quasi-static rigid-floe curve
-|sin(kL/2) / (kL/2)| for reference.
+|sin(kL/2) / (kL/2)| for reference. Each wavelength is run twice: with the
+explicit kicks at dt_max = 0.01 s, and with the implicit step
+([coupling] integrator = "implicit") at dt_max = T / 20.
 
     /usr/bin/python3 scripts/plot_heave_response.py [build/bin/floesim]
 
@@ -29,14 +31,15 @@ FLOESIM = sys.argv[1] if len(sys.argv) > 1 else os.path.join(ROOT, "build", "bin
 L, A, H = 10.0, 0.05, 100.0
 
 
-def response(wavelength, work):
+def response(wavelength, work, implicit=False):
     k = 2 * math.pi / wavelength
     omega = math.sqrt(9.81 * k * math.tanh(k * H))
     period = 2 * math.pi / omega
+    dt = period / 20 if implicit else 0.01
     cfg = f"""[run]
 t_end = {6 * period}
-dt_max = 0.01
-output_interval = 0.02
+dt_max = {dt}
+output_interval = {dt if implicit else 0.02}
 [sea]
 model = "spectral"
 dims = 1
@@ -50,6 +53,7 @@ wavelength = {wavelength}
 [coupling]
 law = "strong"
 stiffness = 100.0
+integrator = "{'implicit' if implicit else 'explicit'}"
 [forcing]
 ocean_drag = 0.0
 air_drag = 0.0
@@ -73,17 +77,19 @@ thickness = 0.5
 
 with tempfile.TemporaryDirectory() as work:
     lams = [5, 7.5, 10, 12.5, 15, 20, 30, 40, 60, 80, 120, 160]
-    rows = [(lam, response(lam, work)) for lam in lams]
-print("wavelength_m,wavelength_over_L,heave_over_amplitude")
-for lam, r in rows:
-    print(f"{lam},{lam / L:.3f},{r:.4f}")
-x = np.array([lam / L for lam, _ in rows])
-y = np.array([r for _, r in rows])
+    rows = [(lam, response(lam, work), response(lam, work, implicit=True)) for lam in lams]
+print("wavelength_m,wavelength_over_L,heave_over_amplitude_explicit,heave_over_amplitude_implicit_T_over_20")
+for lam, r, ri in rows:
+    print(f"{lam},{lam / L:.3f},{r:.4f},{ri:.4f}")
+x = np.array([lam / L for lam, _, _ in rows])
+y = np.array([r for _, r, _ in rows])
+yi = np.array([ri for _, _, ri in rows])
 xs = np.linspace(0.4, 17, 400)
 ks = 2 * np.pi / (xs * L)
 plt.figure(figsize=(6, 4))
 plt.semilogx(xs, np.abs(np.sin(ks * L / 2) / (ks * L / 2)), "k--", lw=1, label="quasi-static rigid floe |sin(kL/2)/(kL/2)|")
-plt.semilogx(x, y, "o-", label="floesim (strong law, K = 100)")
+plt.semilogx(x, y, "o-", label="floesim, explicit kicks, dt = 0.01 s (strong law, K = 100)")
+plt.semilogx(x, yi, "s--", label="floesim, implicit step, dt = T / 20")
 plt.xlabel("wavelength / floe length")
 plt.ylabel("heave amplitude / wave amplitude")
 plt.title("Heave of a 10 m floe in regular waves")
