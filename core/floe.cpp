@@ -8,6 +8,15 @@
 
 namespace floesim {
 
+namespace {
+// A number as a user wrote it (shortest form: 2e+130, 1000, 0.5).
+std::string number(double x) {
+  std::ostringstream s;
+  s << x;
+  return s.str();
+}
+}  // namespace
+
 FloeShape make_floe_shape(const FloeInput& in) {
   auto fail = [&](const std::string& what) {
     throw InputError(in.origin.empty() ? what : in.origin + ": " + what);
@@ -23,6 +32,23 @@ FloeShape make_floe_shape(const FloeInput& in) {
   if (!in.velocity.allFinite() || !std::isfinite(in.angular_velocity) || !std::isfinite(in.yaw) ||
       !in.position.allFinite())
     fail("position, velocity, angular_velocity and yaw must be finite numbers");
+  // Coordinates bounded before any product of them (a 1e300 m square's area
+  // overflows to inf, which the area test below would misread as zero).
+  auto too_far = [](const Vec2& p) { return p.cwiseAbs().maxCoeff() > kMaxCoordinate; };
+  for (std::size_t i = 0; i < in.vertices.size(); ++i)
+    if (too_far(in.vertices[i]))
+      fail("vertex " + std::to_string(i) + " = (" + number(in.vertices[i].x()) + ", " +
+           number(in.vertices[i].y()) + ") m: coordinates too large, expected |x|, |y| <= " +
+           number(kMaxCoordinate) + " m");
+  if (too_far(in.position))
+    fail("position (" + number(in.position.x()) + ", " + number(in.position.y()) +
+         ") m: coordinates too large, expected |x|, |y| <= " + number(kMaxCoordinate) + " m");
+  if (in.velocity.norm() > kMaxSpeed)
+    fail("speed |velocity| = " + number(in.velocity.norm()) + " m/s is not physical, expected <= " +
+         number(kMaxSpeed) + " m/s");
+  if (std::abs(in.heave_rate) > kMaxSpeed)
+    fail("heave_rate = " + number(in.heave_rate) + " m/s is not physical, expected |heave_rate| <= " +
+         number(kMaxSpeed) + " m/s");
 
   FloeShape shape;
   std::vector<Vec2> v = in.vertices;
@@ -51,6 +77,12 @@ FloeShape make_floe_shape(const FloeInput& in) {
     shape.reoriented = true;
   }
   const Vec2 g = m.centroid();
+  double radius = 0.0;  // largest distance from the centroid to a vertex
+  for (const Vec2& p : v) radius = std::max(radius, (p - g).norm());
+  if (std::abs(in.angular_velocity) * radius > kMaxSpeed)
+    fail("angular_velocity = " + number(in.angular_velocity) + " rad/s gives a rim speed of " +
+         number(std::abs(in.angular_velocity) * radius) + " m/s (" + number(radius) +
+         " m from the centroid), which is not physical, expected <= " + number(kMaxSpeed) + " m/s");
   shape.centroid = in.position + rotate(g, in.yaw);
   shape.body.reserve(v.size());
   for (const Vec2& p : v) shape.body.push_back(p - g);

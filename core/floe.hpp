@@ -53,9 +53,23 @@ struct FloeShape {
   bool reoriented = false;  // the input was clockwise and was reversed
 };
 
+// Bounds on what a floe may be given, beyond finiteness (checked here, once,
+// for every source of floes: inline TOML, pack and FloeDyn files):
+//  * |coordinate| <= kMaxCoordinate for vertices and position: 1e9 m, 25
+//    times the Earth's circumference. Beyond it the area, inertias and contact
+//    geometry lose their precision and, near 1e154, overflow;
+//  * speeds <= kMaxSpeed = 1000 m/s: |velocity|, |heave_rate| and the rim
+//    speed |angular_velocity| * (largest distance from the centroid to a
+//    vertex). Sea ice drifts at about 1 m/s; a floe at 2e130 m/s would cross
+//    the domain in far less than any step, and the adaptive step would shrink
+//    without end.
+inline constexpr double kMaxCoordinate = 1e9;  // m
+inline constexpr double kMaxSpeed = 1e3;       // m/s
+
 // Checks a floe and builds its shape. Throws InputError naming input.origin
-// when: fewer than 3 vertices, a non-finite number, zero or negative area
-// (degenerate), a self-intersecting outline, thickness or density <= 0.
+// when: fewer than 3 vertices, a non-finite number, a coordinate or speed past
+// the bounds above, zero or negative area (degenerate), a self-intersecting
+// outline, thickness or density <= 0.
 // A clockwise outline is reversed (reported through FloeShape::reoriented).
 FloeShape make_floe_shape(const FloeInput& input);
 

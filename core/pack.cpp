@@ -1,5 +1,6 @@
 #include "core/pack.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 
@@ -13,8 +14,10 @@ namespace {
 
 constexpr const char* kPackFormat = "floesim-pack-1";
 
-std::vector<double> read_checked(hid_t file, const std::string& path, const std::string& name,
-                                 const std::vector<hsize_t>& expect) {
+// Checks a dataset's rank and shape (0 in `expect`: any extent) before
+// reading it, so that no size claimed by the file is allocated unchecked.
+h5::Handle open_shaped(hid_t file, const std::string& path, const std::string& name,
+                       const std::vector<hsize_t>& expect, const char* type) {
   h5::Handle d = h5::open_dataset(file, name, path);
   const auto dims = h5::dims(d);
   bool ok = dims.size() == expect.size();
@@ -23,9 +26,19 @@ std::vector<double> read_checked(hid_t file, const std::string& path, const std:
     std::string want, got;
     for (hsize_t e : expect) want += (want.empty() ? "" : " x ") + (e ? std::to_string(e) : std::string("any"));
     for (hsize_t e : dims) got += (got.empty() ? "" : " x ") + std::to_string(e);
-    throw InputError(path + ": dataset '" + name + "' has shape [" + got + "], expected [" + want + "]");
+    throw InputError(path + ": dataset '" + name + "' has shape [" + got + "], expected [" + want + "] " + type);
   }
-  return h5::read_doubles(d, path + ": dataset '" + name + "'");
+  return d;
+}
+
+std::vector<double> read_checked(hid_t file, const std::string& path, const std::string& name,
+                                 const std::vector<hsize_t>& expect) {
+  return h5::read_doubles(open_shaped(file, path, name, expect, "numbers"), path + ": dataset '" + name + "'");
+}
+
+std::vector<long long> read_checked_ints(hid_t file, const std::string& path, const std::string& name,
+                                         const std::vector<hsize_t>& expect) {
+  return h5::read_ints(open_shaped(file, path, name, expect, "integers"), path + ": dataset '" + name + "'");
 }
 
 void require_finite(const std::vector<double>& v, const std::string& path, const std::string& name) {
@@ -57,7 +70,9 @@ Pack read_floedyn(hid_t file, const std::string& path, const PackDefaults& def) 
   if (sd.size() != 3 || sd[0] < 1 || sd[1] != n || (sd[2] != 9 && sd[2] != 11))
     throw InputError(path + ": dataset '/floe_states' must be [T, " + std::to_string(n) +
                      ", 9 or 11] (one row per floe in /floe_shapes)");
-  const std::vector<double> all = h5::read_doubles(states, path + ": dataset '/floe_states'");
+  // Only record 0 is used: read it alone (a file may hold a long history, or
+  // claim one it does not store).
+  const std::vector<double> all = h5::read_first_record(states, path + ": dataset '/floe_states'");
   const std::size_t cols = sd[2];
 
   for (std::size_t i = 0; i < n; ++i) {
@@ -68,7 +83,7 @@ Pack read_floedyn(hid_t file, const std::string& path, const PackDefaults& def) 
     FloeInput f;
     f.origin = path + ": floe " + std::to_string(i) + " ('" + name + "')";
     for (std::size_t k = 0; k + 1 < v.size(); k += 2) f.vertices.emplace_back(v[k], v[k + 1]);
-    const double* s = all.data() + i * cols;  // record 0
+    const double* s = all.data() + i * cols;
     for (std::size_t c = 0; c < 6; ++c)
       if (!std::isfinite(s[c]))
         throw InputError(path + ": dataset '/floe_states' record 0, floe " + std::to_string(i) +
@@ -93,20 +108,41 @@ Pack read_floedyn(hid_t file, const std::string& path, const PackDefaults& def) 
 Pack read_ours(hid_t file, const std::string& path, const PackDefaults& def) {
   Pack pack;
   pack.format = kPackFormat;
-  h5::Handle od = h5::open_dataset(file, "/floes/offsets", path);
-  const auto offsets = h5::read_ints(od, path + ": dataset '/floes/offsets'");
-  if (offsets.size() < 2 || offsets[0] != 0)
-    throw InputError(path + ": dataset '/floes/offsets' must have n+1 >= 2 entries starting at 0");
-  const std::size_t n = offsets.size() - 1;
+  // Vertices first: their real extent bounds the number of floes the offsets
+  // may claim (a floe has at least 3 vertices; the bound allows 1 per floe so
+  // that a floe with too few is named by the floe check, not here).
   const auto verts = read_checked(file, path, "/floes/vertices", {0, 2});
   require_finite(verts, path, "/floes/vertices");
-  for (std::size_t i = 0; i < n; ++i)
-    if (offsets[i + 1] < offsets[i] || static_cast<std::size_t>(offsets[i + 1]) * 2 > verts.size())
-      throw InputError(path + ": dataset '/floes/offsets' is not increasing or runs past "
-                       "/floes/vertices at floe " + std::to_string(i));
-  if (static_cast<std::size_t>(offsets[n]) * 2 != verts.size())
-    throw InputError(path + ": '/floes/offsets' ends at " + std::to_string(offsets[n]) +
-                     " but '/floes/vertices' has " + std::to_string(verts.size() / 2) + " rows");
+  const std::size_t nv = verts.size() / 2;
+  const std::string od = path + ": dataset '/floes/offsets'";
+  {
+    const auto d = h5::dims(open_shaped(file, path, "/floes/offsets", {0}, "integers"));
+    if (d[0] < 2)
+      throw InputError(od + " has " + std::to_string(d[0]) + " entries, expected n + 1 >= 2 for n floes");
+    if (d[0] - 1 > std::max<std::size_t>(nv, 1))
+      throw InputError(od + " has " + std::to_string(d[0]) + " entries (" + std::to_string(d[0] - 1) +
+                       " floes) but '/floes/vertices' has only " + std::to_string(nv) +
+                       " rows, expected at most one entry per vertex row plus one");
+  }
+  const auto offsets = read_checked_ints(file, path, "/floes/offsets", {0});
+  const std::size_t n = offsets.size() - 1;
+  // Floe i has vertex rows offsets[i] .. offsets[i+1] - 1: the offsets start
+  // at 0, never decrease, and end at the number of vertex rows.
+  if (offsets[0] != 0)
+    throw InputError(od + " starts at " + std::to_string(offsets[0]) + ", expected 0");
+  for (std::size_t i = 0; i < n; ++i) {
+    if (offsets[i + 1] < offsets[i])
+      throw InputError(od + " decreases at floe " + std::to_string(i) + " (entry " + std::to_string(i + 1) +
+                       " = " + std::to_string(offsets[i + 1]) + " < entry " + std::to_string(i) + " = " +
+                       std::to_string(offsets[i]) + "), expected non-decreasing offsets");
+    if (static_cast<unsigned long long>(offsets[i + 1]) > nv)
+      throw InputError(od + " entry " + std::to_string(i + 1) + " = " + std::to_string(offsets[i + 1]) +
+                       " (floe " + std::to_string(i) + ") points past '/floes/vertices', which has " +
+                       std::to_string(nv) + " rows");
+  }
+  if (static_cast<std::size_t>(offsets[n]) != nv)
+    throw InputError(od + " ends at " + std::to_string(offsets[n]) + " but '/floes/vertices' has " +
+                     std::to_string(nv) + " rows, expected them equal");
   const auto pose = read_checked(file, path, "/floes/pose", {n, 3});
   require_finite(pose, path, "/floes/pose");
   auto optional = [&](const std::string& name, std::vector<hsize_t> shape) {
@@ -120,10 +156,7 @@ Pack read_ours(hid_t file, const std::string& path, const PackDefaults& def) {
   const auto dens = optional("/floes/density", {n});
   const auto drag = optional("/floes/ocean_drag", {n});
   std::vector<long long> stat;
-  if (h5::exists(file, "/floes/static")) {
-    read_checked(file, path, "/floes/static", {n});
-    stat = h5::read_ints(h5::open_dataset(file, "/floes/static", path), path);
-  }
+  if (h5::exists(file, "/floes/static")) stat = read_checked_ints(file, path, "/floes/static", {n});
   for (std::size_t i = 0; i < n; ++i) {
     FloeInput f;
     f.origin = path + ": floe " + std::to_string(i);

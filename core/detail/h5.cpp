@@ -84,17 +84,61 @@ std::vector<hsize_t> dims(hid_t dataset) {
 }
 
 namespace {
-std::size_t count(hid_t dataset) {
+const char* class_name(H5T_class_t cls) {
+  switch (cls) {
+    case H5T_INTEGER: return "integers";
+    case H5T_FLOAT: return "floating-point numbers";
+    case H5T_STRING: return "strings";
+    case H5T_ENUM: return "an enumeration (h5py writes booleans so)";
+    case H5T_COMPOUND: return "a compound type";
+    default: return "a non-numeric type";
+  }
+}
+
+std::string shape_text(const std::vector<hsize_t>& shape) {
+  std::string t;
+  for (hsize_t d : shape) t += (t.empty() ? "" : " x ") + std::to_string(d);
+  return "[" + t + "]";
+}
+
+// Checks that the file really holds the elements `shape` claims: layouts that
+// store every element (contiguous, compact) must have n * element size bytes
+// (chunked datasets may leave chunks unwritten, read as the fill value, so
+// their storage says nothing). Overflow-safe.
+void check_stored(hid_t dataset, hid_t type, const std::vector<hsize_t>& shape, const std::string& what) {
+  Handle plist{H5Dget_create_plist(dataset), H5Pclose};
+  const H5D_layout_t layout = plist.valid() ? H5Pget_layout(plist) : H5D_LAYOUT_ERROR;
+  if (layout != H5D_CONTIGUOUS && layout != H5D_COMPACT) return;
+  const hsize_t stored = H5Dget_storage_size(dataset);
+  hsize_t need = H5Tget_size(type);
+  for (hsize_t d : shape) need = (d != 0 && need > stored / d) ? stored + 1 : need * d;
+  if (need > stored)
+    fail(what + ": the dataspace claims " + shape_text(shape) + " entries but the file stores " +
+         std::to_string(stored) + " bytes for them (the file is truncated or corrupted)");
+}
+
+// Number of elements of `shape`, refused above kMaxElements (overflow-safe).
+// Called before any allocation.
+std::size_t bounded_count(const std::vector<hsize_t>& shape, const std::string& what) {
   std::size_t n = 1;
-  for (hsize_t d : dims(dataset)) n *= d;
+  for (hsize_t d : shape) n = (d != 0 && n > kMaxElements / d) ? kMaxElements + 1 : n * static_cast<std::size_t>(d);
+  if (n > kMaxElements)
+    fail(what + ": the dataspace claims " + shape_text(shape) + " entries, more than the " +
+         std::to_string(kMaxElements) + " one dataset may hold (is the file corrupted?)");
   return n;
 }
+
 template <class T>
-std::vector<T> read_as(hid_t dataset, hid_t mem_type, const std::string& what) {
+std::vector<T> read_as(hid_t dataset, hid_t mem_type, bool integers_only, const std::string& what) {
   Handle type{H5Dget_type(dataset), H5Tclose};
   const H5T_class_t cls = H5Tget_class(type);
-  if (cls != H5T_FLOAT && cls != H5T_INTEGER) fail(what + ": expected numbers");
-  std::vector<T> v(count(dataset));
+  if (integers_only && cls != H5T_INTEGER)
+    fail(what + ": expected integers, got " + class_name(cls));
+  if (cls != H5T_FLOAT && cls != H5T_INTEGER)
+    fail(what + ": expected numbers (integers or floats), got " + class_name(cls));
+  const std::vector<hsize_t> d = dims(dataset);
+  std::vector<T> v(bounded_count(d, what));
+  check_stored(dataset, type, d, what);
   if (!v.empty() && H5Dread(dataset, mem_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, v.data()) < 0)
     fail(what + ": cannot read the dataset");
   return v;
@@ -102,10 +146,32 @@ std::vector<T> read_as(hid_t dataset, hid_t mem_type, const std::string& what) {
 }  // namespace
 
 std::vector<double> read_doubles(hid_t dataset, const std::string& what) {
-  return read_as<double>(dataset, H5T_NATIVE_DOUBLE, what);
+  return read_as<double>(dataset, H5T_NATIVE_DOUBLE, false, what);
 }
 std::vector<long long> read_ints(hid_t dataset, const std::string& what) {
-  return read_as<long long>(dataset, H5T_NATIVE_LLONG, what);
+  return read_as<long long>(dataset, H5T_NATIVE_LLONG, true, what);
+}
+
+std::vector<double> read_first_record(hid_t dataset, const std::string& what) {
+  Handle type{H5Dget_type(dataset), H5Tclose};
+  const H5T_class_t cls = H5Tget_class(type);
+  if (cls != H5T_FLOAT && cls != H5T_INTEGER)
+    fail(what + ": expected numbers (integers or floats), got " + class_name(cls));
+  const std::vector<hsize_t> d = dims(dataset);
+  if (d.empty() || d[0] == 0) fail(what + ": expected at least one record");
+  // The whole dataset must be stored (a claim of 4e9 records in 100 bytes is a
+  // corrupted file even if only record 0 is read); only record 0 is bounded.
+  check_stored(dataset, type, d, what);
+  std::vector<hsize_t> start(d.size(), 0), cnt = d;
+  cnt[0] = 1;
+  std::vector<double> v(bounded_count(cnt, what));
+  if (v.empty()) return v;
+  Handle space{H5Dget_space(dataset), H5Sclose};
+  Handle mem{H5Screate_simple(static_cast<int>(cnt.size()), cnt.data(), nullptr), H5Sclose};
+  if (H5Sselect_hyperslab(space, H5S_SELECT_SET, start.data(), nullptr, cnt.data(), nullptr) < 0 ||
+      H5Dread(dataset, H5T_NATIVE_DOUBLE, mem, space, H5P_DEFAULT, v.data()) < 0)
+    fail(what + ": cannot read the dataset");
+  return v;
 }
 
 namespace {

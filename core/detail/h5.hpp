@@ -44,8 +44,23 @@ Handle open_group(hid_t loc, const std::string& path, const std::string& file);
 Handle create_group(hid_t loc, const std::string& path);
 
 std::vector<hsize_t> dims(hid_t dataset);
+
+// The most numbers one dataset may hold when read whole: 2^28 (2 GiB as
+// doubles; a million floes of a hundred vertices is 2e8 numbers). A file's
+// dataspace is only a claim (a corrupted or hostile file may claim 4e9
+// entries), so every read checks it before allocating: the element count
+// against this bound and, for contiguous or compact layouts, against the bytes
+// the file really stores for the dataset. Failures are InputErrors that start
+// with `what` (the file and the dataset).
+inline constexpr std::size_t kMaxElements = std::size_t{1} << 28;
+
+// Whole datasets. read_doubles takes integers or floats; read_ints takes
+// integers only (a float-typed index array is refused, not truncated).
 std::vector<double> read_doubles(hid_t dataset, const std::string& what);
 std::vector<long long> read_ints(hid_t dataset, const std::string& what);
+// The first entry along dimension 0 (one record of a [T, ...] dataset), read
+// without allocating the other T - 1; the dataset must have rank >= 1 and T >= 1.
+std::vector<double> read_first_record(hid_t dataset, const std::string& what);
 
 // Whole fixed-size datasets.
 void write_doubles(hid_t loc, const std::string& name, const std::vector<hsize_t>& dims,

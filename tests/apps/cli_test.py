@@ -8,6 +8,7 @@ the files it writes. Exits non-zero with a message on the first failure.
 import json
 import os
 import signal
+import struct
 import subprocess
 import sys
 import tempfile
@@ -213,6 +214,106 @@ def case_bad_inputs():
             os.remove(os.path.join(WORK, "out.h5"))
     check(not failures, f"{len(failures)} of {len(cases)} cases:\n" + "\n".join(failures))
     print(f"{len(cases)} malformed inputs refused with exit 2")
+
+
+def bad_pack(name, offsets=None, vertices=None, velocity=None, offsets_dataset=None):
+    # A one-square pack file (ours), with one dataset replaced; returns a config loading it.
+    square = np.array([[0, 0], [10, 0], [10, 10], [0, 10]], float)
+    with h5py.File(os.path.join(WORK, name + ".h5"), "w") as f:
+        f.attrs["format"] = "floesim-pack-1"
+        g = f.create_group("floes")
+        if offsets_dataset is not None:
+            g.create_dataset("offsets", **offsets_dataset)
+        else:
+            g["offsets"] = np.array([0, 4]) if offsets is None else offsets
+        g["vertices"] = square if vertices is None else vertices
+        g["pose"] = np.array([[5.0, 5.0, 0.0]])
+        if velocity is not None:
+            g["velocity"] = np.array([velocity], float)
+    return write(name + ".toml", f'[run]\nt_end = 0.1\n\n[sea]\nmodel = "none"\n\n[floes]\npack = "{name}.h5"\n')
+
+
+def patch_dims(name, dataset_dims, claimed):
+    # Corrupts a contiguous dataset's dataspace message in place (version 1, max
+    # dims present: 1, rank, 1, 0, 4 reserved bytes, dims, max dims), as a flipped
+    # byte on disk would: the file then claims `claimed` entries it does not store.
+    path = os.path.join(WORK, name + ".h5")
+    b = bytearray(open(path, "rb").read())
+    rank = len(dataset_dims)
+    pat = bytes([1, rank, 1, 0, 0, 0, 0, 0]) + struct.pack(f"<{2 * rank}Q", *dataset_dims, *dataset_dims)
+    check(b.count(pat) == 1, f"{name}: one dataspace message {dataset_dims} to patch")
+    i = b.find(pat) + 8
+    b[i:i + 16 * rank] = struct.pack(f"<{2 * rank}Q", *claimed, *claimed)
+    open(path, "wb").write(b)
+
+
+def case_bad_packs():
+    # Malformed pack files (issue 17): each exits 2 with the file, the dataset or
+    # floe, and what was expected; none allocates what the file claims, none hangs.
+    cases = []  # (name, config, words)
+    big = 4_000_000_000
+    cases.append(("offsets claim 4e9 (chunked, unwritten)",
+                  bad_pack("huge", offsets_dataset=dict(shape=(big,), dtype="i8", chunks=(4096,))),
+                  ["huge.h5: dataset '/floes/offsets' has 4000000000 entries", "'/floes/vertices' has only 4 rows"]))
+    cfg = bad_pack("patched_offsets")
+    patch_dims("patched_offsets", [2], [big])
+    cases.append(("offsets dataspace patched to 4e9", cfg,
+                  ["patched_offsets.h5: dataset '/floes/offsets' has 4000000000 entries"]))
+    cfg = bad_pack("patched_vertices")
+    patch_dims("patched_vertices", [4, 2], [big, 2])
+    cases.append(("vertices dataspace patched to 4e9 rows", cfg,
+                  ["patched_vertices.h5: dataset '/floes/vertices'", "claims [4000000000 x 2] entries",
+                   "more than the 268435456"]))
+    cfg = bad_pack("short_vertices")
+    patch_dims("short_vertices", [4, 2], [1000, 2])
+    cases.append(("vertices dataspace claims more than stored", cfg,
+                  ["short_vertices.h5: dataset '/floes/vertices'", "claims [1000 x 2] entries",
+                   "the file stores 64 bytes", "truncated or corrupted"]))
+    cases.append(("float offsets", bad_pack("float_offsets", offsets=np.array([0.0, 4.0])),
+                  ["float_offsets.h5: dataset '/floes/offsets'", "expected integers, got floating-point numbers"]))
+    cases.append(("string offsets", bad_pack("string_offsets", offsets=np.array([b"0", b"4"])),
+                  ["string_offsets.h5: dataset '/floes/offsets'", "expected integers, got strings"]))
+    cases.append(("rank-2 offsets", bad_pack("rank2_offsets", offsets=np.array([[0, 4]])),
+                  ["rank2_offsets.h5: dataset '/floes/offsets' has shape [1 x 2], expected [any] integers"]))
+    cases.append(("offsets start at 1", bad_pack("offsets_start", offsets=np.array([1, 4])),
+                  ["offsets_start.h5: dataset '/floes/offsets' starts at 1, expected 0"]))
+    cases.append(("offsets decrease", bad_pack("offsets_decrease", offsets=np.array([0, 4, 2])),
+                  ["offsets_decrease.h5: dataset '/floes/offsets' decreases at floe 1", "expected non-decreasing"]))
+    cases.append(("offsets past the vertices", bad_pack("offsets_past", offsets=np.array([0, 9])),
+                  ["offsets_past.h5: dataset '/floes/offsets' entry 1 = 9 (floe 0) points past '/floes/vertices'",
+                   "4 rows"]))
+    cases.append(("offsets end short", bad_pack("offsets_short", offsets=np.array([0, 3])),
+                  ["offsets_short.h5: dataset '/floes/offsets' ends at 3", "'/floes/vertices' has 4 rows"]))
+    cases.append(("one offset", bad_pack("one_offset", offsets=np.array([0])),
+                  ["one_offset.h5: dataset '/floes/offsets' has 1 entries, expected n + 1 >= 2"]))
+    cases.append(("absurd speed", bad_pack("fast", velocity=[2e130, 0, 0]),
+                  ["fast.h5: floe 0: speed |velocity| = 2e+130 m/s is not physical", "expected <= 1000 m/s"]))
+    cases.append(("absurd spin", bad_pack("spin", velocity=[0, 0, 1e9]),
+                  ["spin.h5: floe 0: angular_velocity = 1e+09 rad/s", "rim speed", "expected <= 1000 m/s"]))
+    huge_square = np.array([[0, 0], [1e300, 0], [1e300, 1e300], [0, 1e300]])
+    cases.append(("1e300 square", bad_pack("huge_square", vertices=huge_square),
+                  ["huge_square.h5: floe 0: vertex 1 = (1e+300, 0) m: coordinates too large", "<= 1e+09 m"]))
+    # The same bounds on inline floes (one rule for every source of floes).
+    inline = SMALL.replace("[[0, 0], [20, 0], [20, 20], [0, 20]]", "[[0, 0], [1e300, 0], [1e300, 1e300], [0, 1e300]]")
+    cases.append(("inline 1e300 square", write("inline_huge.toml", inline),
+                  ["inline_huge.toml", "[[floes.floe]] 0", "coordinates too large"]))
+    fast = SMALL.replace("[0, 20]]\n", "[0, 20]]\nvelocity = [0.0, -5e3]\n")
+    cases.append(("inline absurd speed", write("inline_fast.toml", fast),
+                  ["inline_fast.toml", "speed |velocity| = 5000 m/s is not physical"]))
+
+    failures = []
+    for name, cfg, words in cases:
+        p = subprocess.run([FLOESIM, "run", cfg, "-o", "out.h5"], cwd=WORK, capture_output=True, text=True,
+                           errors="replace", timeout=60)
+        text = p.stdout + p.stderr
+        missing = [w for w in words if w not in text]
+        if p.returncode != 2 or missing:
+            failures.append(f"{name}: exit {p.returncode} (expected 2), missing {missing}\n  {text.strip()}")
+        if os.path.exists(os.path.join(WORK, "out.h5")):
+            failures.append(f"{name}: wrote out.h5")
+            os.remove(os.path.join(WORK, "out.h5"))
+    check(not failures, f"{len(failures)} of {len(cases)} cases:\n" + "\n".join(failures))
+    print(f"{len(cases)} malformed pack files refused with exit 2")
 
 
 def case_killed_run():

@@ -4,6 +4,8 @@
 #include <hdf5.h>
 
 #include <cmath>
+#include <cstring>
+#include <vector>
 #include <filesystem>
 
 #include "core/error.hpp"
@@ -99,6 +101,78 @@ TEST_CASE("a file that is not a pack is refused by name") {
   const std::string txt = tmp("floesim_text.h5");
   { std::FILE* f = std::fopen(txt.c_str(), "w"); std::fputs("hello", f); std::fclose(f); }
   CHECK_THROWS_WITH_AS(read_pack(txt), doctest::Contains("not an HDF5 file"), InputError);
+}
+
+namespace {
+// A pack file of our format whose /floes/offsets is made by `offsets` (given
+// the group), with one 10 m square in /floes/vertices and /floes/pose.
+template <class MakeOffsets>
+std::string pack_with_offsets(const std::string& name, MakeOffsets offsets) {
+  const std::string p = tmp(name);
+  hid_t f = H5Fcreate(p.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT);
+  hid_t str = H5Tcopy(H5T_C_S1);
+  const char* fmt = "floesim-pack-1";
+  H5Tset_size(str, std::strlen(fmt) + 1);
+  hid_t scalar = H5Screate(H5S_SCALAR);
+  hid_t a = H5Acreate2(f, "format", str, scalar, H5P_DEFAULT, H5P_DEFAULT);
+  H5Awrite(a, str, fmt);
+  H5Aclose(a);
+  H5Sclose(scalar);
+  H5Tclose(str);
+  hid_t g = H5Gcreate2(f, "floes", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+  auto put = [&](const char* dname, std::vector<hsize_t> dims, const double* v) {
+    hid_t sp = H5Screate_simple(static_cast<int>(dims.size()), dims.data(), nullptr);
+    hid_t d = H5Dcreate2(g, dname, H5T_IEEE_F64LE, sp, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+    H5Dwrite(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, v);
+    H5Dclose(d);
+    H5Sclose(sp);
+  };
+  const double square[] = {0, 0, 10, 0, 10, 10, 0, 10}, pose[] = {5, 5, 0};
+  put("vertices", {4, 2}, square);
+  put("pose", {1, 3}, pose);
+  offsets(g);
+  H5Gclose(g);
+  H5Fclose(f);
+  return p;
+}
+}  // namespace
+
+TEST_CASE("pack offsets: sizes bounded before allocation, integers only, checked entry by entry") {
+  // A chunked dataset that claims 4e9 offsets and stores none: refused by the
+  // vertex count before any allocation (it used to throw std::bad_alloc).
+  const std::string huge = pack_with_offsets("floesim_huge_offsets.h5", [](hid_t g) {
+    const hsize_t n = 4000000000ULL, chunk = 4096;
+    hid_t sp = H5Screate_simple(1, &n, nullptr);
+    hid_t plist = H5Pcreate(H5P_DATASET_CREATE);
+    H5Pset_chunk(plist, 1, &chunk);
+    H5Dclose(H5Dcreate2(g, "offsets", H5T_STD_I64LE, sp, H5P_DEFAULT, plist, H5P_DEFAULT));
+    H5Pclose(plist);
+    H5Sclose(sp);
+  });
+  CHECK_THROWS_WITH_AS(read_pack(huge), doctest::Contains("'/floes/offsets' has 4000000000 entries"), InputError);
+  auto with = [](const std::string& name, hid_t type, std::vector<hsize_t> dims, const void* data, hid_t mem) {
+    return pack_with_offsets(name, [&](hid_t g) {
+      hid_t sp = H5Screate_simple(static_cast<int>(dims.size()), dims.data(), nullptr);
+      hid_t d = H5Dcreate2(g, "offsets", type, sp, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+      H5Dwrite(d, mem, H5S_ALL, H5S_ALL, H5P_DEFAULT, data);
+      H5Dclose(d);
+      H5Sclose(sp);
+    });
+  };
+  const double fl[] = {0.0, 4.0};
+  CHECK_THROWS_WITH_AS(read_pack(with("floesim_float_offsets.h5", H5T_IEEE_F64LE, {2}, fl, H5T_NATIVE_DOUBLE)),
+                       doctest::Contains("'/floes/offsets': expected integers, got floating-point numbers"), InputError);
+  const long long good[] = {0, 4}, start[] = {1, 4}, past[] = {0, 9}, down[] = {0, 4, 2};
+  CHECK_THROWS_WITH_AS(read_pack(with("floesim_rank2_offsets.h5", H5T_STD_I64LE, {1, 2}, good, H5T_NATIVE_LLONG)),
+                       doctest::Contains("has shape [1 x 2], expected [any] integers"), InputError);
+  CHECK_THROWS_WITH_AS(read_pack(with("floesim_start_offsets.h5", H5T_STD_I64LE, {2}, start, H5T_NATIVE_LLONG)),
+                       doctest::Contains("starts at 1, expected 0"), InputError);
+  CHECK_THROWS_WITH_AS(read_pack(with("floesim_past_offsets.h5", H5T_STD_I64LE, {2}, past, H5T_NATIVE_LLONG)),
+                       doctest::Contains("points past '/floes/vertices'"), InputError);
+  CHECK_THROWS_WITH_AS(read_pack(with("floesim_down_offsets.h5", H5T_STD_I64LE, {3}, down, H5T_NATIVE_LLONG)),
+                       doctest::Contains("decreases at floe 1"), InputError);
+  const Pack ok = read_pack(with("floesim_good_offsets.h5", H5T_STD_I64LE, {2}, good, H5T_NATIVE_LLONG));
+  CHECK(ok.floes.size() == 1);
 }
 
 TEST_CASE("run file: records are readable, compare detects differences") {

@@ -88,6 +88,30 @@ TEST_CASE("bad floes are refused with a message naming the floe") {
   refused(bow, "intersects itself");
   refused(rect(1, 1, 0.0), "thickness");
   refused(rect(1, 1, 1.0, -1.0), "density");
+  // Finite but absurd: refused for what they are (a 1e300 square's area
+  // overflows to inf and used to be called "zero area").
+  FloeInput huge = rect(1, 1);
+  for (Vec2& p : huge.vertices) p *= 1e300;
+  refused(huge, "coordinates too large");
+  FloeInput far = rect(1, 1);
+  far.position = {0.0, 2e9};
+  refused(far, "coordinates too large");
+  FloeInput fast = rect(1, 1);
+  fast.velocity = {2e130, 0.0};
+  refused(fast, "speed |velocity| = 2e+130 m/s is not physical");
+  FloeInput bobbing = rect(1, 1);
+  bobbing.heave_rate = -2e3;
+  refused(bobbing, "heave_rate");
+  // The spin bound is on the rim speed: 10 rad/s is fine on a 1 m floe, not on a 1 km one.
+  FloeInput spin = rect(1, 1);
+  spin.angular_velocity = 10.0;
+  CHECK_NOTHROW(make_floe_shape(spin));
+  FloeInput big_spin = rect(1000, 1000);
+  big_spin.angular_velocity = 10.0;
+  refused(big_spin, "rim speed");
+  FloeInput drifting = rect(1, 1);
+  drifting.velocity = {600.0, 0.0};  // within kMaxSpeed
+  CHECK_NOTHROW(make_floe_shape(drifting));
 }
 
 TEST_CASE("Floes: contiguous storage, static floes have zero inverse mass") {
