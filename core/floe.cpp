@@ -43,8 +43,8 @@ FloeShape make_floe_shape(const FloeInput& in) {
   if (too_far(in.position))
     fail("position (" + number(in.position.x()) + ", " + number(in.position.y()) +
          ") m: coordinates too large, expected |x|, |y| <= " + number(kMaxCoordinate) + " m");
-  if (in.velocity.norm() > kMaxSpeed)
-    fail("speed |velocity| = " + number(in.velocity.norm()) + " m/s is not physical, expected <= " +
+  if (in.velocity.stableNorm() > kMaxSpeed)  // (stableNorm: |(1e300, 0)| is 1e300, not inf)
+    fail("speed |velocity| = " + number(in.velocity.stableNorm()) + " m/s is not physical, expected <= " +
          number(kMaxSpeed) + " m/s");
   if (std::abs(in.heave_rate) > kMaxSpeed)
     fail("heave_rate = " + number(in.heave_rate) + " m/s is not physical, expected |heave_rate| <= " +
