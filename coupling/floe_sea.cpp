@@ -501,38 +501,6 @@ void FloeSeaContact::advance_vertical(Floes& floes, std::span<const FloeState> s
 
 namespace {
 
-// The discrete gradient of V(d) = c / 2 [d]^+^2 between d0 and d1 (the force
-// held over the step; docs/coupling.md, "The implicit step") and its
-// derivative in d1. f (d1 - d0) = V(d1) - V(d0) exactly; the cases avoid the
-// cancellation of the quotient where both ends are in the water.
-struct SecantForce {
-  double f, df;
-};
-SecantForce secant_force(double c, double d0, double d1) {
-  if (d0 > 0.0 && d1 > 0.0) return {0.5 * c * (d0 + d1), 0.5 * c};
-  if (d0 <= 0.0 && d1 <= 0.0) return {0.0, 0.0};
-  if (d0 > 0.0) {  // leaves the water within the step: d1 <= 0 < d0
-    const double f = 0.5 * c * d0 * d0 / (d0 - d1);
-    return {f, f / (d0 - d1)};
-  }
-  // enters it: d0 <= 0 < d1
-  const double e = d1 - d0;
-  return {0.5 * c * d1 * d1 / e, 0.5 * c * d1 * (d1 - 2.0 * d0) / (e * e)};
-}
-
-// The law's force held over the step: the spring's discrete gradient and
-// the damper's impulse over the step, cd h = c psi a: Lambda = c [delta]^+
-// (seed 000 eq. 17) changes by c ([d1]^+ - [d0]^+), and
-// f (d1 - d0) >= 0 for that part (it only absorbs).
-SecantForce law_force(double c, double cd, double d0, double d1) {
-  SecantForce f = secant_force(c, d0, d1);
-  if (cd > 0.0) {
-    f.f += cd * (std::max(d1, 0.0) - std::max(d0, 0.0));
-    if (d1 > 0.0) f.df += cd;
-  }
-  return f;
-}
-
 double max_abs(std::span<const double> x) {
   double m = 0.0;
   for (double v : x) m = std::max(m, std::abs(v));
@@ -597,35 +565,37 @@ void FloeSeaContact::apply_response(fluid::Sea& sea, double h, std::span<const d
   ++implicit_stats_.g_products;
 }
 
-void FloeSeaContact::implicit_step(Floes& floes, std::span<const FloeState> start, fluid::Sea& sea, double h) {
-  // The footprint at the midpoint of the floes' horizontal motion over the
-  // step (at its end, the vertical forces would lag the drift by h / 2: a
-  // first-order error). Positions are restored once it is built; a
-  // periodic grid's seam is crossed by the shorter way.
-  {
-    std::vector<std::array<double, 3>> end(floes.size());
-    const bool periodic = grid_.edge == fluid::GridEdge::periodic;
-    for (std::size_t i = 0; i < floes.size(); ++i) {
-      FloeState& st = floes.state[i];
-      end[i] = {st.x, st.y, st.yaw};
-      if (!dynamic_[i] || i >= start.size()) continue;
-      double dx = st.x - start[i].x, dy = st.y - start[i].y;
-      if (periodic) {
-        dx -= grid_.lx * std::round(dx / grid_.lx);
-        if (grid_.dims == 2) dy -= grid_.ly * std::round(dy / grid_.ly);
-      }
-      st.x -= 0.5 * dx;
-      st.y -= 0.5 * dy;
-      st.yaw = 0.5 * (st.yaw + start[i].yaw);
+void FloeSeaContact::build_midpoint_footprints(Floes& floes, std::span<const FloeState> start) {
+  // At the step's end the vertical forces would lag the drift by h / 2: a
+  // first-order error. Positions are restored once the footprints are
+  // built; a periodic grid's seam is crossed by the shorter way.
+  std::vector<std::array<double, 3>> end(floes.size());
+  const bool periodic = grid_.edge == fluid::GridEdge::periodic;
+  for (std::size_t i = 0; i < floes.size(); ++i) {
+    FloeState& st = floes.state[i];
+    end[i] = {st.x, st.y, st.yaw};
+    if (!dynamic_[i] || i >= start.size()) continue;
+    double dx = st.x - start[i].x, dy = st.y - start[i].y;
+    if (periodic) {
+      dx -= grid_.lx * std::round(dx / grid_.lx);
+      if (grid_.dims == 2) dy -= grid_.ly * std::round(dy / grid_.ly);
     }
-    rebuild_footprints(floes);
-    for (std::size_t i = 0; i < floes.size(); ++i) {
-      FloeState& st = floes.state[i];
-      st.x = end[i][0];
-      st.y = end[i][1];
-      st.yaw = end[i][2];
-    }
+    st.x -= 0.5 * dx;
+    st.y -= 0.5 * dy;
+    st.yaw = 0.5 * (st.yaw + start[i].yaw);
   }
+  rebuild_footprints(floes);
+  for (std::size_t i = 0; i < floes.size(); ++i) {
+    FloeState& st = floes.state[i];
+    st.x = end[i][0];
+    st.y = end[i][1];
+    st.yaw = end[i][2];
+  }
+}
+
+void FloeSeaContact::implicit_step(Floes& floes, std::span<const FloeState> start, fluid::Sea& sea, double h) {
+  // The footprints at the midpoint of the floes' horizontal motion over the step.
+  build_midpoint_footprints(floes, start);
   const Footprints& fp = footprints_;
   const std::size_t n = fp.cell.size();
   // Each floe's vertical mass matrix diag(M, J) and its inverse on the DOFs
@@ -692,10 +662,10 @@ void FloeSeaContact::implicit_step(Floes& floes, std::span<const FloeState> star
   const double self = self_response_ / cell_area_;
 
   // Newton on R(d1) = d1 - dfree + G f(d0, d1), from the guess.
-  std::vector<double> d1 = guess, f(n), df(n), R(n), Gf(n), sq(n), w(n), r(n), z(n), p(n), Ap(n), tmp(n), step(n),
+  std::vector<double> d1 = guess, f(n), df(n), R(n), sq(n), w(n), r(n), z(n), p(n), Ap(n), tmp(n), step(n),
       trial(n), ftrial(n);
   auto residual = [&](std::span<const double> d, std::vector<double>& force, std::vector<double>& out) {
-    for_each_index(n, threads_, [&](std::size_t k) { force[k] = law_force(c[k], cd[k], d0[k], d[k]).f; });
+    for_each_index(n, threads_, [&](std::size_t k) { force[k] = step_force(c[k], cd[k], d0[k], d[k]).f; });
     apply_response(sea, h, force, out);
     for_each_index(n, threads_, [&](std::size_t k) { out[k] += d[k] - dfree[k]; });
   };
@@ -730,7 +700,7 @@ void FloeSeaContact::implicit_step(Floes& floes, std::span<const FloeState> star
       throw RunError(m.str());
     }
     for_each_index(n, threads_, [&](std::size_t k) {
-      df[k] = law_force(c[k], cd[k], d0[k], d1[k]).df;
+      df[k] = step_force(c[k], cd[k], d0[k], d1[k]).df;
       sq[k] = std::sqrt(df[k]);
       dinv[k] = 1.0 / (1.0 + df[k] * self);
     });

@@ -210,6 +210,9 @@ private:
   // velocity at the sea's time (zero without incident waves).
   void update_water(const Floes& floes, const fluid::Sea& sea, IncidentSea* incident);
   void implicit_step(Floes& floes, std::span<const FloeState> start, fluid::Sea& sea, double h);
+  // Footprints (and coverage) at the midpoint of each floe's horizontal
+  // motion from `start` to its present position.
+  void build_midpoint_footprints(Floes& floes, std::span<const FloeState> start);
   // The implicit step's operator: out = G u on the pieces (see the header).
   void apply_response(fluid::Sea& sea, double h, std::span<const double> u, std::span<double> out);
 

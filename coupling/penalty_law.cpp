@@ -65,30 +65,33 @@ double obstacle_restitution(double s, double K) {
   return 0.0;  // never leaves within 10^9 time units: absorbed
 }
 
+StepForce step_force(double c, double cd, double d0, double d1) {
+  StepForce r;
+  if (d0 > 0.0 && d1 > 0.0) {
+    r = {0.5 * c * (d0 + d1), 0.5 * c};
+  } else if (d0 > 0.0) {  // leaves the water within the step: d1 <= 0 < d0
+    r.f = 0.5 * c * d0 * d0 / (d0 - d1);
+    r.df = r.f / (d0 - d1);
+  } else if (d1 > 0.0) {  // enters it: d0 <= 0 < d1
+    const double e = d1 - d0;
+    r = {0.5 * c * d1 * d1 / e, 0.5 * c * d1 * (d1 - 2.0 * d0) / (e * e)};
+  }
+  if (cd > 0.0) {
+    r.f += cd * (std::max(d1, 0.0) - std::max(d0, 0.0));
+    if (d1 > 0.0) r.df += cd;
+  }
+  return r;
+}
+
 double stepped_obstacle_restitution(double s, double K, double h) {
   const double v0 = std::sqrt(0.75);
   const double ks = s * K, c = (1.0 - s) * K;
-  // Over the step from x0 to x1 (penetration delta = -x), the penalty's
-  // force held over it and its x1-derivative: the spring's discrete gradient
-  // of ks / 2 [delta]^+^2 and the damper's impulse c ([delta1]^+ - [delta0]^+) / h.
+  // The penalty's force held over the step from x0 to x1 (penetration
+  // delta = -x) and its x1-derivative.
   auto penalty = [&](double x0, double x1, double& df) {
-    const double d0 = -x0, d1 = -x1;
-    double f = 0.0;
-    df = 0.0;
-    if (d0 > 0.0 && d1 > 0.0) {
-      f = 0.5 * ks * (d0 + d1);
-      df = -0.5 * ks;
-    } else if (d0 > 0.0) {
-      f = 0.5 * ks * d0 * d0 / (d0 - d1);
-      df = -f / (d0 - d1);
-    } else if (d1 > 0.0) {
-      const double e = d1 - d0;
-      f = 0.5 * ks * d1 * d1 / e;
-      df = -0.5 * ks * d1 * (d1 - 2.0 * d0) / (e * e);
-    }
-    f += c * (std::max(d1, 0.0) - std::max(d0, 0.0)) / h;
-    if (d1 > 0.0) df -= c / h;
-    return f;
+    const StepForce f = step_force(ks, c / h, -x0, -x1);
+    df = -f.df;
+    return f.f;
   };
   double x = 0.0, v = -v0;  // at the surface, going down
   bool touched = false;

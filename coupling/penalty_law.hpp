@@ -33,6 +33,19 @@ struct PenaltyLawParams {
   double strong_share = 1.0;  // s
 };
 
+// The law's force held over one step of the implicit integrator (coupling/
+// floe_sea.hpp) on a piece whose penetration goes from d0 to d1, and its
+// derivative in d1 (>= 0): the spring's discrete gradient of c / 2 [d]^+^2,
+// c ([d1]^+^2 - [d0]^+^2) / (2 (d1 - d0)), so that f (d1 - d0) is exactly
+// the spring energy's change; plus the damper's impulse over the step,
+// cd ([d1]^+ - [d0]^+) with cd = (damper coefficient) / h (Lambda = c [delta]^+,
+// seed eq. 17), which only absorbs. The cases avoid the quotient's
+// cancellation where both ends are in the water.
+struct StepForce {
+  double f = 0.0, df = 0.0;
+};
+StepForce step_force(double spring, double damper_per_step, double d0, double d1);
+
 // Restitution of the obstacle problem above for a share s and stiffness K
 // (the contact phase in closed form: the continuous law).
 double obstacle_restitution(double strong_share, double stiffness);
