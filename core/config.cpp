@@ -343,6 +343,7 @@ void read_coupling(Section s, CouplingParams& c, SeaModel sea_model) {
                                                {"implicit", CouplingIntegrator::implicit}});
   c.newton_tolerance = s.number("newton_tolerance", c.newton_tolerance, positive, "a relative tolerance > 0");
   c.cg_tolerance = s.number("cg_tolerance", c.cg_tolerance, positive, "a relative tolerance > 0");
+  c.cg_forcing = s.number("cg_forcing", c.cg_forcing, positive, "a relative tolerance > 0");
   s.finish();
 }
 
@@ -531,7 +532,8 @@ std::string resolved_toml(const Config& c) {
                                                                {"tent", FootprintChoice::tent}})},
                        {"integrator", c.coupling.integrator == CouplingIntegrator::implicit ? "implicit" : "explicit"},
                        {"newton_tolerance", c.coupling.newton_tolerance},
-                       {"cg_tolerance", c.coupling.cg_tolerance}};
+                       {"cg_tolerance", c.coupling.cg_tolerance},
+                       {"cg_forcing", c.coupling.cg_forcing}};
   if (c.coupling.law == PenaltyLaw::blend) {
     if (c.coupling.restitution >= 0.0) coupling.insert("restitution", c.coupling.restitution);
     else coupling.insert("blend", c.coupling.blend);

@@ -92,10 +92,12 @@ struct CouplingParams {
   CouplingIntegrator integrator = CouplingIntegrator::explicit_kicks;
   // Implicit integrator: the Newton iteration on the end-of-step penetrations
   // stops when every piece's residual is below newton_tolerance times the
-  // thickest floe's draft; each Newton step's conjugate gradients stop at the
-  // relative residual cg_tolerance.
+  // thickest floe's draft; each Newton step's conjugate gradients stop at a
+  // relative residual between cg_tolerance and cg_forcing, looser far from
+  // the solution (inexact Newton: coupling/penalty_step.hpp).
   double newton_tolerance = 1e-8;
   double cg_tolerance = 1e-10;
+  double cg_forcing = 1e-2;
   int max_newton = 40;
   int max_cg = 500;
 };

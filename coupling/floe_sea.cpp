@@ -8,17 +8,22 @@
 
 #include "core/error.hpp"
 #include "coupling/incident.hpp"
+#include "coupling/parallel.hpp"
 #include "coupling/penalty_law.hpp"
 #include "fluid/sea.hpp"
 
 namespace floesim {
 
+using parallel::for_each_index;
+using parallel::kFloesPerThread;
+
 namespace {
 
-// Loops over fewer floes (or pieces, for_each_index) than this stay on one
-// thread: a parallel region costs a fork and a barrier, ruinous for short
-// loops when the cores are shared (each barrier may wait a scheduler slice).
-constexpr std::ptrdiff_t kFloesPerThread = 64;
+// f(i) for the floes of `order` on threads.
+template <class F>
+void for_each_floe(const std::vector<std::uint32_t>& order, int threads, F&& f) {
+  parallel::for_each_of(order, threads, std::forward<F>(f));
+}
 
 // Response eta' at cell `cell` to a pressure impulse (Pa s) from rest: a unit
 // impulse on that cell alone, or (checkerboard) +-1 alternating on every
@@ -66,8 +71,11 @@ double FloeSeaContact::subcell_weight(double coverage) const {
 FloeSeaContact::FloeSeaContact(const CouplingParams& params, const SeaParams& sea_params, const Floes& floes,
                                fluid::Sea& sea, double dt_max)
     : rho_(sea_params.rho), g_(sea_params.g), sigma_(sea_params.sigma), K_(params.stiffness), grid_(sea.grid()),
-      implicit_(params.integrator == CouplingIntegrator::implicit), newton_tolerance_(params.newton_tolerance),
-      cg_tolerance_(params.cg_tolerance), max_newton_(params.max_newton), max_cg_(params.max_cg) {
+      implicit_(params.integrator == CouplingIntegrator::implicit), newton_tolerance_(params.newton_tolerance) {
+  solver_options_.cg_tolerance = params.cg_tolerance;
+  solver_options_.forcing = params.cg_forcing;
+  solver_options_.max_newton = params.max_newton;
+  solver_options_.max_cg = params.max_cg;
   kappa_ = K_ * rho_ * g_;
   switch (params.law) {
     case PenaltyLaw::strong: s_ = 1.0; break;
@@ -499,70 +507,16 @@ void FloeSeaContact::advance_vertical(Floes& floes, std::span<const FloeState> s
   sea.flow(h);
 }
 
-namespace {
-
-double max_abs(std::span<const double> x) {
-  double m = 0.0;
-  for (double v : x) m = std::max(m, std::abs(v));
-  return m;
-}
-
-// f(k) for k < n on `threads` threads (each k's work independent of the
-// others); on one thread when n is at most `grain` (not worth a fork).
-template <class F>
-void for_each_index(std::size_t n, int threads, F&& f, std::size_t grain = 4096) {
-  const auto count = static_cast<std::ptrdiff_t>(n);
-#pragma omp parallel for num_threads(threads) schedule(static) if (n > grain)
-  for (std::ptrdiff_t k = 0; k < count; ++k) f(static_cast<std::size_t>(k));
-}
-
-// f(i) for the floes of `order` on threads.
-template <class F>
-void for_each_floe(const std::vector<std::uint32_t>& order, int threads, F&& f) {
-  const auto count = static_cast<std::ptrdiff_t>(order.size());
-#pragma omp parallel for num_threads(threads) schedule(dynamic, 16) if (count > kFloesPerThread)
-  for (std::ptrdiff_t j = 0; j < count; ++j) f(order[static_cast<std::size_t>(j)]);
-}
-
-// a . b summed in fixed blocks, then the blocks in order: the same bits
-// whatever the thread count.
-double dot(std::span<const double> a, std::span<const double> b, int threads) {
-  constexpr std::size_t kBlock = 2048;
-  const std::size_t blocks = (a.size() + kBlock - 1) / kBlock;
-  std::vector<double> partial(blocks, 0.0);
-  for_each_index(blocks, threads, [&](std::size_t block) {
-    double s = 0.0;
-    for (std::size_t k = block * kBlock; k < std::min(a.size(), (block + 1) * kBlock); ++k) s += a[k] * b[k];
-    partial[block] = s;
-  }, 2);
-  double s = 0.0;
-  for (double x : partial) s += x;
-  return s;
-}
-
-}  // namespace
-
-void FloeSeaContact::apply_response(fluid::Sea& sea, double h, std::span<const double> u, std::span<double> out) {
+void FloeSeaContact::sea_response(fluid::Sea& sea, double h, std::span<const double> u, std::span<double> out) {
   const Footprints& fp = footprints_;
   const double inv_cell_area = 1.0 / cell_area_;
-  // The sea: the pressure of the forces u, held over h, lowers the nodes by
-  // the midpoint response (G_sea u is minus that change).
-  // (The scatter is in order: pieces of several floes share nodes.)
+  // The pressure of the forces u, held over h, lowers the nodes by the
+  // sea's midpoint response (G_sea u is minus that change). The scatter is
+  // in order: pieces of several floes share nodes.
   for (std::size_t k = 0; k < fp.cell.size(); ++k) grid_work_[fp.cell[k]] += u[k] * inv_cell_area;
   sea.midpoint_response(grid_work_, h, grid_eta_);
   for_each_index(fp.cell.size(), threads_, [&](std::size_t k) { out[k] = -grid_eta_[fp.cell[k]]; });
   for (std::uint32_t c : fp.cell) grid_work_[c] = 0.0;
-  // The floes: each one's bottom rises by h^2 / 2 M^-1 of the forces' resultant.
-  const double hh = 0.5 * h * h;
-  for_each_floe(order_, threads_, [&](std::uint32_t i) {
-    Eigen::Vector3d F = Eigen::Vector3d::Zero();
-    for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k)
-      F += u[k] * Eigen::Vector3d(1.0, fp.centroid[k].x(), fp.centroid[k].y());
-    const Eigen::Vector3d x = hh * (inv_mass_[i] * F);
-    for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k)
-      out[k] += x[0] + x[1] * fp.centroid[k].x() + x[2] * fp.centroid[k].y();
-  });
-  ++implicit_stats_.g_products;
 }
 
 void FloeSeaContact::build_midpoint_footprints(Floes& floes, std::span<const FloeState> start) {
@@ -598,56 +552,55 @@ void FloeSeaContact::implicit_step(Floes& floes, std::span<const FloeState> star
   build_midpoint_footprints(floes, start);
   const Footprints& fp = footprints_;
   const std::size_t n = fp.cell.size();
-  // Each floe's vertical mass matrix diag(M, J) and its inverse on the DOFs
-  // it has (slopes it does not have: identity mass, zero inverse).
-  std::vector<Eigen::Matrix3d> mass(floes.size(), Eigen::Matrix3d::Identity());
-  inv_mass_.assign(floes.size(), Eigen::Matrix3d::Zero());
+  // Each floe's vertical inertia on the DOFs it has.
+  inertia_.assign(floes.size(), {});
   for (std::uint32_t i : order_) {
-    mass[i](0, 0) = floes.mass[i];
-    inv_mass_[i](0, 0) = 1.0 / floes.mass[i];
+    VerticalInertia& in = inertia_[i];
+    in.slopes = tilt_[i];
+    in.mass(0, 0) = floes.mass[i];
+    in.inverse_mass(0, 0) = 1.0 / floes.mass[i];
     if (tilt_[i] == 2) {
       const Eigen::Matrix2d J = tilt_inertia(floes, i);
-      mass[i].bottomRightCorner<2, 2>() = J;
-      inv_mass_[i].bottomRightCorner<2, 2>() = J.inverse();
+      in.mass.bottomRightCorner<2, 2>() = J;
+      in.inverse_mass.bottomRightCorner<2, 2>() = J.inverse();
     } else if (tilt_[i] == 1) {
-      mass[i](1, 1) = tilt_inertia(floes, i)(0, 0);
-      inv_mass_[i](1, 1) = 1.0 / mass[i](1, 1);
+      in.mass(1, 1) = tilt_inertia(floes, i)(0, 0);
+      in.inverse_mass(1, 1) = 1.0 / in.mass(1, 1);
     }
   }
   grid_work_.assign(grid_.size(), 0.0);
   grid_eta_.resize(grid_.size());
+  // Per piece: the spring c = s kappa psi a, the damper per step, the
+  // penetrations at t (d0) and with no penalty at t + h (d_free), both on
+  // this footprint.
+  ImplicitPieces& q = pieces_;
+  for (auto* v : {&q.spring, &q.damper, &q.start, &q.free_end, &q.guess}) v->assign(n, 0.0);
+  free_bottom_.assign(floes.size(), Eigen::Vector3d::Zero());  // z, a at t + h with no penalty
   const double ks = s_ * kappa_;
-  // Per piece: the spring coefficient c = s kappa psi a, the penetrations at
-  // t (d0) and with no penalty at t + h (dfree), both on this footprint.
-  std::vector<double> c(n, 0.0), cd(n, 0.0), d0(n, 0.0), dfree(n, 0.0);
-  std::vector<Eigen::Vector3d> free_bottom(floes.size(), Eigen::Vector3d::Zero());  // z, a at t + h with no penalty
   double scale = 0.0;  // the thickest draft: the residual's unit
-  std::vector<double> guess(n, 0.0);  // Newton's start: d0 + h d0' (first order)
-  {
-    const std::span<const double> eta0 = sea.elevation();
-    const std::span<const double> w0 = sea.field(fluid::Field::velocity_z);
-    for (std::uint32_t i : order_) scale = std::max(scale, floes.draft(i, rho_));
-    for_each_floe(order_, threads_, [&](std::uint32_t i) {
-      const FloeState& st = floes.state[i];
-      const double z = st.heave + bottom0_[i];
-      const Vec2 a{st.pitch, st.roll};
-      free_bottom[i] = {z + h * st.heave_rate - 0.5 * h * h * g_, st.pitch + h * st.pitch_rate,
-                        st.roll + h * st.roll_rate};
-      const double damper = (1.0 - s_) * weak_coefficient(floes, i) / h;
-      for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k) {
-        const double psi_area = subcell_weight(cells_[fp.cell[k]].coverage) * fp.area[k];
-        c[k] = ks * psi_area;
-        cd[k] = damper * psi_area;
-        d0[k] = eta0[fp.cell[k]] - z - a.dot(fp.centroid[k]);
-        guess[k] = d0[k] + h * (w0[fp.cell[k]] - st.heave_rate - Vec2{st.pitch_rate, st.roll_rate}.dot(fp.centroid[k]));
-      }
-    });
-  }
+  for (std::uint32_t i : order_) scale = std::max(scale, floes.draft(i, rho_));
+  const std::span<const double> eta0 = sea.elevation();
+  const std::span<const double> w0 = sea.field(fluid::Field::velocity_z);
+  for_each_floe(order_, threads_, [&](std::uint32_t i) {
+    const FloeState& st = floes.state[i];
+    const double z = st.heave + bottom0_[i];
+    const Vec2 a{st.pitch, st.roll};
+    free_bottom_[i] = {z + h * st.heave_rate - 0.5 * h * h * g_, st.pitch + h * st.pitch_rate,
+                       st.roll + h * st.roll_rate};
+    const double damper = (1.0 - s_) * weak_coefficient(floes, i) / h;
+    for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k) {
+      const double psi_area = subcell_weight(cells_[fp.cell[k]].coverage) * fp.area[k];
+      q.spring[k] = ks * psi_area;
+      q.damper[k] = damper * psi_area;
+      q.start[k] = eta0[fp.cell[k]] - z - a.dot(fp.centroid[k]);
+      q.guess[k] = q.start[k] + h * (w0[fp.cell[k]] - st.heave_rate - Vec2{st.pitch_rate, st.roll_rate}.dot(fp.centroid[k]));
+    }
+  });
   sea.midpoint_free_elevation(h, grid_eta_);
   for_each_floe(order_, threads_, [&](std::uint32_t i) {
-    const Eigen::Vector3d& b = free_bottom[i];
+    const Eigen::Vector3d& b = free_bottom_[i];
     for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k)
-      dfree[k] = grid_eta_[fp.cell[k]] - b[0] - b[1] * fp.centroid[k].x() - b[2] * fp.centroid[k].y();
+      q.free_end[k] = grid_eta_[fp.cell[k]] - b[0] - b[1] * fp.centroid[k].x() - b[2] * fp.centroid[k].y();
   });
   // The sea's response on a node to its own pressure over h: the diagonal of
   // G_sea, for the preconditioner (a periodic sea's is the same on every node).
@@ -659,116 +612,45 @@ void FloeSeaContact::implicit_step(Floes& floes, std::span<const FloeState> star
     self_response_ = std::max(-grid_eta_[node], 0.0);
     self_response_h_ = h;
   }
-  const double self = self_response_ / cell_area_;
 
-  // Newton on R(d1) = d1 - dfree + G f(d0, d1), from the guess.
-  std::vector<double> d1 = guess, f(n), df(n), R(n), sq(n), w(n), r(n), z(n), p(n), Ap(n), tmp(n), step(n),
-      trial(n), ftrial(n);
-  auto residual = [&](std::span<const double> d, std::vector<double>& force, std::vector<double>& out) {
-    for_each_index(n, threads_, [&](std::size_t k) { force[k] = step_force(c[k], cd[k], d0[k], d[k]).f; });
-    apply_response(sea, h, force, out);
-    for_each_index(n, threads_, [&](std::size_t k) { out[k] += d[k] - dfree[k]; });
-  };
-  residual(d1, f, R);
-  const double tolerance = newton_tolerance_ * std::max(scale, 1e-300);
-  // Per floe, the preconditioner's small system (C^-1 + U^T D^-1 U) with
-  // U = S Phi, C = h^2 / 2 M^-1, D = I + S self S (Woodbury).
-  std::vector<Eigen::LDLT<Eigen::Matrix3d>> small(floes.size());
-  std::vector<double> dinv(n);  // 1 / (1 + f' self): the sea's diagonal part
-  const double hh = 0.5 * h * h;
-  auto precondition = [&](std::span<const double> in, std::span<double> out) {
-    for_each_floe(order_, threads_, [&](std::uint32_t i) {
-      Eigen::Vector3d t = Eigen::Vector3d::Zero();
-      for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k) {
-        out[k] = dinv[k] * in[k];
-        t += sq[k] * out[k] * Eigen::Vector3d(1.0, fp.centroid[k].x(), fp.centroid[k].y());
-      }
-      if (tilt_[i] < 2) t[2] = 0.0;  // slopes the floe does not have
-      if (tilt_[i] < 1) t[1] = 0.0;
-      const Eigen::Vector3d y = small[i].solve(t);
-      for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k)
-        out[k] -= dinv[k] * sq[k] * (y[0] + y[1] * fp.centroid[k].x() + y[2] * fp.centroid[k].y());
-    });
-  };
-  int newton = 0;
-  double norm = max_abs(R);
-  for (; norm > tolerance; ++newton) {
-    if (newton == max_newton_) {
-      std::ostringstream m;
-      m << "the implicit floe–sea step did not converge in " << max_newton_ << " Newton iterations (largest residual "
-        << norm << " m, tolerance " << tolerance << " m; dt = " << h << " s)";
-      throw RunError(m.str());
-    }
-    for_each_index(n, threads_, [&](std::size_t k) {
-      df[k] = step_force(c[k], cd[k], d0[k], d1[k]).df;
-      sq[k] = std::sqrt(df[k]);
-      dinv[k] = 1.0 / (1.0 + df[k] * self);
-    });
-    for_each_floe(order_, threads_, [&](std::uint32_t i) {
-      Eigen::Matrix3d utu = Eigen::Matrix3d::Zero();
-      for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k) {
-        Eigen::Vector3d u = sq[k] * Eigen::Vector3d(1.0, fp.centroid[k].x(), fp.centroid[k].y());
-        if (tilt_[i] < 2) u[2] = 0.0;
-        if (tilt_[i] < 1) u[1] = 0.0;
-        utu += dinv[k] * u * u.transpose();
-      }
-      small[i].compute(mass[i] / hh + utu);
-    });
-    // Conjugate gradients on (I + S G S) w = -S R.
-    for_each_index(n, threads_, [&](std::size_t k) {
-      w[k] = 0.0;
-      r[k] = -sq[k] * R[k];
-    });
-    const double bnorm = std::sqrt(dot(r, r, threads_));
-
-    precondition(r, z);
-    p = z;
-    double rz = dot(r, z, threads_);
-    for (int it = 0; it < max_cg_ && std::sqrt(dot(r, r, threads_)) > cg_tolerance_ * bnorm; ++it) {
-      for_each_index(n, threads_, [&](std::size_t k) { tmp[k] = sq[k] * p[k]; });
-      apply_response(sea, h, tmp, Ap);
-      for_each_index(n, threads_, [&](std::size_t k) { Ap[k] = p[k] + sq[k] * Ap[k]; });
-      const double alpha = rz / dot(p, Ap, threads_);
-      for_each_index(n, threads_, [&](std::size_t k) {
-        w[k] += alpha * p[k];
-        r[k] -= alpha * Ap[k];
-      });
-      precondition(r, z);
-      const double rz_new = dot(r, z, threads_);
-      const double beta = rz_new / rz;
-      for_each_index(n, threads_, [&](std::size_t k) { p[k] = z[k] + beta * p[k]; });
-      rz = rz_new;
-      ++implicit_stats_.cg;
-    }
-    // The Newton step: (I + G F') step = -R, step = -R - G S w.
-    for_each_index(n, threads_, [&](std::size_t k) { tmp[k] = sq[k] * w[k]; });
-    apply_response(sea, h, tmp, step);
-    for_each_index(n, threads_, [&](std::size_t k) { step[k] = -R[k] - step[k]; });
-    // Backtracking on the residual's norm.
-    const double norm2 = std::sqrt(dot(R, R, threads_));
-    double t = 1.0;
-    for (;;) {
-      for_each_index(n, threads_, [&](std::size_t k) { trial[k] = d1[k] + t * step[k]; });
-      residual(trial, ftrial, tmp);
-      if (std::sqrt(dot(tmp, tmp, threads_)) < (1.0 - 1e-4 * t) * norm2 || t < 1e-6) break;
-      t *= 0.5;
-    }
-    d1.swap(trial);
-    f.swap(ftrial);
-    R.swap(tmp);
-    norm = max_abs(R);
-  }
+  PenaltyStepProblem problem;
+  problem.step = h;
+  problem.offsets = fp.offsets;
+  problem.bodies = order_;
+  problem.inertia = inertia_;
+  problem.lever = fp.centroid;
+  problem.spring = q.spring;
+  problem.damper = q.damper;
+  problem.start = q.start;
+  problem.free_end = q.free_end;
+  problem.guess = q.guess;
+  problem.self_response = self_response_ / cell_area_;
+  problem.tolerance = newton_tolerance_ * std::max(scale, 1e-300);
+  PenaltyStepOptions options = solver_options_;
+  options.threads = threads_;
+  const PenaltyStepResult result = solver_.solve(
+      problem, [&](std::span<const double> u, std::span<double> out) { sea_response(sea, h, u, out); }, options);
   ++implicit_stats_.steps;
-  implicit_stats_.newton += newton;
-  implicit_stats_.last_residual = norm;
+  implicit_stats_.newton += result.newton;
+  implicit_stats_.cg += result.cg;
+  implicit_stats_.g_products += result.responses;
+  implicit_stats_.last_residual = result.residual;
+  if (result.status != PenaltyStepStatus::converged) {
+    std::ostringstream m;
+    m << "the implicit floe–sea step did not converge in " << options.max_newton << " Newton iterations (largest residual "
+      << result.residual << " m, tolerance " << problem.tolerance << " m; dt = " << h << " s)";
+    throw RunError(m.str());
+  }
 
   // The step with the forces f held over it: the floes...
+  const std::span<const double> f = solver_.force();
+  const double hh = 0.5 * h * h;
   for (std::uint32_t i : order_) {
     FloeState& st = floes.state[i];
     Eigen::Vector3d F(-floes.mass[i] * g_, 0.0, 0.0);
     for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k)
       F += f[k] * Eigen::Vector3d(1.0, fp.centroid[k].x(), fp.centroid[k].y());
-    const Eigen::Vector3d acc = inv_mass_[i] * F;
+    const Eigen::Vector3d acc = inertia_[i].inverse_mass * F;
     st.heave += h * st.heave_rate + hh * acc[0];
     st.pitch += h * st.pitch_rate + hh * acc[1];
     st.roll += h * st.roll_rate + hh * acc[2];

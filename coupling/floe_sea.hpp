@@ -106,6 +106,7 @@
 #include "core/floes.hpp"
 #include "core/params.hpp"
 #include "coupling/footprint.hpp"
+#include "coupling/penalty_step.hpp"
 
 namespace floesim {
 
@@ -213,8 +214,9 @@ private:
   // Footprints (and coverage) at the midpoint of each floe's horizontal
   // motion from `start` to its present position.
   void build_midpoint_footprints(Floes& floes, std::span<const FloeState> start);
-  // The implicit step's operator: out = G u on the pieces (see the header).
-  void apply_response(fluid::Sea& sea, double h, std::span<const double> u, std::span<double> out);
+  // The sea's part of the implicit step's operator: out = G_sea u on the
+  // pieces (coupling/penalty_step.hpp).
+  void sea_response(fluid::Sea& sea, double h, std::span<const double> u, std::span<double> out);
 
   FootprintKernel kernel_ = FootprintKernel::cell;
   double rho_ = 1025.0, g_ = 9.81, sigma_ = 0.0, K_ = 1000.0, s_ = 1.0, kappa_ = 0.0;
@@ -241,12 +243,17 @@ private:
   std::vector<Vec2> water_;       // incident velocity under each floe, with the loads
   bool implicit_ = false;
   int threads_ = 1;
-  double newton_tolerance_ = 1e-8, cg_tolerance_ = 1e-10;
-  int max_newton_ = 40, max_cg_ = 500;
+  double newton_tolerance_ = 1e-8;  // times the thickest draft
+  PenaltyStepOptions solver_options_;
+  PenaltyStepSolver solver_;
   ImplicitStats implicit_stats_;
   double self_response_h_ = -1.0, self_response_ = 0.0;  // sea's node response to its own pressure over h
   std::vector<double> grid_work_, grid_eta_;  // grid-sized scratch of the implicit step
-  std::vector<Eigen::Matrix3d> inv_mass_;     // per floe, the implicit step's (zeta, a) inverse mass
+  std::vector<VerticalInertia> inertia_;      // per floe, the implicit step's
+  std::vector<Eigen::Vector3d> free_bottom_;  // per floe: (z, a) at t + h with no penalty
+  struct ImplicitPieces {                     // per piece, the implicit step's problem
+    std::vector<double> spring, damper, start, free_end, guess;
+  } pieces_;
   struct EvaluationScratch {
     std::vector<double> penetration;  // [delta]^+ of each area piece
     std::vector<double> psi;          // psi of each area piece's cell
