@@ -20,7 +20,7 @@ import time
 import h5py
 import numpy as np
 
-FLOESIM, SRC, CASE = sys.argv[1], sys.argv[2], sys.argv[3]
+FLOESIM, SRC, CASE = sys.argv[1], os.path.abspath(sys.argv[2]), sys.argv[3]
 WORK = tempfile.mkdtemp(prefix="floesim_restart_")
 
 
@@ -280,6 +280,22 @@ def case_pack():
     data = continuation(PACK, 60, 30, "pack")
     lcp = data["diagnostics/lcp"]
     check(lcp[-1, 0] > lcp[15, 0] > 0, "collisions before and after the restart")
+
+
+def case_jam():
+    # examples/pack_against_wall.toml: by 1200 s the pack is jamming against
+    # the wall, with LCPs of 500 unknowns and more solved by Lemke
+    # warm-started from the last step's basis: the warm starts must go on.
+    cfg = os.path.join(SRC, "examples", "pack_against_wall.toml")
+    run("run", "-q", cfg, "-o", "full.h5", "--until", "1320")
+    run("run", "-q", cfg, "-o", "half.h5", "--until", "1260")
+    with h5py.File(os.path.join(WORK, "half.h5"), "r") as f:
+        check(f["checkpoint/warm_start/keys"].shape[0] > 0, "the checkpoint holds warm starts")
+        before = dict(zip(f["checkpoint/counters"].attrs["columns"], f["checkpoint/counters"][()]))
+    run("run", "-q", cfg, "--restart", "half.h5", "--until", "1320", "-o", "cont.h5")
+    data = compare_runs(os.path.join(WORK, "full.h5"), os.path.join(WORK, "cont.h5"), "jam")
+    after = dict(zip(datasets(os.path.join(WORK, "cont.h5"))[1], data["checkpoint/counters"]))
+    check(after["collisions.warm"] > before["collisions.warm"] > 0, "warm-started solves before and after the restart")
 
 
 def case_waves_explicit():
