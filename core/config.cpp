@@ -600,8 +600,15 @@ std::string value_text(const toml::node& node) {
 void flatten(const toml::table& t, const std::string& section, std::map<std::string, std::string>& out) {
   for (const auto& [k, node] : t) {
     const std::string key(k.str());
+    const std::string path = section.empty() ? key : section + "." + key;
     if (const toml::table* sub = node.as_table()) {
-      flatten(*sub, section.empty() ? key : section + "." + key, out);
+      flatten(*sub, path, out);
+      continue;
+    }
+    // An array of tables (the inline floes) key by key, "[floes.floe 3] velocity".
+    if (const toml::array* a = node.as_array(); a && !a->empty() && a->is_array_of_tables()) {
+      for (std::size_t i = 0; i < a->size(); ++i) flatten(*a->get(i)->as_table(), path + " " + std::to_string(i), out);
+      out["[" + path + "] count"] = std::to_string(a->size());
       continue;
     }
     out[(section.empty() ? key : "[" + section + "] " + key)] = value_text(node);

@@ -420,6 +420,9 @@ def case_refusals():
     p = run("run", changed, "--restart", "half.h5", expect=2)
     check("differs from the run's" in p.stderr and "[contact] restitution: 0.4 -> 0.5" in p.stderr
           and "[forcing] wind: [20, 3] -> [20, 4]" in p.stderr, f"changed config: message\n{p.stderr}")
+    moved = write("moved.toml", PACK.replace("velocity = [0.6, 0.0]", "velocity = [0.7, 0.0]"))
+    p = run("run", moved, "--restart", "half.h5", expect=2)
+    check("[floes.floe 2] velocity: [0.6, 0] -> [0.7, 0]" in p.stderr, f"changed floe: message\n{p.stderr}")
     check(checkpoint_time("half.h5") == 30.0, "a refused restart leaves the file as it was")
     # What does not change the results may change: t_end, checkpoint_interval, threads.
     free = write("free.toml", PACK.replace("t_end = 60.0", "t_end = 34.0").replace(
