@@ -405,6 +405,26 @@ def case_kill():
     continue_and_compare(cfg, "killed.h5", "killed")
 
 
+def case_run_error():
+    # A run that fails (exit 1: a wind of 1e200 m/s from t = 10.5 s overflows
+    # the drag) keeps, as its checkpoint, the state at its last record: the
+    # same checkpoint, bit for bit, as a run that ended there.
+    write("wind.csv", "t_s,wind_u,wind_v,current_u,current_v\n0,10,0,0,0\n10,10,0,0,0\n10.5,1e200,0,0,0\n")
+    cfg = write("fail.toml", PACK.replace("wind = [20.0, 3.0]", 'series = "wind.csv"'))
+    p = run("run", "-q", cfg, "-o", "failed.h5", "--until", "20", expect=1)
+    check("a checkpoint at the last one" in p.stderr, f"the failure message mentions the checkpoint\n{p.stderr}")
+    with h5py.File(os.path.join(WORK, "failed.h5"), "r") as f:
+        check(f.attrs["status"].startswith("failed:"), "status failed")
+        check(f["time"][-1] == 10.0, f"the last record at 10 s ({f['time'][-1]})")
+    check(checkpoint_time("failed.h5") == 10.0, "the checkpoint at the last record")
+    run("run", "-q", cfg, "-o", "ten.h5", "--until", "10")
+    a, cols, _ = datasets(os.path.join(WORK, "failed.h5"))
+    b, _, _ = datasets(os.path.join(WORK, "ten.h5"))
+    for name in a:
+        if name.startswith("checkpoint/") or name in ("time", "floes/state", "diagnostics/lcp"):
+            check(same_bits(a[name], b[name]), f"/{name} of the failed run equals the run to 10 s")
+
+
 def case_refusals():
     cfg = write("pack.toml", PACK)
     run("run", "-q", cfg, "-o", "half.h5", "--until", "30")
