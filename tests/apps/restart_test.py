@@ -331,6 +331,17 @@ def case_fracture():
     # ... and before the impact: the events come after the restart.
     data = continuation(FRACTURE, 8, 2, "fracture_before")
     check(np.all(data["events/fracture"][:, 0] > 2), "the fracture after the restart")
+    # A run that went on past its last checkpoint (as a killed run does):
+    # the full run's file with the checkpoint of 2 s. The restart drops the
+    # records, the fracture events and the pieces' numbers after 2 s, and
+    # writes them again, equal.
+    shutil.copy(os.path.join(WORK, "full.h5"), os.path.join(WORK, "spliced.h5"))
+    with h5py.File(os.path.join(WORK, "spliced.h5"), "a") as f, h5py.File(os.path.join(WORK, "half.h5"), "r") as h:
+        del f["checkpoint"]
+        h.copy(h["checkpoint"], f, "checkpoint")
+        check(f["floes/thickness"].shape[0] > h["floes/thickness"].shape[0], "pieces after the checkpoint")
+    run("run", "-q", "--restart", "spliced.h5", "--until", "8")
+    compare_runs(os.path.join(WORK, "full.h5"), os.path.join(WORK, "spliced.h5"), "fracture, truncated")
 
 
 def stop_midway(cfg, out, sig, ready):
