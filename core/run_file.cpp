@@ -439,6 +439,10 @@ RunInfo read_run_info(const std::string& path) {
   const auto t = h5::read_doubles(h5::open_dataset(f, "/time", path), path + ": /time");
   r.records = t.size();
   if (!t.empty()) { r.t_first = t.front(); r.t_last = t.back(); }
+  if (h5::exists(f, "/checkpoint")) {
+    h5::Handle c = h5::open_group(f, "/checkpoint", path);
+    if (h5::has_attr(c, "time")) r.checkpoint_time = h5::get_attr_double(c, "time");
+  }
   {
     h5::Handle th = h5::open_dataset(f, "/floes/thickness", path);
     r.floes = h5::dims(th).at(0);

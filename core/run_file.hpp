@@ -137,6 +137,7 @@ struct RunInfo {
   std::string format, status, config;
   std::size_t records = 0, floes = 0, vertices = 0;
   double t_first = 0.0, t_last = 0.0;
+  double checkpoint_time = -1.0;        // s, of /checkpoint (< 0: none)
   std::vector<std::string> energy_columns;
   std::vector<double> energy_last;      // last record
   std::array<double, 4> lcp_last{};     // solves, pivots, failures, fallbacks

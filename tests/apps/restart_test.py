@@ -439,10 +439,13 @@ def case_run_error():
 def case_refusals():
     cfg = write("pack.toml", PACK)
     run("run", "-q", cfg, "-o", "half.h5", "--until", "30")
+    p = run("info", "half.h5")
+    check("checkpoint: t = 30 s (floesim run --restart half.h5)" in p.stdout, f"info shows the checkpoint\n{p.stdout}")
     # No checkpoint (a file from before checkpoints existed).
     shutil.copy(os.path.join(WORK, "half.h5"), os.path.join(WORK, "old.h5"))
     with h5py.File(os.path.join(WORK, "old.h5"), "a") as f:
         del f["checkpoint"]
+    check("checkpoint: none" in run("info", "old.h5").stdout, "info: no checkpoint")
     p = run("run", cfg, "--restart", "old.h5", expect=2)
     check("old.h5: the run has no checkpoint" in p.stderr, f"no checkpoint: message\n{p.stderr}")
     # A configuration that changes the results: each key that differs is named.

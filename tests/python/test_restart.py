@@ -72,6 +72,7 @@ class FromRun(unittest.TestCase):
     def test_steps_on_identically(self):
         path = os.path.join(self.dir, "half.h5")
         floesim.Simulation(self.config).run(path, until=2.0)
+        self.assertEqual(floesim.RunFile(path).info["checkpoint_time"], 2.0)
         reference = floesim.Simulation(self.config)
         reference.run_until(2.0)
         sim = floesim.Simulation.from_run(path)
