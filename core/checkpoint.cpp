@@ -192,8 +192,9 @@ Checkpoint read_checkpoint(const std::string& path) {
   h5::Handle g = h5::open_group(file, "/checkpoint", path);
   const double version = r.attr(g, "version");
   if (version != static_cast<double>(kCheckpointVersion))
-    r.fail("version " + std::to_string(version) + ", this floesim reads version " +
-           std::to_string(kCheckpointVersion));
+    r.fail("version " + (version == std::floor(version) && std::abs(version) < 1e15
+                              ? std::to_string(static_cast<long long>(version)) : std::to_string(version)) +
+           ", this floesim reads version " + std::to_string(kCheckpointVersion));
   Checkpoint c;
   c.time = r.attr(g, "time");
   if (!(std::isfinite(c.time) && c.time >= 0.0)) r.fail("time: expected a finite time >= 0");

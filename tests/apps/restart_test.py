@@ -448,6 +448,18 @@ def case_refusals():
     check("checkpoint: none" in run("info", "old.h5").stdout, "info: no checkpoint")
     p = run("run", cfg, "--restart", "old.h5", expect=2)
     check("old.h5: the run has no checkpoint" in p.stderr, f"no checkpoint: message\n{p.stderr}")
+    # A checkpoint of another format version, or a damaged one.
+    shutil.copy(os.path.join(WORK, "half.h5"), os.path.join(WORK, "v2.h5"))
+    with h5py.File(os.path.join(WORK, "v2.h5"), "a") as f:
+        f["checkpoint"].attrs["version"] = 2.0
+    p = run("run", cfg, "--restart", "v2.h5", expect=2)
+    check("v2.h5: /checkpoint: version 2, this floesim reads version 1" in p.stderr, f"version: message\n{p.stderr}")
+    shutil.copy(os.path.join(WORK, "half.h5"), os.path.join(WORK, "bad.h5"))
+    with h5py.File(os.path.join(WORK, "bad.h5"), "a") as f:
+        del f["checkpoint/floes/state"]
+        f["checkpoint/floes/state"] = np.zeros((4, 12))
+    p = run("run", cfg, "--restart", "bad.h5", expect=2)
+    check("bad.h5: /checkpoint/floes/state: expected 60 numbers, got 48" in p.stderr, f"damaged: message\n{p.stderr}")
     # A configuration that changes the results: each key that differs is named.
     changed = write("changed.toml", PACK.replace("restitution = 0.4", "restitution = 0.5").replace(
         "wind = [20.0, 3.0]", "wind = [20.0, 4.0]"))
