@@ -8,6 +8,12 @@
 namespace floesim::apps {
 
 namespace {
+std::string fmt(double v) {
+  std::ostringstream o;
+  o << v;
+  return o.str();
+}
+
 std::string json_string(const std::string& s) {
   std::ostringstream o;
   o << '"';
@@ -46,7 +52,10 @@ void add_info_command(CLI::App& app, Registry& registry) {
     if (args->json) {
       o << "{\n  \"file\": " << json_string(args->file) << ",\n  \"format\": " << json_string(r.format)
         << ",\n  \"status\": " << json_string(r.status) << ",\n  \"records\": " << r.records
-        << ",\n  \"t_first\": " << r.t_first << ",\n  \"t_last\": " << r.t_last << ",\n  \"floes\": " << r.floes
+        << ",\n  \"t_first\": " << r.t_first << ",\n  \"t_last\": " << r.t_last;
+      if (r.checkpoint_time >= 0.0) o << ",\n  \"checkpoint\": " << r.checkpoint_time;
+      else o << ",\n  \"checkpoint\": null";
+      o << ",\n  \"floes\": " << r.floes
         << ",\n  \"vertices\": " << r.vertices << ",\n  \"energy\": {";
       for (std::size_t k = 0; k < r.energy_columns.size(); ++k)
       {
@@ -68,7 +77,9 @@ void add_info_command(CLI::App& app, Registry& registry) {
     }
     const std::string status = r.status == "running" ? "running (no end mark: still being written, or the run was killed)" : r.status;
     o << "file: " << args->file << "\nformat: " << r.format << "\nstatus: " << status
-      << "\nrecords: " << r.records << "\ntime: " << r.t_first << " .. " << r.t_last << " s\nfloes: " << r.floes
+      << "\nrecords: " << r.records << "\ntime: " << r.t_first << " .. " << r.t_last << " s\ncheckpoint: "
+      << (r.checkpoint_time >= 0.0 ? "t = " + fmt(r.checkpoint_time) + " s (floesim run --restart " + args->file + ")" : "none")
+      << "\nfloes: " << r.floes
       << "\nvertices: " << r.vertices << "\n";
     for (std::size_t k = 0; k < r.energy_columns.size() && k < r.energy_last.size(); ++k)
       o << "energy." << r.energy_columns[k] << ": " << r.energy_last[k] << " J\n";

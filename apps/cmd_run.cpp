@@ -1,6 +1,7 @@
-// floesim run [CONFIG.toml] [-o OUT.h5] [--until T]: runs a scenario, writes
-// the run file (and its .xmf for ParaView), shows progress on a terminal and
-// prints a summary at the end.
+// floesim run [CONFIG.toml] [-o OUT.h5] [--until T] [--restart RUN.h5]: runs
+// a scenario, writes the run file (and its .xmf for ParaView), shows progress
+// on a terminal and prints a summary at the end. With --restart, continues
+// RUN.h5 from its checkpoint (docs/formats.md, "Checkpoint and restart").
 #include <unistd.h>
 
 #include <atomic>
@@ -12,7 +13,9 @@
 #include <sstream>
 
 #include "apps/commands.hpp"
+#include "core/checkpoint.hpp"
 #include "core/config.hpp"
+#include "core/run_file.hpp"
 #include "core/error.hpp"
 #include "coupling/run.hpp"
 
@@ -23,7 +26,31 @@ namespace {
 namespace fs = std::filesystem;
 
 std::atomic<bool> g_interrupted{false};
-extern "C" void on_sigint(int) { g_interrupted = true; }
+extern "C" void on_signal(int) { g_interrupted = true; }
+
+// Exit status of a run stopped by SIGINT or SIGTERM (after the step in
+// progress, with a checkpoint written and the file closed).
+constexpr int kInterruptedExit = 130;
+
+// The configuration of a restart: CONFIG if given, else the one stored in the
+// run file; refused if it differs from the run's in what changes its results.
+Config restart_config(const std::string& run_path, const std::string& config_path, const RunInfo& info) {
+  Config config = config_path.empty()
+                      ? parse_config(info.config, run_path + ": config attribute",
+                                     fs::absolute(run_path).parent_path().string())
+                      : load_config(config_path);
+  const std::vector<std::string> diff = physics_differences(info.config, resolved_toml(config), run_path);
+  if (!diff.empty()) {
+    std::ostringstream m;
+    m << (config_path.empty() ? run_path + ": config attribute" : config_path)
+      << ": the configuration differs from the run's (" << run_path
+      << ": config attribute) in what changes the results, so the restart could not continue that run:";
+    for (const std::string& d : diff) m << "\n  " << d << "  (run -> now)";
+    m << "\n(only [run] t_end, checkpoint_interval and threads may change)";
+    throw InputError(m.str());
+  }
+  return config;
+}
 
 std::string default_config() {
   const fs::path p = fs::path(FLOESIM_SOURCE_DIR) / "examples" / "floes_on_waves.toml";
@@ -67,7 +94,7 @@ private:
 
 void add_run_command(CLI::App& app, Registry& registry) {
   struct Args {
-    std::string config, output;
+    std::string config, output, restart;
     double until = -1.0;
     int threads = -1;
     bool quiet = false, profile = false;
@@ -80,52 +107,91 @@ void add_run_command(CLI::App& app, Registry& registry) {
       ->check(finite_non_negative());
   sub->add_option("--threads", args->threads, "Threads for the per-floe phases (default: [run] threads; 0: OMP_NUM_THREADS if set, else one per core)")
       ->check(CLI::Range(0, 1024));
+  sub->add_option("--restart", args->restart,
+                  "Continue this run file from its checkpoint, bit for bit (CONFIG: by default the run's own; "
+                  "the output: by default the run file itself)");
   sub->add_flag("-q,--quiet", args->quiet, "No progress line");
   sub->add_flag("--profile", args->profile, "Print the time spent in each phase of the step");
   registry[sub] = [args] {
-    const std::string config_path = args->config.empty() ? default_config() : args->config;
-    if (!fs::exists(config_path)) throw InputError(config_path + ": configuration file not found");
-    const std::string output =
-        args->output.empty() ? fs::path(config_path).stem().string() + ".h5" : args->output;
-    if (fs::exists(output) && fs::equivalent(output, config_path))
+    const bool restart = !args->restart.empty();
+    std::string config_path = args->config.empty() && !restart ? default_config() : args->config;
+    if (!config_path.empty() && !fs::exists(config_path)) throw InputError(config_path + ": configuration file not found");
+    std::string output = args->output;
+    if (output.empty()) output = restart ? args->restart : fs::path(config_path).stem().string() + ".h5";
+    if (!config_path.empty() && fs::exists(output) && fs::equivalent(output, config_path))
       throw InputError(output + ": the output would overwrite the configuration");
 
-    Config config = load_config(config_path);
+    Config config;
+    Checkpoint checkpoint;
+    if (restart) {
+      if (!fs::exists(args->restart)) throw InputError(args->restart + ": run file not found (--restart)");
+      const RunInfo info = read_run_info(args->restart);
+      checkpoint = read_checkpoint(args->restart);
+      config = restart_config(args->restart, config_path, info);
+      const double t_end = args->until >= 0.0 ? args->until : config.run.t_end;
+      if (t_end < checkpoint.time) {
+        std::ostringstream m;
+        m << args->restart << ": the checkpoint is at t = " << checkpoint.time << " s, after the end asked for ("
+          << (args->until >= 0.0 ? "--until " : "[run] t_end = ") << t_end << " s): expected an end >= "
+          << checkpoint.time << " s";
+        throw InputError(m.str());
+      }
+    } else {
+      config = load_config(config_path);
+    }
     if (args->threads >= 0) config.run.threads = args->threads;
     // --until replaces t_end: the bound on the records of [run] t_end holds for it too.
     const std::string problem =
         args->until >= 0.0 ? record_count_problem(args->until, config.run.output_interval) : std::string{};
     if (!problem.empty()) {
       std::ostringstream m;
-      m << "--until " << args->until << ": " << problem << " (" << config_path << ": [run] output_interval)";
+      m << "--until " << args->until << ": " << problem << " (" << (config_path.empty() ? args->restart : config_path)
+        << ": [run] output_interval)";
       throw InputError(m.str());
     }
     Simulation sim(build_scenario(config));
+    if (restart) {
+      sim.restore(checkpoint);
+      // A new output starts as a copy of the run; the records after the checkpoint are dropped from it.
+      if (!(fs::exists(output) && fs::equivalent(output, args->restart))) {
+        std::error_code ec;
+        fs::copy_file(args->restart, output, fs::copy_options::overwrite_existing, ec);
+        if (ec) throw InputError(output + ": cannot copy the run file " + args->restart + " to it: " + ec.message());
+      }
+    }
     for (const std::string& note : sim.notes()) std::cerr << "floesim: note: " << note << "\n";
 
     ProgressLine progress(!args->quiet && isatty(STDERR_FILENO));
     g_interrupted = false;
-    auto previous = std::signal(SIGINT, on_sigint);
+    auto previous = std::signal(SIGINT, on_signal);
+    auto previous_term = std::signal(SIGTERM, on_signal);
+    auto restore_signals = [&] {
+      std::signal(SIGINT, previous);
+      std::signal(SIGTERM, previous_term);
+    };
     RunOptions options{output, args->until, [&](const RunProgress& p) { progress(p); },
-                       [] { return g_interrupted.load(); }};
+                       [] { return g_interrupted.load(); }, restart ? &checkpoint : nullptr};
     RunSummary s;
     try {
       s = run_simulation(sim, options);
     } catch (const RunError&) {
       progress.done();
-      std::signal(SIGINT, previous);
-      std::cerr << "floesim: the run file " << output << " keeps every record written before the failure\n";
+      restore_signals();
+      std::cerr << "floesim: the run file " << output
+                << " keeps every record written before the failure, and a checkpoint at the last one\n";
       throw;
     } catch (...) {
       progress.done();
-      std::signal(SIGINT, previous);
+      restore_signals();
       throw;
     }
     progress.done();
-    std::signal(SIGINT, previous);
+    restore_signals();
 
     std::ostream& o = std::cout;
-    o << "status: " << s.status << "\nconfig: " << config_path << "\noutput: " << fs::absolute(s.output).string()
+    o << "status: " << s.status << "\nconfig: " << (config_path.empty() ? args->restart + " (its config)" : config_path);
+    if (restart) o << "\nrestarted_from: " << args->restart << " at t = " << checkpoint.time << " s";
+    o << "\ncheckpoint: " << (s.checkpoint_time >= 0.0 ? std::to_string(s.checkpoint_time) + " s" : "none") << "\noutput: " << fs::absolute(s.output).string()
       << "\nparaview: " << fs::absolute(s.xdmf).string() << "\nfloes: " << sim.floes().size() << "\nsteps: " << s.steps
       << "\nrecords: " << s.records << "\nsimulated: " << s.t_end << " s\nwall_time: " << std::setprecision(4)
       << s.wall_seconds << " s\nsteps_per_second: " << (s.wall_seconds > 0 ? static_cast<double>(s.steps) / s.wall_seconds : 0.0)
@@ -163,7 +229,9 @@ void add_run_command(CLI::App& app, Registry& registry) {
         o << "profile." << kPhaseNames[k] << ": " << std::setprecision(4) << s.profile.seconds[k] << " s ("
           << std::setprecision(3) << (total > 0 ? 100 * s.profile.seconds[k] / total : 0.0) << "%)\n";
     }
-    return s.status == "complete" ? 0 : 130;
+    if (s.status != "complete")
+      std::cerr << "floesim: interrupted; continue with: floesim run --restart " << output << "\n";
+    return s.status == "complete" ? 0 : kInterruptedExit;
   };
 }
 

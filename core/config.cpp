@@ -2,11 +2,13 @@
 
 #include <toml++/toml.h>
 
+#include <charconv>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <functional>
 #include <iomanip>
+#include <map>
 #include <numbers>
 #include <set>
 #include <sstream>
@@ -201,6 +203,9 @@ void read_run(Section s, RunParams& r) {
       s.integer("seed", static_cast<long long>(r.seed), [](long long v) { return v >= 0; }, "a seed >= 0"));
   r.threads = static_cast<int>(s.integer("threads", r.threads, [](long long v) { return v >= 0 && v <= 1024; },
                                          "a thread count in [0, 1024] (0: OMP_NUM_THREADS if set, else one per core)"));
+  r.checkpoint_interval = s.number("checkpoint_interval", r.checkpoint_interval,
+                                   [](double v) { return std::isfinite(v) && v >= 0.0; },
+                                   "an interval >= 0 (s; 0: a checkpoint only at the end)");
   s.finish();
 }
 
@@ -479,7 +484,7 @@ toml::array pair_array(const std::array<double, 2>& a) { return toml::array{a[0]
 std::string resolved_toml(const Config& c) {
   toml::table run{{"t_end", c.run.t_end}, {"dt_max", c.run.dt_max},
                   {"output_interval", c.run.output_interval},
-                  {"seed", static_cast<int64_t>(c.run.seed)}};
+                  {"seed", static_cast<int64_t>(c.run.seed)}, {"checkpoint_interval", c.run.checkpoint_interval}};
   const WaveParams& w = c.sea.waves;
   toml::table waves{{"kind", name_of<WaveKind>(w.kind, {{"none", WaveKind::none}, {"regular", WaveKind::regular},
                                                          {"standing", WaveKind::standing}, {"jonswap", WaveKind::jonswap}})},
@@ -563,6 +568,76 @@ std::string resolved_toml(const Config& c) {
   std::ostringstream os;
   os << root;
   return os.str();
+}
+
+namespace {
+// A TOML value as text, numbers in their shortest exact form (0.4, not
+// 0.40000000000000002), arrays and inline tables whole.
+std::string value_text(const toml::node& node) {
+  if (const auto* d = node.as_floating_point()) {
+    char buf[64];
+    const auto r = std::to_chars(buf, buf + sizeof buf, d->get());
+    return std::string(buf, r.ptr);
+  }
+  if (const auto* i = node.as_integer()) return std::to_string(i->get());
+  if (const auto* b = node.as_boolean()) return b->get() ? "true" : "false";
+  if (const auto* s = node.as_string()) return "\"" + s->get() + "\"";
+  std::string out;
+  if (const auto* a = node.as_array()) {
+    out = "[";
+    for (std::size_t k = 0; k < a->size(); ++k) out += (k ? ", " : "") + value_text(*a->get(k));
+    return out + "]";
+  }
+  if (const auto* t = node.as_table()) {
+    out = "{";
+    for (const auto& [k, v] : *t) out += (out.size() > 1 ? ", " : "") + std::string(k.str()) + " = " + value_text(v);
+    return out + "}";
+  }
+  std::ostringstream o;
+  node.visit([&](const auto& n) { o << n; });
+  return o.str();
+}
+
+// Each leaf of a TOML table as "[section] key" -> its value as text.
+void flatten(const toml::table& t, const std::string& section, std::map<std::string, std::string>& out) {
+  for (const auto& [k, node] : t) {
+    const std::string key(k.str());
+    const std::string path = section.empty() ? key : section + "." + key;
+    if (const toml::table* sub = node.as_table()) {
+      flatten(*sub, path, out);
+      continue;
+    }
+    // An array of tables (the inline floes) key by key, "[floes.floe 3] velocity".
+    if (const toml::array* a = node.as_array(); a && !a->empty() && a->is_array_of_tables()) {
+      for (std::size_t i = 0; i < a->size(); ++i) flatten(*a->get(i)->as_table(), path + " " + std::to_string(i), out);
+      out["[" + path + "] count"] = std::to_string(a->size());
+      continue;
+    }
+    out[(section.empty() ? key : "[" + section + "] " + key)] = value_text(node);
+  }
+}
+}  // namespace
+
+std::vector<std::string> physics_differences(std::string_view run_toml, std::string_view now_toml,
+                                             const std::string& run_name) {
+  std::map<std::string, std::string> a, b;
+  try {
+    flatten(toml::parse(run_toml), "", a);
+  } catch (const toml::parse_error& e) {
+    throw InputError(run_name + ": the stored configuration is not TOML (" + std::string(e.description()) + ")");
+  }
+  flatten(toml::parse(now_toml), "", b);
+  static const std::set<std::string> kFree = {"[run] t_end", "[run] checkpoint_interval"};
+  std::vector<std::string> out;
+  for (const auto& [key, value] : a) {
+    if (kFree.count(key)) continue;
+    const auto it = b.find(key);
+    if (it == b.end()) out.push_back(key + ": " + value + " -> (not set)");
+    else if (it->second != value) out.push_back(key + ": " + value + " -> " + it->second);
+  }
+  for (const auto& [key, value] : b)
+    if (!kFree.count(key) && !a.count(key)) out.push_back(key + ": (not set) -> " + value);
+  return out;
 }
 
 }  // namespace floesim

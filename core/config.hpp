@@ -53,4 +53,13 @@ Config parse_config(std::string_view text, const std::string& name, const std::s
 // echoed into the run file's `config` attribute.
 std::string resolved_toml(const Config& config);
 
+// What differs between two resolved configurations (resolved_toml texts, e.g.
+// the `config` attribute of a run file and a configuration now) in the keys
+// that change a run's results: one "key: run value -> value now" line per
+// key, e.g. "[coupling] stiffness: 1000.0 -> 500.0". Left out: [run] t_end
+// and checkpoint_interval (where a run stops and when it saves itself).
+// Throws InputError (naming `run_name`) if the first text is not TOML.
+std::vector<std::string> physics_differences(std::string_view run_toml, std::string_view now_toml,
+                                             const std::string& run_name);
+
 }  // namespace floesim

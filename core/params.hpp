@@ -20,6 +20,10 @@ struct RunParams {
   // Threads for the per-floe and per-piece phases (0: one per core). The
   // results do not depend on it: an execution setting, not written to run files.
   int threads = 0;
+  // s, simulated time between checkpoints in the run file (/checkpoint, for
+  // `floesim run --restart`); 0: only at the end, on an interruption and on
+  // a run error. An execution setting like threads: results do not depend on it.
+  double checkpoint_interval = 0.0;
 };
 
 enum class SeaModel { none, spectral, bem };

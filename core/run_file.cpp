@@ -8,6 +8,8 @@
 #include <functional>
 #include <sstream>
 
+#include "core/checkpoint.hpp"
+#include "core/detail/checkpoint_io.hpp"
 #include "core/detail/h5.hpp"
 #include "core/error.hpp"
 #include "core/floes.hpp"
@@ -20,6 +22,7 @@ struct RunWriter::Impl {
   std::string path;
   h5::Handle file, floes_group, xdmf_group, time, state, energy, lcp, substeps, verts, eta, events;
   std::size_t n = 0, nverts = 0, records = 0;  // floes (numbers) and vertices in the /floes tables
+  std::size_t event_rows = 0;  // rows of /events/fracture
   // The /floes tables, one row per floe number, and the XDMF topology.
   std::vector<long long> offsets{0}, topology;
   std::vector<double> vertices, thickness, mass, area;
@@ -209,7 +212,115 @@ void RunWriter::record(double t, const Floes& floes, std::span<const double> ene
 void RunWriter::record_fracture(std::span<const FractureEventRow> events) {
   Impl& w = *impl_;
   for (const FractureEventRow& e : events) h5::append_row(w.events, reinterpret_cast<const double*>(&e));
+  w.event_rows += events.size();
   if (!events.empty()) H5Fflush(w.file, H5F_SCOPE_GLOBAL);
+}
+
+RunWriter::RunWriter(Resume, const std::string& path, const Checkpoint& c, const std::string& config_toml,
+                     const std::vector<std::string>& energy_columns, const SeaGridInfo& sea)
+    : impl_(std::make_unique<Impl>()) {
+  Impl& w = *impl_;
+  w.path = path;
+  w.energy_columns = energy_columns;
+  w.sea = sea;
+  w.file = h5::open_file(path, true);
+  auto fail = [&](const std::string& what) { throw InputError(path + ": cannot continue the run: " + what); };
+  w.floes_group = h5::open_group(w.file, "/floes", path);
+  w.xdmf_group = h5::open_group(w.file, "/xdmf", path);
+  // The /floes tables as they were at the checkpoint: the first n numbers.
+  const std::vector<long long> offsets = h5::read_ints(h5::open_dataset(w.floes_group, "offsets", path), path + ": /floes/offsets");
+  std::size_t n = c.floes.ids_issued;
+  for (std::uint32_t id : c.floes.id) n = std::max<std::size_t>(n, id + 1);
+  if (offsets.size() < n + 1) fail("/floes/offsets has " + std::to_string(offsets.size()) + " entries, the checkpoint numbers " + std::to_string(n) + " floes");
+  w.n = n;
+  w.offsets.assign(offsets.begin(), offsets.begin() + static_cast<std::ptrdiff_t>(n + 1));
+  w.nverts = static_cast<std::size_t>(w.offsets.back());
+  auto table = [&](hid_t g, const char* name, std::size_t count) {
+    std::vector<double> v = h5::read_doubles(h5::open_dataset(g, name, path), path + ": /floes/" + name);
+    if (v.size() < count) fail(std::string("/floes/") + name + " is shorter than the checkpoint's floes");
+    v.resize(count);
+    return v;
+  };
+  w.vertices = table(w.floes_group, "vertices", 2 * w.nverts);
+  w.thickness = table(w.floes_group, "thickness", n);
+  w.mass = table(w.floes_group, "mass", n);
+  w.area = table(w.floes_group, "area", n);
+  for (double x : table(w.floes_group, "static", n)) w.is_static.push_back(x != 0.0 ? 1 : 0);
+  const std::vector<long long> topology = h5::read_ints(h5::open_dataset(w.xdmf_group, "topology", path), path + ": /xdmf/topology");
+  const std::size_t ntopo = 2 * n + w.nverts;  // per floe: type, count, its vertex indices
+  if (topology.size() < ntopo) fail("/xdmf/topology is shorter than the checkpoint's floes");
+  w.topology.assign(topology.begin(), topology.begin() + static_cast<std::ptrdiff_t>(ntopo));
+  w.write_tables();
+
+  const auto records = static_cast<std::size_t>(c.records);
+  if (c.record_floes.size() != records) fail("the checkpoint's record_floes does not count its records");
+  auto open_rows = [&](hid_t loc, const char* name, const std::string& full) {
+    h5::Handle d = h5::open_dataset(loc, name, path);
+    std::vector<hsize_t> dims = h5::dims(d);
+    if (dims.empty() || dims[0] < records)
+      fail(full + " has fewer rows than the checkpoint's " + std::to_string(records) + " records");
+    dims[0] = records;
+    h5::set_extent(d, dims);
+    return d;
+  };
+  w.time = open_rows(w.file, "time", "/time");
+  w.times = h5::read_doubles(w.time, path + ": /time");
+  w.state = open_rows(w.floes_group, "state", "/floes/state");
+  h5::set_extent(w.state, {records, w.n, kStateColumns});
+  w.verts = open_rows(w.xdmf_group, "vertices", "/xdmf/vertices");
+  h5::set_extent(w.verts, {records, w.nverts, 3});
+  h5::Handle d = h5::open_group(w.file, "/diagnostics", path);
+  w.energy = open_rows(d, "energy", "/diagnostics/energy");
+  if (h5::get_attr_strings(w.energy, "columns") != w.energy_columns)
+    fail("/diagnostics/energy has other columns than this run's energies (another configuration?)");
+  w.lcp = open_rows(d, "lcp", "/diagnostics/lcp");
+  w.substeps = open_rows(d, "substeps", "/diagnostics/substeps");
+  h5::Handle ev = h5::open_group(w.file, "/events", path);
+  {
+    w.events = h5::open_dataset(ev, "fracture", path);
+    const auto events = static_cast<std::size_t>(c.fracture_events);
+    if (h5::dims(w.events).at(0) < events) fail("/events/fracture has fewer rows than the checkpoint counts");
+    h5::set_extent(w.events, {events, kFractureEventColumns});
+    w.event_rows = events;
+  }
+  if (sea.dims > 0) {
+    h5::Handle s = h5::open_group(w.file, "/sea", path);
+    w.eta = open_rows(s, "eta", "/sea/eta");
+  }
+  for (long long k : c.record_floes) {
+    if (k < 0 || static_cast<std::size_t>(k) > n) fail("the checkpoint's record_floes exceed its floes");
+    const auto nk = static_cast<std::size_t>(k);
+    w.record_floes.push_back(nk);
+    w.record_vertices.push_back(static_cast<std::size_t>(w.offsets[nk]));
+    w.record_topology.push_back(2 * nk + static_cast<std::size_t>(w.offsets[nk]));
+  }
+  w.records = records;
+  h5::set_attr(w.file, "config", config_toml);
+  h5::set_attr(w.file, "status", std::string("running"));
+  H5Fflush(w.file, H5F_SCOPE_GLOBAL);
+}
+
+void RunWriter::count_into(Checkpoint& c) const {
+  const Impl& w = *impl_;
+  c.records = static_cast<long long>(w.records);
+  c.fracture_events = static_cast<long long>(w.event_rows);
+  c.record_floes.assign(w.record_floes.begin(), w.record_floes.end());
+}
+
+void RunWriter::write_checkpoint(const Checkpoint& c) {
+  Impl& w = *impl_;
+  try {
+    // A new group, then the old one replaced by it: a run killed while
+    // writing keeps the previous checkpoint.
+    h5::remove(w.file, "checkpoint_new");
+    write_checkpoint_group(w.file, "checkpoint_new", c);
+    h5::remove(w.file, "checkpoint");
+    if (H5Lmove(w.file, "checkpoint_new", w.file, "checkpoint", H5P_DEFAULT, H5P_DEFAULT) < 0)
+      throw InputError("cannot rename /checkpoint_new");
+    H5Fflush(w.file, H5F_SCOPE_GLOBAL);
+  } catch (const InputError& e) {
+    throw RunError(w.path + ": cannot write the checkpoint: " + e.what());
+  }
 }
 
 void RunWriter::finish(const std::string& status) {
@@ -328,6 +439,10 @@ RunInfo read_run_info(const std::string& path) {
   const auto t = h5::read_doubles(h5::open_dataset(f, "/time", path), path + ": /time");
   r.records = t.size();
   if (!t.empty()) { r.t_first = t.front(); r.t_last = t.back(); }
+  if (h5::exists(f, "/checkpoint")) {
+    h5::Handle c = h5::open_group(f, "/checkpoint", path);
+    if (h5::has_attr(c, "time")) r.checkpoint_time = h5::get_attr_double(c, "time");
+  }
   {
     h5::Handle th = h5::open_dataset(f, "/floes/thickness", path);
     r.floes = h5::dims(th).at(0);
@@ -382,7 +497,10 @@ CompareResult compare_runs(const std::string& a, const std::string& b, const Com
     if (!h5::has_attr(f, "format") || h5::get_attr_string(f, "format") != kRunFormat)
       throw InputError(p + ": not a floesim run file (attribute 'format' is not '" + std::string(kRunFormat) + "')");
   CompareResult r;
+  // /checkpoint is the means to continue a run, not one of its results.
+  auto result = [](const std::string& p) { return p.rfind("/checkpoint", 0) != 0; };
   for (const std::string& p : dataset_paths(fa)) {
+    if (!result(p)) continue;
     if (!h5::exists(fb, p)) { r.differences.push_back({p, "missing in B"}); continue; }
     h5::Handle da = h5::open_dataset(fa, p, a), db = h5::open_dataset(fb, p, b);
     if (h5::dims(da) != h5::dims(db)) { r.differences.push_back({p, "shape"}); continue; }
@@ -401,7 +519,7 @@ CompareResult compare_runs(const std::string& a, const std::string& b, const Com
     if (d.count) r.differences.push_back(d);
   }
   for (const std::string& p : dataset_paths(fb))
-    if (!h5::exists(fa, p)) r.differences.push_back({p, "missing in A"});
+    if (result(p) && !h5::exists(fa, p)) r.differences.push_back({p, "missing in A"});
   return r;
 }
 

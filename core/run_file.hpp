@@ -26,6 +26,8 @@
 //     except largest_cluster (the largest so far)
 //   /xdmf/vertices [T, V, 3]: world vertex positions (x, y, heave) for ParaView
 //   /xdmf/topology [E]: XDMF mixed-polygon connectivity
+//   /checkpoint: the state to continue the run from (core/checkpoint.hpp);
+//     not a result: compare_runs leaves it out
 
 #include <array>
 #include <memory>
@@ -36,6 +38,7 @@
 namespace floesim {
 
 struct Floes;
+struct Checkpoint;
 
 inline constexpr const char* kRunFormat = "floesim-1";
 
@@ -84,6 +87,15 @@ public:
   RunWriter(const std::string& path, const Floes& floes, const std::string& config_toml,
             std::vector<std::string> energy_columns, const SeaGridInfo& sea = {},
             std::size_t expected_records = 0);
+  // Continues the run file `path` from its checkpoint `c` (read_checkpoint):
+  // the records, fracture events and floe numbers after it are dropped (a
+  // run that went on past its last checkpoint), and record() appends after
+  // it. The status is "running" again and `config_toml` replaces the config
+  // attribute. Throws InputError if the file's datasets do not hold what the
+  // checkpoint counts, or its energy columns are not `energy_columns`.
+  struct Resume {};
+  RunWriter(Resume, const std::string& path, const Checkpoint& c, const std::string& config_toml,
+            const std::vector<std::string>& energy_columns, const SeaGridInfo& sea = {});
   ~RunWriter();  // closes; leaves status "running" unless finish() was called
   RunWriter(const RunWriter&) = delete;
   RunWriter& operator=(const RunWriter&) = delete;
@@ -99,6 +111,14 @@ public:
   void note_floes(const Floes& floes);
   // Appends rows to /events/fracture and flushes.
   void record_fracture(std::span<const FractureEventRow> events);
+
+  // Fills in c's counts of this file (records, fracture events, floes per
+  // record) as they are now: call it when the records of the state `c`
+  // holds are written, and none of a later state.
+  void count_into(Checkpoint& c) const;
+  // Writes `c` as /checkpoint, replacing the last one once it is whole.
+  // Throws RunError if the file cannot be written.
+  void write_checkpoint(const Checkpoint& c);
 
   // Marks the run complete, or failed with a reason, and writes the XDMF.
   void finish(const std::string& status);
@@ -117,6 +137,7 @@ struct RunInfo {
   std::string format, status, config;
   std::size_t records = 0, floes = 0, vertices = 0;
   double t_first = 0.0, t_last = 0.0;
+  double checkpoint_time = -1.0;        // s, of /checkpoint (< 0: none)
   std::vector<std::string> energy_columns;
   std::vector<double> energy_last;      // last record
   std::array<double, 4> lcp_last{};     // solves, pivots, failures, fallbacks

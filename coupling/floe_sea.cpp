@@ -159,6 +159,17 @@ void FloeSeaContact::floes_changed(const Floes& floes) {
     stable_step_ = 0.5 / std::sqrt(s_ * kappa_ * (1.0 / min_mass_per_area + sea_inverse_mass_));
 }
 
+FloeSeaState FloeSeaContact::saved_state() const {
+  return {true, bottom0_, loads_h_, penalty_energy_};
+}
+
+void FloeSeaContact::restore(const FloeSeaState& state, const Floes& floes, fluid::Sea& sea, IncidentSea* incident) {
+  floes_changed(floes);
+  bottom0_ = state.bottom0;
+  if (state.loads_h >= 0.0) evaluate_loads(floes, sea, incident, state.loads_h);
+  penalty_energy_ = state.penalty_energy;
+}
+
 double FloeSeaContact::weak_coefficient(const Floes& floes, std::size_t i) const {
   return K_ * rho_ * std::sqrt(g_ * floes.draft(i, rho_));
 }

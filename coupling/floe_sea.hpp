@@ -103,6 +103,7 @@
 #include <string>
 #include <vector>
 
+#include "core/checkpoint.hpp"
 #include "core/floes.hpp"
 #include "core/params.hpp"
 #include "coupling/footprint.hpp"
@@ -195,6 +196,15 @@ public:
   const std::vector<std::string>& notes() const { return notes_; }
   // Floes whose contact rebuilt data must be redone (after a split).
   void floes_changed(const Floes& floes);
+
+  // Restart (core/checkpoint.hpp): what this class carries from one step to
+  // the next beyond the floes and the sea. restore() takes the floes and the
+  // sea (and incident waves) already restored, and evaluates the loads cache
+  // again from them when it held: the loads depend on positions, the
+  // vertical DOFs and the elevation, which the end-of-step kicks leave as
+  // they were, so they come out the same to the bit.
+  FloeSeaState saved_state() const;
+  void restore(const FloeSeaState& state, const Floes& floes, fluid::Sea& sea, IncidentSea* incident);
 
 private:
   double weak_coefficient(const Floes& floes, std::size_t i) const;

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <numbers>
 
+#include "core/error.hpp"
 #include "fluid/waves.hpp"
 
 namespace floesim {
@@ -60,6 +61,52 @@ void IncidentSea::advance_to(double t) {
     t1_ = t0_ + tau_;
     take(u1_, v1_);
   }
+}
+
+IncidentState IncidentSea::saved_state() {
+  IncidentState s;
+  s.present = true;
+  s.sea = save_modal(*sea_);
+  s.t0 = t0_;
+  s.t1 = t1_;
+  s.u0 = u0_;
+  s.v0 = v0_;
+  s.u1 = u1_;
+  s.v1 = v1_;
+  return s;
+}
+
+void IncidentSea::restore(const IncidentState& s) {
+  if (!s.present || s.u0.size() != u0_.size() || s.u1.size() != u1_.size() || s.v0.size() != v0_.size() ||
+      s.v1.size() != v1_.size())
+    throw InputError("checkpoint: the incident waves' snapshots do not match this run's sea grid");
+  restore_modal(*sea_, s.sea, "the incident waves");
+  t0_ = s.t0;
+  t1_ = s.t1;
+  u0_ = s.u0;
+  v0_ = s.v0;
+  u1_ = s.u1;
+  v1_ = s.v1;
+}
+
+ModalState save_modal(fluid::Sea& sea) {
+  const fluid::ModalBank& bank = sea.modes();  // every deferred kick applied
+  ModalState m;
+  m.present = true;
+  m.time = sea.time();
+  m.q.assign(bank.q().begin(), bank.q().end());
+  m.v.assign(bank.v().begin(), bank.v().end());
+  return m;
+}
+
+void restore_modal(fluid::Sea& sea, const ModalState& m, const std::string& what) {
+  fluid::ModalBank& bank = sea.modes();
+  if (!m.present || m.q.size() != bank.q().size() || m.v.size() != bank.v().size())
+    throw InputError("checkpoint: the modal state of " + what + " has " + std::to_string(m.q.size()) +
+                     " amplitudes, this run's sea has " + std::to_string(bank.q().size()));
+  std::copy(m.q.begin(), m.q.end(), bank.q().begin());
+  std::copy(m.v.begin(), m.v.end(), bank.v().begin());
+  sea.set_time(m.time);
 }
 
 double IncidentSea::weight(double t) const {

@@ -13,9 +13,11 @@
 // takes the fields at every time asked.
 
 #include <memory>
+#include <string>
 #include <span>
 #include <vector>
 
+#include "core/checkpoint.hpp"
 #include "core/params.hpp"
 #include "fluid/sea.hpp"
 
@@ -41,6 +43,11 @@ public:
   std::span<const double> u1() const { return u1_; }
   std::span<const double> v1() const { return v1_; }
 
+  // Restart (core/checkpoint.hpp): the sea's modal state and the snapshots.
+  // restore() throws InputError if the state is not of this sea's size.
+  IncidentState saved_state();
+  void restore(const IncidentState& state);
+
 private:
   void take(std::vector<double>& u, std::vector<double>& v);
 
@@ -49,5 +56,10 @@ private:
   double t0_ = 0.0, t1_ = 0.0;
   std::vector<double> u0_, v0_, u1_, v1_;
 };
+
+// A sea's modal state (every deferred kick applied) and back; restore_modal
+// throws InputError naming `what` if the sizes differ (another grid).
+ModalState save_modal(fluid::Sea& sea);
+void restore_modal(fluid::Sea& sea, const ModalState& state, const std::string& what);
 
 }  // namespace floesim

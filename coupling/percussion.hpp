@@ -65,6 +65,9 @@ public:
   // The initiations since the last call.
   std::vector<FractureEventRow> take_events();
   const PercussionStats& stats() const { return stats_; }
+  // Restart: the counts go on from a checkpoint's (models are rebuilt on a
+  // floe's next analysis, to the same bits).
+  void restore_stats(const PercussionStats& stats) { stats_ = stats; }
 
 private:
   fracture::FloeFracture& model_of(const Floes& floes, std::size_t i);

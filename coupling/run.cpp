@@ -2,7 +2,10 @@
 
 #include <chrono>
 #include <cmath>
+#include <memory>
 
+#include "core/checkpoint.hpp"
+#include "core/config.hpp"
 #include "core/error.hpp"
 #include "core/run_file.hpp"
 
@@ -12,6 +15,7 @@ RunSummary run_simulation(Simulation& sim, const RunOptions& options) {
   const Config& cfg = sim.scenario().config;
   const double t_end = options.until >= 0.0 ? options.until : cfg.run.t_end;
   const double interval = cfg.run.output_interval;
+  const double checkpoint_interval = cfg.run.checkpoint_interval;
   const auto start = std::chrono::steady_clock::now();
 
   RunSummary summary;
@@ -20,24 +24,60 @@ RunSummary run_simulation(Simulation& sim, const RunOptions& options) {
   summary.warnings = sim.notes();
   // Records at t = 0, at every multiple of the interval and at the end.
   const auto expected_records = static_cast<std::size_t>(std::ceil(t_end / interval - 1e-9)) + 1;
-  RunWriter writer(options.output, sim.floes(), resolved_toml(cfg), summary.energy_first.names, sim.sea_grid(),
-                   expected_records);
-  summary.xdmf = writer.xdmf_path();
+  std::unique_ptr<RunWriter> writer =
+      options.resume ? std::make_unique<RunWriter>(RunWriter::Resume{}, options.output, *options.resume,
+                                                   resolved_toml(cfg), summary.energy_first.names, sim.sea_grid())
+                     : std::make_unique<RunWriter>(options.output, sim.floes(), resolved_toml(cfg),
+                                                   summary.energy_first.names, sim.sea_grid(), expected_records);
+  summary.xdmf = writer->xdmf_path();
 
   auto record = [&] {
     PhaseTimer _(sim.profile(), Phase::record);
     const Energies e = sim.energies();
-    writer.record(sim.time(), sim.floes(), e.values, sim.lcp_counters(), sim.sea_elevation());
+    writer->record(sim.time(), sim.floes(), e.values, sim.lcp_counters(), sim.sea_elevation());
   };
   auto wall = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); };
 
+  // Index of the next scheduled record: the first multiple of the interval
+  // after the start (a simulation may come here already advanced).
+  std::size_t next = 0;
+  if (options.resume) {
+    next = static_cast<std::size_t>(options.resume->next_record);
+  } else {
+    next = static_cast<std::size_t>(std::floor(sim.time() / interval)) + 1;
+    if (static_cast<double>(next) * interval <= sim.time()) ++next;
+  }
+  // The state at the last record (a run error leaves the present state
+  // half-stepped: that one is the checkpoint then), and the checkpoints.
+  Checkpoint good;
+  bool have_good = false;
+  auto take_good = [&] {
+    good = sim.save();
+    good.next_record = static_cast<long long>(next);
+    writer->count_into(good);
+    have_good = true;
+  };
+  auto next_checkpoint_after = [&](double t) -> double {
+    if (!(checkpoint_interval > 0.0)) return INFINITY;
+    double k = std::floor(t / checkpoint_interval) + 1.0;
+    if (k * checkpoint_interval <= t) k += 1.0;
+    return k * checkpoint_interval;
+  };
+  double next_checkpoint = next_checkpoint_after(sim.time());
+  std::size_t checkpoint_steps = static_cast<std::size_t>(-1);  // steps() at the last checkpoint
+  auto checkpoint = [&] {
+    PhaseTimer _(sim.profile(), Phase::record);
+    if (!(have_good && good.steps == static_cast<long long>(sim.steps()))) take_good();
+    writer->write_checkpoint(good);
+    checkpoint_steps = sim.steps();
+    summary.checkpoint_time = sim.time();
+    next_checkpoint = next_checkpoint_after(sim.time());
+  };
+
   summary.status = "complete";
   try {
-    record();
-    // Index of the next scheduled record: the first multiple of the interval
-    // after the start (a simulation may come here already advanced).
-    auto next = static_cast<std::size_t>(std::floor(sim.time() / interval)) + 1;
-    if (static_cast<double>(next) * interval <= sim.time()) ++next;
+    if (!options.resume) record();
+    take_good();
     while (sim.time() < t_end) {
       // Next record time; a record that would fall within 1e-9 s of the end merges with it.
       double t_record = std::min(static_cast<double>(next) * interval, t_end);
@@ -45,26 +85,45 @@ RunSummary run_simulation(Simulation& sim, const RunOptions& options) {
       bool stop = false;
       while (sim.time() < t_record && !stop) {
         sim.step(t_record);
-        writer.note_floes(sim.floes());  // floes made by splits (numbers are never reused)
-        writer.record_fracture(sim.take_fracture_events());
+        writer->note_floes(sim.floes());  // floes made by splits (numbers are never reused)
+        writer->record_fracture(sim.take_fracture_events());
         if (options.progress) options.progress({sim.time(), t_end, sim.steps(), wall()});
         stop = options.should_stop && options.should_stop();
+        if (!stop && sim.time() < t_record && sim.time() >= next_checkpoint) checkpoint();
       }
-      record();  // on schedule, or the last state of an interrupted run
-      ++next;
+      const bool on_schedule = sim.time() >= t_record;
+      if (on_schedule) {
+        record();
+        ++next;
+        take_good();
+      }
+      // An interruption saves the state before its record off the schedule,
+      // which a restart drops (the run it continues has no such record).
+      if (stop || (on_schedule && sim.time() >= next_checkpoint)) checkpoint();
       if (stop) {
+        if (!on_schedule) record();  // the last state of an interrupted run
         summary.status = "interrupted";
         break;
       }
     }
+    if (checkpoint_steps != sim.steps()) checkpoint();
   } catch (const RunError& e) {
-    writer.finish(std::string("failed: ") + e.what());
+    std::string reason = std::string("failed: ") + e.what();
+    if (have_good) {
+      try {
+        writer->write_checkpoint(good);
+        summary.checkpoint_time = good.time;
+      } catch (const RunError& c) {
+        reason += std::string(" (and ") + c.what() + ")";
+      }
+    }
+    writer->finish(reason);
     throw;
   }
-  writer.finish(summary.status == "complete" ? "complete"
-                                             : "interrupted at t = " + std::to_string(sim.time()) + " s");
+  writer->finish(summary.status == "complete" ? "complete"
+                                              : "interrupted at t = " + std::to_string(sim.time()) + " s");
   summary.steps = sim.steps();
-  summary.records = writer.records();
+  summary.records = writer->records();
   summary.t_end = sim.time();
   summary.wall_seconds = wall();
   summary.energy_last = sim.energies();

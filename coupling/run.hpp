@@ -2,6 +2,14 @@
 // Runs a simulation to its end time, recording on the output schedule into a
 // run file. Records are written at t = 0, at every multiple of
 // output_interval and at the end time; steps are shortened to land on them.
+//
+// Checkpoints (core/checkpoint.hpp) go into the run file's /checkpoint: at
+// the end of the first step at or after each multiple of [run]
+// checkpoint_interval (> 0; after that step's record if it made one), at the
+// end, and when should_stop() asks (after the step in progress). On a run
+// error the state at the last record is written as the checkpoint. Writing
+// one changes no bit of the run: a restart from it (RunOptions::resume)
+// writes the records the run would have written.
 
 #include <functional>
 #include <string>
@@ -22,10 +30,15 @@ struct RunOptions {
   double until = -1.0;                      // s; < 0: [run] t_end
   std::function<void(const RunProgress&)> progress;  // called after every step
   std::function<bool()> should_stop;        // polled after every step (e.g. Ctrl-C)
+  // Continue the run file `output` from this checkpoint, which the
+  // simulation was restored from (Simulation::restore): its records after
+  // the checkpoint are dropped and the run goes on from there.
+  const Checkpoint* resume = nullptr;
 };
 
 struct RunSummary {
   std::string output, xdmf, status;         // status: complete | interrupted
+  double checkpoint_time = -1.0;            // s, of the last checkpoint written (< 0: none)
   std::size_t steps = 0, records = 0;
   double t_end = 0.0, wall_seconds = 0.0;
   Energies energy_first, energy_last;

@@ -53,6 +53,7 @@
 #include "contact/impulse.hpp"
 #include "contact/shapes.hpp"
 #include "contact/substep.hpp"
+#include "core/checkpoint.hpp"
 #include "core/run_file.hpp"
 #include "coupling/scenario.hpp"
 
@@ -95,6 +96,16 @@ public:
   Simulation(Simulation&&) noexcept;
 
   double step(double t_stop);
+
+  // Restart (core/checkpoint.hpp): the run's state at the end of a step, as
+  // data, and back. save() applies the sea's deferred kicks (as a record's
+  // energies do; no bit of the run changes). restore() takes a checkpoint of
+  // a run of this scenario's configuration (the floes at t = 0 built the
+  // same law and sea) and puts the simulation where the checkpoint was:
+  // stepping on gives the steps the saved run took, to the bit. Throws
+  // InputError if the checkpoint does not fit this run (sea, sizes).
+  Checkpoint save();
+  void restore(const Checkpoint& checkpoint);
 
   double time() const { return t_; }
   std::size_t steps() const { return steps_; }

@@ -27,6 +27,7 @@ void bind_run_file(py::module_& m) {
         d["vertices"] = r.vertices;
         d["t_first"] = r.t_first;
         d["t_last"] = r.t_last;
+        d["checkpoint_time"] = r.checkpoint_time >= 0.0 ? py::object(py::float_(r.checkpoint_time)) : py::object(py::none());
         d["energy_columns"] = r.energy_columns;
         py::dict shapes;
         for (const auto& [name, shape] : r.datasets) shapes[py::str(name)] = py::tuple(py::cast(shape));

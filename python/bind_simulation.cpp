@@ -11,6 +11,7 @@
 #include <memory>
 #include <string>
 
+#include "core/checkpoint.hpp"
 #include "core/config.hpp"
 #include "core/error.hpp"
 #include "coupling/run.hpp"
@@ -106,6 +107,10 @@ void bind_simulation(py::module_& m) {
             return s.step(t_stop ? *t_stop : s.time() + s.scenario().config.run.dt_max);
           },
           py::arg("t_stop") = py::none(), "One step, of at most dt_max and not past t_stop; returns dt (s).")
+      .def(
+          "_restore",
+          [](Simulation& s, const std::string& path) { s.restore(read_checkpoint(path)); },
+          py::arg("path"), "Puts the simulation at the checkpoint of a run file of its configuration.")
       .def("run_until", &run_until, py::arg("t"))
       .def("run", &run_to_file, py::arg("output"), py::arg("until") = -1.0)
       .def_property_readonly("state",

@@ -315,6 +315,20 @@ class Simulation(_floesim.Simulation):
         self.config = config.copy()
         config._call(super().__init__)
 
+    @classmethod
+    def from_run(cls, path):
+        """The simulation at the checkpoint of the run file `path` (docs/formats.md,
+        "Checkpoint and restart"), with the run's own configuration: stepping it
+        on (step, run_until) gives the states the run would have had, bit for
+        bit. Raises InputError if the file has no checkpoint."""
+        path = os.fspath(path)
+        info = _floesim.read_run_info(path)
+        config = Config(info["config"], name=path + ": config attribute",
+                        base_dir=os.path.dirname(os.path.abspath(path)))
+        sim = cls(config)
+        sim._restore(path)
+        return sim
+
     def run(self, output, until=-1.0):
         """Runs to [run] t_end (or until) from the present state, writing the run
         file `output` (and its .xmf); returns a summary dict."""

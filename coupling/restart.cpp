@@ -1,0 +1,161 @@
+// Simulation::save and restore (coupling/simulation.hpp): which state each
+// part of a run carries from one step to the next, and what is computed again
+// from it (core/checkpoint.hpp).
+#include <algorithm>
+#include <cstring>
+
+#include "core/error.hpp"
+#include "coupling/simulation.hpp"
+#include "fluid/sea.hpp"
+
+namespace floesim {
+
+namespace {
+
+// The cumulative statistics, by name (Checkpoint::counters).
+struct Counters {
+  std::vector<std::string> names;
+  std::vector<double> values;
+  void add(const std::string& name, double v) {
+    names.push_back(name);
+    values.push_back(v);
+  }
+};
+
+WarmStartState save_warm(const contact::WarmStart& w) {
+  WarmStartState s;
+  s.clock = w.clock;
+  // By key, so that equal states give equal files (the map's order is its history's).
+  for (const auto& [key, pair] : w.pairs) s.keys.push_back(key);
+  std::sort(s.keys.begin(), s.keys.end());
+  for (std::uint64_t key : s.keys) {
+    const contact::WarmStart::Pair& p = w.pairs.at(key);
+    s.stored.push_back(p.stored);
+    for (const contact::WarmStart::Entry& e : p.entries) {
+      s.entries.insert(s.entries.end(), {e.body_point.x(), e.body_point.y(), e.body_normal.x(), e.body_normal.y()});
+      for (std::uint8_t b : e.basic) s.entries.push_back(b);
+    }
+    s.offsets.push_back(static_cast<long long>(s.entries.size() / 8));
+  }
+  return s;
+}
+
+void restore_warm(const WarmStartState& s, contact::WarmStart& w) {
+  w.pairs.clear();
+  w.clock = s.clock;
+  for (std::size_t k = 0; k < s.keys.size(); ++k) {
+    contact::WarmStart::Pair p;
+    p.stored = s.stored[k];
+    for (auto e = static_cast<std::size_t>(s.offsets[k]); e < static_cast<std::size_t>(s.offsets[k + 1]); ++e) {
+      const double* x = &s.entries[8 * e];
+      contact::WarmStart::Entry entry;
+      entry.body_point = Vec2{x[0], x[1]};
+      entry.body_normal = Vec2{x[2], x[3]};
+      for (int b = 0; b < 4; ++b) entry.basic[static_cast<std::size_t>(b)] = x[4 + b] != 0.0 ? 1 : 0;
+      p.entries.push_back(entry);
+    }
+    w.pairs.emplace(s.keys[k], std::move(p));
+  }
+}
+
+}  // namespace
+
+Checkpoint Simulation::save() {
+  Checkpoint c;
+  c.time = t_;
+  c.steps = static_cast<long long>(steps_);
+  c.equal_dt = equal_dt_;
+  c.floes = scenario_.floes;
+  if (sea_) c.sea = save_modal(*sea_);
+  if (incident_) c.incident = incident_->saved_state();
+  if (floe_sea_) c.floe_sea = floe_sea_->saved_state();
+  c.warm = save_warm(*warm_);
+  Counters k;
+  const contact::CollisionStats& s = stats_;
+  for (auto [name, v] : {std::pair{"contacts", s.contacts}, {"lcps", s.lcps}, {"pivots", s.pivots},
+                         {"failures", s.failures}, {"fallbacks", s.fallbacks}, {"flagged", s.flagged},
+                         {"gauss_seidel", s.gauss_seidel}, {"tolerated", s.tolerated}, {"largest", s.largest},
+                         {"total_size", s.total_size}, {"warm", s.warm}, {"warm_missed", s.warm_missed}})
+    k.add(std::string("collisions.") + name, static_cast<double>(v));
+  const contact::SubstepReport& r = substeps_;
+  for (auto [name, v] : {std::pair{"clusters", r.clusters}, {"substeps", r.substeps}, {"time_steps", r.time_steps},
+                         {"largest_cluster", r.largest_cluster}, {"joined", r.joined}, {"merges", r.merges},
+                         {"rejected", r.rejected}, {"floor_steps", r.floor_steps}, {"rebuilt", r.rebuilt},
+                         {"reach_exceeded", r.reach_exceeded}})
+    k.add(std::string("substeps.") + name, static_cast<double>(v));
+  c.floor_pair = r.floor_pair;
+  k.add("rejected_steps", static_cast<double>(rejected_steps_));
+  k.add("budget.external_x", budget_.external.x());
+  k.add("budget.external_y", budget_.external.y());
+  k.add("budget.collisions_x", budget_.collisions.x());
+  k.add("budget.collisions_y", budget_.collisions.y());
+  if (percussion_) {
+    const PercussionStats& p = percussion_->stats();
+    for (auto [name, v] : {std::pair{"checks", p.checks}, {"screened", p.screened}, {"initiations", p.initiations},
+                           {"splits", p.splits}, {"failed_splits", p.failed_splits}})
+      k.add(std::string("fracture.") + name, static_cast<double>(v));
+    k.add("fracture.seconds", p.seconds);
+  }
+  c.counter_names = std::move(k.names);
+  c.counters = std::move(k.values);
+  return c;
+}
+
+void Simulation::restore(const Checkpoint& c) {
+  auto fail = [](const std::string& what) { throw InputError("checkpoint: " + what); };
+  if (c.sea.present != (sea_ != nullptr)) fail("it has " + std::string(c.sea.present ? "a" : "no") + " sea, this run has " + (sea_ ? "one" : "none"));
+  if (c.incident.present != (incident_ != nullptr)) fail("its incident waves do not match this run's sea");
+  if (c.floe_sea.present != (floe_sea_ != nullptr)) fail("its floe–sea contact does not match this run's");
+  if (c.floe_sea.present && c.floe_sea.bottom0.size() != c.floes.size()) fail("floe_sea/bottom0: one entry per floe expected");
+  for (std::size_t i = 0; i < c.floes.size(); ++i)
+    if (!(c.floes.mass[i] > 0.0 && c.floes.area[i] > 0.0)) fail("floe " + std::to_string(i) + " has no mass or area");
+  auto counter = [&](const std::string& name) {
+    const auto it = std::find(c.counter_names.begin(), c.counter_names.end(), name);
+    if (it == c.counter_names.end()) fail("counter '" + name + "' is missing");
+    return c.counters[static_cast<std::size_t>(it - c.counter_names.begin())];
+  };
+  auto count = [&](const std::string& name) { return static_cast<long>(counter(name)); };
+
+  scenario_.floes = c.floes;
+  t_ = c.time;
+  steps_ = static_cast<std::size_t>(c.steps);
+  equal_dt_ = c.equal_dt;
+  // What the floes determine: collision shapes, drag quadrature, the pair
+  // list and contacts as detect_and_check left them at the end of the step.
+  quadrature_ = build_footprint_quadrature(scenario_.floes);
+  shapes_ = contact::build_collision_shapes(scenario_.floes);
+  set_reach();
+  detection_ = contact::detect(scenario_.floes, shapes_, detection_options_);
+  if (sea_) restore_modal(*sea_, c.sea, "the sea");
+  if (incident_) incident_->restore(c.incident);
+  if (floe_sea_) floe_sea_->restore(c.floe_sea, scenario_.floes, *sea_, incident_.get());
+  restore_warm(c.warm, *warm_);
+
+  contact::CollisionStats& s = stats_;
+  for (auto [name, v] : {std::pair{"contacts", &s.contacts}, {"lcps", &s.lcps}, {"pivots", &s.pivots},
+                         {"failures", &s.failures}, {"fallbacks", &s.fallbacks}, {"flagged", &s.flagged},
+                         {"gauss_seidel", &s.gauss_seidel}, {"tolerated", &s.tolerated}, {"largest", &s.largest},
+                         {"total_size", &s.total_size}, {"warm", &s.warm}, {"warm_missed", &s.warm_missed}})
+    *v = count(std::string("collisions.") + name);
+  contact::SubstepReport& r = substeps_;
+  for (auto [name, v] : {std::pair{"clusters", &r.clusters}, {"substeps", &r.substeps}, {"time_steps", &r.time_steps},
+                         {"largest_cluster", &r.largest_cluster}, {"joined", &r.joined}, {"merges", &r.merges},
+                         {"rejected", &r.rejected}, {"floor_steps", &r.floor_steps}, {"rebuilt", &r.rebuilt},
+                         {"reach_exceeded", &r.reach_exceeded}})
+    *v = count(std::string("substeps.") + name);
+  r.floor_pair = c.floor_pair;
+  rejected_steps_ = count("rejected_steps");
+  budget_.external = Vec2{counter("budget.external_x"), counter("budget.external_y")};
+  budget_.collisions = Vec2{counter("budget.collisions_x"), counter("budget.collisions_y")};
+  if (percussion_) {
+    PercussionStats p;
+    for (auto [name, v] : {std::pair{"checks", &p.checks}, {"screened", &p.screened},
+                           {"initiations", &p.initiations}, {"splits", &p.splits},
+                           {"failed_splits", &p.failed_splits}})
+      *v = count(std::string("fracture.") + name);
+    p.seconds = counter("fracture.seconds");
+    percussion_->restore_stats(p);
+  }
+}
+
+}  // namespace floesim
