@@ -60,7 +60,8 @@ expect("${dyn}" "SONAME[^\n]*\\[${soname}\\]" "SONAME ${soname}")
 run(COMMAND ${P}/bin/floesim --version DIR ${WORK}/run OUT v)
 expect("${v}" "^${VERSION}" "floesim --version")
 run(COMMAND ${P}/bin/floesim run -q --until 1 -o default.h5 DIR ${WORK}/run OUT v)
-expect("${v}" "status: complete" "installed floesim run (default example)")
+expect("${v}" "status: complete\nconfig: ${P}/share/floesim/examples/floes_on_waves.toml\n"
+       "installed floesim run with no file runs the installed example")
 run(COMMAND ${P}/bin/floesim run ${P}/share/floesim/examples/floedyn_100.toml -q --until 60 -o floedyn.h5
     DIR ${WORK}/run OUT v)
 expect("${v}" "status: complete" "installed FloeDyn example reads the installed data")
