@@ -74,6 +74,7 @@ install(FILES ${PROJECT_BINARY_DIR}/floesimConfig.cmake ${PROJECT_BINARY_DIR}/fl
 # pkg-config: paths relative to the .pc file's folder, so the install can be
 # moved (or made with --prefix) after configuring.
 file(RELATIVE_PATH _pc_to_prefix /prefix/${CMAKE_INSTALL_LIBDIR}/pkgconfig /prefix)
+string(REGEX REPLACE "/$" "" _pc_to_prefix "${_pc_to_prefix}")
 configure_file(${PROJECT_SOURCE_DIR}/cmake/floesim.pc.in ${PROJECT_BINARY_DIR}/floesim.pc @ONLY)
 install(FILES ${PROJECT_BINARY_DIR}/floesim.pc DESTINATION ${CMAKE_INSTALL_LIBDIR}/pkgconfig)
 
