@@ -88,7 +88,7 @@ int run_lcp(const LcpArgs& args) {
 void add_lcp_command(CLI::App& app, Registry& registry) {
   auto args = std::make_shared<LcpArgs>();
   CLI::App* sub = app.add_subcommand(
-      "lcp", "Solve one LCP in the Siconos text format (see ../shared/data/lcp/README.md)");
+      "lcp", "Solve one LCP in the Siconos text format (described in floesim's data/lcp/README.md)");
   sub->add_option("FILE", args->file, "LCP file (.dat)")->required();
   sub->add_option("--solver", args->solver, "lemke (default) or pgs")
       ->check(CLI::IsMember({"lemke", "pgs"}));

@@ -52,9 +52,18 @@ Config restart_config(const std::string& run_path, const std::string& config_pat
   return config;
 }
 
+// The example run when no file is given: an installed tool's copy
+// (PREFIX/bin/floesim -> PREFIX/share/floesim/examples, cmake/FloesimInstall.cmake)
+// when there is one, else the one in the sources it was built from.
 std::string default_config() {
-  const fs::path p = fs::path(FLOESIM_SOURCE_DIR) / "examples" / "floes_on_waves.toml";
-  return p.string();
+  const fs::path name = fs::path("examples") / "floes_on_waves.toml";
+  std::error_code ec;
+  const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
+  if (!ec) {
+    const fs::path installed = exe.parent_path().parent_path() / "share" / "floesim" / name;
+    if (fs::is_regular_file(installed, ec)) return installed.string();
+  }
+  return (fs::path(FLOESIM_SOURCE_DIR) / name).string();
 }
 
 std::string human_time(double s) {

@@ -1,5 +1,5 @@
 // floesim_bench_lcp: our Lemke against Siconos Numerics' lcp_lexicolemke (when
-// built with it) on the rigid-body contact LCPs of ../shared/data/lcp/contact/.
+// built with it) on the rigid-body contact LCPs of data/lcp/contact/.
 //
 //   floesim_bench_lcp [--data DIR] [--repeat R] [--factorization auto|dense|sparse]
 //                     [--refactor K] [--csv OUT.csv] [--filter SUBSTRING] [--no-siconos]

@@ -13,7 +13,7 @@
 //   /floes/ocean_drag f64 [n]      C_w; NaN or < 0 = [forcing] default (optional)
 //   /window          f64 [4]       xmin, xmax, ymin, ymax (m)          (optional)
 //
-// FloeDyn input (../shared/data/floedyn/README.md): /floe_shapes/{i} body-frame
+// FloeDyn input (data/floedyn/README.md): /floe_shapes/{i} body-frame
 // vertices with attributes C_w, optional obstacle and thickness; /floe_states
 // [T, N, 9 or 11], record 0 used; /window.
 

@@ -1,6 +1,6 @@
 #pragma once
 // Reader for LCPs in the Siconos Numerics text format (the test collection in
-// ../shared/data/lcp/, format described in its README.md):
+// data/lcp/, format described in its README.md):
 //
 //   n
 //   storageType                     0 dense | 1 sparse-block (SBM) | 2 CSparse (refused)

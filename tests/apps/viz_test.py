@@ -409,12 +409,87 @@ def check_hdf_item(f, item, h5name):
     check(int(np.prod(count)) == int(np.prod(declared)), f"{dset}: slab size = declared dimensions")
 
 
+# The XDMF 3 subset our writer may use, as a schema: for each element, the
+# attributes it may carry (None: any value; a set: one of those values) and the
+# children it may have. A misspelt attribute or value is not an error for
+# ParaView, which then silently ignores it: here it fails.
+XDMF_SCHEMA = {
+    "Xdmf": ({"Version": {"3.0"}}, {"Domain"}),
+    "Domain": ({}, {"Grid"}),
+    "Grid": ({"Name": None, "GridType": {"Collection", "Uniform"}, "CollectionType": {"Temporal"}},
+             {"Grid", "Time", "Topology", "Geometry", "Attribute"}),
+    "Time": ({"Value": None}, set()),
+    "Topology": ({"TopologyType": {"Mixed", "3DCoRectMesh"}, "NumberOfElements": None, "Dimensions": None},
+                 {"DataItem"}),
+    "Geometry": ({"GeometryType": {"XYZ", "ORIGIN_DXDYDZ"}}, {"DataItem"}),
+    "Attribute": ({"Name": None, "AttributeType": {"Scalar"}, "Center": {"Cell", "Node"}}, {"DataItem"}),
+    "DataItem": ({"Dimensions": None, "NumberType": {"Float", "Int", "UInt"}, "Precision": {"4", "8"},
+                  "Format": {"HDF", "XML"}, "ItemType": {"Uniform"}}, set()),
+}
+
+
+def check_schema(el, path="Xdmf"):
+    check(el.tag in XDMF_SCHEMA, f"{path}: unknown element <{el.tag}>")
+    attrs, children = XDMF_SCHEMA[el.tag]
+    for k, v in el.attrib.items():
+        check(k in attrs, f"{path}: <{el.tag}> has no attribute {k}")
+        check(attrs[k] is None or v in attrs[k], f"{path}: <{el.tag} {k}=\"{v}\"> not one of {attrs[k]}")
+    for c in el:
+        check(c.tag in children, f"{path}: <{c.tag}> inside <{el.tag}>")
+        check_schema(c, f"{path}/{c.tag}[{c.get('Name', '')}]")
+    if el.tag == "DataItem":
+        check("Dimensions" in el.attrib and el.text and el.text.strip(), f"{path}: DataItem with dimensions and content")
+        dims = [int(v) for v in el.get("Dimensions").split()]
+        check(all(d > 0 for d in dims), f"{path}: positive dimensions {dims}")
+        if el.get("Format", "XML") == "XML":
+            check(len(el.text.split()) == int(np.prod(dims)), f"{path}: {int(np.prod(dims))} inline values")
+    if el.tag == "Grid" and el.get("GridType") == "Uniform":
+        for tag in ("Time", "Topology", "Geometry"):
+            check(len(el.findall(tag)) == 1, f"{path}: one <{tag}>")
+    if el.tag == "Grid" and el.get("GridType") == "Collection":
+        check(all(c.tag == "Grid" for c in el) and len(el) > 0, f"{path}: a collection holds grids")
+
+
+def read_hdf_item(f, item):
+    """The values an HDF DataItem selects (the whole dataset or its hyperslab)."""
+    ref, _, sel = item.text.strip().partition("|")
+    data = f[ref.split(":")[1]]
+    if not sel:
+        return data[()]
+    start, stride, count, _ = (np.array(part.split(), dtype=int) for part in sel.split(":"))
+    return data[tuple(slice(a, a + b * (c - 1) + 1, b) for a, b, c in zip(start, stride, count))]
+
+
+def check_mixed_topology(f, topo, geo, name):
+    """A Mixed topology lists polygons as (3, n, n node indices): exactly
+    NumberOfElements of them, filling the item, every index a node of the
+    geometry, every node used."""
+    tp = read_hdf_item(f, topo.find("DataItem")).ravel()
+    check(geo.get("GeometryType") == "XYZ", f"{name}: XYZ geometry")
+    gdims = [int(v) for v in geo.find("DataItem").get("Dimensions").split()]
+    check(len(gdims) == 2 and gdims[1] == 3, f"{name}: geometry of (nodes, 3), got {gdims}")
+    k, polys, used = 0, 0, np.zeros(gdims[0], dtype=bool)
+    while k < len(tp):
+        check(tp[k] == 3 and k + 1 < len(tp) and tp[k + 1] >= 3, f"{name}: polygon record at {k}")
+        n = int(tp[k + 1])
+        idx = tp[k + 2:k + 2 + n]
+        check(len(idx) == n and np.all((idx >= 0) & (idx < gdims[0])), f"{name}: polygon {polys} node indices")
+        used[idx] = True
+        k += 2 + n
+        polys += 1
+    check(polys == int(topo.get("NumberOfElements")), f"{name}: {polys} polygons, declared {topo.get('NumberOfElements')}")
+    check(bool(used.all()), f"{name}: every geometry node belongs to a polygon")
+
+
 def validate_xdmf(h5path):
-    """Every HDF DataItem names an existing dataset with the declared dimensions,
-    number type and precision; every hyperslab is in bounds and as large as declared;
+    """The XML against XDMF_SCHEMA; every HDF DataItem names an existing dataset
+    with the declared dimensions, number type and precision; every hyperslab is in
+    bounds and as large as declared; times strictly increase and every collection
+    has the run file's records; a Mixed topology's polygons index its geometry;
     every attribute has one value per cell or node of its grid."""
     xmf = os.path.splitext(h5path)[0] + ".xmf"
     root = ET.parse(xmf).getroot()
+    check_schema(root)
     check(root.tag == "Xdmf" and root.get("Version") == "3.0", "Xdmf 3")
     grids = 0
     with h5py.File(h5path) as f:
@@ -423,6 +498,8 @@ def validate_xdmf(h5path):
             check(coll.get("GridType") == "Collection" and coll.get("CollectionType") == "Temporal", "temporal")
             steps = coll.findall("Grid")
             check(len(steps) == T, f"{coll.get('Name')}: one grid per record ({len(steps)} vs {T})")
+            times = np.array([float(g.find("Time").get("Value")) for g in steps])
+            check(bool(np.all(np.diff(times) > 0)), f"{coll.get('Name')}: times strictly increase")
             for k, g in enumerate(steps):
                 grids += 1
                 check(abs(float(g.find("Time").get("Value")) - f["time"][k]) <= 1e-9 * max(1, abs(f["time"][k])),
@@ -434,6 +511,7 @@ def validate_xdmf(h5path):
                     check_hdf_item(f, item, os.path.basename(h5path))
                 topo, geo = g.find("Topology"), g.find("Geometry")
                 if topo.get("TopologyType") == "Mixed":
+                    check_mixed_topology(f, topo, geo, g.get("Name"))
                     cells = int(topo.get("NumberOfElements"))
                     check(cells == f["floes/thickness"].shape[0], "one polygon per floe")
                     nodes = f["floes/vertices"].shape[0]
@@ -459,12 +537,43 @@ def validate_xdmf(h5path):
     return grids
 
 
+def rejected(path, old, new, what):
+    """validate_xdmf fails on the XDMF of `path` with its first `old` replaced by `new`."""
+    xmf = os.path.splitext(path)[0] + ".xmf"
+    text = open(xmf).read()
+    check(old in text, f"mutation '{what}': {old!r} in the XDMF")
+    folder = tempfile.mkdtemp(dir=WORK)
+    shutil.copy(path, folder)
+    copy = os.path.join(folder, os.path.basename(path))
+    with open(os.path.splitext(copy)[0] + ".xmf", "w") as out:
+        out.write(text.replace(old, new, 1))
+    try:
+        validate_xdmf(copy)
+    except SystemExit as e:
+        check(str(e.code).startswith("FAILED"), f"mutation '{what}': failed through a check, got {e.code}")
+        return
+    check(False, f"the XDMF check accepts a file with {what}")
+
+
 def case_xdmf_sea():
     for dims in (2, 1):
         path = real_run(f"x{dims}", dims)
         grids = validate_xdmf(path)
         with h5py.File(path) as f:
             check(grids == 2 * f["time"].shape[0], f"dims {dims}: floes and sea grids at every record")
+            T = f["time"].shape[0]
+            nodes = f["floes/vertices"].shape[0]
+            n = f["floes/thickness"].shape[0]
+    # The check is strict: each of these faults, one at a time, fails it.
+    check(T >= 3, "at least three records")
+    rejected(path, 'AttributeType="Scalar"', 'AttributeType="Scaler"', "a misspelt attribute value")
+    rejected(path, 'Center="Cell"', 'Centre="Cell"', "a misspelt attribute name")
+    rejected(path, '<Grid Name="floes_1" GridType="Uniform"><Time Value="',
+             '<Grid Name="floes_1" GridType="Uniform"><Time Value="-1', "times not increasing")
+    rejected(path, f'NumberOfElements="{n}"', f'NumberOfElements="{n + 1}"', "one polygon too many declared")
+    rejected(path, f'Dimensions="{nodes} 3"', f'Dimensions="{nodes + 1} 3"', "a geometry larger than its slab")
+    rejected(path, ":/floes/state|", ":/floes/states|", "a dataset that does not exist")
+    rejected(path, "<Time ", "<Times ", "an unknown element")
 
 
 def case_paraview():

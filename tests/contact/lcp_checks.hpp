@@ -11,7 +11,7 @@
 namespace floesim::lcp::testing {
 
 inline std::string lcp_data(const std::string& name) {
-  return std::string(FLOESIM_SHARED_DIR) + "/data/lcp/" + name;
+  return std::string(FLOESIM_DATA_DIR) + "/lcp/" + name;
 }
 
 // Asserts z >= 0, w >= 0 and z_i w_i = 0 within `tol`, relative to the scale

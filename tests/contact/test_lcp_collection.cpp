@@ -1,4 +1,4 @@
-// The LCP problem collections of ../shared/data/lcp against the solvers:
+// The LCP problem collections of data/lcp against the solvers:
 // the Siconos test collection with the outcome its README tabulates, and every
 // rigid-body contact LCP (including the degenerate friction ones) solved.
 #include <doctest/doctest.h>
@@ -25,7 +25,7 @@ struct Expected {
   long pivots;  // for a solve; the README's count for a lexicographic Lemke
 };
 
-// ../shared/data/lcp/README.md, table "siconos/".
+// data/lcp/README.md, table "siconos/".
 constexpr Expected kSiconos[] = {
     {"lcp_CPS_1", Status::solved, 2},
     {"lcp_CPS_2", Status::solved, 5},

@@ -19,7 +19,7 @@ namespace fs = std::filesystem;
 TEST_SUITE_BEGIN("core");
 
 namespace {
-const std::string kShared = FLOESIM_SHARED_DIR;
+const std::string kData = FLOESIM_DATA_DIR;
 
 Floes load(const Pack& p) {
   Floes f;
@@ -30,7 +30,7 @@ std::string tmp(const std::string& name) { return (fs::temp_directory_path() / n
 }  // namespace
 
 TEST_CASE("FloeDyn's 100-floe example loads with masses 917 h A") {
-  const Pack p = read_pack(kShared + "/data/floedyn/in_example_100_floes.h5");
+  const Pack p = read_pack(kData + "/floedyn/in_example_100_floes.h5");
   CHECK(p.format == "floedyn");
   REQUIRE(p.floes.size() == 100);
   REQUIRE(p.window.has_value());
@@ -51,7 +51,7 @@ TEST_CASE("FloeDyn's 100-floe example loads with masses 917 h A") {
 }
 
 TEST_CASE("FloeDyn single floe: floe 54's area and thickness as the README states") {
-  const Floes f = load(read_pack(kShared + "/data/floedyn/one_floe.h5"));
+  const Floes f = load(read_pack(kData + "/floedyn/one_floe.h5"));
   REQUIRE(f.size() == 1);
   CHECK(f.area[0] == doctest::Approx(595.1301036).epsilon(1e-9));
   CHECK(f.thickness[0] == doctest::Approx(0.9822713709408214).epsilon(1e-12));

@@ -510,12 +510,12 @@ TEST_CASE("the warm-start store of jam LCPs forgets the pairs not stored for max
 }
 
 TEST_CASE("FloeDyn's 100-floe example stays close to FloeDyn's own output") {
-  // Reference: ../shared/data/floedyn/reference_100_floes.csv (FloeDyn's output for its example).
+  // Reference: data/floedyn/reference_100_floes.csv (FloeDyn's output for its example).
   // Two FloeDyn runs agree to 0.5% in energy; ours differs by its integrator (semi-implicit drag),
   // the yaw inertia with the thickness and the collision instants (docs/contact.md), so the
   // tolerance is 3% of the energy and 3 m of the mass centre (measured: 1.7% and 1.8 m).
   Simulation sim(build_scenario(load_config(std::string(FLOESIM_SOURCE_DIR) + "/examples/floedyn_100.toml")));
-  std::ifstream in(std::string(FLOESIM_SHARED_DIR) + "/data/floedyn/reference_100_floes.csv");
+  std::ifstream in(std::string(FLOESIM_DATA_DIR) + "/floedyn/reference_100_floes.csv");
   std::string line;
   std::getline(in, line);  // header
   double mass = 0;

@@ -19,7 +19,7 @@ namespace fs = std::filesystem;
 TEST_SUITE_BEGIN("coupling");
 
 namespace {
-const std::string kShared = FLOESIM_SHARED_DIR;
+const std::string kData = FLOESIM_DATA_DIR;
 
 std::vector<std::array<double, 6>> read_reference(const std::string& path) {
   std::ifstream in(path);
@@ -41,7 +41,7 @@ std::vector<std::array<double, 6>> read_reference(const std::string& path) {
 }  // namespace
 
 TEST_CASE("single floe under FloeDyn's forcing follows FloeDyn's trajectory") {
-  // Reference: ../shared/data/floedyn/single_floe_check.csv, FloeDyn (forward Euler, dt = 10 s)
+  // Reference: data/floedyn/single_floe_check.csv, FloeDyn (forward Euler, dt = 10 s)
   // on floe 54 of its example, with its per-minute forcing (held constant over each minute),
   // rho_w = 1024.071, Coriolis at 80.207 N with Omega = 7.292e-5 (README of that folder).
   // Our scheme (linearised backward Euler for drag) differs from forward Euler by O(dt) in
@@ -50,11 +50,11 @@ TEST_CASE("single floe under FloeDyn's forcing follows FloeDyn's trajectory") {
   std::ostringstream t;
   t.precision(17);
   t << "[run]\nt_end = 60000\ndt_max = 10\noutput_interval = 60\n[sea]\nrho = 1024.071\n"
-    << "[floes]\npack = \"" << kShared << "/data/floedyn/one_floe.h5\"\n"
-    << "[forcing]\nseries = \"" << kShared << "/data/floedyn/topaz_forcing_minutes_day1.csv\"\n"
+    << "[floes]\npack = \"" << kData << "/floedyn/one_floe.h5\"\n"
+    << "[forcing]\nseries = \"" << kData << "/floedyn/topaz_forcing_minutes_day1.csv\"\n"
     << "series_interpolation = \"previous\"\ncoriolis = " << f << "\nair_drag = 1.7e-3\nair_density = 1.341\n";
   Simulation sim(build_scenario(parse_config(t.str(), "floedyn_single.toml", ".")));
-  const auto ref = read_reference(kShared + "/data/floedyn/single_floe_check.csv");
+  const auto ref = read_reference(kData + "/floedyn/single_floe_check.csv");
   REQUIRE(ref.size() == 1001);  // t = 0, 60, ..., 60000 s
   double max_speed = 0, max_dv = 0, max_dx = 0, max_dist = 0;
   for (const auto& r : ref) {
