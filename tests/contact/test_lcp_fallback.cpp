@@ -104,7 +104,7 @@ TEST_CASE("lcp contact-wise Gauss–Seidel: solves Stewart–Trinkle LCPs from z
     const Result exact = solve_lemke(lcp);
     REQUIRE(exact.status == Status::solved);
     Vector start = exact.z;
-    for (Index i = 0; i < start.size(); ++i) start(i) = std::max(0.0, start(i) + 1e-6 * std::sin(1.0 + i));
+    for (Index i = 0; i < start.size(); ++i) start(i) = std::max(0.0, start(i) + 1e-6 * std::sin(1.0 + static_cast<double>(i)));
     REQUIRE(residual(lcp, start) > 1e-8);
     const Result polished = solve_coulomb_gs(lcp, layout, start);
     REQUIRE(polished.status == Status::solved);
