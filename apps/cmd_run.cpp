@@ -4,8 +4,10 @@
 #include <unistd.h>
 
 #include <atomic>
+#include <cerrno>
 #include <csignal>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <iomanip>
 #include <iostream>
@@ -90,6 +92,15 @@ void add_run_command(CLI::App& app, Registry& registry) {
     if (fs::exists(output) && fs::equivalent(output, config_path))
       throw InputError(output + ": the output would overwrite the configuration");
 
+    {
+      // An output that cannot be written is found before the scenario is built
+      // (which may take long); the writer reports what this cannot foresee.
+      const fs::path dir = fs::absolute(output).parent_path();
+      if (access(dir.c_str(), W_OK) != 0) {
+        const int err = errno;
+        throw RunError(output + ": cannot write the run file in " + dir.string() + " (" + std::strerror(err) + ")");
+      }
+    }
     Config config = load_config(config_path);
     if (args->threads >= 0) config.run.threads = args->threads;
     // --until replaces t_end: the bound on the records of [run] t_end holds for it too.
@@ -114,7 +125,6 @@ void add_run_command(CLI::App& app, Registry& registry) {
     } catch (const RunError&) {
       progress.done();
       std::signal(SIGINT, previous);
-      std::cerr << "floesim: the run file " << output << " keeps every record written before the failure\n";
       throw;
     } catch (...) {
       progress.done();

@@ -37,6 +37,8 @@ struct Config {
 // it bounds the file's size and the steps shortened to land on output times
 // (output_interval = 1e-320 would write records without end).
 inline constexpr double kMaxRecords = 1e7;
+// The most cells a sea grid may have ([sea] cells, nx * ny for dims = 2).
+inline constexpr double kMaxSeaCells = 16777216.0;
 
 // The rule on the number of records, in one place for [run] t_end and for
 // `floesim run --until`: "" if a run to t_end writes at most kMaxRecords records

@@ -58,11 +58,18 @@ RunSummary run_simulation(Simulation& sim, const RunOptions& options) {
       }
     }
   } catch (const RunError& e) {
-    writer.finish(std::string("failed: ") + e.what());
-    throw;
+    // The writer's own failures say what the file keeps; say it for the others.
+    const bool writing = writer.failed();
+    const std::size_t kept = writer.records();
+    const std::string problem = writer.finish(std::string("failed: ") + e.what());
+    std::string message = e.what();
+    if (!writing) message += "; the run file " + options.output + " keeps the " + std::to_string(kept) + " records written before";
+    if (!problem.empty()) message += "; " + problem;
+    throw RunError(message);
   }
-  writer.finish(summary.status == "complete" ? "complete"
-                                             : "interrupted at t = " + std::to_string(sim.time()) + " s");
+  const std::string problem = writer.finish(
+      summary.status == "complete" ? "complete" : "interrupted at t = " + std::to_string(sim.time()) + " s");
+  if (!problem.empty()) throw RunError(writer.path() + ": the run ended but " + problem);
   summary.steps = sim.steps();
   summary.records = writer.records();
   summary.t_end = sim.time();
