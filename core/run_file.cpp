@@ -38,6 +38,9 @@ struct RunWriter::Impl {
   // reservation on this file system); HDF5 cannot make such a file consistent,
   // so nothing more is written to it, it is only closed.
   bool disk_full = false, write_failed = false;
+  // What one record may add to the file (reserve_for_writes), for n floes.
+  hsize_t record_bytes = 0;
+  std::size_t record_bytes_n = 0;
 
   void write_tables();
   bool write_xdmf() const;
@@ -63,12 +66,16 @@ constexpr hsize_t kMetadataMargin = hsize_t{1} << 18;
 }  // namespace
 
 void RunWriter::Impl::reserve_for_writes(hsize_t extra) {
-  hsize_t bytes = kMetadataMargin + extra;
-  for (hid_t d : {time.get(), state.get(), energy.get(), lcp.get(), substeps.get(), verts.get(), eta.get(),
-                  events.get()})
-    if (d >= 0) bytes += h5::append_bytes(d);
-  // The tables are rewritten whole when floes appear.
-  bytes += 8 * (offsets.size() + vertices.size() + 4 * thickness.size() + topology.size());
+  if (record_bytes == 0 || record_bytes_n != n) {  // the datasets' extents change only with n
+    record_bytes = 0;
+    for (hid_t d : {time.get(), state.get(), energy.get(), lcp.get(), substeps.get(), verts.get(), eta.get(),
+                    events.get()})
+      if (d >= 0) record_bytes += h5::append_bytes(d);
+    // The tables are rewritten whole when floes appear.
+    record_bytes += 8 * (offsets.size() + vertices.size() + 4 * thickness.size() + topology.size());
+    record_bytes_n = n;
+  }
+  const hsize_t bytes = kMetadataMargin + record_bytes + extra;
   const int err = h5::reserve(file, bytes);
   if (err != 0) {
     disk_full = true;  // nothing written since the last flush: the file on disk is whole
@@ -190,6 +197,7 @@ void RunWriter::start(const Floes& floes, const std::string& config_toml, unsign
     w.eta = h5::create_extendible(s, "eta", row, rows);
     h5::set_attr(w.eta, "units", std::string("m"));
   }
+  w.record_bytes = 0;  // measured again on the datasets now made
   w.flush();
 }
 

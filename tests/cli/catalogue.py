@@ -361,10 +361,13 @@ def xdmf_matches(name):
     # NAME.xmf describes exactly the records of NAME.h5: one grid per record,
     # every referenced dataset with the declared full dimensions.
     root = ET.parse(os.path.join(WORK, name + ".xmf")).getroot()
-    steps = root.findall("./Domain/Grid")[0].findall("Grid")
     with h5py.File(os.path.join(WORK, name + ".h5"), "r") as f:
-        if len(steps) != f["time"].shape[0]:
-            return f"{len(steps)} XDMF grids for {f['time'].shape[0]} records"
+        for collection in root.findall("./Domain/Grid"):  # "floes" (when there are floes), "sea"
+            steps = len(collection.findall("Grid"))
+            if f["floes/offsets"].shape[0] == 1 and collection.get("Name") == "floes":
+                continue
+            if steps != f["time"].shape[0]:
+                return f"{steps} XDMF grids of {collection.get('Name')} for {f['time'].shape[0]} records"
         for item in root.iter("DataItem"):
             if item.get("Format") != "HDF":
                 continue
@@ -385,6 +388,9 @@ def kept_records(name, at_least):
             t = f["time"][:]
             st = f["floes/state"][:]
             n = int(f.attrs["records"])
+            eta = f["sea/eta"][:] if "sea/eta" in f else np.zeros((len(t), 1))
+        if eta.shape[0] != len(t) or not np.all(np.isfinite(eta)):
+            return f"sea records: {eta.shape} for {len(t)} times, finite {np.all(np.isfinite(eta))}"
         if not status.startswith("failed: "):
             return f"status {status!r}"
         if len(t) < at_least or n != len(t) or st.shape[0] != len(t) or not np.all(np.isfinite(st)):
@@ -405,6 +411,12 @@ def disk_cases():
     case("full disk", "disk fills mid-run (file-size limit 900 kB)", ["run", long, "-q", "-o", "full.h5"],
          ["run failed", "full.h5: cannot reserve", "File too large", "the run file keeps the", "records written before"],
          code=1, check=kept_records("full", 10), preexec=file_size_limit(900_000))
+    waves = write("waves.toml", '[run]\nt_end = 20\ndt_max = 0.1\noutput_interval = 0.1\n[sea]\nmodel = "spectral"\n'
+                  'size = [200.0, 200.0]\ncells = [128, 128]\n[sea.waves]\nkind = "regular"\namplitude = 0.5\n'
+                  'wavelength = 50\n')
+    case("full disk", "disk fills during a wave-only run (128 kB sea records)", ["run", waves, "-q", "-o", "waves.h5"],
+         ["waves.h5: cannot reserve", "records written before"], code=1, check=kept_records("waves", 10),
+         preexec=file_size_limit(3_000_000))
     case("full disk", "disk full from the start (file-size limit 100 kB)", ["run", long, "-q", "-o", "full0.h5"],
          ["full0.h5: cannot reserve", "no record was written", "(the run file could not be started: removed)"],
          code=1, check=absent("full0.h5"), preexec=file_size_limit(100_000))
