@@ -57,14 +57,17 @@ RunSummary run_simulation(Simulation& sim, const RunOptions& options) {
         break;
       }
     }
-  } catch (const RunError& e) {
-    // The writer's own failures say what the file keeps; say it for the others.
+  } catch (const std::exception& e) {
+    // Any failure marks the file failed with its reason (a RunError is the
+    // expected kind; anything else is a bug, still recorded). The writer's own
+    // failures say what the file keeps; say it for the others.
     const bool writing = writer.failed();
     const std::size_t kept = writer.records();
     const std::string problem = writer.finish(std::string("failed: ") + e.what());
     std::string message = e.what();
     if (!writing) message += "; the run file " + options.output + " keeps the " + std::to_string(kept) + " records written before";
     if (!problem.empty()) message += "; " + problem;
+    if (dynamic_cast<const RunError*>(&e) == nullptr) throw;
     throw RunError(message);
   }
   const std::string problem = writer.finish(
