@@ -143,6 +143,7 @@ RunWriter::RunWriter(const std::string& path, const Floes& floes, const std::str
     impl_.reset();
     std::error_code ec;
     fs::remove(path, ec);
+    fs::remove(fs::path(path).replace_extension(".xmf"), ec);  // one left by an earlier run
     throw RunError(std::string(e.what()) + " (the run file could not be started: removed)");
   }
 }

@@ -401,8 +401,8 @@ def kept_records(name, at_least):
     return check_file
 
 
-def absent(name):
-    return lambda: f"{name} was left behind" if os.path.exists(os.path.join(WORK, name)) else None
+def absent(*names):
+    return lambda: next((f"{n} was left behind" for n in names if os.path.exists(os.path.join(WORK, n))), None)
 
 
 def disk_cases():
@@ -417,9 +417,10 @@ def disk_cases():
     case("full disk", "disk fills during a wave-only run (128 kB sea records)", ["run", waves, "-q", "-o", "waves.h5"],
          ["waves.h5: cannot reserve", "records written before"], code=1, check=kept_records("waves", 10),
          preexec=file_size_limit(3_000_000))
+    write("full0.xmf", "<Xdmf/>\n")  # left by an earlier run: removed with the file that could not start
     case("full disk", "disk full from the start (file-size limit 100 kB)", ["run", long, "-q", "-o", "full0.h5"],
          ["full0.h5: cannot reserve", "no record was written", "(the run file could not be started: removed)"],
-         code=1, check=absent("full0.h5"), preexec=file_size_limit(100_000))
+         code=1, check=absent("full0.h5", "full0.xmf"), preexec=file_size_limit(100_000))
     case("full disk", "-o /dev/full", ["run", long, "-q", "-o", "/dev/full"],
          ["/dev/full: cannot create the file (No space left on device)"], code=1)
     case("unwritable output", "a folder that does not exist", ["run", long, "-q", "-o", "no/such/dir/x.h5"],
