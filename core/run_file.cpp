@@ -4,9 +4,9 @@
 #include <cerrno>
 #include <chrono>
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
-#include <cstring>
 #include <functional>
 #include <sstream>
 
@@ -50,7 +50,7 @@ struct RunWriter::Impl {
   void reserve_for_writes(hsize_t extra = 0);
   // Flushes the file to disk; throws RunError when a write failed.
   void flush();
-  // Runs `write` (HDF5 writes); a failure marks the file broken and becomes a
+  // Runs `write` (HDF5 writes); a failure sets write_failed and becomes a
   // RunError naming the file and the records it keeps.
   template <class F> void guarded(F&& write);
   std::string keeps() const {
@@ -194,7 +194,7 @@ void RunWriter::start(const Floes& floes, const std::string& config_toml, unsign
     h5::write_doubles(s, "x", {x.size()}, x.data());
     h5::write_doubles(s, "y", {y.size()}, y.data());
     std::vector<hsize_t> row = w.sea.dims == 2 ? std::vector<hsize_t>{hsize_t(ny), hsize_t(nx)}
-                                             : std::vector<hsize_t>{hsize_t(nx)};
+                                               : std::vector<hsize_t>{hsize_t(nx)};
     w.eta = h5::create_extendible(s, "eta", row, rows);
     h5::set_attr(w.eta, "units", std::string("m"));
   }
