@@ -94,7 +94,11 @@ Simulation::Simulation(Scenario scenario) : scenario_(std::move(scenario)) {
   fluid::SeaOptions sea_options;
   sea_options.tank = {c.sea.tank.enabled, c.sea.tank.generation_length, c.sea.tank.absorption_length,
                       c.sea.tank.rate, c.sea.tank.ramp_periods};
-  sea_ = fluid::make_sea(c.sea, c.run.seed, sea_options);
+  try {
+    sea_ = fluid::make_sea(c.sea, c.run.seed, sea_options);  // its input errors name the [sea] key; add the file
+  } catch (const InputError& e) {
+    throw InputError(c.file.empty() ? std::string(e.what()) : c.file + ": " + e.what());
+  }
   const Floes& f = scenario_.floes;
   const bool any_dynamic = std::any_of(f.is_static.begin(), f.is_static.end(), [](std::uint8_t s) { return !s; });
   if (sea_ && any_dynamic) {

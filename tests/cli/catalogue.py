@@ -157,6 +157,14 @@ def toml_cases():
     case("toml", "tank zones without a regular wave",
          ["run", write("tank_calm.toml", '[sea]\nmodel = "spectral"\n[sea.tank]\nenabled = true\n')],
          ["tank_calm.toml:4", "[sea.tank] enabled", "kind = \"regular\""])
+    case("toml", "tank zones wider than the sea",
+         ["run", write("tank_fit.toml", '[sea]\nmodel = "spectral"\ndims = 1\nsize = [1.0, 0.1]\ncells = [64, 1]\n'
+                       '[sea.waves]\nkind = "regular"\namplitude = 0.001\nwavelength = 0.5\n[sea.tank]\nenabled = true\n')],
+         ["tank_fit.toml: [sea] size", "zones do not fit in the box of 1 m"])
+    case("toml", "a wave the grid cannot resolve",
+         ["run", write("unresolved.toml", '[sea]\nmodel = "spectral"\nsize = [200.0, 200.0]\ncells = [16, 16]\n'
+                       '[sea.waves]\nkind = "regular"\namplitude = 0.5\nwavelength = 20\n')],
+         ["unresolved.toml: [sea.waves] wavelength", "not resolved by the grid spacing 12.5 m"])
     case("toml", "tent footprint in a bem basin",
          ["run", write("tent_bem.toml", bem + '[coupling]\nfootprint = "tent"\n')],
          ["tent_bem.toml:8", "[coupling] footprint", "periodic"])
