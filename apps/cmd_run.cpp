@@ -104,13 +104,14 @@ void add_run_command(CLI::App& app, Registry& registry) {
     Config config = load_config(config_path);
     if (args->threads >= 0) config.run.threads = args->threads;
     // --until replaces t_end: the bound on the records of [run] t_end holds for it too.
-    const std::string problem =
-        args->until >= 0.0 ? record_count_problem(args->until, config.run.output_interval) : std::string{};
-    if (!problem.empty()) {
-      std::ostringstream m;
-      m << "--until " << args->until << ": " << problem << " (" << config_path << ": [run] output_interval)";
-      throw InputError(m.str());
-    }
+    if (args->until >= 0.0)
+      for (auto [problem, key] : {std::pair{record_count_problem(args->until, config.run.output_interval), "output_interval"},
+                                  std::pair{step_count_problem(args->until, config.run.dt_max), "dt_max"}})
+        if (!problem.empty()) {
+          std::ostringstream m;
+          m << "--until " << args->until << ": " << problem << " (" << config_path << ": [run] " << key << ")";
+          throw InputError(m.str());
+        }
     Simulation sim(build_scenario(config));
     for (const std::string& note : sim.notes()) std::cerr << "floesim: note: " << note << "\n";
 

@@ -197,6 +197,7 @@ void read_run(Section s, RunParams& r) {
   r.output_interval = s.number("output_interval", r.output_interval, positive, "an interval > 0 (s)");
   if (const std::string problem = record_count_problem(r.t_end, r.output_interval); !problem.empty())
     s.fail("output_interval", problem);
+  if (const std::string problem = step_count_problem(r.t_end, r.dt_max); !problem.empty()) s.fail("dt_max", problem);
   r.seed = static_cast<unsigned long>(
       s.integer("seed", static_cast<long long>(r.seed), [](long long v) { return v >= 0; }, "a seed >= 0"));
   r.threads = static_cast<int>(s.integer("threads", r.threads, [](long long v) { return v >= 0 && v <= 1024; },
@@ -449,6 +450,17 @@ std::string record_count_problem(double t_end, double output_interval) {
     << static_cast<long>(kMaxRecords) << " records up to t_end = " << t_end << " s), got " << output_interval << " s: ";
   if (std::isfinite(records)) m << std::setprecision(15) << records << " records";
   else m << "more records than a double can count";
+  return m.str();
+}
+
+std::string step_count_problem(double t_end, double dt_max) {
+  const double steps = std::ceil(t_end / dt_max);
+  if (steps <= kMaxSteps) return "";
+  std::ostringstream m;
+  m << "expected a dt_max >= " << t_end / kMaxSteps << " s (at most " << static_cast<long long>(kMaxSteps)
+    << " steps up to t_end = " << t_end << " s), got " << dt_max << " s: ";
+  if (std::isfinite(steps)) m << std::setprecision(15) << steps << " steps";
+  else m << "more steps than a double can count";
   return m.str();
 }
 

@@ -132,6 +132,9 @@ def toml_cases():
     case("toml", "output_interval 1 s to 1e9 s",
          ["run", write("many_records.toml", SMALL.replace("t_end = 2.0", "t_end = 1.0e9"))],
          ["many_records.toml:4:", "[run] output_interval", ">= 100 s", "1000000002 records"])
+    case("toml", "dt_max 1e-300 (a run without end)",
+         ["run", write("tiny_dt.toml", SMALL.replace("dt_max = 0.5", "dt_max = 1e-300"))],
+         ["tiny_dt.toml:3:", "key '[run] dt_max'", "at most 1000000000 steps", "got 1e-300 s"])
     case("toml", "a folder as CONFIG", ["run", os.path.join(WORK, "a_folder")],
          ["a_folder: is a folder", "expected a configuration file"])
     case("toml", "CONFIG not found", ["run", os.path.join(WORK, "nope.toml")], ["nope.toml", "not found"])
@@ -336,6 +339,10 @@ def cli_cases():
              ["--until", "expected a finite number >= 0", f"got '{value}'"])
     case("cli option", "--until 1e12", ["run", small, "--until", "1e12", "-o", "out.h5"],
          ["--until 1e+12", "expected an output_interval >= 100000 s", "at most 10000000 records", "[run] output_interval"])
+    case("cli option", "--until 1e9 at dt_max 0.5 s",
+         ["run", write("until_steps.toml", SMALL.replace("output_interval = 1.0", "output_interval = 1e3")),
+          "--until", "1e9", "-o", "out.h5"],
+         ["--until 1e+09", "at most 1000000000 steps", "[run] dt_max"])
     case("cli option", "--threads -1", ["run", small, "--threads", "-1", "-o", "out.h5"], ["--threads"])
     case("cli option", "-o the configuration itself", ["run", small, "-o", small], ["would overwrite the configuration"])
     for opt in ("--rtol", "--atol"):
