@@ -5,8 +5,10 @@
 #include <unistd.h>
 
 #include <atomic>
+#include <cerrno>
 #include <csignal>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <iomanip>
 #include <iostream>
@@ -130,6 +132,15 @@ void add_run_command(CLI::App& app, Registry& registry) {
     if (!config_path.empty() && fs::exists(output) && fs::equivalent(output, config_path))
       throw InputError(output + ": the output would overwrite the configuration");
 
+    {
+      // An output that cannot be written is found before the scenario is built
+      // (which may take long); the writer reports what this cannot foresee.
+      const fs::path dir = fs::absolute(output).parent_path();
+      if (access(dir.c_str(), W_OK) != 0) {
+        const int err = errno;
+        throw RunError(output + ": cannot write the run file in " + dir.string() + " (" + std::strerror(err) + ")");
+      }
+    }
     Config config;
     Checkpoint checkpoint;
     if (restart) {
@@ -149,15 +160,16 @@ void add_run_command(CLI::App& app, Registry& registry) {
       config = load_config(config_path);
     }
     if (args->threads >= 0) config.run.threads = args->threads;
-    // --until replaces t_end: the bound on the records of [run] t_end holds for it too.
-    const std::string problem =
-        args->until >= 0.0 ? record_count_problem(args->until, config.run.output_interval) : std::string{};
-    if (!problem.empty()) {
-      std::ostringstream m;
-      m << "--until " << args->until << ": " << problem << " (" << (config_path.empty() ? args->restart : config_path)
-        << ": [run] output_interval)";
-      throw InputError(m.str());
-    }
+    // --until replaces t_end: the bounds on the records and steps of [run] t_end hold for it too.
+    if (args->until >= 0.0)
+      for (auto [problem, key] : {std::pair{record_count_problem(args->until, config.run.output_interval), "output_interval"},
+                                  std::pair{step_count_problem(args->until, config.run.dt_max), "dt_max"}})
+        if (!problem.empty()) {
+          std::ostringstream m;
+          m << "--until " << args->until << ": " << problem << " ("
+            << (config_path.empty() ? args->restart : config_path) << ": [run] " << key << ")";
+          throw InputError(m.str());
+        }
     Simulation sim(build_scenario(config));
     if (restart) {
       sim.restore(checkpoint);
@@ -186,8 +198,6 @@ void add_run_command(CLI::App& app, Registry& registry) {
     } catch (const RunError&) {
       progress.done();
       restore_signals();
-      std::cerr << "floesim: the run file " << output
-                << " keeps every record written before the failure, and a checkpoint at the last one\n";
       throw;
     } catch (...) {
       progress.done();

@@ -1,6 +1,7 @@
 // floesim command line: dispatches to one subcommand per apps/cmd_*.cpp.
 #include <iostream>
 #include <map>
+#include <new>
 #include <string>
 
 #include "apps/commands.hpp"
@@ -54,6 +55,12 @@ int main(int argc, char** argv) {
     return 2;
   } catch (const floesim::RunError& e) {
     std::cerr << "floesim: run failed: " << e.what() << "\n";
+    return 1;
+  } catch (const std::bad_alloc&) {
+    std::cerr << "floesim: run failed: out of memory\n";
+    return 1;
+  } catch (const std::exception& e) {  // a bug: said, not an abort
+    std::cerr << "floesim: internal error: " << e.what() << "\n";
     return 1;
   }
   return 2;

@@ -199,6 +199,7 @@ void read_run(Section s, RunParams& r) {
   r.output_interval = s.number("output_interval", r.output_interval, positive, "an interval > 0 (s)");
   if (const std::string problem = record_count_problem(r.t_end, r.output_interval); !problem.empty())
     s.fail("output_interval", problem);
+  if (const std::string problem = step_count_problem(r.t_end, r.dt_max); !problem.empty()) s.fail("dt_max", problem);
   r.seed = static_cast<unsigned long>(
       s.integer("seed", static_cast<long long>(r.seed), [](long long v) { return v >= 0; }, "a seed >= 0"));
   r.threads = static_cast<int>(s.integer("threads", r.threads, [](long long v) { return v >= 0 && v <= 1024; },
@@ -236,12 +237,24 @@ void read_sea(Section s, SeaParams& p, const std::string& file) {
                                                   {"bem", SeaModel::bem}});
   p.dims = static_cast<int>(s.integer("dims", p.dims, [](long long v) { return v == 1 || v == 2; }, "1 or 2"));
   p.size = s.pair("size", p.size, "[Lx, Ly], two sizes > 0 (m)");
-  if (!(p.size[0] > 0.0 && p.size[1] > 0.0)) s.fail("size", "expected two sizes > 0 (m)");
+  if (!(p.size[0] > 0.0 && p.size[1] > 0.0 && p.size[0] <= kMaxCoordinate && p.size[1] <= kMaxCoordinate)) {
+    std::ostringstream m;
+    m << "expected two sizes > 0 and <= " << kMaxCoordinate << " m, got [" << p.size[0] << ", " << p.size[1] << "]";
+    s.fail("size", m.str());
+  }
   if (s.has("cells")) {
     auto c = s.numbers("cells", 2, "[nx, ny], two cell counts >= 1");
     for (double v : c)
-      if (!(v >= 1.0 && v == std::floor(v) && v < 1e6)) s.fail("cells", "expected two whole cell counts >= 1");
+      if (!(v >= 1.0 && v == std::floor(v) && v < 1e6)) s.fail("cells", "expected two whole cell counts in [1, 1e6)");
     p.cells = {static_cast<int>(c[0]), static_cast<int>(c[1])};
+    // The grid is allocated whole (some twenty numbers per cell): bounded here.
+    const double total = p.dims == 2 ? c[0] * c[1] : c[0];
+    if (total > kMaxSeaCells) {
+      std::ostringstream m;
+      m << "expected at most " << static_cast<long long>(kMaxSeaCells) << " cells in all (4096 x 4096), got "
+        << total;
+      s.fail("cells", m.str());
+    }
   } else {
     s.node("cells");
   }
@@ -250,10 +263,26 @@ void read_sea(Section s, SeaParams& p, const std::string& file) {
   p.g = s.number("g", p.g, positive, "a gravity > 0 (m/s^2)");
   p.sigma = s.number("sigma", p.sigma, non_negative, "a surface tension >= 0 (N/m)");
   p.bottom = s.points("bottom", "a polyline [[x, z], ...] (m)");
-  if (!p.bottom.empty() && p.model != SeaModel::bem) s.fail("bottom", "a bottom polyline needs model = \"bem\"");
-  for (auto& b : p.bottom)
-    if (!(std::isfinite(b[0]) && std::isfinite(b[1]) && b[1] < 0.0))
-      s.fail("bottom", "every bottom point must be finite and below the surface (z < 0)");
+  if (!p.bottom.empty()) {
+    // The basin's bottom (fluid/bem.hpp): below the surface, x increasing, spanning [0, Lx].
+    if (p.model != SeaModel::bem) s.fail("bottom", "a bottom polyline needs model = \"bem\"");
+    const auto& b = p.bottom;
+    auto num = [](double v) { std::ostringstream o; o << v; return o.str(); };
+    if (b.size() < 2)
+      s.fail("bottom", "expected a polyline of at least 2 points [x, z] spanning the basin [0, " + num(p.size[0]) +
+                           "] m, got " + std::to_string(b.size()) + " point(s)");
+    for (std::size_t i = 0; i < b.size(); ++i) {
+      if (!(std::isfinite(b[i][0]) && std::isfinite(b[i][1]) && b[i][1] < 0.0))
+        s.fail("bottom", "every bottom point must be finite and below the surface (z < 0): point " +
+                             std::to_string(i) + " is (" + num(b[i][0]) + ", " + num(b[i][1]) + ") m");
+      if (i > 0 && !(b[i][0] > b[i - 1][0]))
+        s.fail("bottom", "x must increase along the polyline (point " + std::to_string(i) + " at x = " +
+                             num(b[i][0]) + " m)");
+    }
+    if (b.front()[0] > 0.0 || b.back()[0] < p.size[0])
+      s.fail("bottom", "the polyline covers x in [" + num(b.front()[0]) + ", " + num(b.back()[0]) +
+                           "] m but must span the basin [0, " + num(p.size[0]) + "] m");
+  }
   read_waves(Section(s.table("waves"), "sea.waves", file), p.waves);
   {
     Section t(s.table("tank"), "sea.tank", file);
@@ -427,6 +456,17 @@ std::string record_count_problem(double t_end, double output_interval) {
     << static_cast<long>(kMaxRecords) << " records up to t_end = " << t_end << " s), got " << output_interval << " s: ";
   if (std::isfinite(records)) m << std::setprecision(15) << records << " records";
   else m << "more records than a double can count";
+  return m.str();
+}
+
+std::string step_count_problem(double t_end, double dt_max) {
+  const double steps = std::ceil(t_end / dt_max);
+  if (steps <= kMaxSteps) return "";
+  std::ostringstream m;
+  m << "expected a dt_max >= " << t_end / kMaxSteps << " s (at most " << static_cast<long long>(kMaxSteps)
+    << " steps up to t_end = " << t_end << " s), got " << dt_max << " s: ";
+  if (std::isfinite(steps)) m << std::setprecision(15) << steps << " steps";
+  else m << "more steps than a double can count";
   return m.str();
 }
 

@@ -37,11 +37,19 @@ struct Config {
 // it bounds the file's size and the steps shortened to land on output times
 // (output_interval = 1e-320 would write records without end).
 inline constexpr double kMaxRecords = 1e7;
+// The most cells a sea grid may have ([sea] cells, nx * ny for dims = 2).
+inline constexpr double kMaxSeaCells = 16777216.0;
 
 // The rule on the number of records, in one place for [run] t_end and for
 // `floesim run --until`: "" if a run to t_end writes at most kMaxRecords records
 // at output_interval (both > 0 and finite), else what was expected.
 std::string record_count_problem(double t_end, double output_interval);
+// At most this many steps of dt_max up to t_end: more would be a run without
+// end in practice (1e9 steps at 1e5 steps/s take three hours); dt_max =
+// 1e-300 s made `floesim run` hang.
+inline constexpr double kMaxSteps = 1e9;
+// The same rule for steps: "" if t_end / dt_max (both > 0) is at most kMaxSteps.
+std::string step_count_problem(double t_end, double dt_max);
 
 // Reads and checks a configuration file.
 Config load_config(const std::string& path);

@@ -25,10 +25,12 @@ FloeShape make_floe_shape(const FloeInput& in) {
     fail("a floe needs at least 3 vertices, got " + std::to_string(in.vertices.size()));
   for (std::size_t i = 0; i < in.vertices.size(); ++i)
     if (!in.vertices[i].allFinite()) fail("vertex " + std::to_string(i) + " is not a finite number");
-  if (!(std::isfinite(in.thickness) && in.thickness > 0.0))
-    fail("thickness must be a finite number > 0 (m), got " + std::to_string(in.thickness));
-  if (!(std::isfinite(in.density) && in.density > 0.0))
-    fail("density must be a finite number > 0 (kg/m^3), got " + std::to_string(in.density));
+  if (!(in.thickness >= kMinLength && in.thickness <= kMaxCoordinate))
+    fail("thickness = " + number(in.thickness) + " m: expected a thickness in [" + number(kMinLength) + ", " +
+         number(kMaxCoordinate) + "] m");
+  if (!(in.density >= kMinDensity && in.density <= kMaxDensity))
+    fail("density = " + number(in.density) + " kg/m^3: expected a density in [" + number(kMinDensity) + ", " +
+         number(kMaxDensity) + "] kg/m^3");
   if (!in.velocity.allFinite() || !std::isfinite(in.angular_velocity) || !std::isfinite(in.yaw) ||
       !in.position.allFinite())
     fail("position, velocity, angular_velocity and yaw must be finite numbers");
@@ -62,6 +64,9 @@ FloeShape make_floe_shape(const FloeInput& in) {
   for (const Vec2& p : v) spread = std::max(spread, std::abs(cross(p - v[0], far - v[0])));
   if (!(spread > 1e-12 * extent * extent) || extent == 0.0)
     fail("the outline has zero area (all vertices on a line?)");
+  if (extent < kMinLength)
+    fail("the outline is " + number(extent) + " m across: expected a floe at least " + number(kMinLength) +
+         " m across");
   if (auto bad = find_self_intersection(v)) {
     std::ostringstream s;
     s << "the outline intersects itself (edges " << bad->first << " and " << bad->second

@@ -63,13 +63,20 @@ struct FloeShape {
 //    vertex). Sea ice drifts at about 1 m/s; a floe at 2e130 m/s would cross
 //    the domain in far less than any step, and the adaptive step would shrink
 //    without end.
+//  * thickness and size (largest distance between two vertices) in
+//    [kMinLength, kMaxCoordinate], density in [kMinDensity, kMaxDensity]: a
+//    floe 1e-164 m thick (one flipped byte of a pack file) has a mass whose
+//    inverse overflows in the first step.
 inline constexpr double kMaxCoordinate = 1e9;  // m
 inline constexpr double kMaxSpeed = 1e3;       // m/s
+inline constexpr double kMinLength = 1e-4;     // m: 0.1 mm
+inline constexpr double kMinDensity = 1.0;     // kg/m^3 (air is 1.2)
+inline constexpr double kMaxDensity = 1e5;     // kg/m^3 (osmium is 2.3e4)
 
 // Checks a floe and builds its shape. Throws InputError naming input.origin
 // when: fewer than 3 vertices, a non-finite number, a coordinate or speed past
 // the bounds above, zero or negative area (degenerate), a self-intersecting
-// outline, thickness or density <= 0.
+// outline.
 // A clockwise outline is reversed (reported through FloeShape::reoriented).
 FloeShape make_floe_shape(const FloeInput& input);
 

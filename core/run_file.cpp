@@ -1,8 +1,10 @@
 #include "core/run_file.hpp"
 
 #include <algorithm>
+#include <cerrno>
 #include <chrono>
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <functional>
@@ -34,10 +36,77 @@ struct RunWriter::Impl {
   SeaGridInfo sea;
   std::chrono::steady_clock::time_point last_xdmf = std::chrono::steady_clock::now();
   std::vector<double> scratch;
+  // disk_full: a reservation was refused; the file is as last flushed (whole) and
+  // only its end mark is still written. write_failed: a write itself failed (no
+  // reservation on this file system); HDF5 cannot make such a file consistent,
+  // so nothing more is written to it, it is only closed.
+  bool disk_full = false, write_failed = false;
+  // What one record may add to the file (reserve_for_writes), for n floes.
+  hsize_t record_bytes = 0;
+  std::size_t record_bytes_n = 0;
 
   void write_tables();
-  void write_xdmf() const;
+  bool write_xdmf() const;
+  // Disk space for what the next record (or the tables, or the end mark) may
+  // add to the file, reserved before it is written (h5::reserve); throws
+  // RunError when the disk is full or the file may not grow.
+  void reserve_for_writes(hsize_t extra = 0);
+  // Flushes the file to disk; throws RunError when a write failed.
+  void flush();
+  // Runs `write` (HDF5 writes); a failure sets write_failed and becomes a
+  // RunError naming the file and the records it keeps.
+  template <class F> void guarded(F&& write);
+  std::string keeps() const {
+    return records == 0 ? std::string("no record was written")
+                        : "the run file keeps the " + std::to_string(records) + " records written before";
+  }
 };
+
+namespace {
+// Room for the end mark (status and record-count attributes) and the
+// metadata HDF5 rewrites at a flush (object headers, B-tree nodes, heap).
+constexpr hsize_t kMetadataMargin = hsize_t{1} << 18;
+}  // namespace
+
+void RunWriter::Impl::reserve_for_writes(hsize_t extra) {
+  if (record_bytes == 0 || record_bytes_n != n) {  // the datasets' extents change only with n
+    record_bytes = 0;
+    for (hid_t d : {time.get(), state.get(), energy.get(), lcp.get(), substeps.get(), verts.get(), eta.get(),
+                    events.get()})
+      if (d >= 0) record_bytes += h5::append_bytes(d);
+    // The tables are rewritten whole when floes appear.
+    record_bytes += 8 * (offsets.size() + vertices.size() + 4 * thickness.size() + topology.size());
+    record_bytes_n = n;
+  }
+  const hsize_t bytes = kMetadataMargin + record_bytes + extra;
+  const int err = h5::reserve(file, bytes);
+  if (err != 0) {
+    disk_full = true;  // nothing written since the last flush: the file on disk is whole
+    throw RunError(path + ": cannot reserve " + std::to_string(bytes) + " bytes of disk space for the next record (" +
+                   std::strerror(err) + (err == ENOSPC ? ": the disk is full" : err == EFBIG ? ": the file may not grow" : "") +
+                   "); " + keeps());
+  }
+}
+
+void RunWriter::Impl::flush() {
+  if (!h5::flush(file)) {
+    write_failed = true;
+    throw RunError(path + ": writing the run file to disk failed (is the disk full?); " + keeps() +
+                   " unless the failed write damaged it");
+  }
+}
+
+template <class F>
+void RunWriter::Impl::guarded(F&& write) {
+  if (disk_full || write_failed) throw RunError(path + ": an earlier write to the run file failed; " + keeps());
+  try {
+    write();
+  } catch (const RunError& e) {
+    if (disk_full || write_failed) throw;  // already says what the file keeps
+    write_failed = true;
+    throw RunError(path + ": " + e.what() + "; " + keeps() + " unless the failed write damaged it");
+  }
+}
 
 namespace {
 std::uint32_t id_of(const Floes& floes, std::size_t i) {
@@ -69,6 +138,22 @@ RunWriter::RunWriter(const std::string& path, const Floes& floes, const std::str
   w.sea = sea;
   const hsize_t rows = expected_records;
   w.file = h5::create_file(path);
+  try {
+    start(floes, config_toml, static_cast<unsigned long long>(rows));
+  } catch (const RunError& e) {
+    // Not one record: close and remove what there is rather than leave a
+    // file that may not open.
+    impl_.reset();
+    std::error_code ec;
+    fs::remove(path, ec);
+    fs::remove(fs::path(path).replace_extension(".xmf"), ec);  // one left by an earlier run
+    throw RunError(std::string(e.what()) + " (the run file could not be started: removed)");
+  }
+}
+
+void RunWriter::start(const Floes& floes, const std::string& config_toml, unsigned long long rows) {
+  Impl& w = *impl_;
+  w.reserve_for_writes(8 * config_toml.size());
   h5::set_attr(w.file, "format", std::string(kRunFormat));
   h5::set_attr(w.file, "config", config_toml);
   h5::set_attr(w.file, "status", std::string("running"));
@@ -103,20 +188,21 @@ RunWriter::RunWriter(const std::string& path, const Floes& floes, const std::str
   h5::set_attr(w.events, "columns",
                std::vector<std::string>(std::begin(kFractureEventColumnNames), std::end(kFractureEventColumnNames)));
 
-  if (sea.dims > 0) {
+  if (w.sea.dims > 0) {
     h5::Handle s = h5::create_group(w.file, "/sea");
-    const int nx = sea.cells[0], ny = sea.dims == 2 ? sea.cells[1] : 1;
+    const int nx = w.sea.cells[0], ny = w.sea.dims == 2 ? w.sea.cells[1] : 1;
     std::vector<double> x(static_cast<std::size_t>(nx)), y(static_cast<std::size_t>(ny));
-    for (int i = 0; i < nx; ++i) x[static_cast<std::size_t>(i)] = (i + 0.5) * sea.size[0] / nx;
-    for (int j = 0; j < ny; ++j) y[static_cast<std::size_t>(j)] = (j + 0.5) * sea.size[1] / ny;
+    for (int i = 0; i < nx; ++i) x[static_cast<std::size_t>(i)] = (i + 0.5) * w.sea.size[0] / nx;
+    for (int j = 0; j < ny; ++j) y[static_cast<std::size_t>(j)] = (j + 0.5) * w.sea.size[1] / ny;
     h5::write_doubles(s, "x", {x.size()}, x.data());
     h5::write_doubles(s, "y", {y.size()}, y.data());
-    std::vector<hsize_t> row = sea.dims == 2 ? std::vector<hsize_t>{hsize_t(ny), hsize_t(nx)}
-                                             : std::vector<hsize_t>{hsize_t(nx)};
+    std::vector<hsize_t> row = w.sea.dims == 2 ? std::vector<hsize_t>{hsize_t(ny), hsize_t(nx)}
+                                               : std::vector<hsize_t>{hsize_t(nx)};
     w.eta = h5::create_extendible(s, "eta", row, rows);
     h5::set_attr(w.eta, "units", std::string("m"));
   }
-  H5Fflush(w.file, H5F_SCOPE_GLOBAL);
+  w.record_bytes = 0;  // measured again on the datasets now made
+  w.flush();
 }
 
 RunWriter::~RunWriter() {
@@ -156,51 +242,57 @@ void RunWriter::note_floes(const Floes& floes) {
     for (std::size_t v = first; v < w.nverts; ++v) w.topology.push_back(static_cast<long long>(v));
   }
   w.n = issued;
-  if (w.state.valid()) {
-    // Earlier records read NaN for the new floes (the fill value).
-    h5::set_extent(w.state, {w.records, w.n, kStateColumns});
-    h5::set_extent(w.verts, {w.records, w.nverts, 3});
-  }
-  if (w.floes_group.valid() && h5::exists(w.floes_group, "offsets")) w.write_tables();
+  if (!w.file.valid()) return;
+  w.guarded([&] {
+    w.reserve_for_writes();  // counts the grown tables
+    if (w.state.valid()) {
+      // Earlier records read NaN for the new floes (the fill value).
+      h5::set_extent(w.state, {w.records, w.n, kStateColumns});
+      h5::set_extent(w.verts, {w.records, w.nverts, 3});
+    }
+    if (w.floes_group.valid() && h5::exists(w.floes_group, "offsets")) w.write_tables();
+  });
 }
 
 void RunWriter::record(double t, const Floes& floes, std::span<const double> energy,
                        const LcpCounters& lcp, std::span<const double> eta) {
   Impl& w = *impl_;
   FLOESIM_ASSERT(energy.size() == w.energy_columns.size());
+  if (w.eta.valid() && eta.empty()) throw RunError("run file: the sea elevation is missing from a record");
   note_floes(floes);
-  h5::append_row(w.time, &t);
-  w.scratch.assign(w.n * kStateColumns, std::nan(""));
-  for (std::size_t i = 0; i < floes.size(); ++i)
-    std::copy_n(reinterpret_cast<const double*>(&floes.state[i]), kStateColumns,
-                w.scratch.begin() + static_cast<std::ptrdiff_t>(id_of(floes, i) * kStateColumns));
-  h5::append_row(w.state, w.scratch.data());
-  h5::append_row(w.energy, energy.data());
-  const double l[4] = {lcp.solves, lcp.pivots, lcp.failures, lcp.fallbacks};
-  h5::append_row(w.lcp, l);
-  h5::append_row(w.substeps, lcp.substeps.data());
-  w.scratch.assign(3 * w.nverts, std::nan(""));
-  for (std::size_t i = 0; i < floes.size(); ++i) {
-    std::size_t k = static_cast<std::size_t>(w.offsets[id_of(floes, i)]);
-    for (const Vec2& b : floes.vertices(i)) {
-      const Vec2 p = floes.to_world(i, b);
-      w.scratch[3 * k] = p.x();
-      w.scratch[3 * k + 1] = p.y();
-      w.scratch[3 * k + 2] = floes.state[i].heave;
-      ++k;
+  // Reserve, write, flush: a refused reservation writes nothing (RunWriter's header).
+  w.guarded([&] {
+    w.reserve_for_writes();
+    h5::append_row(w.time, &t);
+    w.scratch.assign(w.n * kStateColumns, std::nan(""));
+    for (std::size_t i = 0; i < floes.size(); ++i)
+      std::copy_n(reinterpret_cast<const double*>(&floes.state[i]), kStateColumns,
+                  w.scratch.begin() + static_cast<std::ptrdiff_t>(id_of(floes, i) * kStateColumns));
+    h5::append_row(w.state, w.scratch.data());
+    h5::append_row(w.energy, energy.data());
+    const double l[4] = {lcp.solves, lcp.pivots, lcp.failures, lcp.fallbacks};
+    h5::append_row(w.lcp, l);
+    h5::append_row(w.substeps, lcp.substeps.data());
+    w.scratch.assign(3 * w.nverts, std::nan(""));
+    for (std::size_t i = 0; i < floes.size(); ++i) {
+      std::size_t k = static_cast<std::size_t>(w.offsets[id_of(floes, i)]);
+      for (const Vec2& b : floes.vertices(i)) {
+        const Vec2 p = floes.to_world(i, b);
+        w.scratch[3 * k] = p.x();
+        w.scratch[3 * k + 1] = p.y();
+        w.scratch[3 * k + 2] = floes.state[i].heave;
+        ++k;
+      }
     }
-  }
-  h5::append_row(w.verts, w.scratch.data());
-  if (w.eta.valid()) {
-    if (eta.empty()) throw RunError("run file: the sea elevation is missing from a record");
-    h5::append_row(w.eta, eta.data());
-  }
+    h5::append_row(w.verts, w.scratch.data());
+    if (w.eta.valid()) h5::append_row(w.eta, eta.data());
+    w.flush();
+  });
   w.times.push_back(t);
   w.record_floes.push_back(w.n);
   w.record_vertices.push_back(w.nverts);
   w.record_topology.push_back(w.topology.size());
   ++w.records;
-  H5Fflush(w.file, H5F_SCOPE_GLOBAL);
   // Keep the XDMF reasonably current without rewriting it at every record.
   const auto now = std::chrono::steady_clock::now();
   if (w.records == 1 || now - w.last_xdmf > std::chrono::seconds(5)) {
@@ -211,9 +303,13 @@ void RunWriter::record(double t, const Floes& floes, std::span<const double> ene
 
 void RunWriter::record_fracture(std::span<const FractureEventRow> events) {
   Impl& w = *impl_;
-  for (const FractureEventRow& e : events) h5::append_row(w.events, reinterpret_cast<const double*>(&e));
-  w.event_rows += events.size();
-  if (!events.empty()) H5Fflush(w.file, H5F_SCOPE_GLOBAL);
+  if (events.empty()) return;
+  w.guarded([&] {
+    w.reserve_for_writes(8 * kFractureEventColumns * events.size());
+    for (const FractureEventRow& e : events) h5::append_row(w.events, reinterpret_cast<const double*>(&e));
+    w.event_rows += events.size();
+    w.flush();
+  });
 }
 
 RunWriter::RunWriter(Resume, const std::string& path, const Checkpoint& c, const std::string& config_toml,
@@ -309,6 +405,7 @@ void RunWriter::count_into(Checkpoint& c) const {
 
 void RunWriter::write_checkpoint(const Checkpoint& c) {
   Impl& w = *impl_;
+  w.guarded([&] {
   try {
     // A new group, then the old one replaced by it: a run killed while
     // writing keeps the previous checkpoint.
@@ -319,31 +416,59 @@ void RunWriter::write_checkpoint(const Checkpoint& c) {
       throw InputError("cannot rename /checkpoint_new");
     H5Fflush(w.file, H5F_SCOPE_GLOBAL);
   } catch (const InputError& e) {
-    throw RunError(w.path + ": cannot write the checkpoint: " + e.what());
+    throw RunError(std::string("cannot write the checkpoint: ") + e.what());
   }
+  });
 }
 
-void RunWriter::finish(const std::string& status) {
+std::string RunWriter::finish(const std::string& status) {
   Impl& w = *impl_;
-  h5::set_attr(w.file, "status", status);
-  h5::set_attr(w.file, "records", static_cast<long long>(w.records));
-  H5Fflush(w.file, H5F_SCOPE_GLOBAL);
-  w.write_xdmf();
-  w.floes_group.reset();
-  w.xdmf_group.reset();
+  if (!w.file.valid()) return {};
+  std::string problem;
+  if (w.write_failed) problem = "its status could not be written (a write failed)";
+  if (w.disk_full) {
+    // The refused reservation left the file as last flushed; the end mark
+    // takes a little room (what the last flush trimmed off the reservation).
+    if (h5::reserve(w.file, kMetadataMargin) == 0) w.disk_full = false;
+    else problem = "its status could not be written (the disk is full)";
+  }
+  if (!w.disk_full && !w.write_failed) {
+    try {
+      w.guarded([&] {
+        h5::set_attr(w.file, "status", status);
+        h5::set_attr(w.file, "records", static_cast<long long>(w.records));
+        w.flush();
+      });
+    } catch (const RunError&) {
+      problem = "its status could not be written";
+    }
+  }
+  // The XDMF describes exactly the records in the file, or is removed.
+  if (!w.write_xdmf()) {
+    std::error_code ec;
+    fs::remove(xdmf_path(), ec);
+    problem += std::string(problem.empty() ? "" : "; ") + "the XDMF file could not be written (removed)";
+  }
+  // Datasets and groups first, the file last (its close is then the real one).
+  for (h5::Handle* h : {&w.time, &w.state, &w.energy, &w.lcp, &w.substeps, &w.verts, &w.eta, &w.events,
+                        &w.floes_group, &w.xdmf_group})
+    h->reset();
+  if (!w.write_failed) h5::trim(w.file);  // the unused reservation
   w.file.reset();
+  return problem;
 }
 
 std::size_t RunWriter::records() const { return impl_->records; }
+bool RunWriter::failed() const { return impl_->disk_full || impl_->write_failed; }
 const std::string& RunWriter::path() const { return impl_->path; }
 std::string RunWriter::xdmf_path() const { return fs::path(impl_->path).replace_extension(".xmf").string(); }
 
-void RunWriter::Impl::write_xdmf() const {
+bool RunWriter::Impl::write_xdmf() const {
   const std::string h5name = fs::path(path).filename().string();
   const std::string xmf = fs::path(path).replace_extension(".xmf").string();
   const std::string tmp = xmf + ".tmp";
   std::ofstream o(tmp);
-  if (!o) return;  // ParaView support is a convenience: never fail a run for it
+  if (!o) return false;  // ParaView support is a convenience: never fail a run for it
   o.precision(15);  // times and grid spacings as written, not to 6 digits
   const std::size_t T = times.size();
   // A hyperslab of an HDF5 dataset in the Xdmf3 library's own notation
@@ -408,7 +533,12 @@ void RunWriter::Impl::write_xdmf() const {
   o << "</Domain>\n</Xdmf>\n";
   o.close();
   std::error_code ec;
+  if (!o) {  // a full disk: keep the previous XDMF rather than a truncated one
+    fs::remove(tmp, ec);
+    return false;
+  }
   fs::rename(tmp, xmf, ec);
+  return !ec;
 }
 
 // ---------------------------------------------------------------- reading

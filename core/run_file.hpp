@@ -82,8 +82,17 @@ struct LcpCounters {
 class RunWriter {
 public:
   // Creates (truncates) the file and writes the static parts. Throws
-  // InputError if the file cannot be created. expected_records (0: unknown)
-  // sizes the chunks of the per-record datasets (more records still fit).
+  // RunError if the file cannot be created or written (it is then removed).
+  // expected_records (0: unknown) sizes the chunks of the per-record datasets
+  // (more records still fit).
+  //
+  // A full disk: every write is preceded by a reservation of the disk space
+  // it may take (h5::reserve), so a disk that fills (or a file-size limit)
+  // is met before HDF5 writes, never in the middle of a flush. record(),
+  // note_floes() and record_fracture() then throw RunError and write nothing;
+  // finish() can still mark the run failed and close the file, which keeps
+  // every record written before. On a file system that cannot preallocate,
+  // the failed write itself is reported (the file may then be damaged).
   RunWriter(const std::string& path, const Floes& floes, const std::string& config_toml,
             std::vector<std::string> energy_columns, const SeaGridInfo& sea = {},
             std::size_t expected_records = 0);
@@ -120,14 +129,20 @@ public:
   // Throws RunError if the file cannot be written.
   void write_checkpoint(const Checkpoint& c);
 
-  // Marks the run complete, or failed with a reason, and writes the XDMF.
-  void finish(const std::string& status);
+  // Marks the run complete, or failed with a reason, writes the XDMF and
+  // closes the file. Never throws: returns "" or what could not be written
+  // (after a full disk: the status, or the XDMF, which is then removed rather
+  // than left describing other records than the file holds).
+  std::string finish(const std::string& status);
 
+  // True once a write was refused or failed: the file holds records() records.
+  bool failed() const;
   std::size_t records() const;
   const std::string& path() const;
   std::string xdmf_path() const;
 
 private:
+  void start(const Floes& floes, const std::string& config_toml, unsigned long long rows);
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };

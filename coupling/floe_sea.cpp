@@ -109,8 +109,8 @@ FloeSeaContact::FloeSeaContact(const CouplingParams& params, const SeaParams& se
   }
   const fluid::SurfaceGrid& grid = sea.grid();
   const bool periodic = grid.edge == fluid::GridEdge::periodic;
-  if (params.footprint == FootprintChoice::tent && !periodic)
-    throw RunError("[coupling] footprint = \"tent\" needs a periodic sea (a spectral sea); this sea has walls: use \"cell\" or \"automatic\"");
+  // Precondition: no tent on a walled sea (refused at load, core/config.cpp).
+  FLOESIM_ASSERT(params.footprint != FootprintChoice::tent || periodic);
   kernel_ = params.footprint == FootprintChoice::cell || !periodic ? FootprintKernel::cell : FootprintKernel::tent;
   cell_area_ = grid.dx() * (grid.dims == 2 ? grid.dy() : grid.ly);
   // The sea under the floes, as fast as it can answer: one cell, or the

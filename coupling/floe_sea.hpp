@@ -125,7 +125,8 @@ public:
   // Resolves the law (blend from a requested restitution through the
   // calibration table: with the implicit integrator, of the obstacle problem
   // stepped at dt_max on the floes' median draft), measures the sea's local
-  // inverse mass, and prepares the floes' vertical inertia.
+  // inverse mass, and prepares the floes' vertical inertia. Precondition:
+  // footprint "tent" only on a periodic sea (checked at load, core/config.cpp).
   FloeSeaContact(const CouplingParams& params, const SeaParams& sea_params, const Floes& floes, fluid::Sea& sea,
                  double dt_max);
 

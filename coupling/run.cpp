@@ -107,21 +107,36 @@ RunSummary run_simulation(Simulation& sim, const RunOptions& options) {
       }
     }
     if (checkpoint_steps != sim.steps()) checkpoint();
-  } catch (const RunError& e) {
+  } catch (const std::exception& e) {
+    // Any failure marks the file failed with its reason (a RunError is the
+    // expected kind; anything else is a bug, still recorded), with a
+    // checkpoint at the last record unless writing is what failed. The
+    // writer's own failures say what the file keeps; say it for the others.
+    const bool writing = writer->failed();
+    const std::size_t kept = writer->records();
     std::string reason = std::string("failed: ") + e.what();
-    if (have_good) {
+    bool checkpointed = false;
+    if (have_good && !writing) {
       try {
         writer->write_checkpoint(good);
         summary.checkpoint_time = good.time;
-      } catch (const RunError& c) {
+        checkpointed = true;
+      } catch (const std::exception& c) {
         reason += std::string(" (and ") + c.what() + ")";
       }
     }
-    writer->finish(reason);
-    throw;
+    const std::string problem = writer->finish(reason);
+    std::string message = e.what();
+    if (!writing)
+      message += "; the run file " + options.output + " keeps the " + std::to_string(kept) + " records written before";
+    if (checkpointed) message += ", and a checkpoint at the last record (floesim run --restart)";
+    if (!problem.empty()) message += "; " + problem;
+    if (dynamic_cast<const RunError*>(&e) == nullptr) throw;
+    throw RunError(message);
   }
-  writer->finish(summary.status == "complete" ? "complete"
-                                              : "interrupted at t = " + std::to_string(sim.time()) + " s");
+  const std::string problem = writer->finish(
+      summary.status == "complete" ? "complete" : "interrupted at t = " + std::to_string(sim.time()) + " s");
+  if (!problem.empty()) throw RunError(writer->path() + ": the run ended but " + problem);
   summary.steps = sim.steps();
   summary.records = writer->records();
   summary.t_end = sim.time();

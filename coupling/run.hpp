@@ -47,8 +47,10 @@ struct RunSummary {
   contact::CollisionStats collisions;
 };
 
-// Throws RunError when the numerics fail; the run file then says
-// status = "failed: <reason>" and keeps every record written before.
+// Throws RunError when the numerics fail or the run file cannot be written
+// (a full disk); the run file then says status = "failed: <reason>" and keeps
+// every record written before. Any other exception is recorded so too, then
+// passed on.
 RunSummary run_simulation(Simulation& sim, const RunOptions& options);
 
 }  // namespace floesim

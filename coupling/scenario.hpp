@@ -26,4 +26,9 @@ struct Scenario {
 // forcing series. Throws InputError for any bad input.
 Scenario build_scenario(const Config& config);
 
+// InputError unless every floe that moves is on the sea: whole inside a walled
+// sea (bem, or the tank's zones), its centroid inside a periodic sea's box and
+// narrower than that box (along x only when dims = 1). build_scenario calls it.
+void check_floes_on_sea(const Scenario& scenario);
+
 }  // namespace floesim

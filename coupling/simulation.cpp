@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <limits>
 #include <sstream>
 #include <thread>
 
@@ -42,6 +43,28 @@ contact::Domain make_domain(const Scenario& s) {
                            "a periodic domain needs a box = [xmin, xmax, ymin, ymax] (or a pack with a window)"));
   d.periodic = true;
   d.xmin = box[0]; d.xmax = box[1]; d.ymin = box[2]; d.ymax = box[3];
+  // Every floe starts in the box, and is narrower than it (a floe as wide as
+  // the period would touch its own image across the seam).
+  const Floes& f = s.floes;
+  for (std::size_t i = 0; i < f.size(); ++i) {
+    Vec2 lo = Vec2::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+    for (const Vec2& b : f.vertices(i)) {
+      lo = lo.cwiseMin(f.to_world(i, b));
+      hi = hi.cwiseMax(f.to_world(i, b));
+    }
+    std::ostringstream m;
+    const double x = f.state[i].x, y = f.state[i].y;
+    if (!(x >= d.xmin && x <= d.xmax && y >= d.ymin && y <= d.ymax))
+      m << "floe " << i << ": centroid (" << x << ", " << y << ") m is outside the periodic box [" << d.xmin << ", "
+        << d.xmax << "] x [" << d.ymin << ", " << d.ymax << "] m";
+    else if (!f.is_static[i] && (hi.x() - lo.x() >= d.width() || hi.y() - lo.y() >= d.height()))
+      m << "floe " << i << ": " << hi.x() - lo.x() << " m x " << hi.y() - lo.y()
+        << " m, not smaller than the periodic box of " << d.width() << " m x " << d.height()
+        << " m (it would touch its own image across the seam)";
+    else
+      continue;
+    throw InputError(where(s.config.file, 0, "[contact] box", m.str() + " (floes are numbered from 0: pack floes first, then inline ones)"));
+  }
   return d;
 }
 }  // namespace
@@ -71,7 +94,11 @@ Simulation::Simulation(Scenario scenario) : scenario_(std::move(scenario)) {
   fluid::SeaOptions sea_options;
   sea_options.tank = {c.sea.tank.enabled, c.sea.tank.generation_length, c.sea.tank.absorption_length,
                       c.sea.tank.rate, c.sea.tank.ramp_periods};
-  sea_ = fluid::make_sea(c.sea, c.run.seed, sea_options);
+  try {
+    sea_ = fluid::make_sea(c.sea, c.run.seed, sea_options);  // its input errors name the [sea] key; add the file
+  } catch (const InputError& e) {
+    throw InputError(c.file.empty() ? std::string(e.what()) : c.file + ": " + e.what());
+  }
   const Floes& f = scenario_.floes;
   const bool any_dynamic = std::any_of(f.is_static.begin(), f.is_static.end(), [](std::uint8_t s) { return !s; });
   if (sea_ && any_dynamic) {

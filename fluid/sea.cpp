@@ -89,24 +89,14 @@ std::string str(const T& v) {
   throw InputError("[sea] " + key + ": " + what);
 }
 
-void validate_bottom(const SeaParams& p) {
+// Precondition (checked at load, core/config.cpp): the bottom is below the
+// surface, x increasing, spanning the basin.
+[[maybe_unused]] bool bottom_valid(const SeaParams& p) {
   const auto& b = p.bottom;
-  if (b.size() < 2)
-    bad("bottom", "expected a polyline of at least 2 points [x, z] spanning the basin [0, " +
-                      str(p.size[0]) + "] m, got " + str(b.size()) + " point(s)");
-  for (std::size_t i = 0; i < b.size(); ++i) {
-    if (!std::isfinite(b[i][0]) || !std::isfinite(b[i][1]))
-      bad("bottom", "point " + str(i) + " is not finite");
-    if (i > 0 && !(b[i][0] > b[i - 1][0]))
-      bad("bottom", "x must increase along the polyline (point " + str(i) + " at x = " +
-                        str(b[i][0]) + " m)");
-    if (!(b[i][1] < 0.0))
-      bad("bottom", "point " + str(i) + " (x = " + str(b[i][0]) + " m, z = " + str(b[i][1]) +
-                        " m) is not below the surface z = 0");
-  }
-  if (b.front()[0] > 0.0 || b.back()[0] < p.size[0])
-    bad("bottom", "the polyline covers x in [" + str(b.front()[0]) + ", " + str(b.back()[0]) +
-                      "] m but must span the basin [0, " + str(p.size[0]) + "] m");
+  if (b.size() < 2 || b.front()[0] > 0.0 || b.back()[0] < p.size[0]) return false;
+  for (std::size_t i = 0; i < b.size(); ++i)
+    if (!(std::isfinite(b[i][0]) && b[i][1] < 0.0) || (i > 0 && !(b[i][0] > b[i - 1][0]))) return false;
+  return true;
 }
 
 }  // namespace
@@ -136,14 +126,9 @@ void validate(const SeaParams& p) {
     bad("sigma", "expected a surface tension >= 0 N/m, got " + str(p.sigma));
   if (p.g == 0.0 && p.sigma == 0.0)
     bad("g", "with g = 0 and sigma = 0 the surface has no restoring force");
-  if (p.model == SeaModel::spectral && !p.bottom.empty())
-    bad("bottom", "only model = \"bem\" takes a bottom polyline; the spectral sea has a flat "
-                  "bottom at [sea] depth");
-  if (p.model == SeaModel::bem) {
-    if (p.bottom.empty() && !std::isfinite(p.depth))
-      bad("depth", "model = \"bem\" needs a finite depth or a [sea] bottom polyline");
-    if (!p.bottom.empty()) validate_bottom(p);
-  }
+  FLOESIM_ASSERT(p.bottom.empty() || (p.model == SeaModel::bem && bottom_valid(p)));
+  if (p.model == SeaModel::bem && p.bottom.empty() && !std::isfinite(p.depth))
+    bad("depth", "model = \"bem\" needs a finite depth or a [sea] bottom polyline");
 }
 
 std::unique_ptr<Sea> make_sea(const SeaParams& params, unsigned long seed,
@@ -157,9 +142,7 @@ std::unique_ptr<Sea> make_sea(const SeaParams& params, unsigned long seed,
       sea = std::make_unique<SpectralSea>(params, options);
       break;
     case SeaModel::bem:
-      if (options.tank.enabled)
-        throw InputError("[sea] model: relaxation zones are for the spectral sea; a bem basin "
-                         "has walls");
+      FLOESIM_ASSERT(!options.tank.enabled);  // refused at load (core/config.cpp)
       sea = std::make_unique<BemSea>(params, options);
       break;
   }

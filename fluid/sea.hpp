@@ -145,11 +145,16 @@ private:
 };
 
 // Checks a [sea] section; throws InputError naming the key ("[sea] cells: ...").
+// Preconditions, checked once at load with the file and line (core/config.cpp)
+// and only asserted here: a bottom polyline only with model = "bem", below the
+// surface, x increasing, spanning [0, size x].
 void validate(const SeaParams& params);
 
 // The sea of a configuration, with its initial waves ([sea.waves]; `seed` draws
 // the random phases of an irregular sea). Returns nullptr for model = "none".
 // A tank run (options.tank.enabled) starts calm and generates its target wave.
+// Preconditions (checked at load, core/config.cpp; asserted here): tank zones
+// only on the spectral sea, with a regular [sea.waves] wave.
 std::unique_ptr<Sea> make_sea(const SeaParams& params, unsigned long seed,
                               const SeaOptions& options = {});
 

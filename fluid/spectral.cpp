@@ -194,8 +194,7 @@ SpectralSea::SpectralSea(const SeaParams& params, const SeaOptions& options)
   bank_ = ModalBank(std::move(omega), std::move(mass), std::move(gain), 2);
 
   if (options.tank.enabled) {
-    if (params.waves.kind != WaveKind::regular)
-      throw InputError("[sea.waves] kind: a tank run generates a regular wave; got another kind");
+    FLOESIM_ASSERT(params.waves.kind == WaveKind::regular);  // refused at load (core/config.cpp)
     m.tank.emplace(grid_, options.tank, plane_wave(params, grid_));
     m.tank_eta.assign(m.n, 0.0);
     m.tank_rate.assign(m.n, 0.0);

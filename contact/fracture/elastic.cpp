@@ -24,7 +24,7 @@ Principal principal(const Eigen::Vector3d& s) {
 ElasticModel::ElasticModel(Mesh mesh, const Material& material) : mesh_(std::move(mesh)), material_(material) {
   const double e = material.young, nu = material.poisson, h = material.thickness;
   if (!(e > 0.0) || !(nu > -1.0 && nu < 0.5) || !(h > 0.0) || !(material.density > 0.0))
-    throw InputError("fracture: young > 0, -1 < poisson < 0.5, thickness > 0 and density > 0 are required");
+    throw RunError("fracture: young > 0, -1 < poisson < 0.5, thickness > 0 and density > 0 are required");
   const double c = e / (1.0 - nu * nu);
   d_ << c, c * nu, 0.0, c * nu, c, 0.0, 0.0, 0.0, c * (1.0 - nu) / 2.0;
   d_factor_ = d_.llt().matrixL();

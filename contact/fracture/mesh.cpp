@@ -35,13 +35,13 @@ double Mesh::area(std::size_t t) const {
 
 Mesh mesh_polygon(std::span<const Vec2> polygon, const MeshOptions& options) {
   if (polygon.size() < 3)
-    throw InputError("fracture mesh: a polygon needs at least 3 vertices, got " + std::to_string(polygon.size()));
+    throw RunError("fracture mesh: a polygon needs at least 3 vertices, got " + std::to_string(polygon.size()));
   for (const Vec2& p : polygon)
-    if (!p.allFinite()) throw InputError("fracture mesh: non-finite vertex coordinate");
+    if (!p.allFinite()) throw RunError("fracture mesh: non-finite vertex coordinate");
   if (!(options.size > 0.0) || !std::isfinite(options.size))
-    throw InputError("fracture mesh: the mesh size must be a finite number > 0 (m)");
+    throw RunError("fracture mesh: the mesh size must be a finite number > 0 (m)");
   const double area = signed_area(polygon);
-  if (!(area > 0.0)) throw InputError("fracture mesh: the polygon must be counter-clockwise with a positive area");
+  if (!(area > 0.0)) throw RunError("fracture mesh: the polygon must be counter-clockwise with a positive area");
 
   // Refinement to edges <= s gives about one triangle per 0.2 s^2 (measured
   // on squares and discs: 0.18 to 0.22 s^2); keep the count bounded.

@@ -38,7 +38,9 @@ struct Mesh {
 };
 
 // Meshes a simple counter-clockwise polygon (as make_floe_shape produces).
-// Throws InputError for fewer than 3 vertices, non-finite input, size <= 0.
+// Throws RunError for fewer than 3 vertices, non-finite input, size <= 0: the
+// floes and [fracture] mesh_size were checked at load, so this is met only by
+// a polygon made during a run.
 Mesh mesh_polygon(std::span<const Vec2> polygon, const MeshOptions& options);
 
 }  // namespace floesim::fracture

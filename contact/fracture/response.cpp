@@ -47,7 +47,7 @@ void observe_state(const ElasticModel& model, double t, const Eigen::VectorXd& u
 
 Responder::Responder(const ElasticModel& model, const ResponseOptions& options) : model_(model), options_(options) {
   if (!(options.duration > 0.0) || !(options.load_radius > 0.0) || !(options.damping >= 0.0) || options.steps_per_pulse < 1 || options.max_steps < 1)
-    throw InputError("fracture: duration > 0, load radius > 0 and positive step counts are required");
+    throw RunError("fracture: duration > 0, load radius > 0 and positive step counts are required");
   const double c = model.wave_speed();
   const double d = std::max(model.diameter(), model.mesh().size);
   const double tau = options.duration;

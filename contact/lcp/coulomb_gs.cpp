@@ -91,10 +91,10 @@ Result solve_coulomb_gs(const Lcp& lcp, const FrictionLayout& layout, const Vect
   const std::size_t m = layout.contacts;
   const Index mi = static_cast<Index>(m);
   if (m == 0 || lcp.size() != 4 * mi)
-    throw InputError("contact-wise Gauss–Seidel: the LCP has " + std::to_string(lcp.size()) +
+    throw RunError("contact-wise Gauss–Seidel: the LCP has " + std::to_string(lcp.size()) +
                      " unknowns, not 4 per contact for " + std::to_string(m) + " contacts");
   if (start.size() != 0 && start.size() != lcp.size())
-    throw InputError("contact-wise Gauss–Seidel: the start point must have n entries");
+    throw RunError("contact-wise Gauss–Seidel: the start point must have n entries");
   const ContactForm f = contact_form(lcp, m);
   const double mu = layout.friction;
 

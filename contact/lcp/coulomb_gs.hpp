@@ -51,7 +51,7 @@ struct CoulombGsOptions {
 };
 
 // `start` (n entries, or empty for z = 0): a point to start from. Throws
-// InputError if the LCP does not have the layout's size 4m.
+// RunError if the LCP does not have the layout's size 4m.
 Result solve_coulomb_gs(const Lcp& lcp, const FrictionLayout& layout, const Vector& start,
                         const CoulombGsOptions& options = {});
 

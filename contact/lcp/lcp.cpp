@@ -30,11 +30,11 @@ void check_lcp(const Lcp& lcp) {
   const Index n = lcp.size();
   const auto [rows, cols] = std::visit(
       [](const auto& M) { return std::pair<Index, Index>{M.rows(), M.cols()}; }, lcp.M);
-  if (n < 1) throw InputError("LCP: q is empty (n must be at least 1)");
+  if (n < 1) throw RunError("LCP: q is empty (n must be at least 1)");
   if (rows != n || cols != n)
-    throw InputError("LCP: M is " + std::to_string(rows) + " x " + std::to_string(cols) +
+    throw RunError("LCP: M is " + std::to_string(rows) + " x " + std::to_string(cols) +
                      " but q has " + std::to_string(n) + " entries");
-  if (!lcp.q.allFinite()) throw InputError("LCP: q has a non-finite entry");
+  if (!lcp.q.allFinite()) throw RunError("LCP: q has a non-finite entry");
   const bool finite = std::visit(
       [](const auto& M) {
         if constexpr (std::is_same_v<std::decay_t<decltype(M)>, SparseMatrix>)
@@ -43,7 +43,7 @@ void check_lcp(const Lcp& lcp) {
           return M.allFinite();
       },
       lcp.M);
-  if (!finite) throw InputError("LCP: M has a non-finite entry");
+  if (!finite) throw RunError("LCP: M has a non-finite entry");
 }
 
 std::string_view to_string(Status status) {

@@ -42,7 +42,10 @@ SparseMatrix sparse_copy(const Lcp& lcp);
 Index nonzeros(const Lcp& lcp);
 
 // Checks that M is n x n with n = q.size() >= 1 and every entry finite; throws
-// floesim::InputError naming what is wrong. Every solver calls it first.
+// floesim::RunError naming what is wrong. Every solver calls it first. An LCP
+// read from a file was validated when it was read (siconos_io.hpp: InputError);
+// one that fails here was built during a run (a NaN velocity reaching the
+// collide phase), which is a run error: the run stops and its file says so.
 void check_lcp(const Lcp& lcp);
 
 enum class Status {

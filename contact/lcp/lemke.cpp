@@ -306,9 +306,9 @@ Result solve_lemke(const Lcp& lcp, const LemkeOptions& options, LemkeStats* stat
   if (options.covering.size() != 0 &&
       (options.covering.size() != lcp.size() || !(options.covering.array() > 0.0).all() ||
        !options.covering.allFinite()))
-    throw InputError("Lemke: the covering vector must have n positive finite entries");
+    throw RunError("Lemke: the covering vector must have n positive finite entries");
   if (options.start && options.start->size() != static_cast<std::size_t>(lcp.size()))
-    throw InputError("Lemke: the start basis must have n entries");
+    throw RunError("Lemke: the start basis must have n entries");
   LemkeStats local;
   Lemke lemke(lcp, options, stats ? *stats : local);
   if (stats) *stats = {};

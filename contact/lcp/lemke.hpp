@@ -14,7 +14,7 @@
 //                         otherwise Lemke simply could not reach a solution;
 //   * Status::pivot_limit more than options.max_pivots pivots;
 //   * Status::failed      a basis became numerically singular.
-// It never throws on numerical trouble; it throws floesim::InputError when the
+// It never throws on numerical trouble; it throws floesim::RunError when the
 // LCP itself is malformed (check_lcp). Deterministic: same input, same pivots.
 //
 // Mathematics. With a covering vector d > 0 and the artificial variable z0,

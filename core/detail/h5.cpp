@@ -1,6 +1,12 @@
 #include "core/detail/h5.hpp"
 
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
 #include <algorithm>
+#include <cerrno>
+#include <cstring>
 #include <limits>
 #include <mutex>
 
@@ -10,6 +16,8 @@ namespace floesim::h5 {
 
 namespace {
 [[noreturn]] void fail(const std::string& msg) { throw InputError(msg); }
+// A file that cannot be created or written: not the input's fault (exit 1).
+[[noreturn]] void fail_write(const std::string& msg) { throw RunError(msg); }
 }  // namespace
 
 void silence_errors() {
@@ -36,10 +44,48 @@ Handle create_file(const std::string& path) {
   // others (scripts, `floesim info`) while the run goes on; every record is
   // flushed, so readers see whole records.
   Handle fapl{H5Pcreate(H5P_FILE_ACCESS), H5Pclose};
+  H5Pset_fapl_sec2(fapl);  // reserve() needs the file descriptor
   H5Pset_file_locking(fapl, false, true);
+  errno = 0;
   hid_t f = H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, fapl);
-  if (f < 0) fail(path + ": cannot create the file (does its folder exist and is it writable?)");
+  if (f < 0) {
+    const int err = errno;
+    const bool folder = err == ENOENT || err == EACCES || err == EROFS || err == ENOTDIR || err == 0;
+    fail_write(path + ": cannot create the file (" + (err ? std::strerror(err) : "unknown reason") +
+               (folder ? "; does its folder exist and is it writable?)" : ")"));
+  }
   return {f, H5Fclose};
+}
+
+bool flush(hid_t file) { return H5Fflush(file, H5F_SCOPE_GLOBAL) >= 0; }
+
+namespace {
+// The POSIX file descriptor under an HDF5 file on the sec2 driver, or -1.
+int descriptor(hid_t file) {
+  Handle fapl{H5Fget_access_plist(file), H5Pclose};
+  if (!fapl.valid() || H5Pget_driver(fapl) != H5FD_SEC2) return -1;
+  void* handle = nullptr;
+  if (H5Fget_vfd_handle(file, fapl, &handle) < 0 || !handle) return -1;
+  return *static_cast<int*>(handle);
+}
+}  // namespace
+
+int reserve(hid_t file, hsize_t bytes) {
+  const int fd = descriptor(file);
+  haddr_t eoa = 0;
+  if (fd < 0 || H5Fget_eoa(file, &eoa) < 0) return 0;
+  struct stat st {};
+  if (fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) return 0;
+  const int err = posix_fallocate(fd, static_cast<off_t>(eoa), static_cast<off_t>(bytes));
+  return err == EOPNOTSUPP || err == ENODEV || err == ESPIPE ? 0 : err;
+}
+
+void trim(hid_t file) {
+  const int fd = descriptor(file);
+  haddr_t eoa = 0;
+  struct stat st {};
+  if (fd < 0 || H5Fget_eoa(file, &eoa) < 0 || fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) return;
+  if (static_cast<haddr_t>(st.st_size) > eoa && ftruncate(fd, static_cast<off_t>(eoa)) != 0) return;
 }
 
 bool exists(hid_t loc, const std::string& path) {
@@ -71,7 +117,7 @@ Handle open_group(hid_t loc, const std::string& path, const std::string& file) {
 
 Handle create_group(hid_t loc, const std::string& path) {
   hid_t g = H5Gcreate2(loc, path.c_str(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
-  if (g < 0) fail("cannot create HDF5 group '" + path + "'");
+  if (g < 0) fail_write("cannot create HDF5 group '" + path + "'");
   return {g, H5Gclose};
 }
 
@@ -180,11 +226,11 @@ void write_raw(hid_t loc, const std::string& name, const std::vector<hsize_t>& d
   Handle space{H5Screate_simple(static_cast<int>(d.size()), d.data(), nullptr), H5Sclose};
   Handle set{H5Dcreate2(loc, name.c_str(), file_type, space, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT),
              H5Dclose};
-  if (!set.valid()) fail("cannot create dataset '" + name + "'");
+  if (!set.valid()) fail_write("cannot create dataset '" + name + "'");
   bool empty = false;
   for (hsize_t x : d) empty = empty || x == 0;
   if (!empty && H5Dwrite(set, mem_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data) < 0)
-    fail("cannot write dataset '" + name + "'");
+    fail_write("cannot write dataset '" + name + "'");
 }
 }  // namespace
 
@@ -219,7 +265,7 @@ Handle create_extendible(hid_t loc, const std::string& name, const std::vector<h
   Handle props{H5Pcreate(H5P_DATASET_CREATE), H5Pclose};
   H5Pset_chunk(props, static_cast<int>(chunk.size()), chunk.data());
   hid_t set = H5Dcreate2(loc, name.c_str(), H5T_IEEE_F64LE, space, H5P_DEFAULT, props, H5P_DEFAULT);
-  if (set < 0) fail("cannot create dataset '" + name + "'");
+  if (set < 0) fail_write("cannot create dataset '" + name + "'");
   return {set, H5Dclose};
 }
 
@@ -227,7 +273,7 @@ void append_row(hid_t dataset, const double* row) {
   std::vector<hsize_t> d = dims(dataset);
   const hsize_t t = d[0];
   d[0] = t + 1;
-  if (H5Dset_extent(dataset, d.data()) < 0) fail("cannot extend a run-file dataset");
+  if (H5Dset_extent(dataset, d.data()) < 0) fail_write("cannot extend a run-file dataset");
   Handle space{H5Dget_space(dataset), H5Sclose};
   std::vector<hsize_t> start(d.size(), 0), cnt = d;
   start[0] = t;
@@ -235,7 +281,7 @@ void append_row(hid_t dataset, const double* row) {
   H5Sselect_hyperslab(space, H5S_SELECT_SET, start.data(), nullptr, cnt.data(), nullptr);
   Handle mem{H5Screate_simple(static_cast<int>(cnt.size()), cnt.data(), nullptr), H5Sclose};
   if (H5Dwrite(dataset, H5T_NATIVE_DOUBLE, mem, space, H5P_DEFAULT, row) < 0)
-    fail("cannot append to a run-file dataset");
+    fail_write("cannot append to a run-file dataset");
 }
 
 Handle create_growable(hid_t loc, const std::string& name, const std::vector<hsize_t>& row,
@@ -256,17 +302,31 @@ Handle create_growable(hid_t loc, const std::string& name, const std::vector<hsi
   const double nan = std::numeric_limits<double>::quiet_NaN();
   H5Pset_fill_value(props, H5T_NATIVE_DOUBLE, &nan);
   hid_t set = H5Dcreate2(loc, name.c_str(), H5T_IEEE_F64LE, space, H5P_DEFAULT, props, H5P_DEFAULT);
-  if (set < 0) fail("cannot create dataset '" + name + "'");
+  if (set < 0) fail_write("cannot create dataset '" + name + "'");
   return {set, H5Dclose};
 }
 
 void set_extent(hid_t dataset, const std::vector<hsize_t>& d) {
-  if (H5Dset_extent(dataset, d.data()) < 0) fail("cannot resize a run-file dataset");
+  if (H5Dset_extent(dataset, d.data()) < 0) fail_write("cannot resize a run-file dataset");
+}
+
+hsize_t append_bytes(hid_t dataset) {
+  const std::vector<hsize_t> d = dims(dataset);
+  Handle plist{H5Dget_create_plist(dataset), H5Pclose};
+  std::vector<hsize_t> chunk(d.size(), 1);
+  if (d.empty() || !plist.valid() || H5Pget_chunk(plist, static_cast<int>(chunk.size()), chunk.data()) < 0)
+    return 0;
+  hsize_t bytes = 8 * std::max<hsize_t>(chunk[0], 1);
+  for (std::size_t i = 1; i < d.size(); ++i) {
+    const hsize_t c = std::max<hsize_t>(chunk[i], 1);
+    bytes *= (std::max<hsize_t>(d[i], 1) + c - 1) / c * c;
+  }
+  return bytes;
 }
 
 void remove(hid_t loc, const std::string& name) {
   if (H5Lexists(loc, name.c_str(), H5P_DEFAULT) > 0 && H5Ldelete(loc, name.c_str(), H5P_DEFAULT) < 0)
-    fail("cannot replace dataset '" + name + "'");
+    fail_write("cannot replace dataset '" + name + "'");
 }
 
 namespace {
@@ -287,7 +347,7 @@ void set_attr(hid_t obj, const std::string& name, const std::string& value) {
   Handle space{H5Screate(H5S_SCALAR), H5Sclose};
   Handle a{H5Acreate2(obj, name.c_str(), type, space, H5P_DEFAULT, H5P_DEFAULT), H5Aclose};
   const char* p = value.c_str();
-  if (!a.valid() || H5Awrite(a, type, &p) < 0) fail("cannot write attribute '" + name + "'");
+  if (!a.valid() || H5Awrite(a, type, &p) < 0) fail_write("cannot write attribute '" + name + "'");
 }
 
 void set_attr(hid_t obj, const std::string& name, const std::vector<std::string>& values) {
@@ -298,7 +358,7 @@ void set_attr(hid_t obj, const std::string& name, const std::vector<std::string>
   Handle a{H5Acreate2(obj, name.c_str(), type, space, H5P_DEFAULT, H5P_DEFAULT), H5Aclose};
   std::vector<const char*> p;
   for (const auto& s : values) p.push_back(s.c_str());
-  if (!a.valid() || H5Awrite(a, type, p.data()) < 0) fail("cannot write attribute '" + name + "'");
+  if (!a.valid() || H5Awrite(a, type, p.data()) < 0) fail_write("cannot write attribute '" + name + "'");
 }
 
 namespace {
@@ -307,7 +367,7 @@ void set_scalar(hid_t obj, const std::string& name, hid_t file_type, hid_t mem_t
   replace_attr(obj, name);
   Handle space{H5Screate(H5S_SCALAR), H5Sclose};
   Handle a{H5Acreate2(obj, name.c_str(), file_type, space, H5P_DEFAULT, H5P_DEFAULT), H5Aclose};
-  if (!a.valid() || H5Awrite(a, mem_type, &value) < 0) fail("cannot write attribute '" + name + "'");
+  if (!a.valid() || H5Awrite(a, mem_type, &value) < 0) fail_write("cannot write attribute '" + name + "'");
 }
 }  // namespace
 

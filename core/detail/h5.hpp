@@ -1,7 +1,8 @@
 #pragma once
-// Private to core: a thin RAII layer over the HDF5 C API. Every failure becomes
-// an InputError naming the file and the object (HDF5's own error stack printing
-// is switched off so that users see one clear message).
+// Private to core: a thin RAII layer over the HDF5 C API. A failure to read
+// becomes an InputError naming the file and the object; a failure to create or
+// write a file (a folder that is not writable, a full disk) a RunError. HDF5's
+// own error stack printing is switched off so that users see one clear message.
 
 #include <hdf5.h>
 
@@ -37,7 +38,23 @@ void silence_errors();  // once per process: no HDF5 error-stack dumps on stderr
 
 bool is_hdf5(const std::string& path);
 Handle open_file(const std::string& path, bool write = false);
-Handle create_file(const std::string& path);  // truncates
+Handle create_file(const std::string& path);  // truncates; on the sec2 (POSIX) driver
+// Writes every cached object of the file to disk; false when a write failed.
+bool flush(hid_t file);
+// Disk space for the writes to come. HDF5 writes a file in place and keeps its
+// structure consistent only when every write lands: a write that fails for
+// want of space (ENOSPC) or past the file-size limit (EFBIG) in the middle of a
+// flush leaves a file that no longer opens. reserve() allocates `bytes` past the
+// file's end of allocation (posix_fallocate, which extends the file) before
+// they are needed, so that the writes which follow, up to that many bytes, cannot
+// fail for want of space. Returns 0 or the errno of the refusal (ENOSPC,
+// EFBIG, ...); a file system that cannot preallocate (EOPNOTSUPP, a device
+// such as /dev/full) reserves nothing and returns 0: the writes then report
+// their own failure. HDF5 trims the file back to its end of allocation at each
+// flush, so a reservation holds until the next flush.
+int reserve(hid_t file, hsize_t bytes);
+// Cuts the file to its end of allocation (what a reservation added past it).
+void trim(hid_t file);
 bool exists(hid_t loc, const std::string& path);  // a link path like "/floes/state"
 Handle open_dataset(hid_t loc, const std::string& path, const std::string& file);
 Handle open_group(hid_t loc, const std::string& path, const std::string& file);
@@ -82,6 +99,9 @@ void append_row(hid_t dataset, const double* row);
 Handle create_growable(hid_t loc, const std::string& name, const std::vector<hsize_t>& row,
                        hsize_t rows_hint = 0);
 void set_extent(hid_t dataset, const std::vector<hsize_t>& dims);
+// Bytes the file may grow by when one row is appended to a chunked dataset:
+// a new chunk along the first dimension across its whole current extent.
+hsize_t append_bytes(hid_t dataset);
 // Deletes a link (a dataset written whole, before writing it again).
 void remove(hid_t loc, const std::string& name);
 

@@ -423,7 +423,7 @@ def case_run_error():
     write("wind.csv", "t_s,wind_u,wind_v,current_u,current_v\n0,10,0,0,0\n10,10,0,0,0\n10.5,1e200,0,0,0\n")
     cfg = write("fail.toml", PACK.replace("wind = [20.0, 3.0]", 'series = "wind.csv"'))
     p = run("run", "-q", cfg, "-o", "failed.h5", "--until", "20", expect=1)
-    check("a checkpoint at the last one" in p.stderr, f"the failure message mentions the checkpoint\n{p.stderr}")
+    check("a checkpoint at the last record" in p.stderr, f"the failure message mentions the checkpoint\n{p.stderr}")
     with h5py.File(os.path.join(WORK, "failed.h5"), "r") as f:
         check(f.attrs["status"].startswith("failed:"), "status failed")
         check(f["time"][-1] == 10.0, f"the last record at 10 s ({f['time'][-1]})")

@@ -112,9 +112,9 @@ TEST_CASE("lcp contact-wise Gauss–Seidel: solves Stewart–Trinkle LCPs from z
     MESSAGE("sweeps from zero " << r.iterations << ", from Lemke's answer disturbed " << polished.iterations);
     check_complementary(lcp, polished.z, 1e-8);
   }
-  // A wrong layout is an input error, not a wrong answer.
+  // A wrong layout is refused (a RunError: LCPs are built during a run), not answered.
   const Lcp lcp = read_siconos_lcp(lcp_data("contact/friction_m10_s1.dat"));
-  CHECK_THROWS_AS(solve_coulomb_gs(lcp, FrictionLayout{11, 0.5}, Vector()), InputError);
+  CHECK_THROWS_AS(solve_coulomb_gs(lcp, FrictionLayout{11, 0.5}, Vector()), RunError);
 }
 
 TEST_CASE("lcp fallback: a Stewart–Trinkle LCP that Lemke cannot finish is answered by the contact-wise Gauss–Seidel") {

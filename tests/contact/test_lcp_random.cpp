@@ -174,12 +174,12 @@ TEST_CASE("lcp: the pivot limit is reported and a malformed LCP is refused") {
   CHECK(r.status == Status::pivot_limit);
   CHECK(r.pivots == 3);
 
-  CHECK_THROWS_AS(solve_lemke(Lcp{DenseMatrix::Identity(3, 3), Vector::Ones(2)}), InputError);
+  CHECK_THROWS_AS(solve_lemke(Lcp{DenseMatrix::Identity(3, 3), Vector::Ones(2)}), RunError);
   DenseMatrix bad = DenseMatrix::Identity(2, 2);
   bad(0, 1) = std::numeric_limits<double>::quiet_NaN();
-  CHECK_THROWS_AS(solve_lemke(Lcp{bad, Vector::Ones(2)}), InputError);
+  CHECK_THROWS_AS(solve_lemke(Lcp{bad, Vector::Ones(2)}), RunError);
   options.covering = Vector::Zero(30);
-  CHECK_THROWS_AS(solve_lemke(lcp, options), InputError);
+  CHECK_THROWS_AS(solve_lemke(lcp, options), RunError);
 }
 
 TEST_CASE("lcp warm start: Lemke from an earlier basis solves a nearby LCP in few pivots, or says it did not") {
@@ -222,7 +222,7 @@ TEST_CASE("lcp warm start: Lemke from an earlier basis solves a nearby LCP in fe
   CHECK(solve_lemke(Lcp{S, first.q}, warm).status == Status::failed);
   std::vector<std::uint8_t> short_start(3, 0);
   warm.start = &short_start;
-  CHECK_THROWS_AS(solve_lemke(first, warm), InputError);
+  CHECK_THROWS_AS(solve_lemke(first, warm), RunError);
 }
 
 TEST_SUITE_END();

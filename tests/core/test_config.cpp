@@ -101,6 +101,18 @@ TEST_CASE("unknown keys, wrong types and out-of-range values name file, line and
   refused("[coupling]\nblend = 0.5\n", {"[coupling] blend", "blend"});
   refused("[coupling]\nfootprint = \"round\"\n", {"[coupling] footprint", "\"tent\""});
   refused("[sea]\nmodel = \"bem\"\n[coupling]\nfootprint = \"tent\"\n", {"case.toml:4", "[coupling] footprint", "periodic"});
+  // A bem basin's bottom: below the surface, x increasing, spanning [0, Lx].
+  const std::string bem = "[sea]\nmodel = \"bem\"\ndims = 1\nsize = [1.0, 0.1]\ncells = [32, 1]\n";
+  refused(bem + "bottom = [[0.0, -0.1], [0.5, 0.02], [1.0, -0.1]]\n",
+          {"case.toml:6", "[sea] bottom", "below the surface", "point 1 is (0.5, 0.02) m"});
+  refused(bem + "bottom = [[0.2, -0.1], [1.0, -0.1]]\n", {"[sea] bottom", "covers x in [0.2, 1] m", "span the basin [0, 1] m"});
+  refused(bem + "bottom = [[0.0, -0.1], [0.5, -0.1], [0.5, -0.2], [1.0, -0.1]]\n", {"x must increase", "point 2 at x = 0.5 m"});
+  refused(bem + "bottom = [[0.0, -0.1]]\n", {"at least 2 points", "got 1 point(s)"});
+  refused("[sea]\nmodel = \"spectral\"\nbottom = [[0.0, -0.1], [1.0, -0.1]]\n", {"[sea] bottom", "needs model = \"bem\""});
+  CHECK(parse(bem + "bottom = [[0.0, -0.1], [1.2, -0.1]]\n").sea.bottom.size() == 2);
+  // Tank zones: the spectral sea, a regular wave (checked here only: fluid/sea.hpp asserts them).
+  refused(bem + "[sea.tank]\nenabled = true\n", {"[sea.tank] enabled", "need model = \"spectral\""});
+  refused("[sea]\nmodel = \"spectral\"\n[sea.tank]\nenabled = true\n", {"[sea.tank] enabled", "kind = \"regular\""});
   refused("[sea.waves]\nkind = \"regular\"\n", {"[sea.waves] kind", "wavelength or a period"});
   refused("[run\n", {"case.toml:1", "not valid TOML"});
   // At most kMaxRecords records: output_interval = 1e-320 would write records without end.
