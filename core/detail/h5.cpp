@@ -329,7 +329,10 @@ std::vector<std::string> get_attr_strings(hid_t obj, const std::string& name) {
   const hssize_t n = H5Sget_simple_extent_npoints(space);
   std::vector<std::string> out;
   if (H5Tis_variable_str(ftype) > 0) {
+    // In memory with the file's character set: HDF5 converts no string
+    // between ASCII and UTF-8, and C writers (FloeDyn) use ASCII.
     Handle mtype = string_type(0);
+    H5Tset_cset(mtype, H5Tget_cset(ftype));
     std::vector<char*> p(static_cast<std::size_t>(n), nullptr);
     if (H5Aread(a, mtype, p.data()) < 0) fail("cannot read attribute '" + name + "'");
     for (char* s : p) out.emplace_back(s ? s : "");
@@ -354,6 +357,11 @@ std::string get_attr_string(hid_t obj, const std::string& name) {
 double get_attr_double(hid_t obj, const std::string& name) {
   if (!has_attr(obj, name)) fail("attribute '" + name + "' is missing");
   Handle a{H5Aopen(obj, name.c_str(), H5P_DEFAULT), H5Aclose};
+  // H5Aread writes every element: an array attribute would overrun v.
+  Handle space{H5Aget_space(a), H5Sclose};
+  const hssize_t n = H5Sget_simple_extent_npoints(space);
+  if (n != 1)
+    fail("attribute '" + name + "' holds " + std::to_string(n) + " values, expected one number");
   double v = 0.0;
   if (H5Aread(a, H5T_NATIVE_DOUBLE, &v) < 0) fail("attribute '" + name + "' is not a number");
   return v;

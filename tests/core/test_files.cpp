@@ -175,6 +175,22 @@ TEST_CASE("pack offsets: sizes bounded before allocation, integers only, checked
   CHECK(ok.floes.size() == 1);
 }
 
+// Inputs that a fuzz target (fuzz/, docs/fuzzing.md) found a problem with.
+TEST_CASE("pack inputs found by fuzzing: refused by name, or read") {
+  const std::string dir = std::string(FLOESIM_SOURCE_DIR) + "/tests/data/fuzz/";
+  // A FloeDyn C_w attribute holding 2000 numbers: read into one double, it
+  // overran the stack (AddressSanitizer: stack-buffer-overflow in H5Aread).
+  CHECK_THROWS_WITH_AS(read_pack(dir + "floedyn/c_w_array.h5"),
+                       doctest::Contains("c_w_array.h5: dataset '/floe_shapes/0': attribute 'C_w' holds 2000 "
+                                         "values, expected one number"),
+                       InputError);
+  // A format attribute stored as a variable-length ASCII string (not UTF-8):
+  // it was refused with "cannot read attribute 'format'".
+  const Pack ascii = read_pack(dir + "pack/format_vlen_ascii.h5");
+  CHECK(ascii.format == "floesim-pack-1");
+  CHECK(ascii.floes.size() == 1);
+}
+
 TEST_CASE("run file: records are readable, compare detects differences") {
   Floes f;
   FloeInput in;
