@@ -43,6 +43,10 @@ inline constexpr double kMaxRecords = 1e7;
 // at output_interval (both > 0 and finite), else what was expected.
 std::string record_count_problem(double t_end, double output_interval);
 
+// The largest configuration file read: 64 MiB (some hundred thousand inline
+// floes); a larger one, or a device that never ends, is refused.
+inline constexpr std::size_t kMaxConfigBytes = std::size_t{64} << 20;
+
 // Reads and checks a configuration file.
 Config load_config(const std::string& path);
 
