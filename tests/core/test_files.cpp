@@ -189,6 +189,14 @@ TEST_CASE("pack inputs found by fuzzing: refused by name, or read") {
   const Pack ascii = read_pack(dir + "pack/format_vlen_ascii.h5");
   CHECK(ascii.format == "floesim-pack-1");
   CHECK(ascii.floes.size() == 1);
+  // A byte-mutated pack whose HDF5 metadata makes the library ask malloc for
+  // 446 GB: HDF5 gets NULL and fails, and the file is refused like any other
+  // broken one (under ASan only with allocator_may_return_null=1, which
+  // scripts/sanitize and scripts/fuzz set).
+  CHECK_THROWS_WITH_AS(read_pack(dir + "pack/hdf5_huge_metadata.h5"),
+                       doctest::Contains("hdf5_huge_metadata.h5: dataset '/floes/vertices' is missing"), InputError);
+  CHECK_THROWS_WITH_AS(read_pack(dir + "floedyn/hdf5_huge_metadata.h5"),
+                       doctest::Contains("hdf5_huge_metadata.h5: not a floe pack"), InputError);
 }
 
 TEST_CASE("run file: records are readable, compare detects differences") {
