@@ -189,6 +189,7 @@ Pack read_ours(hid_t file, const std::string& path, const PackDefaults& def) {
 
 Pack read_pack(const std::string& path, const PackDefaults& defaults) {
   h5::Handle file = h5::open_file(path);
+  h5::check_global_heaps(path);  // before any variable-length string is read
   if (h5::has_attr(file, "format")) {
     const std::string fmt = h5::get_attr_string(file, "format");
     if (fmt == kPackFormat) return read_ours(file, path, defaults);

@@ -38,6 +38,12 @@ void silence_errors();  // once per process: no HDF5 error-stack dumps on stderr
 bool is_hdf5(const std::string& path);
 Handle open_file(const std::string& path, bool write = false);
 Handle create_file(const std::string& path);  // truncates
+// Refuses (InputError) a file holding a global heap collection (where HDF5
+// keeps variable-length strings, such as our "format" attributes) that
+// HDF5 1.10 would parse without end: an object of index 0 and size 0 makes
+// its reader loop forever (a byte-flipped pack, tests/data/fuzz/pack). Reads
+// the whole file once; for the files a user hands us (packs).
+void check_global_heaps(const std::string& path);
 bool exists(hid_t loc, const std::string& path);  // a link path like "/floes/state"
 Handle open_dataset(hid_t loc, const std::string& path, const std::string& file);
 Handle open_group(hid_t loc, const std::string& path, const std::string& file);

@@ -197,6 +197,13 @@ TEST_CASE("pack inputs found by fuzzing: refused by name, or read") {
                        doctest::Contains("hdf5_huge_metadata.h5: dataset '/floes/vertices' is missing"), InputError);
   CHECK_THROWS_WITH_AS(read_pack(dir + "floedyn/hdf5_huge_metadata.h5"),
                        doctest::Contains("hdf5_huge_metadata.h5: not a floe pack"), InputError);
+  // A byte-mutated pack whose global heap (where the variable-length 'format'
+  // attribute lives) holds an empty free-space object: HDF5 1.10 looped
+  // forever reading 'format' (fuzz_pack -timeout; `floesim run` hung).
+  CHECK_THROWS_WITH_AS(read_pack(dir + "pack/global_heap_loop.h5"),
+                       doctest::Contains("global_heap_loop.h5: corrupted HDF5 file: the global heap at byte 2048 "
+                                         "holds an empty free-space object"),
+                       InputError);
 }
 
 TEST_CASE("run file: records are readable, compare detects differences") {
