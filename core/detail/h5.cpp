@@ -68,7 +68,13 @@ void check_global_heaps(const std::string& path) {
         fail(path + ": corrupted HDF5 file: the global heap at byte " + std::to_string(at) +
              " holds an empty free-space object at byte " + std::to_string(at + p) +
              ", which HDF5 would read without end");
-      if (obj > size) return;  // past the collection: HDF5 stops there
+      // An object must lie inside its collection: HDF5 copies `obj` bytes
+      // from it without checking (a read past the heap's memory).
+      if (index > 0 && obj > size - p - 16)
+        fail(path + ": corrupted HDF5 file: object " + std::to_string(index) + " of the global heap at byte " +
+             std::to_string(at) + " claims " + std::to_string(obj) + " bytes, more than the " +
+             std::to_string(size - p - 16) + " left in its collection");
+      if (obj > size) return;  // the free space runs past the collection: HDF5 stops there
       p += step;
     }
   };

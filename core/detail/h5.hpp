@@ -40,9 +40,10 @@ Handle open_file(const std::string& path, bool write = false);
 Handle create_file(const std::string& path);  // truncates
 // Refuses (InputError) a file holding a global heap collection (where HDF5
 // keeps variable-length strings, such as our "format" attributes) that
-// HDF5 1.10 would parse without end: an object of index 0 and size 0 makes
-// its reader loop forever (a byte-flipped pack, tests/data/fuzz/pack). Reads
-// the whole file once; for the files a user hands us (packs).
+// HDF5 1.10 would mishandle: an object of index 0 and size 0 makes its reader
+// loop forever, an object larger than its collection makes it copy past the
+// heap's memory (byte-flipped packs, tests/data/fuzz/pack). Reads the whole
+// file once; for the files a user hands us (packs).
 void check_global_heaps(const std::string& path);
 bool exists(hid_t loc, const std::string& path);  // a link path like "/floes/state"
 Handle open_dataset(hid_t loc, const std::string& path, const std::string& file);

@@ -204,6 +204,12 @@ TEST_CASE("pack inputs found by fuzzing: refused by name, or read") {
                        doctest::Contains("global_heap_loop.h5: corrupted HDF5 file: the global heap at byte 2048 "
                                          "holds an empty free-space object"),
                        InputError);
+  // The same heap with an object claiming 369 MB of its 4 kB: HDF5 memcpy'd
+  // past the heap (ASan memcpy-param-overlap in H5HG_read).
+  CHECK_THROWS_WITH_AS(read_pack(dir + "pack/global_heap_overrun.h5"),
+                       doctest::Contains("global_heap_overrun.h5: corrupted HDF5 file: object 1 of the global heap "
+                                         "at byte 2048 claims 369098766 bytes, more than the 4064 left"),
+                       InputError);
 }
 
 TEST_CASE("run file: records are readable, compare detects differences") {
