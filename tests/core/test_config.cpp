@@ -109,7 +109,7 @@ TEST_CASE("unknown keys, wrong types and out-of-range values name file, line and
   refused("[run]\nt_end = 1e9\noutput_interval = 1\n", {"case.toml:3", "[run] output_interval", "1000000002 records"});
 }
 
-TEST_CASE("a configuration that never ends (/dev/zero) is refused at a bound, not read into memory") {
+TEST_CASE("a configuration that never ends (/dev/zero) is refused at a bound and not read into memory") {
   CHECK_THROWS_WITH_AS(load_config("/dev/zero"), doctest::Contains("/dev/zero: larger than 64 MiB"), InputError);
   // The same device as a forcing series (tests/data/fuzz/config/series_dev_zero.toml,
   // found by fuzz/fuzz_config): named by the key.

@@ -176,7 +176,7 @@ TEST_CASE("pack offsets: sizes bounded before allocation, integers only, checked
 }
 
 // Inputs that a fuzz target (fuzz/, docs/fuzzing.md) found a problem with.
-TEST_CASE("pack inputs found by fuzzing: refused by name, or read") {
+TEST_CASE("pack inputs found by fuzzing are refused by name or read") {
   const std::string dir = std::string(FLOESIM_SOURCE_DIR) + "/tests/data/fuzz/";
   // A FloeDyn C_w attribute holding 2000 numbers: read into one double, it
   // overran the stack (AddressSanitizer: stack-buffer-overflow in H5Aread).
