@@ -98,6 +98,10 @@ std::vector<Candidate> broad_phase(const std::vector<Entry>& entries, const std:
     y1 = std::max(y1, e.box.ymax);
   }
   const double h = std::max(size / static_cast<double>(entries.size()), 1e-9);
+  // Boxes that are not finite (a state that overflowed; the step's state
+  // check then fails the run) cannot be gridded: their cell numbers would be
+  // undefined behaviour (UBSan: signed overflow). No pair is found among them.
+  if (!std::isfinite(size) || !std::isfinite(x1 - x0) || !std::isfinite(y1 - y0)) return out;
   auto cell = [&](double v, double v0) { return static_cast<std::int64_t>(std::floor((v - v0) / h)); };
   // A pack's grid has about as many cells as floes: its cells are numbered
   // row by row and the items ordered by a counting sort, O(n). A grid with

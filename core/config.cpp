@@ -504,11 +504,18 @@ Config load_config(const std::string& path) {
     throw InputError(path + ": is a folder; expected a configuration file (.toml)");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(path + ": cannot open the configuration file");
-  std::stringstream ss;
-  ss << in.rdbuf();
+  // Read in pieces up to a bound: a device such as /dev/zero never ends.
+  std::string text;
+  char piece[65536];
+  while (in.read(piece, sizeof piece) || in.gcount() > 0) {
+    text.append(piece, static_cast<std::size_t>(in.gcount()));
+    if (text.size() > kMaxConfigBytes)
+      throw InputError(path + ": larger than " + std::to_string(kMaxConfigBytes >> 20) +
+                       " MiB; expected a configuration file (.toml)");
+  }
   if (in.bad()) throw InputError(path + ": cannot read the configuration file");
   const fs::path dir = fs::absolute(fs::path(path)).parent_path();
-  return parse_config(ss.str(), path, dir.string());
+  return parse_config(text, path, dir.string());
 }
 
 namespace {

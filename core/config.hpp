@@ -51,6 +51,10 @@ inline constexpr double kMaxSteps = 1e9;
 // The same rule for steps: "" if t_end / dt_max (both > 0) is at most kMaxSteps.
 std::string step_count_problem(double t_end, double dt_max);
 
+// The largest configuration file read: 64 MiB (some hundred thousand inline
+// floes); a larger one, or a device that never ends, is refused.
+inline constexpr std::size_t kMaxConfigBytes = std::size_t{64} << 20;
+
 // Reads and checks a configuration file.
 Config load_config(const std::string& path);
 

@@ -54,6 +54,11 @@ ForcingSeries ForcingSeries::from_csv(const std::string& path, SeriesInterpolati
   std::error_code ec;
   if (std::filesystem::is_directory(path, ec))
     throw InputError(path + ": the forcing series is a folder; expected a CSV file (" + std::string(kHeader) + ")");
+  // A device or a pipe is refused: /dev/zero would be read as one endless line,
+  // and the series is read twice (checked at load, then by make_forcing).
+  if (std::filesystem::exists(path, ec) && !std::filesystem::is_regular_file(path, ec))
+    throw InputError(path + ": the forcing series is not a regular file (a device or a pipe?); expected a CSV file (" +
+                     std::string(kHeader) + ")");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(path + ": cannot open the forcing series");
   ForcingSeries s;

@@ -95,10 +95,17 @@ Pack read_floedyn(hid_t file, const std::string& path, const PackDefaults& def) 
     f.density = def.density;
     // Thickness: column 10 if > 0, else the dataset's attribute, else 1 m.
     f.thickness = 1.0;
-    if (h5::has_attr(d, "thickness")) f.thickness = h5::get_attr_double(d, "thickness");
+    auto attr = [&](const char* a) {
+      try {
+        return h5::get_attr_double(d, a);
+      } catch (const InputError& e) {
+        throw InputError(path + ": dataset '" + name + "': " + e.what());
+      }
+    };
+    if (h5::has_attr(d, "thickness")) f.thickness = attr("thickness");
     if (cols == 11 && std::isfinite(s[10]) && s[10] > 0.0) f.thickness = s[10];
-    if (h5::has_attr(d, "C_w")) f.ocean_drag = h5::get_attr_double(d, "C_w");
-    if (h5::has_attr(d, "obstacle")) f.is_static = h5::get_attr_double(d, "obstacle") != 0.0;
+    if (h5::has_attr(d, "C_w")) f.ocean_drag = attr("C_w");
+    if (h5::has_attr(d, "obstacle")) f.is_static = attr("obstacle") != 0.0;
     pack.floes.push_back(std::move(f));
   }
   pack.window = read_window(file, path);
@@ -182,6 +189,7 @@ Pack read_ours(hid_t file, const std::string& path, const PackDefaults& def) {
 
 Pack read_pack(const std::string& path, const PackDefaults& defaults) {
   h5::Handle file = h5::open_file(path);
+  h5::check_global_heaps(path);  // before any variable-length string is read
   if (h5::has_attr(file, "format")) {
     const std::string fmt = h5::get_attr_string(file, "format");
     if (fmt == kPackFormat) return read_ours(file, path, defaults);

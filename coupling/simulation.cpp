@@ -242,6 +242,7 @@ void Simulation::percussion(StepContext& ctx) {
 void Simulation::on_floes_changed() {
   quadrature_ = build_footprint_quadrature(scenario_.floes);
   shapes_ = contact::build_collision_shapes(scenario_.floes);
+  set_reach();  // one reach per floe: detect reads reach[i] for every floe, new pieces included
   detection_ = contact::detect(scenario_.floes, shapes_, detection_options_);
   if (floe_sea_) {
     // A split piece keeps its parent's reference bottom (same thickness);

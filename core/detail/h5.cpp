@@ -6,7 +6,9 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <cstdint>
 #include <cstring>
+#include <fstream>
 #include <limits>
 #include <mutex>
 
@@ -36,6 +38,70 @@ Handle open_file(const std::string& path, bool write) {
   hid_t f = H5Fopen(path.c_str(), write ? H5F_ACC_RDWR : H5F_ACC_RDONLY, H5P_DEFAULT);
   if (f < 0) fail(path + ": cannot open the HDF5 file");
   return {f, H5Fclose};
+}
+
+void check_global_heaps(const std::string& path) {
+  // HDF5 File Format Specification, "Global Heap": "GCOL", version 1, 3
+  // reserved bytes, the collection size (8 bytes, counting this header),
+  // then objects: index (2), reference count (2), reserved (4), size (8) and
+  // the data padded to 8 bytes; index 0 is the free space, whose size counts
+  // its own header. HDF5 steps from one object to the next by that size and
+  // never checks that it moves. Collections are found by their signature;
+  // bytes of a dataset that happen to read "GCOL" are walked too, harmlessly:
+  // only a step of 0 is refused.
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return;  // open_file names the problem
+  auto u16 = [](const unsigned char* b) { return static_cast<unsigned>(b[0] | (b[1] << 8)); };
+  auto u64 = [](const unsigned char* b) {
+    std::uint64_t v = 0;
+    for (int k = 7; k >= 0; --k) v = (v << 8) | b[k];
+    return v;
+  };
+  auto read_at = [&](std::uint64_t at, unsigned char* b, std::size_t n) {
+    in.clear();
+    in.seekg(static_cast<std::streamoff>(at));
+    return static_cast<bool>(in.read(reinterpret_cast<char*>(b), static_cast<std::streamsize>(n)));
+  };
+  auto walk = [&](std::uint64_t at) {
+    unsigned char h[16];
+    if (!read_at(at, h, 16) || h[4] != 1) return;
+    const std::uint64_t size = u64(h + 8);
+    if (size < 16 || size > (std::uint64_t{1} << 40)) return;  // HDF5 refuses these itself
+    for (std::uint64_t p = 16; p + 16 <= size;) {
+      if (!read_at(at + p, h, 16)) return;
+      const unsigned index = u16(h);
+      const std::uint64_t obj = u64(h + 8);
+      const std::uint64_t step = index > 0 ? 16 + ((obj + 7) / 8) * 8 : obj;
+      if (step == 0)
+        fail(path + ": corrupted HDF5 file: the global heap at byte " + std::to_string(at) +
+             " holds an empty free-space object at byte " + std::to_string(at + p) +
+             ", which HDF5 would read without end");
+      // An object must lie inside its collection: HDF5 copies `obj` bytes
+      // from it without checking (a read past the heap's memory).
+      if (index > 0 && obj > size - p - 16)
+        fail(path + ": corrupted HDF5 file: object " + std::to_string(index) + " of the global heap at byte " +
+             std::to_string(at) + " claims " + std::to_string(obj) + " bytes, more than the " +
+             std::to_string(size - p - 16) + " left in its collection");
+      if (obj > size) return;  // the free space runs past the collection: HDF5 stops there
+      p += step;
+    }
+  };
+  std::vector<char> buf(std::size_t{1} << 20);
+  std::vector<std::uint64_t> found;
+  std::uint64_t base = 0;  // file offset of buf[0]
+  std::size_t keep = 0;    // bytes carried over from the previous block
+  while (true) {
+    in.read(buf.data() + keep, static_cast<std::streamsize>(buf.size() - keep));
+    const std::size_t n = keep + static_cast<std::size_t>(in.gcount());
+    if (n < 4) break;
+    for (std::size_t k = 0; k + 4 <= n; ++k)
+      if (buf[k] == 'G' && buf[k + 1] == 'C' && buf[k + 2] == 'O' && buf[k + 3] == 'L') found.push_back(base + k);
+    if (!in) break;
+    std::copy(buf.begin() + static_cast<std::ptrdiff_t>(n - 3), buf.begin() + static_cast<std::ptrdiff_t>(n), buf.begin());
+    base += n - 3;
+    keep = 3;
+  }
+  for (std::uint64_t at : found) walk(at);
 }
 
 Handle create_file(const std::string& path) {
@@ -389,7 +455,10 @@ std::vector<std::string> get_attr_strings(hid_t obj, const std::string& name) {
   const hssize_t n = H5Sget_simple_extent_npoints(space);
   std::vector<std::string> out;
   if (H5Tis_variable_str(ftype) > 0) {
+    // In memory with the file's character set: HDF5 converts no string
+    // between ASCII and UTF-8, and C writers (FloeDyn) use ASCII.
     Handle mtype = string_type(0);
+    H5Tset_cset(mtype, H5Tget_cset(ftype));
     std::vector<char*> p(static_cast<std::size_t>(n), nullptr);
     if (H5Aread(a, mtype, p.data()) < 0) fail("cannot read attribute '" + name + "'");
     for (char* s : p) out.emplace_back(s ? s : "");
@@ -414,6 +483,11 @@ std::string get_attr_string(hid_t obj, const std::string& name) {
 double get_attr_double(hid_t obj, const std::string& name) {
   if (!has_attr(obj, name)) fail("attribute '" + name + "' is missing");
   Handle a{H5Aopen(obj, name.c_str(), H5P_DEFAULT), H5Aclose};
+  // H5Aread writes every element: an array attribute would overrun v.
+  Handle space{H5Aget_space(a), H5Sclose};
+  const hssize_t n = H5Sget_simple_extent_npoints(space);
+  if (n != 1)
+    fail("attribute '" + name + "' holds " + std::to_string(n) + " values, expected one number");
   double v = 0.0;
   if (H5Aread(a, H5T_NATIVE_DOUBLE, &v) < 0) fail("attribute '" + name + "' is not a number");
   return v;

@@ -55,6 +55,13 @@ bool flush(hid_t file);
 int reserve(hid_t file, hsize_t bytes);
 // Cuts the file to its end of allocation (what a reservation added past it).
 void trim(hid_t file);
+// Refuses (InputError) a file holding a global heap collection (where HDF5
+// keeps variable-length strings, such as our "format" attributes) that
+// HDF5 1.10 would mishandle: an object of index 0 and size 0 makes its reader
+// loop forever, an object larger than its collection makes it copy past the
+// heap's memory (byte-flipped packs, tests/data/fuzz/pack). Reads the whole
+// file once; for the files a user hands us (packs).
+void check_global_heaps(const std::string& path);
 bool exists(hid_t loc, const std::string& path);  // a link path like "/floes/state"
 Handle open_dataset(hid_t loc, const std::string& path, const std::string& file);
 Handle open_group(hid_t loc, const std::string& path, const std::string& file);

@@ -121,6 +121,15 @@ TEST_CASE("unknown keys, wrong types and out-of-range values name file, line and
   refused("[run]\nt_end = 1e9\noutput_interval = 1\n", {"case.toml:3", "[run] output_interval", "1000000002 records"});
 }
 
+TEST_CASE("a configuration that never ends (/dev/zero) is refused at a bound and not read into memory") {
+  CHECK_THROWS_WITH_AS(load_config("/dev/zero"), doctest::Contains("/dev/zero: larger than 64 MiB"), InputError);
+  // The same device as a forcing series (tests/data/fuzz/config/series_dev_zero.toml,
+  // found by fuzz/fuzz_config): named by the key.
+  CHECK_THROWS_WITH_AS(parse("[forcing]\nseries = \"/dev/zero\"\n"),
+                       doctest::Contains("key '[forcing] series': /dev/zero: the forcing series is not a regular file"),
+                       InputError);
+}
+
 TEST_CASE("the bound on records: kMaxRecords records up to t_end") {
   CHECK(record_count_problem(1e7 - 2, 1.0).empty());  // t = 0, 1, ..., 1e7 - 2 and t_end: kMaxRecords
   CHECK(!record_count_problem(1e7 - 1, 1.0).empty());

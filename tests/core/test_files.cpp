@@ -175,6 +175,43 @@ TEST_CASE("pack offsets: sizes bounded before allocation, integers only, checked
   CHECK(ok.floes.size() == 1);
 }
 
+// Inputs that a fuzz target (fuzz/, docs/fuzzing.md) found a problem with.
+TEST_CASE("pack inputs found by fuzzing are refused by name or read") {
+  const std::string dir = std::string(FLOESIM_SOURCE_DIR) + "/tests/data/fuzz/";
+  // A FloeDyn C_w attribute holding 2000 numbers: read into one double, it
+  // overran the stack (AddressSanitizer: stack-buffer-overflow in H5Aread).
+  CHECK_THROWS_WITH_AS(read_pack(dir + "floedyn/c_w_array.h5"),
+                       doctest::Contains("c_w_array.h5: dataset '/floe_shapes/0': attribute 'C_w' holds 2000 "
+                                         "values, expected one number"),
+                       InputError);
+  // A format attribute stored as a variable-length ASCII string (not UTF-8):
+  // it was refused with "cannot read attribute 'format'".
+  const Pack ascii = read_pack(dir + "pack/format_vlen_ascii.h5");
+  CHECK(ascii.format == "floesim-pack-1");
+  CHECK(ascii.floes.size() == 1);
+  // A byte-mutated pack whose HDF5 metadata makes the library ask malloc for
+  // 446 GB: HDF5 gets NULL and fails, and the file is refused like any other
+  // broken one (under ASan only with allocator_may_return_null=1, which
+  // scripts/sanitize and scripts/fuzz set).
+  CHECK_THROWS_WITH_AS(read_pack(dir + "pack/hdf5_huge_metadata.h5"),
+                       doctest::Contains("hdf5_huge_metadata.h5: dataset '/floes/vertices' is missing"), InputError);
+  CHECK_THROWS_WITH_AS(read_pack(dir + "floedyn/hdf5_huge_metadata.h5"),
+                       doctest::Contains("hdf5_huge_metadata.h5: not a floe pack"), InputError);
+  // A byte-mutated pack whose global heap (where the variable-length 'format'
+  // attribute lives) holds an empty free-space object: HDF5 1.10 looped
+  // forever reading 'format' (fuzz_pack -timeout; `floesim run` hung).
+  CHECK_THROWS_WITH_AS(read_pack(dir + "pack/global_heap_loop.h5"),
+                       doctest::Contains("global_heap_loop.h5: corrupted HDF5 file: the global heap at byte 2048 "
+                                         "holds an empty free-space object"),
+                       InputError);
+  // The same heap with an object claiming 369 MB of its 4 kB: HDF5 memcpy'd
+  // past the heap (ASan memcpy-param-overlap in H5HG_read).
+  CHECK_THROWS_WITH_AS(read_pack(dir + "pack/global_heap_overrun.h5"),
+                       doctest::Contains("global_heap_overrun.h5: corrupted HDF5 file: object 1 of the global heap "
+                                         "at byte 2048 claims 369098766 bytes, more than the 4064 left"),
+                       InputError);
+}
+
 TEST_CASE("run file: records are readable, compare detects differences") {
   Floes f;
   FloeInput in;

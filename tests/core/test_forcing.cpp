@@ -106,6 +106,10 @@ TEST_CASE("malformed CSV series are refused naming file, line and what was expec
                        doctest::Contains("is a folder; expected a CSV file"), InputError);
   CHECK_THROWS_WITH_AS(ForcingSeries::from_csv((dir / "none.csv").string(), SeriesInterpolation::linear),
                        doctest::Contains("cannot open the forcing series"), InputError);
+  // A device (found by fuzz/fuzz_config, tests/data/fuzz/config/series_dev_zero.toml):
+  // /dev/zero was read as one endless line until memory ran out.
+  CHECK_THROWS_WITH_AS(ForcingSeries::from_csv("/dev/zero", SeriesInterpolation::linear),
+                       doctest::Contains("/dev/zero: the forcing series is not a regular file"), InputError);
 }
 
 TEST_CASE("a series without header and with comments, blank lines and CRLF is read") {
