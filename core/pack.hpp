@@ -40,8 +40,13 @@ struct Pack {
 };
 
 // Reads a pack file of either format. Throws InputError naming the file and the
-// dataset for anything missing, mis-shaped or non-finite.
+// dataset for anything missing, mis-shaped or non-finite, or a file that
+// crashes the HDF5 library: the file is first read in a child process (fork;
+// where that fails, only in this one).
 Pack read_pack(const std::string& path, const PackDefaults& defaults = {});
+// The same read in this process only (a corrupt file may crash it): for the
+// fuzz target, which must see such crashes.
+Pack read_pack_in_process(const std::string& path, const PackDefaults& defaults = {});
 
 // Writes floes (their current state) as a floesim-pack-1 file.
 void write_pack(const std::string& path, const Floes& floes,

@@ -21,7 +21,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   if (!fuzz::build_h5(path, data, size)) return 0;
   Pack pack;
   try {
-    pack = read_pack(path);
+    pack = read_pack_in_process(path);
   } catch (const InputError& e) {
     fuzz::refused(e);
     return 0;

@@ -249,8 +249,9 @@ std::vector<T> read_as(hid_t dataset, hid_t mem_type, bool integers_only, const 
   if (cls != H5T_FLOAT && cls != H5T_INTEGER)
     fail(what + ": expected numbers (integers or floats), got " + class_name(cls));
   const std::vector<hsize_t> d = dims(dataset);
-  std::vector<T> v(bounded_count(d, what));
-  check_stored(dataset, type, d, what);
+  const std::size_t count = bounded_count(d, what);
+  check_stored(dataset, type, d, what);  // before the allocation: a corrupt dataspace may claim 2^28 entries
+  std::vector<T> v(count);
   if (!v.empty() && H5Dread(dataset, mem_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, v.data()) < 0)
     fail(what + ": cannot read the dataset");
   return v;
