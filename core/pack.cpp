@@ -1,12 +1,7 @@
 #include "core/pack.hpp"
 
-#include <sys/wait.h>
-#include <unistd.h>
-
 #include <algorithm>
-#include <cerrno>
 #include <cmath>
-#include <cstdio>
 #include <string>
 
 #include "core/detail/h5.hpp"
@@ -193,36 +188,8 @@ Pack read_ours(hid_t file, const std::string& path, const PackDefaults& def) {
 }  // namespace
 
 Pack read_pack(const std::string& path, const PackDefaults& defaults) {
-  // HDF5 1.10 trusts a file's metadata, and a few corrupt files crash it (a
-  // signal) before any check of ours can run (docs/reliability.md). So the
-  // file is read first in a child process: a child killed by a signal means
-  // the library cannot read this file, which is refused; a child that read it
-  // or refused it lets this process read it (the same read: deterministic).
-  // (Under a sanitizer the child's report is printed, and the file refused.)
-  std::fflush(nullptr);
-  const pid_t child = fork();
-  if (child == 0) {
-    int code = 0;
-    try {
-      read_pack_in_process(path, defaults);
-    } catch (...) {
-      code = 2;
-    }
-    _exit(code);
-  }
-  if (child > 0) {
-    int status = 0;
-    while (waitpid(child, &status, 0) < 0 && errno == EINTR) {
-    }
-    // 0: read; 2: refused (this process refuses it again, with the reason).
-    // Anything else is a crash: a signal, or a sanitizer's report and exit.
-    const bool read_or_refused = WIFEXITED(status) && (WEXITSTATUS(status) == 0 || WEXITSTATUS(status) == 2);
-    if (!read_or_refused)
-      throw InputError(path + ": not a readable HDF5 file: the HDF5 library crashed reading it (" +
-                       (WIFSIGNALED(status) ? "signal " + std::to_string(WTERMSIG(status))
-                                            : "exit " + std::to_string(WEXITSTATUS(status))) +
-                       "); the file is corrupt");
-  }
+  // Read first in a child process: a file that crashes HDF5 is refused.
+  h5::refuse_if_read_crashes(path, [&] { read_pack_in_process(path, defaults); });
   return read_pack_in_process(path, defaults);
 }
 

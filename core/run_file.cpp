@@ -557,6 +557,12 @@ std::vector<std::string> dataset_paths(hid_t file) {
 }  // namespace
 
 RunInfo read_run_info(const std::string& path) {
+  // Read first in a child process: a file that crashes HDF5 is refused.
+  h5::refuse_if_read_crashes(path, [&] { read_run_info_in_process(path); });
+  return read_run_info_in_process(path);
+}
+
+RunInfo read_run_info_in_process(const std::string& path) {
   h5::Handle f = h5::open_file(path);
   RunInfo r;
   if (!h5::has_attr(f, "format"))

@@ -159,7 +159,10 @@ struct RunInfo {
   std::array<double, kSubstepColumns> substeps_last{};  // kSubstepColumnNames (0 for files without them)
   std::vector<std::pair<std::string, std::vector<unsigned long long>>> datasets;  // path, shape
 };
+// Reads a run file's summary; a file that crashes the HDF5 library is
+// refused (InputError), having been read first in a child process.
 RunInfo read_run_info(const std::string& path);
+RunInfo read_run_info_in_process(const std::string& path);  // the same, in this process only
 
 // One numeric dataset of a run file (any stored type, converted to double),
 // row-major with its shape, and its `columns` attribute if it has one. For

@@ -5,8 +5,11 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <sys/wait.h>
+
 #include <cerrno>
 #include <cstdint>
+#include <cstdio>
 #include <cstring>
 #include <fstream>
 #include <limits>
@@ -492,6 +495,31 @@ double get_attr_double(hid_t obj, const std::string& name) {
   double v = 0.0;
   if (H5Aread(a, H5T_NATIVE_DOUBLE, &v) < 0) fail("attribute '" + name + "' is not a number");
   return v;
+}
+
+
+void refuse_if_read_crashes(const std::string& path, const std::function<void()>& read) {
+  std::fflush(nullptr);
+  const pid_t child = fork();
+  if (child < 0) return;
+  if (child == 0) {
+    int code = 0;
+    try {
+      read();
+    } catch (...) {
+      code = 2;
+    }
+    _exit(code);
+  }
+  int status = 0;
+  while (waitpid(child, &status, 0) < 0 && errno == EINTR) {
+  }
+  // 0: read; 2: refused (the caller refuses it again, with the reason).
+  if (WIFEXITED(status) && (WEXITSTATUS(status) == 0 || WEXITSTATUS(status) == 2)) return;
+  throw InputError(path + ": not a readable HDF5 file: the HDF5 library crashed reading it (" +
+                   (WIFSIGNALED(status) ? "signal " + std::to_string(WTERMSIG(status))
+                                        : "exit " + std::to_string(WEXITSTATUS(status))) +
+                   "); the file is corrupt");
 }
 
 }  // namespace floesim::h5

@@ -6,6 +6,7 @@
 
 #include <hdf5.h>
 
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -62,6 +63,13 @@ void trim(hid_t file);
 // heap's memory (byte-flipped packs, tests/data/fuzz/pack). Reads the whole
 // file once; for the files a user hands us (packs).
 void check_global_heaps(const std::string& path);
+// HDF5 1.10 trusts a file's metadata, and a few corrupt files crash it (a
+// signal) before any check of ours can run (docs/reliability.md). `read` is
+// run first in a child process (fork): a child that ends by a signal, or by
+// a sanitizer's report, means the library cannot read `path`, which is then
+// refused (InputError); a child that read it or threw lets the caller read it
+// (the same read: deterministic). Where fork fails, nothing is tried.
+void refuse_if_read_crashes(const std::string& path, const std::function<void()>& read);
 bool exists(hid_t loc, const std::string& path);  // a link path like "/floes/state"
 Handle open_dataset(hid_t loc, const std::string& path, const std::string& file);
 Handle open_group(hid_t loc, const std::string& path, const std::string& file);

@@ -218,6 +218,16 @@ TEST_CASE("pack inputs found by fuzzing are refused by name or read") {
                        InputError);
 }
 
+TEST_CASE("a run file that crashes the HDF5 library is refused, not a crash of floesim") {
+  // A byte-flipped run file (a 20-floe pack run, seed 3, flip 167 of a loop
+  // like tests/cli/catalogue.py's) on which HDF5 1.10.8 dies with SIGSEGV
+  // reading its summary: read first in a child process, it is refused.
+  const std::string path = std::string(FLOESIM_SOURCE_DIR) + "/tests/data/fuzz/run_file_segv.h5";
+  CHECK_THROWS_WITH_AS(read_run_info(path),
+                       doctest::Contains("run_file_segv.h5: not a readable HDF5 file: the HDF5 library crashed reading it"),
+                       InputError);
+}
+
 TEST_CASE("run file: records are readable, compare detects differences") {
   Floes f;
   FloeInput in;
