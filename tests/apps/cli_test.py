@@ -17,38 +17,13 @@ import xml.etree.ElementTree as ET
 import h5py
 import numpy as np
 
+from harness import Cli, check, keyvals
+
 FLOESIM, SRC, CASE = sys.argv[1], sys.argv[2], sys.argv[3]
 EXAMPLE = os.path.join(SRC, "examples", "pack_drift.toml")
 WORK = tempfile.mkdtemp(prefix="floesim_cli_")
-
-
-def run(*args, expect=0, cwd=WORK):
-    p = subprocess.run([FLOESIM, *args], cwd=cwd, capture_output=True, text=True, timeout=280)
-    if p.returncode != expect:
-        sys.exit(f"floesim {' '.join(args)}: exit {p.returncode}, expected {expect}\n"
-                 f"stdout:\n{p.stdout}\nstderr:\n{p.stderr}")
-    return p
-
-
-def check(cond, msg):
-    if not cond:
-        sys.exit("FAILED: " + msg)
-
-
-def keyvals(text):
-    out = {}
-    for line in text.splitlines():
-        if ": " in line and not line.startswith(" "):
-            k, v = line.split(": ", 1)
-            out[k] = v
-    return out
-
-
-def write(name, text):
-    path = os.path.join(WORK, name)
-    with open(path, "w") as f:
-        f.write(text)
-    return path
+CLI = Cli(FLOESIM, WORK)
+run, write = CLI.run, CLI.write
 
 
 def case_run_default():

@@ -20,28 +20,12 @@ import time
 import h5py
 import numpy as np
 
+from harness import Cli, check, keyvals
+
 FLOESIM, SRC, CASE = sys.argv[1], os.path.abspath(sys.argv[2]), sys.argv[3]
 WORK = tempfile.mkdtemp(prefix="floesim_restart_")
-
-
-def run(*args, expect=0):
-    p = subprocess.run([FLOESIM, *args], cwd=WORK, capture_output=True, text=True, timeout=280)
-    if p.returncode != expect:
-        sys.exit(f"floesim {' '.join(args)}: exit {p.returncode}, expected {expect}\n"
-                 f"stdout:\n{p.stdout}\nstderr:\n{p.stderr}")
-    return p
-
-
-def check(cond, msg):
-    if not cond:
-        sys.exit("FAILED: " + msg)
-
-
-def write(name, text):
-    path = os.path.join(WORK, name)
-    with open(path, "w") as f:
-        f.write(text)
-    return path
+CLI = Cli(FLOESIM, WORK)
+run, write = CLI.run, CLI.write
 
 
 def datasets(path):

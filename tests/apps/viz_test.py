@@ -20,8 +20,11 @@ import xml.etree.ElementTree as ET
 import h5py
 import numpy as np
 
+from harness import Cli, check, keyvals
+
 FLOESIM, SRC, CASE = sys.argv[1], sys.argv[2], sys.argv[3]
 WORK = os.environ.get("FLOESIM_VIZ_WORK") or tempfile.mkdtemp(prefix="floesim_viz_")
+run = Cli(FLOESIM, WORK).run
 SKIP = 77
 
 # docs/render.md: anchors of the colour maps, evenly spaced on [0, 1].
@@ -42,23 +45,6 @@ def cmap(anchors, t):
 
 def rgb255(c):
     return tuple(255 * v for v in c)
-
-
-def run(*args, expect=0, env=None):
-    p = subprocess.run([FLOESIM, *args], cwd=WORK, capture_output=True, text=True, timeout=280, env=env)
-    if p.returncode != expect:
-        sys.exit(f"floesim {' '.join(args)}: exit {p.returncode}, expected {expect}\n"
-                 f"stdout:\n{p.stdout}\nstderr:\n{p.stderr}")
-    return p
-
-
-def check(cond, msg):
-    if not cond:
-        sys.exit("FAILED: " + msg)
-
-
-def keyvals(text):
-    return dict(line.split(": ", 1) for line in text.splitlines() if ": " in line)
 
 
 def read_png(path):
