@@ -120,7 +120,7 @@ cpu="$(awk -F': ' '/^model name/ { print $2; exit }' /proc/cpuinfo)"
 {
   echo "# command: $command_line"
   echo "# source: commit $commit; floesim: $floesim${note:+; $note}"
-  echo "# machine: $cpu, $(nproc) cores (shared); load before: $load_before; after: $load_after; $(date -u +%Y-%m-%d)"
+  echo "# machine: $cpu, $(nproc --all) cores (shared); load before: $load_before; after: $load_after; $(date -u +%Y-%m-%d)"
   echo "# case: bench/ocean/ocean.toml with [coupling] stiffness = K, run to $until_s s: $(tr '\n' ' ' < "$work/pack.txt" | sed 's/ *$//')"
   echo "# loop_s: summary wall_time (steps and records, not the set-up), least of 'repeats' runs; setup_s = elapsed - loop_s;"
   echo "#   loop_cpu_s: user + system time of the run minus that of a run to t = 0 (setup_cpu_s): the loop's CPU time, which"
