@@ -98,7 +98,7 @@ struct PenaltyStepOptions {
   double forcing = 1e-2;           // the loosest (early Newton steps); cg_tolerance or below: always tight
   double forcing_safety = 0.1;     // aim the linear solve at this share of the tolerance
   double stall_ratio = 0.5;        // an inexact Newton step that keeps more of the residual (2-norm) ...
-  double forcing_cut = 1e-2;       // ... lowers the loosest tolerance by this factor
+  double forcing_cut = 0.1;        // ... lowers the loosest tolerance by this factor
   bool predictor = true;           // start from d_free - G f(d0, d0) (else from d0)
   int threads = 1;                 // results do not depend on it
 };
