@@ -218,7 +218,7 @@ TEST_CASE("pack inputs found by fuzzing are refused by name or read") {
   // on the machine that found it the library died with SIGSEGV (the child's
   // read: refused as a crash), on a fresh clone it read the format as ''
   // (refused as not a pack). Either way a refusal, never a signal.
-  CHECK_THROWS_AS(read_pack(dir + "pack/hdf5_segv.h5"), InputError);
+  CHECK_THROWS_AS(read_pack(dir + "hdf5_unfixed/flipped_pack.h5"), InputError);
 }
 
 // The guard itself (core/detail/h5.hpp), with reads whose end is known: the
@@ -245,7 +245,7 @@ TEST_CASE("a byte-flipped run file that HDF5 misreads is refused, not a crash of
   // reading its summary where it was found: read first in a child process,
   // it is refused (on another machine HDF5 may misread it otherwise: a
   // refusal all the same).
-  const std::string path = std::string(FLOESIM_SOURCE_DIR) + "/tests/data/fuzz/run_file_segv.h5";
+  const std::string path = std::string(FLOESIM_SOURCE_DIR) + "/tests/data/fuzz/hdf5_unfixed/flipped_run_file.h5";
   CHECK_THROWS_AS(read_run_info(path), InputError);
 }
 
