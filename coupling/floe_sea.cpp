@@ -585,13 +585,12 @@ void FloeSeaContact::implicit_step(Floes& floes, std::span<const FloeState> star
   // penetrations at t (d0) and with no penalty at t + h (d_free), both on
   // this footprint.
   ImplicitPieces& q = pieces_;
-  for (auto* v : {&q.spring, &q.damper, &q.start, &q.free_end, &q.guess}) v->assign(n, 0.0);
+  for (auto* v : {&q.spring, &q.damper, &q.start, &q.free_end}) v->assign(n, 0.0);
   free_bottom_.assign(floes.size(), Eigen::Vector3d::Zero());  // z, a at t + h with no penalty
   const double ks = s_ * kappa_;
   double scale = 0.0;  // the thickest draft: the residual's unit
   for (std::uint32_t i : order_) scale = std::max(scale, floes.draft(i, rho_));
   const std::span<const double> eta0 = sea.elevation();
-  const std::span<const double> w0 = sea.field(fluid::Field::velocity_z);
   for_each_floe(order_, threads_, [&](std::uint32_t i) {
     const FloeState& st = floes.state[i];
     const double z = st.heave + bottom0_[i];
@@ -604,7 +603,6 @@ void FloeSeaContact::implicit_step(Floes& floes, std::span<const FloeState> star
       q.spring[k] = ks * psi_area;
       q.damper[k] = damper * psi_area;
       q.start[k] = eta0[fp.cell[k]] - z - a.dot(fp.centroid[k]);
-      q.guess[k] = q.start[k] + h * (w0[fp.cell[k]] - st.heave_rate - Vec2{st.pitch_rate, st.roll_rate}.dot(fp.centroid[k]));
     }
   });
   sea.midpoint_free_elevation(h, grid_eta_);
@@ -634,7 +632,6 @@ void FloeSeaContact::implicit_step(Floes& floes, std::span<const FloeState> star
   problem.damper = q.damper;
   problem.start = q.start;
   problem.free_end = q.free_end;
-  problem.guess = q.guess;
   problem.self_response = self_response_ / cell_area_;
   problem.tolerance = newton_tolerance_ * std::max(scale, 1e-300);
   PenaltyStepOptions options = solver_options_;

@@ -263,7 +263,7 @@ private:
   std::vector<VerticalInertia> inertia_;      // per floe, the implicit step's
   std::vector<Eigen::Vector3d> free_bottom_;  // per floe: (z, a) at t + h with no penalty
   struct ImplicitPieces {                     // per piece, the implicit step's problem
-    std::vector<double> spring, damper, start, free_end, guess;
+    std::vector<double> spring, damper, start, free_end;
   } pieces_;
   struct EvaluationScratch {
     std::vector<double> penetration;  // [delta]^+ of each area piece
