@@ -81,6 +81,11 @@ void write_checkpoint_group(hid_t file, const std::string& name, const Checkpoin
     doubles(s, "bottom0", c.floe_sea.bottom0);
     h5::set_attr(s, "loads_h", c.floe_sea.loads_h);
     h5::set_attr(s, "penalty_energy", c.floe_sea.penalty_energy);
+    if (!c.floe_sea.footprint_reference.empty()) {
+      std::vector<double> flat;
+      for (const auto& p : c.floe_sea.footprint_reference) flat.insert(flat.end(), p.begin(), p.end());
+      doubles(s, "footprint_reference", flat, 3);
+    }
   }
   {
     const WarmStartState& w = c.warm;
@@ -223,6 +228,10 @@ Checkpoint read_checkpoint(const std::string& path) {
     c.floe_sea.bottom0 = r.doubles(s, "bottom0", c.floes.size());
     c.floe_sea.loads_h = r.attr(s, "loads_h");
     c.floe_sea.penalty_energy = r.attr(s, "penalty_energy");
+    if (h5::exists(s, "footprint_reference")) {
+      const std::vector<double> flat = r.doubles(s, "footprint_reference", 3 * c.floes.size());
+      for (std::size_t k = 0; k + 2 < flat.size(); k += 3) c.floe_sea.footprint_reference.push_back({flat[k], flat[k + 1], flat[k + 2]});
+    }
   }
   {
     h5::Handle s = h5::open_group(g, "warm_start", path);

@@ -14,6 +14,7 @@
 // continue it, and a checkpoint always goes with the records it follows.
 
 #include <cstdint>
+#include <array>
 #include <string>
 #include <vector>
 
@@ -49,6 +50,9 @@ struct FloeSeaState {
   std::vector<double> bottom0;  // m
   double loads_h = -1.0;        // s
   double penalty_energy = 0.0;  // J, at that evaluation
+  // Per floe, the pose (x, y, yaw) its footprint was last built at
+  // (coupling/moving_footprint.hpp); empty: none built yet.
+  std::vector<std::array<double, 3>> footprint_reference;
 };
 
 // The jam LCPs' warm starts (contact::WarmStart): per floe pair (key), the

@@ -372,6 +372,8 @@ void read_coupling(Section s, CouplingParams& c, SeaModel sea_model) {
   if (c.footprint == FootprintChoice::tent && sea_model == SeaModel::bem)
     s.fail("footprint", "\"tent\" needs a periodic sea ([sea] model = \"spectral\"): a tent would reach past a bem "
                         "basin's walls; use \"cell\" or \"automatic\"");
+  c.footprint_reach = s.number("footprint_reach", c.footprint_reach, [](double v) { return v >= 0.0 && v <= 0.5; },
+                               "a fraction of a cell in [0, 0.5]");
   c.integrator = s.choice<CouplingIntegrator>("integrator", c.integrator,
                                               {{"explicit", CouplingIntegrator::explicit_kicks},
                                                {"implicit", CouplingIntegrator::implicit}});
@@ -582,6 +584,7 @@ std::string resolved_toml(const Config& c) {
                                                               {{"automatic", FootprintChoice::automatic},
                                                                {"cell", FootprintChoice::cell},
                                                                {"tent", FootprintChoice::tent}})},
+                       {"footprint_reach", c.coupling.footprint_reach},
                        {"integrator", c.coupling.integrator == CouplingIntegrator::implicit ? "implicit" : "explicit"},
                        {"newton_tolerance", c.coupling.newton_tolerance},
                        {"cg_tolerance", c.coupling.cg_tolerance},

@@ -93,6 +93,10 @@ struct CouplingParams {
   // are as given ([[floes.floe]] heave, heave_rate), e.g. for a drop test.
   bool start_given = false;
   FootprintChoice footprint = FootprintChoice::automatic;
+  // Cells a floe may move before its footprint is rebuilt; in between it is
+  // moved to first order (coupling/moving_footprint.hpp). 0: rebuilt at every
+  // evaluation.
+  double footprint_reach = 0.0;
   CouplingIntegrator integrator = CouplingIntegrator::explicit_kicks;
   // Implicit integrator: the Newton iteration on the end-of-step penetrations
   // stops when every piece's residual is below newton_tolerance times the

@@ -112,6 +112,7 @@ FloeSeaContact::FloeSeaContact(const CouplingParams& params, const SeaParams& se
   // Precondition: no tent on a walled sea (refused at load, core/config.cpp).
   FLOESIM_ASSERT(params.footprint != FootprintChoice::tent || periodic);
   kernel_ = params.footprint == FootprintChoice::cell || !periodic ? FootprintKernel::cell : FootprintKernel::tent;
+  footprints_ = MovingFootprints(grid, kernel_, {params.footprint_reach});
   cell_area_ = grid.dx() * (grid.dims == 2 ? grid.dy() : grid.ly);
   // The sea under the floes, as fast as it can answer: one cell, or the
   // grid's shortest wave, at a few places (a walled basin answers faster near
@@ -124,6 +125,7 @@ FloeSeaContact::FloeSeaContact(const CouplingParams& params, const SeaParams& se
 
 void FloeSeaContact::floes_changed(const Floes& floes) {
   loads_h_ = -1.0;  // the loads and the water velocity are the old floes'
+  footprints_.forget();
   const std::size_t n = floes.size(), old = bottom0_.size();
   dynamic_.assign(n, 0);
   tilt_.assign(n, 0);
@@ -160,12 +162,22 @@ void FloeSeaContact::floes_changed(const Floes& floes) {
 }
 
 FloeSeaState FloeSeaContact::saved_state() const {
-  return {true, bottom0_, loads_h_, penalty_energy_};
+  FloeSeaState s{true, bottom0_, loads_h_, penalty_energy_, {}};
+  for (const FloePose& p : footprints_.reference()) s.footprint_reference.push_back({p.x, p.y, p.yaw});
+  return s;
 }
 
 void FloeSeaContact::restore(const FloeSeaState& state, const Floes& floes, fluid::Sea& sea, IncidentSea* incident) {
   floes_changed(floes);
   bottom0_ = state.bottom0;
+  // The footprints move from where they were last built: built there again,
+  // they move to the same bits.
+  if (!state.footprint_reference.empty()) {
+    poses_.clear();
+    for (const auto& p : state.footprint_reference) poses_.push_back({p[0], p[1], p[2]});
+    clear_footprint_cells();
+    footprints_.rebuild_at(floes, dynamic_, poses_, threads_);
+  }
   if (state.loads_h >= 0.0) evaluate_loads(floes, sea, incident, state.loads_h);
   penalty_energy_ = state.penalty_energy;
 }
@@ -188,7 +200,8 @@ void FloeSeaContact::start(Floes& floes, fluid::Sea& sea, bool given) {
   pressure_.assign(grid.size(), 0.0);  // evaluate() clears only the footprints' cells
   cells_.assign(grid.size(), {});
   pressure_kicked_ = false;
-  build_footprints(floes, dynamic_, grid, footprints_, kernel_);
+  pose_at_states(floes);
+  footprints_.rebuild_at(floes, dynamic_, poses_, threads_);
   if (given) {
     free_level_ = 0.0;
     for (std::size_t i = 0; i < n; ++i) bottom0_[i] = -floes.draft(i, rho_) * (1.0 + 1.0 / K_);
@@ -196,7 +209,7 @@ void FloeSeaContact::start(Floes& floes, fluid::Sea& sea, bool given) {
   }
   // The static problem (see the header): on the calm sea first, which fixes
   // each floe's reference bottom (heave 0), then on the sea's waves.
-  const Footprints& fp = footprints_;
+  const Footprints& fp = footprints_.pieces();
   std::vector<double> F(grid.size(), 0.0), S(grid.size(), 0.0), eta(grid.size());
   std::vector<double> z(n, 0.0);
   std::vector<Vec2> a(n, Vec2::Zero());
@@ -309,20 +322,29 @@ void FloeSeaContact::start(Floes& floes, fluid::Sea& sea, bool given) {
   }
 }
 
-void FloeSeaContact::rebuild_footprints(const Floes& floes) {
+void FloeSeaContact::pose_at_states(const Floes& floes) {
+  poses_.resize(floes.size());
+  for (std::size_t i = 0; i < floes.size(); ++i) poses_[i] = {floes.state[i].x, floes.state[i].y, floes.state[i].yaw};
+}
+
+void FloeSeaContact::clear_footprint_cells() {
   // The pressure is zero outside the footprints: clear the cells of the last
   // ones rather than the whole grid (and the cells' coverage and sums).
   if (pressure_.size() != grid_.size()) {
     pressure_.assign(grid_.size(), 0.0);
     cells_.assign(grid_.size(), {});
   } else {
-    for (std::uint32_t c : footprints_.cell) {
+    for (std::uint32_t c : footprints_.pieces().cell) {
       pressure_[c] = 0.0;
       cells_[c] = {};
     }
   }
-  build_footprints(floes, dynamic_, grid_, footprints_, kernel_, threads_);
-  const Footprints& fp = footprints_;
+}
+
+void FloeSeaContact::place_footprints(const Floes& floes) {
+  clear_footprint_cells();
+  footprints_.place(floes, dynamic_, poses_, threads_);
+  const Footprints& fp = footprints_.pieces();
   // Floes in the order of their first cell, so that floes next to each
   // other on the grid come one after the other (the grid's arrays are
   // read and written where each floe lies: this keeps them in cache).
@@ -339,8 +361,10 @@ void FloeSeaContact::rebuild_footprints(const Floes& floes) {
 void FloeSeaContact::evaluate(const Floes& floes, fluid::Sea& sea, double h) {
   pressure_kicked_ = false;
   loads_h_ = h;
-  rebuild_footprints(floes);
-  const Footprints& fp = footprints_;
+  pose_at_states(floes);
+  place_footprints(floes);
+  const Footprints& fp = footprints_.pieces();
+  const std::span<const double> area0 = footprints_.reference_area();
   const std::span<const double> eta = sea.elevation();
   std::span<const double> w;
   if (s_ < 1.0) w = sea.field(fluid::Field::velocity_z);
@@ -379,11 +403,11 @@ void FloeSeaContact::evaluate(const Floes& floes, fluid::Sea& sea, double h) {
       const double delta = eta[cell] - z - a.dot(r);
       const double ps = subcell_weight(cells_[cell].coverage);
       psi[k] = ps;
-      if (delta <= 0.0) continue;
-      u[k] = delta;
       const double area = fp.area[k];
+      if (delta <= 0.0 || area <= 0.0) continue;
+      u[k] = delta;
       double f = spring_kick * ks * ps * area * delta;
-      wet += ps * area * delta;
+      wet += ps * area0[k] * delta;  // d m_c / dG = Q_c - a_c(P0) I (moving_footprint.hpp)
       if (c > 0.0) {
         const double rate = w[cell] - st.heave_rate - ar.dot(r);
         f += area * ps * c / (1.0 + h * ps * c * inv_mass) * rate;
@@ -417,7 +441,7 @@ void FloeSeaContact::evaluate(const Floes& floes, fluid::Sea& sea, double h) {
       double torque = 0.0;
       for (std::size_t k = fp.edge_offsets[i]; k < fp.edge_offsets[i + 1]; ++k) {
         const std::ptrdiff_t piece = fp.edge_piece[k];
-        if (piece < 0) continue;
+        if (piece < 0 || fp.area[piece] <= 0.0) continue;  // none, or a node the floe has left
         const double up = u[piece], sum = cells_[fp.edge_cell[k]].sum;
         if (up <= 0.0 && sum <= 0.0) continue;
         const double ps = psi[piece];
@@ -434,7 +458,7 @@ void FloeSeaContact::evaluate(const Floes& floes, fluid::Sea& sea, double h) {
         fh -= dVdG;
         torque -= dVdyaw;
       }
-      // The explicit-G term of dV/dG: -psi_c a_c u a, summed over the area pieces.
+      // The explicit-G term of dV/dG: -psi_c a_c(P0) u a, summed over the area pieces.
       fh -= ks * wetted[i] * a;
       loads_[i].horizontal = {fh.x(), fh.y(), torque};
     }
@@ -459,7 +483,7 @@ void FloeSeaContact::update_water(const Floes& floes, const fluid::Sea& sea, Inc
   incident->advance_to(sea.time());
   const double w = incident->weight(sea.time());
   const std::span<const double> u0 = incident->u0(), v0 = incident->v0(), u1 = incident->u1(), v1 = incident->v1();
-  const Footprints& fp = footprints_;
+  const Footprints& fp = footprints_.pieces();
   const std::ptrdiff_t count = static_cast<std::ptrdiff_t>(std::min(floes.size(), fp.floes()));
 #pragma omp parallel for num_threads(threads_) schedule(static) if (count > kFloesPerThread)
   for (std::ptrdiff_t i = 0; i < count; ++i) {
@@ -519,7 +543,7 @@ void FloeSeaContact::advance_vertical(Floes& floes, std::span<const FloeState> s
 }
 
 void FloeSeaContact::sea_response(fluid::Sea& sea, double h, std::span<const double> u, std::span<double> out) {
-  const Footprints& fp = footprints_;
+  const Footprints& fp = footprints_.pieces();
   const double inv_cell_area = 1.0 / cell_area_;
   // The pressure of the forces u, held over h, lowers the nodes by the
   // sea's midpoint response (G_sea u is minus that change). The scatter is
@@ -530,38 +554,30 @@ void FloeSeaContact::sea_response(fluid::Sea& sea, double h, std::span<const dou
   for (std::uint32_t c : fp.cell) grid_work_[c] = 0.0;
 }
 
-void FloeSeaContact::build_midpoint_footprints(Floes& floes, std::span<const FloeState> start) {
+void FloeSeaContact::place_midpoint_footprints(const Floes& floes, std::span<const FloeState> start) {
   // At the step's end the vertical forces would lag the drift by h / 2: a
-  // first-order error. Positions are restored once the footprints are
-  // built; a periodic grid's seam is crossed by the shorter way.
-  std::vector<std::array<double, 3>> end(floes.size());
+  // first-order error. A periodic grid's seam is crossed by the shorter way.
+  pose_at_states(floes);
   const bool periodic = grid_.edge == fluid::GridEdge::periodic;
-  for (std::size_t i = 0; i < floes.size(); ++i) {
-    FloeState& st = floes.state[i];
-    end[i] = {st.x, st.y, st.yaw};
-    if (!dynamic_[i] || i >= start.size()) continue;
-    double dx = st.x - start[i].x, dy = st.y - start[i].y;
+  for (std::size_t i = 0; i < floes.size() && i < start.size(); ++i) {
+    if (!dynamic_[i]) continue;
+    FloePose& p = poses_[i];
+    double dx = p.x - start[i].x, dy = p.y - start[i].y;
     if (periodic) {
       dx -= grid_.lx * std::round(dx / grid_.lx);
       if (grid_.dims == 2) dy -= grid_.ly * std::round(dy / grid_.ly);
     }
-    st.x -= 0.5 * dx;
-    st.y -= 0.5 * dy;
-    st.yaw = 0.5 * (st.yaw + start[i].yaw);
+    p.x -= 0.5 * dx;
+    p.y -= 0.5 * dy;
+    p.yaw = 0.5 * (p.yaw + start[i].yaw);
   }
-  rebuild_footprints(floes);
-  for (std::size_t i = 0; i < floes.size(); ++i) {
-    FloeState& st = floes.state[i];
-    st.x = end[i][0];
-    st.y = end[i][1];
-    st.yaw = end[i][2];
-  }
+  place_footprints(floes);
 }
 
 void FloeSeaContact::implicit_step(Floes& floes, std::span<const FloeState> start, fluid::Sea& sea, double h) {
   // The footprints at the midpoint of the floes' horizontal motion over the step.
-  build_midpoint_footprints(floes, start);
-  const Footprints& fp = footprints_;
+  place_midpoint_footprints(floes, start);
+  const Footprints& fp = footprints_.pieces();
   const std::size_t n = fp.cell.size();
   // Each floe's vertical inertia on the DOFs it has.
   inertia_.assign(floes.size(), {});

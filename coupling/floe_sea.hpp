@@ -107,6 +107,7 @@
 #include "core/floes.hpp"
 #include "core/params.hpp"
 #include "coupling/footprint.hpp"
+#include "coupling/moving_footprint.hpp"
 #include "coupling/penalty_step.hpp"
 
 namespace floesim {
@@ -188,7 +189,11 @@ public:
 
   // Height of floe i's bottom at its centroid, z_b(G) = zeta + z0 (m).
   double bottom(const Floes& floes, std::size_t i) const { return floes.state[i].heave + bottom0_[i]; }
-  const Footprints& footprints() const { return footprints_; }
+  const Footprints& footprints() const { return footprints_.pieces(); }
+  // Placements of the footprints and how many of them were rebuilds
+  // (coupling/moving_footprint.hpp; [coupling] footprint_reach).
+  long footprint_placements() const { return footprints_.placements(); }
+  long footprint_rebuilds() const { return footprints_.rebuilds(); }
   std::span<const FloeSeaLoad> loads() const { return loads_; }
   std::span<const double> pressure() const { return pressure_; }
   double strong_share() const { return s_; }
@@ -213,9 +218,14 @@ private:
   // to the share Phi (the header's "Partly covered cells").
   double subcell_weight(double coverage) const;
   Eigen::Matrix2d tilt_inertia(const Floes& floes, std::size_t i) const;
-  // Clears the cells of the present footprints, builds them at the floes'
-  // positions and sums the cells' coverage (cells_[c].coverage).
-  void rebuild_footprints(const Floes& floes);
+  // Clears the cells of the present footprints, places them with floe i at
+  // poses_[i] (moved or rebuilt: coupling/moving_footprint.hpp) and sums the
+  // cells' coverage (cells_[c].coverage).
+  void place_footprints(const Floes& floes);
+  // Zeroes pressure_ and cells_ where the present footprints lie.
+  void clear_footprint_cells();
+  // poses_ <- the floes' present poses.
+  void pose_at_states(const Floes& floes);
   // The contact at the present state for a kick of length h (see evaluate_loads).
   void evaluate(const Floes& floes, fluid::Sea& sea, double h);
   // Mean over each floe's footprint (weights a_c) of the incident waves'
@@ -224,7 +234,7 @@ private:
   void implicit_step(Floes& floes, std::span<const FloeState> start, fluid::Sea& sea, double h);
   // Footprints (and coverage) at the midpoint of each floe's horizontal
   // motion from `start` to its present position.
-  void build_midpoint_footprints(Floes& floes, std::span<const FloeState> start);
+  void place_midpoint_footprints(const Floes& floes, std::span<const FloeState> start);
   // The sea's part of the implicit step's operator: out = G_sea u on the
   // pieces (coupling/penalty_step.hpp).
   void sea_response(fluid::Sea& sea, double h, std::span<const double> u, std::span<double> out);
@@ -240,7 +250,8 @@ private:
   std::vector<double> bottom0_;             // z0_i, m
   double free_level_ = 0.0;                 // the calm sea's free level (m; eta has zero mean)
   std::vector<Eigen::Matrix2d> body_moments_;  // rho h ∫ r r^T in the body frame
-  Footprints footprints_;
+  MovingFootprints footprints_;
+  std::vector<FloePose> poses_;  // where the next placement puts each floe
   std::vector<FloeSeaLoad> loads_;
   std::vector<double> pressure_;
   struct CellSums {

@@ -147,15 +147,16 @@ struct PosedBox {
   int w() const { return i1 - i0 + 1; }
   int h() const { return j1 - j0 + 1; }
 };
-PosedBox pose(const Floes& floes, std::size_t f, double dx, double dy, double shift, bool two_d,
-              std::vector<Vec2>& poly) {
+PosedBox pose(const Floes& floes, std::span<const FloePose> poses, std::size_t f, double dx, double dy, double shift,
+              bool two_d, std::vector<Vec2>& poly) {
   const FloeState& st = floes.state[f];
+  const FloePose at = poses.empty() ? FloePose{st.x, st.y, st.yaw} : poses[f];
   PosedBox b;
-  b.g = {st.x, st.y};
+  b.g = {at.x, at.y};
   poly.clear();
   Vec2 lo = Vec2::Constant(INFINITY), hi = Vec2::Constant(-INFINITY);
   for (const Vec2& p : floes.vertices(f)) {
-    poly.push_back(rotate(p, st.yaw));
+    poly.push_back(rotate(p, at.yaw));
     lo = lo.cwiseMin(poly.back());
     hi = hi.cwiseMax(poly.back());
   }
@@ -233,8 +234,8 @@ void merge_wrapped(Footprints& out, std::size_t first_piece, Scratch& s) {
 //     m_pq(row below) = -sum over the sub-segments above ∫ s^p ds / (q + 1),
 // integrated exactly by 3-point Gauss–Legendre (degree <= 4). With dims = 1
 // there is one row and no t in the tents: t is y relative to G (dy = 1).
-void build_tent(const Floes& floes, std::span<const std::uint8_t> include, const fluid::SurfaceGrid& grid,
-                Footprints& out, Scratch& s, std::size_t first, std::size_t last) {
+void build_tent(const Floes& floes, std::span<const std::uint8_t> include, std::span<const FloePose> poses,
+                const fluid::SurfaceGrid& grid, Footprints& out, Scratch& s, std::size_t first, std::size_t last) {
   const bool two_d = grid.dims == 2;
   const double dx = grid.dx(), dy = two_d ? grid.dy() : 1.0, inv_dx = 1.0 / dx, inv_dy = 1.0 / dy;
   const double area_element = dx * (two_d ? dy : 1.0);
@@ -246,7 +247,7 @@ void build_tent(const Floes& floes, std::span<const std::uint8_t> include, const
       continue;
     }
     // Dual cells of the bounding box, and their corner nodes ((w + 1) x (h + 1); one row with dims = 1).
-    const PosedBox box = pose(floes, f, dx, dy, 0.5, two_d, s.poly);
+    const PosedBox box = pose(floes, poses, f, dx, dy, 0.5, two_d, s.poly);
     const Vec2 g = box.g;
     const int i0 = box.i0, i1 = box.i1, j0 = box.j0, j1 = box.j1, w = box.w(), h = box.h();
     const int nw = w + 1, nh = two_d ? h + 1 : 1;
@@ -448,20 +449,21 @@ void append(Footprints& out, const Footprints& part) {
   out.edge_swept.insert(out.edge_swept.end(), part.edge_swept.begin(), part.edge_swept.end());
 }
 
-void build_cells(const Floes& floes, std::span<const std::uint8_t> include, const fluid::SurfaceGrid& grid,
-                 Footprints& out, Scratch& s, std::size_t first, std::size_t last);
+void build_cells(const Floes& floes, std::span<const std::uint8_t> include, std::span<const FloePose> poses,
+                 const fluid::SurfaceGrid& grid, Footprints& out, Scratch& s, std::size_t first, std::size_t last);
 
 }  // namespace
 
 void build_footprints(const Floes& floes, std::span<const std::uint8_t> include,
-                      const fluid::SurfaceGrid& grid, Footprints& out, FootprintKernel kernel, int threads) {
+                      const fluid::SurfaceGrid& grid, Footprints& out, FootprintKernel kernel, int threads,
+                      std::span<const FloePose> poses) {
   if (kernel == FootprintKernel::tent && grid.edge != fluid::GridEdge::periodic)
     throw std::invalid_argument("the tent footprint kernel needs a periodic grid");
   auto build = [&](Footprints& part, std::size_t first, std::size_t last) {
     static thread_local Scratch scratch;
     clear(part);
-    if (kernel == FootprintKernel::tent) build_tent(floes, include, grid, part, scratch, first, last);
-    else build_cells(floes, include, grid, part, scratch, first, last);
+    if (kernel == FootprintKernel::tent) build_tent(floes, include, poses, grid, part, scratch, first, last);
+    else build_cells(floes, include, poses, grid, part, scratch, first, last);
   };
   // Each floe's pieces depend on that floe alone: ranges of floes are built
   // on threads and joined in order, the same arrays whatever the thread count.
@@ -487,8 +489,8 @@ void build_footprints(const Floes& floes, std::span<const std::uint8_t> include,
 namespace {
 
 // The cell kernel: the exact areas floe ∩ cell, for floes first..last-1.
-void build_cells(const Floes& floes, std::span<const std::uint8_t> include, const fluid::SurfaceGrid& grid,
-                 Footprints& out, Scratch& s, std::size_t first, std::size_t last) {
+void build_cells(const Floes& floes, std::span<const std::uint8_t> include, std::span<const FloePose> poses,
+                 const fluid::SurfaceGrid& grid, Footprints& out, Scratch& s, std::size_t first, std::size_t last) {
   const double dx = grid.dx(), dy = grid.dy();
   const bool periodic = grid.edge == fluid::GridEdge::periodic;
   const bool two_d = grid.dims == 2;
@@ -511,7 +513,7 @@ void build_cells(const Floes& floes, std::span<const std::uint8_t> include, cons
   for (std::size_t f = first; f < last; ++f) {
     if (include[f]) {
       // The bounding box in cells (all of the width when dims = 1: one row).
-      const PosedBox box = pose(floes, f, dx, dy, 0.0, two_d, s.poly);
+      const PosedBox box = pose(floes, poses, f, dx, dy, 0.0, two_d, s.poly);
       const Vec2 g = box.g;
       const int i0 = box.i0, i1 = box.i1, j0 = box.j0, j1 = box.j1, w = box.w(), h = box.h();
       const std::size_t nloc = static_cast<std::size_t>(w) * static_cast<std::size_t>(h);

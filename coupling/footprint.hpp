@@ -72,12 +72,19 @@ struct Footprints {
   std::ptrdiff_t find(std::size_t i, std::uint32_t cell_index) const;
 };
 
-// Pieces of every floe for which include[i] is true (others get none). The
+// Where a floe is placed on the grid: its centroid (m) and yaw (rad).
+struct FloePose {
+  double x = 0.0, y = 0.0, yaw = 0.0;
+};
+
+// Pieces of every floe for which include[i] is true (others get none), with
+// floe i at poses[i] (or, if poses is empty, where its state puts it). The
 // tent kernel needs a periodic grid (a walled one gets std::invalid_argument).
 // With threads > 1 ranges of floes are built on that many threads; the
 // result does not depend on the thread count.
 void build_footprints(const Floes& floes, std::span<const std::uint8_t> include,
                       const fluid::SurfaceGrid& grid, Footprints& out,
-                      FootprintKernel kernel = FootprintKernel::cell, int threads = 1);
+                      FootprintKernel kernel = FootprintKernel::cell, int threads = 1,
+                      std::span<const FloePose> poses = {});
 
 }  // namespace floesim

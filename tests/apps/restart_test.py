@@ -296,6 +296,15 @@ def case_waves_implicit():
     continuation(WAVES.format(coupling='integrator = "implicit"'), 4, 2, "waves_implicit")
 
 
+def case_waves_moving():
+    # Footprints moved between rebuilds (coupling/moving_footprint.hpp): the
+    # checkpoint keeps the poses they were built at.
+    continuation(WAVES.format(coupling='law = "strong"\nstiffness = 100.0\nfootprint_reach = 0.05'), 4, 2,
+                 "waves_moving")
+    continuation(WAVES.format(coupling='integrator = "implicit"\nfootprint_reach = 0.05'), 4, 2,
+                 "waves_moving_implicit")
+
+
 def case_bem():
     continuation(BEM, 4, 2, "bem")
 

@@ -171,6 +171,9 @@ def toml_cases():
     case("toml", "tent footprint in a bem basin",
          ["run", write("tent_bem.toml", bem + '[coupling]\nfootprint = "tent"\n')],
          ["tent_bem.toml:8", "[coupling] footprint", "periodic"])
+    case("toml", "footprint reach of a whole cell",
+         ["run", write("reach.toml", '[coupling]\nfootprint_reach = 1.0\n')],
+         ["reach.toml:2", "[coupling] footprint_reach", "a fraction of a cell in [0, 0.5]"])
     floe = "[[floes.floe]]\nvertices = {}\n"
     square = "[[0, 0], [20, 0], [20, 20], [0, 20]]"
     case("toml", "self-intersecting floe",

@@ -182,6 +182,40 @@ TEST_CASE("strong law without drag conserves the total energy, with a second-ord
   CHECK(e0 / e1 > 3.0);  // second order: 4 in the limit
 }
 
+TEST_CASE("footprints moved between rebuilds: the strong law's energy error grows with the reach, builds fall") {
+  // coupling/moving_footprint.hpp: between rebuilds the forces are the exact
+  // gradient of the energy on the moved pieces, so the splitting conserves
+  // it as above; a rebuild changes a boundary piece by O(reach^2) of a cell,
+  // and the energy with it. Rebuilds come about 1 / reach times as often,
+  // so the error grows about as the reach. The floe of the test above at
+  // dt = 0.004 s.
+  auto drift = [](double reach) {
+    std::ostringstream extra;
+    extra << "velocity = [0.3, 0.1]\nangular_velocity = 0.01\n"
+          << "[coupling]\nlaw = \"strong\"\nstiffness = 100.0\nfootprint_reach = " << reach << "\n"
+          << "[sea.waves]\nkind = \"regular\"\namplitude = 0.1\nwavelength = 25.0\n";
+    std::string text = one_floe(12.0, kSea2d, extra.str());
+    const std::string from = "dt_max = 0.01";
+    text.replace(text.find(from), from.size(), "dt_max = 0.004");
+    Simulation sim = make(text);
+    const double e0 = energy(sim, "total");
+    double worst = 0.0;
+    for (int k = 0; k < 5000; ++k) {
+      sim.step(1e9);
+      worst = std::max(worst, std::abs(energy(sim, "total") - e0));
+    }
+    return std::pair{worst / e0, sim.floe_sea()->footprint_rebuilds()};
+  };
+  const auto [e_exact, builds_exact] = drift(0.0);
+  const auto [e_fine, builds_fine] = drift(0.01);
+  const auto [e_coarse, builds_coarse] = drift(0.04);
+  MESSAGE("relative energy error over 20 s: reach 0: " << e_exact << " (" << builds_exact << " builds), 0.01: "
+          << e_fine << " (" << builds_fine << "), 0.04: " << e_coarse << " (" << builds_coarse << ")");
+  CHECK(builds_fine < builds_exact / 5);
+  CHECK(e_fine < 1e-4);
+  CHECK(e_coarse / e_fine > 3.0);
+}
+
 TEST_CASE("drop test: the strong law rebounds, the weak law does not, and waves carry energy away") {
   // The seed's slamming configuration (seed 000 §1): a floe released above
   // the surface with a downward speed. Strong law: elastic limit, total energy

@@ -14,6 +14,7 @@
 
 #include "core/floes.hpp"
 #include "coupling/footprint.hpp"
+#include "coupling/moving_footprint.hpp"
 
 using namespace floesim;
 
@@ -431,4 +432,131 @@ TEST_CASE("tent footprint needs a periodic grid") {
   Footprints fp;
   const std::vector<std::uint8_t> include{1};
   CHECK_THROWS_AS(build_footprints(floes, include, grid, fp, FootprintKernel::tent), std::invalid_argument);
+}
+
+namespace {
+
+// Largest |a_c| difference between moved and freshly built pieces, over
+// the cells of both (a cell in one only counts its whole area), and the
+// largest first-moment difference |m_c - m'_c| on shared cells.
+struct PieceError {
+  double area = 0.0, moment = 0.0;
+};
+PieceError piece_error(const Footprints& a, const Footprints& b) {
+  PieceError e;
+  for (std::size_t f = 0; f < a.floes(); ++f) {
+    std::map<std::uint32_t, std::pair<double, Vec2>> ref;
+    for (std::size_t k = b.offsets[f]; k < b.offsets[f + 1]; ++k) ref[b.cell[k]] = {b.area[k], b.area[k] * b.centroid[k]};
+    for (std::size_t k = a.offsets[f]; k < a.offsets[f + 1]; ++k) {
+      const auto it = ref.find(a.cell[k]);
+      const double other = it == ref.end() ? 0.0 : it->second.first;
+      e.area = std::max(e.area, std::abs(a.area[k] - other));
+      if (it != ref.end()) {
+        e.moment = std::max(e.moment, (a.area[k] * a.centroid[k] - it->second.second).norm());
+        ref.erase(it);
+      }
+    }
+    for (const auto& [cell, piece] : ref) e.area = std::max(e.area, piece.first);
+  }
+  return e;
+}
+
+std::vector<FloePose> poses_of(const Floes& floes) {
+  std::vector<FloePose> p;
+  for (const FloeState& s : floes.state) p.push_back({s.x, s.y, s.yaw});
+  return p;
+}
+
+}  // namespace
+
+TEST_CASE("moved footprints: second order in the displacement, with the floe's area and centroid exact") {
+  // coupling/moving_footprint.hpp: a_c(P) = a_c(P0) + N . delta + T phi is
+  // the first-order Taylor expansion of the exact piece, so against a fresh
+  // build its error is O(|delta|^2 + R^2 phi^2): halving the displacement
+  // divides it by about 4. The sums are exact: sum N = ∮ n ds = 0 and
+  // sum (Q - a I) = ∮ r n^T ds - A I = 0 (divergence theorem), unless a
+  // piece's affine area went below 0 and was cut to 0 (a node the floe left).
+  const fluid::SurfaceGrid grid = box_grid();
+  std::mt19937_64 rng(11);
+  Floes floes = mixed_floes(rng, 9);
+  scatter(floes, grid, rng);
+  const std::vector<std::uint8_t> include(floes.size(), 1);
+  for (FootprintKernel kernel : {FootprintKernel::tent, FootprintKernel::cell}) {
+    INFO((kernel == FootprintKernel::tent ? "tent" : "cell") << " kernel");
+    MovingFootprints moving(grid, kernel, {0.5});
+    const std::vector<FloePose> p0 = poses_of(floes);
+    CHECK(moving.place(floes, include, p0, 1));  // the first placement builds
+    std::vector<double> errors;
+    for (double step : {0.2, 0.1, 0.05}) {  // of a cell
+      std::vector<FloePose> p = p0;
+      for (std::size_t i = 0; i < p.size(); ++i) {
+        double radius = 0.0;
+        for (const Vec2& v : floes.vertices(i)) radius = std::max(radius, v.norm());
+        p[i].x += 0.6 * step * grid.dx();
+        p[i].y -= 0.5 * step * grid.dy();
+        p[i].yaw += 0.3 * step * grid.dy() / radius;
+      }
+      REQUIRE_FALSE(moving.place(floes, include, p, 1));  // inside the window: moved
+      Footprints exact;
+      build_footprints(floes, include, grid, exact, kernel, 1, p);
+      const PieceError e = piece_error(moving.pieces(), exact);
+      errors.push_back(e.area);
+      MESSAGE("displacement " << step << " cell: largest piece area error " << e.area / grid.cell_area()
+                              << " of a cell, first moment " << e.moment / std::pow(grid.cell_area(), 1.5));
+      const Footprints& fp = moving.pieces();
+      for (std::size_t f = 0; f < floes.size(); ++f) {
+        double area = 0.0;
+        Vec2 moment = Vec2::Zero();
+        int cut = 0;
+        for (std::size_t k = fp.offsets[f]; k < fp.offsets[f + 1]; ++k) {
+          area += fp.area[k];
+          moment += fp.area[k] * fp.centroid[k];
+          cut += fp.area[k] == 0.0;
+        }
+        if (cut > 0) {  // a cut piece's affine area was below 0 <= its exact one: cut by less than its error
+          CHECK(std::abs(area - floes.area[f]) <= cut * e.area);
+          continue;
+        }
+        CHECK(area == doctest::Approx(floes.area[f]).epsilon(1e-12));
+        CHECK(moment.norm() < 1e-9 * floes.area[f] * std::sqrt(floes.area[f]));
+      }
+    }
+    CHECK(errors[0] / errors[1] > 3.0);
+    CHECK(errors[1] / errors[2] > 3.0);
+    CHECK(errors[2] < 0.01 * grid.cell_area());
+  }
+}
+
+TEST_CASE("moved footprints: rebuilt exactly when a floe's vertices may leave their window") {
+  // The window (moving_footprint.hpp): |delta_x| + R |phi| <= reach dx and the
+  // same along y; past it every floe is rebuilt, to the bits of a fresh build.
+  const fluid::SurfaceGrid grid = box_grid();
+  std::mt19937_64 rng(5);
+  Floes floes = mixed_floes(rng, 6);
+  scatter(floes, grid, rng);
+  const std::vector<std::uint8_t> include(floes.size(), 1);
+  MovingFootprints moving(grid, FootprintKernel::tent, {0.1});
+  std::vector<FloePose> p = poses_of(floes);
+  CHECK(moving.place(floes, include, p, 1));
+  p[2].x += 0.09 * grid.dx();
+  CHECK_FALSE(moving.place(floes, include, p, 1));
+  p[2].x += 0.02 * grid.dx();  // 0.11 cell from where it was built
+  CHECK(moving.place(floes, include, p, 1));
+  Footprints fresh;
+  build_footprints(floes, include, grid, fresh, FootprintKernel::tent, 1, p);
+  CHECK(moving.pieces().area == fresh.area);
+  CHECK(moving.pieces().cell == fresh.cell);
+  // A turn counts with the floe's radius; the new reference is the last build.
+  double radius = 0.0;
+  for (const Vec2& v : floes.vertices(4)) radius = std::max(radius, v.norm());
+  p[4].yaw += 0.09 * grid.dy() / radius;
+  CHECK_FALSE(moving.place(floes, include, p, 1));
+  p[4].yaw += 0.02 * grid.dy() / radius;
+  CHECK(moving.place(floes, include, p, 1));
+  CHECK(moving.rebuilds() == 3);
+  CHECK(moving.placements() == 5);
+  // Reach 0: every placement builds.
+  MovingFootprints exact(grid, FootprintKernel::tent, {0.0});
+  CHECK(exact.place(floes, include, p, 1));
+  CHECK(exact.place(floes, include, p, 1));
 }

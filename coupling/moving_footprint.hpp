@@ -1,0 +1,92 @@
+#pragma once
+// Footprints that move with their floes between rebuilds (docs/coupling.md,
+// "Footprints that move").
+//
+// Building a floe's pieces (coupling/footprint.hpp) costs a pass over its
+// outline cut at the grid lines and over its bounding box, while a floe
+// moves a few millimetres per step. So the pieces are built at a reference
+// pose P0 = (G0, theta0) and, while the floe stays near it, moved to first
+// order in its displacement (delta, phi) = (G - G0, theta - theta0) with the
+// outline integrals the build gives anyway (the edge pieces: N = d a_c / dG,
+// T = d a_c / dyaw, Q - a_c I = d m_c / dG, S = d m_c / dyaw, where
+// m_c = a_c r_c is the piece's first moment about G):
+//     a_c(P) = a_c(P0) + N_c . delta + T_c phi,
+//     m_c(P) = m_c(P0) + (Q_c - a_c(P0) I) delta + S_c phi.
+// A piece with no edge piece lies inside the floe: its a_c is fixed and
+// m_c -= a_c delta (its node is fixed while G moves).
+//
+// The moved pieces are affine functions of the pose, so a force computed as
+// the gradient of an energy built on them (the contact's horizontal forces,
+// coupling/floe_sea.hpp, with a_c(P0) where d m_c / dG holds it) is that
+// energy's exact gradient: the splitting keeps its energy behaviour while no
+// floe is rebuilt. The affine pieces differ from the exact ones by
+// O(|delta|^2 + R^2 phi^2) on the floe's boundary (a_c is C^1 in the pose
+// with the tent kernel, piecewise smooth with the cell kernel), so a
+// rebuild changes a boundary piece by about reach^2 / 2 of a cell's area. A
+// piece whose affine area would be negative (a node the floe is leaving)
+// gets none and is left out of the forces.
+//
+// The window: all pieces are rebuilt when any floe's vertices may have moved
+// more than `reach` cells along x or y,
+//     |delta_x| + R |phi| > reach dx  or  |delta_y| + R |phi| > reach dy,
+// R the floe's largest vertex distance from its centroid. reach = 0 rebuilds
+// at every placement (the exact pieces).
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "coupling/footprint.hpp"
+
+namespace floesim {
+
+struct FootprintMotionOptions {
+  // Cells a floe's vertices may move before its pieces are rebuilt ([coupling]
+  // footprint_reach). 0: rebuilt at every placement.
+  double reach = 0.0;
+};
+
+class MovingFootprints {
+public:
+  MovingFootprints() = default;
+  MovingFootprints(const fluid::SurfaceGrid& grid, FootprintKernel kernel, FootprintMotionOptions options);
+
+  // The pieces of every floe with include[i], floe i at poses[i]: moved from
+  // the reference poses when every floe is inside its window (and the floes
+  // and include are those of the reference), else rebuilt with poses as the
+  // new reference. Returns true when rebuilt.
+  bool place(const Floes& floes, std::span<const std::uint8_t> include, std::span<const FloePose> poses,
+             int threads);
+  // Builds at `reference` and makes it the reference (a restart).
+  void rebuild_at(const Floes& floes, std::span<const std::uint8_t> include, std::span<const FloePose> reference,
+                  int threads);
+  // The next placement rebuilds (the floes changed).
+  void forget() { reference_.clear(); }
+
+  const Footprints& pieces() const { return pieces_; }
+  // Each area piece's a_c at the reference pose (m^2).
+  std::span<const double> reference_area() const { return area0_; }
+  // The reference poses (empty before the first placement).
+  std::span<const FloePose> reference() const { return reference_; }
+  long placements() const { return placements_; }
+  long rebuilds() const { return rebuilds_; }
+
+private:
+  bool inside_windows(const Floes& floes, std::span<const FloePose> poses) const;
+  void move(std::span<const FloePose> poses, int threads);
+  // (delta, phi) of floe i from its reference, the grid's seam crossed the short way.
+  FloePose displacement(std::size_t i, const FloePose& at) const;
+
+  fluid::SurfaceGrid grid_;
+  FootprintKernel kernel_ = FootprintKernel::cell;
+  FootprintMotionOptions options_;
+  Footprints pieces_;
+  std::vector<FloePose> reference_;
+  std::vector<std::uint8_t> include_;
+  std::vector<double> radius_;  // per floe, R
+  std::vector<double> area0_;   // per area piece, a_c(P0)
+  std::vector<Vec2> moment0_;   // per area piece, m_c(P0)
+  long placements_ = 0, rebuilds_ = 0;
+};
+
+}  // namespace floesim
