@@ -1,4 +1,7 @@
 // floesim command line: dispatches to one subcommand per apps/cmd_*.cpp.
+#include <unistd.h>
+
+#include <cstdlib>
 #include <iostream>
 #include <map>
 #include <new>
@@ -7,7 +10,23 @@
 #include "apps/commands.hpp"
 #include "core/error.hpp"
 
+namespace {
+
+// OpenMP's idle threads wait for the next parallel loop by spinning (libgomp's
+// default). On cores shared with other work every loop then waits for the
+// spinning threads' scheduler slices (docs/coupling.md, "Threads"). The
+// runtime reads OMP_WAIT_POLICY once, as it loads, so unless the user chose a
+// policy the command line sets "passive" and starts itself again, once.
+void prefer_passive_waits(char** argv) {
+  if (std::getenv("OMP_WAIT_POLICY") != nullptr) return;
+  if (setenv("OMP_WAIT_POLICY", "passive", 0) != 0) return;
+  execv("/proc/self/exe", argv);  // returns only on failure: go on as we are
+}
+
+}  // namespace
+
 int main(int argc, char** argv) {
+  prefer_passive_waits(argv);
   CLI::App app{"floesim: sea-ice floes on waves (rigid floes, Lemke collisions, "
                "penalised capillary-gravity sea)"};
   app.require_subcommand(1);

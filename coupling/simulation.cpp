@@ -94,6 +94,7 @@ Simulation::Simulation(Scenario scenario) : scenario_(std::move(scenario)) {
   fluid::SeaOptions sea_options;
   sea_options.tank = {c.sea.tank.enabled, c.sea.tank.generation_length, c.sea.tank.absorption_length,
                       c.sea.tank.rate, c.sea.tank.ramp_periods};
+  sea_options.threads = resolve_threads(c.run.threads);
   try {
     sea_ = fluid::make_sea(c.sea, c.run.seed, sea_options);  // its input errors name the [sea] key; add the file
   } catch (const InputError& e) {

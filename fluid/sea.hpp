@@ -63,6 +63,7 @@ struct SeaOptions {
   TankParams tank;              // relaxation zones (spectral only)
   bool measure_fft_plans = false;  // FFTW_MEASURE instead of FFTW_ESTIMATE (benchmarks)
   double bem_panel_ratio = 1.0;    // bem: wall and bottom panel length / surface panel length
+  int threads = 1;                 // spectral, dims = 2: threads of the transforms (the bits do not depend on it)
 };
 
 class Sea {

@@ -8,6 +8,7 @@
 #include <optional>
 
 #include "core/error.hpp"
+#include "fluid/fft2d.hpp"
 #include "fluid/waves.hpp"
 
 namespace floesim::fluid {
@@ -42,7 +43,9 @@ struct SpectralSea::Impl {
   // as the x-velocity's (staged_vy) and used by the next velocity_y query.
   fftw_complex* spec_vy = nullptr;
   bool staged_vy = false;
-  fftw_plan r2c = nullptr, c2r = nullptr;
+  fftw_plan r2c = nullptr, c2r = nullptr;  // dims = 1
+  std::unique_ptr<RealFft2d> fft2;         // dims = 2: the same bits on any number of threads
+  int threads = 1;
   // Deferred kicks: up to two (spectrum, h), applied fused with the next flow,
   // in order. kick_spec holds the FFTs of up to two pressures; pending kick i
   // uses kick_spec[kick_buf[i]] (a repeated kick uses the buffer of the last
@@ -73,22 +76,21 @@ struct SpectralSea::Impl {
 
   // to <- FFT(field); `to` is spec or a kick buffer (same alignment).
   void forward(std::span<const double> field, fftw_complex* to) {
-    if (aligned(field.data())) {
-      // r2c plans preserve their input (FFTW_PRESERVE_INPUT is the default).
-      fftw_execute_dft_r2c(r2c, const_cast<double*>(field.data()), to);
-    } else {
+    const double* in = field.data();
+    if (!aligned(in)) {
       std::copy(field.begin(), field.end(), real);
-      fftw_execute_dft_r2c(r2c, real, to);
+      in = real;
     }
+    // r2c plans preserve their input (FFTW_PRESERVE_INPUT is the default).
+    if (fft2) fft2->forward(in, to, threads);
+    else fftw_execute_dft_r2c(r2c, const_cast<double*>(in), to);
   }
   // out <- IFFT(from) (unnormalised; `from`, spec or spec_vy, is destroyed)
   void backward(std::span<double> out, fftw_complex* from) {
-    if (aligned(out.data())) {
-      fftw_execute_dft_c2r(c2r, from, out.data());
-    } else {
-      fftw_execute_dft_c2r(c2r, from, real);
-      std::copy(real, real + n, out.begin());
-    }
+    double* to = aligned(out.data()) ? out.data() : real;
+    if (fft2) fft2->backward(from, to, threads);
+    else fftw_execute_dft_c2r(c2r, from, to);
+    if (to == real) std::copy(real, real + n, out.begin());
   }
   // spec <- (i k)^d factor * a, for a = q or v (d = 0 or 1 via `deriv`); with
   // `gain`, the deferred kicks are added to a on the way (a = v: the rates as
@@ -149,14 +151,17 @@ SpectralSea::SpectralSea(const SeaParams& params, const SeaOptions& options)
   if (m.ny > 1) m.spec_vy = fftw_alloc_complex(m.nc);
   for (auto*& k : m.kick_spec) k = fftw_alloc_complex(m.nc);
   const unsigned flags = options.measure_fft_plans ? FFTW_MEASURE : FFTW_ESTIMATE;
+  m.threads = std::max(options.threads, 1);
+  bool planned = false;
   if (m.ny > 1) {
-    m.r2c = fftw_plan_dft_r2c_2d(m.ny, m.nx, m.real, m.spec, flags);
-    m.c2r = fftw_plan_dft_c2r_2d(m.ny, m.nx, m.spec, m.real, flags);
+    m.fft2 = std::make_unique<RealFft2d>(m.nx, m.ny, flags, m.real, m.spec);
+    planned = m.fft2->valid();
   } else {
     m.r2c = fftw_plan_dft_r2c_1d(m.nx, m.real, m.spec, flags);
     m.c2r = fftw_plan_dft_c2r_1d(m.nx, m.spec, m.real, flags);
+    planned = m.r2c && m.c2r;
   }
-  if (!m.r2c || !m.c2r) throw RunError("fluid: FFTW could not plan the spectral sea transforms");
+  if (!planned) throw RunError("fluid: FFTW could not plan the spectral sea transforms");
 
   // Oscillator bank on the normalised coefficients eta_k = FFT(eta) / n, so that
   // a field is the plain c2r of its coefficients. Parseval on the half spectrum:

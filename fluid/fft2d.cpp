@@ -1,0 +1,82 @@
+#include "fluid/fft2d.hpp"
+
+#include <algorithm>
+#include <cstddef>
+
+namespace floesim::fluid {
+
+namespace {
+
+// f(b) for each of the `blocks` blocks, on threads (the blocks' work is independent).
+template <class F>
+void for_each_block(int blocks, int threads, F&& f) {
+#pragma omp parallel for num_threads(threads) schedule(static) if (threads > 1 && blocks > 1)
+  for (int b = 0; b < blocks; ++b) f(b);
+}
+
+}  // namespace
+
+RealFft2d::RealFft2d(int nx, int ny, unsigned flags, double* real, fftw_complex* spec)
+    : nx_(nx), ny_(ny), hx_(nx / 2 + 1) {
+  const int row_counts[2] = {std::min(kRows, ny), ny % kRows};
+  const int column_counts[2] = {std::min(kColumns, hx_), hx_ % kColumns};
+  for (int k = 0; k < 2; ++k) {
+    if (row_counts[k] == 0 || (k == 1 && ny < kRows)) continue;
+    const int howmany = row_counts[k];
+    // Rows: n = nx, consecutive rows nx reals / hx complex apart.
+    rows_r2c_[k] = fftw_plan_many_dft_r2c(1, &nx_, howmany, real, nullptr, 1, nx_, spec, nullptr, 1, hx_, flags);
+    rows_c2r_[k] = fftw_plan_many_dft_c2r(1, &nx_, howmany, spec, nullptr, 1, hx_, real, nullptr, 1, nx_, flags);
+  }
+  for (int k = 0; k < 2; ++k) {
+    if (column_counts[k] == 0 || (k == 1 && hx_ < kColumns)) continue;
+    const int howmany = column_counts[k];
+    // Columns of the half spectrum, in place: n = ny, stride hx, neighbours 1 apart.
+    columns_forward_[k] =
+        fftw_plan_many_dft(1, &ny_, howmany, spec, nullptr, hx_, 1, spec, nullptr, hx_, 1, FFTW_FORWARD, flags);
+    columns_backward_[k] =
+        fftw_plan_many_dft(1, &ny_, howmany, spec, nullptr, hx_, 1, spec, nullptr, hx_, 1, FFTW_BACKWARD, flags);
+  }
+}
+
+RealFft2d::~RealFft2d() {
+  for (fftw_plan* set : {rows_r2c_, rows_c2r_, columns_forward_, columns_backward_})
+    for (int k = 0; k < 2; ++k)
+      if (set[k]) fftw_destroy_plan(set[k]);
+}
+
+bool RealFft2d::valid() const {
+  const bool row_rest = ny_ >= kRows && ny_ % kRows != 0, column_rest = hx_ >= kColumns && hx_ % kColumns != 0;
+  return rows_r2c_[0] && rows_c2r_[0] && columns_forward_[0] && columns_backward_[0] &&
+         (!row_rest || (rows_r2c_[1] && rows_c2r_[1])) && (!column_rest || (columns_forward_[1] && columns_backward_[1]));
+}
+
+void RealFft2d::forward(const double* in, fftw_complex* out, int threads) const {
+  const int row_blocks = (ny_ + kRows - 1) / kRows, column_blocks = (hx_ + kColumns - 1) / kColumns;
+  for_each_block(row_blocks, threads, [&](int b) {
+    const int r0 = b * kRows;
+    const fftw_plan p = r0 + kRows <= ny_ || ny_ < kRows ? rows_r2c_[0] : rows_r2c_[1];
+    fftw_execute_dft_r2c(p, const_cast<double*>(in) + static_cast<std::ptrdiff_t>(r0) * nx_,
+                         out + static_cast<std::ptrdiff_t>(r0) * hx_);
+  });
+  for_each_block(column_blocks, threads, [&](int b) {
+    const int c0 = b * kColumns;
+    const fftw_plan p = c0 + kColumns <= hx_ || hx_ < kColumns ? columns_forward_[0] : columns_forward_[1];
+    fftw_execute_dft(p, out + c0, out + c0);
+  });
+}
+
+void RealFft2d::backward(fftw_complex* in, double* out, int threads) const {
+  const int row_blocks = (ny_ + kRows - 1) / kRows, column_blocks = (hx_ + kColumns - 1) / kColumns;
+  for_each_block(column_blocks, threads, [&](int b) {
+    const int c0 = b * kColumns;
+    const fftw_plan p = c0 + kColumns <= hx_ || hx_ < kColumns ? columns_backward_[0] : columns_backward_[1];
+    fftw_execute_dft(p, in + c0, in + c0);
+  });
+  for_each_block(row_blocks, threads, [&](int b) {
+    const int r0 = b * kRows;
+    const fftw_plan p = r0 + kRows <= ny_ || ny_ < kRows ? rows_c2r_[0] : rows_c2r_[1];
+    fftw_execute_dft_c2r(p, in + static_cast<std::ptrdiff_t>(r0) * hx_, out + static_cast<std::ptrdiff_t>(r0) * nx_);
+  });
+}
+
+}  // namespace floesim::fluid
