@@ -6,7 +6,10 @@
 #include <cmath>
 #include <numeric>
 #include <cstdlib>
+#include <sstream>
 #include <unordered_map>
+
+#include "contact/lcp/siconos_io.hpp"
 
 namespace floesim::contact {
 
@@ -173,6 +176,18 @@ void warm_store(WarmStart& warm, const Floes& floes, const std::vector<ContactPo
         {body_point(floes, c.a, c.point), body_direction(floes, c.a, c.normal),
          {on(k), on(m + 2 * k), on(m + 2 * k + 1), on(3 * m + k)}});
   }
+}
+
+// Writes a failed LCP as DIR/failed_lcp_<number>.dat ([contact] dump_failed_lcps).
+void dump_failed(const lcp::Lcp& problem, std::size_t m, double friction, const lcp::FallbackResult& res,
+                 long number, const std::string& dir) {
+  std::ostringstream c;
+  c << "floesim collision LCP that the fallback chain did not solve (contact/impulse.hpp): " << m
+    << " contacts, friction " << friction << ", unknowns (lambda[m], beta[2m], alpha[m]), scaled per contact\n"
+    << "attempts (method status pivots residual):";
+  for (const lcp::Attempt& a : res.attempts)
+    c << " " << lcp::to_string(a.method) << " " << lcp::to_string(a.status) << " " << a.pivots << " " << a.residual << ";";
+  lcp::write_siconos_lcp(problem, dir + "/failed_lcp_" + std::to_string(number) + ".dat", c.str());
 }
 
 }  // namespace
@@ -380,6 +395,7 @@ std::vector<ContactImpulse> resolve_collisions(Floes& floes, const std::vector<C
       }
       if (!res.solved()) {
         ++stats.failures;
+        if (!opt.dump_failed_lcps.empty()) dump_failed(problem, m, opt.friction, res, stats.failures, opt.dump_failed_lcps);
         break;  // leave these velocities as they are: counted and reported
       }
       // W += A^-1 G^T diag(1 + e_k) z (pass 1: restitution 0).

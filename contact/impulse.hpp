@@ -85,6 +85,7 @@
 #include <array>
 #include <cstdint>
 #include <span>
+#include <string>
 #include <unordered_map>
 #include <vector>
 
@@ -157,6 +158,13 @@ struct ImpulseOptions {
   // basis in `warm` (null: never); the caller owns it and keeps it across steps.
   WarmStart* warm = nullptr;
   std::size_t warm_min = 200;
+  // A folder ("": none) where every LCP that ends as a failure (counted in
+  // CollisionStats::failures) is written in the Siconos format
+  // (lcp/siconos_io.hpp) as failed_lcp_<k>.dat, k = the failure's number in
+  // the run, with the contact count, friction and the chain's attempts in
+  // its comment: a failure from any run becomes test data. Config key
+  // [contact] dump_failed_lcps.
+  std::string dump_failed_lcps;
 };
 
 // Running totals of a run (written to /diagnostics/lcp and the summary).
