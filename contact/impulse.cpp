@@ -15,28 +15,22 @@ namespace floesim::contact {
 
 namespace {
 
-// Union–find over the floes that have contacts (local indices), so a call
+// Disjoint sets over the floes that have contacts (local indices), so a call
 // costs the size of its contact list, not of the pack.
 struct Components {
-  std::vector<std::uint32_t> parent;
+  DisjointSets sets;
   std::unordered_map<std::uint32_t, std::uint32_t> local;  // floe -> local index
-  std::uint32_t add() {
-    parent.push_back(static_cast<std::uint32_t>(parent.size()));
-    return parent.back();
-  }
+  std::size_t size() const { return sets.size(); }
   // The local index of floe f, added on first sight.
   std::uint32_t node(std::uint32_t f) {
     auto [it, fresh] = local.emplace(f, 0u);
-    if (fresh) it->second = add();
+    if (fresh) it->second = sets.add();
     return it->second;
   }
   // The root of floe f's component; f must have been seen.
-  std::uint32_t root_of(std::uint32_t f) { return find(local.at(f)); }
-  std::uint32_t find(std::uint32_t i) {
-    while (parent[i] != i) i = parent[i] = parent[parent[i]];
-    return i;
-  }
-  void join(std::uint32_t a, std::uint32_t b) { parent[find(a)] = find(b); }
+  std::uint32_t root_of(std::uint32_t f) { return sets.find(local.at(f)); }
+  std::uint32_t find(std::uint32_t i) { return sets.find(i); }
+  void join(std::uint32_t a, std::uint32_t b) { sets.join(a, b); }
 };
 
 // One row of G: up to two floe blocks (local floe index, 3 coefficients).
@@ -100,16 +94,6 @@ double velocity_error(const lcp::Lcp& problem, const Eigen::VectorXd& z, const s
   return worst;
 }
 
-// Lemke's pivot limit on collision LCPs, per unknown (the solver's own
-// default is 50 per unknown). Solved from scratch, the LCPs of a 500-floe jam
-// (3700 to 4600 unknowns) took 1 to 3 pivots per unknown, where one solve of
-// the 70% jam (t = 1140 s) was still inside Lemke after 14 minutes, under the
-// default limit (about 200,000 pivots a step of the chain). At 5 per unknown,
-// 5 LCPs of the 50% jam failed (t = 1920 to 1980 s: Lemke stopped far from
-// the solution and the Gauss–Seidel stalled from there); at 15 none did to
-// t = 2100 s. Beyond this limit the chain's contact-wise Gauss–Seidel takes
-// over (lcp/fallback.hpp).
-constexpr long kLemkePivotsPerUnknown = 15;
 
 // Made by the step (impulse.hpp): the contact approached at the start of the
 // step at most a third as fast as now, or no faster than the step's smooth
@@ -349,7 +333,7 @@ lcp::FallbackResult solve(const ComponentLcp& a, const Floes& floes, const std::
   const std::size_t m = a.contacts(), n = 4 * m;
   lcp::FallbackOptions solver = opt.solver;  // with the layout, for the contact-wise Gauss–Seidel
   solver.friction = {m, opt.friction};
-  if (solver.lemke.max_pivots == 0) solver.lemke.max_pivots = kLemkePivotsPerUnknown * static_cast<long>(n) + 1000;
+  if (solver.lemke.max_pivots == 0) solver.lemke.max_pivots = opt.lemke_pivots_per_unknown * static_cast<long>(n) + 1000;
   lcp::FallbackResult res;
   const bool use_warm = opt.warm != nullptr && n >= opt.warm_min;
   bool warm_solved = false;
@@ -484,16 +468,16 @@ std::size_t resolve_step_collisions(Floes& floes, std::span<const FloeState> sta
   opt.speculative_step = step;
   std::vector<ContactPoint> contacts = detection.contacts;
   // Jams: contact components (dynamic floes joined by contact points) of at
-  // least opt.jam_floes floes.
+  // least opt.jam.floes floes.
   Components jam;
   for (const ContactPoint& c : contacts)
     if (!floes.is_static[c.a] && !floes.is_static[c.b]) jam.join(jam.node(c.a), jam.node(c.b));
-  std::vector<std::uint32_t> jam_size(jam.parent.size(), 0);
+  std::vector<std::uint32_t> jam_size(jam.size(), 0);
   for (const auto& [f, local] : jam.local) ++jam_size[jam.find(local)];
   auto in_jam = [&](std::uint32_t f) {
     if (floes.is_static[f]) return false;
     const auto it = jam.local.find(f);
-    return it != jam.local.end() && jam_size[jam.find(it->second)] >= opt.jam_floes;
+    return it != jam.local.end() && jam_size[jam.find(it->second)] >= opt.jam.floes;
   };
   auto jammed = [&](std::uint32_t a, std::uint32_t b) { return in_jam(a) || in_jam(b); };
   std::vector<std::uint8_t> resting(contacts.size(), 0);
@@ -552,7 +536,7 @@ std::size_t resolve_step_collisions(Floes& floes, std::span<const FloeState> sta
       if (floes.is_static[c.a] || floes.is_static[c.b]) comp.node(dynamic_end(c));
       else comp.join(comp.node(c.a), comp.node(c.b));
     }
-    std::vector<std::uint8_t> redo(comp.parent.size(), 0);
+    std::vector<std::uint8_t> redo(comp.size(), 0);
     for (std::size_t k = first_new; k < contacts.size(); ++k) redo[comp.root_of(dynamic_end(contacts[k]))] = 1;
     again.clear();
     again_resting.clear();
