@@ -18,7 +18,9 @@
 //                on all sides, wind 15 m/s along x (the jam test of
 //                tests/coupling: the pack drifts ~500 m, jams against the
 //                downwind wall and stays there), to 10^4 s (100) / 3 10^3 s
-//                (500). Not part of the cost-vs-N fit.
+//                (500); jam_2000: 2000 floes of jam_500's sizes in a 2 km
+//                walled box (the downwind wall is the coast), to 3 10^3 s.
+//                Not part of the cost-vs-N fit.
 //
 // Per scenario: a warm-up run (to 10% of the simulated time), then R timed
 // runs (each a fresh Simulation; the minimum wall time is kept, the median is
@@ -72,6 +74,7 @@ struct BenchScenario {
   double t_end = 0.0;         // s simulated
   double floedyn_s = -1.0;    // FloeDyn, one core of this machine kind (issue 4); < 0: unknown
   bool jam = false;           // a walled pack pushed by the wind against the downwind wall
+  double jam_box = 1000.0;    // m, side of a jam's walled box
 };
 
 const std::vector<BenchScenario> kScenarios = {
@@ -81,6 +84,7 @@ const std::vector<BenchScenario> kScenarios = {
     {"pack_10000", 10000, 1.0e3, -1.0},
     {"jam_100", 100, 1.0e4, -1.0, true},
     {"jam_500", 500, 3.0e3, -1.0, true},
+    {"jam_2000", 2000, 3.0e3, -1.0, true, 2000.0},
 };
 
 constexpr double kMeanDiameter = 100.0;  // m
@@ -98,14 +102,14 @@ double box_side(std::size_t n) {
   return std::sqrt(static_cast<double>(n) * mean_area / kConcentration);
 }
 
-// The pack of a jam_N scenario: N floes at rest covering 50% of a 1 km box
-// walled on all sides (20 m walls), default sizes and thickness (1 m) as in
+// The pack of a jam_N scenario: N floes at rest covering 50% of a walled box
+// (1 km, 2 km for jam_2000) walled on all sides (20 m walls), default sizes and thickness (1 m) as in
 // the jam test of tests/coupling/test_collisions.cpp.
 std::string write_jam_pack(const BenchScenario& s, const std::string& dir) {
   PackOptions o;
   o.floes = s.floes;
   o.concentration = kConcentration;
-  o.width = o.height = 1000.0;
+  o.width = o.height = s.jam_box;
   o.seed = 11;
   o.wall_width = 20.0;
   GeneratedPack pack = generate_pack(o);
@@ -334,7 +338,7 @@ int main(int argc, char** argv) {
   std::string csv, child, pack_dir_arg;
   app.add_option("--repeats", repeats, "timed runs per scenario after the warm-up (minimum kept)")
       ->check(CLI::PositiveNumber);
-  app.add_option("--repeats-large", repeats_large, "timed runs for scenarios of 10^4 floes or more, and jam_500")
+  app.add_option("--repeats-large", repeats_large, "timed runs for scenarios of 10^4 floes or more, and jams of 500 floes or more")
       ->check(CLI::PositiveNumber);
   app.add_option("--only", only, "scenarios to run (default: all)");
   app.add_option("--csv", csv, "write the results as CSV to this file");

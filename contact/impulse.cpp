@@ -6,34 +6,31 @@
 #include <cmath>
 #include <numeric>
 #include <cstdlib>
+#include <sstream>
 #include <unordered_map>
+
+#include "contact/lcp/siconos_io.hpp"
 
 namespace floesim::contact {
 
 namespace {
 
-// Union–find over the floes that have contacts (local indices), so a call
+// Disjoint sets over the floes that have contacts (local indices), so a call
 // costs the size of its contact list, not of the pack.
 struct Components {
-  std::vector<std::uint32_t> parent;
+  DisjointSets sets;
   std::unordered_map<std::uint32_t, std::uint32_t> local;  // floe -> local index
-  std::uint32_t add() {
-    parent.push_back(static_cast<std::uint32_t>(parent.size()));
-    return parent.back();
-  }
+  std::size_t size() const { return sets.size(); }
   // The local index of floe f, added on first sight.
   std::uint32_t node(std::uint32_t f) {
     auto [it, fresh] = local.emplace(f, 0u);
-    if (fresh) it->second = add();
+    if (fresh) it->second = sets.add();
     return it->second;
   }
   // The root of floe f's component; f must have been seen.
-  std::uint32_t root_of(std::uint32_t f) { return find(local.at(f)); }
-  std::uint32_t find(std::uint32_t i) {
-    while (parent[i] != i) i = parent[i] = parent[parent[i]];
-    return i;
-  }
-  void join(std::uint32_t a, std::uint32_t b) { parent[find(a)] = find(b); }
+  std::uint32_t root_of(std::uint32_t f) { return sets.find(local.at(f)); }
+  std::uint32_t find(std::uint32_t i) { return sets.find(i); }
+  void join(std::uint32_t a, std::uint32_t b) { sets.join(a, b); }
 };
 
 // One row of G: up to two floe blocks (local floe index, 3 coefficients).
@@ -97,16 +94,6 @@ double velocity_error(const lcp::Lcp& problem, const Eigen::VectorXd& z, const s
   return worst;
 }
 
-// Lemke's pivot limit on collision LCPs, per unknown (the solver's own
-// default is 50 per unknown). Solved from scratch, the LCPs of a 500-floe jam
-// (3700 to 4600 unknowns) took 1 to 3 pivots per unknown, where one solve of
-// the 70% jam (t = 1140 s) was still inside Lemke after 14 minutes, under the
-// default limit (about 200,000 pivots a step of the chain). At 5 per unknown,
-// 5 LCPs of the 50% jam failed (t = 1920 to 1980 s: Lemke stopped far from
-// the solution and the Gauss–Seidel stalled from there); at 15 none did to
-// t = 2100 s. Beyond this limit the chain's contact-wise Gauss–Seidel takes
-// over (lcp/fallback.hpp).
-constexpr long kLemkePivotsPerUnknown = 15;
 
 // Made by the step (impulse.hpp): the contact approached at the start of the
 // step at most a third as fast as now, or no faster than the step's smooth
@@ -175,6 +162,241 @@ void warm_store(WarmStart& warm, const Floes& floes, const std::vector<ContactPo
   }
 }
 
+// Writes a failed LCP as DIR/failed_lcp_<number>.dat ([contact] dump_failed_lcps).
+void dump_failed(const lcp::Lcp& problem, std::size_t m, double friction, const lcp::FallbackResult& res,
+                 long number, const std::string& dir) {
+  std::ostringstream c;
+  c << "floesim collision LCP that the fallback chain did not solve (contact/impulse.hpp): " << m
+    << " contacts, friction " << friction << ", unknowns (lambda[m], beta[2m], alpha[m]), scaled per contact\n"
+    << "attempts (method status pivots residual):";
+  for (const lcp::Attempt& a : res.attempts)
+    c << " " << lcp::to_string(a.method) << " " << lcp::to_string(a.status) << " " << a.pivots << " " << a.residual << ";";
+  lcp::write_siconos_lcp(problem, dir + "/failed_lcp_" + std::to_string(number) + ".dat", c.str());
+}
+
+// The collision LCP of one contact component (impulse.hpp), assembled as
+// data: G's rows, the floes' velocities and inverse masses, the per-contact
+// scaling, targets and restitutions, and the scaled LCP itself.
+struct ComponentLcp {
+  std::vector<std::size_t> list;     // the component's contacts (indices into the caller's list)
+  std::vector<std::uint32_t> global; // its dynamic floes, in local order
+  std::vector<Row> rows;             // 3m rows: normals [m], then +T, -T per contact
+  Eigen::VectorXd W, Ainv;           // 3 per floe: (vx, vy, omega), (1/m, 1/m, 1/I)
+  std::vector<double> target;        // m/s, the normal velocity each contact must reach
+  std::vector<double> scale;         // s_k = 1 / sqrt(D_kk)
+  std::vector<double> restitution;   // e_k
+  lcp::Lcp problem;                  // scaled, M' = S M S, q' = S q (q from W, refreshed by fill_q)
+  double fastest = 0.0;              // m/s, the most negative normal entry of q at assembly (fill_q)
+
+  std::size_t contacts() const { return list.size(); }
+  std::size_t contact_of(std::size_t r) const {
+    const std::size_t m = contacts();
+    return r < m ? r : (r - m) / 2;
+  }
+  double row_times(const Row& r, const Eigen::VectorXd& v) const {
+    double s = 0.0;
+    if (r.fa >= 0) s += r.ga.dot(v.segment<3>(3 * r.fa));
+    if (r.fb >= 0) s += r.gb.dot(v.segment<3>(3 * r.fb));
+    return s;
+  }
+  // q' = S (Gn W - target, Gt W, 0); returns the most negative unscaled
+  // normal entry (the fastest approach once the targets are met: nothing to
+  // do if it is >= 0).
+  double fill_q() {
+    const std::size_t m = contacts();
+    problem.q = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(4 * m));
+    double worst = 0.0;
+    for (std::size_t r = 0; r < 3 * m; ++r) {
+      double q = row_times(rows[r], W);
+      if (r < m) {
+        q -= target[r];
+        worst = std::min(worst, q);
+      }
+      problem.q[static_cast<Eigen::Index>(r)] = scale[contact_of(r)] * q;
+    }
+    return worst;
+  }
+};
+
+// Assembles the LCP of the contacts `list` from the floes' present
+// velocities (impulse.hpp). M is dense up to opt.dense_max unknowns.
+ComponentLcp assemble(const Floes& floes, const std::vector<ContactPoint>& contacts, std::vector<std::size_t> list,
+                      const ImpulseOptions& opt, std::span<const std::uint8_t> resting) {
+  ComponentLcp a;
+  a.list = std::move(list);
+  const std::size_t m = a.list.size();
+  // Local numbering of the dynamic floes of the component.
+  std::unordered_map<std::uint32_t, int> local;
+  auto index_of = [&](std::uint32_t f) -> int {
+    if (floes.is_static[f]) return -1;
+    auto [it, fresh] = local.emplace(f, static_cast<int>(a.global.size()));
+    if (fresh) a.global.push_back(f);
+    return it->second;
+  };
+  a.rows.resize(3 * m);
+  for (std::size_t k = 0; k < m; ++k) {
+    const ContactPoint& c = contacts[a.list[k]];
+    const int la = index_of(c.a), lb = index_of(c.b);
+    const FloeState &sa = floes.state[c.a], &sb = floes.state[c.b];
+    const Vec2 T{-c.normal.y(), c.normal.x()};
+    a.rows[k] = make_row(c, c.normal, sa, sb, la, lb);
+    a.rows[m + 2 * k] = make_row(c, T, sa, sb, la, lb);
+    a.rows[m + 2 * k + 1] = make_row(c, -T, sa, sb, la, lb);
+  }
+  const std::size_t nf = a.global.size();
+  a.W.resize(static_cast<Eigen::Index>(3 * nf));
+  a.Ainv.resize(static_cast<Eigen::Index>(3 * nf));
+  for (std::size_t f = 0; f < nf; ++f) {
+    const FloeState& s = floes.state[a.global[f]];
+    a.W.segment<3>(3 * static_cast<Eigen::Index>(f)) << s.vx, s.vy, s.yaw_rate;
+    a.Ainv.segment<3>(3 * static_cast<Eigen::Index>(f)) << floes.inv_mass(a.global[f]), floes.inv_mass(a.global[f]),
+        floes.inv_inertia_z(a.global[f]);
+  }
+  // Normal velocity each contact must reach (>= 0 plus the gap stabilisation).
+  a.target.assign(m, 0.0);
+  for (std::size_t k = 0; k < m; ++k) {
+    const ContactPoint& c = contacts[a.list[k]];
+    if (c.speculative) a.target[k] = -0.9 * (c.gap - 0.5 * opt.collision_distance) / opt.speculative_step;
+    else if (c.gap < opt.min_gap) a.target[k] = (opt.min_gap - c.gap) / opt.relaxation_time;
+    // What the floes' turning closes beyond the linear gap (jam time steps).
+    if (opt.speculative_step > 0.0) a.target[k] += c.turning / opt.speculative_step;
+  }
+  // Scaling (symmetric, so the LCP keeps the structure Lemke relies on):
+  // with s_k = 1 / sqrt(D_kk), D = Gn A^-1 Gn^T (s_k^2 is the effective
+  // mass at contact k), the unknowns are lambda_k = s_k lambda'_k,
+  // beta_k = s_k beta'_k, alpha_k = alpha'_k / s_k, and the rows of contact k
+  // are multiplied by s_k (normal, tangent) and 1/s_k (friction): M' = S M S,
+  // q' = S q. The normal diagonal becomes 1, the E, mu and -E^T entries are
+  // unchanged, and M' is copositive as M is (z'^T M' z' = (S z')^T M (S z')).
+  // Unscaled, inverse masses of 1e-7 next to the O(1) friction rows defeat
+  // the pivoting tolerances; scaled on one side only (M S), the Delassus
+  // block loses its symmetry and Lemke ends on secondary rays in jams.
+  a.scale.assign(m, 1.0);
+  for (std::size_t k = 0; k < m; ++k) {
+    double dkk = 0.0;
+    const Row& r = a.rows[k];
+    if (r.fa >= 0) dkk += r.ga.cwiseProduct(a.Ainv.segment<3>(3 * r.fa)).dot(r.ga);
+    if (r.fb >= 0) dkk += r.gb.cwiseProduct(a.Ainv.segment<3>(3 * r.fb)).dot(r.gb);
+    if (dkk > 0.0) a.scale[k] = 1.0 / std::sqrt(dkk);
+  }
+  // Restitution per contact: 0 for resting and speculative contacts (see the header).
+  a.restitution.assign(m, opt.restitution);
+  for (std::size_t k = 0; k < m; ++k)
+    if (contacts[a.list[k]].speculative || (!resting.empty() && resting[a.list[k]])) a.restitution[k] = 0.0;
+
+  // Delassus blocks G A^-1 G^T: rows interact through shared floes.
+  std::vector<std::vector<std::size_t>> rows_of(nf);
+  for (std::size_t r = 0; r < a.rows.size(); ++r) {
+    if (a.rows[r].fa >= 0) rows_of[static_cast<std::size_t>(a.rows[r].fa)].push_back(r);
+    if (a.rows[r].fb >= 0) rows_of[static_cast<std::size_t>(a.rows[r].fb)].push_back(r);
+  }
+  auto block = [&](const Row& r, int f) -> const Eigen::Vector3d* {
+    if (r.fa == f) return &r.ga;
+    if (r.fb == f) return &r.gb;
+    return nullptr;
+  };
+  const std::size_t n = 4 * m;
+  std::vector<Eigen::Triplet<double>> trip;
+  trip.reserve(n * 8);
+  for (std::size_t f = 0; f < nf; ++f) {
+    const Eigen::Vector3d ai = a.Ainv.segment<3>(3 * static_cast<Eigen::Index>(f));
+    for (std::size_t r1 : rows_of[f])
+      for (std::size_t r2 : rows_of[f]) {
+        const Eigen::Vector3d& g1 = *block(a.rows[r1], static_cast<int>(f));
+        const Eigen::Vector3d& g2 = *block(a.rows[r2], static_cast<int>(f));
+        trip.emplace_back(static_cast<int>(r1), static_cast<int>(r2),
+                          a.scale[a.contact_of(r1)] * g1.cwiseProduct(ai).dot(g2) * a.scale[a.contact_of(r2)]);
+      }
+  }
+  for (std::size_t k = 0; k < m; ++k) {
+    const int al = static_cast<int>(3 * m + k);
+    trip.emplace_back(static_cast<int>(m + 2 * k), al, 1.0);  // E
+    trip.emplace_back(static_cast<int>(m + 2 * k + 1), al, 1.0);
+    trip.emplace_back(al, static_cast<int>(k), opt.friction);  // mu
+    trip.emplace_back(al, static_cast<int>(m + 2 * k), -1.0);  // -E^T
+    trip.emplace_back(al, static_cast<int>(m + 2 * k + 1), -1.0);
+  }
+  lcp::SparseMatrix S(static_cast<int>(n), static_cast<int>(n));
+  S.setFromTriplets(trip.begin(), trip.end());  // duplicates (same floe twice) are summed
+  if (n <= opt.dense_max) a.problem.M = lcp::DenseMatrix(S);
+  else a.problem.M = std::move(S);
+  a.fastest = a.fill_q();
+  return a;
+}
+
+// Solves a component's LCP: large ones first by Lemke from the basis in
+// opt.warm (WarmStart), then the fallback chain (lcp/fallback.hpp); an answer
+// the chain did not accept is still taken within opt.velocity_tolerance. The
+// statistics are counted here; a failure is written to opt.dump_failed_lcps.
+lcp::FallbackResult solve(const ComponentLcp& a, const Floes& floes, const std::vector<ContactPoint>& contacts,
+                          const ImpulseOptions& opt, CollisionStats& stats) {
+  const std::size_t m = a.contacts(), n = 4 * m;
+  lcp::FallbackOptions solver = opt.solver;  // with the layout, for the contact-wise Gauss–Seidel
+  solver.friction = {m, opt.friction};
+  if (solver.lemke.max_pivots == 0) solver.lemke.max_pivots = opt.lemke_pivots_per_unknown * static_cast<long>(n) + 1000;
+  lcp::FallbackResult res;
+  const bool use_warm = opt.warm != nullptr && n >= opt.warm_min;
+  bool warm_solved = false;
+  if (use_warm) {
+    std::vector<std::uint8_t> guess = warm_guess(*opt.warm, floes, contacts, a.list);
+    if (std::find(guess.begin(), guess.end(), 1) != guess.end()) {
+      lcp::LemkeOptions lo = solver.lemke;
+      lo.start = &guess;
+      lcp::Result r = lcp::solve_lemke(a.problem, lo);
+      if (r.status == lcp::Status::solved && r.residual <= opt.solver.accept_residual) {
+        res.result = std::move(r);
+        warm_solved = true;
+        ++stats.warm;
+      } else {
+        ++stats.warm_missed;
+        stats.pivots += r.pivots;  // the warm attempt's pivots count too
+      }
+    }
+  }
+  if (!warm_solved) res = lcp::solve_with_fallbacks(a.problem, solver);
+  if (use_warm && res.solved() && !res.result.z_basic.empty())
+    warm_store(*opt.warm, floes, contacts, a.list, res.result.z_basic);
+  ++stats.lcps;
+  stats.contacts += static_cast<long>(m);
+  stats.pivots += res.result.pivots;
+  stats.largest = std::max(stats.largest, static_cast<long>(n));
+  stats.total_size += static_cast<long>(n);
+  if (res.attempts.size() > 1) ++stats.fallbacks;
+  if (res.flagged) ++stats.flagged;
+  if (res.solved() && res.method == lcp::Method::coulomb_gs) ++stats.gauss_seidel;
+  if (!res.solved() && res.result.z.size() == static_cast<Eigen::Index>(n) &&
+      velocity_error(a.problem, res.result.z, a.scale) <= opt.velocity_tolerance) {
+    res.result.status = lcp::Status::solved;  // within velocity_tolerance (impulse.hpp)
+    ++stats.tolerated;
+  }
+  if (!res.solved()) {
+    ++stats.failures;
+    if (!opt.dump_failed_lcps.empty()) dump_failed(a.problem, m, opt.friction, res, stats.failures, opt.dump_failed_lcps);
+  }
+  return res;
+}
+
+// Applies the scaled answer z' of pass `pass` (0: compression then Poisson's
+// decompression, impulse (1 + e_k) z_k; 1: compression only) to the
+// component's velocities, W += A^-1 G^T z, and adds the impulses to `total`.
+void apply(ComponentLcp& a, const lcp::Vector& z_scaled, int pass, Eigen::VectorXd& total) {
+  const std::size_t m = a.contacts();
+  Eigen::VectorXd z = z_scaled.head(static_cast<Eigen::Index>(3 * m));
+  for (std::size_t r = 0; r < 3 * m; ++r) {
+    const std::size_t k = a.contact_of(r);
+    z[static_cast<Eigen::Index>(r)] *= a.scale[k] * (pass == 0 ? 1.0 + a.restitution[k] : 1.0);
+  }
+  total += z;
+  Eigen::VectorXd p = Eigen::VectorXd::Zero(a.W.size());
+  for (std::size_t r = 0; r < 3 * m; ++r) {
+    const double zr = z[static_cast<Eigen::Index>(r)];
+    if (zr == 0.0) continue;
+    if (a.rows[r].fa >= 0) p.segment<3>(3 * a.rows[r].fa) += zr * a.rows[r].ga;
+    if (a.rows[r].fb >= 0) p.segment<3>(3 * a.rows[r].fb) += zr * a.rows[r].gb;
+  }
+  a.W += a.Ainv.cwiseProduct(p);
+}
+
 }  // namespace
 
 std::vector<ContactImpulse> resolve_collisions(Floes& floes, const std::vector<ContactPoint>& contacts,
@@ -203,212 +425,34 @@ std::vector<ContactImpulse> resolve_collisions(Floes& floes, const std::vector<C
   for (auto& [root, list] : groups) ordered.push_back(std::move(list));
   std::sort(ordered.begin(), ordered.end());  // deterministic order of solves
 
-  for (const std::vector<std::size_t>& list : ordered) {
-    // Local numbering of the dynamic floes of the component.
-    std::unordered_map<std::uint32_t, int> local;
-    std::vector<std::uint32_t> global;
-    auto index_of = [&](std::uint32_t f) -> int {
-      if (floes.is_static[f]) return -1;
-      auto [it, fresh] = local.emplace(f, static_cast<int>(global.size()));
-      if (fresh) global.push_back(f);
-      return it->second;
-    };
-    const std::size_t m = list.size();
-    std::vector<Row> rows(3 * m);
-    for (std::size_t k = 0; k < m; ++k) {
-      const ContactPoint& c = contacts[list[k]];
-      const int la = index_of(c.a), lb = index_of(c.b);
-      const FloeState &sa = floes.state[c.a], &sb = floes.state[c.b];
-      const Vec2 T{-c.normal.y(), c.normal.x()};
-      rows[k] = make_row(c, c.normal, sa, sb, la, lb);
-      rows[m + 2 * k] = make_row(c, T, sa, sb, la, lb);
-      rows[m + 2 * k + 1] = make_row(c, -T, sa, sb, la, lb);
-    }
-    const std::size_t nf = global.size();
-    Eigen::VectorXd W(3 * nf), Ainv(3 * nf);
-    for (std::size_t f = 0; f < nf; ++f) {
-      const FloeState& s = floes.state[global[f]];
-      W.segment<3>(3 * static_cast<Eigen::Index>(f)) << s.vx, s.vy, s.yaw_rate;
-      Ainv.segment<3>(3 * static_cast<Eigen::Index>(f)) << floes.inv_mass(global[f]), floes.inv_mass(global[f]),
-          floes.inv_inertia_z(global[f]);
-    }
-    auto apply = [&](const Row& r, const Eigen::VectorXd& v) {
-      double s = 0.0;
-      if (r.fa >= 0) s += r.ga.dot(v.segment<3>(3 * r.fa));
-      if (r.fb >= 0) s += r.gb.dot(v.segment<3>(3 * r.fb));
-      return s;
-    };
-    // Normal velocity each contact must reach (>= 0 plus the gap stabilisation).
-    std::vector<double> target(m, 0.0);
-    for (std::size_t k = 0; k < m; ++k) {
-      const double g = contacts[list[k]].gap;
-      if (contacts[list[k]].speculative) target[k] = -0.9 * (g - 0.5 * opt.collision_distance) / opt.speculative_step;
-      else if (g < opt.min_gap) target[k] = (opt.min_gap - g) / opt.relaxation_time;
-      // What the floes' turning closes beyond the linear gap (jam time steps).
-      if (opt.speculative_step > 0.0) target[k] += contacts[list[k]].turning / opt.speculative_step;
-    }
-    // Scaling (symmetric, so the LCP keeps the structure Lemke relies on):
-    // with s_k = 1 / sqrt(D_kk), D = Gn A^-1 Gn^T (s_k^2 is the effective
-    // mass at contact k), the unknowns are lambda_k = s_k lambda'_k,
-    // beta_k = s_k beta'_k, alpha_k = alpha'_k / s_k, and the rows of contact k
-    // are multiplied by s_k (normal, tangent) and 1/s_k (friction): M' = S M S,
-    // q' = S q. The normal diagonal becomes 1, the E, mu and -E^T entries are
-    // unchanged, and M' is copositive as M is (z'^T M' z' = (S z')^T M (S z')).
-    // Unscaled, inverse masses of 1e-7 next to the O(1) friction rows defeat
-    // the pivoting tolerances; scaled on one side only (M S), the Delassus
-    // block loses its symmetry and Lemke ends on secondary rays in jams.
-    auto contact_of = [m](std::size_t r) { return r < m ? r : (r - m) / 2; };
-    std::vector<double> scale(m, 1.0);
-    for (std::size_t k = 0; k < m; ++k) {
-      double dkk = 0.0;
-      const Row& r = rows[k];
-      if (r.fa >= 0) dkk += r.ga.cwiseProduct(Ainv.segment<3>(3 * r.fa)).dot(r.ga);
-      if (r.fb >= 0) dkk += r.gb.cwiseProduct(Ainv.segment<3>(3 * r.fb)).dot(r.gb);
-      if (dkk > 0.0) scale[k] = 1.0 / std::sqrt(dkk);
-    }
-    // q' = S (Gn W - target, Gt W, 0); returns the most negative unscaled
-    // normal entry (the fastest approach, once the targets are met: nothing to
-    // do if >= 0).
-    lcp::Lcp problem;
-    auto fill_q = [&] {
-      problem.q = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(4 * m));
-      double worst = 0.0;
-      for (std::size_t r = 0; r < 3 * m; ++r) {
-        double q = apply(rows[r], W);
-        if (r < m) {
-          q -= target[r];
-          worst = std::min(worst, q);
-        }
-        problem.q[static_cast<Eigen::Index>(r)] = scale[contact_of(r)] * q;
-      }
-      return worst;
-    };
-    if (!(fill_q() < -opt.approach_tolerance)) continue;
-    // Restitution per contact: 0 for resting contacts (see the header).
-    std::vector<double> restitution(m, opt.restitution);
-    for (std::size_t k = 0; k < m; ++k)
-      if (contacts[list[k]].speculative) restitution[k] = 0.0;
-    if (!resting.empty())
-      for (std::size_t k = 0; k < m; ++k)
-        if (resting[list[k]]) restitution[k] = 0.0;
-
-    // Delassus blocks G A^-1 G^T: rows interact through shared floes.
-    std::vector<std::vector<std::size_t>> rows_of(nf);
-    for (std::size_t r = 0; r < rows.size(); ++r) {
-      if (rows[r].fa >= 0) rows_of[static_cast<std::size_t>(rows[r].fa)].push_back(r);
-      if (rows[r].fb >= 0) rows_of[static_cast<std::size_t>(rows[r].fb)].push_back(r);
-    }
-    auto block = [&](const Row& r, int f) -> const Eigen::Vector3d* {
-      if (r.fa == f) return &r.ga;
-      if (r.fb == f) return &r.gb;
-      return nullptr;
-    };
-    const std::size_t n = 4 * m;
-    std::vector<Eigen::Triplet<double>> trip;
-    trip.reserve(n * 8);
-    for (std::size_t f = 0; f < nf; ++f) {
-      const Eigen::Vector3d ai = Ainv.segment<3>(3 * static_cast<Eigen::Index>(f));
-      for (std::size_t r1 : rows_of[f])
-        for (std::size_t r2 : rows_of[f]) {
-          const Eigen::Vector3d& g1 = *block(rows[r1], static_cast<int>(f));
-          const Eigen::Vector3d& g2 = *block(rows[r2], static_cast<int>(f));
-          trip.emplace_back(static_cast<int>(r1), static_cast<int>(r2),
-                            scale[contact_of(r1)] * g1.cwiseProduct(ai).dot(g2) * scale[contact_of(r2)]);
-        }
-    }
-    for (std::size_t k = 0; k < m; ++k) {
-      const int a = static_cast<int>(3 * m + k);
-      trip.emplace_back(static_cast<int>(m + 2 * k), a, 1.0);       // E
-      trip.emplace_back(static_cast<int>(m + 2 * k + 1), a, 1.0);
-      trip.emplace_back(a, static_cast<int>(k), opt.friction);        // mu
-      trip.emplace_back(a, static_cast<int>(m + 2 * k), -1.0);       // -E^T
-      trip.emplace_back(a, static_cast<int>(m + 2 * k + 1), -1.0);
-    }
-    lcp::SparseMatrix S(static_cast<int>(n), static_cast<int>(n));
-    S.setFromTriplets(trip.begin(), trip.end());  // duplicates (same floe twice) are summed
-    if (n <= opt.dense_max) problem.M = lcp::DenseMatrix(S);
-    else problem.M = std::move(S);
-
+  for (std::vector<std::size_t>& list : ordered) {
+    ComponentLcp a = assemble(floes, contacts, std::move(list), opt, resting);
+    const std::size_t m = a.contacts();
+    if (!(a.fastest < -opt.approach_tolerance)) continue;  // nothing approaches
     // Pass 0: compression LCP on W^-, then Poisson's decompression. Poisson's
     // law applied to several contacts at once can leave a contact that was
     // separating before the collision approaching after it; pass 1 then
     // solves a compression LCP (restitution 0) from W^+ so that no contact
-    // ends approaching.
+    // ends approaching (only where Poisson's law acted).
     Eigen::VectorXd total = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(3 * m));  // impulses applied
-    lcp::FallbackOptions solver = opt.solver;  // with the layout, for the contact-wise Gauss–Seidel
-    solver.friction = {m, opt.friction};
-    if (solver.lemke.max_pivots == 0) solver.lemke.max_pivots = kLemkePivotsPerUnknown * static_cast<long>(n) + 1000;
+    const bool elastic = std::any_of(a.restitution.begin(), a.restitution.end(), [](double e) { return e != 0.0; });
     for (int pass = 0; pass < 2; ++pass) {
-      // Pass 1 only where Poisson's law acted (no restitution: nothing to undo).
-      if (pass == 1 && std::all_of(restitution.begin(), restitution.end(), [](double e) { return e == 0.0; })) break;
-      if (pass == 1 && !(fill_q() < -opt.approach_tolerance)) break;  // pass 0 uses the q above
-      // Large LCPs: first Lemke from the last basis of their contacts (WarmStart).
-      lcp::FallbackResult res;
-      const bool use_warm = opt.warm != nullptr && n >= opt.warm_min;
-      bool warm_solved = false;
-      if (use_warm) {
-        std::vector<std::uint8_t> guess = warm_guess(*opt.warm, floes, contacts, list);
-        if (std::find(guess.begin(), guess.end(), 1) != guess.end()) {
-          lcp::LemkeOptions lo = solver.lemke;
-          lo.start = &guess;
-          lcp::Result r = lcp::solve_lemke(problem, lo);
-          if (r.status == lcp::Status::solved && r.residual <= opt.solver.accept_residual) {
-            res.result = std::move(r);
-            warm_solved = true;
-            ++stats.warm;
-          } else {
-            ++stats.warm_missed;
-            stats.pivots += r.pivots;  // the warm attempt's pivots count too
-          }
-        }
-      }
-      if (!warm_solved) res = lcp::solve_with_fallbacks(problem, solver);
-      if (use_warm && res.solved() && !res.result.z_basic.empty())
-        warm_store(*opt.warm, floes, contacts, list, res.result.z_basic);
-      ++stats.lcps;
-      stats.contacts += static_cast<long>(m);
-      stats.pivots += res.result.pivots;
-      stats.largest = std::max(stats.largest, static_cast<long>(n));
-      stats.total_size += static_cast<long>(n);
-      if (res.attempts.size() > 1) ++stats.fallbacks;
-      if (res.flagged) ++stats.flagged;
-      if (res.solved() && res.method == lcp::Method::coulomb_gs) ++stats.gauss_seidel;
-      if (!res.solved() && res.result.z.size() == static_cast<Eigen::Index>(n) &&
-          velocity_error(problem, res.result.z, scale) <= opt.velocity_tolerance) {
-        res.result.status = lcp::Status::solved;  // within velocity_tolerance (impulse.hpp)
-        ++stats.tolerated;
-      }
-      if (!res.solved()) {
-        ++stats.failures;
-        break;  // leave these velocities as they are: counted and reported
-      }
-      // W += A^-1 G^T diag(1 + e_k) z (pass 1: restitution 0).
-      Eigen::VectorXd z = res.result.z.head(static_cast<Eigen::Index>(3 * m));
-      for (std::size_t r = 0; r < 3 * m; ++r) {
-        const std::size_t k = contact_of(r);
-        z[static_cast<Eigen::Index>(r)] *= scale[k] * (pass == 0 ? 1.0 + restitution[k] : 1.0);
-      }
-      total += z;
-      Eigen::VectorXd p = Eigen::VectorXd::Zero(3 * static_cast<Eigen::Index>(nf));
-      for (std::size_t r = 0; r < 3 * m; ++r) {
-        const double zr = z[static_cast<Eigen::Index>(r)];
-        if (zr == 0.0) continue;
-        if (rows[r].fa >= 0) p.segment<3>(3 * rows[r].fa) += zr * rows[r].ga;
-        if (rows[r].fb >= 0) p.segment<3>(3 * rows[r].fb) += zr * rows[r].gb;
-      }
-      W += Ainv.cwiseProduct(p);
+      if (pass == 1 && (!elastic || !(a.fill_q() < -opt.approach_tolerance))) break;
+      const lcp::FallbackResult res = solve(a, floes, contacts, opt, stats);
+      if (!res.solved()) break;  // leave these velocities as they are: counted and reported
+      apply(a, res.result.z, pass, total);
     }
-    for (std::size_t f = 0; f < nf; ++f) {
-      FloeState& s = floes.state[global[f]];
-      s.vx = W[3 * static_cast<Eigen::Index>(f)];
-      s.vy = W[3 * static_cast<Eigen::Index>(f) + 1];
-      s.yaw_rate = W[3 * static_cast<Eigen::Index>(f) + 2];
+    for (std::size_t f = 0; f < a.global.size(); ++f) {
+      FloeState& s = floes.state[a.global[f]];
+      s.vx = a.W[3 * static_cast<Eigen::Index>(f)];
+      s.vy = a.W[3 * static_cast<Eigen::Index>(f) + 1];
+      s.yaw_rate = a.W[3 * static_cast<Eigen::Index>(f) + 2];
     }
     for (std::size_t k = 0; k < m; ++k) {
-      ContactImpulse& ci = impulses[list[k]];
+      ContactImpulse& ci = impulses[a.list[k]];
       ci.normal = total[static_cast<Eigen::Index>(k)];
       ci.tangential = total[static_cast<Eigen::Index>(m + 2 * k)] - total[static_cast<Eigen::Index>(m + 2 * k + 1)];
-      const ContactPoint& c = contacts[list[k]];
+      const ContactPoint& c = contacts[a.list[k]];
       ci.vector = ci.normal * c.normal + ci.tangential * Vec2{-c.normal.y(), c.normal.x()};
       ci.point = c.point;
     }
@@ -424,16 +468,16 @@ std::size_t resolve_step_collisions(Floes& floes, std::span<const FloeState> sta
   opt.speculative_step = step;
   std::vector<ContactPoint> contacts = detection.contacts;
   // Jams: contact components (dynamic floes joined by contact points) of at
-  // least opt.jam_floes floes.
+  // least opt.jam.floes floes.
   Components jam;
   for (const ContactPoint& c : contacts)
     if (!floes.is_static[c.a] && !floes.is_static[c.b]) jam.join(jam.node(c.a), jam.node(c.b));
-  std::vector<std::uint32_t> jam_size(jam.parent.size(), 0);
+  std::vector<std::uint32_t> jam_size(jam.size(), 0);
   for (const auto& [f, local] : jam.local) ++jam_size[jam.find(local)];
   auto in_jam = [&](std::uint32_t f) {
     if (floes.is_static[f]) return false;
     const auto it = jam.local.find(f);
-    return it != jam.local.end() && jam_size[jam.find(it->second)] >= opt.jam_floes;
+    return it != jam.local.end() && jam_size[jam.find(it->second)] >= opt.jam.floes;
   };
   auto jammed = [&](std::uint32_t a, std::uint32_t b) { return in_jam(a) || in_jam(b); };
   std::vector<std::uint8_t> resting(contacts.size(), 0);
@@ -492,7 +536,7 @@ std::size_t resolve_step_collisions(Floes& floes, std::span<const FloeState> sta
       if (floes.is_static[c.a] || floes.is_static[c.b]) comp.node(dynamic_end(c));
       else comp.join(comp.node(c.a), comp.node(c.b));
     }
-    std::vector<std::uint8_t> redo(comp.parent.size(), 0);
+    std::vector<std::uint8_t> redo(comp.size(), 0);
     for (std::size_t k = first_new; k < contacts.size(); ++k) redo[comp.root_of(dynamic_end(contacts[k]))] = 1;
     again.clear();
     again_resting.clear();

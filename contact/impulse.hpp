@@ -67,7 +67,7 @@
 //    (at most two more times). Impacts (approaches that are not pushed) keep
 //    their instant and restitution: the step's sub-steps resolve them
 //    (substep.hpp).
-//  * Jams: a contact component of at least jam_floes floes is a jam. Every
+//  * Jams: a contact component of at least jam.floes floes (jam.hpp) is a jam. Every
 //    contact of a jam floe rests and every point beyond xi of its pairs (with
 //    other jam floes, obstacles, or floes coming at it) is speculative from
 //    the first solve: the jam is time-stepped (one LCP per step, as in dense
@@ -85,10 +85,12 @@
 #include <array>
 #include <cstdint>
 #include <span>
+#include <string>
 #include <unordered_map>
 #include <vector>
 
 #include "contact/detection.hpp"
+#include "contact/jam.hpp"
 #include "contact/lcp/fallback.hpp"
 
 namespace floesim::contact {
@@ -139,9 +141,16 @@ struct ImpulseOptions {
   double relaxation_time = 10.0;  // s, tau of the gap stabilisation
   double collision_distance = 0.01;  // xi, m (speculative contacts)
   double speculative_step = 0.0;     // s, the step speculative contacts are for (set by resolve_step_collisions)
-  std::size_t jam_floes = 20;        // a contact component of this many floes is a jam (resolve_step_collisions)
+  JamOptions jam;                    // what a jam is and how it is time-stepped (jam.hpp)
   std::size_t dense_max = 400;  // LCPs up to this size are assembled dense, larger sparse
   lcp::FallbackOptions solver;
+  // Lemke's pivot limit on collision LCPs, per unknown, when
+  // solver.lemke.max_pivots is 0 (Lemke's own default is 50 per unknown):
+  // limit = lemke_pivots_per_unknown n + 1000. From scratch, the LCPs of a
+  // 500-floe jam take 1 to 3 pivots per unknown, and beyond the limit the
+  // chain's contact-wise Gauss–Seidel takes over; at 5 per unknown some of
+  // its LCPs failed, at 15 none did (docs/contact.md).
+  long lemke_pivots_per_unknown = 15;
   // An answer the fallback chain did not accept (its residual above
   // solver.accept_residual) is still taken when every contact's
   // complementarity error, as a velocity, is at most this (m/s; see
@@ -157,6 +166,13 @@ struct ImpulseOptions {
   // basis in `warm` (null: never); the caller owns it and keeps it across steps.
   WarmStart* warm = nullptr;
   std::size_t warm_min = 200;
+  // A folder ("": none) where every LCP that ends as a failure (counted in
+  // CollisionStats::failures) is written in the Siconos format
+  // (lcp/siconos_io.hpp) as failed_lcp_<k>.dat, k = the failure's number in
+  // the run, with the contact count, friction and the chain's attempts in
+  // its comment: a failure from any run becomes test data. Config key
+  // [contact] dump_failed_lcps.
+  std::string dump_failed_lcps;
 };
 
 // Running totals of a run (written to /diagnostics/lcp and the summary).

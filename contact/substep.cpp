@@ -19,19 +19,6 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr int kFree = -1;
 // A sub-step is halved after an overlap down to this fraction of the floor.
 constexpr double kHalvingFloor = 0x1.0p-20;
-// A jam whose time step overlaps halves it (the linearised gaps miss the
-// floes' turning by a term in h^2); below this fraction of dt it goes to events.
-constexpr double kJamStepFloor = 1.0 / 16.0;
-// A jam's time step solves its LCP again while the turning of its floes
-// closes a contact by more than kTurningSlack xi beyond what it asked for
-// (time_step), at most kTurningRounds more times.
-constexpr double kTurningSlack = 0.01;
-constexpr int kTurningRounds = 3;
-// Dynamic floes whose room to a jam-sized cluster is below this many xi
-// (10 m at xi = 1 cm) join it at the start of the step (make_clusters): the
-// jam's time steps move its floes 0.5 to 3 m off their straight paths
-// (jam_500), beyond the budgets of nearer pads.
-constexpr double kJamPad = 1000.0;
 
 // Pairs measured with their contact points and witnesses.
 struct Measured {
@@ -182,12 +169,8 @@ private:
   // by their lowest floe.
   void make_clusters() {
     const std::size_t n = floes_.size();
-    std::vector<std::uint32_t> parent(n);
-    std::iota(parent.begin(), parent.end(), 0u);
-    auto find = [&](std::uint32_t i) {
-      while (parent[i] != i) i = parent[i] = parent[parent[i]];
-      return i;
-    };
+    DisjointSets sets(n);
+    auto find = [&](std::uint32_t i) { return sets.find(i); };
     std::vector<std::uint8_t> hot(n, 0);
     const double tight = opt_.collision_distance;
     for (std::size_t p = 0; p < det_->pairs.size(); ++p) {
@@ -198,18 +181,18 @@ private:
         if (da) hot[q.a] = 1;
         if (db) hot[q.b] = 1;
       }
-      if (da && db) parent[find(q.a)] = find(q.b);
+      if (da && db) sets.join(q.a, q.b);
     }
-    // A jam (a contact component of jam_floes floes or more, impulse.hpp)
+    // A jam (a contact component of jam.floes floes or more, impulse.hpp)
     // joins a cluster whole: its floes would come in one by one anyway, each
     // time with an LCP of the part that came in so far.
     find_jams();
     for (std::uint32_t i = 0; i < n; ++i)
-      if (jam_of_[i] >= 0) parent[find(i)] = find(jams_[static_cast<std::size_t>(jam_of_[i])].front());
-    // A cluster of jam_floes floes or more takes time steps, whose LCP turns
+      if (jam_of_[i] >= 0) sets.join(i, jams_[static_cast<std::size_t>(jam_of_[i])].front());
+    // A cluster of jam.floes floes or more takes time steps, whose LCP turns
     // and speeds up its floes: their deviations from the straight paths
     // outgrow small budgets. The dynamic floes close to such a cluster (room
-    // below kJamPad xi) join it now rather than during its time step, where
+    // below jam.pad xi) join it now rather than during its time step, where
     // each join reruns its LCP.
     {
       std::vector<std::uint32_t> size(n, 0), hot_root(n, 0);
@@ -221,15 +204,15 @@ private:
       std::vector<std::uint8_t> big(n, 0);
       for (std::uint32_t i = 0; i < n; ++i) {
         const std::uint32_t r = find(i);
-        big[i] = !floes_.is_static[i] && hot_root[r] && size[r] >= opt_.impulse.jam_floes;
+        big[i] = !floes_.is_static[i] && hot_root[r] && size[r] >= opt_.impulse.jam.floes;
       }
-      const double pad = kJamPad * tight;
+      const double pad = opt_.impulse.jam.pad * tight;
       for (std::size_t p = 0; p < det_->pairs.size(); ++p) {
         const NearPair& q = det_->pairs[p];
         if (!(room_[p] < pad) || floes_.is_static[q.a] || floes_.is_static[q.b] || !(big[q.a] || big[q.b])) continue;
         hot[q.a] = hot[q.a] || big[q.a];
         hot[q.b] = hot[q.b] || big[q.b];
-        parent[find(q.a)] = find(q.b);
+        sets.join(q.a, q.b);
       }
     }
     std::vector<std::uint8_t> active_root(n, 0);
@@ -252,14 +235,10 @@ private:
   // jam_of_[i]: the jam of floe i (-1: none), jams_: their floes.
   void find_jams() {
     const std::size_t n = floes_.size();
-    std::vector<std::uint32_t> parent(n);
-    std::iota(parent.begin(), parent.end(), 0u);
-    auto find = [&](std::uint32_t i) {
-      while (parent[i] != i) i = parent[i] = parent[parent[i]];
-      return i;
-    };
+    DisjointSets sets(n);
+    auto find = [&](std::uint32_t i) { return sets.find(i); };
     for (const ContactPoint& c : det_->contacts)
-      if (!floes_.is_static[c.a] && !floes_.is_static[c.b]) parent[find(c.a)] = find(c.b);
+      if (!floes_.is_static[c.a] && !floes_.is_static[c.b]) sets.join(c.a, c.b);
     std::vector<std::uint32_t> size(n, 0);
     for (std::uint32_t i = 0; i < n; ++i)
       if (!floes_.is_static[i]) ++size[find(i)];
@@ -267,7 +246,7 @@ private:
     std::vector<int> of_root(n, -1);
     for (std::uint32_t i = 0; i < n; ++i) {
       const std::uint32_t r = find(i);
-      if (floes_.is_static[i] || size[r] < opt_.impulse.jam_floes) continue;
+      if (floes_.is_static[i] || size[r] < opt_.impulse.jam.floes) continue;
       if (of_root[r] < 0) {
         of_root[r] = static_cast<int>(jams_.size());
         jams_.emplace_back();
@@ -337,7 +316,7 @@ private:
   // One event of cluster k: a sub-step, or floes joining it at its time.
   void advance_cluster(int k) {
     Cluster& c = clusters_[static_cast<std::size_t>(k)];
-    if (c.members.size() >= opt_.impulse.jam_floes && !c.events_only) {
+    if (c.members.size() >= opt_.impulse.jam.floes && !c.events_only) {
       time_step(k);
       return;
     }
@@ -422,13 +401,13 @@ private:
     }
   }
 
-  // A dense cluster (jam_floes floes or more) takes the rest of the step in
+  // A dense cluster (jam.floes floes or more) takes the rest of the step in
   // one go: its contacts rest and every point of its pairs beyond xi is a
   // speculative contact for that time (impulse.hpp), one LCP instead of an
   // event, and an LCP of the whole cluster, each time one of its many pairs
   // meets. If that overlaps after all (a pair turning faster than its
   // linearised witness gaps tell: an error in h^2), the time step is redone
-  // with half the length; below kJamStepFloor dt the cluster goes back to
+  // with half the length; below jam.step_floor dt the cluster goes back to
   // events for the rest of the step.
   void time_step(int k) {
     Cluster& c = clusters_[static_cast<std::size_t>(k)];
@@ -464,16 +443,16 @@ private:
       // on the velocities the LCP gives. So the LCP is solved again from the
       // velocities before it, each contact asking for what its turning
       // closed with the last answer on top, until no contact's turning grows
-      // by more than kTurningSlack xi (a few rounds at most: the turning
+      // by more than jam.turning_slack xi (a few rounds at most: the turning
       // hardly changes with the small velocity changes it asks for). The
       // turning kept is the largest seen, so the rounds end.
       for (int turn = 0;; ++turn) {
         resolve_collisions(floes_, contacts, impulse, stats_, resting);
-        if (turn == kTurningRounds) break;
+        if (turn == opt_.impulse.jam.turning_rounds) break;
         bool grew = false;
         for (ContactPoint& cp : contacts) {
           const double closing = turning_closing(floes_, cp, h);
-          if (closing > cp.turning + kTurningSlack * xi) {
+          if (closing > cp.turning + opt_.impulse.jam.turning_slack * xi) {
             cp.turning = closing;
             grew = true;
           }
@@ -530,7 +509,7 @@ private:
       undo();
       for (std::uint32_t i : c.members) posed_.update(floes_, i);
       c.jam_h = 0.5 * h;
-      if (c.jam_h < kJamStepFloor * dt_) c.events_only = true;
+      if (c.jam_h < opt_.impulse.jam.step_floor * dt_) c.events_only = true;
       ++report_.rejected;
       return;
     }

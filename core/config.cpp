@@ -335,7 +335,7 @@ void read_floes(Section s, FloesConfig& c, const std::string& file, const std::s
   s.finish();
 }
 
-void read_contact(Section s, ContactParams& c) {
+void read_contact(Section s, ContactParams& c, const std::string& base_dir) {
   c.collision_distance = s.number("collision_distance", c.collision_distance, positive, "a distance > 0 (m)");
   c.restitution = s.number("restitution", c.restitution, unit_interval, "a restitution in [0, 1]");
   c.friction = s.number("friction", c.friction, non_negative, "a friction coefficient >= 0");
@@ -349,6 +349,9 @@ void read_contact(Section s, ContactParams& c) {
   } else {
     s.node("box");
   }
+  c.dump_failed_lcps = resolve_path(s.string("dump_failed_lcps", ""), base_dir);
+  if (s.has("dump_failed_lcps") && !fs::is_directory(c.dump_failed_lcps))
+    s.fail("dump_failed_lcps", "expected an existing folder, found none at " + c.dump_failed_lcps);
   s.finish();
 }
 
@@ -486,7 +489,7 @@ Config parse_config(std::string_view text, const std::string& name, const std::s
   read_run(Section(top.table("run"), "run", name), c.run);
   read_sea(Section(top.table("sea"), "sea", name), c.sea, name);
   read_floes(Section(top.table("floes"), "floes", name), c.floes, name, base_dir);
-  read_contact(Section(top.table("contact"), "contact", name), c.contact);
+  read_contact(Section(top.table("contact"), "contact", name), c.contact, base_dir);
   read_coupling(Section(top.table("coupling"), "coupling", name), c.coupling, c.sea.model);
   read_forcing(Section(top.table("forcing"), "forcing", name), c.forcing, base_dir);
   read_fracture(Section(top.table("fracture"), "fracture", name), c.fracture, name);
@@ -573,6 +576,7 @@ std::string resolved_toml(const Config& c) {
   toml::table contact{{"collision_distance", c.contact.collision_distance},
                       {"restitution", c.contact.restitution}, {"friction", c.contact.friction},
                       {"domain", c.contact.periodic ? "periodic" : "open"}};
+  if (!c.contact.dump_failed_lcps.empty()) contact.insert("dump_failed_lcps", c.contact.dump_failed_lcps);
   if (c.contact.box[1] > c.contact.box[0])
     contact.insert("box", toml::array{c.contact.box[0], c.contact.box[1], c.contact.box[2], c.contact.box[3]});
   toml::table coupling{{"law", name_of<PenaltyLaw>(c.coupling.law, {{"strong", PenaltyLaw::strong},

@@ -71,6 +71,7 @@ struct ContactParams {
   double friction = 0.7;             // Coulomb mu >= 0
   bool periodic = false;             // a torus made from `box`
   std::array<double, 4> box = {0.0, 0.0, 0.0, 0.0};  // xmin, xmax, ymin, ymax (m); empty: the pack's window
+  std::string dump_failed_lcps;      // an existing folder for the LCPs the solver could not solve ("": none)
 };
 
 enum class PenaltyLaw { strong, weak, blend };

@@ -84,6 +84,7 @@ Simulation::Simulation(Scenario scenario) : scenario_(std::move(scenario)) {
   impulse_options_.relaxation_time = c.run.dt_max;
   impulse_options_.collision_distance = c.contact.collision_distance;
   impulse_options_.warm = warm_.get();
+  impulse_options_.dump_failed_lcps = c.contact.dump_failed_lcps;
   wrap_periodic();
   set_reach();
   detection_ = contact::detect(scenario_.floes, shapes_, detection_options_);

@@ -1,5 +1,6 @@
 #include "contact/lcp/siconos_io.hpp"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <fstream>
@@ -226,6 +227,77 @@ Lcp read_siconos_lcp(const std::string& path) {
   text << file.rdbuf();
   if (file.bad()) throw InputError(where(path, 0, "", "read error"));
   return parse_siconos_lcp(text.str(), path);
+}
+
+namespace {
+void put(std::string& out, double v) {
+  char buf[32];
+  const auto r = std::to_chars(buf, buf + sizeof buf, v);
+  out.append(buf, r.ptr);
+}
+}  // namespace
+
+std::string format_siconos_lcp(const Lcp& lcp, std::string_view comment) {
+  const Index n = lcp.size();
+  std::string out = std::to_string(n) + "\n";
+  if (const auto* D = std::get_if<DenseMatrix>(&lcp.M)) {
+    out += "0\n" + std::to_string(n) + "\n" + std::to_string(n) + "\n";
+    out += std::to_string(n) + " " + std::to_string(n) + "\n";
+    for (Index j = 0; j < n; ++j) {  // column-major: a line per column
+      for (Index i = 0; i < n; ++i) {
+        if (i) out += ' ';
+        put(out, (*D)(i, j));
+      }
+      out += '\n';
+    }
+  } else {
+    // Block-CSR of 1 x 1 blocks: rows of M in order, columns increasing within a row.
+    const Eigen::SparseMatrix<double, Eigen::RowMajor, int> R(std::get<SparseMatrix>(lcp.M));
+    std::vector<std::pair<Index, double>> entries;  // (column, value), row by row
+    std::vector<Index> row_start{0};
+    for (Index i = 0; i < n; ++i) {
+      for (Eigen::SparseMatrix<double, Eigen::RowMajor, int>::InnerIterator it(R, i); it; ++it)
+        if (it.value() != 0.0) entries.emplace_back(it.index(), it.value());
+      row_start.push_back(static_cast<Index>(entries.size()));
+    }
+    const std::string nb = std::to_string(entries.size());
+    out += "1\n" + std::to_string(n) + "\n" + std::to_string(n) + "\n";
+    out += nb + " " + std::to_string(n) + " " + std::to_string(n) + "\n";
+    for (int twice = 0; twice < 2; ++twice) {  // blocksize0 then blocksize1: 1, 2, ..., n
+      for (Index i = 1; i <= n; ++i) out += std::to_string(i) + (i == n ? "\n" : " ");
+    }
+    out += std::to_string(n + 1) + " " + nb + "\n";
+    for (Index i = 0; i <= n; ++i) out += std::to_string(row_start[static_cast<std::size_t>(i)]) + (i == n ? "\n" : " ");
+    for (std::size_t k = 0; k < entries.size(); ++k) out += std::to_string(entries[k].first) + " ";
+    out += "\n";
+    for (std::size_t k = 0; k < entries.size(); ++k) {
+      out += std::to_string(k) + " ";
+      put(out, entries[k].second);
+      out += '\n';
+    }
+  }
+  for (Index i = 0; i < n; ++i) {
+    if (i) out += ' ';
+    put(out, lcp.q(i));
+  }
+  out += '\n';
+  std::size_t at = 0;
+  while (at < comment.size()) {
+    const std::size_t end = std::min(comment.find('\n', at), comment.size());
+    out += "# ";
+    out.append(comment.substr(at, end - at));
+    out += '\n';
+    at = end + 1;
+  }
+  return out;
+}
+
+void write_siconos_lcp(const Lcp& lcp, const std::string& path, std::string_view comment) {
+  const std::string text = format_siconos_lcp(lcp, comment);
+  std::ofstream file(path, std::ios::binary);
+  if (file) file.write(text.data(), static_cast<std::streamsize>(text.size()));
+  if (file) file.close();
+  if (!file) throw RunError(path + ": cannot write the LCP file");
 }
 
 }  // namespace floesim::lcp

@@ -1,5 +1,5 @@
 #pragma once
-// Reader for LCPs in the Siconos Numerics text format (the test collection in
+// Reader and writer for LCPs in the Siconos Numerics text format (the test collection in
 // data/lcp/, format described in its README.md):
 //
 //   n
@@ -31,5 +31,16 @@ Lcp read_siconos_lcp(const std::string& path);
 
 // The same from text in memory; `name` stands for the file in messages.
 Lcp parse_siconos_lcp(std::string_view text, const std::string& name);
+
+// The LCP in that format: a dense M as storage 0, a sparse one as storage 1
+// with 1 x 1 blocks (one block per stored entry, so the file is a CSR of M).
+// Numbers are written in their shortest exact form, so reading the text back
+// gives the same M and q bit for bit. `comment` (one or more lines, each
+// written after "# ") follows q, where the reader ignores it.
+std::string format_siconos_lcp(const Lcp& lcp, std::string_view comment = {});
+
+// Writes format_siconos_lcp to `path`; throws floesim::RunError naming the
+// file when it cannot be written.
+void write_siconos_lcp(const Lcp& lcp, const std::string& path, std::string_view comment = {});
 
 }  // namespace floesim::lcp

@@ -90,6 +90,44 @@ TEST_CASE("lcp io: malformed files are refused naming the file and line and the 
   CHECK(contains(refusal(kHeader2 + "1 2\n3 x\n-1 -1\n"), "bad.dat:7:"));
 }
 
+// The writer's text read back by the reader: the same LCP bit for bit
+// (numbers in shortest exact form), dense and sparse, the comment ignored.
+TEST_CASE("lcp io: written LCPs read back exactly") {
+  DenseMatrix D(3, 3);
+  D << 1.0, 0.1, 0.0,
+       0.1, 2.0 / 3.0, -1e-300,
+       0.7, -1.0, 0.0;
+  Lcp dense;
+  dense.M = D;
+  dense.q = Vector::Zero(3);
+  dense.q << -1.0 / 3.0, 2.5e-17, 4.0;
+  const Lcp back = parse_siconos_lcp(format_siconos_lcp(dense, "a failed LCP\nsecond line 5 6"), "w.dat");
+  REQUIRE(!back.is_sparse());
+  CHECK((std::get<DenseMatrix>(back.M).array() == D.array()).all());
+  CHECK((back.q.array() == dense.q.array()).all());
+
+  Lcp sparse;
+  SparseMatrix S(5, 5);  // row and column 4 empty
+  S.insert(0, 0) = 1.0;
+  S.insert(2, 0) = 1.0 / 7.0;
+  S.insert(1, 3) = -0.7;
+  S.insert(3, 3) = 3e-12;
+  sparse.M = S;
+  sparse.q = Vector::Constant(5, -0.1);
+  const Lcp sback = parse_siconos_lcp(format_siconos_lcp(sparse, "comment"), "s.dat");
+  REQUIRE(sback.is_sparse());
+  CHECK(Eigen::MatrixXd(std::get<SparseMatrix>(sback.M)) == Eigen::MatrixXd(S));
+  CHECK((sback.q.array() == sparse.q.array()).all());
+}
+
+TEST_CASE("lcp io: an LCP written to a folder that does not exist is a run error naming it") {
+  Lcp lcp;
+  lcp.M = DenseMatrix::Identity(1, 1);
+  lcp.q = Vector::Constant(1, -1.0);
+  CHECK_THROWS_WITH_AS(write_siconos_lcp(lcp, "/nonexistent/dir/p.dat"),
+                       doctest::Contains("/nonexistent/dir/p.dat"), RunError);
+}
+
 TEST_CASE("lcp io: a missing file is an input error naming it") {
   CHECK_THROWS_WITH_AS(read_siconos_lcp("/nonexistent/dir/p.dat"),
                        doctest::Contains("/nonexistent/dir/p.dat"), InputError);

@@ -90,6 +90,9 @@ TEST_CASE("unknown keys, wrong types and out-of-range values name file, line and
   refused("[sea]\nmodel = \"fem\"\n", {"[sea] model", "\"spectral\""});
   refused("[sea]\ncells = [0, 4]\n", {"[sea] cells"});
   refused("[contact]\nrestitution = 1.5\n", {"[contact] restitution", "[0, 1]"});
+  refused("[contact]\ndump_failed_lcps = \"no_such_folder\"\n", {"case.toml:2", "[contact] dump_failed_lcps",
+                                                                   "existing folder", "/tmp/no_such_folder"});
+  CHECK(parse("[contact]\ndump_failed_lcps = \".\"\n").contact.dump_failed_lcps == "/tmp/");  // relative to the file
   refused("[forcing]\nwind = [1]\n", {"[forcing] wind", "2 numbers"});
   refused("[forcing]\ncoriolis = 1e-4\nlatitude = 80\n", {"[forcing] latitude", "not both"});
   refused("[bogus]\nx = 1\n", {"case.toml:1", "bogus", "unknown key"});
