@@ -232,7 +232,8 @@ void add_run_command(CLI::App& app, Registry& registry) {
     if (const PercussionStats* f = sim.percussion_stats())
       o << "fracture.checks: " << f->checks << "\nfracture.screened: " << f->screened
         << "\nfracture.sustained: " << f->sustained << "\nfracture.initiations: " << f->initiations
-        << "\nfracture.splits: " << f->splits << "\nfracture.seconds: " << f->seconds << "\n";
+        << "\nfracture.splits: " << f->splits << "\nfracture.seconds: " << f->seconds
+        << "\nfracture.split_seconds: " << f->split_seconds << "\n";
     if (const FloeSeaContact* fs = sim.floe_sea(); fs && fs->implicit()) {
       const FloeSeaContact::ImplicitStats& st = fs->implicit_stats();
       const double steps = std::max<double>(1.0, static_cast<double>(st.steps));

@@ -157,7 +157,11 @@ bool Percussion::check(Floes& floes, const contact::ImpulseRecord& record, doubl
       ev.energy_needed = init.energy_needed;
       ev.delay = init.time;
       ev.sustained = e ? 0.0 : 1.0;
-      if (params_.split && init.through && split(floes, i, init.point, init.direction, ev)) changed = true;
+      if (params_.split && init.through) {
+        const auto cut = std::chrono::steady_clock::now();
+        if (split(floes, i, init.point, init.direction, ev)) changed = true;
+        stats_.split_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - cut).count();
+      }
       events_.push_back(ev);
       break;  // one initiation per floe and step: the floe has cracked
     }

@@ -69,6 +69,7 @@ struct PercussionStats {
   long splits = 0;
   long failed_splits = 0;  // cracked through but not split (sliver, or the pieces would overlap)
   double seconds = 0.0;    // wall time in analyses
+  double split_seconds = 0.0;  // wall time in splits (cut, overlap checks), without the rebuild after them
 };
 
 class Percussion {

@@ -96,6 +96,7 @@ Checkpoint Simulation::save() {
                            {"sustained", p.sustained}})
       k.add(std::string("fracture.") + name, static_cast<double>(v));
     k.add("fracture.seconds", p.seconds);
+    k.add("fracture.split_seconds", p.split_seconds);
   }
   c.counter_names = std::move(k.names);
   c.counters = std::move(k.values);
@@ -155,6 +156,7 @@ void Simulation::restore(const Checkpoint& c) {
                            {"failed_splits", &p.failed_splits}, {"sustained", &p.sustained}})
       *v = count(std::string("fracture.") + name);
     p.seconds = counter("fracture.seconds");
+    p.split_seconds = counter("fracture.split_seconds");
     percussion_->restore_stats(p);
   }
 }
