@@ -16,7 +16,7 @@
 //   its two pieces are new floes appended to the /floes tables, so n grows
 //   during a run; /floes/state (and /xdmf/vertices) hold NaN for a floe at the
 //   records where it does not exist (before it was made, after it split).
-//   /events/fracture [E, 18] (columns attribute): one row per fracture
+//   /events/fracture [E, 17] (columns attribute): one row per fracture
 //     initiation, FractureEventRow below.
 //   /sea/x [nx], /sea/y [ny], /sea/eta [T, ny, nx] (dims 2) or [T, nx] (dims 1)
 //   /diagnostics/energy [T, k] (columns attribute; the last column is "total")
@@ -60,15 +60,14 @@ struct FractureEventRow {
   double x0 = 0.0, y0 = 0.0, x1 = 0.0, y1 = 0.0;  // m, world: the crack's ends
   double criterion = 0.0;   // 0: stress, 1: griffith
   double energy_released = 0.0, energy_needed = 0.0;  // J (griffith; 0 for stress)
-  double delay = 0.0;       // s after the collision of the state judged
+  double delay = 0.0;       // s after the collision of the state judged (0: sustained contact alone, judged statically)
   double piece_a = -1.0, piece_b = -1.0;  // numbers of the two pieces (-1: no split)
-  double sustained = 0.0;   // 0: an impact (with the sustained forces beside it), 1: sustained contact alone
 };
-inline constexpr int kFractureEventColumns = 18;
+inline constexpr int kFractureEventColumns = 17;
 static_assert(sizeof(FractureEventRow) == kFractureEventColumns * sizeof(double));
 inline constexpr const char* kFractureEventColumnNames[kFractureEventColumns] = {
     "time", "floe", "x", "y", "direction", "load", "stress", "x0", "y0", "x1", "y1",
-    "criterion", "energy_released", "energy_needed", "delay", "piece_a", "piece_b", "sustained"};
+    "criterion", "energy_released", "energy_needed", "delay", "piece_a", "piece_b"};
 
 inline constexpr int kSubstepColumns = 9;
 inline constexpr const char* kSubstepColumnNames[kSubstepColumns] = {

@@ -155,8 +155,7 @@ bool Percussion::check(Floes& floes, const contact::ImpulseRecord& record, doubl
       ev.criterion = params_.criterion == FractureCriterion::stress ? 0.0 : 1.0;
       ev.energy_released = init.energy_released;
       ev.energy_needed = init.energy_needed;
-      ev.delay = init.time;
-      ev.sustained = e ? 0.0 : 1.0;
+      ev.delay = init.time;  // 0 for a static analysis (sustained contact alone), > 0 for an impact
       if (params_.split && init.through) {
         const auto cut = std::chrono::steady_clock::now();
         if (split(floes, i, init.point, init.direction, ev)) changed = true;
