@@ -220,7 +220,6 @@ struct CollisionStats {
   long warm_missed = 0;   // warm starts that ended without an accepted solution (then solved from scratch)
 };
 
-
 // Changes the velocities of the floes in contact (W^- -> W^+). Returns the
 // impulses, one per contact, in the order of `contacts`. `resting` (optional,
 // one flag per contact): restitution 0 for those (above).

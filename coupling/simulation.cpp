@@ -7,7 +7,6 @@
 #include <sstream>
 #include <thread>
 
-#include "contact/step_limit.hpp"
 #include "contact/substep.hpp"
 #include "core/error.hpp"
 #include "fluid/sea.hpp"
@@ -172,8 +171,9 @@ StepContext Simulation::choose_dt(double t_stop) {
     }
   }
   // Collisions do not shorten the step: the floes that may meet within it are
-  // sub-stepped by advance() (contact/substep.hpp), which hands its impulses
-  // to the percussion phase (impulse_record_), fracture on or off.
+  // sub-stepped by advance() (contact/substep.hpp); with fracture on, every
+  // solve of the step hands its impulses to the percussion phase
+  // (impulse_record_), whatever sub-step it fell in.
   ctx.start = scenario_.floes.state;
   return ctx;
 }
