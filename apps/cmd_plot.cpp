@@ -1,6 +1,9 @@
-// floesim plot OUT.h5 energy|lcp|heave [-o FILE.png]: diagnostics of a run as
-// PNG line plots (apps/viz/plot.*), so that a run can be judged at a glance.
+// floesim plot OUT.h5 energy|lcp|heave|fracture [-o FILE.png]: diagnostics of
+// a run as PNG line plots (apps/viz/plot.*), so that a run can be judged at a
+// glance.
+#include <cmath>
 #include <filesystem>
+#include <sstream>
 #include <iostream>
 
 #include "apps/commands.hpp"
@@ -65,22 +68,72 @@ std::vector<std::size_t> default_floes(const viz::RunView& run) {
   return out;
 }
 
+// Fracture: the number of (dynamic) floes, and of floes in each size class
+// (equivalent diameter d = sqrt(4 A / pi), `classes` classes of equal width
+// in log d over the run's floes), against time. A floe exists at a record
+// where its state is not NaN (core/run_file.hpp).
+struct FractureSeries {
+  Series count;
+  std::vector<Series> classes;
+};
+FractureSeries fracture_series(const viz::RunView& run, std::size_t classes) {
+  const std::vector<double>& t = run.times();
+  const std::vector<double> area = run.reader().read("/floes/area");
+  const std::size_t n = run.floes();
+  if (area.size() != n)
+    throw InputError(run.path() + ": /floes/area: expected " + std::to_string(n) + " values, one per floe");
+  const std::vector<double> x = run.state_columns(0, 1);  // [T, n]
+  double lo = INFINITY, hi = 0.0;
+  std::vector<double> d(n, 0.0);
+  for (std::size_t i = 0; i < n; ++i) {
+    if (run.is_static(i)) continue;
+    d[i] = std::sqrt(4.0 * area[i] / M_PI);
+    lo = std::min(lo, d[i]);
+    hi = std::max(hi, d[i]);
+  }
+  FractureSeries out;
+  out.count = {"floes", t, {}};
+  if (!(hi > 0.0)) return out;
+  const double span = std::log(hi / lo) > 0.0 ? std::log(hi / lo) : 1.0;
+  auto class_of = [&](double di) {
+    return std::min(classes - 1, static_cast<std::size_t>(static_cast<double>(classes) * std::log(di / lo) / span));
+  };
+  for (std::size_t c = 0; c < classes; ++c) {
+    std::ostringstream name;
+    name.precision(3);
+    name << "d " << lo * std::exp(span * static_cast<double>(c) / static_cast<double>(classes)) << "-"
+         << lo * std::exp(span * static_cast<double>(c + 1) / static_cast<double>(classes)) << " m";
+    out.classes.push_back({name.str(), t, std::vector<double>(t.size(), 0.0)});
+  }
+  for (std::size_t k = 0; k < t.size(); ++k) {
+    double count = 0.0;
+    for (std::size_t i = 0; i < n; ++i) {
+      if (run.is_static(i) || std::isnan(x[k * n + i])) continue;
+      count += 1.0;
+      out.classes[class_of(d[i])].y[k] += 1.0;
+    }
+    out.count.y.push_back(count);
+  }
+  return out;
+}
+
 }  // namespace
 
 void add_plot_command(CLI::App& app, Registry& registry) {
   struct Args { std::string file, what, output, size = "1200x700", floes; };
   auto args = std::make_shared<Args>();
   CLI::App* sub = app.add_subcommand("plot", "Plot a run's diagnostics as PNG: energy (every part), "
-                                              "lcp (collision LCP counters) or heave (floe heave time series)");
+                                              "lcp (collision LCP counters), heave (floe heave time series) or "
+                                              "fracture (floe count and size classes against time)");
   sub->add_option("FILE", args->file, "Run file (.h5)")->required();
-  sub->add_option("WHAT", args->what, "energy, lcp or heave")->required();
+  sub->add_option("WHAT", args->what, "energy, lcp, heave or fracture")->required();
   sub->add_option("-o,--output", args->output, "PNG to write (default: FILE's name with _WHAT.png, here)");
   sub->add_option("--size", args->size, "Picture size in pixels, WxH")->capture_default_str();
   sub->add_option("--floes", args->floes, "heave: floe indices, comma-separated (default: up to 8 moving floes)");
   registry[sub] = [args] {
     const std::string& what = args->what;
-    if (what != "energy" && what != "lcp" && what != "heave")
-      throw InputError("plot: unknown plot '" + what + "', expected energy, lcp or heave");
+    if (what != "energy" && what != "lcp" && what != "heave" && what != "fracture")
+      throw InputError("plot: unknown plot '" + what + "', expected energy, lcp, heave or fracture");
     const auto [width, height] = viz::parse_size(args->size, "--size");
     const viz::RunView run(args->file);
     const RunReader& reader = run.reader();
@@ -92,6 +145,7 @@ void add_plot_command(CLI::App& app, Registry& registry) {
     viz::Canvas canvas(width, height);
     const viz::Rect all{8, 8, width - 16.0, height - 16.0};
     std::size_t drawn = 0;
+    std::string extra;  // more key: value lines
     if (what == "energy") {
       const std::string set = "/diagnostics/energy";
       auto series = columns_vs_time(reader, set, t, reader.strings(set, "columns"));
@@ -111,6 +165,15 @@ void add_plot_command(CLI::App& app, Registry& registry) {
                        {series[k]});
       }
       drawn = series.size();
+    } else if (what == "fracture") {
+      const FractureSeries f = fracture_series(run, 5);
+      const viz::Rect top{all.x, all.y, all.w, 0.4 * all.h}, bottom{all.x, all.y + 0.4 * all.h, all.w, 0.6 * all.h};
+      viz::line_plot(canvas, top, {"floes: " + name, "time (s)", "floes"}, {f.count});
+      viz::line_plot(canvas, bottom, {"floes by equivalent diameter: " + name, "time (s)", "floes"}, f.classes);
+      drawn = 1 + f.classes.size();
+      if (!f.count.y.empty())
+        extra = "floes: " + std::to_string(static_cast<long>(f.count.y.front())) + " -> " +
+                std::to_string(static_cast<long>(f.count.y.back())) + "\n";
     } else {
       const std::vector<std::size_t> floes = args->floes.empty() ? default_floes(run) : parse_floes(args->floes, run.floes());
       const std::vector<double> heave = run.state_columns(viz::kHeave, 1);  // [T, n]
@@ -125,7 +188,7 @@ void add_plot_command(CLI::App& app, Registry& registry) {
     }
     canvas.save_png(out);
     std::cout << "output: " << fs::absolute(out).string() << "\nplot: " << what << "\nseries: " << drawn
-              << "\nsize: " << width << "x" << height << "\n";
+              << "\nsize: " << width << "x" << height << "\n" << extra;
     return 0;
   };
 }

@@ -231,7 +231,9 @@ void add_run_command(CLI::App& app, Registry& registry) {
     }
     if (const PercussionStats* f = sim.percussion_stats())
       o << "fracture.checks: " << f->checks << "\nfracture.screened: " << f->screened
-        << "\nfracture.initiations: " << f->initiations << "\nfracture.splits: " << f->splits << "\n";
+        << "\nfracture.sustained: " << f->sustained << "\nfracture.initiations: " << f->initiations
+        << "\nfracture.splits: " << f->splits << "\nfracture.seconds: " << f->seconds
+        << "\nfracture.split_seconds: " << f->split_seconds << "\n";
     if (const FloeSeaContact* fs = sim.floe_sea())
       o << "footprints.placements: " << fs->footprint_placements() << "\nfootprints.rebuilds: " << fs->footprint_rebuilds()
         << "\n";

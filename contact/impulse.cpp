@@ -8,6 +8,7 @@
 #include <cstdlib>
 #include <sstream>
 #include <unordered_map>
+#include <utility>
 
 #include "contact/lcp/siconos_io.hpp"
 
@@ -457,7 +458,26 @@ std::vector<ContactImpulse> resolve_collisions(Floes& floes, const std::vector<C
       ci.point = c.point;
     }
   }
+  if (opt.record) record_impulses(*opt.record, floes, contacts, impulses, resting);
   return impulses;
+}
+
+void record_impulses(ImpulseRecord& record, const Floes& floes, std::span<const ContactPoint> contacts,
+                     std::span<const ContactImpulse> impulses, std::span<const std::uint8_t> resting) {
+  const std::uint32_t event = record.events++;
+  for (std::size_t j = 0; j < contacts.size() && j < impulses.size(); ++j) {
+    const ContactImpulse& ci = impulses[j];
+    if (!(ci.vector.squaredNorm() > 0.0)) continue;
+    const ContactPoint& c = contacts[j];
+    const bool sustained = c.speculative || (j < resting.size() && resting[j]);
+    const std::pair<std::uint32_t, double> sides[2] = {{c.a, -1.0}, {c.b, 1.0}};
+    for (const auto& [f, sign] : sides) {
+      if (floes.is_static[f]) continue;
+      const Vec2 world = sign > 0.0 ? Vec2(ci.point - c.shift) : ci.point;
+      record.loads.push_back({f, event, body_point(floes, f, world), body_direction(floes, f, sign * ci.vector),
+                              sustained});
+    }
+  }
 }
 
 std::size_t resolve_step_collisions(Floes& floes, std::span<const FloeState> start, const Detection& detection,
@@ -466,6 +486,9 @@ std::size_t resolve_step_collisions(Floes& floes, std::span<const FloeState> sta
   const double xi = options.collision_distance;
   ImpulseOptions opt = options;
   opt.speculative_step = step;
+  // The solves below may be redone from W^-: only the impulses finally
+  // applied are recorded, at the end.
+  ImpulseRecord* record = std::exchange(opt.record, nullptr);
   std::vector<ContactPoint> contacts = detection.contacts;
   // Jams: contact components (dynamic floes joined by contact points) of at
   // least opt.jam.floes floes.
@@ -557,6 +580,7 @@ std::size_t resolve_step_collisions(Floes& floes, std::span<const FloeState> sta
     total.resize(contacts.size());
     for (std::size_t j = 0; j < again.size(); ++j) total[again_index[j]] = redone[j];
   }
+  if (record) record_impulses(*record, floes, contacts, total, resting);
   if (impulses) {
     total.resize(detection.contacts.size());
     *impulses = std::move(total);

@@ -128,6 +128,48 @@ struct WarmStart {
   }
 };
 
+// Per contact: the total impulse applied (compression + decompression), N s.
+// Floe b received `vector` = normal N + tangential T at `point` (the contact's,
+// in a's image of a periodic domain), floe a its opposite (percussion loads).
+struct ContactImpulse {
+  double normal = 0.0, tangential = 0.0;
+  Vec2 vector = Vec2::Zero();  // N s, world
+  Vec2 point = Vec2::Zero();   // m, world
+};
+
+// The contact impulses of a run step, per floe, for the percussion phase
+// (coupling/percussion.hpp): the collisions at the step's start, its
+// sub-steps' events and its jam time steps all append here, so percussion
+// sees every impulse of the step whatever sub-step it fell in. Each load is
+// one contact's impulse on one dynamic floe, in that floe's body frame (a
+// rigid floe's body point is the same material point all step long, so the
+// loads of different instants can be put on one model). `event` numbers the
+// solves (one collision instant each). `sustained`: a resting contact
+// (pushed by the step's forces, speculative, or in a jam: impulse.hpp), whose
+// impulse is a force times the time it acted, not a percussion.
+struct ImpulseRecord {
+  struct Load {
+    std::uint32_t floe = 0;
+    std::uint32_t event = 0;
+    Vec2 point = Vec2::Zero();    // m, body frame of `floe`
+    Vec2 impulse = Vec2::Zero();  // N s, body frame of `floe`
+    bool sustained = false;
+  };
+  std::vector<Load> loads;
+  std::uint32_t events = 0;
+  void clear() {
+    loads.clear();
+    events = 0;
+  }
+};
+
+// Appends to `record` the nonzero impulses of `contacts` (one per contact, at
+// the floes' present poses) as one event: -J on a, J on b (b's point shifted
+// back to its own image). A contact is sustained if `resting` flags it or it
+// is speculative.
+void record_impulses(ImpulseRecord& record, const Floes& floes, std::span<const ContactPoint> contacts,
+                     std::span<const ContactImpulse> impulses, std::span<const std::uint8_t> resting = {});
+
 struct ImpulseOptions {
   double restitution = 0.4;  // e in [0, 1]
   double friction = 0.7;     // mu >= 0
@@ -173,6 +215,9 @@ struct ImpulseOptions {
   // its comment: a failure from any run becomes test data. Config key
   // [contact] dump_failed_lcps.
   std::string dump_failed_lcps;
+  // Where the solves append their impulses for the percussion phase (null:
+  // nowhere); the caller owns it and clears it each step.
+  ImpulseRecord* record = nullptr;
 };
 
 // Running totals of a run (written to /diagnostics/lcp and the summary).
@@ -189,15 +234,6 @@ struct CollisionStats {
   long total_size = 0;    // sum of LCP sizes
   long warm = 0;          // of lcps, solved by Lemke warm-started from the last basis
   long warm_missed = 0;   // warm starts that ended without an accepted solution (then solved from scratch)
-};
-
-// Per contact: the total impulse applied (compression + decompression), N s.
-// Floe b received `vector` = normal N + tangential T at `point` (the contact's,
-// in a's image of a periodic domain), floe a its opposite (percussion loads).
-struct ContactImpulse {
-  double normal = 0.0, tangential = 0.0;
-  Vec2 vector = Vec2::Zero();  // N s, world
-  Vec2 point = Vec2::Zero();   // m, world
 };
 
 // Changes the velocities of the floes in contact (W^- -> W^+). Returns the

@@ -418,6 +418,12 @@ private:
     impulse.speculative_step = h;
     snapshot(c);
     const std::vector<FloeState> before = c.snap;
+    // Each solve from `before` replaces the last: the percussion record keeps
+    // only the impulses of the time step taken (ImpulseRecord).
+    const std::size_t recorded = impulse.record ? impulse.record->loads.size() : 0;
+    auto rewind = [&] {
+      if (impulse.record) impulse.record->loads.resize(recorded);
+    };
     // The witnesses were found within the range the floes' velocities before
     // the LCP gave. The LCP may speed floes up (a jam passes the push on), so
     // vertices beyond that range could close within h, unseen. The pairs are
@@ -459,6 +465,7 @@ private:
         }
         if (!grew) break;
         for (std::size_t m = 0; m < before.size(); ++m) floes_.state[c.members[m]] = before[m];
+        rewind();
       }
       if (round == 3) break;
       // Ranges only grow, so a measure finds every witness the last one found.
@@ -486,12 +493,14 @@ private:
       if (!more) break;
       wit = &into;
       for (std::size_t m = 0; m < before.size(); ++m) floes_.state[c.members[m]] = before[m];
+      rewind();
       ++report_.rejected;
     }
     snapshot(c);  // the velocities of the time step, for merges that look back into it
     auto undo = [&] {
       for (std::size_t m = 0; m < before.size(); ++m) floes_.state[c.members[m]] = before[m];
       c.snap = before;
+      rewind();
     };
     for (std::size_t m = 0; m < c.members.size(); ++m) {
       floes_.state[c.members[m]] = drifted(floes_.state[c.members[m]], h);

@@ -433,6 +433,8 @@ void read_fracture(Section s, FractureParams& f, const std::string& file) {
   f.mesh_size = s.number("mesh_size", f.mesh_size, positive, "a mesh size > 0 (m)");
   f.duration = s.number("duration", f.duration, positive, "a duration > 0 (s)");
   f.load_radius = s.number("load_radius", f.load_radius, non_negative, "a radius >= 0 (m; 0: the floe's thickness)");
+  f.min_fragment_area = s.number("min_fragment_area", f.min_fragment_area, non_negative,
+                                 "an area >= 0 (m^2; 0: mesh_size^2)");
   if (const toml::array* a = s.table_array("load")) {
     for (std::size_t i = 0; i < a->size(); ++i) {
       Section l((*a)[i].as_table(), "fracture.load", file);
@@ -614,7 +616,8 @@ std::string resolved_toml(const Config& c) {
                        {"criterion", fr.criterion == FractureCriterion::stress ? "stress" : "griffith"},
                        {"strength", fr.strength}, {"toughness", fr.toughness}, {"young", fr.young},
                        {"poisson", fr.poisson}, {"split", fr.split}, {"mesh_size", fr.mesh_size},
-                       {"duration", fr.duration}, {"load_radius", fr.load_radius}};
+                       {"duration", fr.duration}, {"load_radius", fr.load_radius},
+                       {"min_fragment_area", fr.min_fragment_area}};
   if (!loads.empty()) fracture.insert("load", loads);
 
   toml::table root{{"run", run}, {"sea", sea}, {"floes", floes}, {"contact", contact},

@@ -147,6 +147,7 @@ struct FractureParams {
   double mesh_size = 2.0;         // m
   double duration = 0.01;         // s
   double load_radius = 0.0;       // m, loads spread over this radius; 0: the floe's thickness
+  double min_fragment_area = 0.0; // m^2, no split leaves a piece smaller; 0: mesh_size^2
   std::vector<FractureLoad> loads;
 };
 

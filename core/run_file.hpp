@@ -60,7 +60,7 @@ struct FractureEventRow {
   double x0 = 0.0, y0 = 0.0, x1 = 0.0, y1 = 0.0;  // m, world: the crack's ends
   double criterion = 0.0;   // 0: stress, 1: griffith
   double energy_released = 0.0, energy_needed = 0.0;  // J (griffith; 0 for stress)
-  double delay = 0.0;       // s after the collision of the state judged
+  double delay = 0.0;       // s after the collision of the state judged (0: sustained contact alone, judged statically)
   double piece_a = -1.0, piece_b = -1.0;  // numbers of the two pieces (-1: no split)
 };
 inline constexpr int kFractureEventColumns = 17;

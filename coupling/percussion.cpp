@@ -51,91 +51,132 @@ fracture::FloeFracture& Percussion::model_of(const Floes& floes, std::size_t i) 
   return *slot;
 }
 
-bool Percussion::check(Floes& floes, const std::vector<contact::ContactPoint>& contacts,
-                       const std::vector<contact::ContactImpulse>& impulses, double t, std::vector<FloeState>& start) {
+// A floe's loads of a step (percussion.hpp): its sustained forces, and its
+// impulses by event.
+struct FloeLoads {
+  std::vector<fracture::PointLoad> forces;  // N, the mean of the step
+  double force_sum = 0.0, force_largest = 0.0;  // N
+  double sustained_impulse = 0.0;  // N s, sum of |J| of the resting contacts
+  struct Event {
+    std::vector<fracture::PointLoad> impulses;  // N s
+    double total = 0.0, largest = 0.0;  // N s
+  };
+  std::map<std::uint32_t, Event> events;  // by event number (time order)
+};
+
+bool Percussion::check(Floes& floes, const contact::ImpulseRecord& record, double t, double dt) {
   if (t != fresh_time_) {
     fresh_.clear();
     fresh_time_ = t;
-  } else {
-    // The step is being redone: its initiations without a split are found again.
-    stats_.initiations -= static_cast<long>(
-        std::erase_if(events_, [&](const FractureEventRow& e) { return e.time == t && e.piece_a < 0.0; }));
   }
-  // The impulses on each floe, in its body frame (ordered by floe index).
-  struct Struck {
-    std::vector<fracture::PointLoad> loads;
-    double total = 0.0, largest = 0.0;  // N s
-  };
-  std::map<std::size_t, Struck> struck;
-  for (std::size_t j = 0; j < contacts.size() && j < impulses.size(); ++j) {
-    const contact::ContactPoint& c = contacts[j];
-    const Vec2& impulse = impulses[j].vector;  // on b
-    const double size = impulse.norm();
-    if (!(size > 0.0)) continue;
-    const std::pair<std::size_t, double> sides[2] = {{c.a, -1.0}, {c.b, 1.0}};
-    for (const auto& [f, sign] : sides) {
-      if (floes.is_static[f] || fresh_.count(floes.id[f])) continue;
-      const FloeState& s = floes.state[f];
-      const Vec2 point = sign > 0.0 ? Vec2(impulses[j].point - c.shift) : impulses[j].point;
-      Struck& st = struck[f];
-      st.loads.push_back({rotate(point - Vec2{s.x, s.y}, -s.yaw), rotate(sign * impulse, -s.yaw), true});
-      st.total += size;
-      st.largest = std::max(st.largest, size);
+  std::map<std::size_t, FloeLoads> loaded;  // by floe index
+  for (const contact::ImpulseRecord::Load& l : record.loads) {
+    if (l.floe >= floes.size() || floes.is_static[l.floe] || fresh_.count(floes.id[l.floe])) continue;
+    FloeLoads& fl = loaded[l.floe];
+    const double size = l.impulse.norm();
+    if (l.sustained) {
+      fl.forces.push_back({l.point, l.impulse / dt, false});
+      fl.sustained_impulse += size;
+    } else {
+      FloeLoads::Event& e = fl.events[l.event];
+      e.impulses.push_back({l.point, l.impulse, true});
+      e.total += size;
+      e.largest = std::max(e.largest, size);
     }
   }
-  if (struck.empty()) return false;
+  if (loaded.empty()) return false;
 
   const double needed = params_.criterion == FractureCriterion::stress
                             ? params_.strength
                             : std::sqrt(params_.young * params_.toughness / (M_PI * params_.mesh_size));
   bool changed = false;
-  for (auto& [i, st] : struck) {
-    const double radius = params_.load_radius > 0.0 ? params_.load_radius : floes.thickness[i];
-    const double pressure = M_PI * st.largest / (2.0 * params_.duration) / (floes.thickness[i] * 2.0 * radius);
-    if (pressure < screen_ * needed) {
+  for (auto& [i, fl] : loaded) {
+    const double h = floes.thickness[i];
+    const double radius = params_.load_radius > 0.0 ? params_.load_radius : h;
+    // Sustained: the forces of the resting contacts, summed at each point
+    // (one contact point hit in several sub-steps is one force), and their
+    // stress scale.
+    double sustained_scale = 0.0;
+    if (!fl.forces.empty()) {
+      std::map<std::pair<double, double>, Vec2> at;
+      for (const fracture::PointLoad& f : fl.forces)
+        at.try_emplace({f.point.x(), f.point.y()}, Vec2::Zero()).first->second += f.value;  // Eigen does not zero
+      fl.forces.clear();
+      for (const auto& [p, v] : at) {
+        fl.forces.push_back({Vec2{p.first, p.second}, v, false});
+        fl.force_sum += v.norm();
+        fl.force_largest = std::max(fl.force_largest, v.norm());
+      }
+      const double diameter = 2.0 * radius_of(floes, i);
+      const double depth = floes.area[i] / diameter;
+      sustained_scale = std::max(fl.force_largest / (h * 2.0 * radius),
+                                 0.75 * fl.force_sum * diameter / (h * depth * depth));
+    }
+    // The analyses to run: each event whose scale (with the sustained one)
+    // reaches the screen, or the sustained forces alone.
+    std::vector<const FloeLoads::Event*> cases;
+    for (const auto& [number, e] : fl.events) {
+      const double impact_scale = M_PI * e.largest / (2.0 * params_.duration) / (h * 2.0 * radius);
+      if (impact_scale + sustained_scale >= screen_ * needed) cases.push_back(&e);
+    }
+    if (cases.empty() && !fl.forces.empty() && sustained_scale >= screen_ * needed) cases.push_back(nullptr);
+    if (cases.empty()) {
       ++stats_.screened;
       continue;
     }
-    const auto begin = std::chrono::steady_clock::now();
-    fracture::FloeFracture& model = model_of(floes, i);
-    const fracture::FloeFracture::Result result = model.analyse(st.loads);
-    stats_.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
-    ++stats_.checks;
-    const fracture::Initiation& init = result.initiation;
-    if (!init.initiates) continue;
-    ++stats_.initiations;
-    const FloeState& s = floes.state[i];
-    const Vec2 g{s.x, s.y};
-    FractureEventRow e;
-    e.time = t;
-    e.floe = floes.id[i];
-    const Vec2 at = g + rotate(init.point, s.yaw), from = g + rotate(init.crack_from, s.yaw),
-               to = g + rotate(init.crack_to, s.yaw);
-    e.x = at.x();
-    e.y = at.y();
-    e.direction = line_degrees(init.direction + s.yaw);
-    e.load = st.total;
-    e.stress = init.stress;
-    e.x0 = from.x();
-    e.y0 = from.y();
-    e.x1 = to.x();
-    e.y1 = to.y();
-    e.criterion = params_.criterion == FractureCriterion::stress ? 0.0 : 1.0;
-    e.energy_released = init.energy_released;
-    e.energy_needed = init.energy_needed;
-    e.delay = init.time;
-    if (params_.split && init.through && split(floes, i, init.point, init.direction, start, e)) changed = true;
-    events_.push_back(e);
+    for (const FloeLoads::Event* e : cases) {
+      std::vector<fracture::PointLoad> loads = fl.forces;
+      if (e) loads.insert(loads.end(), e->impulses.begin(), e->impulses.end());
+      const auto begin = std::chrono::steady_clock::now();
+      fracture::FloeFracture& model = model_of(floes, i);
+      const fracture::FloeFracture::Result result = model.analyse(loads);
+      stats_.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
+      ++stats_.checks;
+      if (!e) ++stats_.sustained;
+      const fracture::Initiation& init = result.initiation;
+      if (!init.initiates) continue;
+      ++stats_.initiations;
+      const FloeState& s = floes.state[i];
+      const Vec2 g{s.x, s.y};
+      FractureEventRow ev;
+      ev.time = t;
+      ev.floe = floes.id[i];
+      const Vec2 at = g + rotate(init.point, s.yaw), from = g + rotate(init.crack_from, s.yaw),
+                 to = g + rotate(init.crack_to, s.yaw);
+      ev.x = at.x();
+      ev.y = at.y();
+      ev.direction = line_degrees(init.direction + s.yaw);
+      ev.load = (e ? e->total : 0.0) + fl.sustained_impulse;
+      ev.stress = init.stress;
+      ev.x0 = from.x();
+      ev.y0 = from.y();
+      ev.x1 = to.x();
+      ev.y1 = to.y();
+      ev.criterion = params_.criterion == FractureCriterion::stress ? 0.0 : 1.0;
+      ev.energy_released = init.energy_released;
+      ev.energy_needed = init.energy_needed;
+      ev.delay = init.time;  // 0 for a static analysis (sustained contact alone), > 0 for an impact
+      if (params_.split && init.through) {
+        const auto cut = std::chrono::steady_clock::now();
+        if (split(floes, i, init.point, init.direction, ev)) changed = true;
+        stats_.split_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - cut).count();
+      }
+      events_.push_back(ev);
+      break;  // one initiation per floe and step: the floe has cracked
+    }
   }
   return changed;
 }
 
-bool Percussion::split(Floes& floes, std::size_t i, const Vec2& point, double direction,
-                       std::vector<FloeState>& start, FractureEventRow& event) {
+double Percussion::min_fragment_area() const {
+  return params_.min_fragment_area > 0.0 ? params_.min_fragment_area : params_.mesh_size * params_.mesh_size;
+}
+
+bool Percussion::split(Floes& floes, std::size_t i, const Vec2& point, double direction, FractureEventRow& event) {
   const fracture::Chord chord =
       fracture::chord_through(floes.vertices(i), point, Vec2{std::cos(direction), std::sin(direction)});
-  // Pieces smaller than a mesh cell are not resolved by the model: no split.
-  const double min_area = params_.mesh_size * params_.mesh_size;
+  // No piece below the minimum fragment area (a sliver): the floe is not split.
+  const double min_area = min_fragment_area();
   // The floes that could touch a piece: within reach of the parent.
   std::vector<std::size_t> near{i};
   const double ri = radius_of(floes, i);
@@ -152,11 +193,8 @@ bool Percussion::split(Floes& floes, std::size_t i, const Vec2& point, double di
     Floes trial = floes.select(near);
     fracture::apply_split(trial, 0, *plan, states);
     if (any_overlap(trial)) continue;
-    const auto before = fracture::piece_states(*plan, start[i], floes.inertia_z[i]);
     const std::uint32_t parent = floes.id[i];
     const std::size_t second = fracture::apply_split(floes, i, *plan, states);
-    start[i] = before[0];
-    start.push_back(before[1]);
     models_.erase(parent);
     fresh_.insert(floes.id[i]);
     fresh_.insert(floes.id[second]);

@@ -1,23 +1,46 @@
 #pragma once
 // The percussion phase of a run step (MODEL.md §5 step 5 and §6): after the
-// collision LCPs, each floe struck by contact impulses is checked for
-// fracture initiation with its elastic model (contact/fracture), and with
-// [fracture] split = true a floe cracked through is replaced by its two
-// pieces (contact/fracture/split.hpp), which carry on in the run.
+// step's collisions, each floe they loaded is checked for fracture initiation
+// with its elastic model (contact/fracture), and with [fracture] split = true
+// a floe cracked through is replaced by its two pieces
+// (contact/fracture/split.hpp), which carry on in the run.
 //
-// Loads. Contact j between floes a and b (normal N from a to b, tangent
-// T = k x N) gave the impulse J = lambda N + beta T to b and -J to a, at the
-// contact point; each floe gets the impulses of all its contacts of the
-// step at once, in its body frame, spread over `duration` (response.hpp).
+// Loads. Every collision solve of the step (at its start, in its sub-steps,
+// in a jam's time steps) appends its impulses to a contact::ImpulseRecord, in
+// each floe's body frame. Contact j between floes a and b (normal N from a to
+// b, tangent T = k x N) gave J = lambda N + beta T to b and -J to a.
 //
-// Screening. An analysis costs a dynamic solve per floe, so a floe is
-// analysed only when the contact pressure scale of its largest impulse,
-//   p = (pi |J| / (2 tau)) / (h 2 r)   (peak force over thickness x patch width,
-//                                      r the load radius),
-// reaches `screen` times the stress the criterion needs (the strength; for
-// griffith the stress sqrt(E G_c / (pi s)) that would open a flaw of one mesh
-// size s). The largest tensile stress of the tests stays below p
-// (docs/fracture.md), so the default screen of 0.1 leaves a wide margin.
+// The load rule (docs/fracture.md). A floe's loads of a step are of two kinds:
+//  * impacts: the impulses of contacts that were not resting, one collision
+//    instant (event) at a time. Each event's impulses are a percussion, spread
+//    over `duration` (response.hpp): the dynamic response, rigid motion
+//    removed.
+//  * sustained contact: the impulses of resting contacts (pushed by the
+//    step's forces, speculative, in a jam; contact/impulse.hpp). Their sum
+//    over the step of length dt is the mean contact force F = sum J / dt, a
+//    quasi-static load: the static response to F with the rigid motion
+//    removed (inertia relief: the forces that accelerate the floe as a whole,
+//    wind and drag included, balance F as body forces). A jam's impulses are
+//    its floes' forces times dt, not blows: judged as percussions over 10 ms
+//    they would be dt/tau times too strong.
+// The model is linear, so an event's percussion is judged with the
+// sustained forces superposed, and the sustained forces alone when no event
+// needs an analysis. Both meet the same criterion and strength.
+//
+// Screening. An analysis costs a solve per floe, so a floe is analysed only
+// when a stress scale of its loads reaches `screen` times the stress the
+// criterion needs (the strength; for griffith the stress sqrt(E G_c / (pi s))
+// that would open a flaw of one mesh size s):
+//   impacts:    p = (pi |J|max / (2 tau)) / (h 2 r)   (peak force over
+//               thickness x patch width, r the load radius)
+//   sustained:  the larger of the contact pressure |F|max / (h 2 r) and the
+//               bending of the floe as a beam of span D (its diameter) and
+//               depth w = A / D under the forces: 3 (sum |F|) D / (4 h w^2)
+//               (a simply supported beam under a uniform load; exact for a
+//               long floe between two supports);
+// the two add when an event has sustained forces beside it. The tests'
+// largest tensile stresses stay below these scales (docs/fracture.md), so
+// the default screen of 0.1 leaves a wide margin.
 //
 // Models are built on a floe's first analysis (meshing and factorisations)
 // and kept for its later ones; a floe that splits drops its model, and its
@@ -40,11 +63,13 @@ namespace fracture { class FloeFracture; }
 
 struct PercussionStats {
   long checks = 0;        // floes analysed (again when a step is redone)
-  long screened = 0;      // floes struck but below the screen
+  long screened = 0;      // floes loaded but below the screen
+  long sustained = 0;     // of checks, of sustained forces alone (static)
   long initiations = 0;   // events (a crack whose line leaves the floe at once, from a corner, is not split)
   long splits = 0;
   long failed_splits = 0;  // cracked through but not split (sliver, or the pieces would overlap)
   double seconds = 0.0;    // wall time in analyses
+  double split_seconds = 0.0;  // wall time in splits (cut, overlap checks), without the rebuild after them
 };
 
 class Percussion {
@@ -55,24 +80,25 @@ public:
   Percussion(Percussion&&) noexcept;
   Percussion& operator=(Percussion&&) noexcept;
 
-  // Checks the floes struck by `impulses` (one per contact of `contacts`)
-  // at time t. Split floes are replaced in `floes`, and `start` (the states
-  // at the start of the step, to redo it) is kept in step with them.
-  // Returns true if the set of floes changed.
-  bool check(Floes& floes, const std::vector<contact::ContactPoint>& contacts,
-             const std::vector<contact::ContactImpulse>& impulses, double t, std::vector<FloeState>& start);
+  // Checks the floes loaded in `record` during the step of length dt that
+  // ends at time t (positions are those of t; the loads are in the floes'
+  // body frames). Split floes are replaced in `floes`. Returns true if the
+  // set of floes changed.
+  bool check(Floes& floes, const contact::ImpulseRecord& record, double t, double dt);
 
   // The initiations since the last call.
   std::vector<FractureEventRow> take_events();
   const PercussionStats& stats() const { return stats_; }
+  // m^2: no split leaves a piece smaller ([fracture] min_fragment_area, or
+  // mesh_size^2 when that is 0: the model does not resolve smaller pieces).
+  double min_fragment_area() const;
   // Restart: the counts go on from a checkpoint's (models are rebuilt on a
   // floe's next analysis, to the same bits).
   void restore_stats(const PercussionStats& stats) { stats_ = stats; }
 
 private:
   fracture::FloeFracture& model_of(const Floes& floes, std::size_t i);
-  bool split(Floes& floes, std::size_t i, const Vec2& point, double direction, std::vector<FloeState>& start,
-             FractureEventRow& event);
+  bool split(Floes& floes, std::size_t i, const Vec2& point, double direction, FractureEventRow& event);
 
   FractureParams params_;
   double gap_, screen_;

@@ -92,9 +92,11 @@ Checkpoint Simulation::save() {
   if (percussion_) {
     const PercussionStats& p = percussion_->stats();
     for (auto [name, v] : {std::pair{"checks", p.checks}, {"screened", p.screened}, {"initiations", p.initiations},
-                           {"splits", p.splits}, {"failed_splits", p.failed_splits}})
+                           {"splits", p.splits}, {"failed_splits", p.failed_splits},
+                           {"sustained", p.sustained}})
       k.add(std::string("fracture.") + name, static_cast<double>(v));
     k.add("fracture.seconds", p.seconds);
+    k.add("fracture.split_seconds", p.split_seconds);
   }
   c.counter_names = std::move(k.names);
   c.counters = std::move(k.values);
@@ -151,9 +153,10 @@ void Simulation::restore(const Checkpoint& c) {
     PercussionStats p;
     for (auto [name, v] : {std::pair{"checks", &p.checks}, {"screened", &p.screened},
                            {"initiations", &p.initiations}, {"splits", &p.splits},
-                           {"failed_splits", &p.failed_splits}})
+                           {"failed_splits", &p.failed_splits}, {"sustained", &p.sustained}})
       *v = count(std::string("fracture.") + name);
     p.seconds = counter("fracture.seconds");
+    p.split_seconds = counter("fracture.split_seconds");
     percussion_->restore_stats(p);
   }
 }

@@ -7,7 +7,6 @@
 #include <sstream>
 #include <thread>
 
-#include "contact/step_limit.hpp"
 #include "contact/substep.hpp"
 #include "core/error.hpp"
 #include "fluid/sea.hpp"
@@ -113,7 +112,11 @@ Simulation::Simulation(Scenario scenario) : scenario_(std::move(scenario)) {
     floe_sea_->ready_loads(scenario_.floes, *sea_, incident_.get(), 0.5 * c.run.dt_max);
   }
   // Pieces of a split are opened by the gap that collisions keep between floes.
-  if (c.fracture.enabled) percussion_ = std::make_unique<Percussion>(c.fracture, impulse_options_.min_gap);
+  if (c.fracture.enabled) {
+    percussion_ = std::make_unique<Percussion>(c.fracture, impulse_options_.min_gap);
+    impulse_record_ = std::make_unique<contact::ImpulseRecord>();
+    impulse_options_.record = impulse_record_.get();
+  }
 }
 
 Simulation::~Simulation() = default;
@@ -127,7 +130,6 @@ double Simulation::step(double t_stop) {
     { PhaseTimer _(profile_, Phase::penalty); floes_half_kick(ctx); }
     { PhaseTimer _(profile_, Phase::drift);   drift(ctx); }
     { PhaseTimer _(profile_, Phase::collide); collide(ctx); }
-    { PhaseTimer _(profile_, Phase::percussion); percussion(ctx); }
     { PhaseTimer _(profile_, Phase::advance); advance(ctx); }
     { PhaseTimer _(profile_, Phase::detect);  accepted = detect_and_check(ctx); }
   }
@@ -135,9 +137,10 @@ double Simulation::step(double t_stop) {
   { PhaseTimer _(profile_, Phase::penalty);   sea_half_kick(ctx); }
   budget_.external += step_budget_.external;
   budget_.collisions += step_budget_.collisions;
-  { PhaseTimer _(profile_, Phase::check);     check_state(ctx); }
   // Land exactly on t_stop when the step was cut to reach it.
   t_ = ctx.dt == t_stop - ctx.t ? t_stop : ctx.t + ctx.dt;
+  { PhaseTimer _(profile_, Phase::percussion); percussion(ctx); }
+  { PhaseTimer _(profile_, Phase::check);     check_state(ctx); }
   ++steps_;
   warm_->tick();  // the jam LCPs' warm starts age by one step
   return ctx.dt;
@@ -170,24 +173,9 @@ StepContext Simulation::choose_dt(double t_stop) {
     }
   }
   // Collisions do not shorten the step: the floes that may meet within it are
-  // sub-stepped by advance() (contact/substep.hpp). With fracture on, the
-  // whole step is cut at the first possible impact (contact/step_limit.hpp)
-  // instead, so every impact falls on the start of a step, where percussion
-  // sees its impulses.
-  if (percussion_) {
-    const contact::StepLimit limit = contact::collision_step_limit(
-        scenario_.floes, shapes_, detection_.pairs, detection_.witnesses, detection_options_.collision_distance);
-    if (limit.dt < ctx.dt) {
-      const double floor = kFloorFraction * dt_max;
-      if (limit.dt < floor) {
-        ++substeps_.floor_steps;
-        std::ostringstream m;
-        m << "floes " << limit.a << " and " << limit.b << " at distance " << limit.distance << " m, t = " << t_ << " s";
-        substeps_.floor_pair = m.str();
-      }
-      ctx.dt = std::max(limit.dt, std::min(floor, ctx.dt));
-    }
-  }
+  // sub-stepped by advance() (contact/substep.hpp); with fracture on, every
+  // solve of the step hands its impulses to the percussion phase
+  // (impulse_record_), whatever sub-step it fell in.
   ctx.start = scenario_.floes.state;
   return ctx;
 }
@@ -228,17 +216,17 @@ void Simulation::collide(StepContext& ctx) {
   // turn W(t-) into W(t+). Contacts the step itself pushed together rest
   // (restitution 0), and pushed points that would close below xi/2 within the
   // step are held by speculative contacts (contact/impulse.hpp).
-  contact::resolve_step_collisions(scenario_.floes, ctx.start, detection_, ctx.dt, impulse_options_, stats_,
-                                   percussion_ ? &ctx.impulses : nullptr);
+  if (impulse_options_.record) impulse_options_.record->clear();  // this try's impulses (a redone step starts again)
+  contact::resolve_step_collisions(scenario_.floes, ctx.start, detection_, ctx.dt, impulse_options_, stats_);
   const Vec2 after = momentum();
   step_budget_.collisions = after - ctx.momentum;
   ctx.momentum = after;
 }
 
-void Simulation::percussion(StepContext& ctx) {
-  // Positions are still those of ctx.t, where the contacts were found.
-  if (percussion_ && percussion_->check(scenario_.floes, detection_.contacts, ctx.impulses, ctx.t, ctx.start))
-    on_floes_changed();
+void Simulation::percussion(const StepContext& ctx) {
+  // The step is done (the floes at t_ = ctx.t + dt): its collisions' loads
+  // are judged; pieces of a split start the next step.
+  if (percussion_ && percussion_->check(scenario_.floes, *impulse_record_, t_, ctx.dt)) on_floes_changed();
 }
 
 void Simulation::on_floes_changed() {

@@ -3,14 +3,11 @@
 // by one step; the step reads as a table of contents, one named and timed
 // phase per line (MODEL.md §5, the staggered loop):
 //
-//   choose dt (output schedule, dt_max, penalty limit; collision limit only
-//      with fracture on)
+//   choose dt (output schedule, dt_max, penalty limit)
 //   -> sample forcing
 //   -> floes' half kick from the sea (penalty loads at t, coupling/floe_sea.hpp)
 //   -> drift velocities (drag relative to current + the incident waves'
 //      orbital velocity, wind, Coriolis) -> collide (LCPs: W(t-) -> W(t+))
-//   -> percussion (fracture checks on the collision impulses; a split floe
-//      becomes two)
 //   -> advance horizontal positions (floes that may collide within the step
 //      are sub-stepped event by event, contact/substep.hpp)
 //   -> detect (new contacts; an overlap rejects the step, which is redone
@@ -20,6 +17,9 @@
 //      implicit: the midpoint step of the penalty spring, floe_sea.hpp)
 //   -> penalty loads at t + dt: second half kick of the sea and the floes,
 //      then the orbital velocity under the floes (for the next drag)
+//   -> percussion (fracture checks on every collision impulse of the step,
+//      collide's and the sub-steps', coupling/percussion.hpp; a split floe
+//      becomes two, which start the next step)
 //   -> check state
 //
 // The kicks and flows are the Strang splitting of the floe–sea Hamiltonian
@@ -79,7 +79,6 @@ struct StepContext {
   ForcingSample forcing;
   std::vector<FloeState> start;  // the floes at t, to redo a rejected step
   Vec2 momentum = Vec2::Zero();   // of the dynamic floes, updated by the phases that change it
-  std::vector<contact::ContactImpulse> impulses;  // of the collide phase, one per contact of detection()
 };
 
 // Energies by part (J), named as the columns of /diagnostics/energy; the last
@@ -152,7 +151,7 @@ private:
   void sea_half_kick(const StepContext& ctx);
   void drift(StepContext& ctx);
   void collide(StepContext& ctx);
-  void percussion(StepContext& ctx);
+  void percussion(const StepContext& ctx);
   void on_floes_changed();  // rebuilds every per-floe structure (after a split)
   void advance(const StepContext& ctx);
   bool detect_and_check(StepContext& ctx);  // false: the step overlapped, dt halved
@@ -177,6 +176,8 @@ private:
   contact::Detection detection_;  // at the present positions
   contact::CollisionStats stats_;
   std::unique_ptr<Percussion> percussion_;  // [fracture] enabled
+  // The step's contact impulses for percussion (impulse_options_.record; null without fracture).
+  std::unique_ptr<contact::ImpulseRecord> impulse_record_;
   MomentumBudget budget_, step_budget_;  // run total; this step's (redone steps do not count)
   contact::SubstepReport substeps_;  // collision sub-steps (floors, merges, ...)
   long rejected_steps_ = 0;       // steps redone after an overlap

@@ -311,9 +311,22 @@ def case_plot():
     p = run("plot", path, "heave", "--floes", "0,7", expect=2)
     check("--floes" in p.stderr and "'7'" in p.stderr, f"floe index out of range: {p.stderr}")
     p = run("plot", path, "spectrum", expect=2)
-    check("spectrum" in p.stderr and "energy, lcp or heave" in p.stderr, f"unknown plot: {p.stderr}")
+    check("spectrum" in p.stderr and "energy, lcp, heave or fracture" in p.stderr, f"unknown plot: {p.stderr}")
     p = run("plot", "nothere.h5", "energy", expect=2)
     check("nothere.h5" in p.stderr, "missing file named")
+    # fracture: examples/percussion.toml splits both floes (docs/fracture.md):
+    # the floe count goes from 2 to 2 + the splits of /events/fracture.
+    perc = os.path.join(WORK, "perc.h5")
+    run("run", os.path.join(SRC, "examples", "percussion.toml"), "-q", "-o", perc)
+    kv = keyvals(run("plot", perc, "fracture", "--size", "600x400").stdout)
+    with h5py.File(perc, "r") as f:
+        ev = f["events/fracture"][:]
+        cols = [c.decode() if isinstance(c, bytes) else c for c in f["events/fracture"].attrs["columns"]]
+    splits = int((ev[:, cols.index("piece_a")] >= 0).sum())
+    check(splits >= 1, f"percussion example splits ({splits})")
+    check(kv["floes"] == f"2 -> {2 + splits}", f"fracture: floe count {kv['floes']} with {splits} splits")
+    check(int(kv["series"]) == 6, f"fracture: count + 5 size classes, got {kv['series']}")
+    check(read_png(kv["output"]).shape == (400, 600, 3), "fracture: size")
 
 
 # ------------------------------------------------------------------ real runs

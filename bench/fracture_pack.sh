@@ -1,0 +1,62 @@
+#!/bin/sh
+# Fracture checks on the multirate steps: wall time of packs with fracture
+# off; on with strength 20 MPa ("strong": the screen lets impacts through and
+# they are analysed, but nothing breaks); and on with the ice's 0.5 MPa
+# ("ice": floes break and split), run alternately, REPEATS rounds, one
+# thread. Writes CSV on stdout:
+#   scenario,variant,round,wall_s,steps,checks,screened,sustained,initiations,splits,analysis_s,split_s
+# (analysis_s: wall time in the analyses; split_s: in the splits, without
+# the rebuild of the per-floe structures after them).
+# Scenarios: wall_100 (examples/pack_against_wall.h5, 15 m/s wind against the
+# wall, 3000 s) and drift_500 (500 floes of 0.5 to 2 m at 50% in a periodic
+# 2 km box, 15 m/s wind: floes of different thickness drift at different
+# speeds and collide; 1000 s).
+# Usage: bench/fracture_pack.sh BUILD_DIR [REPEATS] > bench/results/fracture_pack_<machine>.csv
+set -eu
+BIN=$(cd "$1" && pwd)/bin/floesim
+REPEATS=${2:-3}
+SRC=$(cd "$(dirname "$0")/.." && pwd)
+DIR=$(mktemp -d)
+trap 'rm -rf "$DIR"' EXIT
+"$BIN" pack --floes 500 --concentration 0.5 --box 2000 2000 --seed 1 --thickness-range 0.5 2.0 \
+  -o "$DIR/drift_500.h5" > /dev/null
+write() {  # name pack t_end extra fracture
+  cat > "$DIR/$1_$5.toml" <<TOML
+[run]
+t_end = $3
+dt_max = 10.0
+output_interval = 100.0
+threads = 1
+[sea]
+model = "none"
+[floes]
+pack = "$2"
+[contact]
+collision_distance = 0.01
+$4
+[forcing]
+wind = [15.0, 0.0]
+TOML
+  case $5 in
+    off) ;;
+    strong) printf '[fracture]\nenabled = true\nstrength = 20e6\nsplit = true\nmesh_size = 20.0\n' >> "$DIR/$1_$5.toml" ;;
+    ice) printf '[fracture]\nenabled = true\nstrength = 0.5e6\nsplit = true\nmesh_size = 20.0\n' >> "$DIR/$1_$5.toml" ;;
+  esac
+}
+for v in off strong ice; do
+  write wall_100 "$SRC/examples/pack_against_wall.h5" 3000 "" $v
+  write drift_500 "$DIR/drift_500.h5" 1000 "domain = \"periodic\"
+box = [0.0, 2000.0, 0.0, 2000.0]" $v
+done
+echo "scenario,variant,round,wall_s,steps,checks,screened,sustained,initiations,splits,analysis_s,split_s"
+for r in $(seq 1 "$REPEATS"); do
+  for s in wall_100 drift_500; do
+    for v in off strong ice; do
+      start=$(date +%s.%N)
+      out=$(OMP_NUM_THREADS=1 "$BIN" run "$DIR/${s}_$v.toml" -q -o "$DIR/out.h5")
+      end=$(date +%s.%N)
+      get() { printf '%s\n' "$out" | awk -F': ' -v k="$1" '$1 == k { print $2 }'; }
+      echo "$s,$v,$r,$(echo "$end - $start" | bc),$(get steps),$(get fracture.checks),$(get fracture.screened),$(get fracture.sustained),$(get fracture.initiations),$(get fracture.splits),$(get fracture.seconds),$(get fracture.split_seconds)"
+    done
+  done
+done

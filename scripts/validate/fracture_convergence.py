@@ -1,0 +1,65 @@
+#!/usr/bin/python3
+"""Fragmentation under refinement (docs/fracture.md, "Convergence").
+
+Runs examples/pack_fracture.toml with mesh_size and dt_max as given and
+halved (each alone and both), and prints, per run, the number of floes at
+t_end, the splits, and the fragment-size distribution (equivalent diameter
+d = sqrt(4 A / pi) of the dynamic floes at t_end: counts in fixed classes,
+and quantiles), with the changes against the first run.
+
+Usage: scripts/validate/fracture_convergence.py BUILD_DIR [MESH DT T_END]
+(defaults 20 m, 10 s, 3000 s). Uses numpy and h5py (Debian packages).
+"""
+import os
+import subprocess
+import sys
+import tempfile
+
+import h5py
+import numpy as np
+
+build = sys.argv[1]
+mesh, dt, t_end = (float(a) for a in (sys.argv[2:5] if len(sys.argv) >= 5 else (20.0, 10.0, 3000.0)))
+src = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+floesim = os.path.join(build, "bin", "floesim")
+base = open(os.path.join(src, "examples", "pack_fracture.toml")).read()
+pack = os.path.join(src, "examples", "pack_against_wall.h5")
+classes = [0.0, 20.0, 30.0, 40.0, 50.0, 60.0, 1e9]  # m, equivalent diameter
+
+work = tempfile.mkdtemp(prefix="fracture_convergence_")
+rows = []
+for m, h in ((mesh, dt), (mesh / 2, dt), (mesh, dt / 2), (mesh / 2, dt / 2)):
+    text = []
+    for line in base.splitlines():
+        key = line.split("=")[0].strip()
+        if key == "pack":
+            line = f'pack = "{pack}"'
+        elif key == "mesh_size":
+            line = f"mesh_size = {m}"
+        elif key == "dt_max":
+            line = f"dt_max = {h}"
+        elif key == "t_end":
+            line = f"t_end = {t_end}"
+        text.append(line)
+    cfg = os.path.join(work, f"m{m}_dt{h}.toml")
+    open(cfg, "w").write("\n".join(text) + "\n")
+    out = cfg.replace(".toml", ".h5")
+    p = subprocess.run([floesim, "run", cfg, "-q", "-o", out], capture_output=True, text=True, check=True)
+    kv = dict(l.split(": ", 1) for l in p.stdout.splitlines() if ": " in l)
+    with h5py.File(out, "r") as f:
+        area = f["floes/area"][:]
+        static = f["floes/static"][:].astype(bool)
+        x = f["floes/state"][-1, :, 0]
+    alive = ~static & ~np.isnan(x)
+    d = np.sqrt(4.0 * area[alive] / np.pi)
+    counts, _ = np.histogram(d, bins=classes)
+    rows.append((m, h, int(alive.sum()), int(kv.get("fracture.splits", 0)), counts, np.quantile(d, [0.1, 0.5, 0.9]),
+                 kv.get("fracture.initiations"), float(kv.get("fracture.seconds", 0.0))))
+
+print(f"# {os.path.basename(floesim)} on examples/pack_fracture.toml to t = {t_end} s; classes of d (m): {classes[:-1]}")
+print("mesh_m,dt_s,floes,splits,initiations,analysis_s," + ",".join(f"n_d{c:g}" for c in classes[:-1]) +
+      ",d10_m,d50_m,d90_m,floes_change")
+ref = rows[0]
+for m, h, n, s, counts, q, init, secs in rows:
+    print(f"{m:g},{h:g},{n},{s},{init},{secs:.2f}," + ",".join(str(c) for c in counts) +
+          "," + ",".join(f"{v:.1f}" for v in q) + f",{(n - ref[2]) / ref[2]:+.1%}")
