@@ -5,6 +5,7 @@
 
 #include "core/error.hpp"
 #include "fluid/bem.hpp"
+#include "fluid/bem3d.hpp"
 #include "fluid/spectral.hpp"
 #include "fluid/waves.hpp"
 
@@ -63,15 +64,18 @@ std::span<const double> Sea::field(Field f) {
 }
 
 SurfaceSample Sea::sample(double x, double y) {
-  auto at = [&](Field f, Parity parity) { return interpolate(grid_, field(f), x, y, parity); };
+  // Parities at the walls x = const (then y = const): a derivative across a wall is odd.
+  auto at = [&](Field f, Parity parity, Parity parity_y = Parity::even) {
+    return interpolate(grid_, field(f), x, y, parity, parity_y);
+  };
   SurfaceSample s;
   s.eta = at(Field::elevation, Parity::even);
   s.slope_x = at(Field::slope_x, Parity::odd);
   s.u = at(Field::velocity_x, Parity::odd);
   s.w = at(Field::velocity_z, Parity::even);
   if (grid_.dims == 2) {
-    s.slope_y = at(Field::slope_y, Parity::even);
-    s.v = at(Field::velocity_y, Parity::even);
+    s.slope_y = at(Field::slope_y, Parity::even, Parity::odd);
+    s.v = at(Field::velocity_y, Parity::even, Parity::odd);
   }
   return s;
 }
@@ -111,8 +115,6 @@ void validate(const SeaParams& p) {
   if (!(p.size[1] > 0.0) || !std::isfinite(p.size[1]))
     bad("size", std::string("expected a ") + (p.dims == 1 ? "width" : "length") +
                     " > 0 m along y, got " + str(p.size[1]));
-  if (p.model == SeaModel::bem && p.dims != 1)
-    bad("dims", "model = \"bem\" is a vertical slice: expected dims = 1, got " + str(p.dims));
   const int min_cells = p.model == SeaModel::bem ? 4 : 2;
   if (p.cells[0] < min_cells)
     bad("cells", "expected at least " + str(min_cells) + " cells along x, got " +
@@ -143,7 +145,10 @@ std::unique_ptr<Sea> make_sea(const SeaParams& params, unsigned long seed,
       break;
     case SeaModel::bem:
       FLOESIM_ASSERT(!options.tank.enabled);  // refused at load (core/config.cpp)
-      sea = std::make_unique<BemSea>(params, options);
+      if (params.dims == 1)
+        sea = std::make_unique<BemSea>(params, options);
+      else
+        sea = std::make_unique<Bem3dSea>(params, options);
       break;
   }
   if (!options.tank.enabled) {

@@ -63,6 +63,10 @@ struct SeaOptions {
   TankParams tank;              // relaxation zones (spectral only)
   bool measure_fft_plans = false;  // FFTW_MEASURE instead of FFTW_ESTIMATE (benchmarks)
   double bem_panel_ratio = 1.0;    // bem: wall and bottom panel length / surface panel length
+  // bem, dims = 2: a panel nearer to a collocation point than this many panel
+  // diameters is integrated exactly, a farther one by 2 x 2 Gauss points
+  // (relative error O((1 / bem_near_field)^4); docs/sea.md). inf: all exact.
+  double bem_near_field = 3.0;
 };
 
 class Sea {
