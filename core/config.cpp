@@ -258,6 +258,15 @@ void read_sea(Section s, SeaParams& p, const std::string& file) {
   } else {
     s.node("cells");
   }
+  if (p.model == SeaModel::bem && p.dims == 2 &&
+      static_cast<double>(p.cells[0]) * p.cells[1] > kMaxBem3dCells) {
+    // The 3D basin's set-up is dense (fluid/bem3d.hpp; cost in docs/sea.md).
+    std::ostringstream m;
+    m << "model = \"bem\" with dims = 2 is a dense set-up: expected at most " << static_cast<long long>(kMaxBem3dCells)
+      << " surface cells in all (64 x 64), got " << static_cast<double>(p.cells[0]) * p.cells[1] << " ("
+      << p.cells[0] << " x " << p.cells[1] << ")";
+    s.fail("cells", m.str());
+  }
   p.depth = s.number("depth", p.depth, [](double v) { return v > 0.0; }, "a depth > 0 (m) or inf");
   p.rho = s.number("rho", p.rho, positive, "a density > 0 (kg/m^3)");
   p.g = s.number("g", p.g, positive, "a gravity > 0 (m/s^2)");

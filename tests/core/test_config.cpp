@@ -100,7 +100,11 @@ TEST_CASE("unknown keys, wrong types and out-of-range values name file, line and
           {"[floes.floe] static", "cannot have a velocity"});
   refused("[coupling]\nblend = 0.5\n", {"[coupling] blend", "blend"});
   refused("[coupling]\nfootprint = \"round\"\n", {"[coupling] footprint", "\"tent\""});
-  refused("[sea]\nmodel = \"bem\"\n[coupling]\nfootprint = \"tent\"\n", {"case.toml:4", "[coupling] footprint", "periodic"});
+  refused("[sea]\nmodel = \"bem\"\ndims = 1\n[coupling]\nfootprint = \"tent\"\n", {"case.toml:5", "[coupling] footprint", "periodic"});
+  // A 3D basin's dense set-up is bounded (also with the default cells).
+  refused("[sea]\nmodel = \"bem\"\ndims = 2\ncells = [128, 64]\n", {"[sea] cells", "at most 4096 surface cells", "128 x 64"});
+  refused("[sea]\nmodel = \"bem\"\n", {"[sea] cells", "dense set-up"});
+  CHECK(parse("[sea]\nmodel = \"bem\"\ndims = 2\ncells = [64, 64]\ndepth = 1.0\n").sea.cells[1] == 64);
   // A bem basin's bottom: below the surface, x increasing, spanning [0, Lx].
   const std::string bem = "[sea]\nmodel = \"bem\"\ndims = 1\nsize = [1.0, 0.1]\ncells = [32, 1]\n";
   refused(bem + "bottom = [[0.0, -0.1], [0.5, 0.02], [1.0, -0.1]]\n",
