@@ -301,7 +301,8 @@ void read_sea(Section s, SeaParams& p, const std::string& file) {
     k.absorption_length = t.number("absorption_length", k.absorption_length, non_negative, "a length >= 0 (m; 0: 2 wavelengths)");
     k.rate = t.number("rate", k.rate, non_negative, "a rate >= 0 (1/s; 0: 4 omega)");
     k.ramp_periods = t.number("ramp_periods", k.ramp_periods, non_negative, "a number of periods >= 0");
-    if (k.enabled && p.model != SeaModel::spectral) t.fail("enabled", "tank zones need model = \"spectral\"");
+    if (k.enabled && p.model != SeaModel::spectral && !(p.model == SeaModel::bem && p.dims == 2))
+      t.fail("enabled", "tank zones need model = \"spectral\" (or \"bem\" with dims = 2)");
     if (k.enabled && p.waves.kind != WaveKind::regular)
       t.fail("enabled", "tank zones generate the regular wave of [sea.waves] (kind = \"regular\")");
     t.finish();

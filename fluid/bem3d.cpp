@@ -9,10 +9,13 @@
 #include <map>
 #include <mutex>
 #include <numbers>
+#include <optional>
 #include <sstream>
 
 #include "core/error.hpp"
 #include "fluid/bem.hpp"
+#include "fluid/tank.hpp"
+#include "fluid/waves.hpp"
 
 namespace floesim::fluid {
 
@@ -374,6 +377,8 @@ struct Bem3dSea::Impl {
   bool hit = false;
   bool kicked = false;  // work_modes holds the projection of the last kick's pressure
   VectorXd work_modes, work_surface;
+  std::optional<TankZones> tank;  // relaxation zones along x (fluid/tank.hpp)
+  std::vector<double> tank_eta, tank_rate;
 };
 
 Bem3dSea::Bem3dSea(const SeaParams& params, const SeaOptions& options)
@@ -388,9 +393,25 @@ Bem3dSea::Bem3dSea(const SeaParams& params, const SeaOptions& options)
   bank_ = ModalBank(ops.omega, std::vector<double>(nm, 1.0), std::vector<double>(nm, 1.0), 1);
   impl_->work_modes.resize(static_cast<Eigen::Index>(nm));
   impl_->work_surface.resize(ops.surface);
+  if (options.tank.enabled) {
+    FLOESIM_ASSERT(params.waves.kind == WaveKind::regular);  // refused at load (core/config.cpp)
+    impl_->tank.emplace(grid_, options.tank, plane_wave(params, grid_));
+    impl_->tank_eta.assign(grid_.size(), 0.0);
+    impl_->tank_rate.assign(grid_.size(), 0.0);
+  }
 }
 
 Bem3dSea::~Bem3dSea() = default;
+
+const TankZones* Bem3dSea::tank() const { return impl_->tank ? &*impl_->tank : nullptr; }
+
+void Bem3dSea::relax_tank(double t0, double h) {
+  Impl& m = *impl_;
+  synthesize(bank_.q(), m.tank_eta);
+  synthesize(bank_.v(), m.tank_rate);
+  m.tank->relax(t0, h, m.tank_eta, m.tank_rate);
+  set_surface(m.tank_eta, m.tank_rate);
+}
 
 std::span<const double> Bem3dSea::frequencies() const { return impl_->ops->omega; }
 int Bem3dSea::panels() const { return impl_->ops->panels; }
@@ -414,9 +435,23 @@ void Bem3dSea::repeat_kick(double h) {
 }
 
 void Bem3dSea::flow(double dt) {
-  bank_.flow(dt);
+  if (!impl_->tank) {
+    bank_.flow(dt);
+  } else {
+    // Strang: relax(dt/2) flow(dt) relax(dt/2), as the spectral tank.
+    relax_tank(time_, 0.5 * dt);
+    bank_.flow(dt);
+    relax_tank(time_ + 0.5 * dt, 0.5 * dt);
+  }
   time_ += dt;
   invalidate();
+}
+
+void Bem3dSea::midpoint_step(std::span<const double> p, double h) {
+  if (!impl_->tank) return Sea::midpoint_step(p, h);
+  relax_tank(time_, 0.5 * h);
+  Sea::midpoint_step(p, h);  // advances time_ by h
+  relax_tank(time_ - 0.5 * h, 0.5 * h);
 }
 
 void Bem3dSea::set_surface(std::span<const double> eta, std::span<const double> eta_t) {

@@ -34,6 +34,8 @@
 // about 3 times the surface cells for a basin as deep as a cell is long
 // times its cells across) and the dense eigenproblem of size nx ny; memory
 // 8 (N + 1) (N + 1 + nx ny) bytes at the peak (measured in docs/sea.md).
+// Tank runs: the relaxation zones of fluid/tank.hpp along x (the generation
+// zone against the wall x = 0), applied on the grid around each flow.
 // Per step: a kick projects the pressure on the modes (one dense mat-vec,
 // (nx ny)^2); fields are dense mat-vecs too; slopes and horizontal velocities
 // are centred differences of eta and of the surface potential.
@@ -54,6 +56,7 @@ public:
   void kick(std::span<const double> pressure, double h) override;
   void repeat_kick(double h) override;
   void flow(double dt) override;
+  void midpoint_step(std::span<const double> p, double h) override;
   void set_surface(std::span<const double> eta, std::span<const double> eta_t) override;
 
   std::span<const double> frequencies() const;  // omega of each mode, ascending, rad/s
@@ -69,6 +72,9 @@ public:
   const SetupCost& setup_cost() const;
   double setup_seconds() const { return setup_cost().seconds; }
   bool from_cache() const;                      // the setup was reused
+  // The relaxation zones of a tank run (options.tank), or nullptr. They act
+  // on eta and eta' on the grid around each flow, as on the spectral sea.
+  const TankZones* tank() const;
 
 protected:
   void compute_field(Field f, std::span<double> out) override;
@@ -76,6 +82,7 @@ protected:
   void synthesize(std::span<const double> q, std::span<double> eta) override;
 
 private:
+  void relax_tank(double t0, double h);
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };

@@ -144,7 +144,7 @@ std::unique_ptr<Sea> make_sea(const SeaParams& params, unsigned long seed,
       sea = std::make_unique<SpectralSea>(params, options);
       break;
     case SeaModel::bem:
-      FLOESIM_ASSERT(!options.tank.enabled);  // refused at load (core/config.cpp)
+      FLOESIM_ASSERT(!options.tank.enabled || params.dims == 2);  // refused at load (core/config.cpp)
       if (params.dims == 1)
         sea = std::make_unique<BemSea>(params, options);
       else

@@ -60,7 +60,7 @@ struct SeaEnergy {
 
 // Fluid-side options that are not part of the [sea] configuration.
 struct SeaOptions {
-  TankParams tank;              // relaxation zones (spectral only)
+  TankParams tank;              // relaxation zones (spectral; bem with dims = 2)
   bool measure_fft_plans = false;  // FFTW_MEASURE instead of FFTW_ESTIMATE (benchmarks)
   double bem_panel_ratio = 1.0;    // bem: wall and bottom panel length / surface panel length
   // bem, dims = 2: a panel nearer to a collocation point than this many panel
@@ -158,7 +158,7 @@ void validate(const SeaParams& params);
 // the random phases of an irregular sea). Returns nullptr for model = "none".
 // A tank run (options.tank.enabled) starts calm and generates its target wave.
 // Preconditions (checked at load, core/config.cpp; asserted here): tank zones
-// only on the spectral sea, with a regular [sea.waves] wave.
+// only on the spectral sea and the 3D BEM basin, with a regular [sea.waves] wave.
 std::unique_ptr<Sea> make_sea(const SeaParams& params, unsigned long seed,
                               const SeaOptions& options = {});
 
