@@ -6,6 +6,7 @@
 #include <array>
 #include <chrono>
 #include <cmath>
+#include <functional>
 #include <map>
 #include <mutex>
 #include <numbers>
@@ -33,83 +34,136 @@ P3 cross(const P3& a, const P3& b) {
 }
 double norm(const P3& a) { return std::sqrt(dot(a, a)); }
 
-using Quad = std::array<P3, 4>;
+// A flat panel: a quadrilateral, or a triangle (size 3), counter-clockwise
+// about the fluid's outward normal.
+struct Panel {
+  std::array<P3, 4> v;
+  std::size_t size = 4;
+  std::span<const P3> vertices() const { return {v.data(), size}; }
+};
 
 // Appends the quadrilateral a b c d, ordered counter-clockwise about `outward`.
-void add_quad(std::vector<Quad>& out, const P3& a, const P3& b, const P3& c, const P3& d,
-              const P3& outward) {
+void add_quad(std::vector<Panel>& out, const P3& a, const P3& b, const P3& c, const P3& d, const P3& outward) {
   const P3 n = cross(sub(c, a), sub(d, b));  // twice the vector area
   if (dot(n, outward) >= 0.0)
-    out.push_back({a, b, c, d});
+    out.push_back({{a, b, c, d}, 4});
   else
-    out.push_back({a, d, c, b});
+    out.push_back({{a, d, c, b}, 4});
 }
 
-P3 centroid(const Quad& q) {
+void add_triangle(std::vector<Panel>& out, const P3& a, const P3& b, const P3& c, const P3& outward) {
+  const P3 n = cross(sub(b, a), sub(c, a));
+  if (dot(n, outward) >= 0.0)
+    out.push_back({{a, b, c, c}, 3});
+  else
+    out.push_back({{a, c, b, b}, 3});
+}
+
+P3 centroid(const Panel& q) {
   P3 c{};
-  for (const P3& v : q)
-    for (int k = 0; k < 3; ++k) c[k] += 0.25 * v[k];
+  for (const P3& v : q.vertices())
+    for (int k = 0; k < 3; ++k) c[k] += v[k] / static_cast<double>(q.size);
   return c;
+}
+
+// The bottom z_b(x, y) and the columns along x that the bottom and walls are
+// cut into: the polyline's segments (its vertices are column edges), or, for
+// a bottom grid, equal columns, with z bilinear between the grid's nodes.
+struct Bottom {
+  std::vector<double> xs;  // column edges, 0 .. lx
+  bool planar = true;      // z varies along x only: the bottom's quads are flat
+  std::function<double(double, double)> z;
+};
+
+Bottom bottom_of(const SeaParams& p, double ratio) {
+  const double lx = p.size[0], ly = p.size[1], dx = lx / p.cells[0];
+  Bottom b;
+  if (!p.bottom_grid.empty()) {
+    b.planar = false;
+    const int n = std::max(1, static_cast<int>(std::ceil(lx / (ratio * dx) - 1e-9)));
+    for (int c = 0; c <= n; ++c) b.xs.push_back(lx * c / n);
+    b.z = [&p, lx, ly](double x, double y) {
+      const int mx = p.bottom_nx, my = p.bottom_ny;
+      const double u = std::clamp(x / lx, 0.0, 1.0) * (mx - 1), v = std::clamp(y / ly, 0.0, 1.0) * (my - 1);
+      const int i = std::min(static_cast<int>(u), mx - 2), j = std::min(static_cast<int>(v), my - 2);
+      const double s = u - i, t = v - j;
+      auto at = [&](int ii, int jj) { return p.bottom_grid[static_cast<std::size_t>(jj * mx + ii)]; };
+      return (1 - s) * (1 - t) * at(i, j) + s * (1 - t) * at(i + 1, j) + s * t * at(i + 1, j + 1) + (1 - s) * t * at(i, j + 1);
+    };
+    return b;
+  }
+  // Each segment of the polyline cut into pieces of about ratio dx (along the slope).
+  const auto line = bottom_profile(p);
+  b.xs.push_back(line[0][0]);
+  for (std::size_t k = 1; k < line.size(); ++k) {
+    const double len = std::hypot(line[k][0] - line[k - 1][0], line[k][1] - line[k - 1][1]);
+    const int n = std::max(1, static_cast<int>(std::ceil(len / (ratio * dx) - 1e-9)));
+    for (int m = 1; m <= n; ++m) b.xs.push_back(line[k - 1][0] + (line[k][0] - line[k - 1][0]) * m / n);
+  }
+  b.z = [line](double x, double) {
+    for (std::size_t i = 1; i < line.size(); ++i)
+      if (x <= line[i][0]) {
+        const double t = (x - line[i - 1][0]) / (line[i][0] - line[i - 1][0]);
+        return line[i - 1][1] + t * (line[i][1] - line[i - 1][1]);
+      }
+    return line.back()[1];
+  };
+  return b;
 }
 
 // The watertight boundary of the basin: the surface cells first (panel
 // j nx + i is grid cell (i, j)), then the bottom and the four walls.
-std::vector<Quad> basin_panels(const SeaParams& p, double ratio) {
+std::vector<Panel> basin_panels(const SeaParams& p, double ratio) {
   const int nx = p.cells[0], ny = p.cells[1];
   const double lx = p.size[0], ly = p.size[1], dx = lx / nx, dy = ly / ny;
-  std::vector<Quad> out;
+  std::vector<Panel> out;
   for (int j = 0; j < ny; ++j)
     for (int i = 0; i < nx; ++i)
       add_quad(out, {i * dx, j * dy, 0.0}, {(i + 1) * dx, j * dy, 0.0}, {(i + 1) * dx, (j + 1) * dy, 0.0},
                {i * dx, (j + 1) * dy, 0.0}, {0.0, 0.0, 1.0});
 
-  // Columns along x: each segment of the bottom polyline cut into pieces of
-  // about ratio dx (along the slope).
-  std::vector<double> xs, zs;
-  const auto bottom = bottom_profile(p);
-  xs.push_back(bottom[0][0]);
-  zs.push_back(bottom[0][1]);
-  for (std::size_t k = 1; k < bottom.size(); ++k) {
-    const double len = std::hypot(bottom[k][0] - bottom[k - 1][0], bottom[k][1] - bottom[k - 1][1]);
-    const int n = std::max(1, static_cast<int>(std::ceil(len / (ratio * dx) - 1e-9)));
-    for (int m = 1; m <= n; ++m) {
-      const double t = static_cast<double>(m) / n;
-      xs.push_back(bottom[k - 1][0] + t * (bottom[k][0] - bottom[k - 1][0]));
-      zs.push_back(bottom[k - 1][1] + t * (bottom[k][1] - bottom[k - 1][1]));
-    }
-  }
+  const Bottom bottom = bottom_of(p, ratio);
+  const std::vector<double>& xs = bottom.xs;
   const int cols = static_cast<int>(xs.size()) - 1;
   const int rows = std::max(1, static_cast<int>(std::ceil(ly / (ratio * dy) - 1e-9)));
-  const double deepest = -*std::min_element(zs.begin(), zs.end());
-  const int layers = std::max(1, static_cast<int>(std::ceil(deepest / (ratio * std::min(dx, dy)) - 1e-9)));
   auto y = [&](int r) { return ly * r / rows; };
+  auto node = [&](int c, int r) { return P3{xs[static_cast<std::size_t>(c)], y(r), bottom.z(xs[static_cast<std::size_t>(c)], y(r))}; };
+  double deepest = 0.0;
+  for (int c = 0; c <= cols; ++c)
+    for (int r = 0; r <= rows; ++r) deepest = std::max(deepest, -node(c, r)[2]);
+  const int layers = std::max(1, static_cast<int>(std::ceil(deepest / (ratio * std::min(dx, dy)) - 1e-9)));
   auto t = [&](int l) { return static_cast<double>(l) / layers; };  // fraction of the local depth
+  auto scaled = [](P3 v, double f) { return P3{v[0], v[1], f * v[2]}; };
 
+  const P3 down = {0.0, 0.0, -1.0};
   for (int c = 0; c < cols; ++c)
-    for (int r = 0; r < rows; ++r)
-      add_quad(out, {xs[c], y(r), zs[c]}, {xs[c + 1], y(r), zs[c + 1]}, {xs[c + 1], y(r + 1), zs[c + 1]},
-               {xs[c], y(r + 1), zs[c]}, {0.0, 0.0, -1.0});
-  for (int l = 0; l < layers; ++l) {
     for (int r = 0; r < rows; ++r) {
-      for (int end : {0, cols}) {
-        const double x = xs[end], z = zs[end];
-        add_quad(out, {x, y(r), t(l) * z}, {x, y(r + 1), t(l) * z}, {x, y(r + 1), t(l + 1) * z},
-                 {x, y(r), t(l + 1) * z}, {end == 0 ? -1.0 : 1.0, 0.0, 0.0});
+      const P3 a = node(c, r), b = node(c + 1, r), e = node(c + 1, r + 1), d = node(c, r + 1);
+      if (bottom.planar) {
+        add_quad(out, a, b, e, d, down);
+      } else {  // a bilinear patch is not flat: two triangles
+        add_triangle(out, a, b, e, down);
+        add_triangle(out, a, e, d, down);
       }
     }
-    for (int c = 0; c < cols; ++c) {
-      for (double yw : {0.0, ly}) {
-        add_quad(out, {xs[c], yw, t(l) * zs[c]}, {xs[c + 1], yw, t(l) * zs[c + 1]},
-                 {xs[c + 1], yw, t(l + 1) * zs[c + 1]}, {xs[c], yw, t(l + 1) * zs[c]},
-                 {0.0, yw == 0.0 ? -1.0 : 1.0, 0.0});
-      }
-    }
+  // Walls: each column (row) of the bottom carried up in equal fractions of
+  // its local depth; every such panel lies in its wall's plane.
+  for (int l = 0; l < layers; ++l) {
+    for (int r = 0; r < rows; ++r)
+      for (int end : {0, cols})
+        add_quad(out, scaled(node(end, r), t(l)), scaled(node(end, r + 1), t(l)), scaled(node(end, r + 1), t(l + 1)),
+                 scaled(node(end, r), t(l + 1)), {end == 0 ? -1.0 : 1.0, 0.0, 0.0});
+    for (int c = 0; c < cols; ++c)
+      for (int side : {0, rows})
+        add_quad(out, scaled(node(c, side), t(l)), scaled(node(c + 1, side), t(l)), scaled(node(c + 1, side), t(l + 1)),
+                 scaled(node(c, side), t(l + 1)), {0.0, side == 0 ? -1.0 : 1.0, 0.0});
   }
   return out;
 }
 
-// A panel's far-field rule: 2 x 2 Gauss points of its bilinear map from the
-// unit square, with weights times the area element; exact integrals within
+// A panel's far-field rule: 2 x 2 Gauss points of a quadrilateral's bilinear
+// map from the unit square, with weights times the area element, or a
+// triangle's three-point rule; exact integrals within
 // `near` diameters of its centroid.
 struct FarRule {
   std::array<P3, 4> point;
@@ -118,8 +172,25 @@ struct FarRule {
   double diameter = 0.0;
 };
 
-FarRule far_rule(const Quad& q) {
+FarRule far_rule(const Panel& panel) {
   FarRule r;
+  const auto& q = panel.v;
+  r.centre = centroid(panel);
+  if (panel.size == 3) {
+    // The three-point rule at (2/3, 1/6, 1/6) and its permutations (degree 2).
+    const double area = 0.5 * norm(cross(sub(q[1], q[0]), sub(q[2], q[0])));
+    for (std::size_t k = 0; k < 3; ++k) {
+      for (int c = 0; c < 3; ++c) r.point[k][c] = (4.0 * q[k][c] + q[(k + 1) % 3][c] + q[(k + 2) % 3][c]) / 6.0;
+      r.weight[k] = area / 3.0;
+    }
+    r.weight[3] = 0.0;
+    r.point[3] = r.centre;
+    r.normal = cross(sub(q[1], q[0]), sub(q[2], q[0]));
+    const double nn = norm(r.normal);
+    for (double& c : r.normal) c /= nn;
+    r.diameter = std::max({norm(sub(q[1], q[0])), norm(sub(q[2], q[1])), norm(sub(q[0], q[2]))});
+    return r;
+  }
   const double g = 0.5 / std::sqrt(3.0);
   int k = 0;
   for (double s : {0.5 - g, 0.5 + g})
@@ -137,7 +208,6 @@ FarRule far_rule(const Quad& q) {
   r.normal = cross(sub(q[2], q[0]), sub(q[3], q[1]));
   const double nn = norm(r.normal);
   for (double& c : r.normal) c /= nn;
-  r.centre = centroid(q);
   r.diameter = std::max(norm(sub(q[2], q[0])), norm(sub(q[3], q[1])));
   return r;
 }
@@ -183,7 +253,7 @@ std::shared_ptr<const Operators> build(const SeaParams& p, double ratio, double 
   Bem3dSea::SetupCost cost;
   const int nx = p.cells[0], ny = p.cells[1], ns = nx * ny;
   const double dx = p.size[0] / nx, dy = p.size[1] / ny, area = dx * dy;
-  const std::vector<Quad> panels = basin_panels(p, ratio);
+  const std::vector<Panel> panels = basin_panels(p, ratio);
   const int n = static_cast<int>(panels.size());
   std::vector<P3> centres(panels.size());
   std::vector<FarRule> rules(panels.size());
@@ -202,7 +272,7 @@ std::shared_ptr<const Operators> build(const SeaParams& p, double ratio, double 
     for (int i = 0; i < n; ++i) {
       const P3& c = centres[static_cast<std::size_t>(i)];
       const P3 d = sub(c, rules[uj].centre);
-      const PanelIntegrals in = dot(d, d) > reach2 ? far_integrals(rules[uj], c) : panel_integrals(panels[uj], c);
+      const PanelIntegrals in = dot(d, d) > reach2 ? far_integrals(rules[uj], c) : panel_integrals(panels[uj].vertices(), c);
       a(i, j) = in.double_;
       if (j < ns) phi(i, j) = in.single;
     }
@@ -288,6 +358,8 @@ std::shared_ptr<const Operators> cached(const SeaParams& p, double ratio, double
   key << p.size[0] << ' ' << p.size[1] << ' ' << p.cells[0] << ' ' << p.cells[1] << ' ' << p.depth << ' '
       << p.rho << ' ' << p.g << ' ' << p.sigma << ' ' << ratio << ' ' << near;
   for (const auto& b : p.bottom) key << ' ' << b[0] << ',' << b[1];
+  key << " grid " << p.bottom_nx << ' ' << p.bottom_ny;
+  for (double z : p.bottom_grid) key << ' ' << z;
   std::lock_guard lock(mutex);
   if (auto it = cache.find(key.str()); it != cache.end()) {
     hit = true;

@@ -1,13 +1,15 @@
 #pragma once
 // BEM sea in 3D (dims = 2): a rectangular basin [0, lx] x [0, ly] with four
 // vertical walls and a bottom z_b(x) (a polyline along x, uniform across the
-// basin, or a flat bottom at -depth), the fluid in R^3 under the free surface.
+// basin, or a flat bottom at -depth) or z_b(x, y) (a grid of depths, bilinear
+// between its nodes), the fluid in R^3 under the free surface.
 //
 // Setup (once per basin, cached process-wide by geometry and physics):
 //  1. The fluid boundary is cut into flat constant panels (planar quadrilaterals):
 //     the nx x ny grid cells on the free surface; on the bottom, columns along
 //     the polyline's segments (about bem_panel_ratio times the surface cell
-//     length) times rows across; on the walls, the columns and rows of the
+//     length; equal columns for a bottom grid, whose patches are split into
+//     two flat triangles) times rows across; on the walls, the columns and rows of the
 //     bottom carried up to z = 0 in equal fractions of the local depth. The
 //     panels close the basin exactly (watertight), whatever their sizes.
 //  2. Collocation BEM for Laplace at panel centroids, with the free-space Green

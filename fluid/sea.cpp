@@ -129,8 +129,12 @@ void validate(const SeaParams& p) {
   if (p.g == 0.0 && p.sigma == 0.0)
     bad("g", "with g = 0 and sigma = 0 the surface has no restoring force");
   FLOESIM_ASSERT(p.bottom.empty() || (p.model == SeaModel::bem && bottom_valid(p)));
-  if (p.model == SeaModel::bem && p.bottom.empty() && !std::isfinite(p.depth))
-    bad("depth", "model = \"bem\" needs a finite depth or a [sea] bottom polyline");
+  // A bottom grid only on the 3D basin (checked at load, core/config.cpp).
+  FLOESIM_ASSERT(p.bottom_grid.empty() ||
+                 (p.model == SeaModel::bem && p.dims == 2 && p.bottom.empty() &&
+                  p.bottom_grid.size() == static_cast<std::size_t>(p.bottom_nx) * static_cast<std::size_t>(p.bottom_ny)));
+  if (p.model == SeaModel::bem && p.bottom.empty() && p.bottom_grid.empty() && !std::isfinite(p.depth))
+    bad("depth", "model = \"bem\" needs a finite depth, a [sea] bottom polyline or a bottom_file");
 }
 
 std::unique_ptr<Sea> make_sea(const SeaParams& params, unsigned long seed,

@@ -267,4 +267,51 @@ TEST_CASE("3D BEM tank: the generation zone makes the target wave and the absorb
   CHECK(std::abs(beta) / std::abs(alpha) < 0.05);
 }
 
+TEST_CASE("3D BEM bottom grid z(x, y): the polyline as a grid agrees; a bottom sloping across converges within its bounds") {
+  // The polyline 0.15 m to 0.05 m of the slice tests given as a grid of nodes
+  // every 0.2 m along x (it is linear between them: the same bottom), meshed
+  // into triangles on equal columns instead of flat quads along its segments.
+  auto grid_basin = [](int nx, std::vector<double> z, int mx, int my) {
+    SeaParams p = basin(nx, nx / 2, 1.0, 0.5);
+    p.bottom_grid = std::move(z);
+    p.bottom_nx = mx;
+    p.bottom_ny = my;
+    return p;
+  };
+  std::vector<double> profile;
+  for (int j = 0; j < 2; ++j)
+    for (int i = 0; i <= 5; ++i) profile.push_back(i <= 2 ? -0.15 : -0.15 + (0.2 * i - 0.4) / 0.6 * 0.1);
+  SeaParams line = basin(16, 8, 1.0, 0.5);
+  line.bottom = {{0.0, -0.15}, {0.4, -0.15}, {1.0, -0.05}};
+  Bem3dSea a(line), b(grid_basin(16, profile, 6, 2));
+  for (auto [m, n] : {std::pair{1, 0}, std::pair{0, 1}, std::pair{1, 1}}) {
+    const double fa = mode_frequency(a, m, n), fb = mode_frequency(b, m, n);
+    MESSAGE("mode (" << m << "," << n << "): polyline " << fa << ", grid " << fb << " rad/s");
+    CHECK(std::abs(fb / fa - 1.0) < 0.01);
+  }
+  // Depth 0.05 m at y = 0 to 0.15 m at y = ly, uniform along x.
+  const std::vector<double> across = {-0.05, -0.05, -0.15, -0.15};
+  std::vector<std::array<double, 3>> f;
+  for (int nx : {6, 12, 24}) {
+    Bem3dSea sea(grid_basin(nx, across, 2, 2));
+    f.push_back({mode_frequency(sea, 1, 0), mode_frequency(sea, 0, 1), mode_frequency(sea, 1, 1)});
+    MESSAGE(nx << "x" << nx / 2 << ": " << f.back()[0] << " " << f.back()[1] << " " << f.back()[2] << " rad/s, "
+                << sea.panels() << " panels, setup " << sea.setup_seconds() << " s");
+  }
+  Bem3dSea shallow(basin(12, 6, 1.0, 0.5, 0.05)), deep(basin(12, 6, 1.0, 0.5, 0.15));
+  for (int m = 0; m < 3; ++m) {
+    const double d1 = std::abs(f[1][m] - f[0][m]), d2 = std::abs(f[2][m] - f[1][m]);
+    MESSAGE("mode " << m << ": changes " << d1 << ", " << d2 << ", order " << std::log2(d1 / d2));
+    CAPTURE(m);
+    CHECK(d2 < 0.6 * d1);
+  }
+  const std::array<double, 3> lo = {mode_frequency(shallow, 1, 0), mode_frequency(shallow, 0, 1), mode_frequency(shallow, 1, 1)};
+  const std::array<double, 3> hi = {mode_frequency(deep, 1, 0), mode_frequency(deep, 0, 1), mode_frequency(deep, 1, 1)};
+  for (int m = 0; m < 3; ++m) {
+    CAPTURE(m);
+    CHECK(f[1][m] > lo[static_cast<std::size_t>(m)]);
+    CHECK(f[1][m] < hi[static_cast<std::size_t>(m)]);
+  }
+}
+
 TEST_SUITE_END();
