@@ -4,7 +4,8 @@
 // basin, or a flat bottom at -depth) or z_b(x, y) (a grid of depths, bilinear
 // between its nodes), the fluid in R^3 under the free surface.
 //
-// Setup (once per basin, cached process-wide by geometry and physics):
+// Setup (once per basin, cached process-wide by geometry and physics; the
+// panels and their integrals in fluid/bem3d_panels.hpp):
 //  1. The fluid boundary is cut into flat constant panels (planar quadrilaterals):
 //     the nx x ny grid cells on the free surface; on the bottom, columns along
 //     the polyline's segments (about bem_panel_ratio times the surface cell
@@ -88,16 +89,5 @@ private:
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
-
-// Exact integrals over a flat polygon (vertices counter-clockwise about its
-// normal n = the outward normal of the fluid), seen from a point p:
-//   single = ∫ 1 / (4 pi r) dS,   double_ = ∫ d/dn_y (1 / (4 pi r)) dS.
-// Exposed for tests (against quadrature).
-struct PanelIntegrals {
-  double single = 0.0;
-  double double_ = 0.0;
-};
-PanelIntegrals panel_integrals(std::span<const std::array<double, 3>> polygon,
-                               const std::array<double, 3>& p);
 
 }  // namespace floesim::fluid

@@ -4,7 +4,7 @@
 // Linear potential flow under a capillary-gravity free surface (MODEL.md §3):
 //     m_sf(eta'', v) + a_sf(eta, v) = -∫ p v   for every zero-mean v,
 // where p (Pa) is the pressure that floes apply to the water on the surface grid.
-// A backend (spectral: periodic box; bem: vertical-slice basin) turns this into
+// A backend (spectral: periodic box; bem: a walled basin, vertical slice or 3D) turns this into
 // a ModalBank; the Sea owns it and offers the same operations for both.
 //
 // Step contract (Strang splitting, MODEL.md §5):

@@ -12,6 +12,7 @@
 
 #include "fluid/bem.hpp"
 #include "fluid/bem3d.hpp"
+#include "fluid/bem3d_panels.hpp"
 #include "fluid/tank.hpp"
 #include "fluid/waves.hpp"
 #include "tests/fluid/sea_cases.hpp"
@@ -21,7 +22,6 @@ using namespace floesim::fluid;
 
 TEST_SUITE_BEGIN("fluid");
 constexpr double pi = std::numbers::pi;
-using P3 = std::array<double, 3>;
 
 namespace {
 
