@@ -201,7 +201,7 @@ TEST_CASE("3D BEM sloping bottom: modes (1,0), (0,1), (1,1) converge under refin
   }
 }
 
-TEST_CASE("3D BEM free sea: a standing mode keeps its energy; uniform pressure does nothing") {
+TEST_CASE("3D BEM free sea: a standing mode keeps its energy under uniform pressure") {
   SeaParams p = basin(12, 8, 1.0, 0.6);
   Bem3dSea sea(p);
   std::vector<double> eta(sea.grid().size()), zero(eta.size(), 0.0);
@@ -267,7 +267,7 @@ TEST_CASE("3D BEM tank: the generation zone makes the target wave and the absorb
   CHECK(std::abs(beta) / std::abs(alpha) < 0.05);
 }
 
-TEST_CASE("3D BEM bottom grid z(x, y): the polyline as a grid agrees; a bottom sloping across converges within its bounds") {
+TEST_CASE("3D BEM bottom grid z(x, y): the polyline as a grid agrees and a bottom sloping across converges within its bounds") {
   // The polyline 0.15 m to 0.05 m of the slice tests given as a grid of nodes
   // every 0.2 m along x (it is linear between them: the same bottom), meshed
   // into triangles on equal columns instead of flat quads along its segments.
