@@ -232,7 +232,55 @@ void read_waves(Section s, WaveParams& w) {
   s.finish();
 }
 
-void read_sea(Section s, SeaParams& p, const std::string& file) {
+// The bottom grid of [sea] bottom_file: one line per row of nodes (y from 0),
+// comma-separated depths z < 0 (x from 0); blank lines and lines starting with
+// '#' are skipped. Fails through `fail` with the line that is wrong.
+template <class Fail>
+void read_bottom_grid(SeaParams& p, Fail&& fail) {
+  // A folder, a device or a pipe is refused (/dev/zero would be one endless line), and so is a
+  // file larger than any grid a dense 3D basin could use.
+  std::error_code ec;
+  if (!fs::is_regular_file(p.bottom_file, ec))
+    fail(p.bottom_file + ": not found or not a regular file; expected a CSV grid of depths");
+  if (fs::file_size(p.bottom_file, ec) > (std::uintmax_t{16} << 20))
+    fail(p.bottom_file + ": larger than 16 MiB; expected a CSV grid of depths");
+  std::ifstream in(p.bottom_file);
+  if (!in) fail("cannot read the file " + p.bottom_file);
+  std::string line;
+  int line_no = 0;
+  p.bottom_grid.clear();
+  p.bottom_nx = p.bottom_ny = 0;
+  while (std::getline(in, line)) {
+    ++line_no;
+    const auto first = line.find_first_not_of(" \t\r");
+    if (first == std::string::npos || line[first] == '#') continue;
+    int count = 0;
+    std::size_t pos = 0;
+    while (pos <= line.size()) {
+      const std::size_t comma = std::min(line.find(',', pos), line.size());
+      const std::string field = line.substr(pos, comma - pos);
+      char* end = nullptr;
+      const double z = std::strtod(field.c_str(), &end);
+      if (end == field.c_str() || field.find_first_not_of(" \t\r", static_cast<std::size_t>(end - field.c_str())) != std::string::npos)
+        fail(p.bottom_file + ":" + std::to_string(line_no) + ": expected comma-separated numbers, got \"" + field + "\"");
+      if (!(std::isfinite(z) && z < 0.0))
+        fail(p.bottom_file + ":" + std::to_string(line_no) + ": every depth must be finite and below the surface (z < 0), got " + field);
+      p.bottom_grid.push_back(z);
+      ++count;
+      pos = comma + 1;
+    }
+    if (p.bottom_ny == 0) p.bottom_nx = count;
+    if (count != p.bottom_nx)
+      fail(p.bottom_file + ":" + std::to_string(line_no) + ": expected " + std::to_string(p.bottom_nx) +
+           " values as on the first row, got " + std::to_string(count));
+    ++p.bottom_ny;
+  }
+  if (p.bottom_nx < 2 || p.bottom_ny < 2)
+    fail(p.bottom_file + ": expected a grid of at least 2 x 2 depths (rows along x, one row per y), got " +
+         std::to_string(p.bottom_nx) + " x " + std::to_string(p.bottom_ny));
+}
+
+void read_sea(Section s, SeaParams& p, const std::string& file, const std::string& base_dir) {
   p.model = s.choice<SeaModel>("model", p.model, {{"none", SeaModel::none}, {"spectral", SeaModel::spectral},
                                                   {"bem", SeaModel::bem}});
   p.dims = static_cast<int>(s.integer("dims", p.dims, [](long long v) { return v == 1 || v == 2; }, "1 or 2"));
@@ -257,6 +305,15 @@ void read_sea(Section s, SeaParams& p, const std::string& file) {
     }
   } else {
     s.node("cells");
+  }
+  if (p.model == SeaModel::bem && p.dims == 2 &&
+      static_cast<double>(p.cells[0]) * p.cells[1] > kMaxBem3dCells) {
+    // The 3D basin's set-up is dense (fluid/bem3d.hpp; cost in docs/sea.md).
+    std::ostringstream m;
+    m << "model = \"bem\" with dims = 2 is a dense set-up: expected at most " << static_cast<long long>(kMaxBem3dCells)
+      << " surface cells in all (64 x 64), got " << static_cast<double>(p.cells[0]) * p.cells[1] << " ("
+      << p.cells[0] << " x " << p.cells[1] << ")";
+    s.fail("cells", m.str());
   }
   p.depth = s.number("depth", p.depth, [](double v) { return v > 0.0; }, "a depth > 0 (m) or inf");
   p.rho = s.number("rho", p.rho, positive, "a density > 0 (kg/m^3)");
@@ -283,6 +340,13 @@ void read_sea(Section s, SeaParams& p, const std::string& file) {
       s.fail("bottom", "the polyline covers x in [" + num(b.front()[0]) + ", " + num(b.back()[0]) +
                            "] m but must span the basin [0, " + num(p.size[0]) + "] m");
   }
+  p.bottom_file = resolve_path(s.string("bottom_file", ""), base_dir);
+  if (!p.bottom_file.empty()) {
+    if (!(p.model == SeaModel::bem && p.dims == 2))
+      s.fail("bottom_file", "a bottom grid needs model = \"bem\" with dims = 2");
+    if (!p.bottom.empty()) s.fail("bottom_file", "give bottom or bottom_file, not both");
+    read_bottom_grid(p, [&](const std::string& m) { s.fail("bottom_file", m); });
+  }
   read_waves(Section(s.table("waves"), "sea.waves", file), p.waves);
   {
     Section t(s.table("tank"), "sea.tank", file);
@@ -292,7 +356,8 @@ void read_sea(Section s, SeaParams& p, const std::string& file) {
     k.absorption_length = t.number("absorption_length", k.absorption_length, non_negative, "a length >= 0 (m; 0: 2 wavelengths)");
     k.rate = t.number("rate", k.rate, non_negative, "a rate >= 0 (1/s; 0: 4 omega)");
     k.ramp_periods = t.number("ramp_periods", k.ramp_periods, non_negative, "a number of periods >= 0");
-    if (k.enabled && p.model != SeaModel::spectral) t.fail("enabled", "tank zones need model = \"spectral\"");
+    if (k.enabled && p.model != SeaModel::spectral && !(p.model == SeaModel::bem && p.dims == 2))
+      t.fail("enabled", "tank zones need model = \"spectral\" (or \"bem\" with dims = 2)");
     if (k.enabled && p.waves.kind != WaveKind::regular)
       t.fail("enabled", "tank zones generate the regular wave of [sea.waves] (kind = \"regular\")");
     t.finish();
@@ -489,7 +554,7 @@ Config parse_config(std::string_view text, const std::string& name, const std::s
   c.file = name;
   Section top(&root, "", name);
   read_run(Section(top.table("run"), "run", name), c.run);
-  read_sea(Section(top.table("sea"), "sea", name), c.sea, name);
+  read_sea(Section(top.table("sea"), "sea", name), c.sea, name, base_dir);
   read_floes(Section(top.table("floes"), "floes", name), c.floes, name, base_dir);
   read_contact(Section(top.table("contact"), "contact", name), c.contact, base_dir);
   read_coupling(Section(top.table("coupling"), "coupling", name), c.coupling, c.sea.model);
@@ -554,6 +619,7 @@ std::string resolved_toml(const Config& c) {
                   {"cells", toml::array{c.sea.cells[0], c.sea.cells[1]}}, {"depth", c.sea.depth},
                   {"rho", c.sea.rho}, {"g", c.sea.g}, {"sigma", c.sea.sigma}, {"waves", waves}};
   if (!bottom.empty()) sea.insert("bottom", bottom);
+  if (!c.sea.bottom_file.empty()) sea.insert("bottom_file", c.sea.bottom_file);
   if (c.sea.tank.enabled)
     sea.insert("tank", toml::table{{"enabled", true}, {"generation_length", c.sea.tank.generation_length},
                                    {"absorption_length", c.sea.tank.absorption_length}, {"rate", c.sea.tank.rate},

@@ -61,6 +61,12 @@ struct SeaParams {
   double g = 9.81;                // m/s^2
   double sigma = 0.073;           // N/m, surface tension
   std::vector<std::array<double, 2>> bottom;      // bem: bottom polyline (x, z), z < 0
+  // bem, dims = 2: a bottom z(x, y) (m, every value < 0) given on a uniform grid
+  // of bottom_nx x bottom_ny nodes spanning [0, Lx] x [0, Ly], x fastest,
+  // read at load from bottom_file (a CSV; docs/config.md) and bilinear between nodes.
+  std::string bottom_file;
+  int bottom_nx = 0, bottom_ny = 0;
+  std::vector<double> bottom_grid;
   WaveParams waves;
   TankConfig tank;
 };

@@ -37,26 +37,6 @@ struct Operators {
   double setup_seconds = 0.0;
 };
 
-// Bottom depth profile clipped to [0, L], as the list of its vertices.
-std::vector<Point> bottom_profile(const SeaParams& p) {
-  const double len = p.size[0];
-  if (p.bottom.empty()) return {Point{0.0, -p.depth}, Point{len, -p.depth}};
-  auto z_at = [&](double x) {
-    const auto& b = p.bottom;
-    for (std::size_t i = 1; i < b.size(); ++i)
-      if (x <= b[i][0]) {
-        const double t = (x - b[i - 1][0]) / (b[i][0] - b[i - 1][0]);
-        return b[i - 1][1] + t * (b[i][1] - b[i - 1][1]);
-      }
-    return b.back()[1];
-  };
-  std::vector<Point> out{{0.0, z_at(0.0)}};
-  for (const auto& v : p.bottom)
-    if (v[0] > 0.0 && v[0] < len) out.push_back({v[0], v[1]});
-  out.push_back({len, z_at(len)});
-  return out;
-}
-
 void add_segment(std::vector<Panel>& panels, Point a, Point b, double h) {
   const double len = std::hypot(b[0] - a[0], b[1] - a[1]);
   const int n = std::max(1, static_cast<int>(std::ceil(len / h - 1e-9)));
@@ -194,6 +174,26 @@ SurfaceGrid basin_grid(const SeaParams& p) {
 }
 
 }  // namespace
+
+std::vector<std::array<double, 2>> bottom_profile(const SeaParams& p) {
+  using Point = std::array<double, 2>;
+  const double len = p.size[0];
+  if (p.bottom.empty()) return {Point{0.0, -p.depth}, Point{len, -p.depth}};
+  auto z_at = [&](double x) {
+    const auto& b = p.bottom;
+    for (std::size_t i = 1; i < b.size(); ++i)
+      if (x <= b[i][0]) {
+        const double t = (x - b[i - 1][0]) / (b[i][0] - b[i - 1][0]);
+        return b[i - 1][1] + t * (b[i][1] - b[i - 1][1]);
+      }
+    return b.back()[1];
+  };
+  std::vector<Point> out{{0.0, z_at(0.0)}};
+  for (const auto& v : p.bottom)
+    if (v[0] > 0.0 && v[0] < len) out.push_back({v[0], v[1]});
+  out.push_back({len, z_at(len)});
+  return out;
+}
 
 struct BemSea::Impl {
   std::shared_ptr<const Operators> ops;

@@ -22,8 +22,10 @@
 // fields are dense mat-vecs too; slope and horizontal velocity are centred
 // differences of eta and of the surface potential.
 
+#include <array>
 #include <memory>
 #include <span>
+#include <vector>
 
 #include "fluid/sea.hpp"
 
@@ -54,5 +56,10 @@ private:
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
+
+// The basin's bottom (x, z) clipped to [0, size x], as the list of its
+// vertices: the polyline of [sea] bottom, or the flat bottom at -depth. Shared
+// by the slice and the 3D basin (fluid/bem3d.hpp).
+std::vector<std::array<double, 2>> bottom_profile(const SeaParams& params);
 
 }  // namespace floesim::fluid

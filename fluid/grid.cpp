@@ -49,7 +49,7 @@ Stencil stencil(double pos, double h, int n, bool walls, double odd_sign) {
 }  // namespace
 
 double interpolate(const SurfaceGrid& grid, std::span<const double> field, double x, double y,
-                   Parity parity) {
+                   Parity parity, Parity parity_y) {
   const bool walls = grid.edge == GridEdge::wall;
   const double odd = parity == Parity::odd ? -1.0 : 1.0;
   const Stencil sx = stencil(x, grid.dx(), grid.nx, walls, odd);
@@ -58,7 +58,7 @@ double interpolate(const SurfaceGrid& grid, std::span<const double> field, doubl
     for (int m = 0; m < 4; ++m) v += sx.weight[m] * field[sx.index[m]];
     return v;
   }
-  const Stencil sy = stencil(y, grid.dy(), grid.ny, false, 1.0);
+  const Stencil sy = stencil(y, grid.dy(), grid.ny, walls, parity_y == Parity::odd ? -1.0 : 1.0);
   double v = 0.0;
   for (int a = 0; a < 4; ++a) {
     const std::size_t row = static_cast<std::size_t>(sy.index[a]) * grid.nx;

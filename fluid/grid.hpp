@@ -40,8 +40,10 @@ enum class Parity { even, odd };
 
 // Value at (x, y) of a cell-centred field, by tensor-product cubic Lagrange
 // interpolation on the 4 (x 4) nearest cell centres: error O(h^4) for smooth
-// fields. In dims = 1, y is ignored. Outside a walled basin, x is clamped.
+// fields. In dims = 1, y is ignored. Outside a walled basin, x (and y) are
+// clamped; `parity` is the field's parity at the walls x = 0 and lx,
+// `parity_y` at the walls y = 0 and ly (dims = 2, walled).
 double interpolate(const SurfaceGrid& grid, std::span<const double> field, double x, double y,
-                   Parity parity = Parity::even);
+                   Parity parity = Parity::even, Parity parity_y = Parity::even);
 
 }  // namespace floesim::fluid

@@ -5,6 +5,7 @@
 
 #include "core/error.hpp"
 #include "fluid/bem.hpp"
+#include "fluid/bem3d.hpp"
 #include "fluid/spectral.hpp"
 #include "fluid/waves.hpp"
 
@@ -63,15 +64,18 @@ std::span<const double> Sea::field(Field f) {
 }
 
 SurfaceSample Sea::sample(double x, double y) {
-  auto at = [&](Field f, Parity parity) { return interpolate(grid_, field(f), x, y, parity); };
+  // Parities at the walls x = const (then y = const): a derivative across a wall is odd.
+  auto at = [&](Field f, Parity parity, Parity parity_y = Parity::even) {
+    return interpolate(grid_, field(f), x, y, parity, parity_y);
+  };
   SurfaceSample s;
   s.eta = at(Field::elevation, Parity::even);
   s.slope_x = at(Field::slope_x, Parity::odd);
   s.u = at(Field::velocity_x, Parity::odd);
   s.w = at(Field::velocity_z, Parity::even);
   if (grid_.dims == 2) {
-    s.slope_y = at(Field::slope_y, Parity::even);
-    s.v = at(Field::velocity_y, Parity::even);
+    s.slope_y = at(Field::slope_y, Parity::even, Parity::odd);
+    s.v = at(Field::velocity_y, Parity::even, Parity::odd);
   }
   return s;
 }
@@ -111,8 +115,6 @@ void validate(const SeaParams& p) {
   if (!(p.size[1] > 0.0) || !std::isfinite(p.size[1]))
     bad("size", std::string("expected a ") + (p.dims == 1 ? "width" : "length") +
                     " > 0 m along y, got " + str(p.size[1]));
-  if (p.model == SeaModel::bem && p.dims != 1)
-    bad("dims", "model = \"bem\" is a vertical slice: expected dims = 1, got " + str(p.dims));
   const int min_cells = p.model == SeaModel::bem ? 4 : 2;
   if (p.cells[0] < min_cells)
     bad("cells", "expected at least " + str(min_cells) + " cells along x, got " +
@@ -127,8 +129,12 @@ void validate(const SeaParams& p) {
   if (p.g == 0.0 && p.sigma == 0.0)
     bad("g", "with g = 0 and sigma = 0 the surface has no restoring force");
   FLOESIM_ASSERT(p.bottom.empty() || (p.model == SeaModel::bem && bottom_valid(p)));
-  if (p.model == SeaModel::bem && p.bottom.empty() && !std::isfinite(p.depth))
-    bad("depth", "model = \"bem\" needs a finite depth or a [sea] bottom polyline");
+  // A bottom grid only on the 3D basin (checked at load, core/config.cpp).
+  FLOESIM_ASSERT(p.bottom_grid.empty() ||
+                 (p.model == SeaModel::bem && p.dims == 2 && p.bottom.empty() &&
+                  p.bottom_grid.size() == static_cast<std::size_t>(p.bottom_nx) * static_cast<std::size_t>(p.bottom_ny)));
+  if (p.model == SeaModel::bem && p.bottom.empty() && p.bottom_grid.empty() && !std::isfinite(p.depth))
+    bad("depth", "model = \"bem\" needs a finite depth, a [sea] bottom polyline or a bottom_file");
 }
 
 std::unique_ptr<Sea> make_sea(const SeaParams& params, unsigned long seed,
@@ -142,8 +148,11 @@ std::unique_ptr<Sea> make_sea(const SeaParams& params, unsigned long seed,
       sea = std::make_unique<SpectralSea>(params, options);
       break;
     case SeaModel::bem:
-      FLOESIM_ASSERT(!options.tank.enabled);  // refused at load (core/config.cpp)
-      sea = std::make_unique<BemSea>(params, options);
+      FLOESIM_ASSERT(!options.tank.enabled || params.dims == 2);  // refused at load (core/config.cpp)
+      if (params.dims == 1)
+        sea = std::make_unique<BemSea>(params, options);
+      else
+        sea = std::make_unique<Bem3dSea>(params, options);
       break;
   }
   if (!options.tank.enabled) {

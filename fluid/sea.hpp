@@ -4,7 +4,7 @@
 // Linear potential flow under a capillary-gravity free surface (MODEL.md §3):
 //     m_sf(eta'', v) + a_sf(eta, v) = -∫ p v   for every zero-mean v,
 // where p (Pa) is the pressure that floes apply to the water on the surface grid.
-// A backend (spectral: periodic box; bem: vertical-slice basin) turns this into
+// A backend (spectral: periodic box; bem: a walled basin, vertical slice or 3D) turns this into
 // a ModalBank; the Sea owns it and offers the same operations for both.
 //
 // Step contract (Strang splitting, MODEL.md §5):
@@ -60,9 +60,13 @@ struct SeaEnergy {
 
 // Fluid-side options that are not part of the [sea] configuration.
 struct SeaOptions {
-  TankParams tank;              // relaxation zones (spectral only)
+  TankParams tank;              // relaxation zones (spectral; bem with dims = 2)
   bool measure_fft_plans = false;  // FFTW_MEASURE instead of FFTW_ESTIMATE (benchmarks)
   double bem_panel_ratio = 1.0;    // bem: wall and bottom panel length / surface panel length
+  // bem, dims = 2: a panel nearer to a collocation point than this many panel
+  // diameters is integrated exactly, a farther one by 2 x 2 Gauss points
+  // (relative error O((1 / bem_near_field)^4); docs/sea.md). inf: all exact.
+  double bem_near_field = 3.0;
   int threads = 1;                 // spectral, dims = 2: threads of the transforms (the bits do not depend on it)
 };
 
@@ -155,7 +159,7 @@ void validate(const SeaParams& params);
 // the random phases of an irregular sea). Returns nullptr for model = "none".
 // A tank run (options.tank.enabled) starts calm and generates its target wave.
 // Preconditions (checked at load, core/config.cpp; asserted here): tank zones
-// only on the spectral sea, with a regular [sea.waves] wave.
+// only on the spectral sea and the 3D BEM basin, with a regular [sea.waves] wave.
 std::unique_ptr<Sea> make_sea(const SeaParams& params, unsigned long seed,
                               const SeaOptions& options = {});
 

@@ -1,6 +1,6 @@
 #pragma once
 // Relaxation zones for tank-like runs in a periodic box (dims = 1 or 2, zones
-// along x): a generation zone [0, Lg] that relaxes the surface toward a target
+// along x) or a 3D BEM basin (the zones against its end walls): a generation zone [0, Lg] that relaxes the surface toward a target
 // plane wave, and an absorbing zone [lx - La, lx] that relaxes it toward calm.
 //
 // Inside a zone, both eta and eta' relax toward their targets at the rate

@@ -1,7 +1,11 @@
 // Configuration: defaults, every error names the file, the line and the key.
 #include <doctest/doctest.h>
 
+#include <unistd.h>
+
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <string>
 
 #include "core/config.hpp"
@@ -103,7 +107,37 @@ TEST_CASE("unknown keys, wrong types and out-of-range values name file, line and
           {"[floes.floe] static", "cannot have a velocity"});
   refused("[coupling]\nblend = 0.5\n", {"[coupling] blend", "blend"});
   refused("[coupling]\nfootprint = \"round\"\n", {"[coupling] footprint", "\"tent\""});
-  refused("[sea]\nmodel = \"bem\"\n[coupling]\nfootprint = \"tent\"\n", {"case.toml:4", "[coupling] footprint", "periodic"});
+  refused("[sea]\nmodel = \"bem\"\ndims = 1\n[coupling]\nfootprint = \"tent\"\n", {"case.toml:5", "[coupling] footprint", "periodic"});
+  // A 3D basin's dense set-up is bounded (also with the default cells).
+  refused("[sea]\nmodel = \"bem\"\ndims = 2\ncells = [128, 64]\n", {"[sea] cells", "at most 4096 surface cells", "128 x 64"});
+  refused("[sea]\nmodel = \"bem\"\n", {"[sea] cells", "dense set-up"});
+  CHECK(parse("[sea]\nmodel = \"bem\"\ndims = 2\ncells = [64, 64]\ndepth = 1.0\n").sea.cells[1] == 64);
+  // A 3D basin's bottom grid (bottom_file): checked at load, with the line at fault.
+  {
+    const std::string dir = "/tmp/floesim_bottom_" + std::to_string(::getpid());
+    std::filesystem::create_directories(dir);
+    auto file = [&](const std::string& name, const std::string& text) {
+      std::ofstream(dir + "/" + name) << text;
+      return "[sea]\nmodel = \"bem\"\ndims = 2\ncells = [8, 4]\nbottom_file = \"" + dir + "/" + name + "\"\n";
+    };
+    const Config c = parse(file("ok.csv", "# z(x, y)\n-1.0, -0.5, -0.2\n\n-1.0, -0.6, -0.3\n"));
+    CHECK(c.sea.bottom_nx == 3);
+    CHECK(c.sea.bottom_ny == 2);
+    CHECK(c.sea.bottom_grid[4] == -0.6);
+    refused(file("ragged.csv", "-1, -1\n-1\n"), {"[sea] bottom_file", "ragged.csv:2", "expected 2 values"});
+    refused(file("dry.csv", "-1, -1\n-1, 0.1\n"), {"dry.csv:2", "below the surface"});
+    refused(file("text.csv", "-1, deep\n-1, -1\n"), {"text.csv:1", "comma-separated numbers"});
+    refused(file("one.csv", "-1, -1\n"), {"at least 2 x 2", "2 x 1"});
+    refused("[sea]\nmodel = \"bem\"\ndims = 2\ncells = [8, 4]\nbottom_file = \"/dev/zero\"\n", {"not a regular file"});
+    refused("[sea]\nmodel = \"bem\"\ndims = 2\ncells = [8, 4]\nbottom_file = \"missing.csv\"\n", {"/tmp/missing.csv", "not found"});
+    file("ok2.csv", "-1, -1\n-1, -1\n");
+    refused("[sea]\nmodel = \"bem\"\ndims = 1\ndepth = 1.0\nbottom_file = \"" + dir + "/ok2.csv\"\n",
+            {"[sea] bottom_file", "needs model = \"bem\" with dims = 2"});
+    refused("[sea]\nmodel = \"bem\"\ndims = 2\ncells = [8, 4]\nbottom = [[0.0, -1.0], [200.0, -1.0]]\nbottom_file = \"" +
+                dir + "/ok2.csv\"\n",
+            {"bottom or bottom_file, not both"});
+    std::filesystem::remove_all(dir);
+  }
   // A bem basin's bottom: below the surface, x increasing, spanning [0, Lx].
   const std::string bem = "[sea]\nmodel = \"bem\"\ndims = 1\nsize = [1.0, 0.1]\ncells = [32, 1]\n";
   refused(bem + "bottom = [[0.0, -0.1], [0.5, 0.02], [1.0, -0.1]]\n",

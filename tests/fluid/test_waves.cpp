@@ -168,9 +168,12 @@ TEST_CASE("bad [sea] input is an InputError that names the key") {
   CHECK(input_error(b).empty());
   b.bottom = {{0.0, -0.1}, {1.2, -0.1}};
   CHECK(input_error(b).empty());
+  // A 3D basin (dims = 2, fluid/bem3d.hpp) needs cells across it.
   b = cases::lab_tank_bem(32);
   b.dims = 2;
-  CHECK(has(input_error(b), "[sea] dims"));
+  CHECK(has(input_error(b), "[sea] cells"));
+  b.cells = {32, 4};
+  CHECK(input_error(b).empty());
 }
 
 TEST_SUITE_END();
