@@ -37,6 +37,29 @@ class Pieces(unittest.TestCase):
         x = 0.013 * np.cos(omega * t + 0.7) + 0.02 * t - 1e-3 * t * t + 3.0
         self.assertAlmostEqual(abs(citeph.fit_amplitude(t, x, omega)), 0.013, delta=1e-4)
 
+    def test_response_of_a_drifting_disc(self):
+        # A disc drifting at 0.1 m/s through a progressive wave heaves at 0.8
+        # of the wave it meets (a Doppler-shifted frequency): the fit in its
+        # frame recovers 0.8, a fit at the wave frequency in the basin's would not.
+        period, k, a0 = 1.25, 2.58, 0.02
+        omega = 2 * math.pi / period
+        dx = 0.1
+        centres = (np.arange(200) + 0.5) * dx
+        row = a0 * np.exp(1j * k * centres)
+        empty = dict(row_dx=dx, row_re=row.real.tolist(), row_im=row.imag.tolist())
+        t = np.arange(0.0, 10.0, period / 20)
+        x = 8.0 + 0.1 * t
+        phase = k * x - omega * t
+        series = dict(t=t.tolist(), x=(x + 0.9 * a0 * np.sin(phase)).tolist(),
+                      heave=(0.8 * a0 * np.cos(phase + 0.3)).tolist(),
+                      pitch=(0.7 * k * a0 * np.sin(phase)).tolist())
+        r = citeph.response(series, empty, 1.0, omega)
+        self.assertAlmostEqual(r["heave"], 0.8, delta=2e-3)
+        self.assertAlmostEqual(r["pitch"] / k, 0.7, delta=2e-3)
+        self.assertAlmostEqual(r["x"], 0.9, delta=2e-3)
+        fixed = abs(citeph.fit_amplitude(t, np.array(series["heave"]), omega)) / a0
+        self.assertLess(fixed, 0.7)
+
     def test_lattices_reach_the_concentrations_without_overlap(self):
         strip = (10.0, 10.0 + citeph.STRIP)
         for target in (39, 79):

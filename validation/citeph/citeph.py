@@ -10,15 +10,18 @@ gives the incident amplitude at the disc and at the probes (the sea is
 linear, so one empty run per period serves every wave height: its amplitudes
 are scaled by H / H_ref).
 
-Measurements, as the experiment defines them (data/citeph/README.md), all by a
-least-squares fit of a cos(w t) + b sin(w t) + c0 + c1 t + c2 t^2 over the
-last `window_periods` periods (the polynomial takes up the disc's slow drift):
+Measurements, as the experiment defines them (data/citeph/README.md), by
+least-squares fits over the last `window_periods` periods:
   heave RAO  = |heave| / a_inc
   pitch RAO  = |pitch| / (k a_inc)   (pitch = the bottom's slope along x, rad)
   surge RAO  = |x| / a_inc
   transmission = mean over probes of |eta|^2 behind the array, divided by the
-                 same mean in the empty basin
-with a_inc the empty basin's amplitude at the disc's centre.
+                 same mean in the empty basin.
+The disc is not moored: the mean wave force makes it drift (up to a metre over
+the window), so its motions are fitted against the incident wave it meets on
+its way (`response`: the empty basin's complex amplitude along the middle line,
+read at the disc's centre), which also takes the Doppler shift of the drift.
+Probe amplitudes are fitted as a cos(w t) + b sin(w t) + c0 + c1 t + c2 t^2.
 
 Collisions (79% array): the discs in the middle of the array and their
 neighbours are sampled every step over the window; a collision of two discs
@@ -88,6 +91,7 @@ RESOLUTIONS = {
 class Physics:
     """Model choices (docs/validation.md says why)."""
     law: str = "strong"
+    blend: float = 1.0             # with law = "blend": s in p = s strong + (1 - s) weak
     stiffness: float = 100.0
     restitution: float = 0.5       # disc-disc (plastic on plastic)
     friction: float = 0.3
@@ -255,7 +259,7 @@ generation_length = {b['generation']:.6f}
 absorption_length = {b['absorption']:.6f}
 
 [coupling]
-law = "{physics.law}"
+law = "{physics.law}"{f"{chr(10)}blend = {physics.blend}" if physics.law == "blend" else ""}
 stiffness = {physics.stiffness}
 integrator = "implicit"
 
@@ -281,7 +285,7 @@ thickness = {THICKNESS}
 def fit_amplitude(t, signal, omega):
     """Complex amplitude A (signal ~ Re(A exp(-i w t)) + slow polynomial) by least squares.
     signal may be [n] or [n, m] (one fit per column)."""
-    tc = (t - t.mean()) / max(t.ptp(), 1e-12)
+    tc = (t - t.mean()) / max(np.ptp(t), 1e-12)
     basis = np.column_stack([np.cos(omega * t), np.sin(omega * t), np.ones_like(t), tc, tc * tc])
     coef, *_ = np.linalg.lstsq(basis, signal, rcond=None)
     return coef[0] + 1j * coef[1]
@@ -321,6 +325,31 @@ def collisions(t, state, i, neighbours, mass, contact_distance, cols):
     return times, impulses
 
 
+def response(series, empty, scale, omega):
+    """Complex response of each of x, heave, pitch to the incident wave met by
+    the drifting disc: a signal s(t) is fitted as Re(R b(t)) + a slow
+    quadratic, b(t) = A(x(t)) exp(-i w t) with A the empty basin's complex
+    amplitude (times scale) along the middle line, interpolated at the disc's
+    centre x(t). |R| is then the response per unit incident amplitude (the
+    drift's Doppler shift and the wave's change along the path are in b)."""
+    t = np.array(series["t"])
+    x = np.array(series["x"])
+    row = (np.array(empty["row_re"]) + 1j * np.array(empty["row_im"])) * scale
+    centres = (np.arange(len(row)) + 0.5) * empty["row_dx"]
+    # modulus and phase interpolated apart: a progressive wave's phase is linear
+    # in x, and interpolating re and im would shrink |A| by up to (k dx)^2 / 8
+    a = np.interp(x, centres, np.abs(row)) * np.exp(1j * np.interp(x, centres, np.unwrap(np.angle(row))))
+    b = a * np.exp(-1j * omega * t)
+    tc = (t - t.mean()) / max(np.ptp(t), 1e-12)
+    basis = np.column_stack([b.real, b.imag, np.ones_like(t), tc, tc * tc])
+    out = {}
+    for name in ("x", "heave", "pitch"):
+        (c1, c2, *_), *_ = np.linalg.lstsq(basis, np.array(series[name]), rcond=None)
+        out[name] = math.hypot(c1, c2)
+    out["a_inc"] = float(np.mean(np.abs(a)))
+    return out
+
+
 def run_case(job):
     """Runs one configuration in this process and returns its measurements (a dict)."""
     os.environ["OMP_NUM_THREADS"] = "1"
@@ -339,7 +368,7 @@ def run_case(job):
     t_window = t_end - job["window_periods"] * period
     probe_cols = [int(p / dx) for p in layout["probes"]]
     disc_col = int(layout["disc"][0] / dx)
-    times, states, probes, at_disc = [], [], [], []
+    times, states, probes, at_disc, rows = [], [], [], [], []
     dt = layout["dt"]
     start = time.time()
     cpu0 = resource.getrusage(resource.RUSAGE_SELF).ru_utime
@@ -355,6 +384,8 @@ def run_case(job):
         eta = np.asarray(sim.sea_elevation())
         probes.append(eta[:, probe_cols])
         at_disc.append(eta[:, disc_col].mean())
+        if empty:
+            rows.append(eta[ny // 2, :])
     wall = time.time() - start
     cpu = resource.getrusage(resource.RUSAGE_SELF).ru_utime - cpu0
     t = np.array(times)
@@ -366,14 +397,17 @@ def run_case(job):
     a = fit_amplitude(t[sel], p.reshape(p.shape[0], -1), omega)
     out["probe_energy"] = float(np.mean(np.abs(a) ** 2))
     out["disc_amplitude"] = float(abs(fit_amplitude(t[sel], np.array(at_disc)[sel], omega)))
+    if empty:   # the incident wave's complex amplitude along the basin's middle line
+        row = fit_amplitude(t[sel], np.array(rows)[sel], omega)
+        out["row_dx"] = dx
+        out["row_re"], out["row_im"] = row.real.tolist(), row.imag.tolist()
     if not empty:
         s = np.array(states)                           # [n_all, floes, 12]
         cols = floesim.STATE_COLUMNS
         ix, ih, ip = cols.index("x"), cols.index("heave"), cols.index("pitch")
         if test["concentration"] == 0:
-            out["surge"] = float(abs(fit_amplitude(t[sel], s[sel, 0, ix], omega)))
-            out["heave"] = float(abs(fit_amplitude(t[sel], s[sel, 0, ih], omega)))
-            out["pitch"] = float(abs(fit_amplitude(t[sel], s[sel, 0, ip], omega)))
+            out["series"] = dict(t=t[sel].tolist(), x=s[sel, 0, ix].tolist(), heave=s[sel, 0, ih].tolist(),
+                                 pitch=s[sel, 0, ip].tolist())
             out["drift_m"] = float(s[sel, 0, ix][-1] - s[sel, 0, ix][0])
             out["window_s"] = float(t[sel][-1] - t[sel][0])
         else:
@@ -392,6 +426,10 @@ def run_case(job):
             out["collision_interval_s"] = disc_time / len(impulses) if impulses else float("nan")
             out["collision_impulse_Ns"] = float(np.mean(impulses)) if impulses else float("nan")
             out["lcp"] = sim.lcp()
+            x = s[sel][:, :, ix]
+            out["array_drift_m"] = float(np.mean(x[-1] - centres[:, 0]))
+            out["array_rear_m"] = float(np.max(x[-1]) + DIAMETER / 2)
+            out["first_probe_m"] = float(layout["probes"][0])
     return out
 
 
@@ -473,9 +511,10 @@ def results_rows(workdir):
             scale = test["H_mm"] / empty["H_mm"]
             a_inc = empty["disc_amplitude"] * scale
             if test["concentration"] == 0:
-                k = wavenumber(test["T"])
-                model = dict(heave_rao=r["heave"] / a_inc, pitch_rao=r["pitch"] / (k * a_inc),
-                             surge_rao=r["surge"] / a_inc)
+                if "series" in r and "row_re" in empty:
+                    k = wavenumber(test["T"])
+                    rao = response(r["series"], empty, scale, 2 * math.pi / test["T"])
+                    model = dict(heave_rao=rao["heave"], pitch_rao=rao["pitch"] / k, surge_rao=rao["x"])
             else:
                 model = dict(transmission=r["probe_energy"] / (empty["probe_energy"] * scale * scale))
                 if test["concentration"] == 79:
@@ -580,6 +619,9 @@ def main(argv):
     r.add_argument("--only", help="regular expression on the case names")
     r.add_argument("--law", default=Physics.law)
     r.add_argument("--stiffness", type=float, default=Physics.stiffness)
+    r.add_argument("--blend", type=float, default=Physics.blend)
+    r.add_argument("--restitution", type=float, default=Physics.restitution)
+    r.add_argument("--friction", type=float, default=Physics.friction)
     p = sub.add_parser("report", help="results.csv and figures from the runs in WORKDIR")
     p.add_argument("workdir")
     p.add_argument("outdir")
@@ -591,7 +633,7 @@ def main(argv):
                 f.write(j["text"])
         return 0
     if a.command == "run":
-        physics = Physics(law=a.law, stiffness=a.stiffness)
+        physics = Physics(law=a.law, blend=a.blend, stiffness=a.stiffness, restitution=a.restitution, friction=a.friction)
         results = run_all(a.workdir, RESOLUTIONS[a.resolution], physics, a.jobs, a.only)
         failed = [r["name"] for r in results if "error" in r]
         if failed:
