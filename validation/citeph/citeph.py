@@ -593,9 +593,11 @@ def plot(rows, outdir):
     ax = axes[2]
     for q, c, lab in (("collision_interval_s", "C0", "mean time between collisions (s)"),
                       ("collision_impulse_Ns", "C1", "mean impulse (N s)")):
-        pts = sorted((float(r["T"]), float(r["model"])) for r in sel if r["quantity"] == q)
-        if pts:
-            ax.plot(*zip(*pts), "o-", color=c, label=lab)
+        for h, marker in ((40.0, "D"), (20.0, "o"), (30.0, "s"), (80.0, "v")):
+            pts = sorted((float(r["T"]), float(r["model"])) for r in sel
+                         if r["quantity"] == q and float(r["H_mm"]) == h)
+            if pts:
+                ax.plot(*zip(*pts), marker + ("-" if h == 40.0 else ""), color=c, label=f"{lab}, H = {h:g} mm")
     ax.set_xlabel("T (s)")
     ax.set_title("79% array: collisions of the middle discs")
     ax.set_yscale("log")
