@@ -7,7 +7,8 @@ t_end, the splits, and the fragment-size distribution (equivalent diameter
 d = sqrt(4 A / pi) of the dynamic floes at t_end: counts in fixed classes,
 and quantiles), with the changes against the first run.
 
-Usage: scripts/validate/fracture_convergence.py BUILD_DIR [MESH DT T_END]
+Usage: validation/fracture/convergence.py BUILD_DIR [MESH DT T_END], or
+scripts/validate fracture [MESH DT T_END]
 (defaults 20 m, 10 s, 3000 s). Uses numpy and h5py (Debian packages).
 """
 import os
