@@ -381,6 +381,11 @@ FloeInput read_floe(Section s, const PackDefaults& def, std::size_t index, const
   f.heave_rate = s.number("heave_rate", 0.0, finite, "a heave rate (m/s; with [coupling] start = \"given\")");
   if (f.is_static && (f.heave != 0.0 || f.heave_rate != 0.0)) s.fail("static", "a static floe (obstacle) cannot heave");
   f.ocean_drag = s.number("ocean_drag", -1.0, non_negative, "a drag coefficient >= 0");
+  f.mooring_period = s.number("mooring_period", 0.0, positive, "a mooring period > 0 (s)");
+  f.mooring_damping = s.number("mooring_damping", 0.0, non_negative, "a damping ratio >= 0");
+  if (s.has("mooring_damping") && !s.has("mooring_period"))
+    s.fail("mooring_damping", "a mooring needs its mooring_period (s)");
+  if (f.is_static && s.has("mooring_period")) s.fail("mooring_period", "a static floe (obstacle) cannot be moored");
   if (f.is_static && (s.has("velocity") || s.has("angular_velocity")) &&
       (f.velocity.norm() > 0.0 || f.angular_velocity != 0.0))
     s.fail("static", "a static floe (obstacle) cannot have a velocity");
@@ -635,6 +640,10 @@ std::string resolved_toml(const Config& c) {
     if (f.ocean_drag >= 0.0) t.insert("ocean_drag", f.ocean_drag);
     if (f.heave != 0.0) t.insert("heave", f.heave);
     if (f.heave_rate != 0.0) t.insert("heave_rate", f.heave_rate);
+    if (f.mooring_period > 0.0) {
+      t.insert("mooring_period", f.mooring_period);
+      t.insert("mooring_damping", f.mooring_damping);
+    }
     floe_list.push_back(t);
   }
   toml::table floes{{"thickness", c.floes.defaults.thickness}, {"density", c.floes.defaults.density}};

@@ -26,6 +26,10 @@ struct FloeInput {
   double heave = 0.0;             // m, from floating equilibrium ([coupling] start = "given")
   double heave_rate = 0.0;        // m/s
   double ocean_drag = -1.0;       // C_w of this floe; < 0: the [forcing] default
+  // A soft mooring to where the floe starts (coupling/mooring.hpp): its
+  // period (s; 0: none) and damping ratio.
+  double mooring_period = 0.0;
+  double mooring_damping = 0.0;
   std::string origin;             // where it came from, for messages ("file.toml floe 3")
 };
 

@@ -73,6 +73,7 @@ Simulation::Simulation(Scenario scenario) : scenario_(std::move(scenario)) {
   drift_params_ = DriftParams{c.sea.rho, c.forcing.ocean_drag, c.forcing.air_density, c.forcing.air_drag,
                               c.forcing.coriolis};
   quadrature_ = build_footprint_quadrature(scenario_.floes);
+  moorings_ = Moorings(scenario_.floes, c.floes.floes);  // anchored where the floes start (also on a restart)
   shapes_ = contact::build_collision_shapes(scenario_.floes);
   detection_options_.collision_distance = c.contact.collision_distance;
   detection_options_.domain = make_domain(scenario_);
@@ -205,6 +206,7 @@ void Simulation::drift(StepContext& ctx) {
     water.assign(orbital.begin(), orbital.end());
     for (Vec2& w : water) w += current;
   }
+  moorings_.kick(scenario_.floes, ctx.dt);
   drift_velocities(scenario_.floes, quadrature_, drift_params_, current, wind, ctx.dt, 0, scenario_.floes.size(),
                    water);
   ctx.momentum = momentum();

@@ -48,6 +48,7 @@
 #include "coupling/drift.hpp"
 #include "coupling/floe_sea.hpp"
 #include "coupling/incident.hpp"
+#include "coupling/mooring.hpp"
 #include "coupling/percussion.hpp"
 #include "contact/detection.hpp"
 #include "contact/impulse.hpp"
@@ -169,6 +170,7 @@ private:
   Vec2 ctx_momentum_before_ = Vec2::Zero();  // of the floes at the start of the step's try
   DriftParams drift_params_;
   FootprintQuadrature quadrature_;
+  Moorings moorings_;  // [[floes.floe]] mooring_period
   contact::CollisionShapes shapes_;
   contact::DetectionOptions detection_options_;
   contact::ImpulseOptions impulse_options_;

@@ -266,6 +266,12 @@ def case_pack():
     check(lcp[-1, 0] > lcp[15, 0] > 0, "collisions before and after the restart")
 
 
+def case_moored():
+    # Moorings are anchored where the floes start: a restart anchors them there too.
+    continuation(PACK.replace("velocity = [1.0, 0.0]", "velocity = [1.0, 0.0]\nmooring_period = 30.0\nmooring_damping = 0.2"),
+                 60, 30, "moored")
+
+
 def case_jam():
     # examples/pack_against_wall.toml: by 1200 s the pack is jamming against
     # the wall, with LCPs of 500 unknowns and more solved by Lemke

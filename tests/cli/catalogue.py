@@ -174,6 +174,10 @@ def toml_cases():
     case("toml", "footprint reach of a whole cell",
          ["run", write("reach.toml", '[coupling]\nfootprint_reach = 1.0\n')],
          ["reach.toml:2", "[coupling] footprint_reach", "a fraction of a cell in [0, 0.5]"])
+    case("toml", "mooring damping without a period",
+         ["run", write("moor.toml", '[[floes.floe]]\nvertices = [[0, 0], [20, 0], [20, 20], [0, 20]]\n'
+                       'mooring_damping = 0.5\n')],
+         ["moor.toml", "mooring_damping", "needs its mooring_period"])
     floe = "[[floes.floe]]\nvertices = {}\n"
     square = "[[0, 0], [20, 0], [20, 20], [0, 20]]"
     case("toml", "self-intersecting floe",

@@ -190,3 +190,29 @@ TEST_CASE("stiff drag: a thin floe with a step far above its drag time stays sta
 }
 
 TEST_SUITE_END();
+
+TEST_CASE("a soft mooring: the undamped and damped oscillator of its period and ratio") {
+  // coupling/mooring.hpp: with no drag, a floe started at its anchor with
+  // speed v0 follows x'' = -omega^2 x - 2 zeta omega x', whose solution is
+  //   x(t) = v0 / omega_d exp(-zeta omega t) sin(omega_d t),  omega_d = omega sqrt(1 - zeta^2).
+  const double period = 20.0, v0 = 0.1, omega = 2.0 * std::numbers::pi / period;
+  for (double zeta : {0.0, 0.3}) {
+    INFO("damping ratio " << zeta);
+    std::ostringstream extra;
+    extra << "velocity = [" << v0 << ", 0.0]\nmooring_period = " << period << "\nmooring_damping = " << zeta << "\n";
+    std::ostringstream t;
+    t << "[run]\ndt_max = 0.01\n[[floes.floe]]\nvertices = [[-10, -10], [10, -10], [10, 10], [-10, 10]]\n"
+      << extra.str() << "[forcing]\nocean_drag = 0.0\nair_drag = 0.0\n";
+    Simulation s(build_scenario(parse_config(t.str(), "test.toml", ".")));
+    const double wd = omega * std::sqrt(1.0 - zeta * zeta);
+    double worst = 0.0;
+    for (double t : {0.25 * period, 0.5 * period, 0.8 * period, 1.5 * period}) {
+      advance(s, t);
+      const double exact = v0 / wd * std::exp(-zeta * omega * t) * std::sin(wd * t);
+      worst = std::max(worst, std::abs(s.floes().state[0].x - exact));
+      CHECK(std::abs(s.floes().state[0].y) < 1e-12);
+    }
+    MESSAGE("largest error " << worst << " m of an amplitude " << v0 / omega << " m");
+    CHECK(worst < 0.01 * v0 / omega);
+  }
+}
