@@ -630,7 +630,10 @@ void FloeSeaContact::implicit_step(Floes& floes, std::span<const FloeState> star
   // The sea's response on a node to its own pressure over h: the diagonal of
   // G_sea, for the preconditioner (a periodic sea's is the same on every node).
   if (self_response_h_ != h) {
-    const std::size_t node = grid_.edge == fluid::GridEdge::periodic ? 0 : grid_.size() / 2;
+    // A walled basin's node in the middle (row ny / 2, column nx / 2), away from its walls.
+    const std::size_t middle = static_cast<std::size_t>(grid_.ny / 2) * static_cast<std::size_t>(grid_.nx) +
+                               static_cast<std::size_t>(grid_.nx / 2);
+    const std::size_t node = grid_.edge == fluid::GridEdge::periodic ? 0 : middle;
     grid_work_[node] = 1.0;
     sea.midpoint_response(grid_work_, h, grid_eta_);
     grid_work_[node] = 0.0;
