@@ -14,6 +14,7 @@
 #include <sstream>
 
 #include "core/error.hpp"
+#include "fluid/dense_modes.hpp"
 #include "fluid/bem3d_panels.hpp"
 #include "fluid/tank.hpp"
 #include "fluid/waves.hpp"
@@ -26,14 +27,8 @@ using Eigen::MatrixXd;
 using Eigen::VectorXd;
 
 // The set-up of one basin: modes and the maps from modal state to surface fields.
-struct Operators {
-  int surface = 0;  // surface panels = grid cells
+struct Operators : DenseModes {  // surface = the surface panels
   int panels = 0;   // all panels
-  std::vector<double> omega;  // per mode, ascending
-  MatrixXd x;         // surface x modes: eta = x a (M-orthonormal columns)
-  MatrixXd load;      // modes x surface: modal force per unit pressure, -A x^T
-  MatrixXd project;   // modes x surface: a = project eta, for zero-mean eta (x^T M)
-  MatrixXd potential; // surface x modes: phi on the surface per unit a'
   Bem3dSea::SetupCost cost;
 };
 
@@ -265,29 +260,16 @@ void Bem3dSea::midpoint_step(std::span<const double> p, double h) {
 }
 
 void Bem3dSea::set_surface(std::span<const double> eta, std::span<const double> eta_t) {
-  const auto& ops = *impl_->ops;
-  auto project = [&](std::span<const double> f, std::span<double> a) {
-    Eigen::Map<const VectorXd> fv(f.data(), ops.surface);
-    impl_->work_surface = fv.array() - fv.mean();
-    Eigen::Map<VectorXd>(a.data(), static_cast<Eigen::Index>(a.size())).noalias() =
-        ops.project * impl_->work_surface;
-  };
-  project(eta, bank_.q());
-  project(eta_t, bank_.v());
+  impl_->ops->to_modes(eta, bank_.q(), impl_->work_surface);
+  impl_->ops->to_modes(eta_t, bank_.v(), impl_->work_surface);
   invalidate();
 }
 
 void Bem3dSea::project(std::span<const double> pressure, std::span<double> s) {
-  const auto& ops = *impl_->ops;
-  const Eigen::Map<const VectorXd> p(pressure.data(), ops.surface);
-  Eigen::Map<VectorXd>(s.data(), static_cast<Eigen::Index>(s.size())).noalias() = ops.load * p;
+  impl_->ops->to_forces(pressure, s);
 }
 
-void Bem3dSea::synthesize(std::span<const double> q, std::span<double> eta) {
-  const auto& ops = *impl_->ops;
-  const Eigen::Map<const VectorXd> a(q.data(), static_cast<Eigen::Index>(q.size()));
-  Eigen::Map<VectorXd>(eta.data(), ops.surface).noalias() = ops.x * a;
-}
+void Bem3dSea::synthesize(std::span<const double> q, std::span<double> eta) { impl_->ops->to_surface(q, eta); }
 
 void Bem3dSea::compute_field(Field f, std::span<double> out) {
   const auto& ops = *impl_->ops;
