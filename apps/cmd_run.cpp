@@ -27,6 +27,14 @@ namespace {
 
 namespace fs = std::filesystem;
 
+namespace {
+// false, not an exception, for a path the system cannot look at (too long, say).
+bool path_exists(const std::string& path) {
+  std::error_code ec;
+  return fs::exists(path, ec) && !ec;
+}
+}  // namespace
+
 std::atomic<bool> g_interrupted{false};
 extern "C" void on_signal(int) { g_interrupted = true; }
 
@@ -126,10 +134,10 @@ void add_run_command(CLI::App& app, Registry& registry) {
   registry[sub] = [args] {
     const bool restart = !args->restart.empty();
     std::string config_path = args->config.empty() && !restart ? default_config() : args->config;
-    if (!config_path.empty() && !fs::exists(config_path)) throw InputError(config_path + ": configuration file not found");
+    if (!config_path.empty() && !path_exists(config_path)) throw InputError(config_path + ": configuration file not found");
     std::string output = args->output;
     if (output.empty()) output = restart ? args->restart : fs::path(config_path).stem().string() + ".h5";
-    if (!config_path.empty() && fs::exists(output) && fs::equivalent(output, config_path))
+    if (!config_path.empty() && path_exists(output) && fs::equivalent(output, config_path))
       throw InputError(output + ": the output would overwrite the configuration");
 
     {
@@ -144,7 +152,7 @@ void add_run_command(CLI::App& app, Registry& registry) {
     Config config;
     Checkpoint checkpoint;
     if (restart) {
-      if (!fs::exists(args->restart)) throw InputError(args->restart + ": run file not found (--restart)");
+      if (!path_exists(args->restart)) throw InputError(args->restart + ": run file not found (--restart)");
       const RunInfo info = read_run_info(args->restart);
       checkpoint = read_checkpoint(args->restart);
       config = restart_config(args->restart, config_path, info);
@@ -174,7 +182,7 @@ void add_run_command(CLI::App& app, Registry& registry) {
     if (restart) {
       sim.restore(checkpoint);
       // A new output starts as a copy of the run; the records after the checkpoint are dropped from it.
-      if (!(fs::exists(output) && fs::equivalent(output, args->restart))) {
+      if (!(path_exists(output) && fs::equivalent(output, args->restart))) {
         std::error_code ec;
         fs::copy_file(args->restart, output, fs::copy_options::overwrite_existing, ec);
         if (ec) throw InputError(output + ": cannot copy the run file " + args->restart + " to it: " + ec.message());

@@ -22,6 +22,17 @@ namespace {
 
 namespace fs = std::filesystem;
 
+// A path the system cannot look at (too long, say) does not exist: the
+// error_code overloads answer false where the others would throw.
+bool path_exists(const std::string& path) {
+  std::error_code ec;
+  return fs::exists(path, ec) && !ec;
+}
+bool is_folder(const std::string& path) {
+  std::error_code ec;
+  return fs::is_directory(path, ec) && !ec;
+}
+
 // Reads the keys of one TOML table, remembering which were used so that the
 // rest can be reported as unknown. Every accessor checks type and range and
 // throws InputError "FILE:LINE: key '[section] name': expected ..., got ...".
@@ -397,7 +408,7 @@ void read_floes(Section s, FloesConfig& c, const std::string& file, const std::s
   c.pack = resolve_path(s.string("pack", ""), base_dir);
   c.defaults.thickness = s.number("thickness", c.defaults.thickness, positive, "a thickness > 0 (m)");
   c.defaults.density = s.number("density", c.defaults.density, positive, "a density > 0 (kg/m^3)");
-  if (!c.pack.empty() && !fs::exists(c.pack)) s.fail("pack", "file not found: " + c.pack);
+  if (!c.pack.empty() && !path_exists(c.pack)) s.fail("pack", "file not found: " + c.pack);
   if (const toml::array* a = s.table_array("floe")) {
     for (std::size_t i = 0; i < a->size(); ++i)
       c.floes.push_back(read_floe(Section((*a)[i].as_table(), "floes.floe", file), c.defaults, i, file));
@@ -420,7 +431,7 @@ void read_contact(Section s, ContactParams& c, const std::string& base_dir) {
     s.node("box");
   }
   c.dump_failed_lcps = resolve_path(s.string("dump_failed_lcps", ""), base_dir);
-  if (s.has("dump_failed_lcps") && !fs::is_directory(c.dump_failed_lcps))
+  if (s.has("dump_failed_lcps") && !is_folder(c.dump_failed_lcps))
     s.fail("dump_failed_lcps", "expected an existing folder, found none at " + c.dump_failed_lcps);
   s.finish();
 }
@@ -460,7 +471,7 @@ void read_forcing(Section s, ForcingParams& f, const std::string& base_dir) {
   f.current = s.pair("current", f.current);
   f.wind = s.pair("wind", f.wind);
   f.series = resolve_path(s.string("series", ""), base_dir);
-  if (!f.series.empty() && !fs::exists(f.series)) s.fail("series", "file not found: " + f.series);
+  if (!f.series.empty() && !path_exists(f.series)) s.fail("series", "file not found: " + f.series);
   f.series_interpolation = s.choice<SeriesInterpolation>(
       "series_interpolation", f.series_interpolation,
       {{"linear", SeriesInterpolation::linear}, {"previous", SeriesInterpolation::previous}});

@@ -37,7 +37,8 @@ struct RunReader::Impl {
 
 RunReader::RunReader(const std::string& path) : impl_(std::make_unique<Impl>()) {
   impl_->path = path;
-  if (!std::filesystem::exists(path)) throw InputError(path + ": run file not found");
+  std::error_code ec;
+  if (!std::filesystem::exists(path, ec) || ec) throw InputError(path + ": run file not found");
   impl_->file = h5::open_file(path);
   if (!h5::has_attr(impl_->file, "format"))
     throw InputError(path + ": not a floesim run file (root attribute 'format' is missing)");

@@ -174,6 +174,9 @@ def toml_cases():
     case("toml", "footprint reach of a whole cell",
          ["run", write("reach.toml", '[coupling]\nfootprint_reach = 1.0\n')],
          ["reach.toml:2", "[coupling] footprint_reach", "a fraction of a cell in [0, 0.5]"])
+    case("toml", "a forcing series whose path is too long for the system",
+         ["run", write("long_path.toml", '[forcing]\nseries = "/tmp/' + "x" * 5000 + '"\n')],
+         ["long_path.toml:2", "[forcing] series", "file not found"])
     case("toml", "mooring damping without a period",
          ["run", write("moor.toml", '[[floes.floe]]\nvertices = [[0, 0], [20, 0], [20, 20], [0, 20]]\n'
                        'mooring_damping = 0.5\n')],
