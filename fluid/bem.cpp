@@ -217,13 +217,10 @@ double BemSea::setup_seconds() const { return impl_->ops->setup_seconds; }
 bool BemSea::from_cache() const { return impl_->hit; }
 
 void BemSea::kick(std::span<const double> pressure, double h) {
-  const auto& ops = *impl_->ops;
-  FLOESIM_ASSERT(pressure.size() == static_cast<std::size_t>(ops.surface));
-  const Eigen::Map<const VectorXd> p(pressure.data(), ops.surface);
-  impl_->work_modes.noalias() = ops.load * p;
+  FLOESIM_ASSERT(pressure.size() == static_cast<std::size_t>(impl_->ops->surface));
   impl_->kicked = true;
-  bank_.kick(std::span<const double>(impl_->work_modes.data(), bank_.modes()), h);
-  invalidate_rates();
+  project(pressure, {impl_->work_modes.data(), static_cast<std::size_t>(impl_->work_modes.size())});  // kept for repeat_kick
+  repeat_kick(h);
 }
 
 void BemSea::repeat_kick(double h) {
