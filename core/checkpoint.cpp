@@ -86,6 +86,11 @@ void write_checkpoint_group(hid_t file, const std::string& name, const Checkpoin
       for (const auto& p : c.floe_sea.footprint_reference) flat.insert(flat.end(), p.begin(), p.end());
       doubles(s, "footprint_reference", flat, 3);
     }
+    if (!c.floe_sea.mean_horizontal.empty()) {
+      std::vector<double> flat;
+      for (const auto& p : c.floe_sea.mean_horizontal) flat.insert(flat.end(), p.begin(), p.end());
+      doubles(s, "mean_horizontal", flat, 3);
+    }
   }
   {
     const WarmStartState& w = c.warm;
@@ -231,6 +236,10 @@ Checkpoint read_checkpoint(const std::string& path) {
     if (h5::exists(s, "footprint_reference")) {
       const std::vector<double> flat = r.doubles(s, "footprint_reference", 3 * c.floes.size());
       for (std::size_t k = 0; k + 2 < flat.size(); k += 3) c.floe_sea.footprint_reference.push_back({flat[k], flat[k + 1], flat[k + 2]});
+    }
+    if (h5::exists(s, "mean_horizontal")) {
+      const std::vector<double> flat = r.doubles(s, "mean_horizontal", 3 * c.floes.size());
+      for (std::size_t k = 0; k + 2 < flat.size(); k += 3) c.floe_sea.mean_horizontal.push_back({flat[k], flat[k + 1], flat[k + 2]});
     }
   }
   {

@@ -53,6 +53,10 @@ struct FloeSeaState {
   // Per floe, the pose (x, y, yaw) its footprint was last built at
   // (coupling/moving_footprint.hpp); empty: none built yet.
   std::vector<std::array<double, 3>> footprint_reference;
+  // Implicit integrator, per floe: the horizontal load (Fx, Fy, torque) the
+  // next step's first half kick applies, the last step's mean
+  // (coupling/floe_sea.hpp); empty: the loads at the state.
+  std::vector<std::array<double, 3>> mean_horizontal;
 };
 
 // The jam LCPs' warm starts (contact::WarmStart): per floe pair (key), the

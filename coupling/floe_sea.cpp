@@ -132,6 +132,9 @@ void FloeSeaContact::floes_changed(const Floes& floes) {
   body_moments_.resize(n);
   bottom0_.resize(n);
   loads_.assign(n, {});
+  first_half_.assign(n, Eigen::Vector3d::Zero());
+  step_horizontal_.assign(n, Eigen::Vector3d::Zero());
+  step_mean_pending_ = false;
   double min_mass_per_area = INFINITY;
   for (std::size_t i = 0; i < n; ++i) {
     dynamic_[i] = floes.is_static[i] ? 0 : 1;
@@ -162,8 +165,11 @@ void FloeSeaContact::floes_changed(const Floes& floes) {
 }
 
 FloeSeaState FloeSeaContact::saved_state() const {
-  FloeSeaState s{true, bottom0_, loads_h_, penalty_energy_, {}};
+  FloeSeaState s{true, bottom0_, loads_h_, penalty_energy_, {}, {}};
   for (const FloePose& p : footprints_.reference()) s.footprint_reference.push_back({p.x, p.y, p.yaw});
+  // The implicit step's mean horizontal loads cannot be evaluated again from the state.
+  if (implicit_ && loads_h_ >= 0.0)
+    for (const FloeSeaLoad& load : loads_) s.mean_horizontal.push_back({load.horizontal[0], load.horizontal[1], load.horizontal[2]});
   return s;
 }
 
@@ -179,6 +185,11 @@ void FloeSeaContact::restore(const FloeSeaState& state, const Floes& floes, flui
     footprints_.rebuild_at(floes, dynamic_, poses_, threads_);
   }
   if (state.loads_h >= 0.0) evaluate_loads(floes, sea, incident, state.loads_h);
+  if (state.mean_horizontal.size() == loads_.size())
+    for (std::size_t i = 0; i < loads_.size(); ++i) {
+      loads_[i].horizontal = {state.mean_horizontal[i][0], state.mean_horizontal[i][1], state.mean_horizontal[i][2]};
+      step_horizontal_[i] = loads_[i].horizontal;
+    }
   penalty_energy_ = state.penalty_energy;
 }
 
@@ -428,47 +439,60 @@ void FloeSeaContact::evaluate(const Floes& floes, fluid::Sea& sea, double h) {
       cells_[fp.cell[k]].sum += area * delta * delta;
       pressure_[fp.cell[k]] += force[k] * inv_cell_area;
     }
-  // Strong part, horizontal: -dV/dG and -dV/dyaw through the edge pieces. The
-  // coverage Phi_c moves with every floe's edge in cell c, so an edge also
-  // carries psi'(Phi_c) / (2 A) sum_k a_k u_k^2 of the cell's pieces.
-  if (ks > 0.0) {
-#pragma omp parallel for num_threads(threads_) schedule(dynamic, 16) if (floes_in_order > kFloesPerThread)
-    for (std::ptrdiff_t j = 0; j < floes_in_order; ++j) {
-      const std::uint32_t i = order_[static_cast<std::size_t>(j)];
-      const FloeState& st = floes.state[i];
-      const Vec2 a{st.pitch, st.roll};
-      Vec2 fh = Vec2::Zero();
-      double torque = 0.0;
-      for (std::size_t k = fp.edge_offsets[i]; k < fp.edge_offsets[i + 1]; ++k) {
-        const std::ptrdiff_t piece = fp.edge_piece[k];
-        if (piece < 0 || fp.area[piece] <= 0.0) continue;  // none, or a node the floe has left
-        const double up = u[piece], sum = cells_[fp.edge_cell[k]].sum;
-        if (up <= 0.0 && sum <= 0.0) continue;
-        const double ps = psi[piece];
-        const double dpsi = K_ * ps * ps;  // d psi / d Phi
-        const Vec2& N = fp.edge_normal[k];  // d w_c / dG
-        const double T = fp.edge_twist[k];  // d w_c / dyaw
-        const Vec2 Qa = fp.edge_first[k].transpose() * a;  // ∮ B (r . a) n ds
-        const Vec2& S = fp.edge_swept[k];
-        const Vec2& rc = fp.centroid[piece];
-        const double area_term = 0.5 * ks * (ps * up * up + dpsi * sum * inv_cell_area);  // dV / d a_c
-        const double kf = ks * ps;
-        const Vec2 dVdG = area_term * N - kf * up * (Qa - a.dot(rc) * N);
-        const double dVdyaw = area_term * T - kf * up * a.dot(S - rc * T);
-        fh -= dVdG;
-        torque -= dVdyaw;
-      }
-      // The explicit-G term of dV/dG: -psi_c a_c(P0) u a, summed over the area pieces.
-      fh -= ks * wetted[i] * a;
-      loads_[i].horizontal = {fh.x(), fh.y(), torque};
-    }
-  }
+  // Strong part, horizontal: -dV/dG and -dV/dyaw at the present slopes.
+  slope_.resize(floes.size());
+  for (std::uint32_t i : order_) slope_[i] = {floes.state[i].pitch, floes.state[i].roll};
+  horizontal_loads(u);
   penalty_energy_ = energy;
+}
+
+void FloeSeaContact::horizontal_loads(std::span<const double> u) {
+  // Through the edge pieces. The coverage Phi_c moves with every floe's edge
+  // in cell c, so an edge also carries psi'(Phi_c) / (2 A) sum_k a_k u_k^2 of
+  // the cell's pieces.
+  const Footprints& fp = footprints_.pieces();
+  const std::vector<double>& psi = eval_.psi;
+  const std::vector<double>& wetted = eval_.wetted;
+  const double ks = s_ * kappa_, inv_cell_area = 1.0 / cell_area_;
+  if (ks <= 0.0) return;
+  const std::ptrdiff_t floes_in_order = static_cast<std::ptrdiff_t>(order_.size());
+#pragma omp parallel for num_threads(threads_) schedule(dynamic, 16) if (floes_in_order > kFloesPerThread)
+  for (std::ptrdiff_t j = 0; j < floes_in_order; ++j) {
+    const std::uint32_t i = order_[static_cast<std::size_t>(j)];
+    const Vec2 a = slope_[i];
+    Vec2 fh = Vec2::Zero();
+    double torque = 0.0;
+    for (std::size_t k = fp.edge_offsets[i]; k < fp.edge_offsets[i + 1]; ++k) {
+      const std::ptrdiff_t piece = fp.edge_piece[k];
+      if (piece < 0 || fp.area[piece] <= 0.0) continue;  // none, or a node the floe has left
+      const double up = u[piece], sum = cells_[fp.edge_cell[k]].sum;
+      if (up <= 0.0 && sum <= 0.0) continue;
+      const double ps = psi[piece];
+      const double dpsi = K_ * ps * ps;  // d psi / d Phi
+      const Vec2& N = fp.edge_normal[k];  // d w_c / dG
+      const double T = fp.edge_twist[k];  // d w_c / dyaw
+      const Vec2 Qa = fp.edge_first[k].transpose() * a;  // ∮ B (r . a) n ds
+      const Vec2& S = fp.edge_swept[k];
+      const Vec2& rc = fp.centroid[piece];
+      const double area_term = 0.5 * ks * (ps * up * up + dpsi * sum * inv_cell_area);  // dV / d a_c
+      const double kf = ks * ps;
+      const Vec2 dVdG = area_term * N - kf * up * (Qa - a.dot(rc) * N);
+      const double dVdyaw = area_term * T - kf * up * a.dot(S - rc * T);
+      fh -= dVdG;
+      torque -= dVdyaw;
+    }
+    // The explicit-G term of dV/dG: -psi_c a_c(P0) u a, summed over the area pieces.
+    fh -= ks * wetted[i] * a;
+    loads_[i].horizontal = {fh.x(), fh.y(), torque};
+  }
 }
 
 void FloeSeaContact::evaluate_loads(const Floes& floes, fluid::Sea& sea, IncidentSea* incident, double h) {
   evaluate(floes, sea, h);
   update_water(floes, sea, incident);
+  // After an implicit step the horizontal loads are that step's mean.
+  if (step_mean_pending_)
+    for (std::uint32_t i : order_) loads_[i].horizontal = step_horizontal_[i];
 }
 
 void FloeSeaContact::ready_loads(const Floes& floes, fluid::Sea& sea, IncidentSea* incident, double h) {
@@ -524,10 +548,19 @@ void FloeSeaContact::kick_floes(Floes& floes, double h) {
     } else if (tilt_[i] == 1) {
       st.pitch_rate += h * load.vertical[1] / tilt_inertia(floes, i)(0, 0);
     }
-    st.vx += h * load.horizontal[0] / floes.mass[i];
-    st.vy += h * load.horizontal[1] / floes.mass[i];
-    st.yaw_rate += h * load.horizontal[2] / floes.inertia_z[i];
+    // Implicit: the first half kick of a step applies the last step's mean
+    // load (the drift's predictor), the second completes the step's impulse
+    // to 2 h F_mean (the header's "Horizontal loads of the implicit step").
+    Eigen::Vector3d impulse = h * load.horizontal;
+    if (implicit_) {
+      if (step_mean_pending_) impulse = 2.0 * h * step_horizontal_[i] - first_half_[i];
+      else first_half_[i] = impulse;
+    }
+    st.vx += impulse[0] / floes.mass[i];
+    st.vy += impulse[1] / floes.mass[i];
+    st.yaw_rate += impulse[2] / floes.inertia_z[i];
   }
+  step_mean_pending_ = false;
 }
 
 void FloeSeaContact::advance_vertical(Floes& floes, std::span<const FloeState> start, fluid::Sea& sea, double h) {
@@ -698,6 +731,40 @@ void FloeSeaContact::implicit_step(Floes& floes, std::span<const FloeState> star
   for (std::size_t k = 0; k < n; ++k) grid_work_[fp.cell[k]] += f[k] * inv_cell_area;
   sea.midpoint_step(grid_work_, h);
   for (std::size_t k = 0; k < n; ++k) grid_work_[fp.cell[k]] = 0.0;
+  step_mean_horizontal(floes, start);
+}
+
+void FloeSeaContact::step_mean_horizontal(const Floes& floes, std::span<const FloeState> start) {
+  // On the midpoint footprint: each piece's mean [delta]^+ over the step, the
+  // spring's discrete gradient per unit stiffness (the header's "Horizontal
+  // loads of the implicit step"), and the cells' sums of a_k u_k^2 with it.
+  const Footprints& fp = footprints_.pieces();
+  const std::span<const double> area0 = footprints_.reference_area();
+  const std::span<const double> d1 = solver_.end();
+  std::vector<double>& u = eval_.penetration;
+  std::vector<double>& psi = eval_.psi;
+  u.assign(fp.cell.size(), 0.0);
+  psi.resize(fp.cell.size());
+  eval_.wetted.assign(floes.size(), 0.0);
+  slope_.resize(floes.size());
+  for_each_floe(order_, threads_, [&](std::uint32_t i) {
+    const FloeState& st = floes.state[i];
+    slope_[i] = 0.5 * Vec2{st.pitch + start[i].pitch, st.roll + start[i].roll};
+    double wet = 0.0;
+    for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k) {
+      psi[k] = subcell_weight(cells_[fp.cell[k]].coverage);
+      if (fp.area[k] <= 0.0) continue;
+      u[k] = step_force(1.0, 0.0, pieces_.start[k], d1[k]).f;
+      wet += psi[k] * area0[k] * u[k];
+    }
+    eval_.wetted[i] = wet;
+  });
+  for (std::uint32_t i : order_)
+    for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k)
+      if (u[k] > 0.0) cells_[fp.cell[k]].sum += fp.area[k] * u[k] * u[k];
+  horizontal_loads(u);
+  for (std::uint32_t i : order_) step_horizontal_[i] = loads_[i].horizontal;
+  step_mean_pending_ = true;
 }
 
 double FloeSeaContact::floes_vertical_kinetic(const Floes& floes) const {

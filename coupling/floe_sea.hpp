@@ -81,7 +81,23 @@
 // DOFs). The damper (weak) part is in the same step as the impulse of
 // Lambda = c [delta]^+ over it, f_c += c psi_c a_c ([d1]^+ - [d0]^+) / h (seed
 // eq. 17 on the step: it only absorbs, f (d1 - d0) >= 0, and keeps f
-// non-decreasing in d1); the horizontal forces keep their half kicks.
+// non-decreasing in d1).
+//
+// Horizontal loads of the implicit step. At a step long against the
+// floe–water contact's own period (0.5 / omega_pen), the midpoint rule leaves
+// that stiff mode undamped and turns it by nearly pi per step (d1 ~ -d0 in
+// it): the penetrations at the step's ends carry an alternating part as large
+// as the static one at K = 1000, and -dV/dG sampled there, squared and cut at
+// zero, does not average it out. The step's horizontal impulse
+// is instead h F_mean, F_mean = -dV/d(G, yaw) (the formulas above) on the
+// step's midpoint footprint, at the midpoint slopes, with each piece's mean
+// penetration over the step
+//     u_k = ([d1]^+^2 - [d0]^+^2) / (2 (d1 - d0)),
+// the spring's discrete gradient per unit stiffness (f_k / c_k), in which the
+// alternating part cancels. The drift cannot wait for F_mean: the first half
+// kick applies h/2 of the previous step's F_mean, a predictor, which leaves
+// the position an error h^2 / 2 (F_mean,n+1/2 - F_mean,n-1/2) = O(h^3); the
+// second half kick completes the step's impulse to h F_mean.
 //
 // Start (MODEL.md §1): the static problem is solved first. The sea's static
 // response to a pressure is local, eta = W - p / (rho_w g) + const, W the
@@ -228,6 +244,13 @@ private:
   void pose_at_states(const Floes& floes);
   // The contact at the present state for a kick of length h (see evaluate_loads).
   void evaluate(const Floes& floes, fluid::Sea& sea, double h);
+  // loads_[i].horizontal = -dV/dG, -dV/dyaw (the header's formulas) for the
+  // pieces' [delta]^+ u, with eval_.psi, eval_.wetted, cells_[c].sum and
+  // slope_ already set for them.
+  void horizontal_loads(std::span<const double> u);
+  // Implicit: the step's mean horizontal loads (the header's "Horizontal
+  // loads of the implicit step") into step_horizontal_.
+  void step_mean_horizontal(const Floes& floes, std::span<const FloeState> start);
   // Mean over each floe's footprint (weights a_c) of the incident waves'
   // velocity at the sea's time (zero without incident waves).
   void update_water(const Floes& floes, const fluid::Sea& sea, IncidentSea* incident);
@@ -263,6 +286,12 @@ private:
   bool pressure_kicked_ = false;  // the sea's last kick was with pressure_ as it is
   double loads_h_ = -1.0;         // the kick length of the last evaluation (< 0: stale)
   std::vector<Vec2> water_;       // incident velocity under each floe, with the loads
+  std::vector<Vec2> slope_;       // per floe: the bottom slope the horizontal loads are taken at
+  // Implicit integrator, per floe: the last step's mean horizontal load, and
+  // the impulse the present step's first half kick applied; pending: the
+  // mean is this step's and its second half kick is to come.
+  std::vector<Eigen::Vector3d> step_horizontal_, first_half_;
+  bool step_mean_pending_ = false;
   bool implicit_ = false;
   int threads_ = 1;
   double newton_tolerance_ = 1e-8;  // times the thickest draft

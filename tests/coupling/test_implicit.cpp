@@ -7,9 +7,11 @@
 
 #include <cmath>
 #include <cstring>
-#include <tuple>
 #include <sstream>
 #include <string>
+#include <tuple>
+
+#include <Eigen/Dense>
 
 #include "core/config.hpp"
 #include "coupling/penalty_law.hpp"
@@ -104,10 +106,12 @@ TEST_CASE("implicit step: the strong law conserves energy through a drop at any 
 
 TEST_CASE("implicit step: a floe drifting and spinning on waves keeps its energy to O(dt^2)") {
   // MODEL.md §5 with the strong law and no drag: the vertical part is exact;
-  // the horizontal forces (-dV/dG) keep their half kicks around the drift,
-  // a Strang splitting, so the energy error is second order in dt.
-  auto run = [](double dt) {
-    Simulation sim = make(one_floe(12.0, dt, implicit_law("strong", 100.0), "velocity = [0.3, 0.1]\nangular_velocity = 0.01\n",
+  // the horizontal loads are the step's mean, kicked around the drift
+  // (coupling/floe_sea.hpp, "Horizontal loads of the implicit step"), so the
+  // energy error is second order in dt, at K = 100 and at K = 1000, where the
+  // step is 5 to 10 times the contact's own period.
+  auto run = [](double K, double dt) {
+    Simulation sim = make(one_floe(12.0, dt, implicit_law("strong", K), "velocity = [0.3, 0.1]\nangular_velocity = 0.01\n",
                                    "[sea.waves]\nkind = \"regular\"\namplitude = 0.1\nwavelength = 25.0\n"));
     const double e0 = energy(sim, "total");
     double worst = 0.0;
@@ -117,10 +121,63 @@ TEST_CASE("implicit step: a floe drifting and spinning on waves keeps its energy
     }
     return worst / e0;
   };
-  const double e0 = run(0.02), e1 = run(0.01);
-  MESSAGE("relative energy error over 20 s: dt = 0.02 s: " << e0 << ", dt = 0.01 s: " << e1);
-  CHECK(e1 < 1e-4);
-  CHECK(e0 / e1 > 3.0);
+  for (double K : {100.0, 1000.0}) {
+    const double e0 = run(K, 0.02), e1 = run(K, 0.01);
+    MESSAGE("K = " << K << ": relative energy error over 20 s: dt = 0.02 s: " << e0 << ", dt = 0.01 s: " << e1);
+    CHECK(e1 < 1e-4);
+    CHECK(e0 / e1 > 3.0);
+  }
+}
+
+TEST_CASE("implicit step: a thin floe's surge on a wave at K = 1000 does not depend on the step") {
+  // A square plate like the CITEPH discs (1 m, 33 mm, 545 kg/m^3; data/citeph)
+  // on a regular wave of 1.5 s in 3.1 m of water, K = 1000: the surge
+  // amplitude at the wave's frequency, fitted over the last two of five
+  // periods. Reference: the explicit kicks at their stable step (0.5 /
+  // omega_pen = 0.5 ms). At dt = T/20 the implicit step is 150 times that;
+  // horizontal loads sampled at the step's ends, with the stiff mode's
+  // alternating part in them, gave a surge 2.5 times the reference's here
+  // (docs/coupling.md); the step's mean load (coupling/floe_sea.hpp,
+  // "Horizontal loads of the implicit step") converges to it: within 15% at
+  // T/20 (measured 13%), and closer as the step is halved (measured 6.6% at
+  // T/40).
+  const double T = 1.5, depth = 3.1, omega = 2.0 * M_PI / T;
+  double k = omega * omega / 9.81;  // omega^2 = g k tanh(k H), by fixed point
+  for (int it = 0; it < 100; ++it) k = omega * omega / (9.81 * std::tanh(k * depth));
+  const double wavelength = 2.0 * M_PI / k, lx = 3.0 * wavelength, ly = wavelength / 2.0;
+  auto surge = [&](const std::string& coupling, double dt) {
+    std::ostringstream t;
+    t << "[run]\nt_end = 10.0\ndt_max = " << dt << "\noutput_interval = 1.0\nthreads = 1\n"
+      << "[sea]\nmodel = \"spectral\"\ndims = 2\nsize = [" << lx << ", " << ly << "]\ncells = [96, 16]\ndepth = " << depth
+      << "\nrho = 1000.0\n[sea.waves]\nkind = \"regular\"\namplitude = 0.02\nperiod = " << T << "\n"
+      << "[forcing]\nocean_drag = 0.0\nair_drag = 0.0\n[coupling]\n" << coupling
+      << "[floes]\ndensity = 545.0\nthickness = 0.033\n[[floes.floe]]\nvertices = [[" << lx / 2 - 0.5 << ", " << ly / 2 - 0.5
+      << "], [" << lx / 2 + 0.5 << ", " << ly / 2 - 0.5 << "], [" << lx / 2 + 0.5 << ", " << ly / 2 + 0.5 << "], ["
+      << lx / 2 - 0.5 << ", " << ly / 2 + 0.5 << "]]\n";
+    Simulation sim = make(t.str());
+    // x(t) = c0 + c1 t + a cos(omega t) + b sin(omega t), least squares.
+    Eigen::Matrix4d A = Eigen::Matrix4d::Zero();
+    Eigen::Vector4d r = Eigen::Vector4d::Zero();
+    const double t_end = 5.0 * T;
+    while (sim.time() < t_end - 1e-9) {
+      sim.step(t_end);
+      if (sim.time() < 3.0 * T) continue;
+      const double time = sim.time();
+      const Eigen::Vector4d row(1.0, time, std::cos(omega * time), std::sin(omega * time));
+      A += row * row.transpose();
+      r += row * sim.floes().state[0].x;
+    }
+    const Eigen::Vector4d c = A.ldlt().solve(r);
+    return std::hypot(c[2], c[3]);
+  };
+  const double reference = surge("law = \"strong\"\nstiffness = 1000.0\n", T / 20.0);
+  const double coarse = surge(implicit_law("strong", 1000.0), T / 20.0);
+  const double fine = surge(implicit_law("strong", 1000.0), T / 40.0);
+  MESSAGE("surge amplitude: explicit " << reference << " m; implicit " << coarse << " m at T/20, " << fine
+                                       << " m at T/40 (wave amplitude 0.02 m)");
+  CHECK(reference > 0.01);
+  CHECK(std::abs(coarse / reference - 1.0) < 0.15);
+  CHECK(std::abs(fine / reference - 1.0) < 0.7 * std::abs(coarse / reference - 1.0));
 }
 
 TEST_CASE("implicit step converges to the explicit kicks' answer at second order (heave, pitch, sea)") {
@@ -225,12 +282,14 @@ TEST_SUITE("coupling") {
 TEST_CASE("implicit step: the strong law's energy over 10^4 steps stays bounded, without drift") {
   // MODEL.md §5, the strong law without drag or forcing: the vertical part
   // conserves energy to the Newton tolerance whatever the step; the
-  // horizontal half kicks around the drift are a Strang splitting, whose
-  // energy error is O(dt^2) and, where it is in its asymptotic regime,
-  // bounded. 10^4 steps of 0.025 s (250 s, 62 periods of the 25 m wave) at
-  // K = 1000, a floe drifting (75 m) and spinning. Measured: the error
-  // oscillates within 3.6e-6 with no trend. (At 0.05 s the same floe loses
-  // energy steadily, 8e-5 over 500 s: docs/coupling.md, "The implicit step".)
+  // horizontal loads are the step's mean, kicked around the drift
+  // (coupling/floe_sea.hpp, "Horizontal loads of the implicit step"): not the
+  // exact gradient of the energy at the step's ends, which holds the stiff
+  // floe–water mode's share, so the energy error is O(dt^2) (the test above)
+  // and bounded. 10^4 steps of 0.025 s (250 s, 62 periods of the 25 m wave)
+  // at K = 1000, a floe drifting (75 m) and spinning. Measured: within 4.6e-4,
+  // 3.4e-4 over the first 2000 steps (with the loads at the step's ends:
+  // 3.6e-6, but a thin floe's surge twice too large; docs/coupling.md).
   Simulation sim = make(one_floe(12.0, 0.025, implicit_law("strong", 1000.0), "velocity = [0.3, 0.1]\nangular_velocity = 0.01\n",
                                  "[sea.waves]\nkind = \"regular\"\namplitude = 0.1\nwavelength = 25.0\n"));
   const double e0 = energy(sim, "total");
@@ -246,7 +305,7 @@ TEST_CASE("implicit step: the strong law's energy over 10^4 steps stays bounded,
   CHECK(sim.time() == doctest::Approx(kSteps * 0.025));
   MESSAGE("relative energy error: largest over the first 2000 steps " << first << ", over the last 2000 " << last
                                                                        << ", over all " << worst);
-  CHECK(worst < 1e-5);
+  CHECK(worst < 1e-3);
   CHECK(last < 2.0 * first);
 }
 
