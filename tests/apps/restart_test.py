@@ -22,6 +22,9 @@ import numpy as np
 
 from harness import Cli, check, keyvals
 
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+from restart_scenarios import WAVES  # noqa: E402
+
 FLOESIM, SRC, CASE = sys.argv[1], os.path.abspath(sys.argv[2]), sys.argv[3]
 WORK = tempfile.mkdtemp(prefix="floesim_restart_")
 CLI = Cli(FLOESIM, WORK)
@@ -132,40 +135,7 @@ static = true
 """
 
 # Floes on a spectral sea with regular waves, wind and collisions.
-WAVES = """
-[run]
-t_end = 10.0
-dt_max = 0.05
-output_interval = 0.5
 
-[sea]
-model = "spectral"
-dims = 2
-size = [80.0, 80.0]
-cells = [32, 32]
-depth = 20.0
-
-[sea.waves]
-kind = "regular"
-amplitude = 0.3
-wavelength = 40.0
-direction = 10.0
-
-[coupling]
-{coupling}
-
-[forcing]
-wind = [15.0, 2.0]
-
-[[floes.floe]]
-vertices = [[10, 10], [22, 10], [22, 20], [10, 20]]
-velocity = [0.8, 0.0]
-[[floes.floe]]
-vertices = [[24, 11], [34, 12], [33, 21], [25, 20]]
-[[floes.floe]]
-vertices = [[40, 40], [52, 42], [50, 52], [41, 50]]
-thickness = 1.5
-"""
 
 # A BEM basin (vertical slice) with a floe.
 BEM = """
@@ -289,25 +259,25 @@ def case_jam():
 
 
 def case_waves_explicit():
-    continuation(WAVES.format(coupling='law = "strong"\nstiffness = 100.0'), 4, 2, "waves_explicit")
+    continuation(WAVES.format(t_end=10.0, coupling='law = "strong"\nstiffness = 100.0'), 4, 2, "waves_explicit")
 
 
 def case_waves_blend():
     # The explicit damper: its loads are evaluated afresh at every step.
-    continuation(WAVES.format(coupling='law = "blend"\nrestitution = 0.3\nstiffness = 100.0'), 4, 2, "waves_blend",
+    continuation(WAVES.format(t_end=10.0, coupling='law = "blend"\nrestitution = 0.3\nstiffness = 100.0'), 4, 2, "waves_blend",
                  in_place=True)
 
 
 def case_waves_implicit():
-    continuation(WAVES.format(coupling='integrator = "implicit"'), 4, 2, "waves_implicit")
+    continuation(WAVES.format(t_end=10.0, coupling='integrator = "implicit"'), 4, 2, "waves_implicit")
 
 
 def case_waves_moving():
     # Footprints moved between rebuilds (coupling/moving_footprint.hpp): the
     # checkpoint keeps the poses they were built at.
-    continuation(WAVES.format(coupling='law = "strong"\nstiffness = 100.0\nfootprint_reach = 0.05'), 4, 2,
+    continuation(WAVES.format(t_end=10.0, coupling='law = "strong"\nstiffness = 100.0\nfootprint_reach = 0.05'), 4, 2,
                  "waves_moving")
-    continuation(WAVES.format(coupling='integrator = "implicit"\nfootprint_reach = 0.05'), 4, 2,
+    continuation(WAVES.format(t_end=10.0, coupling='integrator = "implicit"\nfootprint_reach = 0.05'), 4, 2,
                  "waves_moving_implicit")
 
 
@@ -378,7 +348,7 @@ def continue_and_compare(cfg, stopped, what):
 def case_sigint():
     # Ctrl-C (SIGINT) or SIGTERM in the middle of a step: the step finishes,
     # a checkpoint is written, exit 130; the restart equals the full run.
-    cfg = write("waves.toml", WAVES.format(coupling='law = "strong"\nstiffness = 100.0'))
+    cfg = write("waves.toml", WAVES.format(t_end=10.0, coupling='law = "strong"\nstiffness = 100.0'))
     for sig in (signal.SIGINT, signal.SIGTERM):
         out = os.path.join(WORK, "stopped.h5")
         code, stderr = stop_midway(cfg, out, sig, lambda f: f["time"].shape[0] >= 5)
@@ -396,7 +366,7 @@ def case_kill():
     # goes on from its last periodic checkpoint, which is between records
     # (0.7 s against records every 0.5 s); the records written after it are
     # dropped and written again, equal.
-    text = WAVES.format(coupling='law = "strong"\nstiffness = 100.0').replace(
+    text = WAVES.format(t_end=10.0, coupling='law = "strong"\nstiffness = 100.0').replace(
         "output_interval = 0.5", "output_interval = 0.5\ncheckpoint_interval = 0.7")
     cfg = write("waves.toml", text)
     out = os.path.join(WORK, "killed.h5")

@@ -5,6 +5,7 @@ restart"); states, energies, LCP counters and the sea are equal with ==.
 Run by ctest with Debian's python3 and PYTHONPATH at the built package.
 """
 import os
+import sys
 import tempfile
 import unittest
 
@@ -13,42 +14,12 @@ import numpy as np
 
 import floesim
 
-# Floes on a spectral sea with waves and wind, colliding.
-WAVES = """
-[run]
-t_end = 4.0
-dt_max = 0.05
-output_interval = 0.5
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+import restart_scenarios  # noqa: E402
 
-[sea]
-model = "spectral"
-dims = 2
-size = [80.0, 80.0]
-cells = [32, 32]
-depth = 20.0
-
-[sea.waves]
-kind = "regular"
-amplitude = 0.3
-wavelength = 40.0
-
-[coupling]
-law = "blend"
-restitution = 0.3
-stiffness = 100.0
-
-[forcing]
-wind = [15.0, 2.0]
-
-[[floes.floe]]
-vertices = [[10, 10], [22, 10], [22, 20], [10, 20]]
-velocity = [0.8, 0.0]
-[[floes.floe]]
-vertices = [[24, 11], [34, 12], [33, 21], [25, 20]]
-[[floes.floe]]
-vertices = [[40, 40], [52, 42], [50, 52], [41, 50]]
-thickness = 1.5
-"""
+# Floes on a spectral sea with waves and wind, colliding (shared with the
+# command line's restart test).
+WAVES = restart_scenarios.WAVES.format(t_end=4.0, coupling='law = "blend"\nrestitution = 0.3\nstiffness = 100.0')
 
 
 def snapshot(sim):
