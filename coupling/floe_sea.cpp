@@ -490,9 +490,10 @@ void FloeSeaContact::horizontal_loads(std::span<const double> u) {
 void FloeSeaContact::evaluate_loads(const Floes& floes, fluid::Sea& sea, IncidentSea* incident, double h) {
   evaluate(floes, sea, h);
   update_water(floes, sea, incident);
-  // After an implicit step the horizontal loads are that step's mean.
+  // After an implicit step the horizontal loads are that step's mean (zero
+  // on a floe that had no pieces on the step's midpoint footprint).
   if (step_mean_pending_)
-    for (std::uint32_t i : order_) loads_[i].horizontal = step_horizontal_[i];
+    for (std::size_t i = 0; i < loads_.size(); ++i) loads_[i].horizontal = step_horizontal_[i];
 }
 
 void FloeSeaContact::ready_loads(const Floes& floes, fluid::Sea& sea, IncidentSea* incident, double h) {
@@ -763,6 +764,7 @@ void FloeSeaContact::step_mean_horizontal(const Floes& floes, std::span<const Fl
     for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k)
       if (u[k] > 0.0) cells_[fp.cell[k]].sum += fp.area[k] * u[k] * u[k];
   horizontal_loads(u);
+  std::fill(step_horizontal_.begin(), step_horizontal_.end(), Eigen::Vector3d::Zero());
   for (std::uint32_t i : order_) step_horizontal_[i] = loads_[i].horizontal;
   step_mean_pending_ = true;
 }
