@@ -461,6 +461,9 @@ void read_coupling(Section s, CouplingParams& c, SeaModel sea_model) {
   c.integrator = s.choice<CouplingIntegrator>("integrator", c.integrator,
                                               {{"explicit", CouplingIntegrator::explicit_kicks},
                                                {"implicit", CouplingIntegrator::implicit}});
+  c.horizontal_loads = s.choice<HorizontalLoads>("horizontal_loads", c.horizontal_loads,
+                                                 {{"step_mean", HorizontalLoads::step_mean},
+                                                  {"step_ends", HorizontalLoads::step_ends}});
   c.newton_tolerance = s.number("newton_tolerance", c.newton_tolerance, positive, "a relative tolerance > 0");
   c.cg_tolerance = s.number("cg_tolerance", c.cg_tolerance, positive, "a relative tolerance > 0");
   c.cg_forcing = s.number("cg_forcing", c.cg_forcing, positive, "a relative tolerance > 0");
@@ -678,6 +681,8 @@ std::string resolved_toml(const Config& c) {
                                                                {"tent", FootprintChoice::tent}})},
                        {"footprint_reach", c.coupling.footprint_reach},
                        {"integrator", c.coupling.integrator == CouplingIntegrator::implicit ? "implicit" : "explicit"},
+                       {"horizontal_loads",
+                        c.coupling.horizontal_loads == HorizontalLoads::step_mean ? "step_mean" : "step_ends"},
                        {"newton_tolerance", c.coupling.newton_tolerance},
                        {"cg_tolerance", c.coupling.cg_tolerance},
                        {"cg_forcing", c.coupling.cg_forcing}};

@@ -89,6 +89,13 @@ enum class FootprintChoice { automatic, cell, tent };
 // 0.5 / omega_pen, or the implicit midpoint with the discrete gradient of the
 // penalty energy, whose step is limited by dt_max alone.
 enum class CouplingIntegrator { explicit_kicks, implicit };
+// Implicit integrator: the horizontal loads of a step (docs/coupling.md,
+// "Horizontal loads of the implicit step"): the step's mean (the stiff
+// floe–water mode's alternating part cancels in it; the energy is kept to
+// O(dt^2)), or the loads at the step's ends (the exact gradient of the
+// energy there: the energy is kept closely, but that alternating part drives
+// the floes; a thin floe's surge on waves came out twice too large).
+enum class HorizontalLoads { step_mean, step_ends };
 
 struct CouplingParams {
   PenaltyLaw law = PenaltyLaw::strong;
@@ -105,6 +112,7 @@ struct CouplingParams {
   // evaluation.
   double footprint_reach = 0.0;
   CouplingIntegrator integrator = CouplingIntegrator::explicit_kicks;
+  HorizontalLoads horizontal_loads = HorizontalLoads::step_mean;
   // Implicit integrator: the Newton iteration on the end-of-step penetrations
   // stops when every piece's residual is below newton_tolerance times the
   // thickest floe's draft; each Newton step's conjugate gradients stop at a

@@ -71,7 +71,9 @@ double FloeSeaContact::subcell_weight(double coverage) const {
 FloeSeaContact::FloeSeaContact(const CouplingParams& params, const SeaParams& sea_params, const Floes& floes,
                                fluid::Sea& sea, double dt_max)
     : rho_(sea_params.rho), g_(sea_params.g), sigma_(sea_params.sigma), K_(params.stiffness), grid_(sea.grid()),
-      implicit_(params.integrator == CouplingIntegrator::implicit), newton_tolerance_(params.newton_tolerance) {
+      implicit_(params.integrator == CouplingIntegrator::implicit),
+      step_mean_loads_(implicit_ && params.horizontal_loads == HorizontalLoads::step_mean),
+      newton_tolerance_(params.newton_tolerance) {
   solver_options_.cg_tolerance = params.cg_tolerance;
   solver_options_.forcing = params.cg_forcing;
   solver_options_.max_newton = params.max_newton;
@@ -168,7 +170,7 @@ FloeSeaState FloeSeaContact::saved_state() const {
   FloeSeaState s{true, bottom0_, loads_h_, penalty_energy_, {}, {}};
   for (const FloePose& p : footprints_.reference()) s.footprint_reference.push_back({p.x, p.y, p.yaw});
   // The implicit step's mean horizontal loads cannot be evaluated again from the state.
-  if (implicit_ && loads_h_ >= 0.0)
+  if (step_mean_loads_ && loads_h_ >= 0.0)
     for (const FloeSeaLoad& load : loads_) s.mean_horizontal.push_back({load.horizontal[0], load.horizontal[1], load.horizontal[2]});
   return s;
 }
@@ -553,7 +555,7 @@ void FloeSeaContact::kick_floes(Floes& floes, double h) {
     // load (the drift's predictor), the second completes the step's impulse
     // to 2 h F_mean (the header's "Horizontal loads of the implicit step").
     Eigen::Vector3d impulse = h * load.horizontal;
-    if (implicit_) {
+    if (step_mean_loads_) {
       if (step_mean_pending_) impulse = 2.0 * h * step_horizontal_[i] - first_half_[i];
       else first_half_[i] = impulse;
     }
@@ -732,7 +734,7 @@ void FloeSeaContact::implicit_step(Floes& floes, std::span<const FloeState> star
   for (std::size_t k = 0; k < n; ++k) grid_work_[fp.cell[k]] += f[k] * inv_cell_area;
   sea.midpoint_step(grid_work_, h);
   for (std::size_t k = 0; k < n; ++k) grid_work_[fp.cell[k]] = 0.0;
-  step_mean_horizontal(floes, start);
+  if (step_mean_loads_) step_mean_horizontal(floes, start);
 }
 
 void FloeSeaContact::step_mean_horizontal(const Floes& floes, std::span<const FloeState> start) {

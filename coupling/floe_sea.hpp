@@ -97,7 +97,9 @@
 // alternating part cancels. The drift cannot wait for F_mean: the first half
 // kick applies h/2 of the previous step's F_mean, a predictor, which leaves
 // the position an error h^2 / 2 (F_mean,n+1/2 - F_mean,n-1/2) = O(h^3); the
-// second half kick completes the step's impulse to h F_mean.
+// second half kick completes the step's impulse to h F_mean. This is
+// [coupling] horizontal_loads = "step_mean"; "step_ends" keeps the loads at
+// the step's ends, the exact gradient of the energy there, in the half kicks.
 //
 // Start (MODEL.md §1): the static problem is solved first. The sea's static
 // response to a pressure is local, eta = W - p / (rho_w g) + const, W the
@@ -293,6 +295,7 @@ private:
   std::vector<Eigen::Vector3d> step_horizontal_, first_half_;
   bool step_mean_pending_ = false;
   bool implicit_ = false;
+  bool step_mean_loads_ = false;  // implicit, [coupling] horizontal_loads = "step_mean"
   int threads_ = 1;
   double newton_tolerance_ = 1e-8;  // times the thickest draft
   PenaltyStepOptions solver_options_;

@@ -174,6 +174,9 @@ def toml_cases():
     case("toml", "footprint reach of a whole cell",
          ["run", write("reach.toml", '[coupling]\nfootprint_reach = 1.0\n')],
          ["reach.toml:2", "[coupling] footprint_reach", "a fraction of a cell in [0, 0.5]"])
+    case("toml", "horizontal loads of an unknown kind",
+         ["run", write("hloads.toml", '[coupling]\nhorizontal_loads = "ends"\n')],
+         ["hloads.toml:2", "[coupling] horizontal_loads", "step_mean"])
     case("toml", "a forcing series whose path is too long for the system",
          ["run", write("long_path.toml", '[forcing]\nseries = "/tmp/' + "x" * 5000 + '"\n')],
          ["long_path.toml:2", "[forcing] series", "file not found"])
