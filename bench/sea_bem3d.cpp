@@ -8,7 +8,10 @@
 // order, so it is the largest set-up's). A step is kick + flow + elevation +
 // kick, minimum of `repeats` after a warm-up. CSV on stdout.
 //
-// usage: floesim_bench_sea_bem3d [max_nx = 48] [repeats = 20] [first_nx = 8]
+// modes: 0 keeps all of them (the dense eigenproblem), n > 0 the n lowest
+// ([sea] bem_modes, Lanczos).
+//
+// usage: floesim_bench_sea_bem3d [max_nx = 48] [repeats = 20] [first_nx = 8] [modes = 0] [step_nx = 8]
 
 #include <sys/resource.h>
 
@@ -51,13 +54,16 @@ int main(int argc, char** argv) {
   const int max_nx = argc > 1 ? std::atoi(argv[1]) : 48;
   const int repeats = argc > 2 ? std::atoi(argv[2]) : 20;
   const int first_nx = argc > 3 ? std::atoi(argv[3]) : 8;
-  std::printf("nx,ny,surface_nodes,panels,setup_s,assemble_s,solve_s,modes_s,matrix_mb,peak_rss_mb,step_us,"
+  const int modes = argc > 4 ? std::atoi(argv[4]) : 0;
+  const int step_nx = argc > 5 ? std::atoi(argv[5]) : 8;
+  std::printf("nx,ny,surface_nodes,modes,panels,setup_s,assemble_s,solve_s,modes_s,matrix_mb,peak_rss_mb,step_us,"
               "worst_error_10_01_11\n");
-  for (int nx = first_nx; nx <= max_nx; nx += nx < 16 ? 4 : 8) {
+  for (int nx = first_nx; nx <= max_nx; nx += nx < 16 ? 4 : step_nx) {
     SeaParams p = cases::lab_tank_bem(nx, 1.0, 0.2);
     p.dims = 2;
     p.size = {1.0, 0.5};
     p.cells = {nx, nx / 2};
+    p.bem_modes = modes;
     Bem3dSea sea(p);  // each size is a cache miss: a fresh set-up
     const Dispersion d = Dispersion::of(p);
     double worst = 0.0;
@@ -84,7 +90,7 @@ int main(int argc, char** argv) {
     rusage u{};
     getrusage(RUSAGE_SELF, &u);
     const auto& c = sea.setup_cost();
-    std::printf("%d,%d,%zu,%d,%.3f,%.3f,%.3f,%.3f,%.1f,%.1f,%.1f,%.3e\n", nx, nx / 2, sea.grid().size(), sea.panels(),
+    std::printf("%d,%d,%zu,%zu,%d,%.3f,%.3f,%.3f,%.3f,%.1f,%.1f,%.1f,%.3e\n", nx, nx / 2, sea.grid().size(), sea.frequencies().size(), sea.panels(),
                 c.seconds, c.assemble, c.solve, c.modes, c.bytes / 1e6, static_cast<double>(u.ru_maxrss) / 1024.0, best, worst);
     std::fflush(stdout);
     if (sink == 12345.0) std::printf("#\n");
