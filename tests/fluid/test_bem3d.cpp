@@ -240,7 +240,7 @@ TEST_CASE("3D BEM lowest modes (bem_modes = n): the Lanczos modes are the dense 
   CHECK(diff < 1e-8 * scale);
 }
 
-TEST_CASE("3D BEM lowest modes: the kept modes of a free sea keep their energy; the cut drops the rest at set_surface") {
+TEST_CASE("3D BEM lowest modes: the kept modes of a free sea keep their energy, the cut drops the rest at set_surface") {
   // The truncated sea is the dense one restricted to its n lowest modes: the
   // energy of a surface set on it is the dense sea's energy of those modes,
   // conserved under a uniform pressure as for the dense sea.
