@@ -115,9 +115,9 @@ TEST_CASE("unknown keys, wrong types and out-of-range values name file, line and
   CHECK(parse("[sea]\nmodel = \"bem\"\ndims = 2\ncells = [64, 64]\ndepth = 1.0\n").sea.cells[1] == 64);
   // With the lowest modes only (bem_modes = n) the bound is the LU's.
   refused("[sea]\nmodel = \"bem\"\ndims = 2\ncells = [128, 64]\n", {"keep the lowest modes only with bem_modes"});
-  CHECK(parse("[sea]\nmodel = \"bem\"\ndims = 2\ncells = [128, 64]\ndepth = 1.0\nbem_modes = 300\n").sea.bem_modes == 300);
-  refused("[sea]\nmodel = \"bem\"\ndims = 2\ncells = [128, 72]\nbem_modes = 300\n",
-          {"[sea] cells", "at most 8192 surface cells", "with bem_modes > 0", "128 x 72"});
+  CHECK(parse("[sea]\nmodel = \"bem\"\ndims = 2\ncells = [96, 64]\ndepth = 1.0\nbem_modes = 300\n").sea.bem_modes == 300);
+  refused("[sea]\nmodel = \"bem\"\ndims = 2\ncells = [128, 64]\nbem_modes = 300\n",
+          {"[sea] cells", "at most 6144 surface cells", "with bem_modes > 0", "128 x 64"});
   refused("[sea]\nmodel = \"bem\"\ndims = 2\ncells = [4, 4]\nbem_modes = 15\n",
           {"[sea] bem_modes", "at most 14 modes", "got 15"});
   refused("[sea]\nmodel = \"bem\"\ndims = 2\ncells = [4, 4]\nbem_modes = -1\n", {"[sea] bem_modes", ">= 0"});
