@@ -240,6 +240,23 @@ TEST_CASE("3D BEM lowest modes (bem_modes = n): the Lanczos modes are the dense 
   CHECK(diff < 1e-8 * scale);
 }
 
+TEST_CASE("3D BEM lowest modes with surface tension alone (g = 0): the Lanczos modes are still the dense lowest") {
+  // a_sf = sigma L is singular on the constants: the Lanczos iteration pins a
+  // node for its solves (fluid/lowest_modes.cpp). Same check as with gravity.
+  SeaParams p = basin(10, 7, 0.1, 0.057, 0.02);
+  p.g = 0.0;
+  Bem3dSea all(p);
+  p.bem_modes = 12;
+  Bem3dSea low(p);
+  double worst = 0.0;
+  for (std::size_t j = 0; j < 12; ++j)
+    worst = std::max(worst, std::abs(low.frequencies()[j] / all.frequencies()[j] - 1.0));
+  MESSAGE("12 lowest capillary frequencies: largest relative difference " << worst << ", lowest "
+                                                                          << all.frequencies()[0] << " rad/s");
+  CHECK(all.frequencies()[0] > 0.0);
+  CHECK(worst < 1e-10);
+}
+
 TEST_CASE("3D BEM lowest modes: the kept modes of a free sea keep their energy, the cut drops the rest at set_surface") {
   // The truncated sea is the dense one restricted to its n lowest modes: the
   // energy of a surface set on it is the dense sea's energy of those modes,
