@@ -10,7 +10,7 @@
 //  - the Sea's modal side (DenseModalSea): kick and repeat kick, set_surface,
 //    projection and synthesis, the surface elevation and potential from
 //    which each backend differentiates its fields.
-// Internal to fluid/.
+// The BEM seas' headers include it; other layers use them through Sea.
 
 #include <Eigen/Dense>
 #include <Eigen/SparseCore>
