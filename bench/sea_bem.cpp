@@ -2,14 +2,12 @@
 // panel count. Rectangular lab tank L = 1 m, H = 0.1 m (the validation tank):
 // the accuracy column is the worst relative error of the first 10 sloshing
 // frequencies against omega_n^2 = (g k_n + sigma k_n^3 / rho) tanh(k_n H).
-// A step is kick + flow + elevation + kick, minimum of `repeats` after a warm-up
-// (shared machine); the set-up is timed once (each size is built fresh).
+// A step: bench/dense_sea_step.hpp; the set-up is timed once (each size is built fresh).
 // CSV on stdout.
 //
 // usage: floesim_bench_sea_bem [max_surface_panels = 800] [repeats = 50]
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -17,12 +15,12 @@
 #include <vector>
 
 #include "fluid/bem.hpp"
+#include "bench/dense_sea_step.hpp"
 #include "fluid/waves.hpp"
 #include "tests/fluid/sea_cases.hpp"
 
 using namespace floesim;
 using namespace floesim::fluid;
-using clock_type = std::chrono::steady_clock;
 
 int main(int argc, char** argv) {
   const int max_ns = argc > 1 ? std::atoi(argv[1]) : 800;
@@ -35,25 +33,9 @@ int main(int argc, char** argv) {
     double worst = 0.0;
     for (int n = 1; n <= 10; ++n)
       worst = std::max(worst, std::abs(sea.frequencies()[n - 1] / d.omega(n * std::numbers::pi) - 1.0));
-    std::vector<double> p0(sea.grid().size(), 10.0), p1(sea.grid().size(), -10.0);
-    p0[0] = 50.0;
-    double sink = 0.0;
-    auto step = [&] {
-      sea.kick(p0, 0.005);
-      sea.flow(0.01);
-      sink += sea.elevation()[0];
-      sea.kick(p1, 0.005);
-    };
-    step();
-    double best = 1e300;
-    for (int r = 0; r < repeats; ++r) {
-      const auto a = clock_type::now();
-      step();
-      best = std::min(best, std::chrono::duration<double, std::micro>(clock_type::now() - a).count());
-    }
+    const double best = bench::best_step_us(sea, repeats);
     std::printf("%d,%d,%.4f,%.2f,%.3e\n", ns, sea.panels(), sea.setup_seconds(), best, worst);
     std::fflush(stdout);
-    if (sink == 12345.0) std::printf("#\n");
   }
   return 0;
 }

@@ -5,15 +5,17 @@
 // the worst relative error of modes (1,0), (0,1), (1,1) against
 // omega^2 = (g k + sigma k^3 / rho) tanh(k H).
 // Peak memory is the process's maximum resident set (sizes run in increasing
-// order, so it is the largest set-up's). A step is kick + flow + elevation +
-// kick, minimum of `repeats` after a warm-up. CSV on stdout.
+// order, so it is the largest set-up's). A step: bench/dense_sea_step.hpp.
+// CSV on stdout.
 //
-// usage: floesim_bench_sea_bem3d [max_nx = 48] [repeats = 20] [first_nx = 8]
+// modes: 0 keeps all of them (the dense eigenproblem), n > 0 the n lowest
+// ([sea] bem_modes, Lanczos).
+//
+// usage: floesim_bench_sea_bem3d [max_nx = 48] [repeats = 20] [first_nx = 8] [modes = 0] [step_nx = 8]
 
 #include <sys/resource.h>
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -21,12 +23,12 @@
 #include <vector>
 
 #include "fluid/bem3d.hpp"
+#include "bench/dense_sea_step.hpp"
 #include "fluid/waves.hpp"
 #include "tests/fluid/sea_cases.hpp"
 
 using namespace floesim;
 using namespace floesim::fluid;
-using clock_type = std::chrono::steady_clock;
 
 namespace {
 
@@ -51,13 +53,16 @@ int main(int argc, char** argv) {
   const int max_nx = argc > 1 ? std::atoi(argv[1]) : 48;
   const int repeats = argc > 2 ? std::atoi(argv[2]) : 20;
   const int first_nx = argc > 3 ? std::atoi(argv[3]) : 8;
-  std::printf("nx,ny,surface_nodes,panels,setup_s,assemble_s,solve_s,modes_s,matrix_mb,peak_rss_mb,step_us,"
+  const int modes = argc > 4 ? std::atoi(argv[4]) : 0;
+  const int step_nx = argc > 5 ? std::atoi(argv[5]) : 8;
+  std::printf("nx,ny,surface_nodes,modes,panels,setup_s,assemble_s,solve_s,modes_s,matrix_mb,peak_rss_mb,step_us,"
               "worst_error_10_01_11\n");
-  for (int nx = first_nx; nx <= max_nx; nx += nx < 16 ? 4 : 8) {
+  for (int nx = first_nx; nx <= max_nx; nx += nx < 16 ? 4 : step_nx) {
     SeaParams p = cases::lab_tank_bem(nx, 1.0, 0.2);
     p.dims = 2;
     p.size = {1.0, 0.5};
     p.cells = {nx, nx / 2};
+    p.bem_modes = modes;
     Bem3dSea sea(p);  // each size is a cache miss: a fresh set-up
     const Dispersion d = Dispersion::of(p);
     double worst = 0.0;
@@ -65,29 +70,13 @@ int main(int argc, char** argv) {
       const double k = std::numbers::pi * std::hypot(m / 1.0, n / 0.5);
       worst = std::max(worst, std::abs(mode_frequency(sea, m, n) / d.omega(k) - 1.0));
     }
-    std::vector<double> p0(sea.grid().size(), 10.0), p1(sea.grid().size(), -10.0);
-    p0[0] = 50.0;
-    double sink = 0.0;
-    auto step = [&] {
-      sea.kick(p0, 0.005);
-      sea.flow(0.01);
-      sink += sea.elevation()[0];
-      sea.kick(p1, 0.005);
-    };
-    step();
-    double best = 1e300;
-    for (int r = 0; r < repeats; ++r) {
-      const auto a = clock_type::now();
-      step();
-      best = std::min(best, std::chrono::duration<double, std::micro>(clock_type::now() - a).count());
-    }
+    const double best = bench::best_step_us(sea, repeats);
     rusage u{};
     getrusage(RUSAGE_SELF, &u);
     const auto& c = sea.setup_cost();
-    std::printf("%d,%d,%zu,%d,%.3f,%.3f,%.3f,%.3f,%.1f,%.1f,%.1f,%.3e\n", nx, nx / 2, sea.grid().size(), sea.panels(),
+    std::printf("%d,%d,%zu,%zu,%d,%.3f,%.3f,%.3f,%.3f,%.1f,%.1f,%.1f,%.3e\n", nx, nx / 2, sea.grid().size(), sea.frequencies().size(), sea.panels(),
                 c.seconds, c.assemble, c.solve, c.modes, c.bytes / 1e6, static_cast<double>(u.ru_maxrss) / 1024.0, best, worst);
     std::fflush(stdout);
-    if (sink == 12345.0) std::printf("#\n");
   }
   return 0;
 }

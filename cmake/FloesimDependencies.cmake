@@ -4,6 +4,8 @@
 find_package(Eigen3 3.3 REQUIRED NO_MODULE)
 find_package(PkgConfig REQUIRED)
 pkg_check_modules(FFTW3 REQUIRED IMPORTED_TARGET fftw3)
+# Required: the lowest modes of large 3D BEM basins (fluid/lowest_modes.hpp).
+pkg_check_modules(ARPACK REQUIRED IMPORTED_TARGET arpack)
 pkg_check_modules(CAIRO REQUIRED IMPORTED_TARGET cairo)  # pictures (apps/viz)
 find_package(HDF5 REQUIRED COMPONENTS C)
 find_package(tomlplusplus REQUIRED)

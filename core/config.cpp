@@ -13,6 +13,7 @@
 #include <set>
 #include <sstream>
 
+#include "core/detail/h5.hpp"
 #include "core/error.hpp"
 #include "core/forcing.hpp"
 
@@ -243,6 +244,65 @@ void read_waves(Section s, WaveParams& w) {
   s.finish();
 }
 
+// The bottom grid of [sea] bottom_file in HDF5: a dataset /z of shape
+// (ny, nx), z[j][i] the bottom at (x[i], y[j]) (finite, < 0), with its grid:
+// /x (nx values) and /y (ny values), evenly spaced from 0 to Lx and Ly (the
+// grid spans the basin, as the CSV's does). Fails through `fail` naming the
+// file and the dataset at fault.
+template <class Fail>
+void read_bottom_grid_h5(SeaParams& p, Fail&& fail) {
+  const std::string& path = p.bottom_file;
+  auto num = [](double v) { std::ostringstream o; o << v; return o.str(); };
+  // In the read (which may run in a child process) failures are plain InputErrors;
+  // they reach `fail` below.
+  auto bad = [](const std::string& m) { throw InputError(m); };
+  auto read = [&] {
+    h5::Handle file = h5::open_file(path);
+    h5::Handle z = h5::open_dataset(file, "/z", path);
+    const std::vector<hsize_t> d = h5::dims(z);
+    if (d.size() != 2 || d[0] < 2 || d[1] < 2)
+      bad(path + ": dataset /z: expected a 2-D grid of at least 2 x 2 depths, shape (ny, nx), x fastest");
+    // As for the CSV: no larger than any grid a dense 3D basin could use (16 MiB of doubles).
+    if (static_cast<double>(d[0]) * static_cast<double>(d[1]) > static_cast<double>(std::size_t{1} << 21))
+      bad(path + ": dataset /z: expected at most 2097152 depths, got " + num(static_cast<double>(d[0])) + " x " +
+           num(static_cast<double>(d[1])));
+    std::vector<double> grid = h5::read_doubles(z, path + ": dataset /z");
+    const int ny = static_cast<int>(d[0]), nx = static_cast<int>(d[1]);
+    for (std::size_t k = 0; k < grid.size(); ++k)
+      if (!(std::isfinite(grid[k]) && grid[k] < 0.0))
+        bad(path + ": dataset /z: every depth must be finite and below the surface (z < 0), got " + num(grid[k]) +
+             " at [" + std::to_string(k / static_cast<std::size_t>(nx)) + ", " +
+             std::to_string(k % static_cast<std::size_t>(nx)) + "]");
+    auto axis = [&](const std::string& name, int count, double length) {
+      h5::Handle a = h5::open_dataset(file, name, path);
+      const std::vector<hsize_t> da = h5::dims(a);
+      const std::string what = path + ": dataset " + name;
+      if (da.size() != 1 || da[0] != static_cast<hsize_t>(count))
+        bad(what + ": expected " + std::to_string(count) + " coordinates (a 1-D dataset, one per node of /z)");
+      const std::vector<double> c = h5::read_doubles(a, what);
+      for (int i = 0; i < count; ++i) {
+        const double want = length * i / (count - 1);
+        if (!(std::abs(c[static_cast<std::size_t>(i)] - want) <= 1e-6 * length))
+          bad(what + ": expected " + std::to_string(count) + " coordinates evenly spaced from 0 to " + num(length) +
+               " m (the grid spans the basin), got " + num(c[static_cast<std::size_t>(i)]) + " at " +
+               std::to_string(i) + " instead of " + num(want));
+      }
+    };
+    axis("/x", nx, p.size[0]);
+    axis("/y", ny, p.size[1]);
+    p.bottom_grid = std::move(grid);
+    p.bottom_nx = nx;
+    p.bottom_ny = ny;
+  };
+  try {
+    // Read first in a child process: a file that crashes HDF5 is refused.
+    h5::refuse_if_read_crashes(path, read);
+    read();
+  } catch (const InputError& e) {
+    fail(e.what());
+  }
+}
+
 // The bottom grid of [sea] bottom_file: one line per row of nodes (y from 0),
 // comma-separated depths z < 0 (x from 0); blank lines and lines starting with
 // '#' are skipped. Fails through `fail` with the line that is wrong.
@@ -252,7 +312,7 @@ void read_bottom_grid(SeaParams& p, Fail&& fail) {
   // file larger than any grid a dense 3D basin could use.
   std::error_code ec;
   if (!fs::is_regular_file(p.bottom_file, ec))
-    fail(p.bottom_file + ": not found or not a regular file; expected a CSV grid of depths");
+    fail(p.bottom_file + ": not found or not a regular file; expected a CSV or HDF5 grid of depths");
   if (fs::file_size(p.bottom_file, ec) > (std::uintmax_t{16} << 20))
     fail(p.bottom_file + ": larger than 16 MiB; expected a CSV grid of depths");
   std::ifstream in(p.bottom_file);
@@ -317,14 +377,28 @@ void read_sea(Section s, SeaParams& p, const std::string& file, const std::strin
   } else {
     s.node("cells");
   }
-  if (p.model == SeaModel::bem && p.dims == 2 &&
-      static_cast<double>(p.cells[0]) * p.cells[1] > kMaxBem3dCells) {
-    // The 3D basin's set-up is dense (fluid/bem3d.hpp; cost in docs/sea.md).
-    std::ostringstream m;
-    m << "model = \"bem\" with dims = 2 is a dense set-up: expected at most " << static_cast<long long>(kMaxBem3dCells)
-      << " surface cells in all (64 x 64), got " << static_cast<double>(p.cells[0]) * p.cells[1] << " ("
-      << p.cells[0] << " x " << p.cells[1] << ")";
-    s.fail("cells", m.str());
+  p.bem_modes = static_cast<int>(s.integer("bem_modes", p.bem_modes, [](long long v) { return v >= 0 && v < 1000000; },
+                                           "a number of modes >= 0 (0: all)"));
+  if (p.model == SeaModel::bem && p.dims == 2) {
+    // The 3D basin's set-up is a dense LU, then all modes (dense eigenproblem)
+    // or the lowest (Lanczos): fluid/bem3d.hpp, cost in docs/sea.md.
+    const double cells = static_cast<double>(p.cells[0]) * p.cells[1];
+    const double most = p.bem_modes == 0 ? kMaxBem3dCells : kMaxBem3dLowestCells;
+    if (cells > most) {
+      std::ostringstream m;
+      m << "model = \"bem\" with dims = 2 is a dense set-up: expected at most " << static_cast<long long>(most)
+        << " surface cells in all" << (p.bem_modes == 0 ? " with all modes (bem_modes = 0)" : " with bem_modes > 0")
+        << ", got " << cells << " (" << p.cells[0] << " x " << p.cells[1] << ")";
+      if (p.bem_modes == 0) m << "; keep the lowest modes only with bem_modes = n (up to "
+                              << static_cast<long long>(kMaxBem3dLowestCells) << " cells)";
+      s.fail("cells", m.str());
+    }
+    if (p.bem_modes > 0 && p.bem_modes > cells - 2)
+      s.fail("bem_modes", "expected at most " + std::to_string(static_cast<long long>(cells) - 2) +
+                              " modes (surface cells - 2) on " + std::to_string(p.cells[0]) + " x " +
+                              std::to_string(p.cells[1]) + " cells, got " + std::to_string(p.bem_modes));
+  } else if (p.bem_modes != 0) {
+    s.fail("bem_modes", "the lowest modes only apply to model = \"bem\" with dims = 2");
   }
   p.depth = s.number("depth", p.depth, [](double v) { return v > 0.0; }, "a depth > 0 (m) or inf");
   p.rho = s.number("rho", p.rho, positive, "a density > 0 (kg/m^3)");
@@ -356,7 +430,12 @@ void read_sea(Section s, SeaParams& p, const std::string& file, const std::strin
     if (!(p.model == SeaModel::bem && p.dims == 2))
       s.fail("bottom_file", "a bottom grid needs model = \"bem\" with dims = 2");
     if (!p.bottom.empty()) s.fail("bottom_file", "give bottom or bottom_file, not both");
-    read_bottom_grid(p, [&](const std::string& m) { s.fail("bottom_file", m); });
+    auto fail = [&](const std::string& m) { s.fail("bottom_file", m); };
+    std::error_code ec;
+    if (fs::is_regular_file(p.bottom_file, ec) && h5::is_hdf5(p.bottom_file))
+      read_bottom_grid_h5(p, fail);
+    else
+      read_bottom_grid(p, fail);
   }
   read_waves(Section(s.table("waves"), "sea.waves", file), p.waves);
   {
@@ -639,6 +718,7 @@ std::string resolved_toml(const Config& c) {
                   {"rho", c.sea.rho}, {"g", c.sea.g}, {"sigma", c.sea.sigma}, {"waves", waves}};
   if (!bottom.empty()) sea.insert("bottom", bottom);
   if (!c.sea.bottom_file.empty()) sea.insert("bottom_file", c.sea.bottom_file);
+  if (c.sea.bem_modes != 0) sea.insert("bem_modes", c.sea.bem_modes);
   if (c.sea.tank.enabled)
     sea.insert("tank", toml::table{{"enabled", true}, {"generation_length", c.sea.tank.generation_length},
                                    {"absorption_length", c.sea.tank.absorption_length}, {"rate", c.sea.tank.rate},

@@ -42,6 +42,10 @@ inline constexpr double kMaxSeaCells = 16777216.0;
 // [sea] model = "bem", dims = 2: surface cells at most (a dense LU of about
 // three times as many panels: 2048 cells took 4 min and 0.75 GB, docs/sea.md).
 inline constexpr double kMaxBem3dCells = 4096.0;
+// The same with only the lowest modes kept ([sea] bem_modes > 0): the dense LU
+// of the panels is then the bound (4608 cells took 19 min and 2.3 GB; 6144,
+// about 20000 panels, extrapolate to 45 min and 4 GB; docs/sea.md).
+inline constexpr double kMaxBem3dLowestCells = 6144.0;
 
 // The rule on the number of records, in one place for [run] t_end and for
 // `floesim run --until`: "" if a run to t_end writes at most kMaxRecords records

@@ -67,6 +67,9 @@ struct SeaParams {
   std::string bottom_file;
   int bottom_nx = 0, bottom_ny = 0;
   std::vector<double> bottom_grid;
+  // bem, dims = 2: the modes kept. 0: all of them (the dense eigenproblem);
+  // n > 0: the n lowest (Lanczos; fluid/lowest_modes.hpp, docs/sea.md).
+  int bem_modes = 0;
   WaveParams waves;
   TankConfig tank;
 };

@@ -5,13 +5,10 @@
 #include <array>
 #include <chrono>
 #include <cmath>
-#include <map>
-#include <mutex>
 #include <numbers>
 #include <sstream>
 
 #include "core/error.hpp"
-#include "fluid/dense_modes.hpp"
 
 namespace floesim::fluid {
 
@@ -24,12 +21,6 @@ constexpr double pi = std::numbers::pi;
 
 struct Panel {
   Point a, b;  // traversed counter-clockwise around the fluid: outward normal (t_y, -t_x)
-};
-
-// The set-up of one basin: modes and the maps from modal state to surface fields.
-struct Operators : DenseModes {  // surface = the surface panels
-  int panels = 0;   // all panels
-  double setup_seconds = 0.0;
 };
 
 void add_segment(std::vector<Panel>& panels, Point a, Point b, double h) {
@@ -60,7 +51,7 @@ double log_integral(const Panel& pan, Point p) {
   return f(s2) - f(s1);
 }
 
-std::shared_ptr<const Operators> build(const SeaParams& p, double ratio) {
+std::shared_ptr<const DenseSetup> build(const SeaParams& p, double ratio) {
   const auto start = std::chrono::steady_clock::now();
   const int ns = p.cells[0];
   const double len = p.size[0], width = p.size[1];
@@ -100,61 +91,39 @@ std::shared_ptr<const Operators> build(const SeaParams& p, double ratio) {
 
   MatrixXd m = p.rho * width * h * phi;  // rho w D Phi, D = h I
   m = (0.5 * (m + m.transpose())).eval();
-  MatrixXd k = MatrixXd::Zero(ns, ns);
+  // K = w (rho g D + sigma L), the faces between neighbouring panels.
+  std::vector<Eigen::Triplet<double>> entries;
   for (int i = 0; i < ns; ++i) {
-    k(i, i) += p.rho * p.g * h;
+    entries.emplace_back(i, i, width * p.rho * p.g * h);
     if (i + 1 < ns) {  // face between cells i and i + 1
-      const double s = p.sigma / h;
-      k(i, i) += s;
-      k(i + 1, i + 1) += s;
-      k(i, i + 1) -= s;
-      k(i + 1, i) -= s;
+      const double s = width * p.sigma / h;
+      entries.emplace_back(i, i, s);
+      entries.emplace_back(i + 1, i + 1, s);
+      entries.emplace_back(i, i + 1, -s);
+      entries.emplace_back(i + 1, i, -s);
     }
   }
-  k *= width;
+  Eigen::SparseMatrix<double> k(ns, ns);
+  k.setFromTriplets(entries.begin(), entries.end());
 
-  // Zero-mean surfaces: an orthonormal basis q of the complement of the constants.
-  const VectorXd ones = VectorXd::Ones(ns);
-  const MatrixXd qfull = Eigen::HouseholderQR<MatrixXd>(ones).householderQ();
-  const MatrixXd q = qfull.rightCols(ns - 1);
-  const MatrixXd kr = q.transpose() * k * q, mr = q.transpose() * m * q;
-  Eigen::GeneralizedSelfAdjointEigenSolver<MatrixXd> eig(kr, mr);
-  if (eig.info() != Eigen::Success)
-    throw RunError("fluid: the BEM eigenproblem (a_sf, m_sf) did not converge");
-
-  auto ops = std::make_shared<Operators>();
-  ops->surface = ns;
+  auto ops = std::make_shared<DenseSetup>();
   ops->panels = n;
-  ops->x = q * eig.eigenvectors();
-  ops->omega.resize(ns - 1);
-  for (int j = 0; j < ns - 1; ++j) ops->omega[j] = std::sqrt(std::max(0.0, eig.eigenvalues()(j)));
-  ops->load = -width * h * ops->x.transpose();
-  ops->project = ops->x.transpose() * m;
-  ops->potential = phi * ops->x;
-  ops->setup_seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  reduce_to_modes(k, m, phi, width * h, 0, *ops);
+  ops->cost.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return ops;
 }
 
-// Process-wide cache of set-ups, keyed by everything that enters them.
-std::shared_ptr<const Operators> cached(const SeaParams& p, double ratio, bool& hit) {
-  static std::mutex mutex;
-  static std::map<std::string, std::shared_ptr<const Operators>> cache;
+// The set-up of a basin, cached process-wide (16 kept), keyed by everything that enters it.
+DenseModalSea::Cached cached(const SeaParams& p, const SeaOptions& options) {
+  if (!(options.bem_panel_ratio > 0.0))
+    throw InputError("[sea] cells: the BEM panel ratio must be > 0");
+  const double ratio = options.bem_panel_ratio;
   std::ostringstream key;
   key.precision(17);
   key << p.size[0] << ' ' << p.size[1] << ' ' << p.cells[0] << ' ' << p.depth << ' ' << p.rho
       << ' ' << p.g << ' ' << p.sigma << ' ' << ratio;
   for (const auto& b : p.bottom) key << ' ' << b[0] << ',' << b[1];
-  std::lock_guard lock(mutex);
-  if (auto it = cache.find(key.str()); it != cache.end()) {
-    hit = true;
-    return it->second;
-  }
-  hit = false;
-  auto ops = build(p, ratio);
-  if (cache.size() >= 16) cache.clear();
-  cache.emplace(key.str(), ops);
-  return ops;
+  return cached_setup<BemSea>(key.str(), 16, [&] { return build(p, ratio); });
 }
 
 SurfaceGrid basin_grid(const SeaParams& p) {
@@ -190,44 +159,8 @@ std::vector<std::array<double, 2>> bottom_profile(const SeaParams& p) {
   return out;
 }
 
-struct BemSea::Impl {
-  std::shared_ptr<const Operators> ops;
-  bool hit = false;
-  bool kicked = false;  // work_modes holds the projection of the last kick's pressure
-  VectorXd work_modes, work_surface;
-};
-
 BemSea::BemSea(const SeaParams& params, const SeaOptions& options)
-    : Sea(basin_grid(params)), impl_(std::make_unique<Impl>()) {
-  if (!(options.bem_panel_ratio > 0.0))
-    throw InputError("[sea] cells: the BEM panel ratio must be > 0");
-  impl_->ops = cached(params, options.bem_panel_ratio, impl_->hit);
-  const auto& ops = *impl_->ops;
-  const std::size_t nm = ops.omega.size();
-  bank_ = ModalBank(ops.omega, std::vector<double>(nm, 1.0), std::vector<double>(nm, 1.0), 1);
-  impl_->work_modes.resize(static_cast<Eigen::Index>(nm));
-  impl_->work_surface.resize(ops.surface);
-}
-
-BemSea::~BemSea() = default;
-
-std::span<const double> BemSea::frequencies() const { return impl_->ops->omega; }
-int BemSea::panels() const { return impl_->ops->panels; }
-double BemSea::setup_seconds() const { return impl_->ops->setup_seconds; }
-bool BemSea::from_cache() const { return impl_->hit; }
-
-void BemSea::kick(std::span<const double> pressure, double h) {
-  FLOESIM_ASSERT(pressure.size() == static_cast<std::size_t>(impl_->ops->surface));
-  impl_->kicked = true;
-  project(pressure, {impl_->work_modes.data(), static_cast<std::size_t>(impl_->work_modes.size())});  // kept for repeat_kick
-  repeat_kick(h);
-}
-
-void BemSea::repeat_kick(double h) {
-  FLOESIM_ASSERT(impl_->kicked);
-  bank_.kick(std::span<const double>(impl_->work_modes.data(), bank_.modes()), h);
-  invalidate_rates();
-}
+    : DenseModalSea(basin_grid(params), cached(params, options)) {}
 
 void BemSea::flow(double dt) {
   bank_.flow(dt);
@@ -235,40 +168,19 @@ void BemSea::flow(double dt) {
   invalidate();
 }
 
-void BemSea::set_surface(std::span<const double> eta, std::span<const double> eta_t) {
-  impl_->ops->to_modes(eta, bank_.q(), impl_->work_surface);
-  impl_->ops->to_modes(eta_t, bank_.v(), impl_->work_surface);
-  invalidate();
-}
-
-void BemSea::project(std::span<const double> pressure, std::span<double> s) {
-  impl_->ops->to_forces(pressure, s);
-}
-
-void BemSea::synthesize(std::span<const double> q, std::span<double> eta) { impl_->ops->to_surface(q, eta); }
-
 void BemSea::compute_field(Field f, std::span<double> out) {
-  const auto& ops = *impl_->ops;
-  const Eigen::Index nm = static_cast<Eigen::Index>(bank_.modes());
-  const Eigen::Map<const VectorXd> q(bank_.q().data(), nm), v(bank_.v().data(), nm);
-  Eigen::Map<VectorXd> o(out.data(), ops.surface);
+  Eigen::Map<VectorXd> o(out.data(), static_cast<Eigen::Index>(out.size()));
   // Centred difference with mirror ghosts (d/dx = 0 at the walls).
   auto derivative = [&](const VectorXd& g) {
-    const int n = ops.surface;
+    const int n = grid_.nx;
     const double h2 = 2.0 * grid_.dx();
     for (int i = 0; i < n; ++i) o(i) = (g(std::min(i + 1, n - 1)) - g(std::max(i - 1, 0))) / h2;
   };
   switch (f) {
-    case Field::elevation: o.noalias() = ops.x * q; break;
-    case Field::velocity_z: o.noalias() = ops.x * v; break;
-    case Field::slope_x:
-      impl_->work_surface.noalias() = ops.x * q;
-      derivative(impl_->work_surface);
-      break;
-    case Field::velocity_x:
-      impl_->work_surface.noalias() = ops.potential * v;
-      derivative(impl_->work_surface);
-      break;
+    case Field::elevation: o = surface_elevation(); break;
+    case Field::velocity_z: synthesize(bank_.v(), out); break;
+    case Field::slope_x: derivative(surface_elevation()); break;
+    case Field::velocity_x: derivative(surface_potential()); break;
     case Field::slope_y:
     case Field::velocity_y: o.setZero(); break;
   }

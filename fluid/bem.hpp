@@ -17,7 +17,8 @@
 //     a_sf -> K = w (rho g D + sigma L), L the finite-volume Laplacian with
 //     d eta / d x = 0 at the walls. Both restricted to zero-mean surfaces.
 //  4. Modes: the generalised eigenproblem K x = omega^2 M x, x M-orthonormal:
-//     the ModalBank gets one real mode per eigenvector (mass 1).
+//     the ModalBank gets one real mode per eigenvector (mass 1); all of them
+//     (the slice is small: [sea] bem_modes is for the 3D basin).
 // Per step: a kick projects the pressure on the modes (one dense mat-vec, n^2);
 // fields are dense mat-vecs too; slope and horizontal velocity are centred
 // differences of eta and of the surface potential.
@@ -27,34 +28,21 @@
 #include <span>
 #include <vector>
 
-#include "fluid/sea.hpp"
+#include "fluid/dense_modal_sea.hpp"
 
 namespace floesim::fluid {
 
-class BemSea final : public Sea {
+// The modal side (kicks, set_surface, projection, frequencies, the set-up's
+// cost and cache) is DenseModalSea's (fluid/dense_modal_sea.hpp).
+class BemSea final : public DenseModalSea {
 public:
   // params must have passed validate() with model = bem.
   BemSea(const SeaParams& params, const SeaOptions& options = {});
-  ~BemSea() override;
 
-  void kick(std::span<const double> pressure, double h) override;
-  void repeat_kick(double h) override;
   void flow(double dt) override;
-  void set_surface(std::span<const double> eta, std::span<const double> eta_t) override;
-
-  std::span<const double> frequencies() const;  // omega of each mode, ascending, rad/s
-  int panels() const;                           // boundary panels in all
-  double setup_seconds() const;                 // wall time of the setup that built it
-  bool from_cache() const;                      // the setup was reused
 
 protected:
   void compute_field(Field f, std::span<double> out) override;
-  void project(std::span<const double> pressure, std::span<double> s) override;
-  void synthesize(std::span<const double> q, std::span<double> eta) override;
-
-private:
-  struct Impl;
-  std::unique_ptr<Impl> impl_;
 };
 
 // The basin's bottom (x, z) clipped to [0, size x], as the list of its

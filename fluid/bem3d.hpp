@@ -29,60 +29,59 @@
 //     exact integrals; with the far-field rule the diagonal is set so they do.
 //  3. m_sf -> M = rho A Phi, symmetrised (A = dx dy, the cell area);
 //     a_sf -> K = rho g A I + sigma L, L the five-point finite-volume Laplacian
-//     with d eta / d n = 0 at the walls. Both restricted to zero-mean surfaces
-//     (one Householder reflection maps the constants onto the first axis).
-//  4. Modes: the generalised eigenproblem K x = omega^2 M x, x M-orthonormal:
-//     the ModalBank gets one real mode per eigenvector (mass 1, gain 1).
+//     with d eta / d n = 0 at the walls (sparse). Both restricted to zero-mean
+//     surfaces (reduce_to_modes, fluid/dense_modal_sea.hpp).
+//  4. Modes, K x = omega^2 M x with x M-orthonormal, one real mode per
+//     eigenvector in the ModalBank (mass 1, gain 1):
+//     - [sea] bem_modes = 0 (the default): all nx ny - 1 of them, the dense
+//       generalised eigenproblem;
+//     - bem_modes = n > 0: the n lowest only, by implicitly restarted Lanczos
+//       (fluid/lowest_modes.hpp). The sea is then the dense one restricted to
+//       those modes: the same frequencies and shapes (to the Lanczos
+//       tolerance); a surface or a pressure is projected on them and the rest
+//       is dropped (its energy is not in the sea, and a floe's pressure
+//       excites only the kept modes: the local, quasi-static response of the
+//       short waves under a floe is missing). The cut is the user's: n modes
+//       reach the wavenumber k_n with n ~ Lx Ly k_n^2 / (4 pi) (the modes of
+//       a rectangle, cos(m pi x / Lx) cos(n pi y / Ly), in the quarter disc
+//       k < k_n); docs/sea.md says how to choose it.
 // Cost: the dense LU of the (N + 1)^2 collocation matrix (N panels in all,
 // about 3 times the surface cells for a basin as deep as a cell is long
-// times its cells across) and the dense eigenproblem of size nx ny; memory
-// 8 (N + 1) (N + 1 + nx ny) bytes at the peak (measured in docs/sea.md).
+// times its cells across) and its solve for the nx ny surface right-hand
+// sides, then the modes (all: a dense eigenproblem of size nx ny, (nx ny)^3;
+// n lowest: a few n mat-vecs of size (nx ny)^2). Memory: 8 (N + 1) (N + 1 +
+// 2 nx ny) bytes at the peak (measured in docs/sea.md). The n lowest also make
+// every step's mat-vecs nx ny x n instead of (nx ny)^2.
 // Tank runs: the relaxation zones of fluid/tank.hpp along x (the generation
 // zone against the wall x = 0), applied on the grid around each flow.
 // Per step: a kick projects the pressure on the modes (one dense mat-vec,
-// (nx ny)^2); fields are dense mat-vecs too; slopes and horizontal velocities
+// nx ny x modes); fields are dense mat-vecs too; slopes and horizontal velocities
 // are centred differences of eta and of the surface potential.
 
 #include <memory>
 #include <span>
 
-#include "fluid/sea.hpp"
+#include "fluid/dense_modal_sea.hpp"
 
 namespace floesim::fluid {
 
-class Bem3dSea final : public Sea {
+// The modal side (kicks, set_surface, projection, frequencies, the set-up's
+// cost and cache) is DenseModalSea's (fluid/dense_modal_sea.hpp).
+class Bem3dSea final : public DenseModalSea {
 public:
   // params must have passed validate() with model = bem, dims = 2.
   Bem3dSea(const SeaParams& params, const SeaOptions& options = {});
   ~Bem3dSea() override;
 
-  void kick(std::span<const double> pressure, double h) override;
-  void repeat_kick(double h) override;
   void flow(double dt) override;
   void midpoint_step(std::span<const double> p, double h) override;
-  void set_surface(std::span<const double> eta, std::span<const double> eta_t) override;
 
-  std::span<const double> frequencies() const;  // omega of each mode, ascending, rad/s
-  int panels() const;                           // boundary panels in all
-  // Wall time of the set-up that built it (from_cache() or not) and its parts.
-  struct SetupCost {
-    double seconds = 0.0;   // in all
-    double assemble = 0.0;  // the panel integrals
-    double solve = 0.0;     // LU of the collocation system, Phi
-    double modes = 0.0;     // the generalised eigenproblem and the modal maps
-    double bytes = 0.0;     // the dense matrices alive at the peak (the LU's)
-  };
-  const SetupCost& setup_cost() const;
-  double setup_seconds() const { return setup_cost().seconds; }
-  bool from_cache() const;                      // the setup was reused
   // The relaxation zones of a tank run (options.tank), or nullptr. They act
   // on eta and eta' on the grid around each flow, as on the spectral sea.
   const TankZones* tank() const;
 
 protected:
   void compute_field(Field f, std::span<double> out) override;
-  void project(std::span<const double> pressure, std::span<double> s) override;
-  void synthesize(std::span<const double> q, std::span<double> eta) override;
 
 private:
   void relax_tank(double t0, double h);

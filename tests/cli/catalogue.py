@@ -155,6 +155,28 @@ def toml_cases():
     case("toml", "bottom on a spectral sea",
          ["run", write("bottom_spectral.toml", '[sea]\nmodel = "spectral"\nbottom = [[0.0, -1.0], [300.0, -1.0]]\n')],
          ["bottom_spectral.toml:3", "[sea] bottom", "needs model = \"bem\""])
+    # A 3D basin's bottom grid in HDF5 (bottom_file): the file and the dataset at fault.
+    bem3d = '[sea]\nmodel = "bem"\ndims = 2\nsize = [1.0, 0.5]\ncells = [8, 4]\ndepth = 0.2\n'
+    with h5py.File(os.path.join(WORK, "bottom_noz.h5"), "w") as f:
+        f["x"] = np.linspace(0.0, 1.0, 3)
+        f["y"] = np.linspace(0.0, 0.5, 2)
+    case("toml", "HDF5 bottom without /z",
+         ["run", write("bottom_noz.toml", bem3d + 'bottom_file = "bottom_noz.h5"\n')],
+         ["bottom_noz.toml:7", "[sea] bottom_file", "bottom_noz.h5: dataset '/z' is missing"])
+    with h5py.File(os.path.join(WORK, "bottom_dry.h5"), "w") as f:
+        f["z"] = np.array([[-0.2, -0.1, -0.2], [-0.2, np.nan, -0.2]])
+        f["x"] = np.linspace(0.0, 1.0, 3)
+        f["y"] = np.linspace(0.0, 0.5, 2)
+    case("toml", "HDF5 bottom with a NaN depth",
+         ["run", write("bottom_dry.toml", bem3d + 'bottom_file = "bottom_dry.h5"\n')],
+         ["bottom_dry.h5: dataset /z", "finite and below the surface", "at [1, 1]"])
+    with h5py.File(os.path.join(WORK, "bottom_grid.h5"), "w") as f:
+        f["z"] = -0.2 * np.ones((2, 3))
+        f["x"] = np.linspace(0.0, 2.0, 3)
+        f["y"] = np.linspace(0.0, 0.5, 2)
+    case("toml", "HDF5 bottom grid not spanning the basin",
+         ["run", write("bottom_grid.toml", bem3d + 'bottom_file = "bottom_grid.h5"\n')],
+         ["bottom_grid.h5: dataset /x", "evenly spaced from 0 to 1 m"])
     case("toml", "tank zones in a bem basin", ["run", write("tank_bem.toml", bem + "[sea.tank]\nenabled = true\n")],
          ["tank_bem.toml:8", "[sea.tank] enabled", "need model = \"spectral\""])
     case("toml", "tank zones without a regular wave",

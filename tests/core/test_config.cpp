@@ -9,6 +9,7 @@
 #include <string>
 
 #include "core/config.hpp"
+#include "core/detail/h5.hpp"
 #include "core/error.hpp"
 
 using namespace floesim;
@@ -112,6 +113,15 @@ TEST_CASE("unknown keys, wrong types and out-of-range values name file, line and
   refused("[sea]\nmodel = \"bem\"\ndims = 2\ncells = [128, 64]\n", {"[sea] cells", "at most 4096 surface cells", "128 x 64"});
   refused("[sea]\nmodel = \"bem\"\n", {"[sea] cells", "dense set-up"});
   CHECK(parse("[sea]\nmodel = \"bem\"\ndims = 2\ncells = [64, 64]\ndepth = 1.0\n").sea.cells[1] == 64);
+  // With the lowest modes only (bem_modes = n) the bound is the LU's.
+  refused("[sea]\nmodel = \"bem\"\ndims = 2\ncells = [128, 64]\n", {"keep the lowest modes only with bem_modes"});
+  CHECK(parse("[sea]\nmodel = \"bem\"\ndims = 2\ncells = [96, 64]\ndepth = 1.0\nbem_modes = 300\n").sea.bem_modes == 300);
+  refused("[sea]\nmodel = \"bem\"\ndims = 2\ncells = [128, 64]\nbem_modes = 300\n",
+          {"[sea] cells", "at most 6144 surface cells", "with bem_modes > 0", "128 x 64"});
+  refused("[sea]\nmodel = \"bem\"\ndims = 2\ncells = [4, 4]\nbem_modes = 15\n",
+          {"[sea] bem_modes", "at most 14 modes", "got 15"});
+  refused("[sea]\nmodel = \"bem\"\ndims = 2\ncells = [4, 4]\nbem_modes = -1\n", {"[sea] bem_modes", ">= 0"});
+  refused("[sea]\nmodel = \"spectral\"\nbem_modes = 10\n", {"[sea] bem_modes", "dims = 2"});
   // A 3D basin's bottom grid (bottom_file): checked at load, with the line at fault.
   {
     const std::string dir = "/tmp/floesim_bottom_" + std::to_string(::getpid());
@@ -136,6 +146,28 @@ TEST_CASE("unknown keys, wrong types and out-of-range values name file, line and
     refused("[sea]\nmodel = \"bem\"\ndims = 2\ncells = [8, 4]\nbottom = [[0.0, -1.0], [200.0, -1.0]]\nbottom_file = \"" +
                 dir + "/ok2.csv\"\n",
             {"bottom or bottom_file, not both"});
+    // The same grid in HDF5: /z (ny, nx) with its grid /x, /y spanning the basin (200 m x 200 m by default).
+    auto h5file = [&](const std::string& name, std::vector<hsize_t> zd, const std::vector<double>& z,
+                      const std::vector<double>& x, const std::vector<double>& y, bool with_y = true) {
+      h5::Handle f = h5::create_file(dir + "/" + name);
+      h5::write_doubles(f, "z", zd, z.data());
+      h5::write_doubles(f, "x", {x.size()}, x.data());
+      if (with_y) h5::write_doubles(f, "y", {y.size()}, y.data());
+      return "[sea]\nmodel = \"bem\"\ndims = 2\ncells = [8, 4]\nbottom_file = \"" + dir + "/" + name + "\"\n";
+    };
+    const std::vector<double> z = {-1.0, -0.5, -0.2, -1.0, -0.6, -0.3}, x = {0.0, 100.0, 200.0}, y = {0.0, 200.0};
+    const Config h = parse(h5file("ok.h5", {2, 3}, z, x, y));
+    CHECK(h.sea.bottom_nx == 3);
+    CHECK(h.sea.bottom_ny == 2);
+    CHECK(h.sea.bottom_grid == c.sea.bottom_grid);
+    refused(h5file("flat.h5", {6}, z, x, y), {"[sea] bottom_file", "flat.h5: dataset /z", "2-D grid"});
+    refused(h5file("dry.h5", {2, 3}, {-1.0, -0.5, -0.2, -1.0, 0.6, -0.3}, x, y),
+            {"dry.h5: dataset /z", "below the surface", "got 0.6 at [1, 1]"});
+    refused(h5file("noy.h5", {2, 3}, z, x, y, false), {"noy.h5: dataset '/y' is missing"});
+    refused(h5file("shortx.h5", {2, 3}, z, {0.0, 200.0}, y), {"shortx.h5: dataset /x", "expected 3 coordinates"});
+    refused(h5file("skew.h5", {2, 3}, z, {0.0, 120.0, 200.0}, y),
+            {"skew.h5: dataset /x", "evenly spaced from 0 to 200 m", "got 120 at 1"});
+    refused(h5file("small.h5", {2, 3}, z, x, {0.0, 100.0}), {"small.h5: dataset /y", "from 0 to 200 m"});
     std::filesystem::remove_all(dir);
   }
   // A bem basin's bottom: below the surface, x increasing, spanning [0, Lx].

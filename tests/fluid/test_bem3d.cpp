@@ -201,6 +201,96 @@ TEST_CASE("3D BEM sloping bottom: modes (1,0), (0,1), (1,1) converge under refin
   }
 }
 
+TEST_CASE("3D BEM lowest modes (bem_modes = n): the Lanczos modes are the dense problem's lowest, to round-off") {
+  // Same discrete operators, two eigensolvers: the n lowest frequencies agree
+  // to the Lanczos tolerance, and so do the modal coordinates of a surface
+  // (up to each mode's sign) where a mode's frequency is not repeated. A
+  // sloping bottom and an aspect ratio of 0.57 leave no pair of equal modes.
+  SeaParams p = basin(16, 9, 1.0, 0.57);
+  p.bottom = {{0.0, -0.15}, {0.4, -0.15}, {1.0, -0.05}};
+  Bem3dSea all(p);
+  p.bem_modes = 30;
+  Bem3dSea low(p);
+  REQUIRE(low.frequencies().size() == 30);
+  REQUIRE(all.frequencies().size() == 16 * 9 - 1);
+  double worst = 0.0;
+  for (std::size_t j = 0; j < 30; ++j)
+    worst = std::max(worst, std::abs(low.frequencies()[j] / all.frequencies()[j] - 1.0));
+  MESSAGE("30 lowest frequencies: largest relative difference " << worst << "; set-up " << low.setup_seconds()
+                                                                 << " s against " << all.setup_seconds() << " s");
+  CHECK(worst < 1e-10);
+  // A surface with every mode in it.
+  std::vector<double> eta(all.grid().size()), rate(eta.size());
+  for (std::size_t i = 0; i < eta.size(); ++i) {
+    eta[i] = 1e-3 * std::sin(0.37 * static_cast<double>(i * i % 101));
+    rate[i] = 1e-3 * std::cos(0.21 * static_cast<double>(i));
+  }
+  all.set_surface(eta, rate);
+  low.set_surface(eta, rate);
+  double scale = 0.0, diff = 0.0;
+  for (std::size_t j = 0; j < 30; ++j) {
+    const auto& w = all.frequencies();
+    const double gap = std::min(j > 0 ? w[j] - w[j - 1] : 1e300, w[j + 1] - w[j]);
+    if (gap < 1e-3 * w[j]) continue;
+    scale = std::max(scale, std::abs(all.modes().q()[j]));
+    diff = std::max({diff, std::abs(std::abs(low.modes().q()[j]) - std::abs(all.modes().q()[j])),
+                     std::abs(std::abs(low.modes().v()[j]) - std::abs(all.modes().v()[j]))});
+  }
+  MESSAGE("modal coordinates: largest difference " << diff << " against " << scale);
+  CHECK(diff < 1e-8 * scale);
+}
+
+TEST_CASE("3D BEM lowest modes with surface tension alone (g = 0): the Lanczos modes are still the dense lowest") {
+  // a_sf = sigma L is singular on the constants: the Lanczos iteration pins a
+  // node for its solves (fluid/lowest_modes.cpp). Same check as with gravity.
+  SeaParams p = basin(10, 7, 0.1, 0.057, 0.02);
+  p.g = 0.0;
+  Bem3dSea all(p);
+  p.bem_modes = 12;
+  Bem3dSea low(p);
+  double worst = 0.0;
+  for (std::size_t j = 0; j < 12; ++j)
+    worst = std::max(worst, std::abs(low.frequencies()[j] / all.frequencies()[j] - 1.0));
+  MESSAGE("12 lowest capillary frequencies: largest relative difference " << worst << ", lowest "
+                                                                          << all.frequencies()[0] << " rad/s");
+  CHECK(all.frequencies()[0] > 0.0);
+  CHECK(worst < 1e-10);
+}
+
+TEST_CASE("3D BEM lowest modes: the kept modes of a free sea keep their energy, the cut drops the rest at set_surface") {
+  // The truncated sea is the dense one restricted to its n lowest modes: the
+  // energy of a surface set on it is the dense sea's energy of those modes,
+  // conserved under a uniform pressure as for the dense sea.
+  SeaParams p = basin(12, 8, 1.0, 0.6);
+  p.bem_modes = 20;
+  Bem3dSea sea(p);
+  std::vector<double> eta(sea.grid().size()), zero(eta.size(), 0.0);
+  for (int j = 0; j < 8; ++j)
+    for (int i = 0; i < 12; ++i)
+      eta[static_cast<std::size_t>(j * 12 + i)] =
+          1e-3 * std::cos(pi * sea.grid().x(i)) * std::cos(pi * sea.grid().y(j) / 0.6) + 2e-4 * std::cos(9.0 * pi * sea.grid().x(i));
+  sea.set_surface(eta, zero);
+  const double e0 = sea.energy().total();
+  CHECK(e0 > 0.0);
+  p.bem_modes = 0;
+  Bem3dSea dense(p);
+  dense.set_surface(eta, zero);
+  // Mode (9, 0) is above the 20 lowest: the truncated sea holds the dense
+  // sea's energy of its 20 lowest modes (1/2 omega^2 q^2 each, unit modal mass), less than all.
+  double kept = 0.0;
+  for (std::size_t j = 0; j < 20; ++j)
+    kept += 0.5 * std::pow(dense.frequencies()[j] * dense.modes().q()[j], 2);
+  MESSAGE("energy: 20 lowest modes " << e0 << " J (dense, those modes: " << kept << " J), all modes "
+                                     << dense.energy().total() << " J");
+  CHECK(e0 == doctest::Approx(kept).epsilon(1e-9));
+  CHECK(e0 < 0.99 * dense.energy().total());
+  for (int s = 0; s < 200; ++s)
+    sea.step(0.01, [](Sea&, double, std::span<double> pr) {
+      for (double& v : pr) v = 1000.0;
+    });
+  CHECK(sea.energy().total() == doctest::Approx(e0).epsilon(1e-12));
+}
+
 TEST_CASE("3D BEM free sea: a standing mode keeps its energy under uniform pressure") {
   SeaParams p = basin(12, 8, 1.0, 0.6);
   Bem3dSea sea(p);
