@@ -80,7 +80,8 @@ def load():
 
 
 def one(ranks):
-    cmd = [floesim, "run", config, "-o", os.path.join(work, f"r{ranks}.h5"), "-q", "--threads", "1", "--profile"]
+    cmd = ["/usr/bin/time", "-f", "cpu_s: %U %S", floesim, "run", config, "-o", os.path.join(work, f"r{ranks}.h5"),
+           "-q", "--threads", "1", "--profile"]
     if ranks > 0:
         cmd = ["mpirun", "--oversubscribe", "-np", str(ranks)] + cmd
     p = subprocess.run(cmd, capture_output=True, text=True, env=env, cwd=work)
@@ -91,6 +92,9 @@ def one(ranks):
         if ": " in line:
             k, v = line.split(": ", 1)
             out[k.strip()] = v.split()[0]
+    # CPU seconds (user + system) of each process: the mean over the ranks.
+    cpu = [sum(map(float, l.split()[1:3])) for l in p.stderr.splitlines() if l.startswith("cpu_s: ")]
+    out["cpu_s"] = f"{sum(cpu) / len(cpu):.3f}" if cpu else ""
     return out
 
 
@@ -100,8 +104,9 @@ load_before = load()
 for r in range(args.rounds):
     for ranks in args.ranks:
         s = one(ranks)
-        rows.append([str(ranks), str(r), s["wall_time"], s["steps"], s["collisions.lcps"]] +
-                    [s.get("profile." + ph, "") for ph in phases])
+        rows.append([str(ranks), str(r), s["wall_time"], s["steps"], s["collisions.lcps"],
+                     s.get("parallel.bytes_received", "0"), s.get("parallel.collective_seconds", "0"),
+                     s.get("cpu_s", "")] + [s.get("profile." + ph, "") for ph in phases])
 load_after = load()
 
 commit = subprocess.run(["git", "-C", ROOT, "rev-parse", "--short", "HEAD"], capture_output=True, text=True).stdout.strip()
@@ -110,7 +115,10 @@ lines = [f"# command: bench/mpi_pack.py {' '.join(sys.argv[1:])}",
          f"# machine: {platform.processor() or platform.machine()}, {os.cpu_count()} cores (shared); "
          f"load before {load_before}, after {load_after}; {time.strftime('%Y-%m-%d %H:%M', time.gmtime())} UTC",
          f"# scenario: {args.floes} floes, 50 % cover, periodic, to {args.t_end} s; ranks 0 = serial binary without mpirun; "
-         "one thread per rank; wall_s = the run loop (summary wall_time); phases: rank 0's profile (s)"]
+         "one thread per rank; wall_s = the run loop (summary wall_time); bytes_received and collective_s: "
+         "rank 0's collectives over the run (the transfers and the waits for the other ranks); cpu_s: CPU time "
+         "(user + system) of a rank's process, mean over the ranks, set-up included; phases: rank 0's profile (s), "
+         "waits in collectives included"]
 best = {}
 for row in rows:
     best[row[0]] = min(best.get(row[0], float("inf")), float(row[2]))
@@ -118,7 +126,7 @@ ref = best.get("1") or best.get("0")
 for k in sorted(best):
     lines.append(f"# least wall_s on {k} rank(s): {best[k]:.3f} s" +
                  (f" (speed-up over 1 rank: {ref / best[k]:.2f}x)" if ref and k not in ("0", "1") else ""))
-lines.append("ranks,round,wall_s,steps,lcps," + ",".join(p + "_s" for p in phases))
+lines.append("ranks,round,wall_s,steps,lcps,bytes_received,collective_s,cpu_s," + ",".join(p + "_s" for p in phases))
 lines += [",".join(r) for r in rows]
 text = "\n".join(lines) + "\n"
 if args.csv == "-":

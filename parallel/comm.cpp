@@ -1,5 +1,6 @@
 #include "parallel/comm.hpp"
 
+#include <chrono>
 #include <climits>
 #include <cstdio>
 #include <cstdlib>
@@ -22,7 +23,26 @@ struct Communicator::Impl {
   MPI_Comm comm = MPI_COMM_NULL;
 #endif
   bool agreed = false;  // a failure was agreed on (together()); the run is ending
+  Communicator::Traffic traffic;
 };
+
+namespace {
+// Counts one collective call into `traffic` when it goes out of scope.
+class Counted {
+public:
+  Counted(Communicator::Traffic& t, long long bytes) : t_(t), start_(std::chrono::steady_clock::now()) {
+    t_.calls += 1;
+    t_.bytes += bytes;
+  }
+  ~Counted() { t_.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count(); }
+  Counted(const Counted&) = delete;
+  Counted& operator=(const Counted&) = delete;
+
+private:
+  Communicator::Traffic& t_;
+  std::chrono::steady_clock::time_point start_;
+};
+}  // namespace
 
 namespace {
 
@@ -98,6 +118,7 @@ std::vector<std::byte> Communicator::allgather_bytes(std::span<const std::byte> 
     return {mine.begin(), mine.end()};
   }
 #ifdef FLOESIM_HAVE_MPI
+  Counted counted(impl_->traffic, 0);
   long long count = static_cast<long long>(mine.size());
   std::vector<long long> all_counts(static_cast<std::size_t>(size_));
   check(MPI_Allgather(&count, 1, MPI_LONG_LONG, all_counts.data(), 1, MPI_LONG_LONG, impl_->comm), "MPI_Allgather");
@@ -113,6 +134,7 @@ std::vector<std::byte> Communicator::allgather_bytes(std::span<const std::byte> 
     counts[r] = static_cast<std::size_t>(all_counts[r]);
     total += all_counts[r];
   }
+  impl_->traffic.bytes += total;
   std::vector<std::byte> out(static_cast<std::size_t>(total));
   check(MPI_Allgatherv(mine.data(), static_cast<int>(mine.size()), MPI_BYTE, out.data(), sizes.data(),
                        offsets.data(), MPI_BYTE, impl_->comm),
@@ -126,6 +148,7 @@ std::vector<std::byte> Communicator::allgather_bytes(std::span<const std::byte> 
 long long Communicator::sum(long long value) const {
   if (serial() || !impl_) return value;
 #ifdef FLOESIM_HAVE_MPI
+  Counted counted(impl_->traffic, static_cast<long long>(sizeof(long long)) * size_);
   long long total = 0;
   check(MPI_Allreduce(&value, &total, 1, MPI_LONG_LONG, MPI_SUM, impl_->comm), "MPI_Allreduce");
   return total;
@@ -138,7 +161,9 @@ std::vector<std::byte> Communicator::broadcast(std::span<const std::byte> bytes,
   if (serial() || !impl_) return {bytes.begin(), bytes.end()};
 #ifdef FLOESIM_HAVE_MPI
   long long count = static_cast<long long>(bytes.size());
+  Counted counted(impl_->traffic, 0);
   check(MPI_Bcast(&count, 1, MPI_LONG_LONG, root, impl_->comm), "MPI_Bcast");
+  impl_->traffic.bytes += count;
   if (count > INT_MAX) throw RunError("MPI: a broadcast of more than 2 GiB is not supported");
   std::vector<std::byte> out(static_cast<std::size_t>(count));
   if (rank_ == root) std::copy(bytes.begin(), bytes.end(), out.begin());
@@ -157,7 +182,10 @@ void Communicator::agree(std::exception_ptr failure) const {
 #ifdef FLOESIM_HAVE_MPI
   // The lowest failing rank speaks: min over (rank if failed, else size).
   int mine = failure ? rank_ : size_, first = size_;
-  check(MPI_Allreduce(&mine, &first, 1, MPI_INT, MPI_MIN, impl_->comm), "MPI_Allreduce");
+  {
+    Counted counted(impl_->traffic, static_cast<long long>(sizeof(int)) * size_);
+    check(MPI_Allreduce(&mine, &first, 1, MPI_INT, MPI_MIN, impl_->comm), "MPI_Allreduce");
+  }
   if (first == size_) return;
   std::vector<std::byte> said;
   if (rank_ == first) {
@@ -180,9 +208,17 @@ void Communicator::agree(std::exception_ptr failure) const {
 
 bool Communicator::failure_agreed() const { return impl_ && impl_->agreed; }
 
+Communicator::Traffic Communicator::traffic() const { return impl_ ? impl_->traffic : Traffic{}; }
+
 Session::Session() {
 #ifdef FLOESIM_HAVE_MPI
   if (!launched_by_mpi()) return;
+  // A rank waiting in a collective yields its core instead of spinning
+  // (Open MPI's default spins): on cores shared with other work, or with
+  // more ranks than cores, a spinning rank takes the slices the rank it waits
+  // for needs (the passive OpenMP waits of apps/main.cpp, for MPI). Unless
+  // the user chose (OMPI_MCA_mpi_yield_when_idle=0 for dedicated cores).
+  setenv("OMPI_MCA_mpi_yield_when_idle", "1", 0);
   // Only the main thread calls MPI (OpenMP loops do not).
   int provided = 0;
   check(MPI_Init_thread(nullptr, nullptr, MPI_THREAD_FUNNELED, &provided), "MPI_Init_thread");

@@ -93,6 +93,15 @@ public:
   // The same bytes on every rank as on `root`.
   std::vector<std::byte> broadcast(std::span<const std::byte> bytes, int root) const;
 
+  // What this rank has said and heard since the start (zero when serial):
+  // collective calls, bytes received, and the wall time inside them (the
+  // transfer and the wait for the slowest rank).
+  struct Traffic {
+    long long calls = 0, bytes = 0;
+    double seconds = 0.0;
+  };
+  Traffic traffic() const;
+
   // Runs f() on every rank and agrees on failure as said above. Returns
   // normally on every rank only when f() returned on every rank.
   template <class F>
