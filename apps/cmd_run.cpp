@@ -303,8 +303,7 @@ int run(const Args& a, const parallel::Session& session) {
   if (!comm.serial()) {
     // Rank 0's collectives: bytes it received and the time in them, waits for the other ranks included.
     const parallel::Communicator::Traffic t = comm.traffic();
-    o << "parallel.ranks: " << comm.size() << "\nparallel.threads_per_rank: " << sim.scenario().config.run.threads
-      << "\nparallel.collectives: " << t.calls << "\nparallel.bytes_received: " << t.bytes
+    o << "parallel.ranks: " << comm.size() << "\nparallel.collectives: " << t.calls << "\nparallel.bytes_received: " << t.bytes
       << "\nparallel.collective_seconds: " << t.seconds << "\n";
   }
   o << "warnings: " << s.warnings.size() << "\n";

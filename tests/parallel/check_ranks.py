@@ -2,6 +2,7 @@
 """Distributed runs against the serial run (docs/parallel.md).
 
 usage: check_ranks.py FLOESIM MPIEXEC WORKDIR [--floes N] [--t-end T] [--ranks 1 2 3] [--rtol R]
+                      [--also CONFIG...] [--no-errors]
        check_ranks.py --no-mpi    (MPI not built: says so and exits 77, ctest's skip code)
 
 A collisions-only periodic pack (`floesim pack`: N floes at 50 % cover,
@@ -10,7 +11,9 @@ bench/collisions.cpp's packs, with wind, current and Coriolis; they collide,
 also across the seams) run serially, then by `mpirun -np R`
 for each R: every run file must equal the serial one (`floesim compare`,
 rtol 0 and atol 0 by default: bit for bit, which stage one's replicated state
-and ordered gathers promise). Then the errors: bad input and a run file that
+and ordered gathers promise); so must a run stopped half-way on 2 ranks and
+continued with --restart on 2 ranks. Each --also CONFIG (a run with a sea, say) is
+checked so on 2 ranks. Then the errors: bad input and a run file that
 rank 0 cannot create must end every rank with exit 2 and 1, and the message
 said once.
 """
@@ -35,6 +38,7 @@ ap.add_argument("--t-end", type=float, default=1000.0)
 ap.add_argument("--ranks", type=int, nargs="+", default=[1, 2, 3])
 ap.add_argument("--rtol", type=float, default=0.0)
 ap.add_argument("--errors", action=argparse.BooleanOptionalAction, default=True)
+ap.add_argument("--also", nargs="*", default=[], help="other configurations to check on 2 ranks (e.g. with a sea)")
 args = ap.parse_args()
 
 os.makedirs(args.workdir, exist_ok=True)
@@ -118,6 +122,27 @@ for n in args.ranks:
         failures.append(f"{n} ranks differ from the serial run:\n{c.stdout}")
     if p.stdout.count("status: complete") != 1:
         failures.append(f"{n} ranks: the summary should be printed once (by rank 0):\n{p.stdout}")
+
+# A restart on 2 ranks: the first half, then --restart from its checkpoint
+# (written by rank 0, read by every rank), equals the serial run.
+half = args.t_end / 2
+p1 = mpirun(2, "run", config, "-o", "half.h5", "-q", "--until", str(half))
+p2 = mpirun(2, "run", "--restart", "half.h5", "-o", "restarted.h5", "-q") if p1.returncode == 0 else p1
+c = run([args.floesim, "compare", "restarted.h5", "serial.h5", "--rtol", str(args.rtol), "--atol", "0"])
+print(f"restart at {half} s on 2 ranks: {'equal' if p2.returncode == 0 and c.returncode == 0 else 'DIFFERENT'} "
+      "to the serial run")
+if p2.returncode != 0 or c.returncode != 0:
+    failures.append(f"restart on 2 ranks: exit {p2.returncode}\n{p2.stderr}\n{c.stdout}")
+
+# Other scenarios (a sea: replicated in stage one, so the same bits too).
+for other in args.also:
+    name = os.path.splitext(os.path.basename(other))[0]
+    need(run([args.floesim, "run", other, "-o", f"{name}_serial.h5", "-q"]), f"{other}: serial run")
+    p = mpirun(2, "run", other, "-o", f"{name}_2.h5", "-q")
+    c = run([args.floesim, "compare", f"{name}_2.h5", f"{name}_serial.h5", "--rtol", str(args.rtol), "--atol", "0"])
+    print(f"{name}: 2 ranks {'equal' if p.returncode == 0 and c.returncode == 0 else 'DIFFERENT'} to the serial run")
+    if p.returncode != 0 or c.returncode != 0:
+        failures.append(f"{other} on 2 ranks: exit {p.returncode}\n{p.stderr}\n{c.stdout}")
 
 if args.errors:
     # Bad input: every rank reads it, every rank stops, exit 2, said once.
