@@ -2,6 +2,8 @@
 // a scenario, writes the run file (and its .xmf for ParaView), shows progress
 // on a terminal and prints a summary at the end. With --restart, continues
 // RUN.h5 from its checkpoint (docs/formats.md, "Checkpoint and restart").
+// Under mpirun every rank runs it; rank 0 writes the file and prints
+// (docs/parallel.md).
 #include <unistd.h>
 
 #include <atomic>
@@ -126,7 +128,7 @@ void share_cores(Config& config, const parallel::Session& session) {
   config.run.threads = std::max(1, cores / std::max(1, session.local_ranks()));
 }
 
-int run(const Args& a, const parallel::Session& session);
+int run(const Args& args, const parallel::Session& session);
 
 }  // namespace
 
@@ -137,7 +139,7 @@ void add_run_command(CLI::App& app, Registry& registry) {
   sub->add_option("-o,--output", args->output, "Run file to write (default: CONFIG's name with .h5, here)");
   sub->add_option("--until", args->until, "Stop at this time (s) instead of [run] t_end")
       ->check(finite_non_negative());
-  sub->add_option("--threads", args->threads, "Threads for the per-floe phases (default: [run] threads; 0: OMP_NUM_THREADS if set, else one per core)")
+  sub->add_option("--threads", args->threads, "Threads for the per-floe phases (default: [run] threads; 0: OMP_NUM_THREADS if set, else one per core; under mpirun, the node's cores over its ranks)")
       ->check(CLI::Range(0, 1024));
   sub->add_option("--restart", args->restart,
                   "Continue this run file from its checkpoint, bit for bit (CONFIG: by default the run's own; "
@@ -161,15 +163,14 @@ void add_run_command(CLI::App& app, Registry& registry) {
 
 namespace {
 
-int run(const Args& a, const parallel::Session& session) {
+int run(const Args& args, const parallel::Session& session) {
   const parallel::Communicator& comm = session.world();
   // Rank 0 speaks for the run: the other ranks' output would repeat it.
   if (!comm.writer()) {
     std::cout.rdbuf(nullptr);
     std::cerr.rdbuf(nullptr);
   }
-  const Args* args = &a;
-  const bool restart = !args->restart.empty();
+  const bool restart = !args.restart.empty();
   std::string config_path, output;
   Config config;
   Checkpoint checkpoint;
@@ -178,10 +179,10 @@ int run(const Args& a, const parallel::Session& session) {
   // any work is shared: bad input on any rank stops every rank with its
   // message (the same on each, as they read the same files).
   comm.together([&] {
-    config_path = args->config.empty() && !restart ? default_config() : args->config;
+    config_path = args.config.empty() && !restart ? default_config() : args.config;
     if (!config_path.empty() && !path_exists(config_path)) throw InputError(config_path + ": configuration file not found");
-    output = args->output;
-    if (output.empty()) output = restart ? args->restart : fs::path(config_path).stem().string() + ".h5";
+    output = args.output;
+    if (output.empty()) output = restart ? args.restart : fs::path(config_path).stem().string() + ".h5";
     if (!config_path.empty() && path_exists(output) && fs::equivalent(output, config_path))
       throw InputError(output + ": the output would overwrite the configuration");
 
@@ -195,30 +196,30 @@ int run(const Args& a, const parallel::Session& session) {
       }
     }
     if (restart) {
-      if (!path_exists(args->restart)) throw InputError(args->restart + ": run file not found (--restart)");
-      const RunInfo info = read_run_info(args->restart);
-      checkpoint = read_checkpoint(args->restart);
-      config = restart_config(args->restart, config_path, info);
-      const double t_end = args->until >= 0.0 ? args->until : config.run.t_end;
+      if (!path_exists(args.restart)) throw InputError(args.restart + ": run file not found (--restart)");
+      const RunInfo info = read_run_info(args.restart);
+      checkpoint = read_checkpoint(args.restart);
+      config = restart_config(args.restart, config_path, info);
+      const double t_end = args.until >= 0.0 ? args.until : config.run.t_end;
       if (t_end < checkpoint.time) {
         std::ostringstream m;
-        m << args->restart << ": the checkpoint is at t = " << checkpoint.time << " s, after the end asked for ("
-          << (args->until >= 0.0 ? "--until " : "[run] t_end = ") << t_end << " s): expected an end >= "
+        m << args.restart << ": the checkpoint is at t = " << checkpoint.time << " s, after the end asked for ("
+          << (args.until >= 0.0 ? "--until " : "[run] t_end = ") << t_end << " s): expected an end >= "
           << checkpoint.time << " s";
         throw InputError(m.str());
       }
     } else {
       config = load_config(config_path);
     }
-    if (args->threads >= 0) config.run.threads = args->threads;
+    if (args.threads >= 0) config.run.threads = args.threads;
     // --until replaces t_end: the bounds on the records and steps of [run] t_end hold for it too.
-    if (args->until >= 0.0)
-      for (auto [problem, key] : {std::pair{record_count_problem(args->until, config.run.output_interval), "output_interval"},
-                                  std::pair{step_count_problem(args->until, config.run.dt_max), "dt_max"}})
+    if (args.until >= 0.0)
+      for (auto [problem, key] : {std::pair{record_count_problem(args.until, config.run.output_interval), "output_interval"},
+                                  std::pair{step_count_problem(args.until, config.run.dt_max), "dt_max"}})
         if (!problem.empty()) {
           std::ostringstream m;
-          m << "--until " << args->until << ": " << problem << " ("
-            << (config_path.empty() ? args->restart : config_path) << ": [run] " << key << ")";
+          m << "--until " << args.until << ": " << problem << " ("
+            << (config_path.empty() ? args.restart : config_path) << ": [run] " << key << ")";
           throw InputError(m.str());
         }
     share_cores(config, session);
@@ -226,17 +227,17 @@ int run(const Args& a, const parallel::Session& session) {
     if (restart) {
       simulation->restore(checkpoint);
       // A new output starts as a copy of the run; the records after the checkpoint are dropped from it.
-      if (comm.writer() && !(path_exists(output) && fs::equivalent(output, args->restart))) {
+      if (comm.writer() && !(path_exists(output) && fs::equivalent(output, args.restart))) {
         std::error_code ec;
-        fs::copy_file(args->restart, output, fs::copy_options::overwrite_existing, ec);
-        if (ec) throw InputError(output + ": cannot copy the run file " + args->restart + " to it: " + ec.message());
+        fs::copy_file(args.restart, output, fs::copy_options::overwrite_existing, ec);
+        if (ec) throw InputError(output + ": cannot copy the run file " + args.restart + " to it: " + ec.message());
       }
     }
   });
   Simulation& sim = *simulation;
   for (const std::string& note : sim.notes()) std::cerr << "floesim: note: " << note << "\n";
 
-  ProgressLine progress(!args->quiet && comm.writer() && isatty(STDERR_FILENO));
+  ProgressLine progress(!args.quiet && comm.writer() && isatty(STDERR_FILENO));
   g_interrupted = false;
   auto previous = std::signal(SIGINT, on_signal);
   auto previous_term = std::signal(SIGTERM, on_signal);
@@ -244,7 +245,7 @@ int run(const Args& a, const parallel::Session& session) {
     std::signal(SIGINT, previous);
     std::signal(SIGTERM, previous_term);
   };
-  RunOptions options{output, args->until, [&](const RunProgress& p) { progress(p); },
+  RunOptions options{output, args.until, [&](const RunProgress& p) { progress(p); },
                      [] { return g_interrupted.load(); }, restart ? &checkpoint : nullptr};
   RunSummary s;
   try {
@@ -264,8 +265,8 @@ int run(const Args& a, const parallel::Session& session) {
   if (!comm.writer()) return status;  // rank 0 reports the run
 
   std::ostream& o = std::cout;
-  o << "status: " << s.status << "\nconfig: " << (config_path.empty() ? args->restart + " (its config)" : config_path);
-  if (restart) o << "\nrestarted_from: " << args->restart << " at t = " << checkpoint.time << " s";
+  o << "status: " << s.status << "\nconfig: " << (config_path.empty() ? args.restart + " (its config)" : config_path);
+  if (restart) o << "\nrestarted_from: " << args.restart << " at t = " << checkpoint.time << " s";
   o << "\ncheckpoint: " << (s.checkpoint_time >= 0.0 ? std::to_string(s.checkpoint_time) + " s" : "none") << "\noutput: " << fs::absolute(s.output).string()
     << "\nparaview: " << fs::absolute(s.xdmf).string() << "\nfloes: " << sim.floes().size() << "\nsteps: " << s.steps
     << "\nrecords: " << s.records << "\nsimulated: " << s.t_end << " s\nwall_time: " << std::setprecision(4)
@@ -308,7 +309,7 @@ int run(const Args& a, const parallel::Session& session) {
   }
   o << "warnings: " << s.warnings.size() << "\n";
   for (const auto& w : s.warnings) o << "  " << w << "\n";
-  if (args->profile) {
+  if (args.profile) {
     double total = 0;
     for (double x : s.profile.seconds) total += x;
     for (std::size_t k = 0; k < s.profile.seconds.size(); ++k)
