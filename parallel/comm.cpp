@@ -118,24 +118,35 @@ std::vector<std::byte> Communicator::allgather_bytes(std::span<const std::byte> 
     return {mine.begin(), mine.end()};
   }
 #ifdef FLOESIM_HAVE_MPI
-  Counted counted(impl_->traffic, 0);
-  long long count = static_cast<long long>(mine.size());
   std::vector<long long> all_counts(static_cast<std::size_t>(size_));
-  check(MPI_Allgather(&count, 1, MPI_LONG_LONG, all_counts.data(), 1, MPI_LONG_LONG, impl_->comm), "MPI_Allgather");
-  std::vector<int> sizes(all_counts.size()), offsets(all_counts.size());
-  long long total = 0;
-  counts.resize(all_counts.size());
-  for (std::size_t r = 0; r < all_counts.size(); ++r) {
-    if (total + all_counts[r] > INT_MAX)
-      throw RunError("MPI: a gather of more than 2 GiB (" + std::to_string(total + all_counts[r]) +
-                     " bytes) is not supported");
-    sizes[r] = static_cast<int>(all_counts[r]);
-    offsets[r] = static_cast<int>(total);
-    counts[r] = static_cast<std::size_t>(all_counts[r]);
-    total += all_counts[r];
+  {
+    Counted counted(impl_->traffic, static_cast<long long>(sizeof(long long)) * size_);
+    long long count = static_cast<long long>(mine.size());
+    check(MPI_Allgather(&count, 1, MPI_LONG_LONG, all_counts.data(), 1, MPI_LONG_LONG, impl_->comm), "MPI_Allgather");
   }
-  impl_->traffic.bytes += total;
-  std::vector<std::byte> out(static_cast<std::size_t>(total));
+  counts.assign(all_counts.begin(), all_counts.end());
+  return allgather_known(mine, counts);
+#else
+  return {};
+#endif
+}
+
+std::vector<std::byte> Communicator::allgather_known(std::span<const std::byte> mine,
+                                                     const std::vector<std::size_t>& counts) const {
+  if (serial() || !impl_) return {mine.begin(), mine.end()};
+#ifdef FLOESIM_HAVE_MPI
+  std::vector<int> sizes(counts.size()), offsets(counts.size());
+  std::size_t total = 0;
+  for (std::size_t r = 0; r < counts.size(); ++r) {
+    if (total + counts[r] > static_cast<std::size_t>(INT_MAX))
+      throw RunError("MPI: a gather of more than 2 GiB (" + std::to_string(total + counts[r]) +
+                     " bytes) is not supported");
+    sizes[r] = static_cast<int>(counts[r]);
+    offsets[r] = static_cast<int>(total);
+    total += counts[r];
+  }
+  Counted counted(impl_->traffic, static_cast<long long>(total));
+  std::vector<std::byte> out(total);
   check(MPI_Allgatherv(mine.data(), static_cast<int>(mine.size()), MPI_BYTE, out.data(), sizes.data(),
                        offsets.data(), MPI_BYTE, impl_->comm),
         "MPI_Allgatherv");

@@ -77,14 +77,24 @@ public:
   // Each rank holds `values` with its share `mine` of them up to date; on
   // exit every rank's copy equals the owners' values everywhere. Rank r's
   // share is share(values.size(), r, size()).
+  // One collective call: every share's size is known to all.
   template <class T>
   void complete_shares(std::vector<T>& values) const {
     static_assert(kSentAsBytes<T>);
     if (serial()) return;
-    const Range r = share(values.size());
-    std::vector<T> all = allgather(std::span<const T>(values.data() + r.begin, r.size()));
-    values = std::move(all);
+    std::vector<std::size_t> counts(static_cast<std::size_t>(size_));
+    for (int r = 0; r < size_; ++r) counts[static_cast<std::size_t>(r)] = parallel::share(values.size(), r, size_).size() * sizeof(T);
+    const Range mine = share(values.size());
+    const std::vector<std::byte> all = allgather_known(
+        {reinterpret_cast<const std::byte*>(values.data() + mine.begin), mine.size() * sizeof(T)}, counts);
+    std::memcpy(static_cast<void*>(values.data()), all.data(), all.size());
   }
+
+  // Bytes: every rank's `mine` concatenated in rank order; `counts` gets
+  // each rank's byte count. Two collective calls (the counts, then the bytes).
+  std::vector<std::byte> allgather_bytes(std::span<const std::byte> mine, std::vector<std::size_t>& counts) const;
+  // The same when every rank's count is known to all (`counts`): one call.
+  std::vector<std::byte> allgather_known(std::span<const std::byte> mine, const std::vector<std::size_t>& counts) const;
 
   // The sum of one integer over the ranks (in rank order; exact).
   long long sum(long long value) const;
@@ -122,7 +132,6 @@ public:
   struct Impl;  // MPI's communicator, in comm.cpp
 
 private:
-  std::vector<std::byte> allgather_bytes(std::span<const std::byte> mine, std::vector<std::size_t>& counts) const;
   std::shared_ptr<Impl> impl_;  // null: serial
   int rank_ = 0, size_ = 1;
   friend class Session;

@@ -1,6 +1,7 @@
 #include "parallel/detect.hpp"
 
 #include <cstdint>
+#include <cstring>
 #include <type_traits>
 
 namespace floesim::parallel {
@@ -27,33 +28,48 @@ contact::Detection concatenate(std::vector<contact::Detection> parts) {
   return out;
 }
 
+namespace {
+// A rank's part as one message: three counts, then the pairs, contact points
+// and witnesses, each as bytes (copied in and out with memcpy, so the
+// buffer's alignment does not matter).
+template <class T>
+void put(std::vector<std::byte>& out, const std::vector<T>& values) {
+  const auto* bytes = reinterpret_cast<const std::byte*>(values.data());
+  out.insert(out.end(), bytes, bytes + values.size() * sizeof(T));
+}
+
+template <class T>
+std::vector<T> take(const std::byte*& at, std::uint64_t count) {
+  std::vector<T> values(count);
+  std::memcpy(static_cast<void*>(values.data()), at, count * sizeof(T));
+  at += count * sizeof(T);
+  return values;
+}
+}  // namespace
+
 contact::Detection detect(const Communicator& comm, const Floes& floes, const contact::CollisionShapes& shapes,
                           contact::DetectionOptions options) {
   if (comm.serial()) return contact::detect(floes, shapes, options);
   options.part = static_cast<std::size_t>(comm.rank());
   options.parts = static_cast<std::size_t>(comm.size());
   contact::Detection mine = contact::detect(floes, shapes, options);
-  // Three gathers (pairs, contacts, witnesses) and the counts that split them back into parts.
-  const long long sizes[3] = {static_cast<long long>(mine.pairs.size()), static_cast<long long>(mine.contacts.size()),
-                              static_cast<long long>(mine.witnesses.size())};
-  const std::vector<long long> counts = comm.allgather(std::span<const long long>(sizes, 3));
-  const std::vector<contact::NearPair> pairs = comm.allgather(std::span<const contact::NearPair>(mine.pairs));
-  const std::vector<contact::ContactPoint> contacts =
-      comm.allgather(std::span<const contact::ContactPoint>(mine.contacts));
-  const std::vector<contact::Witness> witnesses = comm.allgather(std::span<const contact::Witness>(mine.witnesses));
-  std::vector<contact::Detection> parts(static_cast<std::size_t>(comm.size()));
-  std::size_t p = 0, c = 0, w = 0;
-  for (std::size_t r = 0; r < parts.size(); ++r) {
-    const auto np = static_cast<std::size_t>(counts[3 * r]), nc = static_cast<std::size_t>(counts[3 * r + 1]),
-               nw = static_cast<std::size_t>(counts[3 * r + 2]);
-    parts[r].pairs.assign(pairs.begin() + static_cast<std::ptrdiff_t>(p), pairs.begin() + static_cast<std::ptrdiff_t>(p + np));
-    parts[r].contacts.assign(contacts.begin() + static_cast<std::ptrdiff_t>(c),
-                             contacts.begin() + static_cast<std::ptrdiff_t>(c + nc));
-    parts[r].witnesses.assign(witnesses.begin() + static_cast<std::ptrdiff_t>(w),
-                              witnesses.begin() + static_cast<std::ptrdiff_t>(w + nw));
-    p += np;
-    c += nc;
-    w += nw;
+  const std::uint64_t sizes[3] = {mine.pairs.size(), mine.contacts.size(), mine.witnesses.size()};
+  std::vector<std::byte> message(reinterpret_cast<const std::byte*>(sizes),
+                                 reinterpret_cast<const std::byte*>(sizes) + sizeof(sizes));
+  put(message, mine.pairs);
+  put(message, mine.contacts);
+  put(message, mine.witnesses);
+  std::vector<std::size_t> counts;
+  const std::vector<std::byte> all = comm.allgather_bytes(message, counts);
+  std::vector<contact::Detection> parts(counts.size());
+  const std::byte* at = all.data();
+  for (contact::Detection& part : parts) {
+    std::uint64_t n[3];
+    std::memcpy(n, at, sizeof(n));
+    at += sizeof(n);
+    part.pairs = take<contact::NearPair>(at, n[0]);
+    part.contacts = take<contact::ContactPoint>(at, n[1]);
+    part.witnesses = take<contact::Witness>(at, n[2]);
   }
   parts.front().reach = std::move(mine.reach);  // the same on every rank
   return concatenate(std::move(parts));

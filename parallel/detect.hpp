@@ -3,7 +3,8 @@
 // among the ranks. Every rank holds every floe (stage one of
 // docs/parallel.md: the state is replicated), runs the broad phase, and
 // measures one contiguous share of the candidate pairs
-// (DetectionOptions::part of parts); the shares are gathered in rank order.
+// (DetectionOptions::part of parts); the shares are gathered in rank order
+// (one message a rank: the counts and the three lists).
 // The pairs are sorted by (a, b, shift) before they are shared, so the
 // concatenation is the serial pair list, and each pair is measured by the
 // same code on the same data: the result is the serial one, bit for bit, on
