@@ -5,8 +5,9 @@
 // constructed it is the serial run: rank 0 of 1, and every operation below is
 // a copy or nothing. Session::world() gives the ranks `mpirun` started.
 //
-// Every operation is collective: all ranks call it, in the same order, with
-// the same counts where a count is an argument. The results do not depend on
+// Every operation that exchanges data (gathers, sums, broadcast, together)
+// is collective: all ranks call it, in the same order, with the same counts
+// where a count is an argument. The results do not depend on
 // the number of ranks: gathers concatenate the ranks' parts in rank order, so
 // a list split in contiguous shares (share()) comes back in its serial order,
 // and reductions here are only of integers (exact in any order).
