@@ -2,6 +2,8 @@
 // a scenario, writes the run file (and its .xmf for ParaView), shows progress
 // on a terminal and prints a summary at the end. With --restart, continues
 // RUN.h5 from its checkpoint (docs/formats.md, "Checkpoint and restart").
+// Under mpirun every rank runs it; rank 0 writes the file and prints
+// (docs/parallel.md).
 #include <unistd.h>
 
 #include <atomic>
@@ -13,6 +15,7 @@
 #include <iomanip>
 #include <iostream>
 #include <sstream>
+#include <thread>
 
 #include "apps/commands.hpp"
 #include "core/checkpoint.hpp"
@@ -20,6 +23,7 @@
 #include "core/run_file.hpp"
 #include "core/error.hpp"
 #include "coupling/run.hpp"
+#include "parallel/comm.hpp"
 
 namespace floesim::apps {
 
@@ -109,22 +113,33 @@ private:
   double last_ = -1.0;
 };
 
+struct Args {
+  std::string config, output, restart;
+  double until = -1.0;
+  int threads = -1;
+  bool quiet = false, profile = false;
+};
+
+// [run] threads = 0 (one per core) in a run of several ranks on a node: the
+// node's cores shared among its ranks, unless OMP_NUM_THREADS says.
+void share_cores(Config& config, const parallel::Session& session) {
+  if (session.world().serial() || config.run.threads != 0 || std::getenv("OMP_NUM_THREADS") != nullptr) return;
+  const int cores = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  config.run.threads = std::max(1, cores / std::max(1, session.local_ranks()));
+}
+
+int run(const Args& args, const parallel::Session& session);
+
 }  // namespace
 
 void add_run_command(CLI::App& app, Registry& registry) {
-  struct Args {
-    std::string config, output, restart;
-    double until = -1.0;
-    int threads = -1;
-    bool quiet = false, profile = false;
-  };
   auto args = std::make_shared<Args>();
   CLI::App* sub = app.add_subcommand("run", "Run a scenario (default: examples/floes_on_waves.toml)");
   sub->add_option("CONFIG", args->config, "Configuration file (.toml)");
   sub->add_option("-o,--output", args->output, "Run file to write (default: CONFIG's name with .h5, here)");
   sub->add_option("--until", args->until, "Stop at this time (s) instead of [run] t_end")
       ->check(finite_non_negative());
-  sub->add_option("--threads", args->threads, "Threads for the per-floe phases (default: [run] threads; 0: OMP_NUM_THREADS if set, else one per core)")
+  sub->add_option("--threads", args->threads, "Threads for the per-floe phases (default: [run] threads; 0: OMP_NUM_THREADS if set, else one per core; under mpirun, the node's cores over its ranks)")
       ->check(CLI::Range(0, 1024));
   sub->add_option("--restart", args->restart,
                   "Continue this run file from its checkpoint, bit for bit (CONFIG: by default the run's own; "
@@ -132,11 +147,42 @@ void add_run_command(CLI::App& app, Registry& registry) {
   sub->add_flag("-q,--quiet", args->quiet, "No progress line");
   sub->add_flag("--profile", args->profile, "Print the time spent in each phase of the step");
   registry[sub] = [args] {
-    const bool restart = !args->restart.empty();
-    std::string config_path = args->config.empty() && !restart ? default_config() : args->config;
+    // Under mpirun every rank runs this command (docs/parallel.md); serial otherwise.
+    parallel::Session session;
+    try {
+      return run(*args, session);
+    } catch (const InputError&) {
+      session.abort_alone(std::current_exception(), 2);  // a failure of one rank that the others could not hear of
+      throw;
+    } catch (...) {
+      session.abort_alone(std::current_exception(), 1);
+      throw;
+    }
+  };
+}
+
+namespace {
+
+int run(const Args& args, const parallel::Session& session) {
+  const parallel::Communicator& comm = session.world();
+  // Rank 0 speaks for the run: the other ranks' output would repeat it.
+  if (!comm.writer()) {
+    std::cout.rdbuf(nullptr);
+    std::cerr.rdbuf(nullptr);
+  }
+  const bool restart = !args.restart.empty();
+  std::string config_path, output;
+  Config config;
+  Checkpoint checkpoint;
+  std::unique_ptr<Simulation> simulation;
+  // Every rank reads and checks the input and builds the scenario before
+  // any work is shared: bad input on any rank stops every rank with its
+  // message (the same on each, as they read the same files).
+  comm.together([&] {
+    config_path = args.config.empty() && !restart ? default_config() : args.config;
     if (!config_path.empty() && !path_exists(config_path)) throw InputError(config_path + ": configuration file not found");
-    std::string output = args->output;
-    if (output.empty()) output = restart ? args->restart : fs::path(config_path).stem().string() + ".h5";
+    output = args.output;
+    if (output.empty()) output = restart ? args.restart : fs::path(config_path).stem().string() + ".h5";
     if (!config_path.empty() && path_exists(output) && fs::equivalent(output, config_path))
       throw InputError(output + ": the output would overwrite the configuration");
 
@@ -149,122 +195,132 @@ void add_run_command(CLI::App& app, Registry& registry) {
         throw RunError(output + ": cannot write the run file in " + dir.string() + " (" + std::strerror(err) + ")");
       }
     }
-    Config config;
-    Checkpoint checkpoint;
     if (restart) {
-      if (!path_exists(args->restart)) throw InputError(args->restart + ": run file not found (--restart)");
-      const RunInfo info = read_run_info(args->restart);
-      checkpoint = read_checkpoint(args->restart);
-      config = restart_config(args->restart, config_path, info);
-      const double t_end = args->until >= 0.0 ? args->until : config.run.t_end;
+      if (!path_exists(args.restart)) throw InputError(args.restart + ": run file not found (--restart)");
+      const RunInfo info = read_run_info(args.restart);
+      checkpoint = read_checkpoint(args.restart);
+      config = restart_config(args.restart, config_path, info);
+      const double t_end = args.until >= 0.0 ? args.until : config.run.t_end;
       if (t_end < checkpoint.time) {
         std::ostringstream m;
-        m << args->restart << ": the checkpoint is at t = " << checkpoint.time << " s, after the end asked for ("
-          << (args->until >= 0.0 ? "--until " : "[run] t_end = ") << t_end << " s): expected an end >= "
+        m << args.restart << ": the checkpoint is at t = " << checkpoint.time << " s, after the end asked for ("
+          << (args.until >= 0.0 ? "--until " : "[run] t_end = ") << t_end << " s): expected an end >= "
           << checkpoint.time << " s";
         throw InputError(m.str());
       }
     } else {
       config = load_config(config_path);
     }
-    if (args->threads >= 0) config.run.threads = args->threads;
+    if (args.threads >= 0) config.run.threads = args.threads;
     // --until replaces t_end: the bounds on the records and steps of [run] t_end hold for it too.
-    if (args->until >= 0.0)
-      for (auto [problem, key] : {std::pair{record_count_problem(args->until, config.run.output_interval), "output_interval"},
-                                  std::pair{step_count_problem(args->until, config.run.dt_max), "dt_max"}})
+    if (args.until >= 0.0)
+      for (auto [problem, key] : {std::pair{record_count_problem(args.until, config.run.output_interval), "output_interval"},
+                                  std::pair{step_count_problem(args.until, config.run.dt_max), "dt_max"}})
         if (!problem.empty()) {
           std::ostringstream m;
-          m << "--until " << args->until << ": " << problem << " ("
-            << (config_path.empty() ? args->restart : config_path) << ": [run] " << key << ")";
+          m << "--until " << args.until << ": " << problem << " ("
+            << (config_path.empty() ? args.restart : config_path) << ": [run] " << key << ")";
           throw InputError(m.str());
         }
-    Simulation sim(build_scenario(config));
+    share_cores(config, session);
+    simulation = std::make_unique<Simulation>(build_scenario(config), comm);
     if (restart) {
-      sim.restore(checkpoint);
+      simulation->restore(checkpoint);
       // A new output starts as a copy of the run; the records after the checkpoint are dropped from it.
-      if (!(path_exists(output) && fs::equivalent(output, args->restart))) {
+      if (comm.writer() && !(path_exists(output) && fs::equivalent(output, args.restart))) {
         std::error_code ec;
-        fs::copy_file(args->restart, output, fs::copy_options::overwrite_existing, ec);
-        if (ec) throw InputError(output + ": cannot copy the run file " + args->restart + " to it: " + ec.message());
+        fs::copy_file(args.restart, output, fs::copy_options::overwrite_existing, ec);
+        if (ec) throw InputError(output + ": cannot copy the run file " + args.restart + " to it: " + ec.message());
       }
     }
-    for (const std::string& note : sim.notes()) std::cerr << "floesim: note: " << note << "\n";
+  });
+  Simulation& sim = *simulation;
+  for (const std::string& note : sim.notes()) std::cerr << "floesim: note: " << note << "\n";
 
-    ProgressLine progress(!args->quiet && isatty(STDERR_FILENO));
-    g_interrupted = false;
-    auto previous = std::signal(SIGINT, on_signal);
-    auto previous_term = std::signal(SIGTERM, on_signal);
-    auto restore_signals = [&] {
-      std::signal(SIGINT, previous);
-      std::signal(SIGTERM, previous_term);
-    };
-    RunOptions options{output, args->until, [&](const RunProgress& p) { progress(p); },
-                       [] { return g_interrupted.load(); }, restart ? &checkpoint : nullptr};
-    RunSummary s;
-    try {
-      s = run_simulation(sim, options);
-    } catch (const RunError&) {
-      progress.done();
-      restore_signals();
-      throw;
-    } catch (...) {
-      progress.done();
-      restore_signals();
-      throw;
-    }
+  ProgressLine progress(!args.quiet && comm.writer() && isatty(STDERR_FILENO));
+  g_interrupted = false;
+  auto previous = std::signal(SIGINT, on_signal);
+  auto previous_term = std::signal(SIGTERM, on_signal);
+  auto restore_signals = [&] {
+    std::signal(SIGINT, previous);
+    std::signal(SIGTERM, previous_term);
+  };
+  RunOptions options{output, args.until, [&](const RunProgress& p) { progress(p); },
+                     [] { return g_interrupted.load(); }, restart ? &checkpoint : nullptr};
+  RunSummary s;
+  try {
+    s = run_simulation(sim, options);
+  } catch (const RunError&) {
     progress.done();
     restore_signals();
+    throw;
+  } catch (...) {
+    progress.done();
+    restore_signals();
+    throw;
+  }
+  progress.done();
+  restore_signals();
+  const int status = s.status == "complete" ? 0 : kInterruptedExit;
+  if (!comm.writer()) return status;  // rank 0 reports the run
 
-    std::ostream& o = std::cout;
-    o << "status: " << s.status << "\nconfig: " << (config_path.empty() ? args->restart + " (its config)" : config_path);
-    if (restart) o << "\nrestarted_from: " << args->restart << " at t = " << checkpoint.time << " s";
-    o << "\ncheckpoint: " << (s.checkpoint_time >= 0.0 ? std::to_string(s.checkpoint_time) + " s" : "none") << "\noutput: " << fs::absolute(s.output).string()
-      << "\nparaview: " << fs::absolute(s.xdmf).string() << "\nfloes: " << sim.floes().size() << "\nsteps: " << s.steps
-      << "\nrecords: " << s.records << "\nsimulated: " << s.t_end << " s\nwall_time: " << std::setprecision(4)
-      << s.wall_seconds << " s\nsteps_per_second: " << (s.wall_seconds > 0 ? static_cast<double>(s.steps) / s.wall_seconds : 0.0)
+  std::ostream& o = std::cout;
+  o << "status: " << s.status << "\nconfig: " << (config_path.empty() ? args.restart + " (its config)" : config_path);
+  if (restart) o << "\nrestarted_from: " << args.restart << " at t = " << checkpoint.time << " s";
+  o << "\ncheckpoint: " << (s.checkpoint_time >= 0.0 ? std::to_string(s.checkpoint_time) + " s" : "none") << "\noutput: " << fs::absolute(s.output).string()
+    << "\nparaview: " << fs::absolute(s.xdmf).string() << "\nfloes: " << sim.floes().size() << "\nsteps: " << s.steps
+    << "\nrecords: " << s.records << "\nsimulated: " << s.t_end << " s\nwall_time: " << std::setprecision(4)
+    << s.wall_seconds << " s\nsteps_per_second: " << (s.wall_seconds > 0 ? static_cast<double>(s.steps) / s.wall_seconds : 0.0)
+    << "\n";
+  o << std::setprecision(8);
+  for (std::size_t k = 0; k < s.energy_last.names.size(); ++k)
+    o << "energy." << s.energy_last.names[k] << ": " << s.energy_first.values[k] << " -> "
+      << s.energy_last.values[k] << " J\n";
+  const contact::CollisionStats& c = s.collisions;
+  o << "collisions.lcps: " << c.lcps << "\ncollisions.contacts: " << c.contacts << "\ncollisions.pivots: " << c.pivots
+    << "\ncollisions.largest_lcp: " << c.largest << "\ncollisions.failures: " << c.failures
+    << "\ncollisions.fallbacks: " << c.fallbacks << "\ncollisions.gauss_seidel: " << c.gauss_seidel
+    << "\ncollisions.tolerated: " << c.tolerated << "\n";
+  {
+    const LcpCounters counters = sim.lcp_counters();  // the sub-stepper's counts, as in /diagnostics/substeps
+    for (int k = 0; k < kSubstepColumns; ++k)
+      o << "substeps." << kSubstepColumnNames[k] << ": " << counters.substeps[static_cast<std::size_t>(k)] << "\n";
+  }
+  if (const PercussionStats* f = sim.percussion_stats())
+    o << "fracture.checks: " << f->checks << "\nfracture.screened: " << f->screened
+      << "\nfracture.sustained: " << f->sustained << "\nfracture.initiations: " << f->initiations
+      << "\nfracture.splits: " << f->splits << "\nfracture.seconds: " << f->seconds
+      << "\nfracture.split_seconds: " << f->split_seconds << "\n";
+  if (const FloeSeaContact* fs = sim.floe_sea())
+    o << "footprints.placements: " << fs->footprint_placements() << "\nfootprints.rebuilds: " << fs->footprint_rebuilds()
       << "\n";
-    o << std::setprecision(8);
-    for (std::size_t k = 0; k < s.energy_last.names.size(); ++k)
-      o << "energy." << s.energy_last.names[k] << ": " << s.energy_first.values[k] << " -> "
-        << s.energy_last.values[k] << " J\n";
-    const contact::CollisionStats& c = s.collisions;
-    o << "collisions.lcps: " << c.lcps << "\ncollisions.contacts: " << c.contacts << "\ncollisions.pivots: " << c.pivots
-      << "\ncollisions.largest_lcp: " << c.largest << "\ncollisions.failures: " << c.failures
-      << "\ncollisions.fallbacks: " << c.fallbacks << "\ncollisions.gauss_seidel: " << c.gauss_seidel
-      << "\ncollisions.tolerated: " << c.tolerated << "\n";
-    {
-      const LcpCounters counters = sim.lcp_counters();  // the sub-stepper's counts, as in /diagnostics/substeps
-      for (int k = 0; k < kSubstepColumns; ++k)
-        o << "substeps." << kSubstepColumnNames[k] << ": " << counters.substeps[static_cast<std::size_t>(k)] << "\n";
-    }
-    if (const PercussionStats* f = sim.percussion_stats())
-      o << "fracture.checks: " << f->checks << "\nfracture.screened: " << f->screened
-        << "\nfracture.sustained: " << f->sustained << "\nfracture.initiations: " << f->initiations
-        << "\nfracture.splits: " << f->splits << "\nfracture.seconds: " << f->seconds
-        << "\nfracture.split_seconds: " << f->split_seconds << "\n";
-    if (const FloeSeaContact* fs = sim.floe_sea())
-      o << "footprints.placements: " << fs->footprint_placements() << "\nfootprints.rebuilds: " << fs->footprint_rebuilds()
-        << "\n";
-    if (const FloeSeaContact* fs = sim.floe_sea(); fs && fs->implicit()) {
-      const FloeSeaContact::ImplicitStats& st = fs->implicit_stats();
-      const double steps = std::max<double>(1.0, static_cast<double>(st.steps));
-      o << "implicit.newton_per_step: " << static_cast<double>(st.newton) / steps
-        << "\nimplicit.cg_per_step: " << static_cast<double>(st.cg) / steps
-        << "\nimplicit.sea_responses_per_step: " << static_cast<double>(st.g_products) / steps << "\n";
-    }
-    o << "warnings: " << s.warnings.size() << "\n";
-    for (const auto& w : s.warnings) o << "  " << w << "\n";
-    if (args->profile) {
-      double total = 0;
-      for (double x : s.profile.seconds) total += x;
-      for (std::size_t k = 0; k < s.profile.seconds.size(); ++k)
-        o << "profile." << kPhaseNames[k] << ": " << std::setprecision(4) << s.profile.seconds[k] << " s ("
-          << std::setprecision(3) << (total > 0 ? 100 * s.profile.seconds[k] / total : 0.0) << "%)\n";
-    }
-    if (s.status != "complete")
-      std::cerr << "floesim: interrupted; continue with: floesim run --restart " << output << "\n";
-    return s.status == "complete" ? 0 : kInterruptedExit;
-  };
+  if (const FloeSeaContact* fs = sim.floe_sea(); fs && fs->implicit()) {
+    const FloeSeaContact::ImplicitStats& st = fs->implicit_stats();
+    const double steps = std::max<double>(1.0, static_cast<double>(st.steps));
+    o << "implicit.newton_per_step: " << static_cast<double>(st.newton) / steps
+      << "\nimplicit.cg_per_step: " << static_cast<double>(st.cg) / steps
+      << "\nimplicit.sea_responses_per_step: " << static_cast<double>(st.g_products) / steps << "\n";
+  }
+  if (!comm.serial()) {
+    // Rank 0's collectives: bytes it received and the time in them, waits for the other ranks included.
+    const parallel::Communicator::Traffic t = comm.traffic();
+    o << "parallel.ranks: " << comm.size() << "\nparallel.collectives: " << t.calls << "\nparallel.bytes_received: " << t.bytes
+      << "\nparallel.collective_seconds: " << t.seconds << "\n";
+  }
+  o << "warnings: " << s.warnings.size() << "\n";
+  for (const auto& w : s.warnings) o << "  " << w << "\n";
+  if (args.profile) {
+    double total = 0;
+    for (double x : s.profile.seconds) total += x;
+    for (std::size_t k = 0; k < s.profile.seconds.size(); ++k)
+      o << "profile." << kPhaseNames[k] << ": " << std::setprecision(4) << s.profile.seconds[k] << " s ("
+        << std::setprecision(3) << (total > 0 ? 100 * s.profile.seconds[k] / total : 0.0) << "%)\n";
+  }
+  if (s.status != "complete")
+    std::cerr << "floesim: interrupted; continue with: floesim run --restart " << output << "\n";
+  return status;
 }
+
+}  // namespace
 
 }  // namespace floesim::apps

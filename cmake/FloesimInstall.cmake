@@ -1,7 +1,7 @@
 # What `cmake --install build --prefix P` puts under P (README.md, "Install"):
 #   bin/floesim                                   the command line
-#   lib*/libfloesim.so.X.Y.Z (+ SONAME link)      the library: core, fluid, contact, coupling
-#   include/floesim/{core,fluid,contact,coupling} its public headers
+#   lib*/libfloesim.so.X.Y.Z (+ SONAME link)      the library: core, fluid, contact, parallel, coupling
+#   include/floesim/{core,fluid,contact,parallel,coupling} its public headers
 #   lib*/cmake/floesim/                           find_package(floesim) -> floesim::floesim
 #   lib*/pkgconfig/floesim.pc                     pkg-config --cflags --libs floesim
 #   FLOESIM_INSTALL_PYTHONDIR/floesim/            the Python package (python/CMakeLists.txt)
@@ -12,13 +12,13 @@
 include(GNUInstallDirs)
 include(CMakePackageConfigHelpers)
 
-# The library a user links: one shared object made of the four layer
+# The library a user links: one shared object made of the five layer
 # libraries, whole (a user may call any public function, so every object of
 # each archive goes in, not only those some code of ours needs). The layers
 # stay static libraries for the tool, the tests and the Python module, so the
 # in-tree build is unchanged; their objects are position-independent
 # (CMAKE_POSITION_INDEPENDENT_CODE, set in the top CMakeLists.txt).
-set(_layers floesim_core floesim_fluid floesim_contact floesim_coupling)
+set(_layers floesim_core floesim_fluid floesim_contact floesim_parallel floesim_coupling)
 set(_stub ${PROJECT_BINARY_DIR}/floesim_library_stub.cpp)
 file(CONFIGURE OUTPUT ${_stub} CONTENT "// libfloesim.so is made of the layer archives linked whole.\n")
 add_library(floesim_library SHARED ${_stub})
@@ -29,7 +29,7 @@ foreach(layer IN LISTS _layers)
 endforeach()
 target_link_options(floesim_library PRIVATE "LINKER:--whole-archive" ${_whole} "LINKER:--no-whole-archive")
 # Linking the top layer also orders the build and brings the third-party
-# libraries the layers need (HDF5, FFTW, CHOLMOD, GMP, MPFR, OpenMP).
+# libraries the layers need (HDF5, FFTW, CHOLMOD, GMP, MPFR, OpenMP, MPI).
 target_link_libraries(floesim_library PRIVATE floesim_coupling)
 set_target_properties(floesim_library PROPERTIES
   OUTPUT_NAME floesim
@@ -56,7 +56,7 @@ install(TARGETS floesim_library EXPORT floesimTargets
 
 # Public headers, in the layout the sources use. core/detail holds the HDF5
 # wrapper, which only core's .cpp files include.
-install(DIRECTORY core fluid contact coupling
+install(DIRECTORY core fluid contact parallel coupling
   DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/floesim
   FILES_MATCHING PATTERN "*.hpp"
   PATTERN "detail" EXCLUDE)

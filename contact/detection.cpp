@@ -344,6 +344,13 @@ Detection detect(const Floes& floes, const CollisionShapes& shapes, const Detect
                                }),
                    candidates.end());
 
+  // This call's share of the pairs (all unless a distributed run split them).
+  const std::size_t count = candidates.size(), base = count / opt.parts, extra = count % opt.parts;
+  const std::size_t first = opt.part * base + std::min(opt.part, extra);
+  candidates.erase(candidates.begin() + static_cast<std::ptrdiff_t>(first + base + (opt.part < extra ? 1 : 0)),
+                   candidates.end());
+  candidates.erase(candidates.begin(), candidates.begin() + static_cast<std::ptrdiff_t>(first));
+
   out.pairs.reserve(candidates.size());
   for (const Candidate& c : candidates)
     out.pairs.push_back(measure_pair(posed, c.a, c.b, c.shift, xi,

@@ -58,6 +58,10 @@ struct DetectionOptions {
   std::vector<double> reach;         // m, per floe (optional)
   double horizon = 0.0;              // s: pairs are measured vertex by vertex within exact_range(horizon)
   Domain domain;
+  // Measure only share `part` of `parts` (contiguous, in pair order) of the
+  // candidate pairs: a distributed run's ranks each measure one share and
+  // concatenate them in order (parallel/detect.hpp). The default is all.
+  std::size_t part = 0, parts = 1;
 };
 
 // A vertex of one floe and its closest point on the other (world; b's shifted).

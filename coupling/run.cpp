@@ -17,6 +17,7 @@ RunSummary run_simulation(Simulation& sim, const RunOptions& options) {
   const double interval = cfg.run.output_interval;
   const double checkpoint_interval = cfg.run.checkpoint_interval;
   const auto start = std::chrono::steady_clock::now();
+  const parallel::Communicator& comm = sim.communicator();
 
   RunSummary summary;
   summary.output = options.output;
@@ -24,17 +25,22 @@ RunSummary run_simulation(Simulation& sim, const RunOptions& options) {
   summary.warnings = sim.notes();
   // Records at t = 0, at every multiple of the interval and at the end.
   const auto expected_records = static_cast<std::size_t>(std::ceil(t_end / interval - 1e-9)) + 1;
-  std::unique_ptr<RunWriter> writer =
-      options.resume ? std::make_unique<RunWriter>(RunWriter::Resume{}, options.output, *options.resume,
-                                                   resolved_toml(cfg), summary.energy_first.names, sim.sea_grid())
-                     : std::make_unique<RunWriter>(options.output, sim.floes(), resolved_toml(cfg),
-                                                   summary.energy_first.names, sim.sea_grid(), expected_records);
-  summary.xdmf = writer->xdmf_path();
+  // One writer (rank 0): the other ranks hold the same state and have no file.
+  std::unique_ptr<RunWriter> writer;
+  comm.together([&] {
+    if (!comm.writer()) return;
+    writer = options.resume ? std::make_unique<RunWriter>(RunWriter::Resume{}, options.output, *options.resume,
+                                                          resolved_toml(cfg), summary.energy_first.names, sim.sea_grid())
+                            : std::make_unique<RunWriter>(options.output, sim.floes(), resolved_toml(cfg),
+                                                          summary.energy_first.names, sim.sea_grid(), expected_records);
+    summary.xdmf = writer->xdmf_path();
+  });
 
   auto record = [&] {
     PhaseTimer _(sim.profile(), Phase::record);
     const Energies e = sim.energies();
-    writer->record(sim.time(), sim.floes(), e.values, sim.lcp_counters(), sim.sea_elevation());
+    const std::span<const double> elevation = sim.sea_elevation();  // on every rank: it applies the sea's deferred kicks
+    if (writer) writer->record(sim.time(), sim.floes(), e.values, sim.lcp_counters(), elevation);
   };
   auto wall = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); };
 
@@ -54,7 +60,7 @@ RunSummary run_simulation(Simulation& sim, const RunOptions& options) {
   auto take_good = [&] {
     good = sim.save();
     good.next_record = static_cast<long long>(next);
-    writer->count_into(good);
+    if (writer) writer->count_into(good);
     have_good = true;
   };
   auto next_checkpoint_after = [&](double t) -> double {
@@ -68,7 +74,7 @@ RunSummary run_simulation(Simulation& sim, const RunOptions& options) {
   auto checkpoint = [&] {
     PhaseTimer _(sim.profile(), Phase::record);
     if (!(have_good && good.steps == static_cast<long long>(sim.steps()))) take_good();
-    writer->write_checkpoint(good);
+    if (writer) writer->write_checkpoint(good);
     checkpoint_steps = sim.steps();
     summary.checkpoint_time = sim.time();
     next_checkpoint = next_checkpoint_after(sim.time());
@@ -76,42 +82,56 @@ RunSummary run_simulation(Simulation& sim, const RunOptions& options) {
 
   summary.status = "complete";
   try {
-    if (!options.resume) record();
-    take_good();
+    comm.together([&] {
+      if (!options.resume) record();
+      take_good();
+    });
     while (sim.time() < t_end) {
       // Next record time; a record that would fall within 1e-9 s of the end merges with it.
       double t_record = std::min(static_cast<double>(next) * interval, t_end);
       if (t_end - t_record < 1e-9 * std::max(1.0, t_end)) t_record = t_end;
       bool stop = false;
       while (sim.time() < t_record && !stop) {
-        sim.step(t_record);
-        writer->note_floes(sim.floes());  // floes made by splits (numbers are never reused)
-        writer->record_fracture(sim.take_fracture_events());
-        if (options.progress) options.progress({sim.time(), t_end, sim.steps(), wall()});
-        stop = options.should_stop && options.should_stop();
-        if (!stop && sim.time() < t_record && sim.time() >= next_checkpoint) checkpoint();
+        // The ranks agree after each step: on a failure of any, and on stopping.
+        comm.together([&] {
+          sim.step(t_record);
+          std::vector<FractureEventRow> events = sim.take_fracture_events();
+          if (writer) {
+            writer->note_floes(sim.floes());  // floes made by splits (numbers are never reused)
+            writer->record_fracture(events);
+          }
+          if (options.progress) options.progress({sim.time(), t_end, sim.steps(), wall()});
+        });
+        stop = comm.any(options.should_stop && options.should_stop());
+        if (!stop && sim.time() < t_record && sim.time() >= next_checkpoint) comm.together(checkpoint);
       }
       const bool on_schedule = sim.time() >= t_record;
-      if (on_schedule) {
-        record();
-        ++next;
-        take_good();
-      }
-      // An interruption saves the state before its record off the schedule,
-      // which a restart drops (the run it continues has no such record).
-      if (stop || (on_schedule && sim.time() >= next_checkpoint)) checkpoint();
+      comm.together([&] {
+        if (on_schedule) {
+          record();
+          ++next;
+          take_good();
+        }
+        // An interruption saves the state before its record off the schedule,
+        // which a restart drops (the run it continues has no such record).
+        if (stop || (on_schedule && sim.time() >= next_checkpoint)) checkpoint();
+        if (stop && !on_schedule) record();  // the last state of an interrupted run
+      });
       if (stop) {
-        if (!on_schedule) record();  // the last state of an interrupted run
         summary.status = "interrupted";
         break;
       }
     }
-    if (checkpoint_steps != sim.steps()) checkpoint();
+    if (checkpoint_steps != sim.steps()) comm.together(checkpoint);
   } catch (const std::exception& e) {
     // Any failure marks the file failed with its reason (a RunError is the
     // expected kind; anything else is a bug, still recorded), with a
     // checkpoint at the last record unless writing is what failed. The
     // writer's own failures say what the file keeps; say it for the others.
+    if (!writer) {  // not the writer rank: the same error, without the file's story
+      if (dynamic_cast<const RunError*>(&e) == nullptr) throw;
+      throw RunError(e.what());
+    }
     const bool writing = writer->failed();
     const std::size_t kept = writer->records();
     std::string reason = std::string("failed: ") + e.what();
@@ -134,11 +154,14 @@ RunSummary run_simulation(Simulation& sim, const RunOptions& options) {
     if (dynamic_cast<const RunError*>(&e) == nullptr) throw;
     throw RunError(message);
   }
-  const std::string problem = writer->finish(
-      summary.status == "complete" ? "complete" : "interrupted at t = " + std::to_string(sim.time()) + " s");
-  if (!problem.empty()) throw RunError(writer->path() + ": the run ended but " + problem);
+  comm.together([&] {
+    if (!writer) return;
+    const std::string problem = writer->finish(
+        summary.status == "complete" ? "complete" : "interrupted at t = " + std::to_string(sim.time()) + " s");
+    if (!problem.empty()) throw RunError(writer->path() + ": the run ended but " + problem);
+  });
   summary.steps = sim.steps();
-  summary.records = writer->records();
+  summary.records = writer ? writer->records() : 0;  // 0: this rank wrote no file
   summary.t_end = sim.time();
   summary.wall_seconds = wall();
   summary.energy_last = sim.energies();

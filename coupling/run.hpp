@@ -47,6 +47,10 @@ struct RunSummary {
   contact::CollisionStats collisions;
 };
 
+// In a distributed run (Simulation::communicator() of several ranks) every
+// rank calls this; rank 0 alone writes the run file (docs/parallel.md) and
+// the ranks agree after every step on failures and on should_stop(), so an
+// error on any rank ends every rank with that error and the file closed.
 // Throws RunError when the numerics fail or the run file cannot be written
 // (a full disk); the run file then says status = "failed: <reason>" and keeps
 // every record written before. Any other exception is recorded so too, then

@@ -10,6 +10,7 @@
 #include "contact/substep.hpp"
 #include "core/error.hpp"
 #include "fluid/sea.hpp"
+#include "parallel/detect.hpp"
 
 namespace floesim {
 
@@ -68,7 +69,8 @@ contact::Domain make_domain(const Scenario& s) {
 }
 }  // namespace
 
-Simulation::Simulation(Scenario scenario) : scenario_(std::move(scenario)) {
+Simulation::Simulation(Scenario scenario, parallel::Communicator comm)
+    : scenario_(std::move(scenario)), comm_(std::move(comm)) {
   const Config& c = scenario_.config;
   drift_params_ = DriftParams{c.sea.rho, c.forcing.ocean_drag, c.forcing.air_density, c.forcing.air_drag,
                               c.forcing.coriolis};
@@ -207,8 +209,11 @@ void Simulation::drift(StepContext& ctx) {
     for (Vec2& w : water) w += current;
   }
   moorings_.kick(scenario_.floes, ctx.dt);
-  drift_velocities(scenario_.floes, quadrature_, drift_params_, current, wind, ctx.dt, 0, scenario_.floes.size(),
-                   water);
+  // Each rank drifts its share of the floes (each floe's drift is its own),
+  // then every rank takes the others' shares.
+  const parallel::Range mine = comm_.share(scenario_.floes.size());
+  drift_velocities(scenario_.floes, quadrature_, drift_params_, current, wind, ctx.dt, mine.begin, mine.end, water);
+  comm_.complete_shares(scenario_.floes.state);
   ctx.momentum = momentum();
   step_budget_.external = ctx.momentum - ctx_momentum_before_;
 }
@@ -297,7 +302,7 @@ void Simulation::set_reach() {
 
 bool Simulation::detect_and_check(StepContext& ctx) {
   set_reach();
-  contact::Detection next = contact::detect(scenario_.floes, shapes_, detection_options_);
+  contact::Detection next = parallel::detect(comm_, scenario_.floes, shapes_, detection_options_);
   for (const contact::NearPair& p : next.pairs) {
     if (!p.overlap) continue;
     // Redo the step with half the time.

@@ -57,6 +57,7 @@
 #include "core/checkpoint.hpp"
 #include "core/run_file.hpp"
 #include "coupling/scenario.hpp"
+#include "parallel/comm.hpp"
 
 namespace floesim {
 
@@ -91,7 +92,12 @@ struct Energies {
 
 class Simulation {
 public:
-  explicit Simulation(Scenario scenario);
+  // `comm`: the ranks of a distributed run (parallel/comm.hpp; default: serial).
+  // Every rank holds the whole state and steps it the same way; the ranks
+  // share the drift and the narrow phase of detection and gather their
+  // results, so every rank ends each step with the serial run's state, bit
+  // for bit (docs/parallel.md, stage one). step() is then collective.
+  explicit Simulation(Scenario scenario, parallel::Communicator comm = {});
   ~Simulation();
   Simulation(Simulation&&) noexcept;
 
@@ -111,6 +117,7 @@ public:
   std::size_t steps() const { return steps_; }
   const Floes& floes() const { return scenario_.floes; }
   const Scenario& scenario() const { return scenario_; }
+  const parallel::Communicator& communicator() const { return comm_; }
   const Profile& profile() const { return profile_; }
   Profile& profile() { return profile_; }
   Energies energies() const;
@@ -161,6 +168,7 @@ private:
   void check_state(const StepContext& ctx) const;
 
   Scenario scenario_;
+  parallel::Communicator comm_;
   std::unique_ptr<fluid::Sea> sea_;
   std::unique_ptr<FloeSeaContact> floe_sea_;
   // The incident waves (coupling/incident.hpp), for drag; none on a calm sea

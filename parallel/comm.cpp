@@ -1,0 +1,279 @@
+#include "parallel/comm.hpp"
+
+#include <chrono>
+#include <climits>
+#include <cstdio>
+#include <cstdlib>
+#include <new>
+#include <stdexcept>
+
+#include "core/error.hpp"
+
+#ifdef FLOESIM_HAVE_MPI
+// MPI's C interface only (the C++ bindings are deprecated and need their own library).
+#define OMPI_SKIP_MPICXX 1
+#define MPICH_SKIP_MPICXX 1
+#include <mpi.h>
+#endif
+
+namespace floesim::parallel {
+
+struct Communicator::Impl {
+#ifdef FLOESIM_HAVE_MPI
+  MPI_Comm comm = MPI_COMM_NULL;
+#endif
+  bool agreed = false;  // a failure was agreed on (together()); the run is ending
+  Communicator::Traffic traffic;
+};
+
+namespace {
+// Counts one collective call into `traffic` when it goes out of scope.
+class Counted {
+public:
+  Counted(Communicator::Traffic& t, long long bytes) : t_(t), start_(std::chrono::steady_clock::now()) {
+    t_.calls += 1;
+    t_.bytes += bytes;
+  }
+  ~Counted() { t_.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count(); }
+  Counted(const Counted&) = delete;
+  Counted& operator=(const Counted&) = delete;
+
+private:
+  Communicator::Traffic& t_;
+  std::chrono::steady_clock::time_point start_;
+};
+}  // namespace
+
+namespace {
+
+// The kinds of failure the command line tells apart (apps/main.cpp's exit codes).
+enum class Kind : std::uint8_t { input = 1, run = 2, memory = 3, other = 4 };
+
+struct Described {
+  Kind kind = Kind::other;
+  std::string message;
+};
+
+Described describe(std::exception_ptr failure) {
+  try {
+    std::rethrow_exception(failure);
+  } catch (const InputError& e) {
+    return {Kind::input, e.what()};
+  } catch (const RunError& e) {
+    return {Kind::run, e.what()};
+  } catch (const std::bad_alloc&) {
+    return {Kind::memory, "out of memory"};
+  } catch (const std::exception& e) {
+    return {Kind::other, e.what()};
+  } catch (...) {
+    return {Kind::other, "unknown exception"};
+  }
+}
+
+[[noreturn]] void throw_described(const Described& d) {
+  switch (d.kind) {
+    case Kind::input: throw InputError(d.message);
+    case Kind::run: throw RunError(d.message);
+    case Kind::memory: throw std::bad_alloc();
+    case Kind::other: break;
+  }
+  throw std::runtime_error(d.message);
+}
+
+#ifdef FLOESIM_HAVE_MPI
+void check(int code, const char* what) {
+  if (code == MPI_SUCCESS) return;
+  char text[MPI_MAX_ERROR_STRING];
+  int length = 0;
+  MPI_Error_string(code, text, &length);
+  throw RunError(std::string("MPI: ") + what + " failed: " + std::string(text, static_cast<std::size_t>(length)));
+}
+
+// Set by mpirun (Open MPI), or by a PMI/PMIx launcher (srun, hydra).
+bool launched_by_mpi() {
+  for (const char* name : {"OMPI_COMM_WORLD_SIZE", "PMIX_RANK", "PMI_RANK", "PMI_SIZE"})
+    if (std::getenv(name) != nullptr) return true;
+  return false;
+}
+#endif
+
+}  // namespace
+
+Communicator::Communicator() = default;
+Communicator::~Communicator() = default;
+Communicator::Communicator(const Communicator&) = default;
+Communicator& Communicator::operator=(const Communicator&) = default;
+
+Range share(std::size_t n, int rank, int ranks) {
+  const auto p = static_cast<std::size_t>(ranks), r = static_cast<std::size_t>(rank);
+  const std::size_t base = n / p, extra = n % p;
+  const std::size_t begin = r * base + std::min(r, extra);
+  return {begin, begin + base + (r < extra ? 1 : 0)};
+}
+
+std::vector<std::byte> Communicator::allgather_bytes(std::span<const std::byte> mine,
+                                                     std::vector<std::size_t>& counts) const {
+  if (serial() || !impl_) {
+    counts.assign(1, mine.size());
+    return {mine.begin(), mine.end()};
+  }
+#ifdef FLOESIM_HAVE_MPI
+  std::vector<long long> all_counts(static_cast<std::size_t>(size_));
+  {
+    Counted counted(impl_->traffic, static_cast<long long>(sizeof(long long)) * size_);
+    long long count = static_cast<long long>(mine.size());
+    check(MPI_Allgather(&count, 1, MPI_LONG_LONG, all_counts.data(), 1, MPI_LONG_LONG, impl_->comm), "MPI_Allgather");
+  }
+  counts.assign(all_counts.begin(), all_counts.end());
+  return allgather_known(mine, counts);
+#else
+  return {};
+#endif
+}
+
+std::vector<std::byte> Communicator::allgather_known(std::span<const std::byte> mine,
+                                                     const std::vector<std::size_t>& counts) const {
+  if (serial() || !impl_) return {mine.begin(), mine.end()};
+#ifdef FLOESIM_HAVE_MPI
+  std::vector<int> sizes(counts.size()), offsets(counts.size());
+  std::size_t total = 0;
+  for (std::size_t r = 0; r < counts.size(); ++r) {
+    if (total + counts[r] > static_cast<std::size_t>(INT_MAX))
+      throw RunError("MPI: a gather of more than 2 GiB (" + std::to_string(total + counts[r]) +
+                     " bytes) is not supported");
+    sizes[r] = static_cast<int>(counts[r]);
+    offsets[r] = static_cast<int>(total);
+    total += counts[r];
+  }
+  Counted counted(impl_->traffic, static_cast<long long>(total));
+  std::vector<std::byte> out(total);
+  check(MPI_Allgatherv(mine.data(), static_cast<int>(mine.size()), MPI_BYTE, out.data(), sizes.data(),
+                       offsets.data(), MPI_BYTE, impl_->comm),
+        "MPI_Allgatherv");
+  return out;
+#else
+  return {};
+#endif
+}
+
+long long Communicator::sum(long long value) const {
+  if (serial() || !impl_) return value;
+#ifdef FLOESIM_HAVE_MPI
+  Counted counted(impl_->traffic, static_cast<long long>(sizeof(long long)) * size_);
+  long long total = 0;
+  check(MPI_Allreduce(&value, &total, 1, MPI_LONG_LONG, MPI_SUM, impl_->comm), "MPI_Allreduce");
+  return total;
+#else
+  return value;
+#endif
+}
+
+std::vector<std::byte> Communicator::broadcast(std::span<const std::byte> bytes, int root) const {
+  if (serial() || !impl_) return {bytes.begin(), bytes.end()};
+#ifdef FLOESIM_HAVE_MPI
+  long long count = static_cast<long long>(bytes.size());
+  Counted counted(impl_->traffic, 0);
+  check(MPI_Bcast(&count, 1, MPI_LONG_LONG, root, impl_->comm), "MPI_Bcast");
+  impl_->traffic.bytes += count;
+  if (count > INT_MAX) throw RunError("MPI: a broadcast of more than 2 GiB is not supported");
+  std::vector<std::byte> out(static_cast<std::size_t>(count));
+  if (rank_ == root) std::copy(bytes.begin(), bytes.end(), out.begin());
+  check(MPI_Bcast(out.data(), static_cast<int>(count), MPI_BYTE, root, impl_->comm), "MPI_Bcast");
+  return out;
+#else
+  return {};
+#endif
+}
+
+void Communicator::agree(std::exception_ptr failure) const {
+  if (serial() || !impl_) {
+    if (failure) std::rethrow_exception(failure);
+    return;
+  }
+#ifdef FLOESIM_HAVE_MPI
+  // The lowest failing rank speaks: min over (rank if failed, else size).
+  int mine = failure ? rank_ : size_, first = size_;
+  {
+    Counted counted(impl_->traffic, static_cast<long long>(sizeof(int)) * size_);
+    check(MPI_Allreduce(&mine, &first, 1, MPI_INT, MPI_MIN, impl_->comm), "MPI_Allreduce");
+  }
+  if (first == size_) return;
+  std::vector<std::byte> said;
+  if (rank_ == first) {
+    const Described d = describe(failure);
+    said.push_back(static_cast<std::byte>(d.kind));
+    const auto* text = reinterpret_cast<const std::byte*>(d.message.data());
+    said.insert(said.end(), text, text + d.message.size());
+  }
+  said = broadcast(said, first);
+  impl_->agreed = true;
+  if (rank_ == first) std::rethrow_exception(failure);  // the original, with its full type
+  Described d;
+  d.kind = static_cast<Kind>(said.at(0));
+  d.message.assign(reinterpret_cast<const char*>(said.data()) + 1, said.size() - 1);
+  throw_described(d);
+#else
+  if (failure) std::rethrow_exception(failure);
+#endif
+}
+
+bool Communicator::failure_agreed() const { return impl_ && impl_->agreed; }
+
+Communicator::Traffic Communicator::traffic() const { return impl_ ? impl_->traffic : Traffic{}; }
+
+Session::Session() {
+#ifdef FLOESIM_HAVE_MPI
+  if (!launched_by_mpi()) return;
+  // A rank waiting in a collective yields its core instead of spinning
+  // (Open MPI's default spins): on cores shared with other work, or with
+  // more ranks than cores, a spinning rank takes the slices the rank it waits
+  // for needs (the passive OpenMP waits of apps/main.cpp, for MPI). Unless
+  // the user chose (OMPI_MCA_mpi_yield_when_idle=0 for dedicated cores).
+  setenv("OMPI_MCA_mpi_yield_when_idle", "1", 0);
+  // Only the main thread calls MPI (OpenMP loops do not).
+  int provided = 0;
+  check(MPI_Init_thread(nullptr, nullptr, MPI_THREAD_FUNNELED, &provided), "MPI_Init_thread");
+  initialised_ = true;
+  auto impl = std::make_shared<Communicator::Impl>();
+  impl->comm = MPI_COMM_WORLD;
+  // Errors come back as codes (check() turns them into RunError), not an abort.
+  MPI_Comm_set_errhandler(MPI_COMM_WORLD, MPI_ERRORS_RETURN);
+  MPI_Comm_rank(MPI_COMM_WORLD, &world_.rank_);
+  MPI_Comm_size(MPI_COMM_WORLD, &world_.size_);
+  world_.impl_ = std::move(impl);
+  MPI_Comm node;
+  if (MPI_Comm_split_type(MPI_COMM_WORLD, MPI_COMM_TYPE_SHARED, 0, MPI_INFO_NULL, &node) == MPI_SUCCESS) {
+    MPI_Comm_size(node, &local_ranks_);
+    MPI_Comm_free(&node);
+  }
+#endif
+}
+
+Session::~Session() {
+#ifdef FLOESIM_HAVE_MPI
+  if (initialised_) MPI_Finalize();
+#endif
+}
+
+bool Session::built_with_mpi() {
+#ifdef FLOESIM_HAVE_MPI
+  return true;
+#else
+  return false;
+#endif
+}
+
+void Session::abort_alone(std::exception_ptr failure, int exit_code) const {
+  if (world_.serial() || !initialised_ || world_.failure_agreed()) return;
+#ifdef FLOESIM_HAVE_MPI
+  std::fprintf(stderr, "floesim: rank %d of %d failed alone, ending every rank: %s\n", world_.rank(), world_.size(),
+               describe(failure).message.c_str());
+  std::fflush(stderr);
+  MPI_Abort(MPI_COMM_WORLD, exit_code);
+#else
+  (void)failure;
+  (void)exit_code;
+#endif
+}
+
+}  // namespace floesim::parallel

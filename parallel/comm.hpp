@@ -1,0 +1,170 @@
+#pragma once
+// The ranks of a distributed run and what they say to each other
+// (docs/parallel.md). A Communicator is a value passed down to what splits
+// work (the Simulation, the run loop); there is no global one. Default
+// constructed it is the serial run: rank 0 of 1, and every operation below is
+// a copy or nothing. Session::world() gives the ranks `mpirun` started.
+//
+// Every operation that exchanges data (gathers, sums, broadcast, together)
+// is collective: all ranks call it, in the same order, with the same counts
+// where a count is an argument. The results do not depend on
+// the number of ranks: gathers concatenate the ranks' parts in rank order, so
+// a list split in contiguous shares (share()) comes back in its serial order,
+// and reductions here are only of integers (exact in any order).
+//
+// Errors: a failure on one rank must stop every rank with the same message
+// and exit code. together() runs a piece of work on every rank and then
+// agrees: if any rank threw, every rank throws the error of the lowest
+// failing rank (same kind: InputError, RunError, out of memory, or another
+// exception, and same message). A rank that fails alone inside a collective
+// cannot agree (the others wait in the collective): Session::abort_alone()
+// ends the whole run then (MPI_Abort), after saying why.
+
+#include <cstddef>
+#include <cstdint>
+#include <cstring>
+#include <exception>
+#include <memory>
+#include <span>
+#include <string>
+#include <type_traits>
+#include <vector>
+
+namespace floesim::parallel {
+
+// A contiguous share [begin, end) of n items.
+struct Range {
+  std::size_t begin = 0, end = 0;
+  std::size_t size() const { return end - begin; }
+};
+
+// Share `rank` of n items among `ranks`: contiguous, in rank order, sizes
+// differing by at most one (the first n % ranks shares take one more).
+Range share(std::size_t n, int rank, int ranks);
+
+// Values sent as their bytes: plain data of numbers, which is what
+// trivially copyable says, except that Eigen's fixed-size vectors (a Vec2 is
+// two doubles held inline) declare their own copy and so are not
+// "trivially" copyable to the compiler, though their bytes are their value.
+template <class T>
+inline constexpr bool kSentAsBytes = std::is_trivially_destructible_v<T> && std::is_standard_layout_v<T>;
+
+class Communicator {
+public:
+  Communicator();  // the serial run: rank 0 of 1
+  ~Communicator();
+  Communicator(const Communicator&);
+  Communicator& operator=(const Communicator&);
+
+  int rank() const { return rank_; }
+  int size() const { return size_; }
+  bool serial() const { return size_ == 1; }
+  // Rank 0 writes the run file and speaks for the run (docs/parallel.md: Debian's HDF5 is serial).
+  bool writer() const { return rank_ == 0; }
+
+  // This rank's share of n items (parallel::share).
+  Range share(std::size_t n) const { return parallel::share(n, rank_, size_); }
+
+  // Every rank's `mine` concatenated in rank order, on every rank (T: kSentAsBytes).
+  template <class T>
+  std::vector<T> allgather(std::span<const T> mine) const {
+    static_assert(kSentAsBytes<T>);
+    std::vector<std::size_t> counts;
+    std::vector<std::byte> all = allgather_bytes({reinterpret_cast<const std::byte*>(mine.data()), mine.size_bytes()}, counts);
+    std::vector<T> out(all.size() / sizeof(T));  // T's default, overwritten by the bytes
+    if (!all.empty()) std::memcpy(static_cast<void*>(out.data()), all.data(), all.size());
+    return out;
+  }
+  // Each rank holds `values` with its share `mine` of them up to date; on
+  // exit every rank's copy equals the owners' values everywhere. Rank r's
+  // share is share(values.size(), r, size()).
+  // One collective call: every share's size is known to all.
+  template <class T>
+  void complete_shares(std::vector<T>& values) const {
+    static_assert(kSentAsBytes<T>);
+    if (serial()) return;
+    std::vector<std::size_t> counts(static_cast<std::size_t>(size_));
+    for (int r = 0; r < size_; ++r) counts[static_cast<std::size_t>(r)] = parallel::share(values.size(), r, size_).size() * sizeof(T);
+    const Range mine = share(values.size());
+    const std::vector<std::byte> all = allgather_known(
+        {reinterpret_cast<const std::byte*>(values.data() + mine.begin), mine.size() * sizeof(T)}, counts);
+    std::memcpy(static_cast<void*>(values.data()), all.data(), all.size());
+  }
+
+  // Bytes: every rank's `mine` concatenated in rank order; `counts` gets
+  // each rank's byte count. Two collective calls (the counts, then the bytes).
+  std::vector<std::byte> allgather_bytes(std::span<const std::byte> mine, std::vector<std::size_t>& counts) const;
+  // The same when every rank's count is known to all (`counts`): one call.
+  std::vector<std::byte> allgather_known(std::span<const std::byte> mine, const std::vector<std::size_t>& counts) const;
+
+  // The sum of one integer over the ranks (in rank order; exact).
+  long long sum(long long value) const;
+  // True on every rank when it is true on any.
+  bool any(bool value) const { return sum(value ? 1 : 0) > 0; }
+  // The same bytes on every rank as on `root`.
+  std::vector<std::byte> broadcast(std::span<const std::byte> bytes, int root) const;
+
+  // What this rank has said and heard since the start (zero when serial):
+  // collective calls, bytes received, and the wall time inside them (the
+  // transfer and the wait for the slowest rank).
+  struct Traffic {
+    long long calls = 0, bytes = 0;
+    double seconds = 0.0;
+  };
+  Traffic traffic() const;
+
+  // Runs f() on every rank and agrees on failure as said above. Returns
+  // normally on every rank only when f() returned on every rank.
+  template <class F>
+  void together(F&& f) const {
+    std::exception_ptr failure;
+    try {
+      f();
+    } catch (...) {
+      failure = std::current_exception();
+    }
+    agree(failure);
+  }
+  // The agreement of together(), for a failure caught by the caller (null: none here).
+  void agree(std::exception_ptr failure) const;
+  // True once the ranks have agreed on a failure (the error being thrown is the run's, on every rank).
+  bool failure_agreed() const;
+
+  struct Impl;  // MPI's communicator, in comm.cpp
+
+private:
+  std::shared_ptr<Impl> impl_;  // null: serial
+  int rank_ = 0, size_ = 1;
+  friend class Session;
+};
+
+// The MPI environment of a process: MPI_Init when the process was started
+// by mpirun (or another launcher that sets the PMI/PMIx variables), else
+// nothing (a serial run needs no MPI library at run time). One per process,
+// owned by main's command; MPI_Finalize on destruction.
+class Session {
+public:
+  Session();
+  ~Session();
+  Session(const Session&) = delete;
+  Session& operator=(const Session&) = delete;
+
+  const Communicator& world() const { return world_; }
+  // True when floesim was built with MPI (FLOESIM_MPI).
+  static bool built_with_mpi();
+  // Ranks on this node (for the default threads per rank): 1 when serial.
+  int local_ranks() const { return local_ranks_; }
+
+  // For an exception that the ranks did not agree on (world().failure_agreed()
+  // is false) in a run of several ranks: prints "floesim: rank R: MESSAGE" on
+  // stderr and ends every rank with `exit_code` (MPI_Abort). Returns when
+  // the run is serial or the failure was agreed.
+  void abort_alone(std::exception_ptr failure, int exit_code) const;
+
+private:
+  Communicator world_;
+  bool initialised_ = false;
+  int local_ranks_ = 1;
+};
+
+}  // namespace floesim::parallel

@@ -1,0 +1,169 @@
+#!/usr/bin/env python3
+"""Distributed runs against the serial run (docs/parallel.md).
+
+usage: check_ranks.py FLOESIM MPIEXEC WORKDIR [--floes N] [--t-end T] [--ranks 1 2 3] [--rtol R]
+                      [--also CONFIG...] [--no-errors]
+       check_ranks.py --no-mpi    (MPI not built: says so and exits 77, ctest's skip code)
+
+A collisions-only periodic pack (`floesim pack`: N floes at 50 % cover,
+thickness 0.5 to 2 m, started at random velocities up to 0.1 m/s as
+bench/collisions.cpp's packs, with wind, current and Coriolis; they collide,
+also across the seams) run serially, then by `mpirun -np R`
+for each R: every run file must equal the serial one (`floesim compare`,
+rtol 0 and atol 0 by default: bit for bit, which stage one's replicated state
+and ordered gathers promise); so must a run stopped half-way on 2 ranks and
+continued with --restart on 2 ranks. Each --also CONFIG (a run with a sea, say) is
+checked so on 2 ranks. Then the errors: bad input and a run file that
+rank 0 cannot create must end every rank with exit 2 and 1, and the message
+said once.
+"""
+import argparse
+import os
+import subprocess
+import sys
+
+import h5py
+import numpy as np
+
+if "--no-mpi" in sys.argv:
+    print("floesim was built without MPI (FLOESIM_MPI=OFF): the distributed runs are not checked")
+    sys.exit(77)
+
+ap = argparse.ArgumentParser()
+ap.add_argument("floesim")
+ap.add_argument("mpiexec")
+ap.add_argument("workdir")
+ap.add_argument("--floes", type=int, default=1500)
+ap.add_argument("--t-end", type=float, default=1000.0)
+ap.add_argument("--ranks", type=int, nargs="+", default=[1, 2, 3])
+ap.add_argument("--rtol", type=float, default=0.0)
+ap.add_argument("--errors", action=argparse.BooleanOptionalAction, default=True)
+ap.add_argument("--also", nargs="*", default=[], help="other configurations to check on 2 ranks (e.g. with a sea)")
+args = ap.parse_args()
+
+os.makedirs(args.workdir, exist_ok=True)
+W = args.workdir
+failures = []
+# mpirun as root (CI containers) must be allowed explicitly; one thread per rank.
+ENV = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1", OMP_NUM_THREADS="1")
+
+
+def run(cmd, timeout=600):
+    return subprocess.run(cmd, cwd=W, capture_output=True, text=True, timeout=timeout, env=ENV)
+
+
+def mpirun(n, *floesim_args):
+    return run([args.mpiexec, "--oversubscribe", "-np", str(n), args.floesim, *floesim_args])
+
+
+def need(p, what):
+    if p.returncode != 0:
+        sys.exit(f"FAILED: {what}: exit {p.returncode}\n{p.stdout}\n{p.stderr}")
+    return p
+
+
+def start_moving(path, seed):
+    # bench/collisions.cpp's packs: each floe at a speed uniform in [0, 0.1]
+    # m/s in a random direction, so they collide from the first steps.
+    rng = np.random.default_rng(seed)
+    with h5py.File(path, "r+") as f:
+        v = f["floes/velocity"][...]
+        speed, angle = rng.uniform(0.0, 0.1, len(v)), rng.uniform(0.0, 2 * np.pi, len(v))
+        v[:, 0], v[:, 1] = speed * np.cos(angle), speed * np.sin(angle)
+        f["floes/velocity"][...] = v
+
+
+side = 130.4 * args.floes ** 0.5  # 50 % cover of floes of mean diameter ~100 m (bench/collisions.cpp's packs)
+pack = os.path.join(W, "pack.h5")
+need(run([args.floesim, "pack", "--floes", str(args.floes), "--concentration", "0.5", "--box", str(side), str(side),
+          "--thickness-range", "0.5", "2.0", "--seed", "5", "-o", pack]), "floesim pack")
+start_moving(pack, seed=5)
+config = os.path.join(W, "pack.toml")
+with open(config, "w") as f:
+    f.write(f"""[run]
+t_end = {args.t_end}
+dt_max = 10.0
+output_interval = {args.t_end / 4}
+threads = 1
+
+[sea]
+model = "none"
+
+[contact]
+domain = "periodic"
+restitution = 0.4
+friction = 0.7
+
+[forcing]
+wind = [10.0, 3.0]
+current = [0.0, 0.05]
+latitude = 80.2
+
+[floes]
+pack = "pack.h5"
+""")
+
+serial = need(run([args.floesim, "run", config, "-o", "serial.h5", "-q"]), "serial run")
+lcps = next(int(l.split()[1]) for l in serial.stdout.splitlines() if l.startswith("collisions.lcps:"))
+print(f"serial: {args.floes} floes to {args.t_end} s, {lcps} collision LCPs")
+if lcps == 0:
+    failures.append("the serial run had no collision: the check would not test the collisions")
+
+for n in args.ranks:
+    out = f"ranks{n}.h5"
+    p = mpirun(n, "run", config, "-o", out, "-q")
+    if p.returncode != 0:
+        failures.append(f"{n} ranks: exit {p.returncode}\n{p.stdout}\n{p.stderr}")
+        continue
+    c = run([args.floesim, "compare", out, "serial.h5", "--rtol", str(args.rtol), "--atol", "0"])
+    verdict = "equal" if c.returncode == 0 else "DIFFERENT"
+    print(f"{n} ranks: {verdict} to the serial run (rtol {args.rtol}, atol 0)")
+    if c.returncode != 0:
+        failures.append(f"{n} ranks differ from the serial run:\n{c.stdout}")
+    if p.stdout.count("status: complete") != 1:
+        failures.append(f"{n} ranks: the summary should be printed once (by rank 0):\n{p.stdout}")
+
+# A restart on 2 ranks: the first half, then --restart from its checkpoint
+# (written by rank 0, read by every rank), equals the serial run.
+half = args.t_end / 2
+p1 = mpirun(2, "run", config, "-o", "half.h5", "-q", "--until", str(half))
+p2 = mpirun(2, "run", "--restart", "half.h5", "-o", "restarted.h5", "-q") if p1.returncode == 0 else p1
+c = run([args.floesim, "compare", "restarted.h5", "serial.h5", "--rtol", str(args.rtol), "--atol", "0"])
+print(f"restart at {half} s on 2 ranks: {'equal' if p2.returncode == 0 and c.returncode == 0 else 'DIFFERENT'} "
+      "to the serial run")
+if p2.returncode != 0 or c.returncode != 0:
+    failures.append(f"restart on 2 ranks: exit {p2.returncode}\n{p2.stderr}\n{c.stdout}")
+
+# Other scenarios (a sea: replicated in stage one, so the same bits too).
+for other in args.also:
+    name = os.path.splitext(os.path.basename(other))[0]
+    need(run([args.floesim, "run", other, "-o", f"{name}_serial.h5", "-q"]), f"{other}: serial run")
+    p = mpirun(2, "run", other, "-o", f"{name}_2.h5", "-q")
+    c = run([args.floesim, "compare", f"{name}_2.h5", f"{name}_serial.h5", "--rtol", str(args.rtol), "--atol", "0"])
+    print(f"{name}: 2 ranks {'equal' if p.returncode == 0 and c.returncode == 0 else 'DIFFERENT'} to the serial run")
+    if p.returncode != 0 or c.returncode != 0:
+        failures.append(f"{other} on 2 ranks: exit {p.returncode}\n{p.stderr}\n{c.stdout}")
+
+if args.errors:
+    # Bad input: every rank reads it, every rank stops, exit 2, said once.
+    bad = os.path.join(W, "bad.toml")
+    with open(bad, "w") as f:
+        f.write(open(config).read().replace("dt_max = 10.0", "dt_max = -1.0"))
+    p = mpirun(2, "run", bad, "-o", "bad.h5", "-q")
+    if p.returncode != 2 or p.stderr.count("dt_max") != 1:
+        failures.append(f"bad input on 2 ranks: expected exit 2 and one message naming dt_max, got exit "
+                        f"{p.returncode}:\n{p.stderr}")
+    # A failure of rank 0 alone (its run file cannot be created: the path is a
+    # folder): the other rank hears of it, both stop, exit 1, said once.
+    os.makedirs(os.path.join(W, "a_folder.h5"), exist_ok=True)
+    p = mpirun(2, "run", config, "-o", "a_folder.h5", "-q")
+    if p.returncode != 1 or p.stderr.count("floesim: run failed") != 1 or "a_folder.h5" not in p.stderr:
+        failures.append(f"unwritable run file on 2 ranks: expected exit 1 and one message naming the file, got exit "
+                        f"{p.returncode}:\n{p.stderr}")
+    else:
+        print("errors: bad input (exit 2) and rank 0's failure alone (exit 1) stop both ranks, said once")
+
+if failures:
+    print("FAILED:\n" + "\n".join(failures))
+    sys.exit(1)
+print("ok")
