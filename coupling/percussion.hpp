@@ -61,6 +61,12 @@ namespace floesim {
 
 namespace fracture { class FloeFracture; }
 
+// The step's collisions as rows of /events/collisions, from the loads of
+// `record` (floes at the end of the step, t): one row per solve and pair of
+// floes, the pair's contacts summed (normal impulse; point weighted by it).
+// Rows are in the order of the solves, then of the floe numbers.
+std::vector<CollisionEventRow> collision_rows(const Floes& floes, const contact::ImpulseRecord& record, double t);
+
 struct PercussionStats {
   long checks = 0;        // floes analysed (again when a step is redone)
   long screened = 0;      // floes loaded but below the screen

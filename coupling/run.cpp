@@ -86,6 +86,7 @@ RunSummary run_simulation(Simulation& sim, const RunOptions& options) {
       while (sim.time() < t_record && !stop) {
         sim.step(t_record);
         writer->note_floes(sim.floes());  // floes made by splits (numbers are never reused)
+        writer->record_collisions(sim.take_collision_events());
         writer->record_fracture(sim.take_fracture_events());
         if (options.progress) options.progress({sim.time(), t_end, sim.steps(), wall()});
         stop = options.should_stop && options.should_stop();
