@@ -239,6 +239,7 @@ void add_run_command(CLI::App& app, Registry& registry) {
     }
     if (const PercussionStats* f = sim.percussion_stats())
       o << "fracture.checks: " << f->checks << "\nfracture.screened: " << f->screened
+        << "\nfracture.bounded: " << f->bounded
         << "\nfracture.sustained: " << f->sustained << "\nfracture.initiations: " << f->initiations
         << "\nfracture.splits: " << f->splits << "\nfracture.seconds: " << f->seconds
         << "\nfracture.split_seconds: " << f->split_seconds << "\n";

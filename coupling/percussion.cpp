@@ -160,6 +160,13 @@ bool Percussion::check(Floes& floes, const contact::ImpulseRecord& record, doubl
       if (e) loads.insert(loads.end(), e->impulses.begin(), e->impulses.end());
       const auto begin = std::chrono::steady_clock::now();
       fracture::FloeFracture& model = model_of(floes, i);
+      // The stress criterion cannot initiate below the strength: a case whose
+      // bound (Responder::stress_bound) is below it needs no time loop.
+      if (params_.criterion == FractureCriterion::stress && model.responder().stress_bound(loads) < params_.strength) {
+        stats_.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
+        ++stats_.bounded;
+        continue;
+      }
       const fracture::FloeFracture::Result result = model.analyse(loads);
       stats_.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
       ++stats_.checks;

@@ -70,6 +70,7 @@ std::vector<CollisionEventRow> collision_rows(const Floes& floes, const contact:
 struct PercussionStats {
   long checks = 0;        // floes analysed (again when a step is redone)
   long screened = 0;      // floes loaded but below the screen
+  long bounded = 0;       // load cases past the screen whose stress bound is below the strength (not analysed)
   long sustained = 0;     // of checks, of sustained forces alone (static)
   long initiations = 0;   // events (a crack whose line leaves the floe at once, from a corner, is not split)
   long splits = 0;
