@@ -82,3 +82,29 @@ TEST_CASE("stress bound: static forces alone give the analysed stress itself") {
   const double stress = floe.analyse(loads).response.peak_stress.max_principal;
   CHECK(floe.responder().stress_bound(loads) == doctest::Approx(stress).epsilon(1e-12));
 }
+
+// A crack starts at the most stressed node, which a coarse mesh often puts on
+// a corner of the floe, where the crack's line may only touch the floe from
+// outside. It then starts at the centroid of that node's most stressed
+// triangle (criteria.cpp), so on a convex floe every initiation is a crack
+// through (an interior point's chord always is). Mesh 20 m on a 60 m square,
+// load radius 20 m, blows near the corners and along the sides.
+TEST_CASE("stress criterion: on a convex floe every initiation is a crack through, however coarse the mesh") {
+  FractureParams params;
+  params.mesh_size = 20.0;
+  params.load_radius = 20.0;
+  params.strength = 1.0;  // Pa: every load initiates
+  const std::vector<Vec2> square = {{0, 0}, {60, 0}, {60, 60}, {0, 60}};
+  FloeFracture floe(square, 1.0, 917.0, params);
+  int cases = 0;
+  for (const double s : {2.0, 8.0, 20.0, 30.0, 45.0, 58.0})
+    for (const double slant : {-0.8, 0.0, 0.5}) {
+      const std::vector<PointLoad> loads = {{{s, 0.0}, {slant * 1e4, 1e4}, true}};
+      const Initiation init = floe.analyse(loads).initiation;
+      REQUIRE(init.initiates);
+      CHECK(init.through);
+      CHECK((init.crack_to - init.crack_from).norm() > 1.0);
+      ++cases;
+    }
+  CHECK(cases == 18);
+}
