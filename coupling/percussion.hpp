@@ -42,7 +42,11 @@
 // largest tensile stresses stay below these scales (docs/fracture.md), so
 // the default screen of 0.1 leaves a wide margin.
 //
-// Models are built on a floe's first analysis (meshing and factorisations)
+// Stress bound. Past the screen, a stress-criterion case whose exact upper
+// bound (fracture::Responder::stress_bound) is below the strength is not
+// analysed (PercussionStats::bounded): it could not initiate.
+//
+// Models are built on a floe's first case past the screen (meshing and factorisations)
 // and kept for its later ones; a floe that splits drops its model, and its
 // pieces are not checked again in the step that made them.
 
