@@ -288,6 +288,7 @@ int run(const Args& args, const parallel::Session& session) {
   }
   if (const PercussionStats* f = sim.percussion_stats())
     o << "fracture.checks: " << f->checks << "\nfracture.screened: " << f->screened
+      << "\nfracture.bounded: " << f->bounded
       << "\nfracture.sustained: " << f->sustained << "\nfracture.initiations: " << f->initiations
       << "\nfracture.splits: " << f->splits << "\nfracture.seconds: " << f->seconds
       << "\nfracture.split_seconds: " << f->split_seconds << "\n";

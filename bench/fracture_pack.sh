@@ -4,8 +4,8 @@
 # they are analysed, but nothing breaks); and on with the ice's 0.5 MPa
 # ("ice": floes break and split), run alternately, REPEATS rounds, one
 # thread. Writes CSV on stdout:
-#   scenario,variant,round,wall_s,steps,checks,screened,sustained,initiations,splits,analysis_s,split_s
-# (analysis_s: wall time in the analyses; split_s: in the splits, without
+#   scenario,variant,round,wall_s,steps,checks,screened,bounded,sustained,initiations,splits,analysis_s,split_s
+# (bounded: cases skipped by the stress bound; analysis_s: wall time in the analyses and bounds; split_s: in the splits, without
 # the rebuild of the per-floe structures after them).
 # Scenarios: wall_100 (examples/pack_against_wall.h5, 15 m/s wind against the
 # wall, 3000 s) and drift_500 (500 floes of 0.5 to 2 m at 50% in a periodic
@@ -48,7 +48,7 @@ for v in off strong ice; do
   write drift_500 "$DIR/drift_500.h5" 1000 "domain = \"periodic\"
 box = [0.0, 2000.0, 0.0, 2000.0]" $v
 done
-echo "scenario,variant,round,wall_s,steps,checks,screened,sustained,initiations,splits,analysis_s,split_s"
+echo "scenario,variant,round,wall_s,steps,checks,screened,bounded,sustained,initiations,splits,analysis_s,split_s"
 for r in $(seq 1 "$REPEATS"); do
   for s in wall_100 drift_500; do
     for v in off strong ice; do
@@ -56,7 +56,7 @@ for r in $(seq 1 "$REPEATS"); do
       out=$(OMP_NUM_THREADS=1 "$BIN" run "$DIR/${s}_$v.toml" -q -o "$DIR/out.h5")
       end=$(date +%s.%N)
       get() { printf '%s\n' "$out" | awk -F': ' -v k="$1" '$1 == k { print $2 }'; }
-      echo "$s,$v,$r,$(echo "$end - $start" | bc),$(get steps),$(get fracture.checks),$(get fracture.screened),$(get fracture.sustained),$(get fracture.initiations),$(get fracture.splits),$(get fracture.seconds),$(get fracture.split_seconds)"
+      echo "$s,$v,$r,$(echo "$end - $start" | bc),$(get steps),$(get fracture.checks),$(get fracture.screened),$(get fracture.bounded),$(get fracture.sustained),$(get fracture.initiations),$(get fracture.splits),$(get fracture.seconds),$(get fracture.split_seconds)"
     done
   done
 done

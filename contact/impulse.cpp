@@ -475,7 +475,7 @@ void record_impulses(ImpulseRecord& record, const Floes& floes, std::span<const 
       if (floes.is_static[f]) continue;
       const Vec2 world = sign > 0.0 ? Vec2(ci.point - c.shift) : ci.point;
       record.loads.push_back({f, event, body_point(floes, f, world), body_direction(floes, f, sign * ci.vector),
-                              sustained});
+                              sustained, sign > 0.0 ? c.a : c.b, ci.normal, ci.point});
     }
   }
 }

@@ -154,6 +154,12 @@ struct ImpulseRecord {
     Vec2 point = Vec2::Zero();    // m, body frame of `floe`
     Vec2 impulse = Vec2::Zero();  // N s, body frame of `floe`
     bool sustained = false;
+    // The contact as a collision (the run file's /events/collisions): the
+    // other floe (an index, static or not), the contact's normal impulse
+    // lambda >= 0 (N s) and its point (m, world, in a's image).
+    std::uint32_t other = 0;
+    double normal = 0.0;
+    Vec2 world = Vec2::Zero();
   };
   std::vector<Load> loads;
   std::uint32_t events = 0;

@@ -62,6 +62,7 @@ void write_checkpoint_group(hid_t file, const std::string& name, const Checkpoin
   h5::set_attr(g, "next_record", static_cast<double>(c.next_record));
   h5::set_attr(g, "records", static_cast<double>(c.records));
   h5::set_attr(g, "fracture_events", static_cast<double>(c.fracture_events));
+  h5::set_attr(g, "collision_events", static_cast<double>(c.collision_events));
   h5::set_attr(g, "floor_pair", c.floor_pair);
   write_floes(g, c.floes);
   if (c.sea.present) write_modal(g, "sea", c.sea);
@@ -213,6 +214,8 @@ Checkpoint read_checkpoint(const std::string& path) {
   c.next_record = r.count(g, "next_record");
   c.records = r.count(g, "records");
   c.fracture_events = r.count(g, "fracture_events");
+  // Absent from checkpoints written before /events/collisions existed.
+  c.collision_events = h5::has_attr(g, "collision_events") ? r.count(g, "collision_events") : 0;
   c.floor_pair = h5::has_attr(g, "floor_pair") ? h5::get_attr_string(g, "floor_pair") : "";
   c.floes = read_floes(r, g);
   c.sea = r.modal(g, "sea");

@@ -90,6 +90,7 @@ struct Checkpoint {
   long long next_record = 1;        // index k of the next scheduled record, at k output_interval
   long long records = 0;            // records written on schedule up to this state
   long long fracture_events = 0;    // rows of /events/fracture up to this state
+  long long collision_events = 0;   // rows of /events/collisions up to this state
   std::vector<long long> record_floes;  // floes numbered at each of those records (/floes tables' sizes)
 };
 

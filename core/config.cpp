@@ -219,6 +219,7 @@ void read_run(Section s, RunParams& r) {
   r.checkpoint_interval = s.number("checkpoint_interval", r.checkpoint_interval,
                                    [](double v) { return std::isfinite(v) && v >= 0.0; },
                                    "an interval >= 0 (s; 0: a checkpoint only at the end)");
+  r.record_collisions = s.boolean("record_collisions", r.record_collisions);
   s.finish();
 }
 
@@ -701,7 +702,8 @@ toml::array pair_array(const std::array<double, 2>& a) { return toml::array{a[0]
 std::string resolved_toml(const Config& c) {
   toml::table run{{"t_end", c.run.t_end}, {"dt_max", c.run.dt_max},
                   {"output_interval", c.run.output_interval},
-                  {"seed", static_cast<int64_t>(c.run.seed)}, {"checkpoint_interval", c.run.checkpoint_interval}};
+                  {"seed", static_cast<int64_t>(c.run.seed)}, {"checkpoint_interval", c.run.checkpoint_interval},
+                  {"record_collisions", c.run.record_collisions}};
   const WaveParams& w = c.sea.waves;
   toml::table waves{{"kind", name_of<WaveKind>(w.kind, {{"none", WaveKind::none}, {"regular", WaveKind::regular},
                                                          {"standing", WaveKind::standing}, {"jonswap", WaveKind::jonswap}})},

@@ -24,6 +24,9 @@ struct RunParams {
   // `floesim run --restart`); 0: only at the end, on an interruption and on
   // a run error. An execution setting like threads: results do not depend on it.
   double checkpoint_interval = 0.0;
+  // Record every collision solve's impulses, per pair of floes, in the run
+  // file (/events/collisions; docs/formats.md).
+  bool record_collisions = false;
 };
 
 enum class SeaModel { none, spectral, bem };

@@ -22,9 +22,10 @@ namespace fs = std::filesystem;
 
 struct RunWriter::Impl {
   std::string path;
-  h5::Handle file, floes_group, xdmf_group, time, state, energy, lcp, substeps, verts, eta, events;
+  h5::Handle file, floes_group, xdmf_group, time, state, energy, lcp, substeps, verts, eta, events, collisions;
   std::size_t n = 0, nverts = 0, records = 0;  // floes (numbers) and vertices in the /floes tables
   std::size_t event_rows = 0;  // rows of /events/fracture
+  std::size_t collision_rows = 0;  // rows of /events/collisions
   // The /floes tables, one row per floe number, and the XDMF topology.
   std::vector<long long> offsets{0}, topology;
   std::vector<double> vertices, thickness, mass, area;
@@ -312,6 +313,22 @@ void RunWriter::record_fracture(std::span<const FractureEventRow> events) {
   });
 }
 
+void RunWriter::record_collisions(std::span<const CollisionEventRow> events) {
+  Impl& w = *impl_;
+  if (events.empty()) return;
+  w.guarded([&] {
+    w.reserve_for_writes(8 * kCollisionEventColumns * events.size());
+    if (!w.collisions.valid()) {  // made by the first rows: a run that records none has no /events/collisions
+      h5::Handle ev = h5::open_group(w.file, "/events", w.path);
+      w.collisions = h5::create_extendible(ev, "collisions", {kCollisionEventColumns});
+      h5::set_attr(w.collisions, "columns", std::vector<std::string>(std::begin(kCollisionEventColumnNames),
+                                                                     std::end(kCollisionEventColumnNames)));
+    }
+    for (const CollisionEventRow& e : events) h5::append_row(w.collisions, reinterpret_cast<const double*>(&e));
+    w.collision_rows += events.size();
+  });
+}
+
 RunWriter::RunWriter(Resume, const std::string& path, const Checkpoint& c, const std::string& config_toml,
                      const std::vector<std::string>& energy_columns, const SeaGridInfo& sea)
     : impl_(std::make_unique<Impl>()) {
@@ -379,6 +396,18 @@ RunWriter::RunWriter(Resume, const std::string& path, const Checkpoint& c, const
     h5::set_extent(w.events, {events, kFractureEventColumns});
     w.event_rows = events;
   }
+  {
+    // Made by the first rows (record_collisions): absent until then.
+    const auto rows = static_cast<std::size_t>(c.collision_events);
+    if (h5::exists(ev, "collisions")) {
+      w.collisions = h5::open_dataset(ev, "collisions", path);
+      if (h5::dims(w.collisions).at(0) < rows) fail("/events/collisions has fewer rows than the checkpoint counts");
+      h5::set_extent(w.collisions, {rows, kCollisionEventColumns});
+    } else if (rows > 0) {
+      fail("/events/collisions is missing, the checkpoint counts " + std::to_string(rows) + " rows");
+    }
+    w.collision_rows = rows;
+  }
   if (sea.dims > 0) {
     h5::Handle s = h5::open_group(w.file, "/sea", path);
     w.eta = open_rows(s, "eta", "/sea/eta");
@@ -400,6 +429,7 @@ void RunWriter::count_into(Checkpoint& c) const {
   const Impl& w = *impl_;
   c.records = static_cast<long long>(w.records);
   c.fracture_events = static_cast<long long>(w.event_rows);
+  c.collision_events = static_cast<long long>(w.collision_rows);
   c.record_floes.assign(w.record_floes.begin(), w.record_floes.end());
 }
 

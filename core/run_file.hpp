@@ -18,6 +18,9 @@
 //   records where it does not exist (before it was made, after it split).
 //   /events/fracture [E, 17] (columns attribute): one row per fracture
 //     initiation, FractureEventRow below.
+//   /events/collisions [C, 7] (columns attribute): one row per collision
+//     solve and pair of floes, CollisionEventRow; only in runs with
+//     [run] record_collisions that had a collision.
 //   /sea/x [nx], /sea/y [ny], /sea/eta [T, ny, nx] (dims 2) or [T, nx] (dims 1)
 //   /diagnostics/energy [T, k] (columns attribute; the last column is "total")
 //   /diagnostics/lcp [T, 4]: solves, pivots, failures, fallbacks (cumulative)
@@ -69,6 +72,20 @@ inline constexpr const char* kFractureEventColumnNames[kFractureEventColumns] = 
     "time", "floe", "x", "y", "direction", "load", "stress", "x0", "y0", "x1", "y1",
     "criterion", "energy_released", "energy_needed", "delay", "piece_a", "piece_b"};
 
+// One pair's share of one collision solve (an LCP at the start of a step, a
+// sub-step event, a jam's time step): a row of /events/collisions.
+struct CollisionEventRow {
+  double time = 0.0;    // s, the end of the step the solve fell in
+  double floe_a = 0.0, floe_b = 0.0;  // the floes' numbers (floe_a < floe_b, or floe_b static)
+  double normal = 0.0;  // N s, the normal impulse of the pair's contacts, summed (compression + restitution)
+  double x = 0.0, y = 0.0;  // m, world: the contact point (impulse-weighted mean of the pair's points)
+  double resting = 0.0;  // 1: every contact of the pair rested (pushed by the step, speculative, jammed), 0: an impact
+};
+inline constexpr int kCollisionEventColumns = 7;
+static_assert(sizeof(CollisionEventRow) == kCollisionEventColumns * sizeof(double));
+inline constexpr const char* kCollisionEventColumnNames[kCollisionEventColumns] = {
+    "time", "floe_a", "floe_b", "normal", "x", "y", "resting"};
+
 inline constexpr int kSubstepColumns = 9;
 inline constexpr const char* kSubstepColumnNames[kSubstepColumns] = {
     "clusters", "substeps", "time_steps", "largest_cluster", "joined", "merges", "rejected", "floor_steps",
@@ -97,7 +114,7 @@ public:
             std::vector<std::string> energy_columns, const SeaGridInfo& sea = {},
             std::size_t expected_records = 0);
   // Continues the run file `path` from its checkpoint `c` (read_checkpoint):
-  // the records, fracture events and floe numbers after it are dropped (a
+  // the records, fracture and collision events and floe numbers after it are dropped (a
   // run that went on past its last checkpoint), and record() appends after
   // it. The status is "running" again and `config_toml` replaces the config
   // attribute. Throws InputError if the file's datasets do not hold what the
@@ -120,6 +137,9 @@ public:
   void note_floes(const Floes& floes);
   // Appends rows to /events/fracture and flushes.
   void record_fracture(std::span<const FractureEventRow> events);
+  // Appends rows to /events/collisions (flushed with the next record or
+  // fracture event; a run killed midway may lose the rows since).
+  void record_collisions(std::span<const CollisionEventRow> events);
 
   // Fills in c's counts of this file (records, fracture events, floes per
   // record) as they are now: call it when the records of the state `c`

@@ -3,6 +3,7 @@
 #include <chrono>
 #include <cmath>
 #include <map>
+#include <tuple>
 #include <utility>
 
 #include "contact/fracture/floe_fracture.hpp"
@@ -37,6 +38,36 @@ double radius_of(const Floes& floes, std::size_t i) {
 }
 
 }  // namespace
+
+std::vector<CollisionEventRow> collision_rows(const Floes& floes, const contact::ImpulseRecord& record, double t) {
+  // A contact between two dynamic floes is recorded on both: keep it once,
+  // from the floe with the lower index (or the dynamic one against a static).
+  struct Sum {
+    double normal = 0.0;
+    Vec2 point = Vec2::Zero(), weighted = Vec2::Zero();
+    bool resting = true;
+  };
+  std::map<std::tuple<std::uint32_t, std::uint32_t, std::uint32_t>, Sum> pairs;  // (event, number a, number b)
+  for (const contact::ImpulseRecord::Load& l : record.loads) {
+    if (l.floe >= floes.size() || l.other >= floes.size()) continue;
+    if (!floes.is_static[l.other] && l.other < l.floe) continue;
+    std::uint32_t a = floes.id[l.floe], b = floes.id[l.other];
+    if (!floes.is_static[l.other] && b < a) std::swap(a, b);
+    Sum& s = pairs[{l.event, a, b}];
+    s.normal += l.normal;
+    s.weighted += l.normal * l.world;
+    s.point = l.world;
+    s.resting = s.resting && l.sustained;
+  }
+  std::vector<CollisionEventRow> rows;
+  rows.reserve(pairs.size());
+  for (const auto& [key, s] : pairs) {
+    const Vec2 p = s.normal > 0.0 ? Vec2(s.weighted / s.normal) : s.point;
+    rows.push_back({t, static_cast<double>(std::get<1>(key)), static_cast<double>(std::get<2>(key)), s.normal, p.x(),
+                    p.y(), s.resting ? 1.0 : 0.0});
+  }
+  return rows;
+}
 
 Percussion::Percussion(const FractureParams& params, double gap, double screen)
     : params_(params), gap_(gap), screen_(screen) {}
@@ -129,6 +160,13 @@ bool Percussion::check(Floes& floes, const contact::ImpulseRecord& record, doubl
       if (e) loads.insert(loads.end(), e->impulses.begin(), e->impulses.end());
       const auto begin = std::chrono::steady_clock::now();
       fracture::FloeFracture& model = model_of(floes, i);
+      // The stress criterion cannot initiate below the strength: a case whose
+      // bound (Responder::stress_bound) is below it needs no time loop.
+      if (params_.criterion == FractureCriterion::stress && model.responder().stress_bound(loads) < params_.strength) {
+        stats_.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
+        ++stats_.bounded;
+        continue;
+      }
       const fracture::FloeFracture::Result result = model.analyse(loads);
       stats_.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
       ++stats_.checks;

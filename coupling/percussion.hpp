@@ -42,7 +42,11 @@
 // largest tensile stresses stay below these scales (docs/fracture.md), so
 // the default screen of 0.1 leaves a wide margin.
 //
-// Models are built on a floe's first analysis (meshing and factorisations)
+// Stress bound. Past the screen, a stress-criterion case whose exact upper
+// bound (fracture::Responder::stress_bound) is below the strength is not
+// analysed (PercussionStats::bounded): it could not initiate.
+//
+// Models are built on a floe's first case past the screen (meshing and factorisations)
 // and kept for its later ones; a floe that splits drops its model, and its
 // pieces are not checked again in the step that made them.
 
@@ -61,9 +65,16 @@ namespace floesim {
 
 namespace fracture { class FloeFracture; }
 
+// The step's collisions as rows of /events/collisions, from the loads of
+// `record` (floes at the end of the step, t): one row per solve and pair of
+// floes, the pair's contacts summed (normal impulse; point weighted by it).
+// Rows are in the order of the solves, then of the floe numbers.
+std::vector<CollisionEventRow> collision_rows(const Floes& floes, const contact::ImpulseRecord& record, double t);
+
 struct PercussionStats {
   long checks = 0;        // floes analysed (again when a step is redone)
   long screened = 0;      // floes loaded but below the screen
+  long bounded = 0;       // load cases past the screen whose stress bound is below the strength (not analysed)
   long sustained = 0;     // of checks, of sustained forces alone (static)
   long initiations = 0;   // events (a crack whose line leaves the floe at once, from a corner, is not split)
   long splits = 0;

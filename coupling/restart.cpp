@@ -95,6 +95,7 @@ Checkpoint Simulation::save() {
                            {"splits", p.splits}, {"failed_splits", p.failed_splits},
                            {"sustained", p.sustained}})
       k.add(std::string("fracture.") + name, static_cast<double>(v));
+    k.add("fracture.bounded", static_cast<double>(p.bounded));
     k.add("fracture.seconds", p.seconds);
     k.add("fracture.split_seconds", p.split_seconds);
   }
@@ -155,6 +156,9 @@ void Simulation::restore(const Checkpoint& c) {
                            {"initiations", &p.initiations}, {"splits", &p.splits},
                            {"failed_splits", &p.failed_splits}, {"sustained", &p.sustained}})
       *v = count(std::string("fracture.") + name);
+    // Absent from checkpoints written before the stress bound.
+    if (std::find(c.counter_names.begin(), c.counter_names.end(), "fracture.bounded") != c.counter_names.end())
+      p.bounded = count("fracture.bounded");
     p.seconds = counter("fracture.seconds");
     p.split_seconds = counter("fracture.split_seconds");
     percussion_->restore_stats(p);

@@ -95,9 +95,11 @@ RunSummary run_simulation(Simulation& sim, const RunOptions& options) {
         // The ranks agree after each step: on a failure of any, and on stopping.
         comm.together([&] {
           sim.step(t_record);
+          std::vector<CollisionEventRow> collisions = sim.take_collision_events();
           std::vector<FractureEventRow> events = sim.take_fracture_events();
           if (writer) {
             writer->note_floes(sim.floes());  // floes made by splits (numbers are never reused)
+            writer->record_collisions(collisions);
             writer->record_fracture(events);
           }
           if (options.progress) options.progress({sim.time(), t_end, sim.steps(), wall()});

@@ -115,8 +115,9 @@ Simulation::Simulation(Scenario scenario, parallel::Communicator comm)
     floe_sea_->ready_loads(scenario_.floes, *sea_, incident_.get(), 0.5 * c.run.dt_max);
   }
   // Pieces of a split are opened by the gap that collisions keep between floes.
-  if (c.fracture.enabled) {
-    percussion_ = std::make_unique<Percussion>(c.fracture, impulse_options_.min_gap);
+  if (c.fracture.enabled) percussion_ = std::make_unique<Percussion>(c.fracture, impulse_options_.min_gap);
+  record_collisions_ = c.run.record_collisions;
+  if (percussion_ || record_collisions_) {
     impulse_record_ = std::make_unique<contact::ImpulseRecord>();
     impulse_options_.record = impulse_record_.get();
   }
@@ -142,6 +143,7 @@ double Simulation::step(double t_stop) {
   budget_.collisions += step_budget_.collisions;
   // Land exactly on t_stop when the step was cut to reach it.
   t_ = ctx.dt == t_stop - ctx.t ? t_stop : ctx.t + ctx.dt;
+  { PhaseTimer _(profile_, Phase::record);     note_collisions(); }
   { PhaseTimer _(profile_, Phase::percussion); percussion(ctx); }
   { PhaseTimer _(profile_, Phase::check);     check_state(ctx); }
   ++steps_;
@@ -228,6 +230,13 @@ void Simulation::collide(StepContext& ctx) {
   const Vec2 after = momentum();
   step_budget_.collisions = after - ctx.momentum;
   ctx.momentum = after;
+}
+
+void Simulation::note_collisions() {
+  // Before percussion: a split renumbers the floes the record refers to.
+  if (!record_collisions_) return;
+  const std::vector<CollisionEventRow> rows = collision_rows(scenario_.floes, *impulse_record_, t_);
+  collision_events_.insert(collision_events_.end(), rows.begin(), rows.end());
 }
 
 void Simulation::percussion(const StepContext& ctx) {

@@ -43,6 +43,7 @@
 #include <memory>
 #include <span>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "coupling/drift.hpp"
@@ -141,6 +142,8 @@ public:
 
   // Fracture initiations since the last call ([fracture] enabled), and counts.
   std::vector<FractureEventRow> take_fracture_events();
+  // The collisions since the last call ([run] record_collisions; rows of /events/collisions).
+  std::vector<CollisionEventRow> take_collision_events() { return std::exchange(collision_events_, {}); }
   const PercussionStats* percussion_stats() const { return percussion_ ? &percussion_->stats() : nullptr; }
 
   // The sea surface, if the run has one ([sea] model != "none").
@@ -159,6 +162,7 @@ private:
   void sea_half_kick(const StepContext& ctx);
   void drift(StepContext& ctx);
   void collide(StepContext& ctx);
+  void note_collisions();
   void percussion(const StepContext& ctx);
   void on_floes_changed();  // rebuilds every per-floe structure (after a split)
   void advance(const StepContext& ctx);
@@ -186,8 +190,11 @@ private:
   contact::Detection detection_;  // at the present positions
   contact::CollisionStats stats_;
   std::unique_ptr<Percussion> percussion_;  // [fracture] enabled
-  // The step's contact impulses for percussion (impulse_options_.record; null without fracture).
+  // The step's contact impulses for percussion and /events/collisions
+  // (impulse_options_.record; null without fracture and record_collisions).
   std::unique_ptr<contact::ImpulseRecord> impulse_record_;
+  bool record_collisions_ = false;
+  std::vector<CollisionEventRow> collision_events_;  // since take_collision_events()
   MomentumBudget budget_, step_budget_;  // run total; this step's (redone steps do not count)
   contact::SubstepReport substeps_;  // collision sub-steps (floors, merges, ...)
   long rejected_steps_ = 0;       // steps redone after an overlap

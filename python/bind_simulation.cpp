@@ -153,6 +153,15 @@ void bind_simulation(py::module_& m) {
              return a;
            },
            "Fracture initiations since the last call, rows of FRACTURE_EVENT_COLUMNS.")
+      .def("take_collision_events",
+           [](Simulation& s) {
+             const std::vector<CollisionEventRow> rows = s.take_collision_events();
+             Array a({static_cast<py::ssize_t>(rows.size()), static_cast<py::ssize_t>(kCollisionEventColumns)});
+             if (!rows.empty()) std::copy_n(&rows[0].time, rows.size() * kCollisionEventColumns, a.mutable_data());
+             return a;
+           },
+           "Collisions since the last call ([run] record_collisions), rows of COLLISION_EVENT_COLUMNS: "
+           "one per solve and pair of floes.")
       .def_property_readonly("mass", [](const Simulation& s) { return per_floe(s.floes().mass); })
       .def_property_readonly("thickness", [](const Simulation& s) { return per_floe(s.floes().thickness); })
       .def_property_readonly("area", [](const Simulation& s) { return per_floe(s.floes().area); })

@@ -22,6 +22,10 @@ PYBIND11_MODULE(_floesim, m) {
   for (int k = 0; k < floesim::kFractureEventColumns; ++k)
     events[static_cast<std::size_t>(k)] = floesim::kFractureEventColumnNames[k];
   m.attr("FRACTURE_EVENT_COLUMNS") = events;
+  py::tuple collisions(floesim::kCollisionEventColumns);
+  for (int k = 0; k < floesim::kCollisionEventColumns; ++k)
+    collisions[static_cast<std::size_t>(k)] = floesim::kCollisionEventColumnNames[k];
+  m.attr("COLLISION_EVENT_COLUMNS") = collisions;
   floesim::python::bind_config(m);
   floesim::python::bind_simulation(m);
   floesim::python::bind_run_file(m);

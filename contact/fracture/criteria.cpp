@@ -33,7 +33,31 @@ Initiation judge_stress(const Responder& responder, const Response& response, st
   r.time = s.time;
   r.load_factor = s.max_principal > 0.0 ? options.strength / s.max_principal : std::numeric_limits<double>::infinity();
   r.initiates = s.max_principal >= options.strength;
-  const Chord c = chord_through(polygon, r.point, unit(r.direction));
+  Chord c = chord_through(polygon, r.point, unit(r.direction));
+  if (!c.valid && s.u.size() > 0) {
+    // A peak on the outline, at a corner the crack's line only touches from
+    // outside: the mesh puts the peak on a node, and coarse meshes put it on
+    // the polygon's corners, so the crack is started where the mesh resolves
+    // it, at the centroid of the node's most stressed triangle (one element
+    // from the node; the same place as the mesh is refined), with the node's
+    // direction.
+    const Mesh& mesh = responder.model().mesh();
+    const std::vector<Eigen::Vector3d> stress = responder.model().element_stress(s.u);
+    double best = -std::numeric_limits<double>::infinity();
+    for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
+      const auto& tri = mesh.triangles[t];
+      if (std::find(tri.begin(), tri.end(), static_cast<int>(s.node)) == tri.end()) continue;
+      const double value = principal(stress[t]).value;
+      if (!(value > best)) continue;
+      const Vec2 centroid = (mesh.nodes[static_cast<std::size_t>(tri[0])] + mesh.nodes[static_cast<std::size_t>(tri[1])] +
+                             mesh.nodes[static_cast<std::size_t>(tri[2])]) / 3.0;
+      const Chord inside = chord_through(polygon, centroid, unit(r.direction));
+      if (!inside.valid) continue;
+      best = value;
+      r.point = centroid;
+      c = inside;
+    }
+  }
   if (c.valid) {
     r.crack_from = c.from;
     r.crack_to = c.to;

@@ -23,13 +23,13 @@ void observe_state(const ElasticModel& model, double t, const Eigen::VectorXd& u
   Snapshot now;
   now.time = t;
   for (std::size_t i = 0; i < s.size(); ++i) {
-    const Principal p = principal(s[i]);
-    if (p.value > now.max_principal) {
-      now.max_principal = p.value;
+    const double value = 0.5 * (s[i][0] + s[i][1]) + std::hypot(0.5 * (s[i][0] - s[i][1]), s[i][2]);  // sigma_1
+    if (value > now.max_principal) {
+      now.max_principal = value;
       now.node = i;
-      now.angle = p.angle;
     }
   }
+  if (!s.empty()) now.angle = principal(s[now.node]).angle;  // the direction where it matters only
   now.strain_energy = model.strain_energy(u);
   const bool stress = now.max_principal > r.peak_stress.max_principal;
   const bool energy = now.strain_energy > r.peak_energy.strain_energy || r.peak_energy.u.size() == 0;
@@ -60,10 +60,33 @@ Responder::Responder(const ElasticModel& model, const ResponseOptions& options) 
   }
   t_end_ = steps_ * dt_;
   beta_ = 2.0 * options.damping * model.mesh().size / (M_PI * c);
+  min_area_ = std::numeric_limits<double>::infinity();
+  for (std::size_t t = 0; t < model.mesh().triangles.size(); ++t) min_area_ = std::min(min_area_, model.mesh().area(t));
   eps_ = 1e-6 * (c / d) * (c / d);
 }
 
 Responder::~Responder() = default;
+
+double Responder::stress_bound(std::span<const PointLoad> loads) {
+  // Static part: its largest sigma_1, as respond() finds it (one solve).
+  double bound = 0.0;
+  const Eigen::VectorXd fs = nodal_loads(loads, false);
+  if (fs.squaredNorm() > 0.0) {
+    double largest = -std::numeric_limits<double>::infinity();
+    for (const Eigen::Vector3d& s : model_.nodal_stress(solve_static(fs)))
+      largest = std::max(largest, 0.5 * (s[0] + s[1]) + std::hypot(0.5 * (s[0] - s[1]), s[2]));
+    bound = largest;
+  }
+  // Dynamic part: the energy bound (response.hpp).
+  const bool dynamic = std::any_of(loads.begin(), loads.end(), [](const PointLoad& l) { return l.impulse; });
+  if (dynamic) {
+    const Eigen::VectorXd j = model_.relieve(nodal_loads(loads, true));
+    const double energy = 0.5 * j.cwiseAbs2().cwiseQuotient(model_.lumped_mass()).sum();  // J
+    const Material& mat = model_.material();
+    bound += std::sqrt(2.0 * mat.young * energy / ((1.0 - mat.poisson * mat.poisson) * mat.thickness * min_area_));
+  }
+  return bound;
+}
 
 Eigen::VectorXd Responder::nodal_loads(std::span<const PointLoad> loads, bool impulses) const {
   Eigen::VectorXd f = Eigen::VectorXd::Zero(model_.dofs());

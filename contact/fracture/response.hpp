@@ -103,10 +103,32 @@ public:
 
   Response respond(std::span<const PointLoad> loads, const Observer& observe = {});
 
+  // An upper bound of the largest sigma_1 that respond(loads) finds, at the
+  // cost of a static solve (none without static forces) instead of its time
+  // loop: a load case whose bound is below the strength cannot initiate by
+  // the stress criterion, so skipping it changes nothing.
+  //   bound = max over nodes of sigma_1(u_static) + sqrt(2 E U / ((1 - nu^2) h A_min)),
+  //   U = j_r^T M^-1 j_r / 2,  j_r = relieve(nodal impulses).
+  // Why. The elastic modes phi_n (M-orthonormal; C = beta K keeps them
+  // uncoupled) are each driven by phi_n^T j_r times the half-sine pulse,
+  // which has one sign, so a mode's energy (v^2 + omega^2 q^2) / 2 never
+  // exceeds (phi_n^T j_r)^2 / 2: exactly, |int F e^{i omega t} dt| <= int F dt;
+  // in the discrete response, the trapezoidal rule's step is a contraction in
+  // (v, omega q) (a Cayley transform of a dissipative system) and the forcing
+  // enters through an operator of norm <= 1 with the pulse's fractions
+  // summing to one. So the strain energy never exceeds U (the sum over the
+  // modes). In a linear triangle of area A whose largest principal stress
+  // is sigma_1, the strain energy is at least A h sigma_1^2 (1 - nu^2) / (2 E)
+  // (the least of (s1^2 + s2^2 - 2 nu s1 s2) / (2 E) over s2, at s2 = nu s1);
+  // a nodal stress is a mean of its triangles' (sigma_1 is convex) and
+  // sigma_1 of a sum is at most the sum of the sigma_1 (subadditive).
+  double stress_bound(std::span<const PointLoad> loads);
+
 private:
   const ElasticModel& model_;
   ResponseOptions options_;
   double dt_ = 0.0, t_end_ = 0.0, beta_ = 0.0, eps_ = 0.0;
+  double min_area_ = 0.0;  // m^2, the smallest triangle (stress_bound)
   int steps_ = 0;
   std::unique_ptr<SpdFactor> static_, dynamic_;
 };

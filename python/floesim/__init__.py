@@ -21,10 +21,11 @@ import re
 import numpy as np
 
 from . import _floesim
-from ._floesim import FRACTURE_EVENT_COLUMNS, LCP_COLUMNS, STATE_COLUMNS, InputError, RunError, __version__
+from ._floesim import COLLISION_EVENT_COLUMNS, FRACTURE_EVENT_COLUMNS, LCP_COLUMNS, STATE_COLUMNS, InputError, RunError, __version__
 
 __all__ = ["Config", "Simulation", "RunFile", "read_run", "compare_runs", "InputError", "RunError",
-           "STATE_COLUMNS", "LCP_COLUMNS", "FRACTURE_EVENT_COLUMNS", "__version__"]
+           "STATE_COLUMNS", "LCP_COLUMNS", "FRACTURE_EVENT_COLUMNS", "COLLISION_EVENT_COLUMNS",
+           "__version__"]
 
 
 def _frozen(value):
@@ -433,6 +434,14 @@ class RunFile:
         if "/events/fracture" not in self.info["datasets"]:
             return np.zeros((0, len(FRACTURE_EVENT_COLUMNS)))
         return self["/events/fracture"]
+
+    @property
+    def collision_events(self):
+        """[k, 7] collisions (COLLISION_EVENT_COLUMNS; [run] record_collisions): one row per
+        solve and pair of floes; empty when not recorded."""
+        if "/events/collisions" not in self.info["datasets"]:
+            return np.zeros((0, len(COLLISION_EVENT_COLUMNS)))
+        return self["/events/collisions"]
 
     @property
     def mass(self):

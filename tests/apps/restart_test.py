@@ -203,6 +203,7 @@ FRACTURE = """
 t_end = 8.0
 dt_max = 0.1
 output_interval = 0.25
+record_collisions = true
 
 [sea]
 model = "none"
@@ -300,9 +301,11 @@ def case_fracture():
     # ... and before the impact: the events come after the restart.
     data = continuation(FRACTURE, 8, 2, "fracture_before")
     check(np.all(data["events/fracture"][:, 0] > 2), "the fracture after the restart")
+    check(data["events/collisions"].shape[0] >= 1 and np.all(data["events/collisions"][:, 0] > 2),
+          "the collisions after the restart (/events/collisions, [run] record_collisions)")
     # A run that went on past its last checkpoint (as a killed run does):
     # the full run's file with the checkpoint of 2 s. The restart drops the
-    # records, the fracture events and the pieces' numbers after 2 s, and
+    # records, the fracture and collision events and the pieces' numbers after 2 s, and
     # writes them again, equal.
     shutil.copy(os.path.join(WORK, "full.h5"), os.path.join(WORK, "spliced.h5"))
     with h5py.File(os.path.join(WORK, "spliced.h5"), "a") as f, h5py.File(os.path.join(WORK, "half.h5"), "r") as h:

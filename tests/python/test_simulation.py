@@ -135,6 +135,39 @@ class MatchesTheCommandLine(unittest.TestCase):
             polys = run.polygons(-1)
             self.assertEqual([p is None for p in polys], [True, True, False, False, False, False])
 
+    def test_collisions_in_the_run_file_are_the_solver_impulses(self):
+        # tests/regression/two_floes_collide.toml with [run] record_collisions:
+        # the run file's /events/collisions are the rows Python takes step by
+        # step, and the impacts' impulses are the floes' changes of momentum.
+        with open(os.path.join(SRC, "tests", "regression", "two_floes_collide.toml")) as f:
+            text = f.read().replace("[run]\n", "[run]\nrecord_collisions = true\n", 1)
+        with tempfile.TemporaryDirectory() as d:
+            case = os.path.join(d, "case.toml")
+            with open(case, "w") as f:
+                f.write(text)
+            out = os.path.join(d, "out.h5")
+            subprocess.run([FLOESIM, "run", case, "-q", "-o", out], check=True, capture_output=True)
+            run = floesim.read_run(out)
+            sim = floesim.Simulation(case)
+            rows = []
+            for t in run.time:
+                sim.run_until(t)
+                rows.append(sim.take_collision_events())
+            rows = np.vstack(rows)
+            np.testing.assert_array_equal(rows, run.collision_events)
+            cols = list(floesim.COLLISION_EVENT_COLUMNS)
+            self.assertEqual(cols, ["time", "floe_a", "floe_b", "normal", "x", "y", "resting"])
+            impacts = rows[rows[:, cols.index("resting")] == 0]
+            self.assertGreaterEqual(len(impacts), 1)
+            self.assertTrue(np.all(rows[:, cols.index("normal")] > 0))
+            self.assertTrue(np.all(rows[:, 1] == 0) and np.all(rows[:, 2] == 1))
+            # The first impact falls between the records where floe 0's velocity
+            # jumps most (ocean drag changes it slowly otherwise).
+            vx = run.state[:, 0, floesim.STATE_COLUMNS.index("vx")]
+            k = int(np.argmax(np.abs(np.diff(vx))))
+            self.assertGreater(impacts[0, 0], run.time[k])
+            self.assertLessEqual(impacts[0, 0], run.time[k + 1])
+
     def test_run_writes_a_run_file(self):
         cfg = floesim.Config.load(os.path.join(SRC, "tests", "regression", "two_floes_collide.toml"))
         with tempfile.TemporaryDirectory() as d:

@@ -8,7 +8,7 @@ waves are 5.3 m long, 5.4 disc diameters, and the disc is far below its
 heave and pitch resonance (about 0.27 s), so it follows the surface
 (analytic long-wave limit: heave and pitch RAO 1, surge RAO 1 / tanh(k h),
 the water particle's orbit); an array cannot transmit much more energy than
-comes in; neighbours 2 cm apart in 40 mm waves collide.
+comes in; neighbours 2 cm apart in 40 mm waves collide (the run's recorded collisions).
 """
 import csv
 import math
@@ -59,6 +59,17 @@ class Pieces(unittest.TestCase):
         self.assertAlmostEqual(r["x"], 0.9, delta=2e-3)
         fixed = abs(citeph.fit_amplitude(t, np.array(series["heave"]), omega)) / a0
         self.assertLess(fixed, 0.7)
+
+    def test_collision_episodes_group_the_rows_of_a_contact(self):
+        # Rows of /events/collisions (time, floe_a, floe_b, normal, x, y, resting),
+        # steps of 0.1 s: discs 3 and 4 (both middle) collide at 1.0 s and stay
+        # in contact two more steps, then collide again at 2.0 s; 4 and 9 (9 not
+        # middle) once; 7 and 8 (neither) are left out.
+        rows = [[1.0, 3, 4, 2.0, 0, 0, 0], [1.1, 3, 4, 0.5, 0, 0, 1], [1.2, 3, 4, 0.5, 0, 0, 1],
+                [2.0, 3, 4, 1.0, 0, 0, 0], [1.5, 4, 9, 0.7, 0, 0, 0], [1.5, 7, 8, 9.0, 0, 0, 0]]
+        times, impulses = citeph.collision_episodes(rows, [3, 4], 0.2)
+        self.assertEqual(sorted(zip(times, impulses)),
+                         [(1.0, 3.0), (1.0, 3.0), (1.5, 0.7), (2.0, 1.0), (2.0, 1.0)])
 
     def test_lattices_reach_the_concentrations_without_overlap(self):
         strip = (10.0, 10.0 + citeph.STRIP)

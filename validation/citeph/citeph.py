@@ -23,13 +23,14 @@ motions against the incident wave the disc meets on its way (`response`: the emp
 read at the disc's centre), which also takes the Doppler shift of the drift.
 Probe amplitudes are fitted as a cos(w t) + b sin(w t) + c0 + c1 t + c2 t^2.
 
-Collisions (79% array): the discs in the middle of the array and their
-neighbours are sampled every step over the window; a collision of two discs
-starts when their centres come within DIAMETER + collision_distance and ends
-when they part again (`collisions`). The mean time between collisions is the
-window times the number of middle discs over the number of their collisions
-(a collision of two middle discs counts for both); the impulse is the jump of
-the pair's relative normal velocity times m / 2.
+Collisions (79% array): the run records the collision solver's impulses
+([run] record_collisions: one row per solve and pair of discs, its normal
+impulse, docs/formats.md), taken over the window. A collision of two discs is
+a run of rows of their pair no more than two steps apart (an impact and the
+contact held after it; `collision_episodes`), its impulse the sum of their
+normal impulses. The mean time between collisions is the window times the
+number of middle discs over the number of their collisions (a collision of
+two middle discs counts for both).
 
     python3 validation/citeph/citeph.py generate OUTDIR [--resolution NAME]
     python3 validation/citeph/citeph.py run WORKDIR [--jobs 2] [--resolution NAME] [--only REGEX]
@@ -248,6 +249,7 @@ t_end = {b['duration']:.6f}
 dt_max = {b['dt']:.8f}
 output_interval = {b['dt']:.8f}
 threads = 1
+record_collisions = {'true' if len(centres) > 1 else 'false'}
 
 [sea]
 model = "spectral"
@@ -308,30 +310,35 @@ def middle_discs(centres, strip):
             if x0 + (x1 - x0) / 3 <= x <= x1 - (x1 - x0) / 3 and 0.25 * WIDTH <= y <= 0.75 * WIDTH]
 
 
-def collisions(t, state, i, neighbours, mass, contact_distance, cols):
-    """Collisions of disc i with its neighbours from states [n, floes, 12]
-    sampled every step. A collision starts when two centres come closer than
-    DIAMETER + contact_distance (the floes are in contact, [contact]
-    collision_distance) and ends when they part by twice that; its impulse is
-    the change of their relative normal velocity from the step before to the
-    step after, times the reduced mass m / 2. Returns (times, impulses)."""
-    ix, iy, ivx, ivy = (cols.index(c) for c in ("x", "y", "vx", "vy"))
+def collision_episodes(rows, discs, gap):
+    """Collisions of the discs `discs` from rows of /events/collisions
+    (time, floe_a, floe_b, normal, x, y, resting; floe numbers are the discs'
+    indices): the rows of a pair whose times are at most `gap` apart are one
+    collision (an impact, then the contact held after it, one row per
+    step), at the time of its first row, with the sum of their normal
+    impulses. A collision of two discs of `discs` counts for both.
+    Returns (times, impulses)."""
+    discs = set(discs)
+    rows = np.asarray(rows, dtype=float).reshape(-1, 7)
+    pairs = {}
+    for time, a, b, normal, *_ in rows:
+        pairs.setdefault((int(a), int(b)), []).append((time, normal))
     times, impulses = [], []
-    for j in neighbours:
-        d = state[:, j, [ix, iy]] - state[:, i, [ix, iy]]
-        dist = np.linalg.norm(d, axis=1)
-        n = d / dist[:, None]
-        v = state[:, j, [ivx, ivy]] - state[:, i, [ivx, ivy]]
-        touching = False
-        for k in range(1, len(t) - 1):
-            if not touching and dist[k] < DIAMETER + contact_distance:
-                touching = True
-                before = np.dot(v[k - 1], n[k])
-                after = np.dot(v[k + 1], n[k])
-                times.append(t[k])
-                impulses.append(0.5 * mass * abs(after - before))
-            elif touching and dist[k] > DIAMETER + 2 * contact_distance:
-                touching = False
+    for (a, b), hits in sorted(pairs.items()):
+        weight = (a in discs) + (b in discs)
+        if not weight:
+            continue
+        hits.sort()
+        start, total, last = hits[0][0], 0.0, None
+        for time, normal in hits:
+            if last is not None and time - last > gap:
+                times.extend([start] * weight)
+                impulses.extend([total] * weight)
+                start, total = time, 0.0
+            total += normal
+            last = time
+        times.extend([start] * weight)
+        impulses.extend([total] * weight)
     return times, impulses
 
 
@@ -378,7 +385,7 @@ def run_case(job):
     t_window = t_end - job["window_periods"] * period
     probe_cols = [int(p / dx) for p in layout["probes"]]
     disc_col = int(layout["disc"][0] / dx)
-    times, states, probes, at_disc, rows = [], [], [], [], []
+    times, states, probes, at_disc, rows, hits = [], [], [], [], [], []
     dt = layout["dt"]
     start = time.time()
     cpu0 = resource.getrusage(resource.RUSAGE_SELF).ru_utime
@@ -386,8 +393,10 @@ def run_case(job):
     while sim.time < t_end - 1e-9:
         k += 1
         sim.run_until(min(k * dt, t_end))
+        collided = sim.take_collision_events()
         if sim.time < t_window - 2 * dt:
             continue
+        hits.append(collided[collided[:, 0] >= t_window])
         times.append(sim.time)
         if not empty:
             states.append(np.array(sim.state))
@@ -421,16 +430,11 @@ def run_case(job):
             out["drift_m"] = float(s[sel, 0, ix][-1] - s[sel, 0, ix][0])
             out["window_s"] = float(t[sel][-1] - t[sel][0])
         else:
-            mass = float(np.asarray(sim.mass)[0])
-            contact_distance = float(cfg.resolved()["contact"]["collision_distance"])
             centres = np.array(layout["centres"])
-            impulses, disc_time = [], 0.0
-            for i in middle_discs(layout["centres"], layout["strip"]):
-                near = [j for j in range(len(centres)) if j != i
-                        and np.linalg.norm(centres[j] - centres[i]) < 1.6 * DIAMETER]
-                _, j = collisions(t, s, i, near, mass, contact_distance, cols)
-                impulses.extend(j)
-                disc_time += t[-1] - t[0]
+            middle = middle_discs(layout["centres"], layout["strip"])
+            window = float(t[sel][-1] - t_window)
+            _, impulses = collision_episodes(np.vstack(hits), middle, 2 * dt)
+            disc_time = window * len(middle)
             out["collisions"] = len(impulses)
             out["disc_time_s"] = disc_time
             out["collision_interval_s"] = disc_time / len(impulses) if impulses else float("nan")

@@ -7,9 +7,10 @@ t_end, the splits, and the fragment-size distribution (equivalent diameter
 d = sqrt(4 A / pi) of the dynamic floes at t_end: counts in fixed classes,
 and quantiles), with the changes against the first run.
 
-Usage: validation/fracture/convergence.py BUILD_DIR [MESH DT T_END], or
-scripts/validate fracture [MESH DT T_END]
-(defaults 20 m, 10 s, 3000 s). Uses numpy and h5py (Debian packages).
+Usage: validation/fracture/convergence.py BUILD_DIR [MESH DT T_END [LOAD_RADIUS]], or
+scripts/validate fracture [MESH DT T_END [LOAD_RADIUS]]
+(defaults 20 m, 10 s, 3000 s, and the example's load radius: [fracture]
+load_radius, the floes' thickness when unset). Uses numpy and h5py (Debian packages).
 """
 import os
 import subprocess
@@ -21,6 +22,7 @@ import numpy as np
 
 build = sys.argv[1]
 mesh, dt, t_end = (float(a) for a in (sys.argv[2:5] if len(sys.argv) >= 5 else (20.0, 10.0, 3000.0)))
+load_radius = float(sys.argv[5]) if len(sys.argv) >= 6 else None
 src = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 floesim = os.path.join(build, "bin", "floesim")
 base = open(os.path.join(src, "examples", "pack_fracture.toml")).read()
@@ -42,6 +44,8 @@ for m, h in ((mesh, dt), (mesh / 2, dt), (mesh, dt / 2), (mesh / 2, dt / 2)):
         elif key == "t_end":
             line = f"t_end = {t_end}"
         text.append(line)
+    if load_radius is not None:  # [fracture] is the example's last table
+        text.append(f"load_radius = {load_radius}")
     cfg = os.path.join(work, f"m{m}_dt{h}.toml")
     open(cfg, "w").write("\n".join(text) + "\n")
     out = cfg.replace(".toml", ".h5")
@@ -57,7 +61,9 @@ for m, h in ((mesh, dt), (mesh / 2, dt), (mesh, dt / 2), (mesh / 2, dt / 2)):
     rows.append((m, h, int(alive.sum()), int(kv.get("fracture.splits", 0)), counts, np.quantile(d, [0.1, 0.5, 0.9]),
                  kv.get("fracture.initiations"), float(kv.get("fracture.seconds", 0.0))))
 
-print(f"# {os.path.basename(floesim)} on examples/pack_fracture.toml to t = {t_end} s; classes of d (m): {classes[:-1]}")
+radius = "the example's" if load_radius is None else f"{load_radius:g} m"
+print(f"# {os.path.basename(floesim)} on examples/pack_fracture.toml to t = {t_end} s, load radius {radius}; "
+      f"classes of d (m): {classes[:-1]}")
 print("mesh_m,dt_s,floes,splits,initiations,analysis_s," + ",".join(f"n_d{c:g}" for c in classes[:-1]) +
       ",d10_m,d50_m,d90_m,floes_change")
 ref = rows[0]
