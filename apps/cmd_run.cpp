@@ -151,12 +151,12 @@ void add_run_command(CLI::App& app, Registry& registry) {
     parallel::Session session;
     try {
       return run(*args, session);
-    } catch (const InputError&) {
-      session.abort_alone(std::current_exception(), 2);  // a failure of one rank that the others could not hear of
-      throw;
     } catch (...) {
-      session.abort_alone(std::current_exception(), 1);
-      throw;
+      // Said before the session ends: once another rank has left with an
+      // error, mpirun may end this one at any moment (only rank 0 prints).
+      const int code = report_failure(std::current_exception());
+      session.abort_alone(std::current_exception(), code);  // a failure of one rank that the others could not hear of
+      return code;
     }
   };
 }

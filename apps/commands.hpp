@@ -5,6 +5,7 @@
 
 #include <CLI/CLI.hpp>
 #include <cmath>
+#include <exception>
 #include <functional>
 #include <map>
 #include <string>
@@ -13,6 +14,12 @@ namespace floesim::apps {
 
 using Handler = std::function<int()>;
 using Registry = std::map<CLI::App*, Handler>;
+
+// Says a command's failure on stderr ("floesim: error: ..." for bad input,
+// "floesim: run failed: ..." otherwise) and returns its exit code (2 or 1).
+// apps/main.cpp says every command's failures so; a command that must say
+// it before it ends (the run under mpirun: docs/parallel.md) calls it itself.
+int report_failure(std::exception_ptr failure);
 
 // Checks of option values shared by the subcommands; a failed check is a usage
 // error (exit 2) "--OPTION: expected ..., got ...".

@@ -69,10 +69,21 @@ int main(int argc, char** argv) {
   try {
     for (auto& [sub, handler] : handlers)
       if (sub->parsed()) return handler();
-  } catch (const floesim::InputError& e) {
+  } catch (...) {
+    return floesim::apps::report_failure(std::current_exception());
+  }
+  return 2;
+}
+
+namespace floesim::apps {
+
+int report_failure(std::exception_ptr failure) {
+  try {
+    std::rethrow_exception(failure);
+  } catch (const InputError& e) {
     std::cerr << "floesim: error: " << e.what() << "\n";
     return 2;
-  } catch (const floesim::RunError& e) {
+  } catch (const RunError& e) {
     std::cerr << "floesim: run failed: " << e.what() << "\n";
     return 1;
   } catch (const std::bad_alloc&) {
@@ -81,6 +92,10 @@ int main(int argc, char** argv) {
   } catch (const std::exception& e) {  // a bug: said, not an abort
     std::cerr << "floesim: internal error: " << e.what() << "\n";
     return 1;
+  } catch (...) {
+    std::cerr << "floesim: internal error: an exception of unknown type\n";
+    return 1;
   }
-  return 2;
 }
+
+}  // namespace floesim::apps
