@@ -204,8 +204,10 @@ struct ImpulseOptions {
   // the approach below which a component is not solved at all: 1 um in a
   // 10 s step.
   double velocity_tolerance = 1e-7;
-  // LCPs of at least warm_min unknowns are first solved by Lemke from the
-  // basis in `warm` (null: never); the caller owns it and keeps it across steps.
+  // LCPs of at least warm_min unknowns start from the basis in `warm`
+  // (null: never): the Newton method (from solver.newton_min_size unknowns)
+  // and Lemke both take it as their first guess; the caller owns it and
+  // keeps it across steps.
   WarmStart* warm = nullptr;
   std::size_t warm_min = 200;
   // A folder ("": none) where every LCP that ends as a failure (counted in
@@ -234,6 +236,9 @@ struct CollisionStats {
   long total_size = 0;    // sum of LCP sizes
   long warm = 0;          // of lcps, solved by Lemke warm-started from the last basis
   long warm_missed = 0;   // warm starts that ended without an accepted solution (then solved from scratch)
+  long newton = 0;        // of lcps, solved by the Newton method (lcp/newton.hpp)
+  long newton_tried = 0;  // LCPs the Newton method was tried on (solver.newton_min_size)
+  long newton_iterations = 0;
 };
 
 // Changes the velocities of the floes in contact (W^- -> W^+). Returns the

@@ -7,6 +7,8 @@ namespace floesim::lcp {
 
 std::string_view to_string(Method method) {
   switch (method) {
+    case Method::newton: return "newton";
+    case Method::lemke_warm: return "lemke_warm";
     case Method::lemke: return "lemke";
     case Method::lemke_other_covering: return "lemke_other_covering";
     case Method::lemke_regularised: return "lemke_regularised";
@@ -49,7 +51,17 @@ FallbackResult solve_with_fallbacks(const Lcp& lcp, const FallbackOptions& optio
     return accepted;
   };
 
-  if (record(Method::lemke, solve_lemke(lcp, options.lemke))) return out;
+  if (options.newton_min_size > 0 && lcp.size() >= options.newton_min_size) {
+    NewtonOptions newton = options.newton;
+    newton.tolerance = std::min(newton.tolerance, options.accept_residual);
+    if (record(Method::newton, solve_newton(lcp, newton))) return out;
+  }
+  LemkeOptions cold = options.lemke;
+  if (cold.start) {
+    if (record(Method::lemke_warm, solve_lemke(lcp, options.lemke))) return out;
+    cold.start = nullptr;
+  }
+  if (record(Method::lemke, solve_lemke(lcp, cold))) return out;
 
   if (options.friction.contacts > 0) {
     CoulombGsOptions gs = options.coulomb_gs;
@@ -57,13 +69,13 @@ FallbackResult solve_with_fallbacks(const Lcp& lcp, const FallbackOptions& optio
     if (record(Method::coulomb_gs, solve_coulomb_gs(lcp, options.friction, out.result.z, gs))) return out;
   }
 
-  LemkeOptions other = options.lemke;
+  LemkeOptions other = cold;
   other.covering.resize(lcp.size());
   for (Index i = 0; i < lcp.size(); ++i) other.covering(i) = 1.0 + static_cast<double>(i % 7) / 7.0;
   if (record(Method::lemke_other_covering, solve_lemke(lcp, other))) return out;
 
   const Lcp shifted = regularised(lcp, options.regularisation);
-  if (record(Method::lemke_regularised, solve_lemke(shifted, options.lemke))) return out;
+  if (record(Method::lemke_regularised, solve_lemke(shifted, cold))) return out;
 
   if (options.allow_pgs) {
     PgsOptions pgs = options.pgs;
