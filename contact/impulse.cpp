@@ -363,7 +363,12 @@ lcp::FallbackResult solve(const ComponentLcp& a, const Floes& floes, const std::
   stats.contacts += static_cast<long>(m);
   stats.largest = std::max(stats.largest, static_cast<long>(n));
   stats.total_size += static_cast<long>(n);
-  if (res.attempts.size() > 1 && res.method != lcp::Method::lemke_warm) ++stats.fallbacks;
+  // A fallback: the chain went past Lemke from scratch (Newton and the warm
+  // start are first tries, not fallbacks).
+  const auto first_tries = std::count_if(res.attempts.begin(), res.attempts.end(), [](const lcp::Attempt& at) {
+    return at.method == lcp::Method::newton || at.method == lcp::Method::lemke_warm;
+  });
+  if (res.attempts.size() - static_cast<std::size_t>(first_tries) > 1) ++stats.fallbacks;
   if (res.flagged) ++stats.flagged;
   if (res.solved() && res.method == lcp::Method::coulomb_gs) ++stats.gauss_seidel;
   if (!res.solved() && res.result.z.size() == static_cast<Eigen::Index>(n) &&
