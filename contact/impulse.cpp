@@ -349,16 +349,11 @@ lcp::FallbackResult solve(const ComponentLcp& a, const Floes& floes, const std::
   if (use_warm && res.solved() && !res.result.z_basic.empty())
     warm_store(*opt.warm, floes, contacts, a.list, res.result.z_basic);
   for (const lcp::Attempt& at : res.attempts) {
-    if (at.method == lcp::Method::newton) {
-      ++stats.newton_tried;
-      stats.newton_iterations += at.pivots;
-    } else if (at.method == lcp::Method::lemke_warm) {
-      ++(at.status == lcp::Status::solved ? stats.warm : stats.warm_missed);
-    }
+    if (at.method == lcp::Method::lemke_warm) ++(at.status == lcp::Status::solved ? stats.warm : stats.warm_missed);
+    // Lemke's pivots, of every attempt (the others count iterations or sweeps).
     if (at.method != lcp::Method::newton && at.method != lcp::Method::coulomb_gs && at.method != lcp::Method::pgs)
       stats.pivots += at.pivots;
   }
-  if (res.solved() && res.method == lcp::Method::newton) ++stats.newton;
   ++stats.lcps;
   stats.contacts += static_cast<long>(m);
   stats.largest = std::max(stats.largest, static_cast<long>(n));

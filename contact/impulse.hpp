@@ -236,9 +236,6 @@ struct CollisionStats {
   long total_size = 0;    // sum of LCP sizes
   long warm = 0;          // of lcps, solved by Lemke warm-started from the last basis
   long warm_missed = 0;   // warm starts that ended without an accepted solution (then solved from scratch)
-  long newton = 0;        // of lcps, solved by the Newton method (lcp/newton.hpp)
-  long newton_tried = 0;  // LCPs the Newton method was tried on (solver.newton_min_size)
-  long newton_iterations = 0;
 };
 
 // Changes the velocities of the floes in contact (W^- -> W^+). Returns the
