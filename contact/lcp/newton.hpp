@@ -1,8 +1,9 @@
 #pragma once
 // A semismooth Newton method on the natural map of the LCP (lcp.hpp), in its
-// active-set form, with sparse factorisations: the solver of the fallback
-// chain for large LCPs (fallback.hpp), where it changes many unknowns per
-// iteration where Lemke changes one per pivot.
+// active-set form, with sparse factorisations: it changes many unknowns per
+// iteration where Lemke changes one per pivot. The fallback chain
+// (fallback.hpp) can run it first on large LCPs (off by default: see "Where
+// it works" below).
 //
 // Mathematics. z solves LCP(M, q) exactly when the natural map
 //
@@ -19,9 +20,9 @@
 // the complementary point of the basis "z_A basic" (the primal-dual
 // active-set method of Hintermüller, Ito and Kunisch 2002 is this iteration
 // without damping). The next A is read off F at the new point, and so on: an
-// active set that is right gives F = 0 at once, and from the active set of
-// the previous, similar LCP (a warm start: `start`) a time-coherent jam
-// needs a few iterations, each changing as many unknowns as it needs to.
+// active set that is right gives F = 0 at once; the active set of a
+// previous, similar LCP can be given as the first one (a warm start:
+// `start`).
 //
 // Globalisation. The step to (1) is damped by backtracking on the merit
 // phi(z) = ||F(z)||^2 / 2 (Armijo: phi(z + t d) <= (1 - 2 sigma t) phi(z),
@@ -52,11 +53,11 @@
 // Where it works (measured, docs/contact.md "Jam solver"): the frictionless
 // Delassus LCPs and the Siconos problems of data/lcp, in 1 to 18 iterations
 // (lcp_CPS_3, where Lemke ends on a ray, included). On the Stewart–Trinkle
-// LCPs of frictional contact of 100 contacts and more it converges only when
-// its warm start is already right (one iteration): their active sets, read
-// row by row, give
-// inconsistent or nearly singular systems (a friction row alpha without its
-// beta, redundant contacts of a jam), and the damped steps stall.
+// LCPs of frictional contact of 100 contacts and more it rarely converges,
+// and on those of jams mostly only when its warm start is already right (one
+// iteration): their active sets, read row by row, give inconsistent or
+// nearly singular systems (a friction row alpha without its beta, redundant
+// contacts of a jam), and the damped steps stall.
 //
 // Answer. z is returned with its negative entries (rounding, at most of the
 // size of the residual) set to 0, and judged by the one residual of lcp.hpp:
