@@ -37,6 +37,10 @@ Lcp regularised(const Lcp& lcp, double relative_shift) {
 FallbackResult solve_with_fallbacks(const Lcp& lcp, const FallbackOptions& options) {
   FallbackResult out;
   // Records an attempt, judged on the original LCP; true when it is accepted.
+  // The first tries (Newton, the warm start) are kept only when accepted:
+  // the best failed attempt, which the Gauss–Seidel step starts from and the
+  // chain returns when nothing succeeds, is one of the steps from scratch.
+  bool from_scratch = false;  // out.result holds a step from scratch
   auto record = [&](Method method, Result result) {
     finish(lcp, result);
     if (result.status == Status::solved && result.residual > options.accept_residual)
@@ -44,7 +48,10 @@ FallbackResult solve_with_fallbacks(const Lcp& lcp, const FallbackOptions& optio
     out.attempts.push_back({method, result.status, std::max(result.pivots, result.iterations),
                             result.residual});
     const bool accepted = result.status == Status::solved;
-    if (accepted || out.attempts.size() == 1 || result.residual < out.result.residual) {
+    const bool first_try = method == Method::newton || method == Method::lemke_warm;
+    if (accepted || out.attempts.size() == 1 || (!first_try && !from_scratch) ||
+        result.residual < out.result.residual) {
+      from_scratch = from_scratch || !first_try;
       out.result = std::move(result);
       out.method = method;
     }
