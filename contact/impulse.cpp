@@ -325,44 +325,45 @@ ComponentLcp assemble(const Floes& floes, const std::vector<ContactPoint>& conta
   return a;
 }
 
-// Solves a component's LCP: large ones first by Lemke from the basis in
-// opt.warm (WarmStart), then the fallback chain (lcp/fallback.hpp); an answer
-// the chain did not accept is still taken within opt.velocity_tolerance. The
-// statistics are counted here; a failure is written to opt.dump_failed_lcps.
+// Solves a component's LCP by the fallback chain (lcp/fallback.hpp): large
+// ones start from the basis in opt.warm (WarmStart), both the Newton method
+// (from n >= solver.newton_min_size) and Lemke; an answer the chain did not
+// accept is still taken within opt.velocity_tolerance. The statistics are
+// counted here; a failure is written to opt.dump_failed_lcps.
 lcp::FallbackResult solve(const ComponentLcp& a, const Floes& floes, const std::vector<ContactPoint>& contacts,
                           const ImpulseOptions& opt, CollisionStats& stats) {
   const std::size_t m = a.contacts(), n = 4 * m;
   lcp::FallbackOptions solver = opt.solver;  // with the layout, for the contact-wise Gauss–Seidel
   solver.friction = {m, opt.friction};
   if (solver.lemke.max_pivots == 0) solver.lemke.max_pivots = opt.lemke_pivots_per_unknown * static_cast<long>(n) + 1000;
-  lcp::FallbackResult res;
   const bool use_warm = opt.warm != nullptr && n >= opt.warm_min;
-  bool warm_solved = false;
+  std::vector<std::uint8_t> guess;
   if (use_warm) {
-    std::vector<std::uint8_t> guess = warm_guess(*opt.warm, floes, contacts, a.list);
+    guess = warm_guess(*opt.warm, floes, contacts, a.list);
     if (std::find(guess.begin(), guess.end(), 1) != guess.end()) {
-      lcp::LemkeOptions lo = solver.lemke;
-      lo.start = &guess;
-      lcp::Result r = lcp::solve_lemke(a.problem, lo);
-      if (r.status == lcp::Status::solved && r.residual <= opt.solver.accept_residual) {
-        res.result = std::move(r);
-        warm_solved = true;
-        ++stats.warm;
-      } else {
-        ++stats.warm_missed;
-        stats.pivots += r.pivots;  // the warm attempt's pivots count too
-      }
+      solver.lemke.start = &guess;
+      solver.newton.start = &guess;
     }
   }
-  if (!warm_solved) res = lcp::solve_with_fallbacks(a.problem, solver);
+  lcp::FallbackResult res = lcp::solve_with_fallbacks(a.problem, solver);
   if (use_warm && res.solved() && !res.result.z_basic.empty())
     warm_store(*opt.warm, floes, contacts, a.list, res.result.z_basic);
+  for (const lcp::Attempt& at : res.attempts) {
+    if (at.method == lcp::Method::lemke_warm) ++(at.status == lcp::Status::solved ? stats.warm : stats.warm_missed);
+    // Lemke's pivots, of every attempt (the others count iterations or sweeps).
+    if (at.method != lcp::Method::newton && at.method != lcp::Method::coulomb_gs && at.method != lcp::Method::pgs)
+      stats.pivots += at.pivots;
+  }
   ++stats.lcps;
   stats.contacts += static_cast<long>(m);
-  stats.pivots += res.result.pivots;
   stats.largest = std::max(stats.largest, static_cast<long>(n));
   stats.total_size += static_cast<long>(n);
-  if (res.attempts.size() > 1) ++stats.fallbacks;
+  // A fallback: the chain went past Lemke from scratch (Newton and the warm
+  // start are first tries, not fallbacks).
+  const auto first_tries = std::count_if(res.attempts.begin(), res.attempts.end(), [](const lcp::Attempt& at) {
+    return at.method == lcp::Method::newton || at.method == lcp::Method::lemke_warm;
+  });
+  if (res.attempts.size() - static_cast<std::size_t>(first_tries) > 1) ++stats.fallbacks;
   if (res.flagged) ++stats.flagged;
   if (res.solved() && res.method == lcp::Method::coulomb_gs) ++stats.gauss_seidel;
   if (!res.solved() && res.result.z.size() == static_cast<Eigen::Index>(n) &&

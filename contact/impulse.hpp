@@ -210,8 +210,10 @@ struct ImpulseOptions {
   // the approach below which a component is not solved at all: 1 um in a
   // 10 s step.
   double velocity_tolerance = 1e-7;
-  // LCPs of at least warm_min unknowns are first solved by Lemke from the
-  // basis in `warm` (null: never); the caller owns it and keeps it across steps.
+  // LCPs of at least warm_min unknowns start from the basis in `warm`
+  // (null: never): the Newton method (from solver.newton_min_size unknowns)
+  // and Lemke both take it as their first guess; the caller owns it and
+  // keeps it across steps.
   WarmStart* warm = nullptr;
   std::size_t warm_min = 200;
   // A folder ("": none) where every LCP that ends as a failure (counted in

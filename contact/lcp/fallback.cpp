@@ -7,6 +7,8 @@ namespace floesim::lcp {
 
 std::string_view to_string(Method method) {
   switch (method) {
+    case Method::newton: return "newton";
+    case Method::lemke_warm: return "lemke_warm";
     case Method::lemke: return "lemke";
     case Method::lemke_other_covering: return "lemke_other_covering";
     case Method::lemke_regularised: return "lemke_regularised";
@@ -35,6 +37,10 @@ Lcp regularised(const Lcp& lcp, double relative_shift) {
 FallbackResult solve_with_fallbacks(const Lcp& lcp, const FallbackOptions& options) {
   FallbackResult out;
   // Records an attempt, judged on the original LCP; true when it is accepted.
+  // The first tries (Newton, the warm start) are kept only when accepted:
+  // the best failed attempt, which the Gauss–Seidel step starts from and the
+  // chain returns when nothing succeeds, is one of the steps from scratch.
+  bool from_scratch = false;  // out.result holds a step from scratch
   auto record = [&](Method method, Result result) {
     finish(lcp, result);
     if (result.status == Status::solved && result.residual > options.accept_residual)
@@ -42,14 +48,27 @@ FallbackResult solve_with_fallbacks(const Lcp& lcp, const FallbackOptions& optio
     out.attempts.push_back({method, result.status, std::max(result.pivots, result.iterations),
                             result.residual});
     const bool accepted = result.status == Status::solved;
-    if (accepted || out.attempts.size() == 1 || result.residual < out.result.residual) {
+    const bool first_try = method == Method::newton || method == Method::lemke_warm;
+    if (accepted || out.attempts.size() == 1 || (!first_try && !from_scratch) ||
+        result.residual < out.result.residual) {
+      from_scratch = from_scratch || !first_try;
       out.result = std::move(result);
       out.method = method;
     }
     return accepted;
   };
 
-  if (record(Method::lemke, solve_lemke(lcp, options.lemke))) return out;
+  if (options.newton_min_size > 0 && lcp.size() >= options.newton_min_size) {
+    NewtonOptions newton = options.newton;
+    newton.tolerance = std::min(newton.tolerance, options.accept_residual);
+    if (record(Method::newton, solve_newton(lcp, newton))) return out;
+  }
+  LemkeOptions cold = options.lemke;
+  if (cold.start) {
+    if (record(Method::lemke_warm, solve_lemke(lcp, options.lemke))) return out;
+    cold.start = nullptr;
+  }
+  if (record(Method::lemke, solve_lemke(lcp, cold))) return out;
 
   if (options.friction.contacts > 0) {
     CoulombGsOptions gs = options.coulomb_gs;
@@ -57,13 +76,13 @@ FallbackResult solve_with_fallbacks(const Lcp& lcp, const FallbackOptions& optio
     if (record(Method::coulomb_gs, solve_coulomb_gs(lcp, options.friction, out.result.z, gs))) return out;
   }
 
-  LemkeOptions other = options.lemke;
+  LemkeOptions other = cold;
   other.covering.resize(lcp.size());
   for (Index i = 0; i < lcp.size(); ++i) other.covering(i) = 1.0 + static_cast<double>(i % 7) / 7.0;
   if (record(Method::lemke_other_covering, solve_lemke(lcp, other))) return out;
 
   const Lcp shifted = regularised(lcp, options.regularisation);
-  if (record(Method::lemke_regularised, solve_lemke(shifted, options.lemke))) return out;
+  if (record(Method::lemke_regularised, solve_lemke(shifted, cold))) return out;
 
   if (options.allow_pgs) {
     PgsOptions pgs = options.pgs;

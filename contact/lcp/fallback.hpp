@@ -2,7 +2,14 @@
 // The robust LCP solve used by the contact layer: Lemke, and when Lemke does not
 // deliver a solution, a fixed chain of fallbacks, every step recorded.
 //
-//   1. Lemke, covering vector of ones (the options' own covering if given);
+//   0. for LCPs of at least newton_min_size unknowns (0, the default: never):
+//      the semismooth Newton method (newton.hpp), from options.newton.start
+//      when given. It solves the frictionless (Delassus) LCPs of data/lcp in
+//      a few iterations but not the Stewart–Trinkle LCPs of jams
+//      (docs/contact.md, "Jam solver"), so the contact layer leaves it off;
+//   1. Lemke from options.lemke.start when given (a warm start: Method::lemke_warm),
+//      then Lemke from scratch, covering vector of ones (the options' own
+//      covering if given);
 //   2. for the Stewart–Trinkle LCPs of frictional contact (`friction` set):
 //      contact-wise Gauss–Seidel (coulomb_gs.hpp) from the point where Lemke
 //      ended, accepted on the same residual as Lemke's answers. It comes
@@ -27,14 +34,18 @@
 
 #include "contact/lcp/coulomb_gs.hpp"
 #include "contact/lcp/lemke.hpp"
+#include "contact/lcp/newton.hpp"
 #include "contact/lcp/pgs.hpp"
 
 namespace floesim::lcp {
 
-enum class Method { lemke, lemke_other_covering, lemke_regularised, coulomb_gs, pgs };
+enum class Method { newton, lemke_warm, lemke, lemke_other_covering, lemke_regularised, coulomb_gs, pgs };
 std::string_view to_string(Method method);
 
 struct FallbackOptions {
+  NewtonOptions newton;
+  // Step 0 runs for LCPs of at least this many unknowns (0: never).
+  Index newton_min_size = 0;
   LemkeOptions lemke;
   PgsOptions pgs;
   FrictionLayout friction;  // contacts = 0: not a Stewart–Trinkle LCP (no step 4)
@@ -47,7 +58,7 @@ struct FallbackOptions {
 struct Attempt {
   Method method;
   Status status;
-  long pivots;      // or sweeps, for PGS
+  long pivots;      // or sweeps (PGS, Gauss–Seidel), or iterations (Newton)
   double residual;  // on the original LCP
 };
 
