@@ -102,6 +102,9 @@ public:
   ~Simulation();
   Simulation(Simulation&&) noexcept;
 
+  // One step toward t_stop (never past it); returns its length. A t_stop
+  // within 1e-12 max(1, t) of the clock is round-off: the clock lands on it
+  // with no step, and 0 is returned.
   double step(double t_stop);
 
   // Restart (core/checkpoint.hpp): the run's state at the end of a step, as
