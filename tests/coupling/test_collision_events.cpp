@@ -25,14 +25,10 @@ std::vector<CollisionEventRow> run_rows(Simulation& sim, double until) {
   return rows;
 }
 
-}  // namespace
-
-// Two equal squares (m each), the second coming at the first at v along -x,
-// frictionless, restitution e: one impact whose normal impulse is the reduced
-// mass times the change of the approach speed, (m/2)(1 + e) v, at the middle
-// of the touching sides (x = 10).
-TEST_CASE("collision events: a head-on impact records the impulse (m/2)(1 + e) v once, between the floes") {
-  const std::string config = R"(
+// Two 10 m squares 0.5 m apart, the second coming at the first at 1 m/s along
+// -x, frictionless, restitution 0.4, no sea, collisions recorded.
+std::string head_on() {
+  return R"(
 [run]
 t_end = 2.0
 dt_max = 0.05
@@ -52,6 +48,16 @@ vertices = [[0, 0], [10, 0], [10, 10], [0, 10]]
 vertices = [[10.5, 0], [20.5, 0], [20.5, 10], [10.5, 10]]
 velocity = [-1.0, 0.0]
 )";
+}
+
+}  // namespace
+
+// Two equal squares (m each), the second coming at the first at v along -x,
+// frictionless, restitution e: one impact whose normal impulse is the reduced
+// mass times the change of the approach speed, (m/2)(1 + e) v, at the middle
+// of the touching sides (x = 10).
+TEST_CASE("collision events: a head-on impact records the impulse (m/2)(1 + e) v once, between the floes") {
+  const std::string config = head_on();
   Simulation sim(build_scenario(parse_config(config, "head_on.toml", ".")));
   const double m = sim.floes().mass[0], v = 1.0, e = 0.4;
   const std::vector<CollisionEventRow> rows = run_rows(sim, 2.0);
@@ -77,25 +83,7 @@ velocity = [-1.0, 0.0]
 // 5 cm apart closing at 1 m/s: the sliver changes nothing, and the impact
 // that follows is the one a run without it has.
 TEST_CASE("a stop within round-off of the clock is reached without a step") {
-  const std::string config = R"(
-[run]
-t_end = 2.0
-dt_max = 0.05
-output_interval = 1.0
-[sea]
-model = "none"
-[forcing]
-ocean_drag = 0.0
-air_drag = 0.0
-[contact]
-restitution = 0.4
-friction = 0.0
-[[floes.floe]]
-vertices = [[0, 0], [10, 0], [10, 10], [0, 10]]
-[[floes.floe]]
-vertices = [[10.5, 0], [20.5, 0], [20.5, 10], [10.5, 10]]
-velocity = [-1.0, 0.0]
-)";
+  const std::string config = head_on();
   Simulation sim(build_scenario(parse_config(config, "sliver.toml", ".")));
   Simulation plain(build_scenario(parse_config(config, "sliver.toml", ".")));
   while (sim.time() < 0.45) sim.step(0.45);
