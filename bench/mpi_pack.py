@@ -1,11 +1,8 @@
 #!/usr/bin/env python3
 """bench/mpi_pack.py: a collisions-only periodic pack on 1 and 2 ranks, side by side.
 
-The pack of bench/collisions.cpp's pack_N (`floesim pack`: N floes at 50 %
-cover in a periodic box of side 130.4 sqrt(N) m, thickness 0.5 to 2 m, seed
-1; each floe started at a speed uniform in [0, 0.1] m/s in a random
-direction), wind 10 m/s, current 0.05 m/s, Coriolis at 80.2 N, dt_max 10 s, to
---t-end. For each round, the ranks in --ranks are run one after another
+The pack of scripts/scenarios/moving_pack.py (bench/collisions.cpp's pack_N
+as a run configuration), seed 1, wind 10 m/s, to --t-end. For each round, the ranks in --ranks are run one after another
 (alternating, so load changes on the shared machine hit both), each
 `mpirun --oversubscribe -np R floesim run --threads 1 --profile` (R = 0: the
 serial binary without mpirun). Per run: the summary's wall_time (the loop:
@@ -24,10 +21,10 @@ import sys
 import tempfile
 import time
 
-import h5py
-import numpy as np
-
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+sys.path.insert(0, os.path.join(ROOT, "scripts", "scenarios"))
+import moving_pack  # noqa: E402  (the pack shared with tests/parallel/check_ranks.py)
+
 ap = argparse.ArgumentParser()
 ap.add_argument("--build", default=os.path.join(ROOT, "build"))
 ap.add_argument("--floes", type=int, default=10000)
@@ -41,37 +38,7 @@ args = ap.parse_args()
 floesim = os.path.join(args.build, "bin", "floesim")
 env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1", OMP_NUM_THREADS="1")
 work = tempfile.mkdtemp(prefix="floesim_mpi_bench_")
-side = 130.4 * args.floes ** 0.5
-subprocess.run([floesim, "pack", "--floes", str(args.floes), "--concentration", "0.5", "--box", str(side), str(side),
-                "--thickness-range", "0.5", "2.0", "--seed", "1", "-o", os.path.join(work, "pack.h5")],
-               check=True, capture_output=True)
-# Each floe at a speed uniform in [0, 0.1] m/s in a random direction (bench/collisions.cpp).
-rng = np.random.default_rng(1)
-with h5py.File(os.path.join(work, "pack.h5"), "r+") as f:
-    v = f["floes/velocity"][...]
-    speed, angle = rng.uniform(0.0, 0.1, len(v)), rng.uniform(0.0, 2 * np.pi, len(v))
-    v[:, 0], v[:, 1] = speed * np.cos(angle), speed * np.sin(angle)
-    f["floes/velocity"][...] = v
-config = os.path.join(work, "pack.toml")
-with open(config, "w") as f:
-    f.write(f"""[run]
-t_end = {args.t_end}
-dt_max = 10.0
-output_interval = {args.t_end}
-threads = 1
-[sea]
-model = "none"
-[contact]
-domain = "periodic"
-restitution = 0.4
-friction = 0.7
-[forcing]
-wind = [10.0, 0.0]
-current = [0.0, 0.05]
-latitude = 80.2
-[floes]
-pack = "pack.h5"
-""")
+config = moving_pack.write(floesim, work, args.floes, args.t_end, seed=1, output_interval=args.t_end)
 
 
 def load():

@@ -5,8 +5,8 @@ usage: check_ranks.py FLOESIM MPIEXEC WORKDIR [--floes N] [--t-end T] [--ranks 1
                       [--also CONFIG...] [--no-errors]
        check_ranks.py --no-mpi    (MPI not built: says so and exits 77, ctest's skip code)
 
-A collisions-only periodic pack (`floesim pack`: N floes at 50 % cover,
-thickness 0.5 to 2 m, started at random velocities up to 0.1 m/s as
+The collisions-only periodic pack of scripts/scenarios/moving_pack.py (N
+floes at 50 % cover, started at random velocities up to 0.1 m/s as
 bench/collisions.cpp's packs, with wind, current and Coriolis; they collide,
 also across the seams) run serially, then by `mpirun -np R`
 for each R: every run file must equal the serial one (`floesim compare`,
@@ -22,8 +22,9 @@ import os
 import subprocess
 import sys
 
-import h5py
-import numpy as np
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))),
+                                "scripts", "scenarios"))
+import moving_pack  # noqa: E402  (the pack shared with bench/mpi_pack.py)
 
 if "--no-mpi" in sys.argv:
     print("floesim was built without MPI (FLOESIM_MPI=OFF): the distributed runs are not checked")
@@ -62,46 +63,11 @@ def need(p, what):
     return p
 
 
-def start_moving(path, seed):
-    # bench/collisions.cpp's packs: each floe at a speed uniform in [0, 0.1]
-    # m/s in a random direction, so they collide from the first steps.
-    rng = np.random.default_rng(seed)
-    with h5py.File(path, "r+") as f:
-        v = f["floes/velocity"][...]
-        speed, angle = rng.uniform(0.0, 0.1, len(v)), rng.uniform(0.0, 2 * np.pi, len(v))
-        v[:, 0], v[:, 1] = speed * np.cos(angle), speed * np.sin(angle)
-        f["floes/velocity"][...] = v
-
-
-side = 130.4 * args.floes ** 0.5  # 50 % cover of floes of mean diameter ~100 m (bench/collisions.cpp's packs)
-pack = os.path.join(W, "pack.h5")
-need(run([args.floesim, "pack", "--floes", str(args.floes), "--concentration", "0.5", "--box", str(side), str(side),
-          "--thickness-range", "0.5", "2.0", "--seed", "5", "-o", pack]), "floesim pack")
-start_moving(pack, seed=5)
-config = os.path.join(W, "pack.toml")
-with open(config, "w") as f:
-    f.write(f"""[run]
-t_end = {args.t_end}
-dt_max = 10.0
-output_interval = {args.t_end / 4}
-threads = 1
-
-[sea]
-model = "none"
-
-[contact]
-domain = "periodic"
-restitution = 0.4
-friction = 0.7
-
-[forcing]
-wind = [10.0, 3.0]
-current = [0.0, 0.05]
-latitude = 80.2
-
-[floes]
-pack = "pack.h5"
-""")
+try:
+    config = moving_pack.write(args.floesim, W, args.floes, args.t_end, seed=5, output_interval=args.t_end / 4,
+                               wind=(10.0, 3.0))
+except RuntimeError as e:
+    sys.exit(f"FAILED: {e}")
 
 serial = need(run([args.floesim, "run", config, "-o", "serial.h5", "-q"]), "serial run")
 lcps = next(int(l.split()[1]) for l in serial.stdout.splitlines() if l.startswith("collisions.lcps:"))
