@@ -92,7 +92,7 @@ FractureSeries fracture_series(const viz::RunView& run, std::size_t classes) {
     hi = std::max(hi, d[i]);
   }
   FractureSeries out;
-  out.count = {"floes", t, {}};
+  out.count = {"all floes", t, {}};
   if (!(hi > 0.0)) return out;
   const double span = std::log(hi / lo) > 0.0 ? std::log(hi / lo) : 1.0;
   auto class_of = [&](double di) {
@@ -167,10 +167,11 @@ void add_plot_command(CLI::App& app, Registry& registry) {
       drawn = series.size();
     } else if (what == "fracture") {
       const FractureSeries f = fracture_series(run, 5);
-      const viz::Rect top{all.x, all.y, all.w, 0.4 * all.h}, bottom{all.x, all.y + 0.4 * all.h, all.w, 0.6 * all.h};
-      viz::line_plot(canvas, top, {"floes: " + name, "time (s)", "floes"}, {f.count});
-      viz::line_plot(canvas, bottom, {"floes by equivalent diameter: " + name, "time (s)", "floes"}, f.classes);
-      drawn = 1 + f.classes.size();
+      // One panel: the count and its classes share the unit (floes) and the axis.
+      std::vector<Series> series{f.count};
+      series.insert(series.end(), f.classes.begin(), f.classes.end());
+      viz::line_plot(canvas, all, {"floes, all and by equivalent diameter: " + name, "time (s)", "floes"}, series);
+      drawn = series.size();
       if (!f.count.y.empty())
         extra = "floes: " + std::to_string(static_cast<long>(f.count.y.front())) + " -> " +
                 std::to_string(static_cast<long>(f.count.y.back())) + "\n";
