@@ -200,10 +200,10 @@ TEST_CASE("a soft mooring: the undamped and damped oscillator of its period and 
     INFO("damping ratio " << zeta);
     std::ostringstream extra;
     extra << "velocity = [" << v0 << ", 0.0]\nmooring_period = " << period << "\nmooring_damping = " << zeta << "\n";
-    std::ostringstream t;
-    t << "[run]\ndt_max = 0.01\n[[floes.floe]]\nvertices = [[-10, -10], [10, -10], [10, 10], [-10, 10]]\n"
+    std::ostringstream toml;
+    toml << "[run]\ndt_max = 0.01\n[[floes.floe]]\nvertices = [[-10, -10], [10, -10], [10, 10], [-10, 10]]\n"
       << extra.str() << "[forcing]\nocean_drag = 0.0\nair_drag = 0.0\n";
-    Simulation s(build_scenario(parse_config(t.str(), "test.toml", ".")));
+    Simulation s(build_scenario(parse_config(toml.str(), "test.toml", ".")));
     const double wd = omega * std::sqrt(1.0 - zeta * zeta);
     double worst = 0.0;
     for (double t : {0.25 * period, 0.5 * period, 0.8 * period, 1.5 * period}) {
