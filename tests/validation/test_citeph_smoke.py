@@ -9,6 +9,7 @@ heave and pitch resonance (about 0.27 s), so it follows the surface
 (analytic long-wave limit: heave and pitch RAO 1, surge RAO 1 / tanh(k h),
 the water particle's orbit); an array cannot transmit much more energy than
 comes in; neighbours 2 cm apart in 40 mm waves collide (the run's recorded collisions).
+The report must write results.csv with the columns of issue 18 and the two PNG figures.
 """
 import csv
 import math
@@ -92,9 +93,21 @@ class Smoke(unittest.TestCase):
             self.assertEqual(len(results), 4)
             for r in results:
                 self.assertNotIn("error", r, r.get("error"))
-            citeph.write_results(work, work)
+            # the report as scripts/validate makes it: results.csv and the two figures
+            self.assertEqual(citeph.main(["report", work, work]), 0)
             with open(os.path.join(work, "results.csv"), newline="") as f:
-                rows = {(r["case"], r["quantity"]): r for r in csv.DictReader(f)}
+                reader = csv.DictReader(f)
+                rows = {(r["case"], r["quantity"]): r for r in reader}
+                # the columns issue 18 asks for, in its order
+                self.assertEqual(reader.fieldnames,
+                                 ["case", "concentration", "T", "H_mm", "quantity", "model", "data", "lo", "hi"])
+            for figure in ("single_disc.png", "arrays.png"):
+                with open(os.path.join(work, figure), "rb") as f:
+                    self.assertEqual(f.read(8), b"\x89PNG\r\n\x1a\n", figure)
+        quantities = {"heave_rao", "pitch_rao", "surge_rao", "transmission", "collision_interval_s",
+                      "collision_impulse_Ns"}
+        self.assertEqual({r["quantity"] for r in rows.values()}, quantities)
+        self.assertEqual({r["concentration"] for r in rows.values()}, {"0", "39", "79"})
         model = {key: float(r["model"]) for key, r in rows.items() if r["model"]}
         k = citeph.wavenumber(1.85)
         self.assertAlmostEqual(model[("disc_T1.85_H40", "heave_rao")], 1.0, delta=0.2)
