@@ -37,6 +37,7 @@ void Sea::midpoint_response(std::span<const double> p, double h, std::span<doubl
   project(p, modal_a_);
   bank_.midpoint_response(modal_a_, h, modal_b_);
   synthesize(modal_b_, eta);
+  add_static_response(p, modal_a_, eta);
 }
 
 void Sea::midpoint_step(std::span<const double> p, double h) {
@@ -44,7 +45,17 @@ void Sea::midpoint_step(std::span<const double> p, double h) {
   modal_a_.resize(bank_.q().size());
   project(p, modal_a_);
   bank_.midpoint(modal_a_, h);
+  hold(p, modal_a_);
   time_ += h;
+  invalidate();
+}
+
+void Sea::hold_pressure(std::span<const double> p) {
+  if (!has_static_part()) return;
+  settle();
+  modal_a_.resize(bank_.q().size());
+  project(p, modal_a_);
+  hold(p, modal_a_);
   invalidate();
 }
 
