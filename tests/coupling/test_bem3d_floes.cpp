@@ -178,9 +178,25 @@ TEST_CASE("3D BEM basin, lowest modes with the static correction: a floe's motio
       << "[forcing]\nocean_drag = 0.0\nair_drag = 0.0\n" << square(1.1, 2.1, 1.0);
     Simulation sim = make(t.str());
     std::vector<std::array<double, 2>> track;
+    const double e0 = energy(sim, "total");
+    double top = e0;
     for (int k = 1; k <= 80; ++k) {
-      while (sim.time() < 0.05 * k - 1e-12) sim.step(0.05 * k);
+      while (sim.time() < 0.05 * k - 1e-12) {
+        sim.step(0.05 * k);
+        top = std::max(top, energy(sim, "total"));
+      }
       track.push_back({sim.floes().state[0].heave, sim.floes().state[0].x});
+    }
+    MESSAGE(modes << " modes" << std::string(correct ? ", corrected" : "") << ": total energy " << e0 << " J, at 4 s "
+                  << energy(sim, "total") << " J, largest " << top << " J");
+    if (correct) {
+      // The corrected implicit step only absorbs: the dropped modes' static
+      // part takes the work 1/2 dF^T R dF more than it stores per step
+      // (docs/sea.md, "Static correction"): measured 1.6e-5 (128 modes) and
+      // 7e-6 (256) of the energy over 4 s. It starts from the full-mode
+      // sea's energy (71.7633 J; 99.73 J cut to 128 modes without it).
+      CHECK(top <= e0 * (1.0 + 1e-9));
+      CHECK(energy(sim, "total") > e0 * (1.0 - 1e-4));
     }
     return track;
   };
@@ -209,9 +225,13 @@ TEST_CASE("3D BEM basin, lowest modes with the static correction: a floe's motio
                     << " corrected; drift difference " << cut[m][1] << " cut, " << corrected[m][1]
                     << " corrected (of the largest heave " << heave << " m and drift " << drift << " m)");
   }
+  // Measured: 128 modes, heave 2.08 cut, 3.0e-3 corrected; drift 3.45,
+  // 3.1e-2. 256 modes: heave 0.26, 2.5e-3; drift 1.28, 1.4e-2.
   for (int m = 0; m < 2; ++m) {
-    CHECK(corrected[m][0] < 0.1 * cut[m][0]);
-    CHECK(corrected[m][1] < 0.1 * cut[m][1]);
+    CHECK(corrected[m][0] < cut[m][0] / 50.0);
+    CHECK(corrected[m][1] < cut[m][1] / 50.0);
+    CHECK(corrected[m][0] < 0.01);
+    CHECK(corrected[m][1] < 0.05);
   }
 }
 
