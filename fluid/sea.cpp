@@ -144,6 +144,8 @@ void validate(const SeaParams& p) {
   FLOESIM_ASSERT(p.bottom_grid.empty() ||
                  (p.model == SeaModel::bem && p.dims == 2 && p.bottom.empty() &&
                   p.bottom_grid.size() == static_cast<std::size_t>(p.bottom_nx) * static_cast<std::size_t>(p.bottom_ny)));
+  if (p.bem_static_correction && !(p.model == SeaModel::bem && p.dims == 2 && p.bem_modes > 0))
+    bad("bem_static_correction", "corrects the lowest modes of a 3D basin only (model = \"bem\", dims = 2, bem_modes > 0)");
   if (p.model == SeaModel::bem && p.bottom.empty() && p.bottom_grid.empty() && !std::isfinite(p.depth))
     bad("depth", "model = \"bem\" needs a finite depth, a [sea] bottom polyline or a bottom_file");
 }
