@@ -401,6 +401,11 @@ void read_sea(Section s, SeaParams& p, const std::string& file, const std::strin
   } else if (p.bem_modes != 0) {
     s.fail("bem_modes", "the lowest modes only apply to model = \"bem\" with dims = 2");
   }
+  p.bem_static_correction = s.boolean("bem_static_correction", p.bem_static_correction);
+  if (p.bem_static_correction && p.bem_modes == 0)
+    s.fail("bem_static_correction",
+           "corrects the lowest modes only (bem_modes = n > 0 on model = \"bem\" with dims = 2); with all modes "
+           "there is nothing dropped to correct");
   p.depth = s.number("depth", p.depth, [](double v) { return v > 0.0; }, "a depth > 0 (m) or inf");
   p.rho = s.number("rho", p.rho, positive, "a density > 0 (kg/m^3)");
   p.g = s.number("g", p.g, positive, "a gravity > 0 (m/s^2)");
@@ -660,6 +665,13 @@ Config parse_config(std::string_view text, const std::string& name, const std::s
   read_forcing(Section(top.table("forcing"), "forcing", name), c.forcing, base_dir);
   read_fracture(Section(top.table("fracture"), "fracture", name), c.fracture, name);
   top.finish();
+  // The static correction acts through the pressure held over a step, which
+  // only the implicit step has (fluid/sea.hpp, hold_pressure; docs/sea.md).
+  if (c.sea.bem_static_correction && c.coupling.integrator != CouplingIntegrator::implicit &&
+      (!c.floes.floes.empty() || !c.floes.pack.empty()))
+    throw InputError(name + ": [sea] bem_static_correction: the floes on a corrected sea need [coupling] integrator = "
+                     "\"implicit\" (the correction is the dropped modes' response to the pressure held over a step; "
+                     "the explicit kicks are impulses and would not see it)");
   if (!c.coupling.start_given)
     for (const FloeInput& f : c.floes.floes)
       if (f.heave != 0.0 || f.heave_rate != 0.0)
@@ -721,6 +733,7 @@ std::string resolved_toml(const Config& c) {
   if (!bottom.empty()) sea.insert("bottom", bottom);
   if (!c.sea.bottom_file.empty()) sea.insert("bottom_file", c.sea.bottom_file);
   if (c.sea.bem_modes != 0) sea.insert("bem_modes", c.sea.bem_modes);
+  if (c.sea.bem_static_correction) sea.insert("bem_static_correction", true);
   if (c.sea.tank.enabled)
     sea.insert("tank", toml::table{{"enabled", true}, {"generation_length", c.sea.tank.generation_length},
                                    {"absorption_length", c.sea.tank.absorption_length}, {"rate", c.sea.tank.rate},

@@ -73,6 +73,10 @@ struct SeaParams {
   // bem, dims = 2: the modes kept. 0: all of them (the dense eigenproblem);
   // n > 0: the n lowest (Lanczos; fluid/lowest_modes.hpp, docs/sea.md).
   int bem_modes = 0;
+  // bem, dims = 2, bem_modes > 0: the dropped modes' static response to the
+  // pressure held over a step is part of the surface (fluid/static_correction.hpp;
+  // the floes need the implicit integrator for it).
+  bool bem_static_correction = false;
   WaveParams waves;
   TankConfig tank;
 };

@@ -207,6 +207,19 @@ Eigen::Matrix2d FloeSeaContact::tilt_inertia(const Floes& floes, std::size_t i) 
   return R * body_moments_[i] * R.transpose() + floes.mass[i] * h * h / 12.0 * Eigen::Matrix2d::Identity();
 }
 
+void FloeSeaContact::hold_static_pressure(fluid::Sea& sea, std::span<const double> waves,
+                                          std::span<const double> eta) {
+  // A sea with a static part (a truncated BEM sea with its static correction,
+  // fluid/sea.hpp) keeps only its kept modes at set_surface; the rest of the
+  // floes' dimples is its static answer to their pressure, which it must
+  // hold from the start. The start's local response eta = W + L - p / (rho g)
+  // gives that pressure, up to a constant (which does nothing).
+  if (!sea.has_static_part()) return;
+  std::vector<double> p(eta.size());
+  for (std::size_t c = 0; c < eta.size(); ++c) p[c] = rho_ * g_ * (waves[c] - eta[c]);
+  sea.hold_pressure(p);
+}
+
 void FloeSeaContact::start(Floes& floes, fluid::Sea& sea, bool given) {
   const fluid::SurfaceGrid& grid = sea.grid();
   const std::size_t n = floes.size();
@@ -319,6 +332,7 @@ void FloeSeaContact::start(Floes& floes, fluid::Sea& sea, bool given) {
   }
   const double wave_level = solve(wave_eta);
   sea.set_surface(eta, eta_t);
+  hold_static_pressure(sea, wave_eta, eta);
   for (std::size_t i = 0; i < n; ++i) {
     if (!dynamic_[i]) continue;
     FloeState& st = floes.state[i];

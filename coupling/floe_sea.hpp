@@ -257,6 +257,9 @@ private:
   // velocity at the sea's time (zero without incident waves).
   void update_water(const Floes& floes, const fluid::Sea& sea, IncidentSea* incident);
   void implicit_step(Floes& floes, std::span<const FloeState> start, fluid::Sea& sea, double h);
+  // The static start's pressure, held by a sea with a static part (a
+  // truncated BEM sea's correction): p = rho g (W - eta), W the waves.
+  void hold_static_pressure(fluid::Sea& sea, std::span<const double> waves, std::span<const double> eta);
   // Footprints (and coverage) at the midpoint of each floe's horizontal
   // motion from `start` to its present position.
   void place_midpoint_footprints(const Floes& floes, std::span<const FloeState> start);

@@ -98,6 +98,7 @@ std::shared_ptr<const DenseSetup> build(const SeaParams& p, double ratio, double
   ops->panels = n;
   reduce_to_modes(k, m, phi, area, p.bem_modes, *ops);
   cost.modes = since(modes_start);
+  cost.correction = ops->cost.correction;  // within cost.modes
   cost.seconds = since(start);
   ops->cost = cost;
   return ops;
@@ -140,7 +141,8 @@ struct Bem3dSea::Impl {
 };
 
 Bem3dSea::Bem3dSea(const SeaParams& params, const SeaOptions& options)
-    : DenseModalSea(basin_grid(params), cached(params, options)), impl_(std::make_unique<Impl>()) {
+    : DenseModalSea(basin_grid(params), cached(params, options), params.bem_static_correction),
+      impl_(std::make_unique<Impl>()) {
   if (options.tank.enabled) {
     FLOESIM_ASSERT(params.waves.kind == WaveKind::regular);  // refused at load (core/config.cpp)
     impl_->tank.emplace(grid_, options.tank, plane_wave(params, grid_));

@@ -44,7 +44,10 @@
 //       short waves under a floe is missing). The cut is the user's: n modes
 //       reach the wavenumber k_n with n ~ Lx Ly k_n^2 / (4 pi) (the modes of
 //       a rectangle, cos(m pi x / Lx) cos(n pi y / Ly), in the quarter disc
-//       k < k_n); docs/sea.md says how to choose it.
+//       k < k_n); docs/sea.md says how to choose it. With
+//       `bem_static_correction` the dropped modes answer the pressure held
+//       over a step quasi-statically (fluid/static_correction.hpp): the
+//       sea's static part, through Sea::midpoint_step and hold_pressure.
 // Cost: the dense LU of the (N + 1)^2 collocation matrix (N panels in all,
 // about 3 times the surface cells for a basin as deep as a cell is long
 // times its cells across) and its solve for the nx ny surface right-hand

@@ -1,6 +1,7 @@
 #include "fluid/dense_modal_sea.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <vector>
 
@@ -47,8 +48,9 @@ void all_modes(MatrixXd k, MatrixXd m, DenseModes& out) {
 }  // namespace
 
 void reduce_to_modes(const Eigen::SparseMatrix<double>& a_sf, const MatrixXd& m_sf, const MatrixXd& phi, double weight,
-                     int count, DenseModes& out) {
+                     int count, DenseSetup& out) {
   out.surface = static_cast<int>(m_sf.rows());
+  out.weight = weight;
   if (count == 0) {
     all_modes(MatrixXd(a_sf), m_sf, out);
   } else {
@@ -61,10 +63,16 @@ void reduce_to_modes(const Eigen::SparseMatrix<double>& a_sf, const MatrixXd& m_
   out.load = -weight * out.x.transpose();
   out.project = out.x.transpose() * m_sf;
   out.potential = phi * out.x;
+  if (count > 0) {
+    const auto start = std::chrono::steady_clock::now();
+    out.correction = std::make_shared<const StaticCorrection>(a_sf, out.omega);
+    out.cost.correction = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  }
 }
 
-DenseModalSea::DenseModalSea(const SurfaceGrid& grid, Cached setup)
-    : Sea(grid), setup_(std::move(setup.setup)), hit_(setup.hit) {
+DenseModalSea::DenseModalSea(const SurfaceGrid& grid, Cached setup, bool correct)
+    : Sea(grid), setup_(std::move(setup.setup)), hit_(setup.hit), correct_(correct) {
+  FLOESIM_ASSERT(!correct_ || setup_->correction);
   const std::size_t nm = setup_->omega.size();
   bank_ = ModalBank(setup_->omega, std::vector<double>(nm, 1.0), std::vector<double>(nm, 1.0), 1);
   work_modes_.resize(static_cast<Eigen::Index>(nm));
@@ -97,7 +105,29 @@ void DenseModalSea::synthesize(std::span<const double> q, std::span<double> eta)
 const VectorXd& DenseModalSea::surface_elevation() {
   const Eigen::Map<const VectorXd> q(bank_.q().data(), static_cast<Eigen::Index>(bank_.modes()));
   work_surface_.noalias() = setup_->x * q;
+  if (held_) work_surface_ += held_eta_;
   return work_surface_;
+}
+
+void DenseModalSea::static_response(std::span<const double> pressure, std::span<const double> s, VectorXd& out) {
+  const Eigen::Map<const VectorXd> p(pressure.data(), setup_->surface);
+  load_ = -setup_->weight * p;
+  setup_->correction->apply(setup_->x, load_, s, out, centred_, modal_);
+}
+
+void DenseModalSea::hold(std::span<const double> pressure, std::span<const double> s) {
+  if (!correct_) return;
+  static_response(pressure, s, held_eta_);
+  held_potential_ = 0.5 * load_.dot(held_eta_);  // 1/2 F^T R F
+  held_ = true;
+  invalidate();
+}
+
+void DenseModalSea::add_static_response(std::span<const double> pressure, std::span<const double> s,
+                                        std::span<double> eta) {
+  if (!correct_) return;
+  static_response(pressure, s, response_);
+  Eigen::Map<VectorXd>(eta.data(), setup_->surface) += response_;
 }
 
 const VectorXd& DenseModalSea::surface_potential() {

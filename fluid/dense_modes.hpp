@@ -15,6 +15,7 @@ namespace floesim::fluid {
 
 struct DenseModes {
   int surface = 0;              // surface nodes (grid cells)
+  double weight = 0.0;          // a node's area: a pressure p_i is the nodal load -weight p_i
   std::vector<double> omega;    // per mode, ascending (rad/s)
   Eigen::MatrixXd x;            // surface x modes: eta = x a (m_sf-orthonormal columns)
   Eigen::MatrixXd load;         // modes x surface: modal force per unit pressure

@@ -2,8 +2,6 @@
 
 #include <arpack/arpack.h>
 
-#include <Eigen/SparseCholesky>
-
 #include <algorithm>
 #include <cmath>
 #include <numbers>
@@ -11,6 +9,7 @@
 #include <string>
 
 #include "core/error.hpp"
+#include "fluid/static_correction.hpp"
 
 namespace floesim::fluid {
 
@@ -26,18 +25,8 @@ LowestModes lowest_modes(const MatrixXd& m_sf, const Eigen::SparseMatrix<double>
     throw InputError("fluid: expected between 1 and " + std::to_string(n - 2) + " lowest modes, got " +
                      std::to_string(nev));
 
-  // a_sf^-1 on zero-mean right-hand sides. With g = 0, a_sf = sigma L is
-  // singular on the constants: one node is pinned (adding c e_0 e_0^T); for a
-  // zero-mean b the pinned solution has y_0 = 0 and L y = b, and removing its
-  // mean gives the zero-mean solution. With g > 0 the solution of a zero-mean
-  // b is already zero-mean (1^T a_sf y = rho g A 1^T y) and the pin is not added.
-  Eigen::SparseMatrix<double> pinned = a_sf;
-  const double diag = a_sf.diagonal().cwiseAbs().maxCoeff();
-  const VectorXd ones = VectorXd::Ones(n);
-  if (std::abs((a_sf * ones).sum()) <= 1e-12 * diag * n) pinned.coeffRef(0, 0) += diag;
-  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> stiff(pinned);
-  if (stiff.info() != Eigen::Success)
-    throw RunError("fluid: the surface stiffness a_sf is not positive definite on zero-mean surfaces");
+  // a_sf^-1 on zero-mean right-hand sides (the pin of g = 0 in fluid/static_correction.hpp).
+  const ZeroMeanStiffness stiff(a_sf);
 
   const int ncv = std::min(n, std::max(2 * nev + 1, nev + 32));
   const int lworkl = ncv * (ncv + 8);
@@ -66,8 +55,8 @@ LowestModes lowest_modes(const MatrixXd& m_sf, const Eigen::SparseMatrix<double>
       t = x.array() - x.mean();
       x.noalias() = m_sf * t;
       x.array() -= x.mean();
-      y = stiff.solve(x);
-      y.array() -= y.mean();
+      stiff.solve(x, t);
+      y = t;
       ++out.operator_applications;
     } else if (ido == 2) {
       y = a_sf * x;

@@ -37,6 +37,7 @@ void Sea::midpoint_response(std::span<const double> p, double h, std::span<doubl
   project(p, modal_a_);
   bank_.midpoint_response(modal_a_, h, modal_b_);
   synthesize(modal_b_, eta);
+  add_static_response(p, modal_a_, eta);
 }
 
 void Sea::midpoint_step(std::span<const double> p, double h) {
@@ -44,7 +45,17 @@ void Sea::midpoint_step(std::span<const double> p, double h) {
   modal_a_.resize(bank_.q().size());
   project(p, modal_a_);
   bank_.midpoint(modal_a_, h);
+  hold(p, modal_a_);
   time_ += h;
+  invalidate();
+}
+
+void Sea::hold_pressure(std::span<const double> p) {
+  if (!has_static_part()) return;
+  settle();
+  modal_a_.resize(bank_.q().size());
+  project(p, modal_a_);
+  hold(p, modal_a_);
   invalidate();
 }
 
@@ -133,6 +144,8 @@ void validate(const SeaParams& p) {
   FLOESIM_ASSERT(p.bottom_grid.empty() ||
                  (p.model == SeaModel::bem && p.dims == 2 && p.bottom.empty() &&
                   p.bottom_grid.size() == static_cast<std::size_t>(p.bottom_nx) * static_cast<std::size_t>(p.bottom_ny)));
+  if (p.bem_static_correction && !(p.model == SeaModel::bem && p.dims == 2 && p.bem_modes > 0))
+    bad("bem_static_correction", "corrects the lowest modes of a 3D basin only (model = \"bem\", dims = 2, bem_modes > 0)");
   if (p.model == SeaModel::bem && p.bottom.empty() && p.bottom_grid.empty() && !std::isfinite(p.depth))
     bad("depth", "model = \"bem\" needs a finite depth, a [sea] bottom polyline or a bottom_file");
 }

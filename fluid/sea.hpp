@@ -99,7 +99,21 @@ public:
   void midpoint_response(std::span<const double> p, double h, std::span<double> eta);
   // Advances the state over h with p held over the step; t += h. A tank's
   // relaxation zones act over h / 2 before and after (as in flow()).
+  // On a sea with a static part (below) p becomes the pressure held.
   virtual void midpoint_step(std::span<const double> p, double h);
+
+  // The static part of a truncated BEM sea (`[sea] bem_static_correction`;
+  // fluid/static_correction.hpp): the modes it drops answer the pressure
+  // held over a step quasi-statically, eta = X q + R F(p). midpoint_step(p)
+  // holds p; hold_pressure(p) holds p without stepping (the coupling's static
+  // start). Then elevation(), the slopes and sample() include R F(p),
+  // midpoint_response(p) includes it (the response of p held over the step;
+  // midpoint_free_elevation, with no pressure, does not), and energy()'s
+  // potential includes 1/2 F^T R F. kick(), repeat_kick() (impulses),
+  // flow() and set_surface() (the kept modes' state) neither use nor change
+  // the pressure held. A sea without a static part ignores all of this.
+  void hold_pressure(std::span<const double> p);
+  virtual bool has_static_part() const { return false; }
 
   // pressure(sea, t, p) fills p (grid().size() values, Pa) for time t; it may
   // query the sea (called with the state at t, then at t + dt).
@@ -114,7 +128,7 @@ public:
   SurfaceSample sample(double x, double y = 0.0);
   SeaEnergy energy() {
     settle();
-    return {bank_.kinetic(), bank_.potential()};
+    return {bank_.kinetic(), bank_.potential() + static_potential()};
   }
 
   // The modal state (settled: every kick applied).
@@ -135,6 +149,12 @@ protected:
   // elevation on the grid of modal amplitudes q.
   virtual void project(std::span<const double> pressure, std::span<double> s) = 0;
   virtual void synthesize(std::span<const double> q, std::span<double> eta) = 0;
+  // The static part (see hold_pressure), s = project(pressure): hold the
+  // pressure; add its static response to eta; the energy of the held one.
+  virtual void hold(std::span<const double> /*pressure*/, std::span<const double> /*s*/) {}
+  virtual void add_static_response(std::span<const double> /*pressure*/, std::span<const double> /*s*/,
+                                   std::span<double> /*eta*/) {}
+  virtual double static_potential() const { return 0.0; }
   void invalidate() { valid_.fill(false); }
   void invalidate_rates();  // only the fields that depend on eta' (after a kick)
 

@@ -122,6 +122,18 @@ TEST_CASE("unknown keys, wrong types and out-of-range values name file, line and
           {"[sea] bem_modes", "at most 14 modes", "got 15"});
   refused("[sea]\nmodel = \"bem\"\ndims = 2\ncells = [4, 4]\nbem_modes = -1\n", {"[sea] bem_modes", ">= 0"});
   refused("[sea]\nmodel = \"spectral\"\nbem_modes = 10\n", {"[sea] bem_modes", "dims = 2"});
+  // The static correction of the lowest modes: only with them; floes on it need the implicit step.
+  const std::string corrected = "[sea]\nmodel = \"bem\"\ndims = 2\ncells = [8, 4]\ndepth = 1.0\nbem_modes = 10\n"
+                                "bem_static_correction = true\n";
+  CHECK(parse(corrected).sea.bem_static_correction);
+  CHECK(parse(corrected + "[[floes.floe]]\nvertices = [[0,0],[1,0],[1,1]]\n[coupling]\nintegrator = \"implicit\"\n")
+            .sea.bem_static_correction);
+  refused(corrected + "[[floes.floe]]\nvertices = [[0,0],[1,0],[1,1]]\n",
+          {"[sea] bem_static_correction", "integrator = \"implicit\""});
+  refused("[sea]\nmodel = \"bem\"\ndims = 2\ncells = [8, 4]\ndepth = 1.0\nbem_static_correction = true\n",
+          {"[sea] bem_static_correction", "bem_modes = n > 0"});
+  refused("[sea]\nmodel = \"bem\"\ndims = 2\ncells = [8, 4]\ndepth = 1.0\nbem_modes = 10\nbem_static_correction = 1\n",
+          {"[sea] bem_static_correction", "true or false"});
   // A 3D basin's bottom grid (bottom_file): checked at load, with the line at fault.
   {
     const std::string dir = "/tmp/floesim_bottom_" + std::to_string(::getpid());
