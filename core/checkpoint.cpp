@@ -25,6 +25,7 @@ void write_modal(hid_t parent, const std::string& name, const ModalState& m) {
   h5::set_attr(g, "time", m.time);
   doubles(g, "q", m.q);
   doubles(g, "v", m.v);
+  if (!m.held_pressure.empty()) doubles(g, "held_pressure", m.held_pressure);
 }
 
 void write_floes(hid_t parent, const Floes& f) {
@@ -145,6 +146,7 @@ struct Reader {
     m.time = attr(g, "time");
     m.q = doubles(g, "q");
     m.v = doubles(g, "v", m.q.size());
+    if (h5::exists(g, "held_pressure")) m.held_pressure = doubles(g, "held_pressure");
     return m;
   }
   void fail(const std::string& what) const { throw InputError(path + ": /checkpoint: " + what); }

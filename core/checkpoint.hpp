@@ -31,6 +31,9 @@ struct ModalState {
   bool present = false;
   double time = 0.0;          // s
   std::vector<double> q, v;
+  // The pressure a sea with a static part holds (fluid::Sea::hold_pressure;
+  // Pa, one value per grid node); empty when none is held.
+  std::vector<double> held_pressure;
 };
 
 // The incident waves kept for drag (coupling/incident.hpp): their sea and the

@@ -96,6 +96,8 @@ ModalState save_modal(fluid::Sea& sea) {
   m.time = sea.time();
   m.q.assign(bank.q().begin(), bank.q().end());
   m.v.assign(bank.v().begin(), bank.v().end());
+  const std::span<const double> held = sea.held_pressure();
+  m.held_pressure.assign(held.begin(), held.end());
   return m;
 }
 
@@ -107,6 +109,13 @@ void restore_modal(fluid::Sea& sea, const ModalState& m, const std::string& what
   std::copy(m.q.begin(), m.q.end(), bank.q().begin());
   std::copy(m.v.begin(), m.v.end(), bank.v().begin());
   sea.set_time(m.time);
+  if (!m.held_pressure.empty()) {
+    if (!sea.has_static_part() || m.held_pressure.size() != sea.grid().size())
+      throw InputError("checkpoint: " + what + " holds a pressure on " + std::to_string(m.held_pressure.size()) +
+                       " nodes, this run's sea " +
+                       (sea.has_static_part() ? "has " + std::to_string(sea.grid().size()) : std::string("has no static part")));
+    sea.hold_pressure(m.held_pressure);
+  }
 }
 
 double IncidentSea::weight(double t) const {

@@ -118,6 +118,7 @@ void DenseModalSea::static_response(std::span<const double> pressure, std::span<
 void DenseModalSea::hold(std::span<const double> pressure, std::span<const double> s) {
   if (!correct_) return;
   static_response(pressure, s, held_eta_);
+  held_pressure_.assign(pressure.begin(), pressure.end());
   held_potential_ = 0.5 * load_.dot(held_eta_);  // 1/2 F^T R F
   held_ = true;
   invalidate();

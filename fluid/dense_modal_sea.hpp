@@ -22,6 +22,7 @@
 #include <memory>
 #include <mutex>
 #include <span>
+#include <vector>
 #include <string>
 
 #include "fluid/dense_modes.hpp"
@@ -95,6 +96,9 @@ protected:
   void add_static_response(std::span<const double> pressure, std::span<const double> s,
                            std::span<double> eta) override;
   double static_potential() const override { return held_ ? held_potential_ : 0.0; }
+  std::span<const double> held_pressure() const override {
+    return held_ ? std::span<const double>(held_pressure_) : std::span<const double>();
+  }
   // The surface elevation x q (plus the static part when one is held), or
   // the surface potential Phi x v (of the rates), in a surface-sized buffer
   // valid until the next call.
@@ -111,6 +115,7 @@ private:
   bool correct_ = false;
   bool held_ = false;                  // a pressure is held: held_eta_ is its static part
   Eigen::VectorXd held_eta_;           // R F of the held pressure (m)
+  std::vector<double> held_pressure_;  // the held pressure itself (Pa), for checkpoints
   double held_potential_ = 0.0;        // 1/2 F^T R F (J)
   Eigen::VectorXd load_, centred_, modal_, response_;  // scratch of the static part
 };

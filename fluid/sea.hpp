@@ -114,6 +114,9 @@ public:
   // the pressure held. A sea without a static part ignores all of this.
   void hold_pressure(std::span<const double> p);
   virtual bool has_static_part() const { return false; }
+  // The pressure held now (grid().size() values, Pa); empty when none is
+  // (no static part, or nothing held yet). A checkpoint keeps it.
+  virtual std::span<const double> held_pressure() const { return {}; }
 
   // pressure(sea, t, p) fills p (grid().size() values, Pa) for time t; it may
   // query the sea (called with the state at t, then at t + dt).

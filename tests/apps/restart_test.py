@@ -161,6 +161,41 @@ vertices = [[15, 0], [21, 0], [21, 2], [15, 2]]
 thickness = 0.5
 """
 
+# A 3D BEM basin cut to its lowest modes with the static correction of the
+# dropped ones (fluid/static_correction.hpp): the pressure the sea holds is
+# part of the state (/checkpoint/sea/held_pressure).
+BEM3D_CORRECTED = """
+[run]
+t_end = 2.0
+dt_max = 0.02
+output_interval = 0.25
+threads = 1
+
+[sea]
+model = "bem"
+dims = 2
+size = [4.0, 2.0]
+cells = [16, 8]
+depth = 1.0
+rho = 1000.0
+bem_modes = 40
+bem_static_correction = true
+
+[sea.waves]
+kind = "standing"
+amplitude = 0.02
+wavelength = 8.0
+
+[coupling]
+law = "strong"
+stiffness = 100.0
+integrator = "implicit"
+
+[[floes.floe]]
+vertices = [[0.8, 0.6], [1.6, 0.6], [1.6, 1.4], [0.8, 1.4]]
+thickness = 0.1
+"""
+
 # A wave tank (relaxation zones) with a disc-like floe, implicit coupling.
 TANK = """
 [run]
@@ -284,6 +319,12 @@ def case_waves_moving():
 
 def case_bem():
     continuation(BEM, 4, 2, "bem")
+
+
+def case_bem3d_corrected():
+    continuation(BEM3D_CORRECTED, 2, 1, "bem3d_corrected")
+    with h5py.File(os.path.join(WORK, "half.h5"), "r") as f:
+        check("held_pressure" in f["checkpoint/sea"], "the checkpoint keeps the pressure the sea holds")
 
 
 def case_tank():
