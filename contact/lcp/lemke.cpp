@@ -1,5 +1,7 @@
 #include "contact/lcp/lemke.hpp"
 
+#include "contact/lcp/basis_repair.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -310,9 +312,17 @@ Result solve_lemke(const Lcp& lcp, const LemkeOptions& options, LemkeStats* stat
   if (options.start && options.start->size() != static_cast<std::size_t>(lcp.size()))
     throw RunError("Lemke: the start basis must have n entries");
   LemkeStats local;
-  Lemke lemke(lcp, options, stats ? *stats : local);
   if (stats) *stats = {};
-  Result result = lemke.run();
+  Result result = Lemke(lcp, options, stats ? *stats : local).run();
+  if (options.start && options.repair_start.rounds > 0 && result.status == Status::failed && result.pivots == 0) {
+    // The start basis was singular (basis_repair.hpp): start again from its repair.
+    const std::vector<std::uint8_t> repaired = repair_basis(sparse_copy(lcp), *options.start, options.repair_start);
+    if (repaired != *options.start) {
+      LemkeOptions again = options;
+      again.start = &repaired;
+      result = Lemke(lcp, again, stats ? *stats : local).run();
+    }
+  }
   finish(lcp, result);
   return result;
 }
