@@ -351,7 +351,8 @@ lcp::FallbackResult solve(const ComponentLcp& a, const Floes& floes, const std::
   for (const lcp::Attempt& at : res.attempts) {
     if (at.method == lcp::Method::lemke_warm) ++(at.status == lcp::Status::solved ? stats.warm : stats.warm_missed);
     // Lemke's pivots, of every attempt (the others count iterations or sweeps).
-    if (at.method != lcp::Method::newton && at.method != lcp::Method::coulomb_gs && at.method != lcp::Method::pgs)
+    if (at.method != lcp::Method::newton && at.method != lcp::Method::contact_newton &&
+        at.method != lcp::Method::coulomb_gs && at.method != lcp::Method::pgs)
       stats.pivots += at.pivots;
   }
   ++stats.lcps;
@@ -361,7 +362,8 @@ lcp::FallbackResult solve(const ComponentLcp& a, const Floes& floes, const std::
   // A fallback: the chain went past Lemke from scratch (Newton and the warm
   // start are first tries, not fallbacks).
   const auto first_tries = std::count_if(res.attempts.begin(), res.attempts.end(), [](const lcp::Attempt& at) {
-    return at.method == lcp::Method::newton || at.method == lcp::Method::lemke_warm;
+    return at.method == lcp::Method::newton || at.method == lcp::Method::contact_newton ||
+           at.method == lcp::Method::lemke_warm;
   });
   if (res.attempts.size() - static_cast<std::size_t>(first_tries) > 1) ++stats.fallbacks;
   if (res.flagged) ++stats.flagged;

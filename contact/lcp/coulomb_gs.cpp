@@ -13,47 +13,6 @@ namespace floesim::lcp {
 
 namespace {
 
-// W and b of the header, in the order (n_0, t_0, n_1, t_1, ...).
-struct ContactForm {
-  SparseMatrix W;
-  Vector b;
-  std::vector<std::array<double, 4>> block;  // W_kk: nn, nt, tn, tt
-};
-
-ContactForm contact_form(const Lcp& lcp, std::size_t m) {
-  const SparseMatrix M = sparse_copy(lcp);
-  const Index mi = static_cast<Index>(m);
-  // LCP index -> contact-form index: normal rows/columns k -> 2k, +T ones m + 2k -> 2k + 1,
-  // the -T and alpha ones -> -1 (not part of W).
-  auto map = [mi](Index i) -> Index {
-    if (i < mi) return 2 * i;
-    if (i < 3 * mi && (i - mi) % 2 == 0) return 2 * ((i - mi) / 2) + 1;
-    return -1;
-  };
-  ContactForm f;
-  std::vector<Eigen::Triplet<double>> trip;
-  for (Index j = 0; j < M.outerSize(); ++j) {
-    const Index c = map(j);
-    if (c < 0) continue;
-    for (SparseMatrix::InnerIterator it(M, j); it; ++it) {
-      const Index r = map(it.index());
-      if (r >= 0) trip.emplace_back(static_cast<int>(r), static_cast<int>(c), it.value());
-    }
-  }
-  f.W.resize(2 * mi, 2 * mi);
-  f.W.setFromTriplets(trip.begin(), trip.end());
-  f.b.resize(2 * mi);
-  f.block.assign(m, {0.0, 0.0, 0.0, 0.0});
-  for (Index k = 0; k < mi; ++k) {
-    f.b(2 * k) = lcp.q(k);
-    f.b(2 * k + 1) = lcp.q(mi + 2 * k);
-    auto& B = f.block[static_cast<std::size_t>(k)];
-    B = {f.W.coeff(2 * k, 2 * k), f.W.coeff(2 * k, 2 * k + 1), f.W.coeff(2 * k + 1, 2 * k),
-         f.W.coeff(2 * k + 1, 2 * k + 1)};
-  }
-  return f;
-}
-
 // The contact's own 2x2 Coulomb problem, the others held: u = W_kk r + c.
 std::array<double, 2> local_solve(const std::array<double, 4>& B, double cn, double ct, double mu) {
   const double nn = B[0], nt = B[1], tn = B[2], tt = B[3];
@@ -87,35 +46,18 @@ std::array<double, 2> local_solve(const std::array<double, 4>& B, double cn, dou
 
 Result solve_coulomb_gs(const Lcp& lcp, const FrictionLayout& layout, const Vector& start,
                         const CoulombGsOptions& options) {
-  check_lcp(lcp);
+  const ContactForm f = contact_form(lcp, layout, "contact-wise Gauss–Seidel");
   const std::size_t m = layout.contacts;
   const Index mi = static_cast<Index>(m);
-  if (m == 0 || lcp.size() != 4 * mi)
-    throw RunError("contact-wise Gauss–Seidel: the LCP has " + std::to_string(lcp.size()) +
-                     " unknowns, not 4 per contact for " + std::to_string(m) + " contacts");
   if (start.size() != 0 && start.size() != lcp.size())
     throw RunError("contact-wise Gauss–Seidel: the start point must have n entries");
-  const ContactForm f = contact_form(lcp, m);
   const double mu = layout.friction;
 
-  Vector r = Vector::Zero(2 * mi);  // (lambda_k, beta_k)
-  if (start.size() != 0)
-    for (Index k = 0; k < mi; ++k) {
-      r(2 * k) = std::max(0.0, start(k));
-      r(2 * k + 1) = start(mi + 2 * k) - start(mi + 2 * k + 1);
-    }
+  Vector r = start.size() != 0 ? contact_impulses(start, m) : Vector(Vector::Zero(2 * mi));  // (lambda_k, beta_k)
   Vector u = f.W * r + f.b;
 
   Result result;
-  auto to_z = [&] {
-    result.z = Vector::Zero(lcp.size());
-    for (Index k = 0; k < mi; ++k) {
-      result.z(k) = r(2 * k);
-      result.z(mi + 2 * k) = std::max(0.0, r(2 * k + 1));
-      result.z(mi + 2 * k + 1) = std::max(0.0, -r(2 * k + 1));
-      result.z(3 * mi + k) = std::abs(u(2 * k + 1));
-    }
-  };
+  auto to_z = [&] { result.z = lcp_point(r, u); };
   const int check_every = std::max(1, options.check_every);
   to_z();  // the start, should no sweep run
   result.status = Status::pivot_limit;

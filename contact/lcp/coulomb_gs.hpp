@@ -35,14 +35,9 @@
 
 #include <cstddef>
 
-#include "contact/lcp/lcp.hpp"
+#include "contact/lcp/contact_form.hpp"
 
 namespace floesim::lcp {
-
-struct FrictionLayout {
-  std::size_t contacts = 0;  // m; 0: not a Stewart–Trinkle LCP
-  double friction = 0.0;     // mu
-};
 
 struct CoulombGsOptions {
   long max_sweeps = 20000;

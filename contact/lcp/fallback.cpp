@@ -8,6 +8,7 @@ namespace floesim::lcp {
 std::string_view to_string(Method method) {
   switch (method) {
     case Method::newton: return "newton";
+    case Method::contact_newton: return "contact_newton";
     case Method::lemke_warm: return "lemke_warm";
     case Method::lemke: return "lemke";
     case Method::lemke_other_covering: return "lemke_other_covering";
@@ -48,7 +49,8 @@ FallbackResult solve_with_fallbacks(const Lcp& lcp, const FallbackOptions& optio
     out.attempts.push_back({method, result.status, std::max(result.pivots, result.iterations),
                             result.residual});
     const bool accepted = result.status == Status::solved;
-    const bool first_try = method == Method::newton || method == Method::lemke_warm;
+    const bool first_try =
+        method == Method::newton || method == Method::contact_newton || method == Method::lemke_warm;
     if (accepted || out.attempts.size() == 1 || (!first_try && !from_scratch) ||
         result.residual < out.result.residual) {
       from_scratch = from_scratch || !first_try;
@@ -62,6 +64,13 @@ FallbackResult solve_with_fallbacks(const Lcp& lcp, const FallbackOptions& optio
     NewtonOptions newton = options.newton;
     newton.tolerance = std::min(newton.tolerance, options.accept_residual);
     if (record(Method::newton, solve_newton(lcp, newton))) return out;
+  }
+  if (options.friction.contacts > 0 && options.contact_newton_min_size > 0 &&
+      lcp.size() >= options.contact_newton_min_size) {
+    ContactNewtonOptions contact = options.contact_newton;
+    contact.tolerance = std::min(contact.tolerance, options.accept_residual);
+    if (!contact.start) contact.start = options.lemke.start;
+    if (record(Method::contact_newton, solve_contact_newton(lcp, options.friction, contact))) return out;
   }
   LemkeOptions cold = options.lemke;
   if (cold.start) {

@@ -7,6 +7,13 @@
 //      when given. It solves the frictionless (Delassus) LCPs of data/lcp in
 //      a few iterations but not the Stewart–Trinkle LCPs of jams
 //      (docs/contact.md, "Jam solver"), so the contact layer leaves it off;
+//   0b. for Stewart–Trinkle LCPs (`friction` set) of at least
+//      contact_newton_min_size unknowns (0, the default: never): the contact
+//      Newton method (contact_newton.hpp), its first states read off
+//      options.lemke.start when given. It solves the friction LCPs of
+//      data/lcp/contact from z = 0 but is slower than Lemke's warm start on
+//      the LCPs of jams, and often does not converge there (docs/contact.md,
+//      "Jam solver, third round"), so the contact layer leaves it off;
 //   1. Lemke from options.lemke.start when given (a warm start: Method::lemke_warm),
 //      then Lemke from scratch, covering vector of ones (the options' own
 //      covering if given);
@@ -32,6 +39,7 @@
 #include <string>
 #include <vector>
 
+#include "contact/lcp/contact_newton.hpp"
 #include "contact/lcp/coulomb_gs.hpp"
 #include "contact/lcp/lemke.hpp"
 #include "contact/lcp/newton.hpp"
@@ -39,13 +47,16 @@
 
 namespace floesim::lcp {
 
-enum class Method { newton, lemke_warm, lemke, lemke_other_covering, lemke_regularised, coulomb_gs, pgs };
+enum class Method { newton, contact_newton, lemke_warm, lemke, lemke_other_covering, lemke_regularised, coulomb_gs, pgs };
 std::string_view to_string(Method method);
 
 struct FallbackOptions {
   NewtonOptions newton;
   // Step 0 runs for LCPs of at least this many unknowns (0: never).
   Index newton_min_size = 0;
+  ContactNewtonOptions contact_newton;
+  // Step 0b runs for friction LCPs of at least this many unknowns (0: never).
+  Index contact_newton_min_size = 0;
   LemkeOptions lemke;
   PgsOptions pgs;
   FrictionLayout friction;  // contacts = 0: not a Stewart–Trinkle LCP (no step 4)

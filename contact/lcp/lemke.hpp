@@ -49,6 +49,7 @@
 // Cost per pivot: one solve with the factorised basis (lemke_basis.hpp) plus
 // one per lexicographic tie-break column, instead of a dense tableau update.
 
+#include "contact/lcp/basis_repair.hpp"
 #include "contact/lcp/lcp.hpp"
 
 namespace floesim::lcp {
@@ -85,6 +86,10 @@ struct LemkeOptions {
   // not hold: a warm start that ends on a ray or a singular basis is for the
   // caller to redo from scratch. `covering` is ignored.
   const std::vector<std::uint8_t>* start = nullptr;
+  // A start basis that is singular (redundant contacts in a jam) is repaired
+  // (basis_repair.hpp: its dependent z's turned to w's) and Lemke starts
+  // again from the repair; rounds = 0: not repaired (the run ends failed).
+  BasisRepairOptions repair_start{.tolerance = 1e-10, .rounds = 0};
 };
 
 // What the revised method did, for benchmarks and diagnostics.
