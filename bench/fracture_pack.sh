@@ -12,6 +12,7 @@
 # 2 km box, 15 m/s wind: floes of different thickness drift at different
 # speeds and collide; 1000 s).
 # Usage: bench/fracture_pack.sh BUILD_DIR [REPEATS] > bench/results/fracture_pack_<machine>.csv
+# (SCENARIOS="drift_500" runs only those named; default both.)
 set -eu
 BIN=$(cd "$1" && pwd)/bin/floesim
 REPEATS=${2:-3}
@@ -50,7 +51,7 @@ box = [0.0, 2000.0, 0.0, 2000.0]" $v
 done
 echo "scenario,variant,round,wall_s,steps,checks,screened,bounded,sustained,initiations,splits,analysis_s,split_s"
 for r in $(seq 1 "$REPEATS"); do
-  for s in wall_100 drift_500; do
+  for s in ${SCENARIOS:-wall_100 drift_500}; do
     for v in off strong ice; do
       start=$(date +%s.%N)
       out=$(OMP_NUM_THREADS=1 "$BIN" run "$DIR/${s}_$v.toml" -q -o "$DIR/out.h5")

@@ -97,9 +97,11 @@ double velocity_error(const lcp::Lcp& problem, const Eigen::VectorXd& z, const s
 
 
 // Made by the step (impulse.hpp): the contact approached at the start of the
-// step at most a third as fast as now, or no faster than the step's smooth
-// forces move either floe's point (or not at all).
-bool made_by_step(double now, double at_start, double kick) { return at_start <= std::max(kick, now / 3.0); }
+// step no faster than rest_speed, or than a third of now, or than the step's
+// smooth forces move either floe's point.
+bool made_by_step(double now, double at_start, double kick, double rest_speed) {
+  return at_start <= std::max({rest_speed, kick, now / 3.0});
+}
 std::uint64_t pair_key(std::uint32_t a, std::uint32_t b) { return (std::uint64_t{a} << 32) | b; }
 Vec2 body_point(const Floes& floes, std::uint32_t a, const Vec2& p) {
   const FloeState& s = floes.state[a];
@@ -254,13 +256,16 @@ ComponentLcp assemble(const Floes& floes, const std::vector<ContactPoint>& conta
         floes.inv_inertia_z(a.global[f]);
   }
   // Normal velocity each contact must reach (>= 0 plus the gap stabilisation).
+  // Speculative gaps and turning become speeds over the step, taken no
+  // shorter than step_floor (impulse.hpp: round-off over a sliver).
+  const double h = std::max(opt.speculative_step, opt.step_floor);
   a.target.assign(m, 0.0);
   for (std::size_t k = 0; k < m; ++k) {
     const ContactPoint& c = contacts[a.list[k]];
-    if (c.speculative) a.target[k] = -0.9 * (c.gap - 0.5 * opt.collision_distance) / opt.speculative_step;
+    if (c.speculative) a.target[k] = -0.9 * (c.gap - 0.5 * opt.collision_distance) / h;
     else if (c.gap < opt.min_gap) a.target[k] = (opt.min_gap - c.gap) / opt.relaxation_time;
     // What the floes' turning closes beyond the linear gap (jam time steps).
-    if (opt.speculative_step > 0.0) a.target[k] += c.turning / opt.speculative_step;
+    if (opt.speculative_step > 0.0) a.target[k] += c.turning / h;
   }
   // Scaling (symmetric, so the LCP keeps the structure Lemke relies on):
   // with s_k = 1 / sqrt(D_kk), D = Gn A^-1 Gn^T (s_k^2 is the effective
@@ -408,6 +413,9 @@ std::vector<ContactImpulse> resolve_collisions(Floes& floes, const std::vector<C
                                                std::span<const std::uint8_t> resting) {
   std::vector<ContactImpulse> impulses(contacts.size());
   if (contacts.empty()) return impulses;
+  // Sustained or impact, by the approach before the solve (ImpulseRecord).
+  const std::vector<std::uint8_t> slow = opt.record ? slow_contacts(floes, contacts, opt.rest_speed)
+                                                    : std::vector<std::uint8_t>{};
 
   // Contact graph over dynamic floes.
   Components comp;
@@ -461,18 +469,29 @@ std::vector<ContactImpulse> resolve_collisions(Floes& floes, const std::vector<C
       ci.point = c.point;
     }
   }
-  if (opt.record) record_impulses(*opt.record, floes, contacts, impulses, resting);
+  if (opt.record) record_impulses(*opt.record, floes, contacts, impulses, slow);
   return impulses;
 }
 
+std::vector<std::uint8_t> slow_contacts(const Floes& floes, std::span<const ContactPoint> contacts, double rest_speed,
+                                        std::span<const FloeState> velocities) {
+  const std::span<const FloeState> v = velocities.empty() ? std::span<const FloeState>(floes.state) : velocities;
+  std::vector<std::uint8_t> slow(contacts.size(), 0);
+  for (std::size_t k = 0; k < contacts.size(); ++k) {
+    const ContactPoint& c = contacts[k];
+    slow[k] = approach(floes, v, c.a, c.b, c.point, c.point - c.shift, c.normal) <= rest_speed;
+  }
+  return slow;
+}
+
 void record_impulses(ImpulseRecord& record, const Floes& floes, std::span<const ContactPoint> contacts,
-                     std::span<const ContactImpulse> impulses, std::span<const std::uint8_t> resting) {
+                     std::span<const ContactImpulse> impulses, std::span<const std::uint8_t> slow) {
   const std::uint32_t event = record.events++;
   for (std::size_t j = 0; j < contacts.size() && j < impulses.size(); ++j) {
     const ContactImpulse& ci = impulses[j];
     if (!(ci.vector.squaredNorm() > 0.0)) continue;
     const ContactPoint& c = contacts[j];
-    const bool sustained = c.speculative || (j < resting.size() && resting[j]);
+    const bool sustained = j < slow.size() && slow[j];
     const std::pair<std::uint32_t, double> sides[2] = {{c.a, -1.0}, {c.b, 1.0}};
     for (const auto& [f, sign] : sides) {
       if (floes.is_static[f]) continue;
@@ -512,7 +531,8 @@ std::size_t resolve_step_collisions(Floes& floes, std::span<const FloeState> sta
     const Vec2 pb = c.point - c.shift;  // in b's own image
     resting[k] = jammed(c.a, c.b) || made_by_step(approach(floes, floes.state, c.a, c.b, c.point, pb, c.normal),
                                                   approach(floes, start, c.a, c.b, c.point, pb, c.normal),
-                                                  smooth_kick(floes, start, floes.state, c.a, c.b, c.point, pb));
+                                                  smooth_kick(floes, start, floes.state, c.a, c.b, c.point, pb),
+                                                  opt.rest_speed);
   }
   // In a jam every point beyond xi is speculative from the start.
   std::vector<std::uint8_t> taken(detection.witnesses.size(), 0);
@@ -545,7 +565,7 @@ std::size_t resolve_step_collisions(Floes& floes, std::span<const FloeState> sta
         const double now = approach(floes, floes.state, p.a, p.b, w.pa, pb, w.normal);
         if (!(now * step > w.distance - 0.5 * xi)) continue;
         if (!made_by_step(now, approach(floes, start, p.a, p.b, w.pa, pb, w.normal),
-                          smooth_kick(floes, start, before, p.a, p.b, w.pa, pb)))
+                          smooth_kick(floes, start, before, p.a, p.b, w.pa, pb), opt.rest_speed))
           continue;
         taken[k] = 1;
         contacts.push_back({p.a, p.b, 0.5 * (w.pa + w.pb), w.normal, w.distance, p.shift, true, w.vertex_of_b});
@@ -583,7 +603,9 @@ std::size_t resolve_step_collisions(Floes& floes, std::span<const FloeState> sta
     total.resize(contacts.size());
     for (std::size_t j = 0; j < again.size(); ++j) total[again_index[j]] = redone[j];
   }
-  if (record) record_impulses(*record, floes, contacts, total, resting);
+  // Sustained or impact by the approach at the start of the step, before the
+  // step's smooth forces: a physical speed, not one the step's length made.
+  if (record) record_impulses(*record, floes, contacts, total, slow_contacts(floes, contacts, opt.rest_speed, start));
   if (impulses) {
     total.resize(detection.contacts.size());
     *impulses = std::move(total);

@@ -32,12 +32,18 @@
 // at or above min_gap keep the exact Signorini condition (and the exact
 // restitution law).
 //
+// Resting contacts (ImpulseOptions::rest_speed): a contact whose points
+// approach no faster than rest_speed before its collision (in a sub-step's
+// event, or at the start of a step before the step's smooth forces) rests:
+// restitution 0. Its rebound would not lift the floes out of the contact
+// distance before the push that made the approach closes it again.
+//
 // Collisions at the start of a step (resolve_step_collisions): resting and
 // speculative contacts. Poisson's law is a law of impacts. A contact is
 // "pushed" when its approach was made by this step: at the start of the step
-// it approached no faster than a third of its approach now, or no faster
-// than the step's smooth forces move either floe's point there (|dv(P)| of
-// either floe between the start of the step and W^-), or not at all. The
+// it approached no faster than rest_speed, or than a third of its approach
+// now, or than the step's smooth forces move either floe's point there
+// (|dv(P)| of either floe between the start of the step and W^-). The
 // approach then comes from the step's forces, and from the impulses of the
 // contacts around it: in a jam, neighbours get the same push from the wind
 // and approach because the floe ahead is held.
@@ -144,9 +150,13 @@ struct ContactImpulse {
 // one contact's impulse on one dynamic floe, in that floe's body frame (a
 // rigid floe's body point is the same material point all step long, so the
 // loads of different instants can be put on one model). `event` numbers the
-// solves (one collision instant each). `sustained`: a resting contact
-// (pushed by the step's forces, speculative, or in a jam: impulse.hpp), whose
-// impulse is a force times the time it acted, not a percussion.
+// solves (one collision instant each). `sustained`: a contact whose points
+// approached no faster than ImpulseOptions::rest_speed before its solve (at
+// the step's start, before the step's smooth forces), whose impulse is a
+// force times the time it acted, not a percussion. The test is on a speed,
+// not on the step: a jam's contacts, a floe's push against a coast, a
+// speculative contact that stops a pushed floe are sustained; a floe that
+// drifts into a jam at dm/s strikes it, speculative or not.
 struct ImpulseRecord {
   struct Load {
     std::uint32_t floe = 0;
@@ -171,10 +181,18 @@ struct ImpulseRecord {
 
 // Appends to `record` the nonzero impulses of `contacts` (one per contact, at
 // the floes' present poses) as one event: -J on a, J on b (b's point shifted
-// back to its own image). A contact is sustained if `resting` flags it or it
-// is speculative.
+// back to its own image). A contact is sustained if `sustained` flags it
+// (slow_contacts below: its approach before the solve was at most
+// rest_speed); otherwise it is an impact.
 void record_impulses(ImpulseRecord& record, const Floes& floes, std::span<const ContactPoint> contacts,
-                     std::span<const ContactImpulse> impulses, std::span<const std::uint8_t> resting = {});
+                     std::span<const ContactImpulse> impulses, std::span<const std::uint8_t> sustained = {});
+
+// Per contact, 1 if its two points approach no faster than `rest_speed`
+// (m/s) with the velocities `velocities` (one per floe; the floes' present
+// ones when empty), at the floes' present positions: a resting contact
+// (ImpulseOptions::rest_speed).
+std::vector<std::uint8_t> slow_contacts(const Floes& floes, std::span<const ContactPoint> contacts, double rest_speed,
+                                        std::span<const FloeState> velocities = {});
 
 struct ImpulseOptions {
   double restitution = 0.4;  // e in [0, 1]
@@ -189,6 +207,30 @@ struct ImpulseOptions {
   double relaxation_time = 10.0;  // s, tau of the gap stabilisation
   double collision_distance = 0.01;  // xi, m (speculative contacts)
   double speculative_step = 0.0;     // s, the step speculative contacts are for (set by resolve_step_collisions)
+  // The step a contact's target is divided by is at least this (s): the
+  // speculative gap and the floes' turning (turning_closing, step_limit.hpp)
+  // become speeds over the step, and a gap measured at positions of size L
+  // carries a round-off of about 1e-16 L (1e-12 m in a 10 km basin), which
+  // over a 1.8e-15 s sliver asked for hundreds of m/s and threw a pack
+  // apart. Over 1e-5 s (the sub-stepper's floor, substep.hpp) that round-off
+  // is 1e-7 m/s, a tenth of approach_tolerance. Below the floor a contact
+  // asks what it would over the floor: it may close less than the step
+  // allows (never an overlap), and the turning it makes up for, O(h^2), is
+  // round-off there.
+  double step_floor = 1e-5;
+  // The approach speed (m/s, the normal relative speed of a contact's two
+  // points before its collision) at or below which a contact is resting, not
+  // an impact. A floe pushed against another by a smooth acceleration a
+  // (wind, drag, waves) that rebounds at e v climbs back (e v)^2/(2a) before
+  // the push closes the gap again: below v_rest = sqrt(2 a xi)/e it never
+  // leaves the contact distance xi, so the contact rests and the rebound is
+  // a chatter below what the model resolves. A 1 m floe under a 15 m/s wind
+  // (a = rho_a C_a U^2/(rho_i h) = 5.6e-4 m/s^2) gives, with xi = 1 cm and
+  // e = 0.4, 8.4e-3 m/s; at 20 m/s 1.1e-2 m/s. Resting contacts get
+  // restitution 0 and are recorded as sustained forces (ImpulseRecord); the
+  // test is on the physical speed, so it does not depend on the step
+  // (docs/contact.md, "Resting contacts"). Config key [contact] rest_speed.
+  double rest_speed = 0.01;
   JamOptions jam;                    // what a jam is and how it is time-stepped (jam.hpp)
   std::size_t dense_max = 400;  // LCPs up to this size are assembled dense, larger sparse
   lcp::FallbackOptions solver;
@@ -246,7 +288,9 @@ struct CollisionStats {
 
 // Changes the velocities of the floes in contact (W^- -> W^+). Returns the
 // impulses, one per contact, in the order of `contacts`. `resting` (optional,
-// one flag per contact): restitution 0 for those (above).
+// one flag per contact): restitution 0 for those (above). The record
+// (options.record) takes the impulses of the contacts that approached no
+// faster than rest_speed before the solve as sustained.
 std::vector<ContactImpulse> resolve_collisions(Floes& floes, const std::vector<ContactPoint>& contacts,
                                                const ImpulseOptions& options, CollisionStats& stats,
                                                std::span<const std::uint8_t> resting = {});

@@ -363,7 +363,7 @@ private:
         ++report_.substeps;
         // Collisions at the end of the sub-step (at the end of the step they
         // are left to the next step, which starts with them).
-        if (c.tau < dt_ && !c.cur.contacts.empty()) resolve_collisions(floes_, c.cur.contacts, opt_.impulse, stats_);
+        if (c.tau < dt_ && !c.cur.contacts.empty()) collide(c.cur.contacts);
         return;
       }
       // Overlap: redo with half the length.
@@ -568,8 +568,15 @@ private:
     compute_budgets(k);
     collect_internal(k);
     measure_internal(c);
-    if (!c.cur.contacts.empty()) resolve_collisions(floes_, c.cur.contacts, opt_.impulse, stats_);
+    if (!c.cur.contacts.empty()) collide(c.cur.contacts);
     snapshot(c);
+  }
+
+  // An event's collisions: contacts approaching no faster than rest_speed
+  // rest (restitution 0, impulse.hpp), the others are impacts.
+  void collide(const std::vector<ContactPoint>& contacts) {
+    resolve_collisions(floes_, contacts, opt_.impulse, stats_,
+                       slow_contacts(floes_, contacts, opt_.impulse.rest_speed));
   }
 
   Floes& floes_;

@@ -505,6 +505,7 @@ void read_contact(Section s, ContactParams& c, const std::string& base_dir) {
   c.collision_distance = s.number("collision_distance", c.collision_distance, positive, "a distance > 0 (m)");
   c.restitution = s.number("restitution", c.restitution, unit_interval, "a restitution in [0, 1]");
   c.friction = s.number("friction", c.friction, non_negative, "a friction coefficient >= 0");
+  c.rest_speed = s.number("rest_speed", c.rest_speed, non_negative, "a speed >= 0 (m/s)");
   const std::string domain = s.string("domain", "open");
   if (domain != "open" && domain != "periodic") s.fail("domain", "expected \"open\" or \"periodic\", got \"" + domain + "\"");
   c.periodic = domain == "periodic";
@@ -761,6 +762,7 @@ std::string resolved_toml(const Config& c) {
 
   toml::table contact{{"collision_distance", c.contact.collision_distance},
                       {"restitution", c.contact.restitution}, {"friction", c.contact.friction},
+                      {"rest_speed", c.contact.rest_speed},
                       {"domain", c.contact.periodic ? "periodic" : "open"}};
   if (!c.contact.dump_failed_lcps.empty()) contact.insert("dump_failed_lcps", c.contact.dump_failed_lcps);
   if (c.contact.box[1] > c.contact.box[0])

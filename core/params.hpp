@@ -85,6 +85,7 @@ struct ContactParams {
   double collision_distance = 0.01;  // m
   double restitution = 0.4;          // Poisson restitution e in [0, 1]
   double friction = 0.7;             // Coulomb mu >= 0
+  double rest_speed = 0.01;          // m/s: contacts approaching no faster rest (contact::ImpulseOptions::rest_speed)
   bool periodic = false;             // a torus made from `box`
   std::array<double, 4> box = {0.0, 0.0, 0.0, 0.0};  // xmin, xmax, ymin, ymax (m); empty: the pack's window
   std::string dump_failed_lcps;      // an existing folder for the LCPs the solver could not solve ("": none)

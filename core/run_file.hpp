@@ -79,7 +79,7 @@ struct CollisionEventRow {
   double floe_a = 0.0, floe_b = 0.0;  // the floes' numbers (floe_a < floe_b, or floe_b static)
   double normal = 0.0;  // N s, the normal impulse of the pair's contacts, summed (compression + restitution)
   double x = 0.0, y = 0.0;  // m, world: the contact point (impulse-weighted mean of the pair's points)
-  double resting = 0.0;  // 1: every contact of the pair rested (pushed by the step, speculative, jammed), 0: an impact
+  double resting = 0.0;  // 1: every contact of the pair rested (approached no faster than rest_speed), 0: an impact
 };
 inline constexpr int kCollisionEventColumns = 7;
 static_assert(sizeof(CollisionEventRow) == kCollisionEventColumns * sizeof(double));

@@ -15,8 +15,10 @@
 //    instant (event) at a time. Each event's impulses are a percussion, spread
 //    over `duration` (response.hpp): the dynamic response, rigid motion
 //    removed.
-//  * sustained contact: the impulses of resting contacts (pushed by the
-//    step's forces, speculative, in a jam; contact/impulse.hpp). Their sum
+//  * sustained contact: the impulses of resting contacts (their points
+//    approached no faster than [contact] rest_speed before the solve:
+//    a jam's contacts, a floe pushed against a coast; contact/impulse.hpp,
+//    ImpulseRecord). Their sum
 //    over the step of length dt is the mean contact force F = sum J / dt, a
 //    quasi-static load: the static response to F with the rigid motion
 //    removed (inertia relief: the forces that accelerate the floe as a whole,

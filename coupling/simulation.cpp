@@ -85,6 +85,7 @@ Simulation::Simulation(Scenario scenario, parallel::Communicator comm)
   detection_options_.horizon = c.run.dt_max;
   impulse_options_.restitution = c.contact.restitution;
   impulse_options_.friction = c.contact.friction;
+  impulse_options_.rest_speed = c.contact.rest_speed;
   impulse_options_.min_gap = 0.1 * c.contact.collision_distance;
   impulse_options_.relaxation_time = c.run.dt_max;
   impulse_options_.collision_distance = c.contact.collision_distance;

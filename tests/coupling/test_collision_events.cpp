@@ -25,13 +25,15 @@ std::vector<CollisionEventRow> run_rows(Simulation& sim, double until) {
   return rows;
 }
 
-// Two 10 m squares 0.5 m apart, the second coming at the first at 1 m/s along
-// -x, frictionless, restitution 0.4, no sea, collisions recorded.
-std::string head_on() {
+// Two 10 m squares `gap` m apart, the second coming at the first at v m/s
+// along -x, frictionless, restitution 0.4, no sea, collisions recorded, steps
+// of at most dt s.
+std::string head_on(double v = 1.0, double gap = 0.5, double dt = 0.05) {
+  const std::string x0 = std::to_string(10.0 + gap), x1 = std::to_string(20.0 + gap);
   return R"(
 [run]
 t_end = 2.0
-dt_max = 0.05
+dt_max = )" + std::to_string(dt) + R"(
 output_interval = 1.0
 record_collisions = true
 [sea]
@@ -45,8 +47,8 @@ friction = 0.0
 [[floes.floe]]
 vertices = [[0, 0], [10, 0], [10, 10], [0, 10]]
 [[floes.floe]]
-vertices = [[10.5, 0], [20.5, 0], [20.5, 10], [10.5, 10]]
-velocity = [-1.0, 0.0]
+vertices = [[)" + x0 + ", 0], [" + x1 + ", 0], [" + x1 + ", 10], [" + x0 + R"(, 10]]
+velocity = [)" + std::to_string(-v) + R"(, 0.0]
 )";
 }
 
@@ -145,4 +147,32 @@ static = true
   // The impulses are all the momentum the wall took (the run's own budget).
   CHECK(sum == doctest::Approx(-sim.momentum_budget().collisions.x()).epsilon(1e-9));
   CHECK(sum + m * sim.floes().state[0].vx == doctest::Approx(force * T).epsilon(1e-3));
+}
+
+// Resting contact or impact is decided by the approach speed against
+// [contact] rest_speed (0.01 m/s), not by the step (contact/impulse.hpp). The
+// head-on pair at 5 mm/s rests: restitution 0, the reduced mass times v,
+// (m/2) v, recorded as a sustained force; at 2 cm/s it is an impact,
+// (m/2)(1 + e) v. Each the same with steps of 0.05 s and of 2 s (the impact
+// falls inside a step, in the sub-stepper's events, in both).
+TEST_CASE("collision events: a contact rests or strikes by its approach speed, whatever the step") {
+  const double e = 0.4;
+  for (double dt : {0.05, 2.0}) {
+    for (double v : {0.005, 0.02}) {
+      CAPTURE(dt);
+      CAPTURE(v);
+      Simulation sim(build_scenario(parse_config(head_on(v, 0.05, dt), "rest.toml", ".")));
+      const double m = sim.floes().mass[0];
+      const bool slow = v <= 0.01;
+      const std::vector<CollisionEventRow> rows = run_rows(sim, 0.05 / v + 3.0);
+      REQUIRE(rows.size() >= 1);
+      CHECK(rows.front().resting == (slow ? 1.0 : 0.0));
+      double sum = 0.0;
+      for (const CollisionEventRow& r : rows) sum += r.normal;
+      CHECK(sum == doctest::Approx(0.5 * m * (slow ? 1.0 : 1.0 + e) * v).epsilon(1e-6));
+      // Restitution 0 leaves the pair moving together at v/2; e = 0.4 parts them at e v.
+      CHECK(sim.floes().state[1].vx - sim.floes().state[0].vx ==
+            doctest::Approx(slow ? 0.0 : e * v).epsilon(1e-6).scale(v));
+    }
+  }
 }

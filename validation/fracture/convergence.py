@@ -7,10 +7,11 @@ t_end, the splits, and the fragment-size distribution (equivalent diameter
 d = sqrt(4 A / pi) of the dynamic floes at t_end: counts in fixed classes,
 and quantiles), with the changes against the first run.
 
-Usage: validation/fracture/convergence.py BUILD_DIR [MESH DT T_END [LOAD_RADIUS]], or
-scripts/validate fracture [MESH DT T_END [LOAD_RADIUS]]
+Usage: validation/fracture/convergence.py BUILD_DIR [--jobs N] [MESH DT T_END [LOAD_RADIUS]], or
+scripts/validate fracture [--jobs N] [MESH DT T_END [LOAD_RADIUS]]
 (defaults 20 m, 10 s, 3000 s, and the example's load radius: [fracture]
-load_radius, the floes' thickness when unset). Uses numpy and h5py (Debian packages).
+load_radius, the floes' thickness when unset; --jobs: runs at once, 1).
+Uses numpy and h5py (Debian packages).
 """
 import os
 import subprocess
@@ -21,8 +22,13 @@ import h5py
 import numpy as np
 
 build = sys.argv[1]
-mesh, dt, t_end = (float(a) for a in (sys.argv[2:5] if len(sys.argv) >= 5 else (20.0, 10.0, 3000.0)))
-load_radius = float(sys.argv[5]) if len(sys.argv) >= 6 else None
+argv = sys.argv[2:]
+jobs = 1
+if argv[:1] == ["--jobs"]:
+    jobs = int(argv[1])
+    argv = argv[2:]
+mesh, dt, t_end = (float(a) for a in (argv[0:3] if len(argv) >= 3 else (20.0, 10.0, 3000.0)))
+load_radius = float(argv[3]) if len(argv) >= 4 else None
 src = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 floesim = os.path.join(build, "bin", "floesim")
 base = open(os.path.join(src, "examples", "pack_fracture.toml")).read()
@@ -30,7 +36,7 @@ pack = os.path.join(src, "examples", "pack_against_wall.h5")
 classes = [0.0, 20.0, 30.0, 40.0, 50.0, 60.0, 1e9]  # m, equivalent diameter
 
 work = tempfile.mkdtemp(prefix="fracture_convergence_")
-rows = []
+runs = []
 for m, h in ((mesh, dt), (mesh / 2, dt), (mesh, dt / 2), (mesh / 2, dt / 2)):
     text = []
     for line in base.splitlines():
@@ -48,9 +54,26 @@ for m, h in ((mesh, dt), (mesh / 2, dt), (mesh, dt / 2), (mesh / 2, dt / 2)):
         text.append(f"load_radius = {load_radius}")
     cfg = os.path.join(work, f"m{m}_dt{h}.toml")
     open(cfg, "w").write("\n".join(text) + "\n")
-    out = cfg.replace(".toml", ".h5")
-    p = subprocess.run([floesim, "run", cfg, "-q", "-o", out], capture_output=True, text=True, check=True)
-    kv = dict(l.split(": ", 1) for l in p.stdout.splitlines() if ": " in l)
+    runs.append((m, h, cfg, cfg.replace(".toml", ".h5")))
+
+# Run them, `jobs` at a time (one thread each).
+outputs = {}
+pending = list(runs)
+active = []
+while pending or active:
+    while pending and len(active) < jobs:
+        m, h, cfg, out = pending.pop(0)
+        active.append((cfg, subprocess.Popen([floesim, "run", cfg, "-q", "-o", out], stdout=subprocess.PIPE,
+                                             stderr=subprocess.PIPE, text=True)))
+    cfg, p = active.pop(0)
+    stdout, stderr = p.communicate()
+    if p.returncode != 0:
+        sys.exit(f"{cfg}: floesim run failed (exit {p.returncode}): {stderr}")
+    outputs[cfg] = stdout
+
+rows = []
+for m, h, cfg, out in runs:
+    kv = dict(l.split(": ", 1) for l in outputs[cfg].splitlines() if ": " in l)
     with h5py.File(out, "r") as f:
         area = f["floes/area"][:]
         static = f["floes/static"][:].astype(bool)
