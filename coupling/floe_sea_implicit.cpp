@@ -1,0 +1,227 @@
+// The implicit floe–sea step (FloeSeaContact::implicit_step and what only it
+// uses; coupling/floe_sea.hpp, "Implicit step"; docs/coupling.md, "The
+// implicit step"): the problem on the midpoint footprint, its solve by
+// coupling/penalty_step.hpp, the step of the floes and the sea with the
+// forces found, and the step's mean horizontal loads. The explicit kicks and
+// the rest of the contact are in floe_sea.cpp.
+#include "coupling/floe_sea.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include <Eigen/Dense>
+
+#include "core/error.hpp"
+#include "coupling/parallel.hpp"
+#include "coupling/penalty_law.hpp"
+#include "fluid/sea.hpp"
+
+namespace floesim {
+
+using parallel::for_each_index;
+
+namespace {
+
+// f(i) for the floes of `order` on threads.
+template <class F>
+void for_each_floe(const std::vector<std::uint32_t>& order, int threads, F&& f) {
+  parallel::for_each_of(order, threads, std::forward<F>(f));
+}
+
+}  // namespace
+
+void FloeSeaContact::sea_response(fluid::Sea& sea, double h, std::span<const double> u, std::span<double> out) {
+  const Footprints& fp = footprints_.pieces();
+  const double inv_cell_area = 1.0 / cell_area_;
+  // The pressure of the forces u, held over h, lowers the nodes by the
+  // sea's midpoint response (G_sea u is minus that change). The scatter is
+  // in order: pieces of several floes share nodes.
+  for (std::size_t k = 0; k < fp.cell.size(); ++k) grid_work_[fp.cell[k]] += u[k] * inv_cell_area;
+  sea.midpoint_response(grid_work_, h, grid_eta_);
+  for_each_index(fp.cell.size(), threads_, [&](std::size_t k) { out[k] = -grid_eta_[fp.cell[k]]; });
+  for (std::uint32_t c : fp.cell) grid_work_[c] = 0.0;
+}
+
+void FloeSeaContact::place_midpoint_footprints(const Floes& floes, std::span<const FloeState> start) {
+  // At the step's end the vertical forces would lag the drift by h / 2: a
+  // first-order error. A periodic grid's seam is crossed by the shorter way.
+  pose_at_states(floes);
+  const bool periodic = grid_.edge == fluid::GridEdge::periodic;
+  for (std::size_t i = 0; i < floes.size() && i < start.size(); ++i) {
+    if (!dynamic_[i]) continue;
+    FloePose& p = poses_[i];
+    double dx = p.x - start[i].x, dy = p.y - start[i].y;
+    if (periodic) {
+      dx -= grid_.lx * std::round(dx / grid_.lx);
+      if (grid_.dims == 2) dy -= grid_.ly * std::round(dy / grid_.ly);
+    }
+    p.x -= 0.5 * dx;
+    p.y -= 0.5 * dy;
+    p.yaw = 0.5 * (p.yaw + start[i].yaw);
+  }
+  place_footprints(floes);
+}
+
+void FloeSeaContact::implicit_step(Floes& floes, std::span<const FloeState> start, fluid::Sea& sea, double h) {
+  // The footprints at the midpoint of the floes' horizontal motion over the step.
+  place_midpoint_footprints(floes, start);
+  const Footprints& fp = footprints_.pieces();
+  const std::size_t n = fp.cell.size();
+  // Each floe's vertical inertia on the DOFs it has.
+  inertia_.assign(floes.size(), {});
+  for (std::uint32_t i : order_) {
+    VerticalInertia& in = inertia_[i];
+    in.slopes = tilt_[i];
+    in.mass(0, 0) = floes.mass[i];
+    in.inverse_mass(0, 0) = 1.0 / floes.mass[i];
+    if (tilt_[i] == 2) {
+      const Eigen::Matrix2d J = tilt_inertia(floes, i);
+      in.mass.bottomRightCorner<2, 2>() = J;
+      in.inverse_mass.bottomRightCorner<2, 2>() = J.inverse();
+    } else if (tilt_[i] == 1) {
+      in.mass(1, 1) = tilt_inertia(floes, i)(0, 0);
+      in.inverse_mass(1, 1) = 1.0 / in.mass(1, 1);
+    }
+  }
+  grid_work_.assign(grid_.size(), 0.0);
+  grid_eta_.resize(grid_.size());
+  // Per piece: the spring c = s kappa psi a, the damper per step, the
+  // penetrations at t (d0) and with no penalty at t + h (d_free), both on
+  // this footprint.
+  ImplicitPieces& q = pieces_;
+  for (auto* v : {&q.spring, &q.damper, &q.start, &q.free_end}) v->assign(n, 0.0);
+  free_bottom_.assign(floes.size(), Eigen::Vector3d::Zero());  // z, a at t + h with no penalty
+  const double ks = s_ * kappa_;
+  double scale = 0.0;  // the thickest draft: the residual's unit
+  for (std::uint32_t i : order_) scale = std::max(scale, floes.draft(i, rho_));
+  const std::span<const double> eta0 = sea.elevation();
+  for_each_floe(order_, threads_, [&](std::uint32_t i) {
+    const FloeState& st = floes.state[i];
+    const double z = st.heave + bottom0_[i];
+    const Vec2 a{st.pitch, st.roll};
+    free_bottom_[i] = {z + h * st.heave_rate - 0.5 * h * h * g_, st.pitch + h * st.pitch_rate,
+                       st.roll + h * st.roll_rate};
+    const double damper = (1.0 - s_) * weak_coefficient(floes, i) / h;
+    for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k) {
+      const double psi_area = subcell_weight(cells_[fp.cell[k]].coverage) * fp.area[k];
+      q.spring[k] = ks * psi_area;
+      q.damper[k] = damper * psi_area;
+      q.start[k] = eta0[fp.cell[k]] - z - a.dot(fp.centroid[k]);
+    }
+  });
+  sea.midpoint_free_elevation(h, grid_eta_);
+  for_each_floe(order_, threads_, [&](std::uint32_t i) {
+    const Eigen::Vector3d& b = free_bottom_[i];
+    for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k)
+      q.free_end[k] = grid_eta_[fp.cell[k]] - b[0] - b[1] * fp.centroid[k].x() - b[2] * fp.centroid[k].y();
+  });
+  // The sea's response on a node to its own pressure over h: the diagonal of
+  // G_sea, for the preconditioner (a periodic sea's is the same on every node).
+  if (self_response_h_ != h) {
+    // A walled basin's node in the middle (row ny / 2, column nx / 2), away from its walls.
+    const std::size_t middle = static_cast<std::size_t>(grid_.ny / 2) * static_cast<std::size_t>(grid_.nx) +
+                               static_cast<std::size_t>(grid_.nx / 2);
+    const std::size_t node = grid_.edge == fluid::GridEdge::periodic ? 0 : middle;
+    grid_work_[node] = 1.0;
+    sea.midpoint_response(grid_work_, h, grid_eta_);
+    grid_work_[node] = 0.0;
+    self_response_ = std::max(-grid_eta_[node], 0.0);
+    self_response_h_ = h;
+  }
+
+  PenaltyStepProblem problem;
+  problem.step = h;
+  problem.offsets = fp.offsets;
+  problem.bodies = order_;
+  problem.inertia = inertia_;
+  problem.lever = fp.centroid;
+  problem.spring = q.spring;
+  problem.damper = q.damper;
+  problem.start = q.start;
+  problem.free_end = q.free_end;
+  problem.self_response = self_response_ / cell_area_;
+  problem.tolerance = newton_tolerance_ * std::max(scale, 1e-300);
+  PenaltyStepOptions options = solver_options_;
+  options.threads = threads_;
+  const PenaltyStepResult result = solver_.solve(
+      problem, [&](std::span<const double> u, std::span<double> out) { sea_response(sea, h, u, out); }, options);
+  ++implicit_stats_.steps;
+  implicit_stats_.newton += result.newton;
+  implicit_stats_.cg += result.cg;
+  implicit_stats_.g_products += result.responses;
+  implicit_stats_.last_residual = result.residual;
+  if (result.status != PenaltyStepStatus::converged) {
+    std::ostringstream m;
+    m << "the implicit floe–sea step did not converge in " << options.max_newton << " Newton iterations (largest residual "
+      << result.residual << " m, tolerance " << problem.tolerance << " m; dt = " << h << " s)";
+    throw RunError(m.str());
+  }
+
+  // The step with the forces f held over it: the floes...
+  const std::span<const double> f = solver_.force();
+  const double hh = 0.5 * h * h;
+  for (std::uint32_t i : order_) {
+    FloeState& st = floes.state[i];
+    Eigen::Vector3d F(-floes.mass[i] * g_, 0.0, 0.0);
+    for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k)
+      F += f[k] * Eigen::Vector3d(1.0, fp.centroid[k].x(), fp.centroid[k].y());
+    const Eigen::Vector3d acc = inertia_[i].inverse_mass * F;
+    st.heave += h * st.heave_rate + hh * acc[0];
+    st.pitch += h * st.pitch_rate + hh * acc[1];
+    st.roll += h * st.roll_rate + hh * acc[2];
+    st.heave_rate += h * acc[0];
+    st.pitch_rate += h * acc[1];
+    st.roll_rate += h * acc[2];
+  }
+  // Floes with no pieces (outside the sea) drift, as with the explicit kicks.
+  for (std::size_t i = 0; i < floes.size(); ++i) {
+    if (!dynamic_[i] || fp.offsets[i] < fp.offsets[i + 1]) continue;
+    FloeState& st = floes.state[i];
+    st.heave += h * st.heave_rate;
+    st.pitch += h * st.pitch_rate;
+    st.roll += h * st.roll_rate;
+  }
+  // ... and the sea.
+  const double inv_cell_area = 1.0 / cell_area_;
+  for (std::size_t k = 0; k < n; ++k) grid_work_[fp.cell[k]] += f[k] * inv_cell_area;
+  sea.midpoint_step(grid_work_, h);
+  for (std::size_t k = 0; k < n; ++k) grid_work_[fp.cell[k]] = 0.0;
+  if (step_mean_loads_) step_mean_horizontal(floes, start);
+}
+
+void FloeSeaContact::step_mean_horizontal(const Floes& floes, std::span<const FloeState> start) {
+  // On the midpoint footprint: each piece's mean [delta]^+ over the step, the
+  // spring's discrete gradient per unit stiffness (the header's "Horizontal
+  // loads of the implicit step"), and the cells' sums of a_k u_k^2 with it.
+  const Footprints& fp = footprints_.pieces();
+  const std::span<const double> area0 = footprints_.reference_area();
+  const std::span<const double> d1 = solver_.end();
+  std::vector<double>& u = eval_.penetration;
+  std::vector<double>& psi = eval_.psi;
+  u.assign(fp.cell.size(), 0.0);
+  psi.resize(fp.cell.size());
+  eval_.wetted.assign(floes.size(), 0.0);
+  slope_.resize(floes.size());
+  for_each_floe(order_, threads_, [&](std::uint32_t i) {
+    const FloeState& st = floes.state[i];
+    slope_[i] = 0.5 * Vec2{st.pitch + start[i].pitch, st.roll + start[i].roll};
+    double wet = 0.0;
+    for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k) {
+      psi[k] = subcell_weight(cells_[fp.cell[k]].coverage);
+      if (fp.area[k] <= 0.0) continue;
+      u[k] = step_force(1.0, 0.0, pieces_.start[k], d1[k]).f;
+      wet += psi[k] * area0[k] * u[k];
+    }
+    eval_.wetted[i] = wet;
+  });
+  for (std::uint32_t i : order_)
+    for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k)
+      if (u[k] > 0.0) cells_[fp.cell[k]].sum += fp.area[k] * u[k] * u[k];
+  horizontal_loads(u);
+  std::fill(step_horizontal_.begin(), step_horizontal_.end(), Eigen::Vector3d::Zero());
+  for (std::uint32_t i : order_) step_horizontal_[i] = loads_[i].horizontal;
+  step_mean_pending_ = true;
+}
+
+}  // namespace floesim
