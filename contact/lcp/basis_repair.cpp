@@ -10,17 +10,9 @@ std::vector<std::uint8_t> repair_basis(const SparseMatrix& M, const std::vector<
                                        const BasisRepairOptions& options, long* dropped) {
   std::vector<std::uint8_t> flags = z_basic;
   long count = 0;
-  const Index n = M.cols();
-  std::vector<Index> list, position(static_cast<std::size_t>(n));
+  std::vector<Index> list, position;
   for (int round = 0; round < options.rounds; ++round) {
-    list.clear();
-    std::fill(position.begin(), position.end(), -1);
-    for (Index i = 0; i < n; ++i)
-      if (flags[static_cast<std::size_t>(i)]) {
-        position[static_cast<std::size_t>(i)] = static_cast<Index>(list.size());
-        list.push_back(i);
-      }
-    const Index k = static_cast<Index>(list.size());
+    const Index k = select_unknowns(flags, list, position);
     if (k == 0) break;
     std::vector<Eigen::Triplet<double>> trip;
     double largest = 0.0;

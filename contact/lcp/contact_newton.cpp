@@ -89,12 +89,7 @@ Result solve_contact_newton(const Lcp& lcp, const FrictionLayout& layout, const 
   const ContactForm f = contact_form(lcp, layout, "contact Newton method");
   const Index n = lcp.size(), m = n / 4;
   const double mu = layout.friction;
-  if (options.start && static_cast<Index>(options.start->size()) != n)
-    throw RunError("contact Newton method: the warm start has " + std::to_string(options.start->size()) +
-                   " flags for " + std::to_string(n) + " unknowns");
-  if (options.start_point.size() != 0 && options.start_point.size() != n)
-    throw RunError("contact Newton method: the start point has " + std::to_string(options.start_point.size()) +
-                   " entries for " + std::to_string(n) + " unknowns");
+  check_start("contact Newton method", n, options.start, options.start_point);
   ContactNewtonStats local;
   ContactNewtonStats& st = stats ? *stats : local;
 

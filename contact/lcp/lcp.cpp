@@ -26,6 +26,26 @@ Index nonzeros(const Lcp& lcp) {
   return (D.array() != 0.0).count();
 }
 
+void check_start(std::string_view solver, Index n, const std::vector<std::uint8_t>* flags, const Vector& point) {
+  if (flags && static_cast<Index>(flags->size()) != n)
+    throw RunError(std::string(solver) + ": the warm start has " + std::to_string(flags->size()) + " flags for " +
+                   std::to_string(n) + " unknowns");
+  if (point.size() != 0 && point.size() != n)
+    throw RunError(std::string(solver) + ": the start point has " + std::to_string(point.size()) + " entries for " +
+                   std::to_string(n) + " unknowns");
+}
+
+Index select_unknowns(const std::vector<std::uint8_t>& flags, std::vector<Index>& list, std::vector<Index>& position) {
+  list.clear();
+  position.assign(flags.size(), -1);
+  for (std::size_t i = 0; i < flags.size(); ++i)
+    if (flags[i]) {
+      position[i] = static_cast<Index>(list.size());
+      list.push_back(static_cast<Index>(i));
+    }
+  return static_cast<Index>(list.size());
+}
+
 void check_lcp(const Lcp& lcp) {
   const Index n = lcp.size();
   const auto [rows, cols] = std::visit(

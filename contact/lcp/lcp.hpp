@@ -48,6 +48,16 @@ Index nonzeros(const Lcp& lcp);
 // collide phase), which is a run error: the run stops and its file says so.
 void check_lcp(const Lcp& lcp);
 
+// Checks a solver's warm start against an LCP of n unknowns: `flags` (one
+// per unknown, or null) and `point` (n entries, or empty); throws
+// floesim::RunError naming `solver` if a size differs.
+void check_start(std::string_view solver, Index n, const std::vector<std::uint8_t>* flags, const Vector& point);
+
+// The unknowns i with flags[i] set, ascending, into `list`, and each one's
+// place in it into `position` (-1 for the others): the index maps of a
+// principal block M_AA. Returns the block's size.
+Index select_unknowns(const std::vector<std::uint8_t>& flags, std::vector<Index>& list, std::vector<Index>& position);
+
 enum class Status {
   solved,       // z, w satisfy the LCP (see the residual for how well)
   ray,          // Lemke ended on a secondary ray: no solution found this way

@@ -37,12 +37,7 @@ double merit(const Vector& z, const Vector& w) { return 0.5 * z.cwiseMin(w).squa
 Result solve_newton(const Lcp& lcp, const NewtonOptions& options, NewtonStats* stats) {
   check_lcp(lcp);
   const Index n = lcp.size();
-  if (options.start && static_cast<Index>(options.start->size()) != n)
-    throw RunError("Newton LCP solver: the warm start has " + std::to_string(options.start->size()) +
-                   " flags for " + std::to_string(n) + " unknowns");
-  if (options.start_point.size() != 0 && options.start_point.size() != n)
-    throw RunError("Newton LCP solver: the start point has " + std::to_string(options.start_point.size()) +
-                   " entries for " + std::to_string(n) + " unknowns");
+  check_start("Newton LCP solver", n, options.start, options.start_point);
   NewtonStats local;
   NewtonStats& st = stats ? *stats : local;
   const SparseMatrix M = sparse_copy(lcp);
@@ -58,19 +53,12 @@ Result solve_newton(const Lcp& lcp, const NewtonOptions& options, NewtonStats* s
                                                         : static_cast<std::uint8_t>(w(i) < z(i));
   Result result;
   result.status = Status::pivot_limit;
-  std::vector<Index> list, position(static_cast<std::size_t>(n), -1);
+  std::vector<Index> list, position;
   Eigen::UmfPackLU<SparseMatrix> lu;
   for (int iteration = 1; iteration <= options.max_iterations; ++iteration) {
     result.iterations = iteration;
     // The point (1) of the header for the present active set.
-    list.clear();
-    std::fill(position.begin(), position.end(), -1);
-    for (Index i = 0; i < n; ++i)
-      if (active[static_cast<std::size_t>(i)]) {
-        position[static_cast<std::size_t>(i)] = static_cast<Index>(list.size());
-        list.push_back(i);
-      }
-    const Index k = static_cast<Index>(list.size());
+    const Index k = select_unknowns(active, list, position);
     Vector target = Vector::Zero(n);
     if (k > 0) {
       SparseMatrix B = principal_block(M, list, position, delta);
