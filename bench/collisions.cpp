@@ -32,8 +32,18 @@
 // A scenario that throws, or runs past --time-limit, is reported with its
 // status and the simulated time it reached.
 //
+// FloeDyn side by side (--floedyn BIN, its FLOE program built from its public
+// source): after each timed run of floedyn_100, FloeDyn runs the same input
+// (data/floedyn/in_example_100_floes.h5) to the same end time, one thread,
+// `BIN -i INPUT -t 10000 [--floedyn-arg ...]`, in its checkout (--floedyn-dir,
+// default the folder above BIN's: waf builds into build/, and FloeDyn reads its
+// default forcing from io/inputs/ there); its output goes to floedyn.log in the
+// pack folder. floedyn_s is its least wall time, speedup = floedyn_s / wall_s,
+// both measured in this run; without --floedyn both are empty.
+//
 // Usage: floesim_bench_collisions [--repeats R] [--repeats-large R] [--only NAME...]
 //                                 [--csv FILE] [--time-limit S] [--note TEXT...] [--pack-dir DIR]
+//                                 [--floedyn BIN [--floedyn-dir DIR] [--floedyn-arg ARG...]]
 // To profile one scenario: run once with --pack-dir DIR --only NAME, then
 //   perf record -g floesim_bench_collisions --child NAME --pack-dir DIR
 #include <sys/wait.h>
@@ -62,6 +72,7 @@
 #include "core/pack_generator.hpp"
 #include "coupling/scenario.hpp"
 #include "coupling/simulation.hpp"
+#include "external_run.hpp"
 
 using namespace floesim;
 namespace fs = std::filesystem;
@@ -72,19 +83,19 @@ struct BenchScenario {
   std::string name;
   std::size_t floes = 0;      // 0: FloeDyn's example
   double t_end = 0.0;         // s simulated
-  double floedyn_s = -1.0;    // FloeDyn, one core of this machine kind (issue 4); < 0: unknown
+  std::string floedyn_input;  // FloeDyn's input for the same case (under the source folder); empty: none
   bool jam = false;           // a walled pack pushed by the wind against the downwind wall
   double jam_box = 1000.0;    // m, side of a jam's walled box
 };
 
 const std::vector<BenchScenario> kScenarios = {
-    {"floedyn_100", 0, 1.0e4, 13.8},
-    {"pack_500", 500, 1.0e3, 24.6},
-    {"pack_2000", 2000, 1.0e3, 204.0},
-    {"pack_10000", 10000, 1.0e3, -1.0},
-    {"jam_100", 100, 1.0e4, -1.0, true},
-    {"jam_500", 500, 3.0e3, -1.0, true},
-    {"jam_2000", 2000, 3.0e3, -1.0, true, 2000.0},
+    {"floedyn_100", 0, 1.0e4, "data/floedyn/in_example_100_floes.h5"},
+    {"pack_500", 500, 1.0e3, ""},
+    {"pack_2000", 2000, 1.0e3, ""},
+    {"pack_10000", 10000, 1.0e3, ""},
+    {"jam_100", 100, 1.0e4, "", true},
+    {"jam_500", 500, 3.0e3, "", true},
+    {"jam_2000", 2000, 3.0e3, "", true, 2000.0},
 };
 
 constexpr double kMeanDiameter = 100.0;  // m
@@ -309,6 +320,21 @@ struct Row {
   int repeats = 0;
   double wall_median = 0.0;
   double peak_rss_mb = -1.0;
+  std::vector<double> floedyn_walls;  // s, FloeDyn's runs that exited 0, one after each timed run
+  std::string floedyn_status;         // the first failure of a FloeDyn run; empty: none failed
+  double floedyn_min() const { return *std::min_element(floedyn_walls.begin(), floedyn_walls.end()); }
+};
+
+// FloeDyn's program and how to run it (--floedyn ...); bin empty: not run.
+struct FloedynCommand {
+  std::string bin, dir;
+  std::vector<std::string> extra;
+  std::vector<std::string> argv(const BenchScenario& s) const {
+    std::vector<std::string> a = {bin, "-i", std::string(FLOESIM_BENCH_SOURCE_DIR) + "/" + s.floedyn_input, "-t",
+                                  std::to_string(static_cast<long>(s.t_end))};
+    a.insert(a.end(), extra.begin(), extra.end());
+    return a;
+  }
 };
 
 // Least-squares slope of log y against log x.
@@ -336,6 +362,7 @@ int main(int argc, char** argv) {
   double time_limit = 600.0;
   std::vector<std::string> only, notes;
   std::string csv, child, pack_dir_arg;
+  FloedynCommand floedyn;
   app.add_option("--repeats", repeats, "timed runs per scenario after the warm-up (minimum kept)")
       ->check(CLI::PositiveNumber);
   app.add_option("--repeats-large", repeats_large, "timed runs for scenarios of 10^4 floes or more, and jams of 500 floes or more")
@@ -346,7 +373,20 @@ int main(int argc, char** argv) {
   app.add_option("--note", notes, "extra comment lines for the CSV header");
   app.add_option("--child", child, "internal: run one scenario once (peak memory)");
   app.add_option("--pack-dir", pack_dir_arg, "keep the generated packs in this folder (default: a temporary one)");
+  app.add_option("--floedyn", floedyn.bin, "FloeDyn's FLOE program: time it side by side on floedyn_100")
+      ->check(CLI::ExistingFile);
+  app.add_option("--floedyn-dir", floedyn.dir, "folder FloeDyn runs in (default: the one above --floedyn's folder)")
+      ->check(CLI::ExistingDirectory);
+  app.add_option("--floedyn-arg", floedyn.extra, "extra arguments for FloeDyn (e.g. --floedyn-arg=--fext=FILE)");
   CLI11_PARSE(app, argc, argv);
+  if (!floedyn.bin.empty()) {
+    floedyn.bin = fs::absolute(floedyn.bin).string();
+    if (access(floedyn.bin.c_str(), X_OK) != 0) {
+      std::fprintf(stderr, "--floedyn %s: not an executable file\n", floedyn.bin.c_str());
+      return 1;
+    }
+    if (floedyn.dir.empty()) floedyn.dir = fs::path(floedyn.bin).parent_path().parent_path().string();
+  }
 
   if (child == "none") {  // the baseline: a process that only starts
     print_own_peak_rss();
@@ -424,6 +464,14 @@ int main(int argc, char** argv) {
       walls[i].push_back(r.wall);
       const bool better = k == 0 || (r.status == "ok" && (row.best.status != "ok" || r.wall < row.best.wall));
       if (better) row.best = std::move(r);
+      if (!floedyn.bin.empty() && !row.scenario->floedyn_input.empty() && row.floedyn_status.empty()) {
+        const bench::ExternalRun f =
+            bench::run_external(floedyn.argv(*row.scenario), floedyn.dir, pack_dir + "/floedyn.log");
+        std::printf("# FloeDyn on %s, run %d: %s, %.3f s\n", row.scenario->name.c_str(), k + 1, f.status.c_str(),
+                    f.wall);
+        if (f.ok) row.floedyn_walls.push_back(f.wall);
+        else row.floedyn_status = f.status + " (its output: " + pack_dir + "/floedyn.log)";
+      }
     }
   for (std::size_t i = 0; i < rows.size(); ++i) {
     Row& row = rows[i];
@@ -446,15 +494,19 @@ int main(int argc, char** argv) {
                 b.substeps.rebuilt, b.substeps.time_steps, b.stats.warm, b.stats.warm_missed, b.stats.pivots,
                 b.stats.failures);
     for (const std::string& w : b.warnings) std::printf("#   warning: %s\n", w.c_str());
+    if (!row.floedyn_status.empty()) std::printf("#   FloeDyn failed: %s\n", row.floedyn_status.c_str());
     std::fflush(stdout);
   }
-  if (pack_dir_arg.empty()) fs::remove_all(pack_dir);
+  // A failed FloeDyn run keeps the folder, for its log.
+  bool floedyn_failed = false;
+  for (const Row& row : rows) floedyn_failed = floedyn_failed || !row.floedyn_status.empty();
+  if (pack_dir_arg.empty() && !floedyn_failed) fs::remove_all(pack_dir);
 
   // Table and CSV.
   std::ostringstream out;
   out << "scenario,status,floes,simulated_s,repeats,wall_s,wall_s_median,setup_s,steps,lcps,pivots,failures,"
          "fallbacks,contacts,largest_lcp,rejected_steps,clusters,substeps,largest_cluster,joined,merges,"
-         "rejected_substeps,floor_substeps,pairs_rebuilt,peak_rss_mb,floedyn_s,speedup";
+         "rejected_substeps,floor_substeps,pairs_rebuilt,peak_rss_mb,floedyn_s,floedyn_s_median,speedup";
   for (const char* p : kPhaseNames) out << "," << p << "_s";
   out << "\n";
   for (const Row& row : rows) {
@@ -467,14 +519,17 @@ int main(int argc, char** argv) {
                   b.stats.contacts, b.stats.largest, b.rejected_steps, sr.clusters, sr.substeps, sr.largest_cluster,
                   sr.joined, sr.merges, sr.rejected, sr.floor_steps, sr.rebuilt, row.peak_rss_mb);
     out << buf;
-    if (row.scenario->floedyn_s > 0 && b.status == "ok") {
-      std::snprintf(buf, sizeof buf, "%.1f,%.1f", row.scenario->floedyn_s, row.scenario->floedyn_s / b.wall);
+    if (!row.floedyn_walls.empty()) {
+      std::vector<double> f = row.floedyn_walls;
+      std::sort(f.begin(), f.end());
+      std::snprintf(buf, sizeof buf, "%.3f,%.3f,", f.front(), f[f.size() / 2]);
       out << buf;
-    } else if (row.scenario->floedyn_s > 0) {
-      std::snprintf(buf, sizeof buf, "%.1f,", row.scenario->floedyn_s);
-      out << buf;
+      if (b.status == "ok") {
+        std::snprintf(buf, sizeof buf, "%.1f", f.front() / b.wall);
+        out << buf;
+      }
     } else {
-      out << ",";
+      out << ",,";
     }
     for (double sec : b.profile.seconds) {
       std::snprintf(buf, sizeof buf, ",%.4f", sec);
@@ -498,8 +553,8 @@ int main(int argc, char** argv) {
       phases += buf;
     }
     char speed[32] = "-";
-    if (row.scenario->floedyn_s > 0 && b.status == "ok")
-      std::snprintf(speed, sizeof speed, "%.1fx", row.scenario->floedyn_s / b.wall);
+    if (!row.floedyn_walls.empty() && b.status == "ok")
+      std::snprintf(speed, sizeof speed, "%.1fx", row.floedyn_min() / b.wall);
     std::printf("%-12s %-8s %6zu %8g %9.3f %7zu %7ld %9ld %5ld %8.1f %8s  %s\n", row.scenario->name.c_str(),
                 b.status == "ok" ? "ok" : "FAILED", b.floes, b.simulated, b.wall, b.steps, b.stats.lcps,
                 b.stats.pivots, b.stats.failures, row.peak_rss_mb, speed, phases.c_str());
@@ -536,14 +591,21 @@ int main(int argc, char** argv) {
       << "# peak_rss_mb: MiB, VmHWM of a separate process running the scenario once (baseline of a process "
          "that only starts: "
       << std::fixed << std::setprecision(1) << base_rss << " MiB)\n"
-      << "# floedyn_s: FloeDyn on one core of this machine kind (issue 4); speedup = floedyn_s / wall_s\n"
-      << "# " << scaling.str() << "\n"
-      << out.str();
+      << "# floedyn_s: FloeDyn's least wall time, one thread, run after each timed run of the same case "
+         "(--floedyn); speedup = floedyn_s / wall_s; empty: not run\n";
+    if (!floedyn.bin.empty()) {
+      f << "# FloeDyn:";
+      for (const std::string& a : floedyn.argv(*find_scenario("floedyn_100"))) f << " " << a;
+      f << " (in " << floedyn.dir << ")\n";
+    }
+    for (const Row& row : rows)
+      if (!row.floedyn_status.empty()) f << "# FloeDyn failed on " << row.scenario->name << ": " << row.floedyn_status << "\n";
+    f << "# " << scaling.str() << "\n" << out.str();
     if (!f) {
       std::fprintf(stderr, "cannot write %s\n", csv.c_str());
       return 1;
     }
     std::printf("wrote %s\n", csv.c_str());
   }
-  return 0;
+  return floedyn_failed ? 1 : 0;
 }
