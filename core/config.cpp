@@ -1,19 +1,20 @@
+// The configuration file read into Config (core/config.hpp): one reader per
+// table, each key checked once, here, by the Section reader
+// (core/detail/toml_section.hpp); then the rules that tie tables together.
 #include "core/config.hpp"
 
 #include <toml++/toml.h>
 
-#include <charconv>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
-#include <functional>
 #include <iomanip>
-#include <map>
 #include <numbers>
-#include <set>
 #include <sstream>
 
+#include "core/detail/config_names.hpp"
 #include "core/detail/h5.hpp"
+#include "core/detail/toml_section.hpp"
 #include "core/error.hpp"
 #include "core/forcing.hpp"
 
@@ -22,6 +23,7 @@ namespace floesim {
 namespace {
 
 namespace fs = std::filesystem;
+using namespace detail;
 
 // A path the system cannot look at (too long, say) does not exist: the
 // error_code overloads answer false where the others would throw.
@@ -34,169 +36,6 @@ bool is_folder(const std::string& path) {
   return fs::is_directory(path, ec) && !ec;
 }
 
-// Reads the keys of one TOML table, remembering which were used so that the
-// rest can be reported as unknown. Every accessor checks type and range and
-// throws InputError "FILE:LINE: key '[section] name': expected ..., got ...".
-class Section {
-public:
-  Section(const toml::table* table, std::string name, const std::string& file)
-      : table_(table), name_(std::move(name)), file_(file) {}
-
-  bool present() const { return table_ != nullptr; }
-  bool has(const std::string& key) const { return table_ && table_->get(key) != nullptr; }
-
-  [[noreturn]] void fail(const std::string& key, const std::string& what) const {
-    const toml::node* n = table_ ? table_->get(key) : nullptr;
-    const long line = n ? static_cast<long>(n->source().begin.line)
-                        : (table_ ? static_cast<long>(table_->source().begin.line) : 0);
-    throw InputError(where(file_, line, qualified(key), what));
-  }
-  std::string qualified(const std::string& key) const {
-    return name_.empty() ? key : "[" + name_ + "] " + key;
-  }
-
-  const toml::node* node(const std::string& key) {
-    used_.insert(key);
-    return table_ ? table_->get(key) : nullptr;
-  }
-
-  double number(const std::string& key, double def, const std::function<bool(double)>& ok = {},
-                const std::string& expected = "a number") {
-    const toml::node* n = node(key);
-    if (!n) return def;
-    double v = to_double(key, *n, expected);
-    if (ok && !ok(v)) fail(key, "expected " + expected + ", got " + format(v));
-    return v;
-  }
-  long long integer(const std::string& key, long long def, const std::function<bool(long long)>& ok,
-                    const std::string& expected) {
-    const toml::node* n = node(key);
-    if (!n) return def;
-    if (!n->is_integer()) fail(key, "expected " + expected + " (an integer), got " + type_name(*n));
-    const long long v = n->as_integer()->get();
-    if (ok && !ok(v)) fail(key, "expected " + expected + ", got " + std::to_string(v));
-    return v;
-  }
-  bool boolean(const std::string& key, bool def) {
-    const toml::node* n = node(key);
-    if (!n) return def;
-    if (!n->is_boolean()) fail(key, "expected true or false, got " + type_name(*n));
-    return n->as_boolean()->get();
-  }
-  std::string string(const std::string& key, const std::string& def) {
-    const toml::node* n = node(key);
-    if (!n) return def;
-    if (!n->is_string()) fail(key, "expected a string, got " + type_name(*n));
-    return n->as_string()->get();
-  }
-  template <class E>
-  E choice(const std::string& key, E def, const std::vector<std::pair<std::string, E>>& options) {
-    const toml::node* n = node(key);
-    if (!n) return def;
-    std::string list;
-    for (auto& [s, e] : options) list += (list.empty() ? "" : " | ") + ("\"" + s + "\"");
-    if (!n->is_string()) fail(key, "expected one of " + list + ", got " + type_name(*n));
-    const std::string v = n->as_string()->get();
-    for (auto& [s, e] : options)
-      if (s == v) return e;
-    fail(key, "expected one of " + list + ", got \"" + v + "\"");
-  }
-  std::vector<double> numbers(const std::string& key, std::size_t count, const std::string& what) {
-    const toml::node* n = node(key);
-    const toml::array* a = n ? n->as_array() : nullptr;
-    if (!a || (count && a->size() != count))
-      fail(key, "expected " + what + ", got " + (n ? describe(*n) : std::string("nothing")));
-    std::vector<double> v;
-    for (const toml::node& e : *a) v.push_back(to_double(key, e, what));
-    return v;
-  }
-  std::array<double, 2> pair(const std::string& key, std::array<double, 2> def,
-                             const std::string& what = "an array of 2 numbers") {
-    if (!has(key)) { node(key); return def; }
-    auto v = numbers(key, 2, what);
-    for (double x : v)
-      if (!std::isfinite(x)) fail(key, "expected finite numbers");
-    return {v[0], v[1]};
-  }
-  std::vector<std::array<double, 2>> points(const std::string& key, const std::string& what) {
-    const toml::node* n = node(key);
-    if (!n) return {};
-    const toml::array* a = n->as_array();
-    if (!a) fail(key, "expected " + what + ", got " + type_name(*n));
-    std::vector<std::array<double, 2>> out;
-    for (std::size_t i = 0; i < a->size(); ++i) {
-      const toml::array* p = (*a)[i].as_array();
-      if (!p || p->size() != 2)
-        fail(key, "expected " + what + "; entry " + std::to_string(i) + " is " + describe((*a)[i]));
-      out.push_back({to_double(key, (*p)[0], what), to_double(key, (*p)[1], what)});
-    }
-    return out;
-  }
-  const toml::table* table(const std::string& key) {
-    const toml::node* n = node(key);
-    if (!n) return nullptr;
-    if (!n->is_table()) fail(key, "expected a table ([" + (name_.empty() ? key : name_ + "." + key) + "])");
-    return n->as_table();
-  }
-  const toml::array* table_array(const std::string& key) {
-    const toml::node* n = node(key);
-    if (!n) return nullptr;
-    if (!n->is_array_of_tables())
-      fail(key, "expected an array of tables ([[" + (name_.empty() ? key : name_ + "." + key) + "]])");
-    return n->as_array();
-  }
-  long line() const { return table_ ? static_cast<long>(table_->source().begin.line) : 0; }
-
-  // Any key not read by now is unknown.
-  void finish() const {
-    if (!table_) return;
-    for (auto&& [k, v] : *table_) {
-      const std::string key(k.str());
-      if (!used_.count(key)) {
-        std::string known;
-        for (const auto& u : used_) known += (known.empty() ? "" : ", ") + u;
-        fail(key, "unknown key (known keys here: " + known + ")");
-      }
-    }
-  }
-
-private:
-  double to_double(const std::string& key, const toml::node& n, const std::string& expected) const {
-    if (n.is_integer()) return static_cast<double>(n.as_integer()->get());
-    if (n.is_floating_point()) return n.as_floating_point()->get();
-    fail(key, "expected " + expected + ", got " + type_name(n));
-  }
-  static std::string type_name(const toml::node& n) {
-    switch (n.type()) {
-      case toml::node_type::string: return "a string";
-      case toml::node_type::integer: return "an integer";
-      case toml::node_type::floating_point: return "a number";
-      case toml::node_type::boolean: return "a boolean";
-      case toml::node_type::array: return "an array";
-      case toml::node_type::table: return "a table";
-      default: return "a date/time";
-    }
-  }
-  static std::string describe(const toml::node& n) {
-    if (const toml::array* a = n.as_array()) return "an array of " + std::to_string(a->size());
-    return type_name(n);
-  }
-  static std::string format(double v) {
-    std::ostringstream s;
-    s << v;
-    return s.str();
-  }
-
-  const toml::table* table_;
-  std::string name_;
-  const std::string& file_;
-  std::set<std::string> used_;
-};
-
-const auto positive = [](double v) { return std::isfinite(v) && v > 0.0; };
-const auto non_negative = [](double v) { return std::isfinite(v) && v >= 0.0; };
-const auto finite = [](double v) { return std::isfinite(v); };
-const auto unit_interval = [](double v) { return v >= 0.0 && v <= 1.0; };
 
 std::string resolve_path(const std::string& p, const std::string& base_dir) {
   if (p.empty()) return p;
@@ -224,8 +63,7 @@ void read_run(Section s, RunParams& r) {
 }
 
 void read_waves(Section s, WaveParams& w) {
-  w.kind = s.choice<WaveKind>("kind", w.kind, {{"none", WaveKind::none}, {"regular", WaveKind::regular},
-                                               {"standing", WaveKind::standing}, {"jonswap", WaveKind::jonswap}});
+  w.kind = s.choice("kind", w.kind, kWaveKinds);
   w.amplitude = s.number("amplitude", w.amplitude, non_negative, "an amplitude >= 0 (m)");
   w.wavelength = s.number("wavelength", w.wavelength, non_negative, "a wavelength > 0 (m)");
   w.period = s.number("period", w.period, non_negative, "a period > 0 (s)");
@@ -353,8 +191,7 @@ void read_bottom_grid(SeaParams& p, Fail&& fail) {
 }
 
 void read_sea(Section s, SeaParams& p, const std::string& file, const std::string& base_dir) {
-  p.model = s.choice<SeaModel>("model", p.model, {{"none", SeaModel::none}, {"spectral", SeaModel::spectral},
-                                                  {"bem", SeaModel::bem}});
+  p.model = s.choice("model", p.model, kSeaModels);
   p.dims = static_cast<int>(s.integer("dims", p.dims, [](long long v) { return v == 1 || v == 2; }, "1 or 2"));
   p.size = s.pair("size", p.size, "[Lx, Ly], two sizes > 0 (m)");
   if (!(p.size[0] > 0.0 && p.size[1] > 0.0 && p.size[0] <= kMaxCoordinate && p.size[1] <= kMaxCoordinate)) {
@@ -506,9 +343,7 @@ void read_contact(Section s, ContactParams& c, const std::string& base_dir) {
   c.restitution = s.number("restitution", c.restitution, unit_interval, "a restitution in [0, 1]");
   c.friction = s.number("friction", c.friction, non_negative, "a friction coefficient >= 0");
   c.rest_speed = s.number("rest_speed", c.rest_speed, non_negative, "a speed >= 0 (m/s)");
-  const std::string domain = s.string("domain", "open");
-  if (domain != "open" && domain != "periodic") s.fail("domain", "expected \"open\" or \"periodic\", got \"" + domain + "\"");
-  c.periodic = domain == "periodic";
+  c.periodic = s.choice("domain", c.periodic, kDomains);
   if (s.has("box")) {
     auto b = s.numbers("box", 4, "[xmin, xmax, ymin, ymax] (m)");
     if (!(b[1] > b[0] && b[3] > b[2])) s.fail("box", "expected xmin < xmax and ymin < ymax");
@@ -523,8 +358,7 @@ void read_contact(Section s, ContactParams& c, const std::string& base_dir) {
 }
 
 void read_coupling(Section s, CouplingParams& c, SeaModel sea_model) {
-  c.law = s.choice<PenaltyLaw>("law", c.law, {{"strong", PenaltyLaw::strong}, {"weak", PenaltyLaw::weak},
-                                              {"blend", PenaltyLaw::blend}});
+  c.law = s.choice("law", c.law, kPenaltyLaws);
   c.stiffness = s.number("stiffness", c.stiffness, positive, "a relative stiffness K > 0");
   c.blend = s.number("blend", c.blend, unit_interval, "a blend s in [0, 1]");
   c.restitution = s.number("restitution", c.restitution, unit_interval, "a restitution in [0, 1]");
@@ -532,24 +366,16 @@ void read_coupling(Section s, CouplingParams& c, SeaModel sea_model) {
   if ((s.has("blend") || s.has("restitution")) && c.law != PenaltyLaw::blend)
     s.fail(s.has("blend") ? "blend" : "restitution", "only used with law = \"blend\"");
   if (!s.has("restitution")) c.restitution = -1.0;
-  const std::string start = s.string("start", "equilibrium");
-  if (start != "equilibrium" && start != "given")
-    s.fail("start", "expected \"equilibrium\" (floes at rest on the sea, then the waves) or \"given\" (the floes' heave as given), got \"" + start + "\"");
-  c.start_given = start == "given";
-  c.footprint = s.choice<FootprintChoice>("footprint", c.footprint, {{"automatic", FootprintChoice::automatic},
-                                                                     {"cell", FootprintChoice::cell},
-                                                                     {"tent", FootprintChoice::tent}});
+  // "equilibrium": the floes at rest on the sea, then the waves; "given": the floes' heave as given.
+  c.start_given = s.choice("start", c.start_given, kStarts);
+  c.footprint = s.choice("footprint", c.footprint, kFootprints);
   if (c.footprint == FootprintChoice::tent && sea_model == SeaModel::bem)
     s.fail("footprint", "\"tent\" needs a periodic sea ([sea] model = \"spectral\"): a tent would reach past a bem "
                         "basin's walls; use \"cell\" or \"automatic\"");
   c.footprint_reach = s.number("footprint_reach", c.footprint_reach, [](double v) { return v >= 0.0 && v <= 0.5; },
                                "a fraction of a cell in [0, 0.5]");
-  c.integrator = s.choice<CouplingIntegrator>("integrator", c.integrator,
-                                              {{"explicit", CouplingIntegrator::explicit_kicks},
-                                               {"implicit", CouplingIntegrator::implicit}});
-  c.horizontal_loads = s.choice<HorizontalLoads>("horizontal_loads", c.horizontal_loads,
-                                                 {{"step_mean", HorizontalLoads::step_mean},
-                                                  {"step_ends", HorizontalLoads::step_ends}});
+  c.integrator = s.choice("integrator", c.integrator, kIntegrators);
+  c.horizontal_loads = s.choice("horizontal_loads", c.horizontal_loads, kHorizontalLoads);
   c.newton_tolerance = s.number("newton_tolerance", c.newton_tolerance, positive, "a relative tolerance > 0");
   c.cg_tolerance = s.number("cg_tolerance", c.cg_tolerance, positive, "a relative tolerance > 0");
   c.cg_forcing = s.number("cg_forcing", c.cg_forcing, positive, "a relative tolerance > 0");
@@ -561,9 +387,7 @@ void read_forcing(Section s, ForcingParams& f, const std::string& base_dir) {
   f.wind = s.pair("wind", f.wind);
   f.series = resolve_path(s.string("series", ""), base_dir);
   if (!f.series.empty() && !path_exists(f.series)) s.fail("series", "file not found: " + f.series);
-  f.series_interpolation = s.choice<SeriesInterpolation>(
-      "series_interpolation", f.series_interpolation,
-      {{"linear", SeriesInterpolation::linear}, {"previous", SeriesInterpolation::previous}});
+  f.series_interpolation = s.choice("series_interpolation", f.series_interpolation, kSeriesInterpolations);
   // The series is checked here, at load, by its reader (the one place of its rules), so that
   // a bad file is refused before any scenario is built; make_forcing reads it again.
   if (!f.series.empty()) {
@@ -591,9 +415,7 @@ void read_forcing(Section s, ForcingParams& f, const std::string& base_dir) {
 
 void read_fracture(Section s, FractureParams& f, const std::string& file) {
   f.enabled = s.boolean("enabled", f.enabled);
-  f.criterion = s.choice<FractureCriterion>("criterion", f.criterion,
-                                            {{"stress", FractureCriterion::stress},
-                                             {"griffith", FractureCriterion::griffith}});
+  f.criterion = s.choice("criterion", f.criterion, kFractureCriteria);
   f.strength = s.number("strength", f.strength, positive, "a strength > 0 (Pa)");
   f.toughness = s.number("toughness", f.toughness, positive, "a toughness > 0 (J/m^2)");
   f.young = s.number("young", f.young, positive, "a Young's modulus > 0 (Pa)");
@@ -700,189 +522,6 @@ Config load_config(const std::string& path) {
   if (in.bad()) throw InputError(path + ": cannot read the configuration file");
   const fs::path dir = fs::absolute(fs::path(path)).parent_path();
   return parse_config(text, path, dir.string());
-}
-
-namespace {
-template <class E>
-std::string name_of(E e, const std::vector<std::pair<std::string, E>>& options) {
-  for (auto& [s, v] : options)
-    if (v == e) return s;
-  return "?";
-}
-toml::array pair_array(const std::array<double, 2>& a) { return toml::array{a[0], a[1]}; }
-}  // namespace
-
-std::string resolved_toml(const Config& c) {
-  toml::table run{{"t_end", c.run.t_end}, {"dt_max", c.run.dt_max},
-                  {"output_interval", c.run.output_interval},
-                  {"seed", static_cast<int64_t>(c.run.seed)}, {"checkpoint_interval", c.run.checkpoint_interval},
-                  {"record_collisions", c.run.record_collisions}};
-  const WaveParams& w = c.sea.waves;
-  toml::table waves{{"kind", name_of<WaveKind>(w.kind, {{"none", WaveKind::none}, {"regular", WaveKind::regular},
-                                                         {"standing", WaveKind::standing}, {"jonswap", WaveKind::jonswap}})},
-                    {"amplitude", w.amplitude}, {"direction", w.direction}, {"hs", w.hs}, {"tp", w.tp}, {"gamma", w.gamma},
-                    {"spreading", w.spreading}};
-  if (w.wavelength > 0.0) waves.insert("wavelength", w.wavelength);
-  if (w.period > 0.0) waves.insert("period", w.period);
-  toml::array bottom;
-  for (auto& b : c.sea.bottom) bottom.push_back(pair_array(b));
-  toml::table sea{{"model", name_of<SeaModel>(c.sea.model, {{"none", SeaModel::none}, {"spectral", SeaModel::spectral},
-                                                             {"bem", SeaModel::bem}})},
-                  {"dims", c.sea.dims}, {"size", pair_array(c.sea.size)},
-                  {"cells", toml::array{c.sea.cells[0], c.sea.cells[1]}}, {"depth", c.sea.depth},
-                  {"rho", c.sea.rho}, {"g", c.sea.g}, {"sigma", c.sea.sigma}, {"waves", waves}};
-  if (!bottom.empty()) sea.insert("bottom", bottom);
-  if (!c.sea.bottom_file.empty()) sea.insert("bottom_file", c.sea.bottom_file);
-  if (c.sea.bem_modes != 0) sea.insert("bem_modes", c.sea.bem_modes);
-  if (c.sea.bem_static_correction) sea.insert("bem_static_correction", true);
-  if (c.sea.tank.enabled)
-    sea.insert("tank", toml::table{{"enabled", true}, {"generation_length", c.sea.tank.generation_length},
-                                   {"absorption_length", c.sea.tank.absorption_length}, {"rate", c.sea.tank.rate},
-                                   {"ramp_periods", c.sea.tank.ramp_periods}});
-
-  toml::array floe_list;
-  for (const FloeInput& f : c.floes.floes) {
-    toml::array verts;
-    for (auto& v : f.vertices) verts.push_back(toml::array{v.x(), v.y()});
-    toml::table t{{"vertices", verts}, {"velocity", toml::array{f.velocity.x(), f.velocity.y()}},
-                  {"angular_velocity", f.angular_velocity}, {"thickness", f.thickness},
-                  {"density", f.density}, {"static", f.is_static}};
-    if (f.ocean_drag >= 0.0) t.insert("ocean_drag", f.ocean_drag);
-    if (f.heave != 0.0) t.insert("heave", f.heave);
-    if (f.heave_rate != 0.0) t.insert("heave_rate", f.heave_rate);
-    if (f.mooring_period > 0.0) {
-      t.insert("mooring_period", f.mooring_period);
-      t.insert("mooring_damping", f.mooring_damping);
-    }
-    floe_list.push_back(t);
-  }
-  toml::table floes{{"thickness", c.floes.defaults.thickness}, {"density", c.floes.defaults.density}};
-  if (!c.floes.pack.empty()) floes.insert("pack", c.floes.pack);
-  if (!floe_list.empty()) floes.insert("floe", floe_list);
-
-  toml::table contact{{"collision_distance", c.contact.collision_distance},
-                      {"restitution", c.contact.restitution}, {"friction", c.contact.friction},
-                      {"rest_speed", c.contact.rest_speed},
-                      {"domain", c.contact.periodic ? "periodic" : "open"}};
-  if (!c.contact.dump_failed_lcps.empty()) contact.insert("dump_failed_lcps", c.contact.dump_failed_lcps);
-  if (c.contact.box[1] > c.contact.box[0])
-    contact.insert("box", toml::array{c.contact.box[0], c.contact.box[1], c.contact.box[2], c.contact.box[3]});
-  toml::table coupling{{"law", name_of<PenaltyLaw>(c.coupling.law, {{"strong", PenaltyLaw::strong},
-                                                                   {"weak", PenaltyLaw::weak},
-                                                                   {"blend", PenaltyLaw::blend}})},
-                       {"stiffness", c.coupling.stiffness},
-                       {"start", c.coupling.start_given ? "given" : "equilibrium"},
-                       {"footprint", name_of<FootprintChoice>(c.coupling.footprint,
-                                                              {{"automatic", FootprintChoice::automatic},
-                                                               {"cell", FootprintChoice::cell},
-                                                               {"tent", FootprintChoice::tent}})},
-                       {"footprint_reach", c.coupling.footprint_reach},
-                       {"integrator", c.coupling.integrator == CouplingIntegrator::implicit ? "implicit" : "explicit"},
-                       {"horizontal_loads",
-                        c.coupling.horizontal_loads == HorizontalLoads::step_mean ? "step_mean" : "step_ends"},
-                       {"newton_tolerance", c.coupling.newton_tolerance},
-                       {"cg_tolerance", c.coupling.cg_tolerance},
-                       {"cg_forcing", c.coupling.cg_forcing}};
-  if (c.coupling.law == PenaltyLaw::blend) {
-    if (c.coupling.restitution >= 0.0) coupling.insert("restitution", c.coupling.restitution);
-    else coupling.insert("blend", c.coupling.blend);
-  }
-  toml::table forcing{{"current", pair_array(c.forcing.current)}, {"wind", pair_array(c.forcing.wind)},
-                      {"series_interpolation",
-                       c.forcing.series_interpolation == SeriesInterpolation::linear ? "linear" : "previous"},
-                      {"coriolis", c.forcing.coriolis}, {"ocean_drag", c.forcing.ocean_drag},
-                      {"air_drag", c.forcing.air_drag}, {"air_density", c.forcing.air_density}};
-  if (!c.forcing.series.empty()) forcing.insert("series", c.forcing.series);
-  const FractureParams& fr = c.fracture;
-  toml::array loads;
-  for (auto& l : fr.loads) {
-    toml::table t{{"point", pair_array(l.point)}};
-    t.insert(l.is_impulse ? "impulse" : "force", pair_array(l.is_impulse ? l.impulse : l.force));
-    loads.push_back(t);
-  }
-  toml::table fracture{{"enabled", fr.enabled},
-                       {"criterion", fr.criterion == FractureCriterion::stress ? "stress" : "griffith"},
-                       {"strength", fr.strength}, {"toughness", fr.toughness}, {"young", fr.young},
-                       {"poisson", fr.poisson}, {"split", fr.split}, {"mesh_size", fr.mesh_size},
-                       {"duration", fr.duration}, {"load_radius", fr.load_radius},
-                       {"min_fragment_area", fr.min_fragment_area}};
-  if (!loads.empty()) fracture.insert("load", loads);
-
-  toml::table root{{"run", run}, {"sea", sea}, {"floes", floes}, {"contact", contact},
-                   {"coupling", coupling}, {"forcing", forcing}, {"fracture", fracture}};
-  std::ostringstream os;
-  os << root;
-  return os.str();
-}
-
-namespace {
-// A TOML value as text, numbers in their shortest exact form (0.4, not
-// 0.40000000000000002), arrays and inline tables whole.
-std::string value_text(const toml::node& node) {
-  if (const auto* d = node.as_floating_point()) {
-    char buf[64];
-    const auto r = std::to_chars(buf, buf + sizeof buf, d->get());
-    return std::string(buf, r.ptr);
-  }
-  if (const auto* i = node.as_integer()) return std::to_string(i->get());
-  if (const auto* b = node.as_boolean()) return b->get() ? "true" : "false";
-  if (const auto* s = node.as_string()) return "\"" + s->get() + "\"";
-  std::string out;
-  if (const auto* a = node.as_array()) {
-    out = "[";
-    for (std::size_t k = 0; k < a->size(); ++k) out += (k ? ", " : "") + value_text(*a->get(k));
-    return out + "]";
-  }
-  if (const auto* t = node.as_table()) {
-    out = "{";
-    for (const auto& [k, v] : *t) out += (out.size() > 1 ? ", " : "") + std::string(k.str()) + " = " + value_text(v);
-    return out + "}";
-  }
-  std::ostringstream o;
-  node.visit([&](const auto& n) { o << n; });
-  return o.str();
-}
-
-// Each leaf of a TOML table as "[section] key" -> its value as text.
-void flatten(const toml::table& t, const std::string& section, std::map<std::string, std::string>& out) {
-  for (const auto& [k, node] : t) {
-    const std::string key(k.str());
-    const std::string path = section.empty() ? key : section + "." + key;
-    if (const toml::table* sub = node.as_table()) {
-      flatten(*sub, path, out);
-      continue;
-    }
-    // An array of tables (the inline floes) key by key, "[floes.floe 3] velocity".
-    if (const toml::array* a = node.as_array(); a && !a->empty() && a->is_array_of_tables()) {
-      for (std::size_t i = 0; i < a->size(); ++i) flatten(*a->get(i)->as_table(), path + " " + std::to_string(i), out);
-      out["[" + path + "] count"] = std::to_string(a->size());
-      continue;
-    }
-    out[(section.empty() ? key : "[" + section + "] " + key)] = value_text(node);
-  }
-}
-}  // namespace
-
-std::vector<std::string> physics_differences(std::string_view run_toml, std::string_view now_toml,
-                                             const std::string& run_name) {
-  std::map<std::string, std::string> a, b;
-  try {
-    flatten(toml::parse(run_toml), "", a);
-  } catch (const toml::parse_error& e) {
-    throw InputError(run_name + ": the stored configuration is not TOML (" + std::string(e.description()) + ")");
-  }
-  flatten(toml::parse(now_toml), "", b);
-  static const std::set<std::string> kFree = {"[run] t_end", "[run] checkpoint_interval"};
-  std::vector<std::string> out;
-  for (const auto& [key, value] : a) {
-    if (kFree.count(key)) continue;
-    const auto it = b.find(key);
-    if (it == b.end()) out.push_back(key + ": " + value + " -> (not set)");
-    else if (it->second != value) out.push_back(key + ": " + value + " -> " + it->second);
-  }
-  for (const auto& [key, value] : b)
-    if (!kFree.count(key) && !a.count(key)) out.push_back(key + ": (not set) -> " + value);
-  return out;
 }
 
 }  // namespace floesim
