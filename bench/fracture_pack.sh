@@ -12,7 +12,10 @@
 # 2 km box, 15 m/s wind: floes of different thickness drift at different
 # speeds and collide; 1000 s).
 # Usage: bench/fracture_pack.sh BUILD_DIR [REPEATS] > bench/results/fracture_pack_<machine>.csv
-# (SCENARIOS="drift_500" runs only those named; default both.)
+# (SCENARIOS="drift_500" runs only those named, default both; VARIANTS="off strong"
+# only those variants, default all three; BASELINE=path/to/an/older/floesim also runs
+# each variant with fracture on with that binary, right after the current one, as
+# variant NAME_base: an A/B comparison alternating in one run.)
 set -eu
 BIN=$(cd "$1" && pwd)/bin/floesim
 REPEATS=${2:-3}
@@ -49,15 +52,19 @@ for v in off strong ice; do
   write drift_500 "$DIR/drift_500.h5" 1000 "domain = \"periodic\"
 box = [0.0, 2000.0, 0.0, 2000.0]" $v
 done
-echo "scenario,variant,round,wall_s,steps,checks,screened,bounded,sustained,initiations,splits,analysis_s,split_s"
+echo "scenario,variant,round,wall_s,steps,checks,screened,bounded,sustained,initiations,splits,analysis_s,split_s,cut_short,models,model_s"
+one() {  # scenario variant round binary name
+  start=$(date +%s.%N)
+  out=$(OMP_NUM_THREADS=1 "$4" run "$DIR/${1}_$2.toml" -q -o "$DIR/out.h5")
+  end=$(date +%s.%N)
+  get() { printf '%s\n' "$out" | awk -F': ' -v k="$1" '$1 == k { print $2 }'; }
+  echo "$1,$5,$3,$(echo "$end - $start" | bc),$(get steps),$(get fracture.checks),$(get fracture.screened),$(get fracture.bounded),$(get fracture.sustained),$(get fracture.initiations),$(get fracture.splits),$(get fracture.seconds),$(get fracture.split_seconds),$(get fracture.cut_short),$(get fracture.models),$(get fracture.model_seconds)"
+}
 for r in $(seq 1 "$REPEATS"); do
   for s in ${SCENARIOS:-wall_100 drift_500}; do
-    for v in off strong ice; do
-      start=$(date +%s.%N)
-      out=$(OMP_NUM_THREADS=1 "$BIN" run "$DIR/${s}_$v.toml" -q -o "$DIR/out.h5")
-      end=$(date +%s.%N)
-      get() { printf '%s\n' "$out" | awk -F': ' -v k="$1" '$1 == k { print $2 }'; }
-      echo "$s,$v,$r,$(echo "$end - $start" | bc),$(get steps),$(get fracture.checks),$(get fracture.screened),$(get fracture.bounded),$(get fracture.sustained),$(get fracture.initiations),$(get fracture.splits),$(get fracture.seconds),$(get fracture.split_seconds)"
+    for v in ${VARIANTS:-off strong ice}; do
+      one "$s" "$v" "$r" "$BIN" "$v"
+      if [ -n "${BASELINE:-}" ] && [ "$v" != off ]; then one "$s" "$v" "$r" "$BASELINE" "${v}_base"; fi
     done
   done
 done

@@ -81,11 +81,15 @@ double Responder::stress_bound(std::span<const PointLoad> loads) {
   const bool dynamic = std::any_of(loads.begin(), loads.end(), [](const PointLoad& l) { return l.impulse; });
   if (dynamic) {
     const Eigen::VectorXd j = model_.relieve(nodal_loads(loads, true));
-    const double energy = 0.5 * j.cwiseAbs2().cwiseQuotient(model_.lumped_mass()).sum();  // J
-    const Material& mat = model_.material();
-    bound += std::sqrt(2.0 * mat.young * energy / ((1.0 - mat.poisson * mat.poisson) * mat.thickness * min_area_));
+    bound += stress_of_energy(0.5 * j.cwiseAbs2().cwiseQuotient(model_.lumped_mass()).sum());
   }
   return bound;
+}
+
+double Responder::stress_of_energy(double energy) const {
+  const Material& mat = model_.material();
+  return std::sqrt(2.0 * mat.young * std::max(energy, 0.0) /
+                   ((1.0 - mat.poisson * mat.poisson) * mat.thickness * min_area_));
 }
 
 Eigen::VectorXd Responder::nodal_loads(std::span<const PointLoad> loads, bool impulses) const {
@@ -113,7 +117,7 @@ Eigen::VectorXd Responder::solve_static(const Eigen::VectorXd& f) {
   return u;
 }
 
-Response Responder::respond(std::span<const PointLoad> loads, const Observer& observe) {
+Response Responder::respond(std::span<const PointLoad> loads, const Observer& observe, double level) {
   Response r;
   const Eigen::VectorXd fs = nodal_loads(loads, false);
   Eigen::VectorXd us = Eigen::VectorXd::Zero(model_.dofs());
@@ -123,8 +127,10 @@ Response Responder::respond(std::span<const PointLoad> loads, const Observer& ob
   if (observe) observe(0.0, us);
   if (!dynamic) return r;
 
+  const double static_peak = r.peak_stress.max_principal;  // Pa, the static forces' largest nodal sigma_1
   const Eigen::VectorXd j = model_.relieve(nodal_loads(loads, true));
   const Eigen::VectorXd& m = model_.lumped_mass();
+  const double root_blow = std::sqrt(0.5 * j.cwiseAbs2().cwiseQuotient(m).sum());  // sqrt(U), sqrt(J)
   const Eigen::SparseMatrix<double>& k = model_.stiffness();
   const double dt = dt_, tau = options_.duration;
   if (!dynamic_) {
@@ -150,6 +156,19 @@ Response Responder::respond(std::span<const PointLoad> loads, const Observer& ob
     const Eigen::VectorXd total = us + u;
     observe_state(model_, t, total, r);
     if (observe) observe(t, total);
+    if (step < steps_ && r.peak_stress.max_principal < level) {
+      // The energy bound of every later step (response.hpp).
+      const double energy = 0.5 * (v.dot(m.cwiseProduct(v)) + u.dot(k * u));
+      const double to_come = 0.5 * pulse_fraction(t - dt, t, tau) + pulse_fraction(t, tau, tau);
+      const double root = std::sqrt(std::max(energy, 0.0)) + root_blow * to_come;
+      const double later = static_peak + stress_of_energy(root * root);
+      if (later + 1e-6 * std::abs(later) < level) {
+        r.steps = step;
+        r.cut_short = true;
+        r.later_bound = later;
+        return r;
+      }
+    }
   }
   return r;
 }
