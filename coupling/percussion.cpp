@@ -176,6 +176,7 @@ bool Percussion::check(Floes& floes, const contact::ImpulseRecord& record, doubl
       ++stats_.checks;
       if (!e) ++stats_.sustained;
       if (result.response.cut_short) ++stats_.cut_short;
+      stats_.loop_steps += result.response.steps;
       const fracture::Initiation& init = result.initiation;
       if (!init.initiates) continue;
       ++stats_.initiations;

@@ -82,6 +82,7 @@ struct PercussionStats {
   long bounded = 0;       // load cases past the screen whose stress bound is below the strength (not analysed)
   long sustained = 0;     // of checks, of sustained forces alone (static)
   long cut_short = 0;     // of checks, time loops stopped once they could no longer initiate (Response::cut_short)
+  long loop_steps = 0;    // time steps run by the checks' responses
   long initiations = 0;   // events (a crack whose line leaves the floe at once, from a corner, is not split)
   long splits = 0;
   long failed_splits = 0;  // cracked through but not split (sliver, or the pieces would overlap)
