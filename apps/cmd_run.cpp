@@ -288,9 +288,11 @@ int run(const Args& args, const parallel::Session& session) {
   }
   if (const PercussionStats* f = sim.percussion_stats())
     o << "fracture.checks: " << f->checks << "\nfracture.screened: " << f->screened
-      << "\nfracture.bounded: " << f->bounded
+      << "\nfracture.bounded: " << f->bounded << "\nfracture.cut_short: " << f->cut_short
+      << "\nfracture.loop_steps: " << f->loop_steps
       << "\nfracture.sustained: " << f->sustained << "\nfracture.initiations: " << f->initiations
-      << "\nfracture.splits: " << f->splits << "\nfracture.seconds: " << f->seconds
+      << "\nfracture.splits: " << f->splits << "\nfracture.seconds: " << f->seconds << "\nfracture.models: " << f->models
+      << "\nfracture.model_seconds: " << f->model_seconds
       << "\nfracture.split_seconds: " << f->split_seconds << "\n";
   if (const FloeSeaContact* fs = sim.floe_sea())
     o << "footprints.placements: " << fs->footprint_placements() << "\nfootprints.rebuilds: " << fs->footprint_rebuilds()

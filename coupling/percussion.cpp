@@ -77,8 +77,12 @@ Percussion& Percussion::operator=(Percussion&&) noexcept = default;
 
 fracture::FloeFracture& Percussion::model_of(const Floes& floes, std::size_t i) {
   auto& slot = models_[floes.id[i]];
-  if (!slot)
+  if (!slot) {
+    const auto begin = std::chrono::steady_clock::now();
     slot = std::make_unique<fracture::FloeFracture>(floes.vertices(i), floes.thickness[i], floes.density[i], params_);
+    ++stats_.models;
+    stats_.model_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
+  }
   return *slot;
 }
 
@@ -167,10 +171,12 @@ bool Percussion::check(Floes& floes, const contact::ImpulseRecord& record, doubl
         ++stats_.bounded;
         continue;
       }
-      const fracture::FloeFracture::Result result = model.analyse(loads);
+      const fracture::FloeFracture::Result result = model.decide(loads);
       stats_.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
       ++stats_.checks;
       if (!e) ++stats_.sustained;
+      if (result.response.cut_short) ++stats_.cut_short;
+      stats_.loop_steps += result.response.steps;
       const fracture::Initiation& init = result.initiation;
       if (!init.initiates) continue;
       ++stats_.initiations;

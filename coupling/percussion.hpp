@@ -46,7 +46,10 @@
 //
 // Stress bound. Past the screen, a stress-criterion case whose exact upper
 // bound (fracture::Responder::stress_bound) is below the strength is not
-// analysed (PercussionStats::bounded): it could not initiate.
+// analysed (PercussionStats::bounded): it could not initiate. A case that is
+// analysed stops its time loop as soon as the same bound, taken on the
+// energy the response holds, shows that no later step can reach the
+// strength (FloeFracture::decide; PercussionStats::cut_short).
 //
 // Models are built on a floe's first case past the screen (meshing and factorisations)
 // and kept for its later ones; a floe that splits drops its model, and its
@@ -78,10 +81,14 @@ struct PercussionStats {
   long screened = 0;      // floes loaded but below the screen
   long bounded = 0;       // load cases past the screen whose stress bound is below the strength (not analysed)
   long sustained = 0;     // of checks, of sustained forces alone (static)
+  long cut_short = 0;     // of checks, time loops stopped once they could no longer initiate (Response::cut_short)
+  long loop_steps = 0;    // time steps run by the checks' responses
   long initiations = 0;   // events (a crack whose line leaves the floe at once, from a corner, is not split)
   long splits = 0;
   long failed_splits = 0;  // cracked through but not split (sliver, or the pieces would overlap)
-  double seconds = 0.0;    // wall time in analyses
+  double seconds = 0.0;    // wall time in analyses and bounds, models included
+  long models = 0;         // floe models built (mesh, elastic model), on a floe's first case past the screen
+  double model_seconds = 0.0;  // of seconds, wall time building them
   double split_seconds = 0.0;  // wall time in splits (cut, overlap checks), without the rebuild after them
 };
 

@@ -96,6 +96,10 @@ Checkpoint Simulation::save() {
                            {"sustained", p.sustained}})
       k.add(std::string("fracture.") + name, static_cast<double>(v));
     k.add("fracture.bounded", static_cast<double>(p.bounded));
+    k.add("fracture.cut_short", static_cast<double>(p.cut_short));
+    k.add("fracture.loop_steps", static_cast<double>(p.loop_steps));
+    k.add("fracture.models", static_cast<double>(p.models));
+    k.add("fracture.model_seconds", p.model_seconds);
     k.add("fracture.seconds", p.seconds);
     k.add("fracture.split_seconds", p.split_seconds);
   }
@@ -159,6 +163,13 @@ void Simulation::restore(const Checkpoint& c) {
     // Absent from checkpoints written before the stress bound.
     if (std::find(c.counter_names.begin(), c.counter_names.end(), "fracture.bounded") != c.counter_names.end())
       p.bounded = count("fracture.bounded");
+    // Absent from checkpoints written before the energy bound in the time loop.
+    if (std::find(c.counter_names.begin(), c.counter_names.end(), "fracture.cut_short") != c.counter_names.end()) {
+      p.cut_short = count("fracture.cut_short");
+      p.loop_steps = count("fracture.loop_steps");
+      p.models = count("fracture.models");
+      p.model_seconds = counter("fracture.model_seconds");
+    }
     p.seconds = counter("fracture.seconds");
     p.split_seconds = counter("fracture.split_seconds");
     percussion_->restore_stats(p);

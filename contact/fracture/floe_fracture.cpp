@@ -37,4 +37,12 @@ FloeFracture::Result FloeFracture::analyse(std::span<const PointLoad> loads, con
   return r;
 }
 
+FloeFracture::Result FloeFracture::decide(std::span<const PointLoad> loads) {
+  if (criterion_.criterion != Criterion::stress) return analyse(loads);
+  Result r;
+  r.response = responder_.respond(loads, {}, criterion_.strength);
+  r.initiation = judge(responder_, r.response, polygon_, criterion_);
+  return r;
+}
+
 }  // namespace floesim::fracture

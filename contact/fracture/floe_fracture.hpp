@@ -33,6 +33,12 @@ public:
     Initiation initiation;
   };
   Result analyse(std::span<const PointLoad> loads, const Observer& observe = {});
+  // The same verdict (initiates or not, and where and how when it does) at
+  // less cost: by the stress criterion the response stops as soon as it can
+  // no longer reach the strength (Responder::respond's level), and the
+  // stress, time and load factor reported for a case that does not initiate
+  // are then those of the steps run (Response::cut_short). By griffith, analyse().
+  Result decide(std::span<const PointLoad> loads);
 
 private:
   std::vector<Vec2> polygon_;

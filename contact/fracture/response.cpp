@@ -17,8 +17,8 @@ double pulse_fraction(double t0, double t1, double tau) {
   return 0.5 * (std::cos(M_PI * t0 / tau) - std::cos(M_PI * t1 / tau));
 }
 
-// Updates a snapshot from the state u at time t if it beats it on `key`.
-void observe_state(const ElasticModel& model, double t, const Eigen::VectorXd& u, Response& r) {
+// Updates the response's peaks with the state u at time t; returns its strain energy (J).
+double observe_state(const ElasticModel& model, double t, const Eigen::VectorXd& u, Response& r) {
   const std::vector<Eigen::Vector3d> s = model.nodal_stress(u);
   Snapshot now;
   now.time = t;
@@ -31,6 +31,7 @@ void observe_state(const ElasticModel& model, double t, const Eigen::VectorXd& u
   }
   if (!s.empty()) now.angle = principal(s[now.node]).angle;  // the direction where it matters only
   now.strain_energy = model.strain_energy(u);
+  const double strain = now.strain_energy;
   const bool stress = now.max_principal > r.peak_stress.max_principal;
   const bool energy = now.strain_energy > r.peak_energy.strain_energy || r.peak_energy.u.size() == 0;
   if (stress) {
@@ -41,6 +42,7 @@ void observe_state(const ElasticModel& model, double t, const Eigen::VectorXd& u
     r.peak_energy = std::move(now);
     r.peak_energy.u = u;
   }
+  return strain;
 }
 
 }  // namespace
@@ -81,11 +83,15 @@ double Responder::stress_bound(std::span<const PointLoad> loads) {
   const bool dynamic = std::any_of(loads.begin(), loads.end(), [](const PointLoad& l) { return l.impulse; });
   if (dynamic) {
     const Eigen::VectorXd j = model_.relieve(nodal_loads(loads, true));
-    const double energy = 0.5 * j.cwiseAbs2().cwiseQuotient(model_.lumped_mass()).sum();  // J
-    const Material& mat = model_.material();
-    bound += std::sqrt(2.0 * mat.young * energy / ((1.0 - mat.poisson * mat.poisson) * mat.thickness * min_area_));
+    bound += stress_of_energy(0.5 * j.cwiseAbs2().cwiseQuotient(model_.lumped_mass()).sum());
   }
   return bound;
+}
+
+double Responder::stress_of_energy(double energy) const {
+  const Material& mat = model_.material();
+  return std::sqrt(2.0 * mat.young * std::max(energy, 0.0) /
+                   ((1.0 - mat.poisson * mat.poisson) * mat.thickness * min_area_));
 }
 
 Eigen::VectorXd Responder::nodal_loads(std::span<const PointLoad> loads, bool impulses) const {
@@ -113,18 +119,21 @@ Eigen::VectorXd Responder::solve_static(const Eigen::VectorXd& f) {
   return u;
 }
 
-Response Responder::respond(std::span<const PointLoad> loads, const Observer& observe) {
+Response Responder::respond(std::span<const PointLoad> loads, const Observer& observe, double level) {
   Response r;
   const Eigen::VectorXd fs = nodal_loads(loads, false);
   Eigen::VectorXd us = Eigen::VectorXd::Zero(model_.dofs());
-  if (fs.squaredNorm() > 0.0) us = solve_static(fs);
+  const bool statics = fs.squaredNorm() > 0.0;
+  if (statics) us = solve_static(fs);
   const bool dynamic = std::any_of(loads.begin(), loads.end(), [](const PointLoad& l) { return l.impulse; });
   observe_state(model_, 0.0, us, r);
   if (observe) observe(0.0, us);
   if (!dynamic) return r;
 
+  const double static_peak = r.peak_stress.max_principal;  // Pa, the static forces' largest nodal sigma_1
   const Eigen::VectorXd j = model_.relieve(nodal_loads(loads, true));
   const Eigen::VectorXd& m = model_.lumped_mass();
+  const double root_blow = std::sqrt(0.5 * j.cwiseAbs2().cwiseQuotient(m).sum());  // sqrt(U), sqrt(J)
   const Eigen::SparseMatrix<double>& k = model_.stiffness();
   const double dt = dt_, tau = options_.duration;
   if (!dynamic_) {
@@ -148,8 +157,21 @@ Response Responder::respond(std::span<const PointLoad> loads, const Observer& ob
     u = next;
     if (!u.allFinite()) throw RunError("fracture: the percussion response is not finite");
     const Eigen::VectorXd total = us + u;
-    observe_state(model_, t, total, r);
+    const double strain = observe_state(model_, t, total, r);
     if (observe) observe(t, total);
+    if (step < steps_ && r.peak_stress.max_principal < level) {
+      // The energy bound of every later step (response.hpp).
+      const double energy = 0.5 * v.dot(m.cwiseProduct(v)) + (statics ? model_.strain_energy(u) : strain);
+      const double to_come = 0.5 * pulse_fraction(t - dt, t, tau) + pulse_fraction(t, tau, tau);
+      const double root = std::sqrt(std::max(energy, 0.0)) + root_blow * to_come;
+      const double later = static_peak + stress_of_energy(root * root);
+      if (later + 1e-6 * std::abs(later) < level) {
+        r.steps = step;
+        r.cut_short = true;
+        r.later_bound = later;
+        return r;
+      }
+    }
   }
   return r;
 }

@@ -76,8 +76,13 @@ struct Snapshot {
 struct Response {
   Snapshot peak_stress;   // the instant of the largest sigma_1
   Snapshot peak_energy;   // the instant of the largest strain energy
-  int steps = 0;          // dynamic steps (0: static loads only)
+  int steps = 0;          // dynamic steps run (0: static loads only)
   double dt = 0.0;        // s
+  // The time loop stopped after `steps` because sigma_1 could no longer reach
+  // the level asked (respond's `level`): the peaks are those of the steps run,
+  // and `later_bound` (Pa) bounds sigma_1 at every later step.
+  bool cut_short = false;
+  double later_bound = std::numeric_limits<double>::infinity();
 };
 
 // Called at every instant with the time and the elastic displacement.
@@ -101,27 +106,49 @@ public:
   // The factor of K + eps M (built on first use), e.g. to copy and downdate.
   const SpdFactor& static_factor();
 
-  Response respond(std::span<const PointLoad> loads, const Observer& observe = {});
+  // The response to the loads over [0, end_time()]. With a finite `level`
+  // (Pa), the time loop stops as soon as neither the steps run nor any later
+  // one can have sigma_1 >= level (Response::cut_short; the energy bound
+  // below). Whether sigma_1 reaches the level is then decided exactly as by
+  // the whole loop; the peaks reported are those of the steps run.
+  //
+  // The energy bound. Newmark's average acceleration with C = beta K keeps
+  // M a_n + C v_n + K u_n = f_n at every step and u_{n+1} - u_n = dt v_bar,
+  // v_{n+1} - v_n = dt a_bar (bars: means of the two ends), so the energy
+  // E_n = (v_n^T M v_n + u_n^T K u_n) / 2 of the elastic part changes by
+  //   E_{n+1} - E_n = dt (v_bar^T f_bar - beta v_bar^T K v_bar) <= dt v_bar^T f_bar
+  // exactly (the trapezoidal rule conserves quadratic invariants of linear
+  // systems; damping only removes energy). With f_n = (phi_n / dt) j_r
+  // (phi_n the pulse's fraction delivered in step n, j_r the relieved
+  // nodal impulses) and |M^1/2 v_bar| <= (sqrt(2 E_n) + sqrt(2 E_{n+1})) / 2,
+  //   sqrt(E_{n+1}) - sqrt(E_n) <= (phi_n + phi_{n+1}) / 2 sqrt(U),
+  //   U = j_r^T M^-1 j_r / 2,
+  // hence for every later step m > n
+  //   sqrt(E_m) <= sqrt(E_n) + sqrt(U) (phi_n / 2 + sum_{k > n} phi_k).
+  // Once the pulse has passed, E_m <= E_n: the energy it left is all later
+  // steps can have. The strain energy of u_m is at most E_m, and a linear
+  // triangle of area A whose largest principal stress is s holds at least
+  // A h s^2 (1 - nu^2) / (2 E) (the least of (s^2 + s2^2 - 2 nu s s2) / (2 E)
+  // over the other principal stress s2, at s2 = nu s), so no triangle has
+  // sigma_1 above sqrt(2 E E_m / ((1 - nu^2) h A_min)). A nodal stress is an
+  // area-weighted mean of its triangles' (sigma_1 is convex) and sigma_1 of a
+  // sum is at most the sum of the sigma_1 (subadditive), so the static
+  // forces' largest nodal sigma_1 plus that bounds every later step. The
+  // loop stops when that bound, raised by 1e-6 of itself (round-off), and
+  // the largest sigma_1 so far are below the level.
+  Response respond(std::span<const PointLoad> loads, const Observer& observe = {},
+                   double level = -std::numeric_limits<double>::infinity());
 
   // An upper bound of the largest sigma_1 that respond(loads) finds, at the
   // cost of a static solve (none without static forces) instead of its time
   // loop: a load case whose bound is below the strength cannot initiate by
-  // the stress criterion, so skipping it changes nothing.
+  // the stress criterion, so skipping it changes nothing. It is the energy
+  // bound of respond() taken before the first step (E_0 = 0, the whole
+  // pulse to come):
   //   bound = max over nodes of sigma_1(u_static) + sqrt(2 E U / ((1 - nu^2) h A_min)),
-  //   U = j_r^T M^-1 j_r / 2,  j_r = relieve(nodal impulses).
-  // Why. The elastic modes phi_n (M-orthonormal; C = beta K keeps them
-  // uncoupled) are each driven by phi_n^T j_r times the half-sine pulse,
-  // which has one sign, so a mode's energy (v^2 + omega^2 q^2) / 2 never
-  // exceeds (phi_n^T j_r)^2 / 2: exactly, |int F e^{i omega t} dt| <= int F dt;
-  // in the discrete response, the trapezoidal rule's step is a contraction in
-  // (v, omega q) (a Cayley transform of a dissipative system) and the forcing
-  // enters through an operator of norm <= 1 with the pulse's fractions
-  // summing to one. So the strain energy never exceeds U (the sum over the
-  // modes). In a linear triangle of area A whose largest principal stress
-  // is sigma_1, the strain energy is at least A h sigma_1^2 (1 - nu^2) / (2 E)
-  // (the least of (s1^2 + s2^2 - 2 nu s1 s2) / (2 E) over s2, at s2 = nu s1);
-  // a nodal stress is a mean of its triangles' (sigma_1 is convex) and
-  // sigma_1 of a sum is at most the sum of the sigma_1 (subadditive).
+  //   U = j_r^T M^-1 j_r / 2,  j_r = relieve(nodal impulses)
+  // (U is also the energy the elastic modes would take from the impulses
+  // given at once: each mode, driven by a pulse of one sign, never holds more).
   double stress_bound(std::span<const PointLoad> loads);
 
 private:
@@ -130,6 +157,8 @@ private:
   double dt_ = 0.0, t_end_ = 0.0, beta_ = 0.0, eps_ = 0.0;
   double min_area_ = 0.0;  // m^2, the smallest triangle (stress_bound)
   int steps_ = 0;
+  // Pa: the largest sigma_1 a triangle can have with strain energy `energy` (J).
+  double stress_of_energy(double energy) const;
   std::unique_ptr<SpdFactor> static_, dynamic_;
 };
 
