@@ -471,10 +471,14 @@ void FloeSeaContact::horizontal_loads(std::span<const double> u) {
   const std::vector<double>& wetted = eval_.wetted;
   const double ks = s_ * kappa_, inv_cell_area = 1.0 / cell_area_;
   if (ks <= 0.0) return;
+  // Each rank its own floes (their edge pieces are only there), then the
+  // owners' loads to every rank.
+  const parallel::Range mine = footprints_.owned(loads_.size());
   const std::ptrdiff_t floes_in_order = static_cast<std::ptrdiff_t>(order_.size());
 #pragma omp parallel for num_threads(threads_) schedule(dynamic, 16) if (floes_in_order > kFloesPerThread)
   for (std::ptrdiff_t j = 0; j < floes_in_order; ++j) {
     const std::uint32_t i = order_[static_cast<std::size_t>(j)];
+    if (i < mine.begin || i >= mine.end) continue;
     const Vec2 a = slope_[i];
     Vec2 fh = Vec2::Zero();
     double torque = 0.0;
@@ -501,6 +505,7 @@ void FloeSeaContact::horizontal_loads(std::span<const double> u) {
     fh -= ks * wetted[i] * a;
     loads_[i].horizontal = {fh.x(), fh.y(), torque};
   }
+  comm_.complete_shares(loads_);
 }
 
 void FloeSeaContact::evaluate_loads(const Floes& floes, fluid::Sea& sea, IncidentSea* incident, double h) {
@@ -525,9 +530,12 @@ void FloeSeaContact::update_water(const Floes& floes, const fluid::Sea& sea, Inc
   const double w = incident->weight(sea.time());
   const std::span<const double> u0 = incident->u0(), v0 = incident->v0(), u1 = incident->u1(), v1 = incident->v1();
   const Footprints& fp = footprints_.pieces();
-  const std::ptrdiff_t count = static_cast<std::ptrdiff_t>(std::min(floes.size(), fp.floes()));
-#pragma omp parallel for num_threads(threads_) schedule(static) if (count > kFloesPerThread)
-  for (std::ptrdiff_t i = 0; i < count; ++i) {
+  // Each rank its share of the floes, then the shares to every rank.
+  const parallel::Range mine = comm_.share(water_.size());
+  const std::ptrdiff_t first = static_cast<std::ptrdiff_t>(mine.begin);
+  const std::ptrdiff_t count = static_cast<std::ptrdiff_t>(std::min(mine.end, fp.floes()));
+#pragma omp parallel for num_threads(threads_) schedule(static) if (count - first > kFloesPerThread)
+  for (std::ptrdiff_t i = first; i < count; ++i) {
     double area = 0.0;
     Vec2 sum0 = Vec2::Zero(), sum1 = Vec2::Zero();
     for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k) {
@@ -538,6 +546,7 @@ void FloeSeaContact::update_water(const Floes& floes, const fluid::Sea& sea, Inc
     }
     if (area > 0.0) water_[i] = ((1.0 - w) * sum0 + w * sum1) / area;
   }
+  comm_.complete_shares(water_);
 }
 
 void FloeSeaContact::kick_sea(fluid::Sea& sea, double h) {

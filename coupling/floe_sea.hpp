@@ -188,6 +188,15 @@ public:
   bool implicit() const { return implicit_; }
   // Threads for the per-floe and per-piece work (results do not depend on it).
   void set_threads(int threads) { threads_ = std::max(threads, 1); }
+  // Ranks that share the per-floe work (results do not depend on them:
+  // docs/parallel.md, stage two). Each rank builds its share's footprints
+  // and computes its share's horizontal loads and water velocities; the
+  // other ranks receive them. Every rank calls every method in the same
+  // order (they may exchange data).
+  void set_communicator(const parallel::Communicator& comm) {
+    comm_ = comm;
+    footprints_.set_communicator(comm);
+  }
   struct ImplicitStats {
     long steps = 0, newton = 0, cg = 0, g_products = 0;  // totals over the run
     double last_residual = 0.0;  // m, the last step's largest piece residual
@@ -300,6 +309,7 @@ private:
   bool implicit_ = false;
   bool step_mean_loads_ = false;  // implicit, [coupling] horizontal_loads = "step_mean"
   int threads_ = 1;
+  parallel::Communicator comm_;
   double newton_tolerance_ = 1e-8;  // times the thickest draft
   PenaltyStepOptions solver_options_;
   PenaltyStepSolver solver_;
