@@ -258,12 +258,17 @@ private:
   // loads_[i].horizontal = -dV/dG, -dV/dyaw (the header's formulas) for the
   // pieces' [delta]^+ u, with eval_.psi, eval_.wetted, cells_[c].sum and
   // slope_ already set for them.
+  // On several ranks, for this rank's floes only (share_owned completes them).
   void horizontal_loads(std::span<const double> u);
+  // The owners' horizontal loads, and with `water` their water velocities,
+  // to every rank, in one call (nothing when serial).
+  void share_owned(bool water);
   // Implicit: the step's mean horizontal loads (the header's "Horizontal
   // loads of the implicit step") into step_horizontal_.
   void step_mean_horizontal(const Floes& floes, std::span<const FloeState> start);
   // Mean over each floe's footprint (weights a_c) of the incident waves'
   // velocity at the sea's time (zero without incident waves).
+  // On several ranks, for this rank's floes only (share_owned completes them).
   void update_water(const Floes& floes, const fluid::Sea& sea, IncidentSea* incident);
   void implicit_step(Floes& floes, std::span<const FloeState> start, fluid::Sea& sea, double h);
   // The static start's pressure, held by a sea with a static part (a
