@@ -55,8 +55,8 @@ void MovingFootprints::rebuild_at(const Floes& floes, std::span<const std::uint8
   } else {
     const parallel::Range mine = owned(floes.size());
     std::vector<std::uint8_t> mask(include.size(), 0);
-    std::copy(include.begin() + static_cast<std::ptrdiff_t>(mine.begin),
-              include.begin() + static_cast<std::ptrdiff_t>(mine.end), mask.begin() + static_cast<std::ptrdiff_t>(mine.begin));
+    const auto from = static_cast<std::ptrdiff_t>(mine.begin), to = static_cast<std::ptrdiff_t>(mine.end);
+    std::copy(include.begin() + from, include.begin() + to, mask.begin() + from);
     build_footprints(floes, mask, grid_, pieces_, kernel_, threads, reference);
     gather_built();
   }
@@ -128,7 +128,8 @@ void MovingFootprints::gather_built() {
   const parallel::Range mine = owned(n);
   const std::size_t first = fp.offsets[mine.begin], count = fp.offsets[mine.end] - first;
   std::vector<std::uint64_t> per_floe(mine.size());
-  for (std::size_t j = 0; j < mine.size(); ++j) per_floe[j] = fp.offsets[mine.begin + j + 1] - fp.offsets[mine.begin + j];
+  for (std::size_t j = 0; j < mine.size(); ++j)
+    per_floe[j] = fp.offsets[mine.begin + j + 1] - fp.offsets[mine.begin + j];
   std::vector<std::byte> message;
   message.reserve(per_floe.size() * 8 + count * (4 + 8 + 16));
   put(message, per_floe.data(), per_floe.size());
@@ -176,7 +177,8 @@ void MovingFootprints::gather_moved() {
   std::vector<std::size_t> sizes(static_cast<std::size_t>(comm_.size()));
   for (int r = 0; r < comm_.size(); ++r) {
     const parallel::Range share = parallel::share(n, r, comm_.size());
-    sizes[static_cast<std::size_t>(r)] = (fp.offsets[share.end] - fp.offsets[share.begin]) * (sizeof(double) + sizeof(Vec2));
+    const std::size_t pieces = fp.offsets[share.end] - fp.offsets[share.begin];
+    sizes[static_cast<std::size_t>(r)] = pieces * (sizeof(double) + sizeof(Vec2));
   }
   const parallel::Range mine = owned(n);
   const std::size_t first = fp.offsets[mine.begin], count = fp.offsets[mine.end] - first;
