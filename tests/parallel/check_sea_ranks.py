@@ -16,8 +16,9 @@ floe order, so every run file must equal the serial one bit for bit
 (`floesim compare --rtol 0 --atol 0`), for three variants of the coupling:
 footprints rebuilt at every evaluation, footprints moved between rebuilds
 (footprint_reach: the pieces are moved by their owner and gathered), and the
-implicit integrator (its step-mean horizontal loads). Then a restart across
-rank counts: the first half on 2 ranks, the rest from its checkpoint on 3
+implicit integrator (its step-mean horizontal loads). Then floes that split
+on a sea (the floe count, and so the shares, change during the run) on 2 and
+3 ranks, and a restart across rank counts: the first half on 2 ranks, the rest from its checkpoint on 3
 ranks and serially, both equal to the serial run.
 """
 import argparse
@@ -121,6 +122,30 @@ for name, extra in VARIANTS.items():
         print(f"{name}: {n} ranks {verdict} to the serial run (bit for bit)")
         if c.returncode != 0:
             failures.append(f"{name} on {n} ranks: exit {p.returncode}\n{p.stderr}\n{c.stdout}")
+
+# Floes that split on a sea: the floe count changes during the run, and with
+# it every rank's share. tests/regression/floes_on_sea.toml with the first
+# floe thrown at 3 m/s into the second, and fracture with splits.
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+with open(os.path.join(ROOT, "tests", "regression", "floes_on_sea.toml")) as f:
+    text = f.read()
+if "velocity = [0.6, 0.0]" not in text:
+    sys.exit("FAILED: tests/regression/floes_on_sea.toml changed: the split case needs its moving floe")
+config = os.path.join(W, "sea_splits.toml")
+with open(config, "w") as f:
+    f.write(text.replace("velocity = [0.6, 0.0]", "velocity = [3.0, 0.0]") +
+            "\n[fracture]\nenabled = true\nsplit = true\nstrength = 2.0e4\nmesh_size = 0.5\n")
+serial = need(run([args.floesim, "run", config, "-o", "splits_serial.h5", "-q", "--until", "4"]), "splits: serial run")
+summary = dict(l.split(": ", 1) for l in serial.stdout.splitlines() if ": " in l)
+print(f"splits: serial to 4 s, {summary.get('fracture.splits')} splits, {summary.get('floes')} floes at the end")
+if summary.get("fracture.splits", "0") == "0":
+    failures.append("splits: no floe split: the check would not test a changing floe count")
+for n in (2, 3):
+    p = mpirun(n, "run", config, "-o", f"splits_{n}.h5", "-q", "--until", "4")
+    c = same(f"splits_{n}.h5", "splits_serial.h5") if p.returncode == 0 else p
+    print(f"splits: {n} ranks {'equal' if c.returncode == 0 else 'DIFFERENT'} to the serial run (bit for bit)")
+    if c.returncode != 0:
+        failures.append(f"splits on {n} ranks: exit {p.returncode}\n{p.stderr}\n{c.stdout}")
 
 # A restart across rank counts: stopped half-way on 2 ranks, continued on 3
 # ranks and serially from the checkpoint rank 0 wrote.
