@@ -122,7 +122,8 @@ const std::byte* take(const std::byte* in, T* data, std::size_t count) {
 void MovingFootprints::gather_built() {
   // pieces_ holds this rank's floes' pieces only (the other floes have none).
   // Message: the pieces per floe of the share, then their cells, areas and
-  // centroids; the ranks' messages come back in rank order = floe order.
+  // centroids; the ranks' messages come back in rank order = floe order
+  // (one call while they fit the slot of the last ones).
   Footprints& fp = pieces_;
   const std::size_t n = fp.floes();
   const parallel::Range mine = owned(n);
@@ -137,7 +138,7 @@ void MovingFootprints::gather_built() {
   put(message, fp.area.data() + first, count);
   put(message, fp.centroid.data() + first, count);
   std::vector<std::size_t> sizes;
-  const std::vector<std::byte> all = comm_.allgather_bytes(message, sizes);
+  const std::vector<std::byte> all = comm_.allgather_slotted(message, slot_, sizes);
 
   Footprints full;
   full.offsets.assign(1, 0);

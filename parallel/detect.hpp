@@ -18,9 +18,10 @@
 namespace floesim::parallel {
 
 // Collective: every rank calls it with the same floes and options (part and
-// parts are set here).
+// parts are set here). With `slot` (kept by the caller from one detection to
+// the next), the gather is one call (Communicator::allgather_slotted).
 contact::Detection detect(const Communicator& comm, const Floes& floes, const contact::CollisionShapes& shapes,
-                          contact::DetectionOptions options);
+                          contact::DetectionOptions options, Communicator::Slot* slot = nullptr);
 
 // The detections of parts 0, 1, ... of one detection, concatenated: pairs,
 // contacts and witnesses in order, each pair's first_contact and
