@@ -122,8 +122,7 @@ const std::byte* take(const std::byte* in, T* data, std::size_t count) {
 void MovingFootprints::gather_built() {
   // pieces_ holds this rank's floes' pieces only (the other floes have none).
   // Message: the pieces per floe of the share, then their cells, areas and
-  // centroids; the ranks' messages come back in rank order = floe order
-  // (one call while they fit the slot of the last ones).
+  // centroids; the ranks' messages come back in rank order = floe order.
   Footprints& fp = pieces_;
   const std::size_t n = fp.floes();
   const parallel::Range mine = owned(n);
@@ -138,7 +137,7 @@ void MovingFootprints::gather_built() {
   put(message, fp.area.data() + first, count);
   put(message, fp.centroid.data() + first, count);
   std::vector<std::size_t> sizes;
-  const std::vector<std::byte> all = comm_.allgather_slotted(message, slot_, sizes);
+  const std::vector<std::byte> all = comm_.allgather_bytes(message, sizes);
 
   Footprints full;
   full.offsets.assign(1, 0);

@@ -107,7 +107,6 @@ private:
   std::vector<Vec2> moment0_;   // per area piece, m_c(P0)
   long placements_ = 0, rebuilds_ = 0;
   parallel::Communicator comm_;
-  parallel::Communicator::Slot slot_;  // of gather_built's messages
 };
 
 }  // namespace floesim

@@ -326,7 +326,7 @@ void Simulation::set_reach() {
 
 bool Simulation::detect_and_check(StepContext& ctx) {
   set_reach();
-  contact::Detection next = parallel::detect(comm_, scenario_.floes, shapes_, detection_options_, &detect_slot_);
+  contact::Detection next = parallel::detect(comm_, scenario_.floes, shapes_, detection_options_);
   for (const contact::NearPair& p : next.pairs) {
     if (!p.overlap) continue;
     // Redo the step with half the time.

@@ -176,7 +176,6 @@ private:
 
   Scenario scenario_;
   parallel::Communicator comm_;
-  parallel::Communicator::Slot detect_slot_;  // the detection gather's (one call a step)
   std::unique_ptr<fluid::Sea> sea_;
   std::unique_ptr<FloeSeaContact> floe_sea_;
   // The incident waves (coupling/incident.hpp), for drag; none on a calm sea

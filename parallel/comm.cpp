@@ -1,12 +1,9 @@
 #include "parallel/comm.hpp"
 
-#include <algorithm>
 #include <chrono>
 #include <climits>
 #include <cstdio>
-#include <cstdint>
 #include <cstdlib>
-#include <cstring>
 #include <new>
 #include <stdexcept>
 
@@ -153,53 +150,6 @@ std::vector<std::byte> Communicator::allgather_known(std::span<const std::byte> 
   check(MPI_Allgatherv(mine.data(), static_cast<int>(mine.size()), MPI_BYTE, out.data(), sizes.data(),
                        offsets.data(), MPI_BYTE, impl_->comm),
         "MPI_Allgatherv");
-  return out;
-#else
-  return {};
-#endif
-}
-
-std::vector<std::byte> Communicator::allgather_slotted(std::span<const std::byte> mine, Slot& slot,
-                                                       std::vector<std::size_t>& counts) const {
-  if (serial() || !impl_) {
-    counts.assign(1, mine.size());
-    return {mine.begin(), mine.end()};
-  }
-#ifdef FLOESIM_HAVE_MPI
-  constexpr std::size_t kHead = sizeof(std::uint64_t);
-  const std::size_t block = kHead + slot.bytes;
-  if (block * static_cast<std::size_t>(size_) > static_cast<std::size_t>(INT_MAX))
-    throw RunError("MPI: a gather of more than 2 GiB (" + std::to_string(block * static_cast<std::size_t>(size_)) +
-                   " bytes) is not supported");
-  std::vector<std::byte> send(block), blocks(block * static_cast<std::size_t>(size_));
-  const std::uint64_t size = mine.size();
-  std::memcpy(send.data(), &size, kHead);
-  if (mine.size() <= slot.bytes) std::copy(mine.begin(), mine.end(), send.begin() + kHead);
-  {
-    Counted counted(impl_->traffic, static_cast<long long>(blocks.size()));
-    check(MPI_Allgather(send.data(), static_cast<int>(block), MPI_BYTE, blocks.data(), static_cast<int>(block),
-                        MPI_BYTE, impl_->comm),
-          "MPI_Allgather");
-  }
-  counts.resize(static_cast<std::size_t>(size_));
-  std::size_t largest = 0, total = 0;
-  for (std::size_t r = 0; r < counts.size(); ++r) {
-    std::uint64_t n = 0;
-    std::memcpy(&n, blocks.data() + r * block, kHead);
-    counts[r] = static_cast<std::size_t>(n);
-    largest = std::max(largest, counts[r]);
-    total += counts[r];
-  }
-  const bool fits = largest <= slot.bytes;
-  if (!fits || 2 * largest < slot.bytes) slot.bytes = largest + largest / 8;
-  if (!fits) return allgather_known(mine, counts);
-  std::vector<std::byte> out(total);
-  std::size_t at = 0;
-  for (std::size_t r = 0; r < counts.size(); ++r) {
-    const std::byte* from = blocks.data() + r * block + kHead;
-    std::copy(from, from + counts[r], out.begin() + static_cast<std::ptrdiff_t>(at));
-    at += counts[r];
-  }
   return out;
 #else
   return {};

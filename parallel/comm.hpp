@@ -96,21 +96,6 @@ public:
   std::vector<std::byte> allgather_bytes(std::span<const std::byte> mine, std::vector<std::size_t>& counts) const;
   // The same when every rank's count is known to all (`counts`): one call.
   std::vector<std::byte> allgather_known(std::span<const std::byte> mine, const std::vector<std::size_t>& counts) const;
-  // The block each rank sends in allgather_slotted: zero at first, then set
-  // after each call from the sizes of that call's messages, which every rank
-  // sees, by the same rule, so it is the same on every rank.
-  struct Slot {
-    std::size_t bytes = 0;
-  };
-  // allgather_bytes, in one collective call when every rank's message fits
-  // in slot.bytes: each rank sends a block of that size led by its message's
-  // size (MPI_Allgather); if one does not fit, a second call with the exact
-  // sizes. Then the slot is 9/8 of the largest message when that one did not
-  // fit or is below half the slot. For gathers repeated every step whose
-  // sizes change slowly (the contact detection, the footprints): one call
-  // instead of two, for at most an eighth more bytes.
-  std::vector<std::byte> allgather_slotted(std::span<const std::byte> mine, Slot& slot,
-                                           std::vector<std::size_t>& counts) const;
 
   // The sum of one integer over the ranks (in rank order; exact).
   long long sum(long long value) const;

@@ -48,7 +48,7 @@ std::vector<T> take(const std::byte*& at, std::uint64_t count) {
 }  // namespace
 
 contact::Detection detect(const Communicator& comm, const Floes& floes, const contact::CollisionShapes& shapes,
-                          contact::DetectionOptions options, Communicator::Slot* slot) {
+                          contact::DetectionOptions options) {
   if (comm.serial()) return contact::detect(floes, shapes, options);
   options.part = static_cast<std::size_t>(comm.rank());
   options.parts = static_cast<std::size_t>(comm.size());
@@ -60,8 +60,7 @@ contact::Detection detect(const Communicator& comm, const Floes& floes, const co
   put(message, mine.contacts);
   put(message, mine.witnesses);
   std::vector<std::size_t> counts;
-  const std::vector<std::byte> all =
-      slot ? comm.allgather_slotted(message, *slot, counts) : comm.allgather_bytes(message, counts);
+  const std::vector<std::byte> all = comm.allgather_bytes(message, counts);
   std::vector<contact::Detection> parts(counts.size());
   const std::byte* at = all.data();
   for (contact::Detection& part : parts) {

@@ -18,10 +18,9 @@
 namespace floesim::parallel {
 
 // Collective: every rank calls it with the same floes and options (part and
-// parts are set here). With `slot` (kept by the caller from one detection to
-// the next), the gather is one call (Communicator::allgather_slotted).
+// parts are set here).
 contact::Detection detect(const Communicator& comm, const Floes& floes, const contact::CollisionShapes& shapes,
-                          contact::DetectionOptions options, Communicator::Slot* slot = nullptr);
+                          contact::DetectionOptions options);
 
 // The detections of parts 0, 1, ... of one detection, concatenated: pairs,
 // contacts and witnesses in order, each pair's first_contact and

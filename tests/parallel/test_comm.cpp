@@ -52,16 +52,6 @@ TEST_CASE("the serial communicator is rank 0 of 1: gathers copy and sums are the
   CHECK(r.end == 9);
 }
 
-TEST_CASE("allgather_slotted on one rank is a copy and leaves the slot") {
-  const parallel::Communicator comm;
-  parallel::Communicator::Slot slot;
-  const std::vector<std::byte> bytes{std::byte{1}, std::byte{2}, std::byte{3}};
-  std::vector<std::size_t> counts;
-  CHECK(comm.allgather_slotted(bytes, slot, counts) == bytes);
-  CHECK(counts == std::vector<std::size_t>{3});
-  CHECK(slot.bytes == 0);
-}
-
 TEST_CASE("together_any on one rank gives the flag, or the error with its type") {
   const parallel::Communicator comm;
   int ran = 0;
