@@ -471,10 +471,14 @@ void FloeSeaContact::horizontal_loads(std::span<const double> u) {
   const std::vector<double>& wetted = eval_.wetted;
   const double ks = s_ * kappa_, inv_cell_area = 1.0 / cell_area_;
   if (ks <= 0.0) return;
+  // Each rank its own floes (their edge pieces are only there); the caller
+  // shares the loads (share_owned).
+  const parallel::Range mine = footprints_.owned(loads_.size());
   const std::ptrdiff_t floes_in_order = static_cast<std::ptrdiff_t>(order_.size());
 #pragma omp parallel for num_threads(threads_) schedule(dynamic, 16) if (floes_in_order > kFloesPerThread)
   for (std::ptrdiff_t j = 0; j < floes_in_order; ++j) {
     const std::uint32_t i = order_[static_cast<std::size_t>(j)];
+    if (i < mine.begin || i >= mine.end) continue;
     const Vec2 a = slope_[i];
     Vec2 fh = Vec2::Zero();
     double torque = 0.0;
@@ -503,9 +507,30 @@ void FloeSeaContact::horizontal_loads(std::span<const double> u) {
   }
 }
 
+void FloeSeaContact::share_owned(bool water) {
+  if (comm_.serial()) return;
+  struct Owned {
+    double fx, fy, torque, u, v;
+  };
+  std::vector<Owned> owned(loads_.size());
+  const parallel::Range mine = comm_.share(owned.size());
+  for (std::size_t i = mine.begin; i < mine.end; ++i) {
+    const Eigen::Vector3d& f = loads_[i].horizontal;
+    const Vec2 w = water ? water_[i] : Vec2::Zero();
+    owned[i] = {f[0], f[1], f[2], w.x(), w.y()};
+  }
+  comm_.complete_shares(owned);
+  for (std::size_t i = 0; i < owned.size(); ++i) {
+    if (i >= mine.begin && i < mine.end) continue;
+    loads_[i].horizontal = {owned[i].fx, owned[i].fy, owned[i].torque};
+    if (water) water_[i] = {owned[i].u, owned[i].v};
+  }
+}
+
 void FloeSeaContact::evaluate_loads(const Floes& floes, fluid::Sea& sea, IncidentSea* incident, double h) {
   evaluate(floes, sea, h);
   update_water(floes, sea, incident);
+  share_owned(true);
   // After an implicit step the horizontal loads are that step's mean (zero
   // on a floe that had no pieces on the step's midpoint footprint).
   if (step_mean_pending_)
@@ -525,9 +550,12 @@ void FloeSeaContact::update_water(const Floes& floes, const fluid::Sea& sea, Inc
   const double w = incident->weight(sea.time());
   const std::span<const double> u0 = incident->u0(), v0 = incident->v0(), u1 = incident->u1(), v1 = incident->v1();
   const Footprints& fp = footprints_.pieces();
-  const std::ptrdiff_t count = static_cast<std::ptrdiff_t>(std::min(floes.size(), fp.floes()));
-#pragma omp parallel for num_threads(threads_) schedule(static) if (count > kFloesPerThread)
-  for (std::ptrdiff_t i = 0; i < count; ++i) {
+  // Each rank its share of the floes; the caller shares them (share_owned).
+  const parallel::Range mine = comm_.share(water_.size());
+  const std::ptrdiff_t first = static_cast<std::ptrdiff_t>(mine.begin);
+  const std::ptrdiff_t count = static_cast<std::ptrdiff_t>(std::min(mine.end, fp.floes()));
+#pragma omp parallel for num_threads(threads_) schedule(static) if (count - first > kFloesPerThread)
+  for (std::ptrdiff_t i = first; i < count; ++i) {
     double area = 0.0;
     Vec2 sum0 = Vec2::Zero(), sum1 = Vec2::Zero();
     for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k) {

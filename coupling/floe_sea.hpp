@@ -188,6 +188,15 @@ public:
   bool implicit() const { return implicit_; }
   // Threads for the per-floe and per-piece work (results do not depend on it).
   void set_threads(int threads) { threads_ = std::max(threads, 1); }
+  // Ranks that share the per-floe work (results do not depend on them:
+  // docs/parallel.md, stage two). Each rank builds its share's footprints
+  // and computes its share's horizontal loads and water velocities; the
+  // other ranks receive them. Every rank calls every method in the same
+  // order (they may exchange data).
+  void set_communicator(const parallel::Communicator& comm) {
+    comm_ = comm;
+    footprints_.set_communicator(comm);
+  }
   struct ImplicitStats {
     long steps = 0, newton = 0, cg = 0, g_products = 0;  // totals over the run
     double last_residual = 0.0;  // m, the last step's largest piece residual
@@ -249,12 +258,17 @@ private:
   // loads_[i].horizontal = -dV/dG, -dV/dyaw (the header's formulas) for the
   // pieces' [delta]^+ u, with eval_.psi, eval_.wetted, cells_[c].sum and
   // slope_ already set for them.
+  // On several ranks, for this rank's floes only (share_owned completes them).
   void horizontal_loads(std::span<const double> u);
+  // The owners' horizontal loads, and with `water` their water velocities,
+  // to every rank, in one call (nothing when serial).
+  void share_owned(bool water);
   // Implicit: the step's mean horizontal loads (the header's "Horizontal
   // loads of the implicit step") into step_horizontal_.
   void step_mean_horizontal(const Floes& floes, std::span<const FloeState> start);
   // Mean over each floe's footprint (weights a_c) of the incident waves'
   // velocity at the sea's time (zero without incident waves).
+  // On several ranks, for this rank's floes only (share_owned completes them).
   void update_water(const Floes& floes, const fluid::Sea& sea, IncidentSea* incident);
   void implicit_step(Floes& floes, std::span<const FloeState> start, fluid::Sea& sea, double h);
   // The static start's pressure, held by a sea with a static part (a
@@ -300,6 +314,7 @@ private:
   bool implicit_ = false;
   bool step_mean_loads_ = false;  // implicit, [coupling] horizontal_loads = "step_mean"
   int threads_ = 1;
+  parallel::Communicator comm_;
   double newton_tolerance_ = 1e-8;  // times the thickest draft
   PenaltyStepOptions solver_options_;
   PenaltyStepSolver solver_;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 
 #include "coupling/parallel.hpp"
 
@@ -49,7 +50,16 @@ bool MovingFootprints::place(const Floes& floes, std::span<const std::uint8_t> i
 void MovingFootprints::rebuild_at(const Floes& floes, std::span<const std::uint8_t> include,
                                   std::span<const FloePose> reference, int threads) {
   ++rebuilds_;
-  build_footprints(floes, include, grid_, pieces_, kernel_, threads, reference);
+  if (comm_.serial()) {
+    build_footprints(floes, include, grid_, pieces_, kernel_, threads, reference);
+  } else {
+    const parallel::Range mine = owned(floes.size());
+    std::vector<std::uint8_t> mask(include.size(), 0);
+    const auto from = static_cast<std::ptrdiff_t>(mine.begin), to = static_cast<std::ptrdiff_t>(mine.end);
+    std::copy(include.begin() + from, include.begin() + to, mask.begin() + from);
+    build_footprints(floes, mask, grid_, pieces_, kernel_, threads, reference);
+    gather_built();
+  }
   reference_.assign(reference.begin(), reference.end());
   include_.assign(include.begin(), include.end());
   radius_.assign(floes.size(), 0.0);
@@ -62,7 +72,9 @@ void MovingFootprints::rebuild_at(const Floes& floes, std::span<const std::uint8
 
 void MovingFootprints::move(std::span<const FloePose> poses, int threads) {
   Footprints& fp = pieces_;
-  parallel::for_each_index(fp.floes(), threads, [&](std::size_t i) {
+  const parallel::Range mine = owned(fp.floes());
+  parallel::for_each_index(mine.size(), threads, [&](std::size_t j) {
+    const std::size_t i = mine.begin + j;
     if (fp.offsets[i] == fp.offsets[i + 1]) return;
     const FloePose d = displacement(i, poses[i]);
     const Vec2 delta{d.x, d.y};
@@ -88,6 +100,100 @@ void MovingFootprints::move(std::span<const FloePose> poses, int threads) {
       }
     }
   }, static_cast<std::size_t>(parallel::kFloesPerThread));
+  if (!comm_.serial()) gather_moved();
+}
+
+namespace {
+
+// Bytes of a message, appended and read back in order.
+template <class T>
+void put(std::vector<std::byte>& out, const T* data, std::size_t count) {
+  const auto* b = reinterpret_cast<const std::byte*>(data);
+  out.insert(out.end(), b, b + count * sizeof(T));
+}
+template <class T>
+const std::byte* take(const std::byte* in, T* data, std::size_t count) {
+  std::memcpy(static_cast<void*>(data), in, count * sizeof(T));
+  return in + count * sizeof(T);
+}
+
+}  // namespace
+
+void MovingFootprints::gather_built() {
+  // pieces_ holds this rank's floes' pieces only (the other floes have none).
+  // Message: the pieces per floe of the share, then their cells, areas and
+  // centroids; the ranks' messages come back in rank order = floe order.
+  Footprints& fp = pieces_;
+  const std::size_t n = fp.floes();
+  const parallel::Range mine = owned(n);
+  const std::size_t first = fp.offsets[mine.begin], count = fp.offsets[mine.end] - first;
+  std::vector<std::uint64_t> per_floe(mine.size());
+  for (std::size_t j = 0; j < mine.size(); ++j)
+    per_floe[j] = fp.offsets[mine.begin + j + 1] - fp.offsets[mine.begin + j];
+  std::vector<std::byte> message;
+  message.reserve(per_floe.size() * 8 + count * (4 + 8 + 16));
+  put(message, per_floe.data(), per_floe.size());
+  put(message, fp.cell.data() + first, count);
+  put(message, fp.area.data() + first, count);
+  put(message, fp.centroid.data() + first, count);
+  std::vector<std::size_t> sizes;
+  const std::vector<std::byte> all = comm_.allgather_bytes(message, sizes);
+
+  Footprints full;
+  full.offsets.assign(1, 0);
+  const std::byte* in = all.data();
+  for (int r = 0; r < comm_.size(); ++r) {
+    const parallel::Range share = parallel::share(n, r, comm_.size());
+    per_floe.resize(share.size());
+    in = take(in, per_floe.data(), per_floe.size());
+    std::size_t pieces = 0;
+    for (std::uint64_t c : per_floe) {
+      pieces += c;
+      full.offsets.push_back(full.offsets.back() + c);
+    }
+    const std::size_t at = full.cell.size();
+    full.cell.resize(at + pieces);
+    full.area.resize(at + pieces);
+    full.centroid.resize(at + pieces);
+    in = take(in, full.cell.data() + at, pieces);
+    in = take(in, full.area.data() + at, pieces);
+    in = take(in, full.centroid.data() + at, pieces);
+  }
+  // This rank's edge pieces point into the full list of area pieces.
+  const auto shift = static_cast<std::ptrdiff_t>(full.offsets[mine.begin]) - static_cast<std::ptrdiff_t>(first);
+  for (std::ptrdiff_t& p : fp.edge_piece)
+    if (p >= 0) p += shift;
+  fp.offsets = std::move(full.offsets);
+  fp.cell = std::move(full.cell);
+  fp.area = std::move(full.area);
+  fp.centroid = std::move(full.centroid);
+}
+
+void MovingFootprints::gather_moved() {
+  // Every rank knows where each floe's pieces lie (the last build's layout):
+  // one call, the shares' areas then centroids.
+  Footprints& fp = pieces_;
+  const std::size_t n = fp.floes();
+  std::vector<std::size_t> sizes(static_cast<std::size_t>(comm_.size()));
+  for (int r = 0; r < comm_.size(); ++r) {
+    const parallel::Range share = parallel::share(n, r, comm_.size());
+    const std::size_t pieces = fp.offsets[share.end] - fp.offsets[share.begin];
+    sizes[static_cast<std::size_t>(r)] = pieces * (sizeof(double) + sizeof(Vec2));
+  }
+  const parallel::Range mine = owned(n);
+  const std::size_t first = fp.offsets[mine.begin], count = fp.offsets[mine.end] - first;
+  std::vector<std::byte> message;
+  message.reserve(count * (sizeof(double) + sizeof(Vec2)));
+  put(message, fp.area.data() + first, count);
+  put(message, fp.centroid.data() + first, count);
+  const std::vector<std::byte> all = comm_.allgather_known(message, sizes);
+  const std::byte* in = all.data();
+  for (int r = 0; r < comm_.size(); ++r) {
+    const parallel::Range share = parallel::share(n, r, comm_.size());
+    const std::size_t at = fp.offsets[share.begin], pieces = fp.offsets[share.end] - at;
+    in = take(in, fp.area.data() + at, pieces);
+    in = take(in, fp.centroid.data() + at, pieces);
+  }
 }
 
 }  // namespace floesim

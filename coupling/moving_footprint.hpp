@@ -31,12 +31,21 @@
 //     |delta_x| + R |phi| > reach dx  or  |delta_y| + R |phi| > reach dy,
 // R the floe's largest vertex distance from its centroid. reach = 0 rebuilds
 // at every placement (the exact pieces).
+//
+// On several ranks (a parallel::Communicator, docs/parallel.md) each rank
+// builds or moves the pieces of its own share of the floes
+// (Communicator::share) and receives every other floe's area pieces from
+// its owner, so every rank holds all area pieces, to the bit as a serial
+// run builds them (each floe's pieces depend on that floe alone). The edge
+// pieces stay with their floe's owner: only the horizontal loads read them,
+// and the owner computes those (owned()).
 
 #include <cstdint>
 #include <span>
 #include <vector>
 
 #include "coupling/footprint.hpp"
+#include "parallel/comm.hpp"
 
 namespace floesim {
 
@@ -60,6 +69,11 @@ public:
   // Builds at `reference` and makes it the reference (a restart).
   void rebuild_at(const Floes& floes, std::span<const std::uint8_t> include, std::span<const FloePose> reference,
                   int threads);
+  // Share the work among these ranks (by default the serial run: one rank).
+  void set_communicator(const parallel::Communicator& comm) { comm_ = comm; }
+  // The floes whose edge pieces this rank holds: all of them when serial.
+  parallel::Range owned(std::size_t floes) const { return comm_.share(floes); }
+
   // The next placement rebuilds (the floes changed).
   void forget() { reference_.clear(); }
 
@@ -76,6 +90,11 @@ private:
   void move(std::span<const FloePose> poses, int threads);
   // (delta, phi) of floe i from its reference, the grid's seam crossed the short way.
   FloePose displacement(std::size_t i, const FloePose& at) const;
+  // After this rank built its floes' pieces alone: every floe's area pieces
+  // from their owners, in floe order; the edge pieces are this rank's.
+  void gather_built();
+  // After this rank moved its floes' pieces: the others' areas and centroids.
+  void gather_moved();
 
   fluid::SurfaceGrid grid_;
   FootprintKernel kernel_ = FootprintKernel::cell;
@@ -87,6 +106,7 @@ private:
   std::vector<double> area0_;   // per area piece, a_c(P0)
   std::vector<Vec2> moment0_;   // per area piece, m_c(P0)
   long placements_ = 0, rebuilds_ = 0;
+  parallel::Communicator comm_;
 };
 
 }  // namespace floesim

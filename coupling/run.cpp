@@ -92,8 +92,9 @@ RunSummary run_simulation(Simulation& sim, const RunOptions& options) {
       if (t_end - t_record < 1e-9 * std::max(1.0, t_end)) t_record = t_end;
       bool stop = false;
       while (sim.time() < t_record && !stop) {
-        // The ranks agree after each step: on a failure of any, and on stopping.
-        comm.together([&] {
+        // The ranks agree after each step, in one call: on a failure of any,
+        // and on stopping.
+        stop = comm.together_any([&] {
           sim.step(t_record);
           std::vector<CollisionEventRow> collisions = sim.take_collision_events();
           std::vector<FractureEventRow> events = sim.take_fracture_events();
@@ -103,8 +104,7 @@ RunSummary run_simulation(Simulation& sim, const RunOptions& options) {
             writer->record_fracture(events);
           }
           if (options.progress) options.progress({sim.time(), t_end, sim.steps(), wall()});
-        });
-        stop = comm.any(options.should_stop && options.should_stop());
+        }, [&] { return options.should_stop && options.should_stop(); });
         if (!stop && sim.time() < t_record && sim.time() >= next_checkpoint) comm.together(checkpoint);
       }
       const bool on_schedule = sim.time() >= t_record;

@@ -112,6 +112,7 @@ Simulation::Simulation(Scenario scenario, parallel::Communicator comm)
   if (sea_ && any_dynamic) {
     floe_sea_ = std::make_unique<FloeSeaContact>(c.coupling, c.sea, scenario_.floes, *sea_, c.run.dt_max);
     floe_sea_->set_threads(resolve_threads(c.run.threads));
+    floe_sea_->set_communicator(comm_);
     if (c.sea.waves.kind != WaveKind::none || c.sea.tank.enabled)
       incident_ = std::make_unique<IncidentSea>(fluid::make_sea(c.sea, c.run.seed, sea_options),
                                                 IncidentSea::interval_for(c.sea));

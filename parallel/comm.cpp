@@ -185,19 +185,21 @@ std::vector<std::byte> Communicator::broadcast(std::span<const std::byte> bytes,
 #endif
 }
 
-void Communicator::agree(std::exception_ptr failure) const {
+bool Communicator::agree(std::exception_ptr failure, bool value) const {
   if (serial() || !impl_) {
     if (failure) std::rethrow_exception(failure);
-    return;
+    return value;
   }
 #ifdef FLOESIM_HAVE_MPI
-  // The lowest failing rank speaks: min over (rank if failed, else size).
-  int mine = failure ? rank_ : size_, first = size_;
+  // The lowest failing rank speaks: min over (rank if failed, else size);
+  // and the value is true on some rank when min over (value ? 0 : 1) is 0.
+  int mine[2] = {failure ? rank_ : size_, value ? 0 : 1}, least[2] = {size_, 1};
   {
-    Counted counted(impl_->traffic, static_cast<long long>(sizeof(int)) * size_);
-    check(MPI_Allreduce(&mine, &first, 1, MPI_INT, MPI_MIN, impl_->comm), "MPI_Allreduce");
+    Counted counted(impl_->traffic, static_cast<long long>(sizeof(mine)) * size_);
+    check(MPI_Allreduce(mine, least, 2, MPI_INT, MPI_MIN, impl_->comm), "MPI_Allreduce");
   }
-  if (first == size_) return;
+  const int first = least[0];
+  if (first == size_) return least[1] == 0;
   std::vector<std::byte> said;
   if (rank_ == first) {
     const Described d = describe(failure);
@@ -214,6 +216,7 @@ void Communicator::agree(std::exception_ptr failure) const {
   throw_described(d);
 #else
   if (failure) std::rethrow_exception(failure);
+  return value;
 #endif
 }
 

@@ -125,8 +125,25 @@ public:
     }
     agree(failure);
   }
-  // The agreement of together(), for a failure caught by the caller (null: none here).
-  void agree(std::exception_ptr failure) const;
+  // together(f), and in the same collective call whether flag() is true on
+  // any rank (flag() runs on each rank after f() returned there): true on
+  // every rank when it is true on any. One call instead of two (a step's
+  // agreement on failures and on stopping).
+  template <class F, class G>
+  bool together_any(F&& f, G&& flag) const {
+    std::exception_ptr failure;
+    bool value = false;
+    try {
+      f();
+      value = flag();
+    } catch (...) {
+      failure = std::current_exception();
+    }
+    return agree(failure, value);
+  }
+  // The agreement of together(), for a failure caught by the caller (null:
+  // none here); returns whether `value` is true on any rank.
+  bool agree(std::exception_ptr failure, bool value = false) const;
   // True once the ranks have agreed on a failure (the error being thrown is the run's, on every rank).
   bool failure_agreed() const;
 

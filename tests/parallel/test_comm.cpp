@@ -52,6 +52,17 @@ TEST_CASE("the serial communicator is rank 0 of 1: gathers copy and sums are the
   CHECK(r.end == 9);
 }
 
+TEST_CASE("together_any on one rank gives the flag, or the error with its type") {
+  const parallel::Communicator comm;
+  int ran = 0;
+  CHECK(comm.together_any([&] { ++ran; }, [] { return true; }));
+  CHECK_FALSE(comm.together_any([&] { ++ran; }, [] { return false; }));
+  CHECK(ran == 2);
+  bool asked = false;
+  CHECK_THROWS_AS(comm.together_any([] { throw RunError("diverged"); }, [&] { return asked = true; }), RunError);
+  CHECK_FALSE(asked);  // the flag is not asked after a failure
+}
+
 TEST_CASE("together on one rank throws the original error with its type") {
   const parallel::Communicator comm;
   bool ran = false;

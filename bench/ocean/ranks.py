@@ -1,0 +1,122 @@
+#!/usr/bin/env python3
+"""bench/ocean/ranks.py: bench/ocean/ocean.toml on 1 and 2 ranks, side by side.
+
+Writes the pack beside ocean.toml (as run.sh does: floesim pack, seed 1),
+then for each round runs the ranks of --ranks one after another
+(alternating, so load changes on the shared machine hit each), each
+`mpirun --oversubscribe -np R floesim run ocean.toml --until T --threads 1
+--profile` under /usr/bin/time (R = 0: the binary without mpirun). Per run:
+the loop's wall time (summary wall_time), the steps, rank 0's collectives
+(bytes received, seconds inside them: transfers and waits for the other
+rank), the CPU time of every process (user + system, set-up included) and
+rank 0's profile per phase; and whether the run file equals the first
+serial run's bit for bit (`floesim compare --rtol 0 --atol 0`).
+
+usage: bench/ocean/ranks.py [--build build] [--until 10] [--ranks 0 1 2] [--rounds 3]
+                            [--csv FILE | -] [--note TEXT]
+"""
+import argparse
+import os
+import platform
+import subprocess
+import sys
+import tempfile
+import time
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.dirname(os.path.dirname(HERE))
+
+ap = argparse.ArgumentParser()
+ap.add_argument("--build", default=os.path.join(ROOT, "build"))
+ap.add_argument("--until", type=float, default=10.0)
+ap.add_argument("--ranks", type=int, nargs="+", default=[0, 1, 2])
+ap.add_argument("--rounds", type=int, default=3)
+ap.add_argument("--csv", default="-")
+ap.add_argument("--note", default="")
+args = ap.parse_args()
+
+floesim = os.path.join(args.build, "bin", "floesim")
+env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1", OMP_NUM_THREADS="1")
+work = tempfile.mkdtemp(prefix="floesim_ocean_ranks_")
+pack = os.path.join(HERE, "ocean_pack.h5")
+subprocess.run([floesim, "pack", "--floes", "1000", "--concentration", "0.3", "--box", "1000", "1000", "--seed", "1",
+                "--min-size", "10", "--max-size", "30", "--thickness", "1", "-o", pack], check=True,
+               capture_output=True)
+config = os.path.join(work, "ocean.toml")
+with open(os.path.join(HERE, "ocean.toml")) as f, open(config, "w") as g:
+    for line in f:
+        g.write(f'pack = "{pack}"\n' if line.startswith("pack = ") else line)
+
+
+def load():
+    with open("/proc/loadavg") as f:
+        return " ".join(f.read().split()[:3])
+
+
+reference = None
+
+
+def one(ranks, label):
+    global reference
+    out_file = os.path.join(work, f"{label}.h5")
+    cmd = ["/usr/bin/time", "-f", "cpu_s: %U %S", floesim, "run", config, "--until", str(args.until), "-o", out_file,
+           "-q", "--threads", "1", "--profile"]
+    if ranks > 0:
+        cmd = ["mpirun", "--oversubscribe", "-np", str(ranks)] + cmd
+    p = subprocess.run(cmd, capture_output=True, text=True, env=env, cwd=work)
+    if p.returncode != 0:
+        sys.exit(f"{' '.join(cmd)}: exit {p.returncode}\n{p.stderr}")
+    out = {}
+    for line in p.stdout.splitlines():
+        if ": " in line:
+            k, v = line.split(": ", 1)
+            out[k.strip()] = v.split()[0]
+    cpu = [sum(map(float, l.split()[1:3])) for l in p.stderr.splitlines() if l.startswith("cpu_s: ")]
+    out["cpu_s"] = " ".join(f"{c:.2f}" for c in cpu)
+    if reference is None:
+        reference = out_file
+        out["equal"] = "reference"
+    else:
+        c = subprocess.run([floesim, "compare", out_file, reference, "--rtol", "0", "--atol", "0"],
+                           capture_output=True, text=True)
+        out["equal"] = "yes" if c.returncode == 0 else "NO"
+    return out
+
+
+phases = ["penalty", "sea", "drift", "detect", "advance", "collide", "record"]
+rows = []
+load_before = load()
+for r in range(args.rounds):
+    for ranks in args.ranks:
+        s = one(ranks, f"r{ranks}_{r}")
+        print(f"round {r}, ranks {ranks}: loop {s['wall_time']} s, cpu {s['cpu_s']}", file=sys.stderr)
+        rows.append([str(ranks), str(r), s["wall_time"], s["steps"], s.get("parallel.collectives", "0"),
+                     s.get("parallel.bytes_received", "0"), s.get("parallel.collective_seconds", "0"), s["cpu_s"],
+                     s["equal"]] + [s.get("profile." + ph, "") for ph in phases])
+load_after = load()
+
+commit = subprocess.run(["git", "-C", ROOT, "rev-parse", "--short", "HEAD"], capture_output=True, text=True).stdout.strip()
+lines = [f"# command: bench/ocean/ranks.py {' '.join(sys.argv[1:])}",
+         f"# commit: {commit} (Release build){'; ' + args.note if args.note else ''}",
+         f"# machine: {platform.processor() or platform.machine()}, {os.cpu_count()} cores (shared); "
+         f"load before {load_before}, after {load_after}; {time.strftime('%Y-%m-%d %H:%M', time.gmtime())} UTC",
+         f"# scenario: bench/ocean/ocean.toml (1000 floes, 512^2 spectral sea, K = 100) to {args.until} s; ranks 0 = "
+         "the binary without mpirun; one thread per rank; wall_s = the run loop (summary wall_time); collectives, "
+         "bytes_received, collective_s: rank 0's over the run (transfers and waits for the other ranks); cpu_s: CPU "
+         "time (user + system) of each process, set-up (about 0.3 s) included, waits that yield the core included; "
+         "equal: the run file equals the first run's bit for bit; phases: rank 0's profile (s), waits included"]
+best = {}
+for row in rows:
+    best[row[0]] = min(best.get(row[0], float("inf")), float(row[2]))
+ref = best.get("1") or best.get("0")
+for k in sorted(best):
+    lines.append(f"# least wall_s on {k} rank(s): {best[k]:.3f} s" +
+                 (f" (speed-up over 1 rank: {ref / best[k]:.2f}x)" if ref and k not in ("0", "1") else ""))
+lines.append("ranks,round,wall_s,steps,collectives,bytes_received,collective_s,cpu_s,equal," +
+             ",".join(p + "_s" for p in phases))
+lines += [",".join(r) for r in rows]
+text = "\n".join(lines) + "\n"
+if args.csv != "-":
+    with open(args.csv, "w") as f:
+        f.write(text)
+sys.stdout.write(text)
