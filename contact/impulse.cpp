@@ -108,6 +108,19 @@ Vec2 body_point(const Floes& floes, std::uint32_t a, const Vec2& p) {
   return rotate(p - Vec2{s.x, s.y}, -s.yaw);
 }
 Vec2 body_direction(const Floes& floes, std::uint32_t a, const Vec2& v) { return rotate(v, -floes.state[a].yaw); }
+// A contact point as a feature pair, in body frames that do not change while
+// the floes move: its vertex, in the body frame of the floe it belongs to
+// (vertex_of_b: b's, from b's own image), and its normal, in the body frame
+// of the floe whose edge it is on. The point itself (the mid-point of the
+// vertex and its closest boundary point) slides with the floes.
+struct Feature {
+  Vec2 vertex, normal;
+};
+Feature feature(const Floes& floes, const ContactPoint& c) {
+  if (c.vertex_of_b)
+    return {body_point(floes, c.b, c.point + 0.5 * c.gap * c.normal - c.shift), body_direction(floes, c.a, c.normal)};
+  return {body_point(floes, c.a, c.point - 0.5 * c.gap * c.normal), body_direction(floes, c.b, c.normal)};
+}
 
 // The guess for the LCP of the contacts `list` (unknowns ordered as in
 // impulse.hpp: lambda [m], beta [2m], alpha [m]).
@@ -123,13 +136,13 @@ std::vector<std::uint8_t> warm_guess(const WarmStart& warm, const Floes& floes,
     const ContactPoint& c = contacts[list[k]];
     const auto it = warm.pairs.find(pair_key(c.a, c.b));
     if (it == warm.pairs.end()) continue;
-    const Vec2 p = body_point(floes, c.a, c.point);
-    const Vec2 n = body_direction(floes, c.a, c.normal);
+    const Feature f = feature(floes, c);
     const WarmStart::Entry* best = nullptr;
     double best_d = warm.match_distance;
     for (const WarmStart::Entry& e : it->second.entries) {
-      // Points within match_distance, normals within about 0.1 rad.
-      const double d = (e.body_point - p).norm() + 10.0 * warm.match_distance * (e.body_normal - n).norm();
+      // The same vertex (within match_distance) on the same edge (normals within about 0.1 rad).
+      if (e.vertex_of_b != c.vertex_of_b) continue;
+      const double d = (e.body_point - f.vertex).norm() + 10.0 * warm.match_distance * (e.body_normal - f.normal).norm();
       if (d <= best_d && !taken.contains(&e)) {
         best_d = d;
         best = &e;
@@ -159,9 +172,9 @@ void warm_store(WarmStart& warm, const Floes& floes, const std::vector<ContactPo
   auto on = [&](std::size_t i) -> std::uint8_t { return z_basic[i]; };
   for (std::size_t k = 0; k < m; ++k) {
     const ContactPoint& c = contacts[list[k]];
+    const Feature f = feature(floes, c);
     warm.pairs[pair_key(c.a, c.b)].entries.push_back(
-        {body_point(floes, c.a, c.point), body_direction(floes, c.a, c.normal),
-         {on(k), on(m + 2 * k), on(m + 2 * k + 1), on(3 * m + k)}});
+        {f.vertex, f.normal, {on(k), on(m + 2 * k), on(m + 2 * k + 1), on(3 * m + k)}, c.vertex_of_b});
   }
 }
 
@@ -176,6 +189,24 @@ void dump_failed(const lcp::Lcp& problem, std::size_t m, double friction, const 
     c << " " << lcp::to_string(a.method) << " " << lcp::to_string(a.status) << " " << a.pivots << " " << a.residual << ";";
   lcp::write_siconos_lcp(problem, dir + "/failed_lcp_" + std::to_string(number) + ".dat", c.str());
 }
+
+}  // namespace
+
+double normal_target(const ContactPoint& c, const ImpulseOptions& opt) {
+  const double h = std::max(opt.speculative_step, opt.step_floor);
+  double target = 0.0;
+  if (c.speculative) target = -0.9 * (c.gap - 0.5 * opt.collision_distance) / h;
+  else if (c.gap < opt.min_gap) target = (opt.min_gap - c.gap) / opt.relaxation_time;
+  // What the floes' turning closes beyond the linear gap (jam time steps).
+  if (opt.speculative_step > 0.0) target += c.turning / h;
+  return target;
+}
+
+double target_shortfall(const Floes& floes, const ContactPoint& c, const ImpulseOptions& opt) {
+  return normal_target(c, opt) + approach(floes, floes.state, c.a, c.b, c.point, c.point - c.shift, c.normal);
+}
+
+namespace {
 
 // The collision LCP of one contact component (impulse.hpp), assembled as
 // data: G's rows, the floes' velocities and inverse masses, the per-contact
@@ -258,15 +289,8 @@ ComponentLcp assemble(const Floes& floes, const std::vector<ContactPoint>& conta
   // Normal velocity each contact must reach (>= 0 plus the gap stabilisation).
   // Speculative gaps and turning become speeds over the step, taken no
   // shorter than step_floor (impulse.hpp: round-off over a sliver).
-  const double h = std::max(opt.speculative_step, opt.step_floor);
   a.target.assign(m, 0.0);
-  for (std::size_t k = 0; k < m; ++k) {
-    const ContactPoint& c = contacts[a.list[k]];
-    if (c.speculative) a.target[k] = -0.9 * (c.gap - 0.5 * opt.collision_distance) / h;
-    else if (c.gap < opt.min_gap) a.target[k] = (opt.min_gap - c.gap) / opt.relaxation_time;
-    // What the floes' turning closes beyond the linear gap (jam time steps).
-    if (opt.speculative_step > 0.0) a.target[k] += c.turning / h;
-  }
+  for (std::size_t k = 0; k < m; ++k) a.target[k] = normal_target(contacts[a.list[k]], opt);
   // Scaling (symmetric, so the LCP keeps the structure Lemke relies on):
   // with s_k = 1 / sqrt(D_kk), D = Gn A^-1 Gn^T (s_k^2 is the effective
   // mass at contact k), the unknowns are lambda_k = s_k lambda'_k,
@@ -511,11 +535,10 @@ std::size_t resolve_step_collisions(Floes& floes, std::span<const FloeState> sta
   // The solves below may be redone from W^-: only the impulses finally
   // applied are recorded, at the end.
   ImpulseRecord* record = std::exchange(opt.record, nullptr);
-  std::vector<ContactPoint> contacts = detection.contacts;
   // Jams: contact components (dynamic floes joined by contact points) of at
   // least opt.jam.floes floes.
   Components jam;
-  for (const ContactPoint& c : contacts)
+  for (const ContactPoint& c : detection.contacts)
     if (!floes.is_static[c.a] && !floes.is_static[c.b]) jam.join(jam.node(c.a), jam.node(c.b));
   std::vector<std::uint32_t> jam_size(jam.size(), 0);
   for (const auto& [f, local] : jam.local) ++jam_size[jam.find(local)];
@@ -525,16 +548,25 @@ std::size_t resolve_step_collisions(Floes& floes, std::span<const FloeState> sta
     return it != jam.local.end() && jam_size[jam.find(it->second)] >= opt.jam.floes;
   };
   auto jammed = [&](std::uint32_t a, std::uint32_t b) { return in_jam(a) || in_jam(b); };
-  std::vector<std::uint8_t> resting(contacts.size(), 0);
-  for (std::size_t k = 0; k < contacts.size(); ++k) {
-    const ContactPoint& c = contacts[k];
+  // The contacts solved here (a jam's are left to its time step unless
+  // jam.at_step_start) and where each came from in detection.contacts.
+  std::vector<ContactPoint> contacts;
+  std::vector<std::size_t> from;
+  std::vector<std::uint8_t> resting;
+  for (std::size_t k = 0; k < detection.contacts.size(); ++k) {
+    const ContactPoint& c = detection.contacts[k];
+    if (!opt.jam.at_step_start && jammed(c.a, c.b)) continue;
+    contacts.push_back(c);
+    from.push_back(k);
     const Vec2 pb = c.point - c.shift;  // in b's own image
-    resting[k] = jammed(c.a, c.b) || made_by_step(approach(floes, floes.state, c.a, c.b, c.point, pb, c.normal),
+    resting.push_back(jammed(c.a, c.b) || made_by_step(approach(floes, floes.state, c.a, c.b, c.point, pb, c.normal),
                                                   approach(floes, start, c.a, c.b, c.point, pb, c.normal),
                                                   smooth_kick(floes, start, floes.state, c.a, c.b, c.point, pb),
-                                                  opt.rest_speed);
+                                                  opt.rest_speed));
   }
-  // In a jam every point beyond xi is speculative from the start.
+  const std::size_t detected = contacts.size();
+  // In a jam every point beyond xi is speculative from the start (or left,
+  // with the jam's contacts, to its time step).
   std::vector<std::uint8_t> taken(detection.witnesses.size(), 0);
   std::size_t added = 0;
   for (const NearPair& p : detection.pairs) {
@@ -543,6 +575,7 @@ std::size_t resolve_step_collisions(Floes& floes, std::span<const FloeState> sta
       const Witness& w = detection.witnesses[k];
       if (w.distance < xi) continue;
       taken[k] = 1;
+      if (!opt.jam.at_step_start) continue;
       contacts.push_back({p.a, p.b, 0.5 * (w.pa + w.pb), w.normal, w.distance, p.shift, true, w.vertex_of_b});
       resting.push_back(1);
       ++added;
@@ -607,8 +640,8 @@ std::size_t resolve_step_collisions(Floes& floes, std::span<const FloeState> sta
   // step's smooth forces: a physical speed, not one the step's length made.
   if (record) record_impulses(*record, floes, contacts, total, slow_contacts(floes, contacts, opt.rest_speed, start));
   if (impulses) {
-    total.resize(detection.contacts.size());
-    *impulses = std::move(total);
+    impulses->assign(detection.contacts.size(), ContactImpulse{});
+    for (std::size_t j = 0; j < detected; ++j) (*impulses)[from[j]] = total[j];
   }
   return added;
 }

@@ -78,7 +78,9 @@
 //    other jam floes, obstacles, or floes coming at it) is speculative from
 //    the first solve: the jam is time-stepped (one LCP per step, as in dense
 //    granular flows, where event-driven collisions collapse into ever shorter
-//    sub-steps). Floes jammed by the wind against an obstacle touch each other
+//    sub-steps). That LCP is solved in the jam's time step
+//    (advance_with_collisions, substep.hpp), from W^-: this function leaves
+//    the jam's contacts and points alone (unless jam.at_step_start). Floes jammed by the wind against an obstacle touch each other
 //    all the time, and would otherwise need an event, and an LCP of the whole
 //    jam, each time one pair among hundreds closed a gap; a floe that drifts
 //    into a jam is stopped within the last step before it touches (at most
@@ -103,11 +105,14 @@ namespace floesim::contact {
 
 // Warm starts of large LCPs (LemkeOptions::start, lemke.hpp): Lemke's final
 // complementary basis for each large component, per contact point (which of
-// lambda, beta+, beta-, alpha were basic), keyed by its pair of floes and the
-// point in floe a's body frame (jammed floes hardly move, so a point keeps
-// its place from one step to the next). A contact of a large LCP takes the
-// flags of the nearest stored point of its pair within `match_distance`; a
-// point with none starts with its w's basic. Lemke then starts from that
+// lambda, beta+, beta-, alpha were basic), keyed by its pair of floes and its
+// features: the vertex, in the body frame of the floe it belongs to, and the
+// normal, in the body frame of the floe whose boundary the vertex faces
+// (vertex_of_b says which). Both stay put while the floes move and the
+// contact's mid-point slides along the edge. A contact of a large LCP takes
+// the flags of the nearest stored point of its pair with the same vertex
+// (within `match_distance`) and normal (within about 0.1 rad); a point with
+// none starts with its w's basic. Lemke then starts from that
 // basis. A wrong guess costs only time: the answer is accepted only with a
 // residual within the fallback chain's accept_residual, and otherwise the
 // LCP is solved from scratch by the chain (counted in warm_missed).
@@ -119,6 +124,7 @@ struct WarmStart {
     Vec2 body_point = Vec2::Zero();
     Vec2 body_normal = Vec2::UnitX();
     std::array<std::uint8_t, 4> basic{};  // lambda, beta+, beta-, alpha basic
+    bool vertex_of_b = false;             // body_point is b's vertex in b's frame, body_normal in a's (else the other way)
   };
   struct Pair {
     std::vector<Entry> entries;
@@ -285,6 +291,14 @@ struct CollisionStats {
   long warm = 0;          // of lcps, solved by Lemke warm-started from the last basis
   long warm_missed = 0;   // warm starts that ended without an accepted solution (then solved from scratch)
 };
+
+// The normal relative velocity (m/s, > 0: separating) contact c must reach
+// in its LCP (above): 0, the gap stabilisation's, a speculative contact's
+// allowed closing, plus its turning over options.speculative_step.
+double normal_target(const ContactPoint& c, const ImpulseOptions& options);
+// How far the contact's normal relative velocity, with the floes' present
+// velocities, is below its target (m/s; <= 0: met).
+double target_shortfall(const Floes& floes, const ContactPoint& c, const ImpulseOptions& options);
 
 // Changes the velocities of the floes in contact (W^- -> W^+). Returns the
 // impulses, one per contact, in the order of `contacts`. `resting` (optional,

@@ -18,6 +18,15 @@ namespace floesim::contact {
 struct JamOptions {
   // A contact component of at least this many dynamic floes is a jam.
   std::size_t floes = 20;
+  // Where a jam's LCP is solved. false: only in its time step
+  // (advance_with_collisions, substep.hpp), which starts from the
+  // velocities before any collision of the step; resolve_step_collisions
+  // leaves the jam's contacts and speculative points alone, and the
+  // sub-stepper time-steps every jam from the step's start. true: also at
+  // the start of the step (resolve_step_collisions), after which the time
+  // step solves it again from those velocities, a second LCP of the whole
+  // jam per step that mostly confirms the first.
+  bool at_step_start = false;
   // Dynamic floes whose room to a jam-sized cluster is below pad * xi (10 m
   // at xi = 1 cm) join it at the start of the step: a jam's time steps move
   // its floes 0.5 to 3 m off their straight paths (jam_500), beyond the

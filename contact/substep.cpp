@@ -189,6 +189,12 @@ private:
     find_jams();
     for (std::uint32_t i = 0; i < n; ++i)
       if (jam_of_[i] >= 0) sets.join(i, jams_[static_cast<std::size_t>(jam_of_[i])].front());
+    // A jam whose LCP was not solved at the start of the step (jam.hpp,
+    // at_step_start) is time-stepped whatever its rooms: its time step is
+    // where its contacts are resolved.
+    if (!opt_.impulse.jam.at_step_start)
+      for (std::uint32_t i = 0; i < n; ++i)
+        if (jam_of_[i] >= 0) hot[i] = 1;
     // A cluster of jam.floes floes or more takes time steps, whose LCP turns
     // and speeds up its floes: their deviations from the straight paths
     // outgrow small budgets. The dynamic floes close to such a cluster (room
@@ -311,6 +317,11 @@ private:
   }
   void restore(Cluster& c) {
     for (std::size_t m = 0; m < c.snap.size(); ++m) floes_.state[c.members[m]] = c.snap[m];
+  }
+
+  // The speculative contact of witness w of pair q (impulse.hpp).
+  static ContactPoint speculative(const NearPair& q, const Witness& w) {
+    return {q.a, q.b, 0.5 * (w.pa + w.pb), w.normal, w.distance, q.shift, true, w.vertex_of_b};
   }
 
   // One event of cluster k: a sub-step, or floes joining it at its time.
@@ -438,11 +449,19 @@ private:
       const NearPair& q = det_->pairs[c.internal[i]];
       ranges[i] = exact_range(floes_, shapes_, q.a, q.b, dt_, xi);
     }
+    std::vector<ContactPoint> contacts = c.cur.contacts;
+    for (const NearPair& q : wit->pairs)
+      for (const Witness& w : witnesses_of(q, wit->witnesses))
+        if (w.distance >= xi) contacts.push_back(speculative(q, w));
+    // A contact whose target grew (its turning) or that joined (a wider
+    // witness) needs the LCP solved again only if the answer no longer solves
+    // it: if it took an impulse, or if its target is not met by the present
+    // velocities (by more than approach_tolerance, below which a contact is
+    // not solved at all, impulse.hpp). Otherwise the answer is the new LCP's
+    // too: that contact's impulse is 0, its velocity meets its target, and no
+    // other row changed.
+    const double tolerance = opt_.impulse.approach_tolerance;
     for (int round = 0;; ++round) {
-      std::vector<ContactPoint> contacts = c.cur.contacts;
-      for (const NearPair& q : wit->pairs)
-        for (const Witness& w : witnesses_of(q, wit->witnesses))
-          if (w.distance >= xi) contacts.push_back({q.a, q.b, 0.5 * (w.pa + w.pb), w.normal, w.distance, q.shift, true, w.vertex_of_b});
       const std::vector<std::uint8_t> resting(contacts.size(), 1);
       // The LCP sees each contact's gap after h as linear; the floes' turning
       // closes some further (turning_closing, step_limit.hpp), which depends
@@ -453,17 +472,18 @@ private:
       // hardly changes with the small velocity changes it asks for). The
       // turning kept is the largest seen, so the rounds end.
       for (int turn = 0;; ++turn) {
-        resolve_collisions(floes_, contacts, impulse, stats_, resting);
+        const std::vector<ContactImpulse> impulses = resolve_collisions(floes_, contacts, impulse, stats_, resting);
         if (turn == opt_.impulse.jam.turning_rounds) break;
-        bool grew = false;
-        for (ContactPoint& cp : contacts) {
+        bool again = false;
+        for (std::size_t k = 0; k < contacts.size(); ++k) {
+          ContactPoint& cp = contacts[k];
           const double closing = turning_closing(floes_, cp, h);
           if (closing > cp.turning + opt_.impulse.jam.turning_slack * xi) {
             cp.turning = closing;
-            grew = true;
+            again = again || impulses[k].normal > 0.0 || target_shortfall(floes_, cp, impulse) > tolerance;
           }
         }
-        if (!grew) break;
+        if (!again) break;
         for (std::size_t m = 0; m < before.size(); ++m) floes_.state[c.members[m]] = before[m];
         rewind();
       }
@@ -484,14 +504,29 @@ private:
       into.pairs.clear();
       into.contacts.clear();
       into.witnesses.clear();
-      bool more = false;
+      bool unmet = false;
+      const std::size_t known = contacts.size();
       for (std::size_t i = 0; i < c.internal.size(); ++i) {
         const NearPair& q = det_->pairs[c.internal[i]];
         into.pairs.push_back(measure_pair(posed_, q.a, q.b, q.shift, xi, ranges[i], into.contacts, into.witnesses));
-        more = more || i >= wit->pairs.size() || into.pairs.back().witness_count > wit->pairs[i].witness_count;
+        // The pair's new witnesses beyond xi: those the last measure (at the
+        // same poses, within a smaller range) did not find.
+        const std::span<const Witness> old =
+            i < wit->pairs.size() ? witnesses_of(wit->pairs[i], wit->witnesses) : std::span<const Witness>{};
+        for (const Witness& w : witnesses_of(into.pairs.back(), into.witnesses)) {
+          if (w.distance < xi) continue;
+          const bool seen = std::any_of(old.begin(), old.end(), [&](const Witness& o) {
+            return o.vertex_of_b == w.vertex_of_b && o.pa == w.pa && o.pb == w.pb;
+          });
+          if (seen) continue;
+          ContactPoint cp = speculative(q, w);
+          cp.turning = turning_closing(floes_, cp, h);
+          unmet = unmet || target_shortfall(floes_, cp, impulse) > tolerance;
+          contacts.push_back(cp);
+        }
       }
-      if (!more) break;
       wit = &into;
+      if (contacts.size() == known || !unmet) break;
       for (std::size_t m = 0; m < before.size(); ++m) floes_.state[c.members[m]] = before[m];
       rewind();
       ++report_.rejected;
@@ -518,8 +553,17 @@ private:
       undo();
       for (std::uint32_t i : c.members) posed_.update(floes_, i);
       c.jam_h = 0.5 * h;
-      if (c.jam_h < opt_.impulse.jam.step_floor * dt_) c.events_only = true;
       ++report_.rejected;
+      if (c.jam_h < opt_.impulse.jam.step_floor * dt_) {
+        c.events_only = true;
+        // Events resolve collisions at the end of their sub-steps; a jam
+        // that took no time step yet has its contacts unresolved (jam.hpp,
+        // at_step_start): they are an event now.
+        if (c.tau == 0.0 && !opt_.impulse.jam.at_step_start && !c.cur.contacts.empty()) {
+          collide(c.cur.contacts);
+          snapshot(c);
+        }
+      }
       return;
     }
     c.tau = t1;

@@ -5,7 +5,7 @@
 //
 // Contract. On entry the floes are at time t with the velocities they keep
 // over the step (drift done, and the collisions of the contacts found at t
-// resolved: W(t+)); `detection` was measured at these positions, with the
+// resolved: W(t+), except a jam's, item 5); `detection` was measured at these positions, with the
 // reach of each floe (detection.hpp). On exit the positions are at t + dt (not
 // wrapped into a periodic box) and velocities carry the collisions of the
 // step; every pair the sub-steps measured ended each sub-step apart, and
@@ -39,6 +39,13 @@
 //     merges the two clusters, which rerun from the start of the step.
 //  4. A floe whose linear travel exceeds its reach before the step makes the
 //     pair list be rebuilt (once) with a larger reach.
+//  5. A jam (jam.hpp) is a cluster from the step's start, whatever its
+//     rooms, and takes time steps: one LCP for the rest of the step, its
+//     contacts resting and its witnesses beyond xi speculative. Its velocities
+//     on entry are W^- (resolve_step_collisions leaves jams alone). The LCP is
+//     solved again only when its answer stops being one: a contact whose
+//     turning grew, or a witness that a wider range found, took an impulse or
+//     is not met by the answer's velocities.
 // With no collision in sight this is one step for every floe; the cost of a
 // collision is the cost of its cluster's sub-steps, not of the whole pack's.
 

@@ -103,7 +103,7 @@ void write_checkpoint_group(hid_t file, const std::string& name, const Checkpoin
     ints(s, "keys", keys);
     ints(s, "stored", w.stored);
     ints(s, "offsets", w.offsets);
-    doubles(s, "entries", w.entries, 8);
+    doubles(s, "entries", w.entries, WarmStartState::kWidth);
   }
   doubles(g, "counters", c.counters);
   h5::Handle counters = h5::open_dataset(g, "counters", "");
@@ -257,8 +257,21 @@ Checkpoint read_checkpoint(const std::string& path) {
     w.stored = r.ints(s, "stored");
     w.offsets = r.ints(s, "offsets");
     w.entries = r.doubles(s, "entries");
+    // Files written before the vertex_of_b column (8 numbers an entry) get
+    // it as 0; their points were contact mid-points, so those warm starts
+    // mostly find nothing and the LCPs start from scratch.
+    if (!w.offsets.empty() && w.offsets.back() > 0 &&
+        static_cast<std::size_t>(w.offsets.back()) * 8 == w.entries.size()) {
+      std::vector<double> wide;
+      for (std::size_t e = 0; e < w.entries.size(); e += 8) {
+        wide.insert(wide.end(), w.entries.begin() + static_cast<std::ptrdiff_t>(e),
+                    w.entries.begin() + static_cast<std::ptrdiff_t>(e + 8));
+        wide.push_back(0.0);
+      }
+      w.entries = std::move(wide);
+    }
     if (w.stored.size() != keys.size() || w.offsets.size() != keys.size() + 1 || w.offsets.front() != 0 ||
-        static_cast<std::size_t>(w.offsets.back()) * 8 != w.entries.size())
+        static_cast<std::size_t>(w.offsets.back()) * WarmStartState::kWidth != w.entries.size())
       r.fail("warm_start: keys, stored, offsets and entries do not agree");
     for (std::size_t k = 1; k < w.offsets.size(); ++k)
       if (w.offsets[k] < w.offsets[k - 1]) r.fail("warm_start/offsets: expected non-decreasing offsets");

@@ -63,9 +63,11 @@ struct FloeSeaState {
 };
 
 // The jam LCPs' warm starts (contact::WarmStart): per floe pair (key), the
-// step clock when stored and its entries, each 8 numbers: body point (2),
-// body normal (2), the 4 basic flags (0 or 1).
+// step clock when stored and its entries, each kWidth numbers: body point (2,
+// the contact's vertex), body normal (2), the 4 basic flags (0 or 1),
+// vertex_of_b (0 or 1).
 struct WarmStartState {
+  static constexpr std::size_t kWidth = 9;
   long long clock = 0;
   std::vector<std::uint64_t> keys;
   std::vector<long long> stored;

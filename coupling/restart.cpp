@@ -34,8 +34,9 @@ WarmStartState save_warm(const contact::WarmStart& w) {
     for (const contact::WarmStart::Entry& e : p.entries) {
       s.entries.insert(s.entries.end(), {e.body_point.x(), e.body_point.y(), e.body_normal.x(), e.body_normal.y()});
       for (std::uint8_t b : e.basic) s.entries.push_back(b);
+      s.entries.push_back(e.vertex_of_b ? 1.0 : 0.0);
     }
-    s.offsets.push_back(static_cast<long long>(s.entries.size() / 8));
+    s.offsets.push_back(static_cast<long long>(s.entries.size() / WarmStartState::kWidth));
   }
   return s;
 }
@@ -47,11 +48,12 @@ void restore_warm(const WarmStartState& s, contact::WarmStart& w) {
     contact::WarmStart::Pair p;
     p.stored = s.stored[k];
     for (auto e = static_cast<std::size_t>(s.offsets[k]); e < static_cast<std::size_t>(s.offsets[k + 1]); ++e) {
-      const double* x = &s.entries[8 * e];
+      const double* x = &s.entries[WarmStartState::kWidth * e];
       contact::WarmStart::Entry entry;
       entry.body_point = Vec2{x[0], x[1]};
       entry.body_normal = Vec2{x[2], x[3]};
       for (int b = 0; b < 4; ++b) entry.basic[static_cast<std::size_t>(b)] = x[4 + b] != 0.0 ? 1 : 0;
+      entry.vertex_of_b = x[8] != 0.0;
       p.entries.push_back(entry);
     }
     w.pairs.emplace(s.keys[k], std::move(p));
