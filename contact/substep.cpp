@@ -475,12 +475,12 @@ private:
         const std::vector<ContactImpulse> impulses = resolve_collisions(floes_, contacts, impulse, stats_, resting);
         if (turn == opt_.impulse.jam.turning_rounds) break;
         bool again = false;
-        for (std::size_t k = 0; k < contacts.size(); ++k) {
-          ContactPoint& cp = contacts[k];
+        for (std::size_t j = 0; j < contacts.size(); ++j) {
+          ContactPoint& cp = contacts[j];
           const double closing = turning_closing(floes_, cp, h);
           if (closing > cp.turning + opt_.impulse.jam.turning_slack * xi) {
             cp.turning = closing;
-            again = again || impulses[k].normal > 0.0 || target_shortfall(floes_, cp, impulse) > tolerance;
+            again = again || impulses[j].normal > 0.0 || target_shortfall(floes_, cp, impulse) > tolerance;
           }
         }
         if (!again) break;
