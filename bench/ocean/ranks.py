@@ -17,14 +17,14 @@ usage: bench/ocean/ranks.py [--build build] [--until 10] [--ranks 0 1 2] [--roun
 """
 import argparse
 import os
-import platform
 import subprocess
 import sys
 import tempfile
-import time
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
+sys.path.insert(0, os.path.join(ROOT, "scripts", "scenarios"))
+import ranks_bench  # noqa: E402  (the timing shared with bench/mpi_pack.py)
 
 ap = argparse.ArgumentParser()
 ap.add_argument("--build", default=os.path.join(ROOT, "build"))
@@ -36,7 +36,6 @@ ap.add_argument("--note", default="")
 args = ap.parse_args()
 
 floesim = os.path.join(args.build, "bin", "floesim")
-env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1", OMP_NUM_THREADS="1")
 work = tempfile.mkdtemp(prefix="floesim_ocean_ranks_")
 pack = os.path.join(HERE, "ocean_pack.h5")
 subprocess.run([floesim, "pack", "--floes", "1000", "--concentration", "0.3", "--box", "1000", "1000", "--seed", "1",
@@ -47,32 +46,15 @@ with open(os.path.join(HERE, "ocean.toml")) as f, open(config, "w") as g:
     for line in f:
         g.write(f'pack = "{pack}"\n' if line.startswith("pack = ") else line)
 
-
-def load():
-    with open("/proc/loadavg") as f:
-        return " ".join(f.read().split()[:3])
-
-
 reference = None
 
 
 def one(ranks, label):
+    """One run, and whether its file equals the first run's bit for bit."""
     global reference
     out_file = os.path.join(work, f"{label}.h5")
-    cmd = ["/usr/bin/time", "-f", "cpu_s: %U %S", floesim, "run", config, "--until", str(args.until), "-o", out_file,
-           "-q", "--threads", "1", "--profile"]
-    if ranks > 0:
-        cmd = ["mpirun", "--oversubscribe", "-np", str(ranks)] + cmd
-    p = subprocess.run(cmd, capture_output=True, text=True, env=env, cwd=work)
-    if p.returncode != 0:
-        sys.exit(f"{' '.join(cmd)}: exit {p.returncode}\n{p.stderr}")
-    out = {}
-    for line in p.stdout.splitlines():
-        if ": " in line:
-            k, v = line.split(": ", 1)
-            out[k.strip()] = v.split()[0]
-    cpu = [sum(map(float, l.split()[1:3])) for l in p.stderr.splitlines() if l.startswith("cpu_s: ")]
-    out["cpu_s"] = " ".join(f"{c:.2f}" for c in cpu)
+    out = ranks_bench.timed(floesim, config, out_file, ranks, work, extra=("--until", str(args.until)))
+    out["cpu_s"] = " ".join(f"{c:.2f}" for c in out["cpu"])
     if reference is None:
         reference = out_file
         out["equal"] = "reference"
@@ -85,7 +67,7 @@ def one(ranks, label):
 
 phases = ["penalty", "sea", "drift", "detect", "advance", "collide", "record"]
 rows = []
-load_before = load()
+load_before = ranks_bench.load()
 for r in range(args.rounds):
     for ranks in args.ranks:
         s = one(ranks, f"r{ranks}_{r}")
@@ -93,30 +75,13 @@ for r in range(args.rounds):
         rows.append([str(ranks), str(r), s["wall_time"], s["steps"], s.get("parallel.collectives", "0"),
                      s.get("parallel.bytes_received", "0"), s.get("parallel.collective_seconds", "0"), s["cpu_s"],
                      s["equal"]] + [s.get("profile." + ph, "") for ph in phases])
-load_after = load()
-
-commit = subprocess.run(["git", "-C", ROOT, "rev-parse", "--short", "HEAD"], capture_output=True, text=True).stdout.strip()
-lines = [f"# command: bench/ocean/ranks.py {' '.join(sys.argv[1:])}",
-         f"# commit: {commit} (Release build){'; ' + args.note if args.note else ''}",
-         f"# machine: {platform.processor() or platform.machine()}, {os.cpu_count()} cores (shared); "
-         f"load before {load_before}, after {load_after}; {time.strftime('%Y-%m-%d %H:%M', time.gmtime())} UTC",
-         f"# scenario: bench/ocean/ocean.toml (1000 floes, 512^2 spectral sea, K = 100) to {args.until} s; ranks 0 = "
-         "the binary without mpirun; one thread per rank; wall_s = the run loop (summary wall_time); collectives, "
-         "bytes_received, collective_s: rank 0's over the run (transfers and waits for the other ranks); cpu_s: CPU "
-         "time (user + system) of each process, set-up (about 0.3 s) included, waits that yield the core included; "
-         "equal: the run file equals the first run's bit for bit; phases: rank 0's profile (s), waits included"]
-best = {}
-for row in rows:
-    best[row[0]] = min(best.get(row[0], float("inf")), float(row[2]))
-ref = best.get("1") or best.get("0")
-for k in sorted(best):
-    lines.append(f"# least wall_s on {k} rank(s): {best[k]:.3f} s" +
-                 (f" (speed-up over 1 rank: {ref / best[k]:.2f}x)" if ref and k not in ("0", "1") else ""))
-lines.append("ranks,round,wall_s,steps,collectives,bytes_received,collective_s,cpu_s,equal," +
-             ",".join(p + "_s" for p in phases))
-lines += [",".join(r) for r in rows]
-text = "\n".join(lines) + "\n"
-if args.csv != "-":
-    with open(args.csv, "w") as f:
-        f.write(text)
-sys.stdout.write(text)
+ranks_bench.write_table(
+    args.csv, f"bench/ocean/ranks.py {' '.join(sys.argv[1:])}", args.note,
+    f"bench/ocean/ocean.toml (1000 floes, 512^2 spectral sea, K = 100) to {args.until} s; ranks 0 = "
+    "the binary without mpirun; one thread per rank; wall_s = the run loop (summary wall_time); collectives, "
+    "bytes_received, collective_s: rank 0's over the run (transfers and waits for the other ranks); cpu_s: CPU "
+    "time (user + system) of each process, set-up (about 0.3 s) included, waits that yield the core included; "
+    "equal: the run file equals the first run's bit for bit; phases: rank 0's profile (s), waits included",
+    load_before, ranks_bench.load(),
+    "ranks,round,wall_s,steps,collectives,bytes_received,collective_s,cpu_s,equal," +
+    ",".join(p + "_s" for p in phases), rows)

@@ -19,8 +19,9 @@ said once.
 """
 import argparse
 import os
-import subprocess
 import sys
+
+from ranks_harness import Ranks, need
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))),
                                 "scripts", "scenarios"))
@@ -42,25 +43,10 @@ ap.add_argument("--errors", action=argparse.BooleanOptionalAction, default=True)
 ap.add_argument("--also", nargs="*", default=[], help="other configurations to check on 2 ranks (e.g. with a sea)")
 args = ap.parse_args()
 
-os.makedirs(args.workdir, exist_ok=True)
 W = args.workdir
 failures = []
-# mpirun as root (CI containers) must be allowed explicitly; one thread per rank.
-ENV = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1", OMP_NUM_THREADS="1")
-
-
-def run(cmd, timeout=600):
-    return subprocess.run(cmd, cwd=W, capture_output=True, text=True, timeout=timeout, env=ENV)
-
-
-def mpirun(n, *floesim_args):
-    return run([args.mpiexec, "--oversubscribe", "-np", str(n), args.floesim, *floesim_args])
-
-
-def need(p, what):
-    if p.returncode != 0:
-        sys.exit(f"FAILED: {what}: exit {p.returncode}\n{p.stdout}\n{p.stderr}")
-    return p
+harness = Ranks(args.floesim, args.mpiexec, W)
+run, mpirun = harness.run, harness.mpirun
 
 
 try:

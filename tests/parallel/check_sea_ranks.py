@@ -23,8 +23,9 @@ ranks and serially, both equal to the serial run.
 """
 import argparse
 import os
-import subprocess
 import sys
+
+from ranks_harness import Ranks, need
 
 if "--no-mpi" in sys.argv:
     print("floesim was built without MPI (FLOESIM_MPI=OFF): the distributed sea runs are not checked")
@@ -38,24 +39,10 @@ ap.add_argument("--ranks", type=int, nargs="+", default=[1, 2, 3])
 ap.add_argument("--t-end", type=float, default=2.0)
 args = ap.parse_args()
 
-os.makedirs(args.workdir, exist_ok=True)
 W = args.workdir
-ENV = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1", OMP_NUM_THREADS="1")
 failures = []
-
-
-def run(cmd, timeout=600):
-    return subprocess.run(cmd, cwd=W, capture_output=True, text=True, timeout=timeout, env=ENV)
-
-
-def mpirun(n, *floesim_args):
-    return run([args.mpiexec, "--oversubscribe", "-np", str(n), args.floesim, *floesim_args])
-
-
-def need(p, what):
-    if p.returncode != 0:
-        sys.exit(f"FAILED: {what}: exit {p.returncode}\n{p.stdout}\n{p.stderr}")
-    return p
+harness = Ranks(args.floesim, args.mpiexec, W)
+run, mpirun = harness.run, harness.mpirun
 
 
 def same(a, b):

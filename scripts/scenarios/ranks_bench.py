@@ -1,0 +1,69 @@
+"""Timing floesim serially and on several ranks, for the benches that compare
+them (bench/mpi_pack.py, bench/ocean/ranks.py).
+
+`timed(...)` runs `floesim run CONFIG ... --threads 1 --profile`, under
+`mpirun --oversubscribe -np R` when R > 0 (R = 0: the binary alone), each
+process under /usr/bin/time, and returns the run's summary lines as a dict
+(wall_time, steps, profile.*, parallel.*) with "cpu" the CPU seconds (user +
+system) of each process. `write_table(...)` writes a bench's CSV: comment
+lines (command, commit, machine and its load, the scenario), the least wall
+time per rank count with the speed-up over one rank, then the rows.
+"""
+import os
+import platform
+import subprocess
+import sys
+import time
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+# mpirun as root (CI containers) must be allowed explicitly; one thread per rank.
+ENV = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1", OMP_NUM_THREADS="1")
+
+
+def load():
+    """The machine's load averages (1, 5, 15 min) as text."""
+    with open("/proc/loadavg") as f:
+        return " ".join(f.read().split()[:3])
+
+
+def timed(floesim, config, out_file, ranks, cwd, extra=()):
+    cmd = ["/usr/bin/time", "-f", "cpu_s: %U %S", floesim, "run", config, *extra, "-o", out_file,
+           "-q", "--threads", "1", "--profile"]
+    if ranks > 0:
+        cmd = ["mpirun", "--oversubscribe", "-np", str(ranks)] + cmd
+    p = subprocess.run(cmd, capture_output=True, text=True, env=ENV, cwd=cwd)
+    if p.returncode != 0:
+        sys.exit(f"{' '.join(cmd)}: exit {p.returncode}\n{p.stderr}")
+    out = {}
+    for line in p.stdout.splitlines():
+        if ": " in line:
+            k, v = line.split(": ", 1)
+            out[k.strip()] = v.split()[0]
+    out["cpu"] = [sum(map(float, l.split()[1:3])) for l in p.stderr.splitlines() if l.startswith("cpu_s: ")]
+    return out
+
+
+def write_table(path, command, note, scenario, load_before, load_after, header, rows):
+    """The CSV text (also printed); rows' first column is the rank count, the third the wall time."""
+    commit = subprocess.run(["git", "-C", ROOT, "rev-parse", "--short", "HEAD"], capture_output=True,
+                            text=True).stdout.strip()
+    lines = [f"# command: {command}",
+             f"# commit: {commit} (Release build){'; ' + note if note else ''}",
+             f"# machine: {platform.processor() or platform.machine()}, {os.cpu_count()} cores (shared); "
+             f"load before {load_before}, after {load_after}; {time.strftime('%Y-%m-%d %H:%M', time.gmtime())} UTC",
+             f"# scenario: {scenario}"]
+    best = {}
+    for row in rows:
+        best[row[0]] = min(best.get(row[0], float("inf")), float(row[2]))
+    ref = best.get("1") or best.get("0")
+    for k in sorted(best):
+        lines.append(f"# least wall_s on {k} rank(s): {best[k]:.3f} s" +
+                     (f" (speed-up over 1 rank: {ref / best[k]:.2f}x)" if ref and k not in ("0", "1") else ""))
+    lines.append(header)
+    lines += [",".join(r) for r in rows]
+    text = "\n".join(lines) + "\n"
+    if path != "-":
+        with open(path, "w") as f:
+            f.write(text)
+    sys.stdout.write(text)
+    return text
