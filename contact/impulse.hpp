@@ -80,7 +80,8 @@
 //    granular flows, where event-driven collisions collapse into ever shorter
 //    sub-steps). That LCP is solved in the jam's time step
 //    (advance_with_collisions, substep.hpp), from W^-: this function leaves
-//    the jam's contacts and points alone (unless jam.at_step_start). Floes jammed by the wind against an obstacle touch each other
+//    the jam's contacts and points alone (unless jam.at_step_start). Floes
+//    jammed by the wind against an obstacle touch each other
 //    all the time, and would otherwise need an event, and an LCP of the whole
 //    jam, each time one pair among hundreds closed a gap; a floe that drifts
 //    into a jam is stopped within the last step before it touches (at most
