@@ -1,5 +1,7 @@
 #include "contact/fracture/floe_fracture.hpp"
 
+#include <limits>
+
 namespace floesim::fracture {
 
 MeshOptions mesh_options(const FractureParams& p) {
@@ -30,19 +32,21 @@ FloeFracture::FloeFracture(std::span<const Vec2> polygon, double thickness, doub
       responder_(model_, response_options(params, thickness)),
       criterion_(criterion_options(params)) {}
 
-FloeFracture::Result FloeFracture::analyse(std::span<const PointLoad> loads, const Observer& observe) {
+FloeFracture::Result FloeFracture::judged(std::span<const PointLoad> loads, const Observer& observe, double level) {
   Result r;
-  r.response = responder_.respond(loads, observe);
+  r.response = responder_.respond(loads, observe, level);
   r.initiation = judge(responder_, r.response, polygon_, criterion_);
   return r;
 }
 
+FloeFracture::Result FloeFracture::analyse(std::span<const PointLoad> loads, const Observer& observe) {
+  return judged(loads, observe, -std::numeric_limits<double>::infinity());
+}
+
 FloeFracture::Result FloeFracture::decide(std::span<const PointLoad> loads) {
-  if (criterion_.criterion != Criterion::stress) return analyse(loads);
-  Result r;
-  r.response = responder_.respond(loads, {}, criterion_.strength);
-  r.initiation = judge(responder_, r.response, polygon_, criterion_);
-  return r;
+  // Griffith's criterion judges the energy peak of the whole response: no level stops it.
+  const bool stress = criterion_.criterion == Criterion::stress;
+  return judged(loads, {}, stress ? criterion_.strength : -std::numeric_limits<double>::infinity());
 }
 
 }  // namespace floesim::fracture

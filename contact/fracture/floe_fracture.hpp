@@ -41,6 +41,9 @@ public:
   Result decide(std::span<const PointLoad> loads);
 
 private:
+  // The response up to `level` (respond's), judged.
+  Result judged(std::span<const PointLoad> loads, const Observer& observe, double level);
+
   std::vector<Vec2> polygon_;
   ElasticModel model_;
   Responder responder_;

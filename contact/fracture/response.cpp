@@ -17,6 +17,11 @@ double pulse_fraction(double t0, double t1, double tau) {
   return 0.5 * (std::cos(M_PI * t0 / tau) - std::cos(M_PI * t1 / tau));
 }
 
+// U = j^T M^-1 j / 2 (J): the energy the impulses j would give the lumped masses m at once.
+double blow_energy(const Eigen::VectorXd& j, const Eigen::VectorXd& m) {
+  return 0.5 * j.cwiseAbs2().cwiseQuotient(m).sum();
+}
+
 // Updates the response's peaks with the state u at time t; returns its strain energy (J).
 double observe_state(const ElasticModel& model, double t, const Eigen::VectorXd& u, Response& r) {
   const std::vector<Eigen::Vector3d> s = model.nodal_stress(u);
@@ -83,7 +88,7 @@ double Responder::stress_bound(std::span<const PointLoad> loads) {
   const bool dynamic = std::any_of(loads.begin(), loads.end(), [](const PointLoad& l) { return l.impulse; });
   if (dynamic) {
     const Eigen::VectorXd j = model_.relieve(nodal_loads(loads, true));
-    bound += stress_of_energy(0.5 * j.cwiseAbs2().cwiseQuotient(model_.lumped_mass()).sum());
+    bound += stress_of_energy(blow_energy(j, model_.lumped_mass()));
   }
   return bound;
 }
@@ -133,7 +138,7 @@ Response Responder::respond(std::span<const PointLoad> loads, const Observer& ob
   const double static_peak = r.peak_stress.max_principal;  // Pa, the static forces' largest nodal sigma_1
   const Eigen::VectorXd j = model_.relieve(nodal_loads(loads, true));
   const Eigen::VectorXd& m = model_.lumped_mass();
-  const double root_blow = std::sqrt(0.5 * j.cwiseAbs2().cwiseQuotient(m).sum());  // sqrt(U), sqrt(J)
+  const double root_blow = std::sqrt(blow_energy(j, m));  // sqrt(U), sqrt(J)
   const Eigen::SparseMatrix<double>& k = model_.stiffness();
   const double dt = dt_, tau = options_.duration;
   if (!dynamic_) {
