@@ -21,22 +21,24 @@ import unittest
 import numpy as np
 
 sys.path.insert(0, os.path.join(os.environ["FLOESIM_SOURCE_DIR"], "validation", "citeph"))
+import cases  # noqa: E402
 import citeph  # noqa: E402
+import measure  # noqa: E402
 
 
 class Pieces(unittest.TestCase):
     def test_wavenumber_solves_the_dispersion_relation(self):
         for period in (0.65, 1.25, 2.0):
-            k = citeph.wavenumber(period)
+            k = cases.wavenumber(period)
             omega = 2 * math.pi / period
-            lhs = (citeph.G * k + citeph.SIGMA * k ** 3 / citeph.RHO_WATER) * math.tanh(k * citeph.DEPTH)
+            lhs = (cases.G * k + cases.SIGMA * k ** 3 / cases.RHO_WATER) * math.tanh(k * cases.DEPTH)
             self.assertAlmostEqual(lhs / omega ** 2, 1.0, places=12)
 
     def test_fit_recovers_an_amplitude_on_a_drift(self):
         t = np.linspace(10.0, 25.0, 400)
         omega = 2 * math.pi / 1.5
         x = 0.013 * np.cos(omega * t + 0.7) + 0.02 * t - 1e-3 * t * t + 3.0
-        self.assertAlmostEqual(abs(citeph.fit_amplitude(t, x, omega)), 0.013, delta=1e-4)
+        self.assertAlmostEqual(abs(measure.fit_amplitude(t, x, omega)), 0.013, delta=1e-4)
 
     def test_response_of_a_drifting_disc(self):
         # A disc drifting at 0.1 m/s through a progressive wave heaves at 0.8
@@ -54,11 +56,11 @@ class Pieces(unittest.TestCase):
         series = dict(t=t.tolist(), x=(x + 0.9 * a0 * np.sin(phase)).tolist(),
                       heave=(0.8 * a0 * np.cos(phase + 0.3)).tolist(),
                       pitch=(0.7 * k * a0 * np.sin(phase)).tolist())
-        r = citeph.response(series, empty, 1.0, omega)
+        r = measure.response(series, empty, 1.0, omega)
         self.assertAlmostEqual(r["heave"], 0.8, delta=2e-3)
         self.assertAlmostEqual(r["pitch"] / k, 0.7, delta=2e-3)
         self.assertAlmostEqual(r["x"], 0.9, delta=2e-3)
-        fixed = abs(citeph.fit_amplitude(t, np.array(series["heave"]), omega)) / a0
+        fixed = abs(measure.fit_amplitude(t, np.array(series["heave"]), omega)) / a0
         self.assertLess(fixed, 0.7)
 
     def test_collision_episodes_group_the_rows_of_a_contact(self):
@@ -68,27 +70,27 @@ class Pieces(unittest.TestCase):
         # middle) once; 7 and 8 (neither) are left out.
         rows = [[1.0, 3, 4, 2.0, 0, 0, 0], [1.1, 3, 4, 0.5, 0, 0, 1], [1.2, 3, 4, 0.5, 0, 0, 1],
                 [2.0, 3, 4, 1.0, 0, 0, 0], [1.5, 4, 9, 0.7, 0, 0, 0], [1.5, 7, 8, 9.0, 0, 0, 0]]
-        times, impulses = citeph.collision_episodes(rows, [3, 4], 0.2)
+        times, impulses = measure.collision_episodes(rows, [3, 4], 0.2)
         self.assertEqual(sorted(zip(times, impulses)),
                          [(1.0, 3.0), (1.0, 3.0), (1.5, 0.7), (2.0, 1.0), (2.0, 1.0)])
 
     def test_lattices_reach_the_concentrations_without_overlap(self):
-        strip = (10.0, 10.0 + citeph.STRIP)
+        strip = (10.0, 10.0 + cases.STRIP)
         for target in (39, 79):
-            centres, c = citeph.lattice(target, strip)
+            centres, c = cases.lattice(target, strip)
             self.assertLess(abs(c - target), 2.0)
             p = np.array(centres)
             d = np.linalg.norm(p[:, None, :] - p[None, :, :], axis=2) + 1e9 * np.eye(len(p))
-            self.assertGreater(d.min(), citeph.DIAMETER)
-            r = citeph.DIAMETER / 2
-            self.assertTrue(np.all((p[:, 1] > r) & (p[:, 1] < citeph.WIDTH - r)))
+            self.assertGreater(d.min(), cases.DIAMETER)
+            r = cases.DIAMETER / 2
+            self.assertTrue(np.all((p[:, 1] > r) & (p[:, 1] < cases.WIDTH - r)))
             self.assertTrue(np.all((p[:, 0] > strip[0]) & (p[:, 0] < strip[1])))
 
 
 class Smoke(unittest.TestCase):
     def test_disc_and_array(self):
         with tempfile.TemporaryDirectory() as work:
-            results = citeph.run_all(work, citeph.RESOLUTIONS["smoke"], citeph.Physics(), 1,
+            results = citeph.run_all(work, cases.RESOLUTIONS["smoke"], cases.Physics(), 1,
                                      only="disc_T1.85_H40|array79_T2.00_H40|empty_T1.85|empty_T2.00")
             self.assertEqual(len(results), 4)
             for r in results:
@@ -109,10 +111,10 @@ class Smoke(unittest.TestCase):
         self.assertEqual({r["quantity"] for r in rows.values()}, quantities)
         self.assertEqual({r["concentration"] for r in rows.values()}, {"0", "39", "79"})
         model = {key: float(r["model"]) for key, r in rows.items() if r["model"]}
-        k = citeph.wavenumber(1.85)
+        k = cases.wavenumber(1.85)
         self.assertAlmostEqual(model[("disc_T1.85_H40", "heave_rao")], 1.0, delta=0.2)
         self.assertAlmostEqual(model[("disc_T1.85_H40", "pitch_rao")], 1.0, delta=0.3)
-        self.assertAlmostEqual(model[("disc_T1.85_H40", "surge_rao")], 1 / math.tanh(k * citeph.DEPTH), delta=0.3)
+        self.assertAlmostEqual(model[("disc_T1.85_H40", "surge_rao")], 1 / math.tanh(k * cases.DEPTH), delta=0.3)
         t = model[("array79_T2.00_H40", "transmission")]
         self.assertGreater(t, 0.0)
         self.assertLess(t, 1.1)
