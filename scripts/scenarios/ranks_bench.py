@@ -5,7 +5,8 @@ them (bench/mpi_pack.py, bench/ocean/ranks.py).
 `mpirun --oversubscribe -np R` when R > 0 (R = 0: the binary alone), each
 process under /usr/bin/time, and returns the run's summary lines as a dict
 (wall_time, steps, profile.*, parallel.*) with "cpu" the CPU seconds (user +
-system) of each process. `write_table(...)` writes a bench's CSV: comment
+system) of each process, "elapsed" their wall seconds (set-up included) and
+"rss_mb" their peak resident memory (MiB). `write_table(...)` writes a bench's CSV: comment
 lines (command, commit, machine and its load, the scenario), the least wall
 time per rank count with the speed-up over one rank, then the rows.
 """
@@ -27,7 +28,7 @@ def load():
 
 
 def timed(floesim, config, out_file, ranks, cwd, extra=()):
-    cmd = ["/usr/bin/time", "-f", "cpu_s: %U %S", floesim, "run", config, *extra, "-o", out_file,
+    cmd = ["/usr/bin/time", "-f", "cpu_s: %U %S %e %M", floesim, "run", config, *extra, "-o", out_file,
            "-q", "--threads", "1", "--profile"]
     if ranks > 0:
         cmd = ["mpirun", "--oversubscribe", "-np", str(ranks)] + cmd
@@ -39,7 +40,10 @@ def timed(floesim, config, out_file, ranks, cwd, extra=()):
         if ": " in line:
             k, v = line.split(": ", 1)
             out[k.strip()] = v.split()[0]
-    out["cpu"] = [sum(map(float, l.split()[1:3])) for l in p.stderr.splitlines() if l.startswith("cpu_s: ")]
+    processes = [l.split()[1:] for l in p.stderr.splitlines() if l.startswith("cpu_s: ")]
+    out["cpu"] = [float(u) + float(s) for u, s, _, _ in processes]
+    out["elapsed"] = [float(e) for _, _, e, _ in processes]
+    out["rss_mb"] = [int(m) / 1024.0 for _, _, _, m in processes]
     return out
 
 
