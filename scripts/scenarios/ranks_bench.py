@@ -12,8 +12,10 @@ time per rank count with the speed-up over one rank, then the rows.
 """
 import os
 import platform
+import shutil
 import subprocess
 import sys
+import tempfile
 import time
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
@@ -28,19 +30,29 @@ def load():
 
 
 def timed(floesim, config, out_file, ranks, cwd, extra=()):
-    cmd = ["/usr/bin/time", "-f", "cpu_s: %U %S %e %M", floesim, "run", config, *extra, "-o", out_file,
-           "-q", "--threads", "1", "--profile"]
+    # Each process writes its /usr/bin/time line to a file of its own (named
+    # by its rank): lines on stderr forwarded by mpirun can be lost at exit.
+    times = tempfile.mkdtemp(prefix="times_", dir=cwd)
+    run = [floesim, "run", config, *extra, "-o", out_file, "-q", "--threads", "1", "--profile"]
+    cmd = ["sh", "-c", '/usr/bin/time -o "$0/time.${OMPI_COMM_WORLD_RANK:-0}" -f "cpu_s: %U %S %e %M" "$@"',
+           times, *run]
     if ranks > 0:
         cmd = ["mpirun", "--oversubscribe", "-np", str(ranks)] + cmd
     p = subprocess.run(cmd, capture_output=True, text=True, env=ENV, cwd=cwd)
     if p.returncode != 0:
-        sys.exit(f"{' '.join(cmd)}: exit {p.returncode}\n{p.stderr}")
+        sys.exit(f"{' '.join(run)} on {ranks} rank(s): exit {p.returncode}\n{p.stderr}")
     out = {}
     for line in p.stdout.splitlines():
         if ": " in line:
             k, v = line.split(": ", 1)
             out[k.strip()] = v.split()[0]
-    processes = [l.split()[1:] for l in p.stderr.splitlines() if l.startswith("cpu_s: ")]
+    processes = []
+    for name in sorted(os.listdir(times), key=lambda n: int(n.split(".")[1])):
+        with open(os.path.join(times, name)) as f:
+            processes += [l.split()[1:] for l in f if l.startswith("cpu_s: ")]
+    shutil.rmtree(times)
+    if len(processes) != max(ranks, 1):
+        sys.exit(f"{' '.join(run)} on {ranks} rank(s): {len(processes)} timings of its processes")
     out["cpu"] = [float(u) + float(s) for u, s, _, _ in processes]
     out["elapsed"] = [float(e) for _, _, e, _ in processes]
     out["rss_mb"] = [int(m) / 1024.0 for _, _, _, m in processes]
