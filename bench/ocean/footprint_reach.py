@@ -28,6 +28,9 @@ import numpy as np
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
+sys.path.insert(0, os.path.join(ROOT, "scripts", "scenarios"))
+import ocean_pack  # noqa: E402
+
 CASES = [("explicit", 100.0), ("implicit", 1000.0)]
 
 
@@ -79,9 +82,7 @@ def main():
     rows = []
     with tempfile.TemporaryDirectory() as work:
         pack = os.path.join(work, "ocean_pack.h5")
-        subprocess.run([floesim, "pack", "--floes", "1000", "--concentration", "0.3", "--box", "1000", "1000",
-                        "--seed", "1", "--min-size", "10", "--max-size", "30", "--thickness", "1", "-o", pack],
-                       check=True, capture_output=True)
+        ocean_pack.write(floesim, pack)
         base = open(os.path.join(HERE, "ocean.toml")).read().replace('pack = "ocean_pack.h5"', f'pack = "{pack}"')
         for integrator, K in CASES:
             tomls = {}

@@ -24,12 +24,12 @@ usage: bench/ocean/large.py [--build build] [--floes 100000] [--cells 4096] [--u
 import argparse
 import os
 import re
-import subprocess
 import sys
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
 sys.path.insert(0, os.path.join(ROOT, "scripts", "scenarios"))
+import ocean_pack  # noqa: E402
 import ranks_bench  # noqa: E402  (the timing shared with bench/ocean/ranks.py)
 
 CELL = 1000.0 / 512  # bench/ocean's cell (m)
@@ -56,9 +56,7 @@ side = args.cells * CELL
 pack = os.path.join(args.work, f"pack_{args.floes}_{args.cells}.h5")
 if not os.path.exists(pack):
     print(f"writing {pack} ({args.floes} floes in {side:.0f} m x {side:.0f} m)", file=sys.stderr)
-    subprocess.run([floesim, "pack", "--floes", str(args.floes), "--concentration", "0.3", "--box", str(side),
-                    str(side), "--seed", "1", "--min-size", "10", "--max-size", "30", "--thickness", "1",
-                    "-o", pack + ".part"], check=True, capture_output=True)
+    ocean_pack.write(floesim, pack + ".part", args.floes, side)
     os.replace(pack + ".part", pack)
 
 # bench/ocean/ocean.toml with the box, the cells, the pack, the records and the integrator replaced.

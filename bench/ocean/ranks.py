@@ -24,6 +24,7 @@ import tempfile
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
 sys.path.insert(0, os.path.join(ROOT, "scripts", "scenarios"))
+import ocean_pack  # noqa: E402
 import ranks_bench  # noqa: E402  (the timing shared with bench/mpi_pack.py)
 
 ap = argparse.ArgumentParser()
@@ -38,9 +39,7 @@ args = ap.parse_args()
 floesim = os.path.join(args.build, "bin", "floesim")
 work = tempfile.mkdtemp(prefix="floesim_ocean_ranks_")
 pack = os.path.join(HERE, "ocean_pack.h5")
-subprocess.run([floesim, "pack", "--floes", "1000", "--concentration", "0.3", "--box", "1000", "1000", "--seed", "1",
-                "--min-size", "10", "--max-size", "30", "--thickness", "1", "-o", pack], check=True,
-               capture_output=True)
+ocean_pack.write(floesim, pack)
 config = os.path.join(work, "ocean.toml")
 with open(os.path.join(HERE, "ocean.toml")) as f, open(config, "w") as g:
     for line in f:

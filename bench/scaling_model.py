@@ -1,0 +1,186 @@
+#!/usr/bin/env python3
+"""bench/scaling_model.py: a weak-scaling model of floesim's distributed step to 1024 ranks.
+
+The model is of the decomposition docs/parallel.md plans (its "next
+stages"), not of today's replicated state: each rank owns a square of sea
+and the floes whose centroid it holds, the sea's transforms are distributed,
+and a rank exchanges only halos with its neighbours. Weak scaling: every rank
+keeps bench/ocean's share (its pack: 1000 floes on a 1 km, 512^2-cell
+square), so P ranks run P km^2, P 10^3 floes, 512^2 P cells. docs/scaling.md
+derives the terms; one step on P ranks costs
+
+  T(P) = C + F (log2(n P) / log2 n) + X(P) + H + R(P)
+
+  C      the step's work other than the transforms, per rank (measured: bench/ocean's
+         serial step, less its transforms)
+  F      the transforms' work on n = 512^2 cells (measured share of the step), growing
+         as n log(nP) per rank
+  X(P)   the transposes of the distributed transforms: tau transforms a step, each
+         moving the rank's half spectrum (8 n bytes) across the ranks: slabs, one
+         all-to-all of P ranks; or 2D blocks, two all-to-alls of sqrt(P) ranks
+  H      the halo exchange with the 8 neighbours: the states of floes within a
+         floe's reach of the square's edges (measured on the pack), then the area
+         pieces they put in the neighbour's cells (upper bound: all their pieces)
+  R(P)   the step's agreements (time step, failures, stopping): r reductions of
+         latency alpha log2 P
+
+with a message of b bytes taking alpha + b / beta, and beta the rank's share of
+its node's network when P fills more than a node. alpha, the node's bandwidth
+and the ranks per node are a cluster's, not this machine's (assumed, command
+line); every other input is measured on bench/ocean and named in the CSV.
+
+usage: bench/scaling_model.py [--step-ms 22.6] [--fft-share 0.13] [--pieces-per-floe 130]
+                              [--alpha-us 2] [--node-gbs 12.5] [--ranks-per-node 32]
+                              [--memory-gbs 5] [--build build] [--csv FILE | -]
+"""
+import argparse
+import math
+import os
+import subprocess
+import sys
+
+import h5py
+import numpy as np
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.dirname(HERE)
+sys.path.insert(0, os.path.join(ROOT, "scripts", "scenarios"))
+import ocean_pack  # noqa: E402  (bench/ocean's pack)
+
+ap = argparse.ArgumentParser()
+# Measured inputs (bench/ocean, docs/scaling.md says where each comes from).
+ap.add_argument("--step-ms", type=float, default=22.6,
+                help="serial explicit step of bench/ocean, ms (bench/results/ocean_ranks_epyc-2core.csv: 26.03 s / 1154)")
+ap.add_argument("--fft-share", type=float, default=0.13, help="the transforms' share of that step (perf, docs/parallel.md)")
+ap.add_argument("--implicit-step-ms", type=float, default=352.5,
+                help="serial implicit step, dt 0.05 s (bench/results/ocean_implicit_dt_18ef897_epyc-2core.csv)")
+ap.add_argument("--implicit-responses", type=float, default=47.48,
+                help="sea responses a step of the implicit step (same CSV), each one forward and one backward transform")
+ap.add_argument("--pieces-per-floe", type=float, default=130.0,
+                help="area pieces a floe (about 1.3e5 for 1000 floes, docs/parallel.md)")
+ap.add_argument("--state-bytes", type=int, default=96, help="a floe's state (FloeState)")
+ap.add_argument("--piece-bytes", type=int, default=12, help="a piece's (cell, area) for the owner of its cell")
+ap.add_argument("--reductions", type=int, default=2, help="agreements a step (time step; failures and stopping)")
+# A cluster's network (assumed).
+ap.add_argument("--alpha-us", type=float, default=2.0, help="latency of a message, us")
+ap.add_argument("--node-gbs", type=float, default=12.5, help="a node's network bandwidth, GB/s (100 Gb/s)")
+ap.add_argument("--ranks-per-node", type=int, default=32)
+ap.add_argument("--memory-gbs", type=float, default=5.0, help="a rank's copy bandwidth within a node, GB/s")
+ap.add_argument("--build", default=os.path.join(ROOT, "build"), help="where floesim is, to write the pack if missing")
+ap.add_argument("--csv", default="-")
+args = ap.parse_args()
+
+CELLS = 512 * 512          # a rank's cells
+SIDE = 1000.0              # a rank's square, m
+FLOES = 1000
+TRANSFORMS_EXPLICIT = 2    # one forward (the kick), one backward (the elevation) a step: counted, docs/scaling.md
+
+
+def pack_radii():
+    """Centroids, circumradii and window of bench/ocean's pack (one rank's share)."""
+    pack = os.path.join(HERE, "ocean", "ocean_pack.h5")
+    if not os.path.exists(pack):
+        floesim = os.path.join(args.build, "bin", "floesim")
+        if not os.access(floesim, os.X_OK):
+            sys.exit(f"scaling_model.py: no {pack}, and no {floesim} to write it")
+        ocean_pack.write(floesim, pack)
+    with h5py.File(pack, "r") as f:
+        offsets = f["floes/offsets"][:]
+        vertices = f["floes/vertices"][:]       # body frame, about the centroid
+        c = f["floes/pose"][:, :2]              # centroids
+        window = f["window"][:]
+    r = np.array([np.max(np.linalg.norm(vertices[a:b], axis=1)) for a, b in zip(offsets[:-1], offsets[1:])])
+    return c, r, window
+
+
+def halo_blocks(c, r, window):
+    """A rank's square: the floes whose state a neighbour needs (centroid within
+    the largest circumradius and a step's reach, 1 m, of an edge) and the floes
+    that put pieces in a neighbour's cells (circumscribed disc across an edge),
+    counted on the pack."""
+    x0, x1, y0, y1 = window
+    edge = np.minimum.reduce([c[:, 0] - x0, x1 - c[:, 0], c[:, 1] - y0, y1 - c[:, 1]])
+    return float(np.sum(edge < r.max() + 1.0)), float(np.sum(edge < r))
+
+
+def halo_slabs(r, thickness):
+    """A rank's slab of the given thickness (the same floes, spread along it):
+    with centroids uniform across the slab, a floe is within d of one of its two
+    long edges with probability min(1, 2 d / thickness)."""
+    state = len(r) * min(1.0, 2 * (r.max() + 1.0) / thickness)
+    straddle = float(np.sum(np.minimum(1.0, 2 * r / thickness)))
+    return state, straddle
+
+
+def all_to_all(ranks, bytes_, beta):
+    """One all-to-all among `ranks` ranks, each holding `bytes_` (sent but its own share)."""
+    alpha = args.alpha_us * 1e-6
+    return (ranks - 1) * alpha + bytes_ * (ranks - 1) / ranks / beta
+
+
+def halo_time(neighbours, state, straddle, beta):
+    """States before detection, pieces after the footprints: two messages to each neighbour."""
+    alpha = args.alpha_us * 1e-6
+    return 2 * neighbours * alpha + (state * args.state_bytes + straddle * args.pieces_per_floe * args.piece_bytes) / beta
+
+
+def model(P, step_ms, transforms, c, r, window):
+    """Per rank and step (s): compute, the transforms' work, and for slabs and for
+    blocks the transposes and the halo; the reductions."""
+    alpha = args.alpha_us * 1e-6
+    beta = args.node_gbs * 1e9 / args.ranks_per_node if P > args.ranks_per_node else args.memory_gbs * 1e9
+    fft = args.fft_share * args.step_ms * 1e-3 / TRANSFORMS_EXPLICIT * transforms
+    compute = step_ms * 1e-3 - fft
+    fft_p = fft * math.log2(CELLS * P) / math.log2(CELLS)
+    spectrum = 8.0 * CELLS   # a rank's half spectrum, complex doubles, bytes
+    if P == 1:
+        return compute, fft_p, 0.0, 0.0, 0.0, 0.0, 0.0
+    # slabs: one all-to-all of P ranks a transform; a slab 1 km / sqrt(P) thick, 2 neighbours
+    slab_x = transforms * all_to_all(P, spectrum, beta)
+    slab_h = halo_time(2, *halo_slabs(r, SIDE / math.sqrt(P)), beta)
+    # blocks: a transform is two all-to-alls among sqrt(P) ranks; squares, 8 neighbours
+    groups = math.sqrt(P)
+    block_x = transforms * 2 * all_to_all(groups, spectrum, beta)
+    block_h = halo_time(8, *halo_blocks(c, r, window), beta)
+    reductions = args.reductions * alpha * math.ceil(math.log2(P))
+    return compute, fft_p, slab_x, slab_h, block_x, block_h, reductions
+
+
+c, r, window = pack_radii()
+state, straddle = halo_blocks(c, r, window)
+rows = []
+for kind, step_ms, transforms in (("explicit", args.step_ms, TRANSFORMS_EXPLICIT),
+                                  ("implicit", args.implicit_step_ms, 2 * args.implicit_responses)):
+    base = None
+    for P in (1, 4, 16, 64, 256, 1024):
+        compute, fft_p, slab_x, slab_h, block_x, block_h, red = model(P, step_ms, transforms, c, r, window)
+        slab = compute + fft_p + slab_x + slab_h + red
+        block = compute + fft_p + block_x + block_h + red
+        base = base or slab
+        side = 512 * math.isqrt(P)
+        rows.append([kind, P, P * FLOES, f"{side}x{side}", f"{compute * 1e3:.2f}", f"{fft_p * 1e3:.2f}",
+                     f"{slab_x * 1e3:.3f}", f"{slab_h * 1e3:.3f}", f"{slab * 1e3:.2f}", f"{base / slab:.3f}",
+                     f"{block_x * 1e3:.3f}", f"{block_h * 1e3:.3f}", f"{block * 1e3:.2f}", f"{base / block:.3f}",
+                     f"{red * 1e3:.4f}"])
+
+commit = subprocess.run(["git", "-C", ROOT, "rev-parse", "--short", "HEAD"], capture_output=True, text=True).stdout.strip()
+lines = [
+    f"# command: bench/scaling_model.py {' '.join(sys.argv[1:])}",
+    f"# commit: {commit}; a model (docs/scaling.md), not a run",
+    f"# measured inputs: explicit step {args.step_ms} ms (transforms {args.fft_share:.0%} of it, {TRANSFORMS_EXPLICIT} a step); "
+    f"implicit step {args.implicit_step_ms} ms ({args.implicit_responses} sea responses a step); "
+    f"{args.pieces_per_floe:g} area pieces a floe; bench/ocean's pack: {state:.0f} of {FLOES} floes within "
+    f"{r.max():.1f} + 1 m of its square's edges, {straddle:.0f} across them",
+    f"# assumed network: latency {args.alpha_us} us, {args.node_gbs} GB/s a node shared by {args.ranks_per_node} ranks, "
+    f"{args.memory_gbs} GB/s a rank within a node",
+    "# per rank and step, ms: compute = the step less its transforms; fft = the transforms' work on the rank's share "
+    "of the whole sea; for slabs and for square blocks: the transposes, the halo, the step and the efficiency "
+    "T(1) / T(P); reductions (both)",
+    "integrator,ranks,floes,cells,compute_ms,fft_ms,slab_transpose_ms,slab_halo_ms,slab_step_ms,slab_efficiency,"
+    "block_transpose_ms,block_halo_ms,block_step_ms,block_efficiency,reductions_ms",
+] + [",".join(str(x) for x in r) for r in rows]
+text = "\n".join(lines) + "\n"
+if args.csv != "-":
+    with open(args.csv, "w") as f:
+        f.write(text)
+sys.stdout.write(text)
