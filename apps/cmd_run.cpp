@@ -310,6 +310,8 @@ int run(const Args& args, const parallel::Session& session) {
     o << "parallel.ranks: " << comm.size() << "\nparallel.collectives: " << t.calls << "\nparallel.bytes_received: " << t.bytes
       << "\nparallel.collective_seconds: " << t.seconds << "\n";
   }
+  o << "notes: " << s.notes.size() << "\n";
+  for (const auto& n : s.notes) o << "  " << n << "\n";
   o << "warnings: " << s.warnings.size() << "\n";
   for (const auto& w : s.warnings) o << "  " << w << "\n";
   if (args.profile) {

@@ -22,7 +22,7 @@ RunSummary run_simulation(Simulation& sim, const RunOptions& options) {
   RunSummary summary;
   summary.output = options.output;
   summary.energy_first = sim.energies();
-  summary.warnings = sim.notes();
+  summary.notes = sim.notes();
   // Records at t = 0, at every multiple of the interval and at the end.
   const auto expected_records = static_cast<std::size_t>(std::ceil(t_end / interval - 1e-9)) + 1;
   // One writer (rank 0): the other ranks hold the same state and have no file.
@@ -168,7 +168,7 @@ RunSummary run_simulation(Simulation& sim, const RunOptions& options) {
   summary.wall_seconds = wall();
   summary.energy_last = sim.energies();
   summary.profile = sim.profile();
-  for (const std::string& w : sim.warnings()) summary.warnings.push_back(w);
+  summary.warnings = sim.warnings();
   summary.collisions = sim.collision_stats();
   return summary;
 }

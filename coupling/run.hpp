@@ -42,7 +42,8 @@ struct RunSummary {
   std::size_t steps = 0, records = 0;
   double t_end = 0.0, wall_seconds = 0.0;
   Energies energy_first, energy_last;
-  std::vector<std::string> warnings;
+  std::vector<std::string> notes;     // said once at the start (Simulation::notes: e.g. a calibrated blend)
+  std::vector<std::string> warnings;  // what went wrong or was approximated (Simulation::warnings)
   Profile profile;
   contact::CollisionStats collisions;
 };

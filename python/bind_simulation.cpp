@@ -84,6 +84,7 @@ py::dict run_to_file(Simulation& sim, const std::string& output, double until) {
   d["wall_seconds"] = s.wall_seconds;
   d["energy_first"] = energies_dict(s.energy_first);
   d["energy_last"] = energies_dict(s.energy_last);
+  d["notes"] = s.notes;
   d["warnings"] = s.warnings;
   return d;
 }

@@ -35,6 +35,10 @@ def case_run_default():
     check(os.path.isabs(out) and os.path.exists(out), f"run file printed and present: {out}")
     check(os.path.dirname(out) == os.path.realpath(WORK) or os.path.dirname(out) == WORK, "written here")
     check(os.path.exists(kv["paraview"]), "xdmf beside the run file")
+    # Its blend law calibrated for a restitution is a note, not a warning: nothing went wrong.
+    check(kv.get("notes") == "1" and "obstacle-problem calibration" in p.stdout.split("\nnotes: ")[1].split("\nwarnings: ")[0],
+          f"one note, the blend's calibration: {p.stdout}")
+    check(kv.get("warnings") == "0", f"no warning: {p.stdout}")
     with h5py.File(out) as f:
         check(f.attrs["format"] == "floesim-1", "format attribute")
         check("[forcing]" in f.attrs["config"], "resolved config echoed")
