@@ -187,7 +187,10 @@ def case_xdmf():
 def case_example():
     cfg = sys.argv[4]
     p = run("run", cfg, "-q", "--until", "60", "-o", "example.h5")
-    check(keyvals(p.stdout).get("status") == "complete", f"{cfg} runs")
+    kv = keyvals(p.stdout)
+    check(kv.get("status") == "complete", f"{cfg} runs")
+    # An example shows the code working: no failed or approximate LCP, no refused split, no floor step.
+    check(kv.get("warnings") == "0", f"{cfg} runs without warnings: {p.stdout}")
 
 
 def case_pack():
