@@ -90,33 +90,42 @@ std::string human_time(double s) {
 }
 
 // A single status line on stderr, refreshed at most 5 times a second.
+// Progress of a run on stderr: on a terminal one line redrawn at most every
+// 0.2 s; into a file or pipe (a batch job's log) one full line every
+// `log_every` seconds of wall time (0: none), so that a long run in a queue
+// still says how far it is.
 class ProgressLine {
 public:
-  explicit ProgressLine(bool enabled) : enabled_(enabled) {}
+  ProgressLine(bool enabled, bool terminal, double log_every)
+      : enabled_(enabled && (terminal || log_every > 0.0)), terminal_(terminal),
+        every_(terminal ? 0.2 : log_every), last_(terminal ? -1.0 : 0.0) {}
   void operator()(const RunProgress& p) {
     if (!enabled_) return;
-    if (p.wall_seconds - last_ < 0.2 && p.t < p.t_end) return;
+    if (p.wall_seconds - last_ < every_ && (p.t < p.t_end || !terminal_)) return;
     last_ = p.wall_seconds;
     const double frac = p.t_end > 0 ? p.t / p.t_end : 1.0;
     const double rate = p.wall_seconds > 0 ? static_cast<double>(p.steps) / p.wall_seconds : 0.0;
     const double eta = frac > 0 ? p.wall_seconds * (1 - frac) / frac : 0.0;
-    std::fprintf(stderr, "\r[%5.1f%%] t = %.6g / %.6g s | %zu steps | %.0f steps/s | ETA %s   ",
-                 100 * frac, p.t, p.t_end, p.steps, rate, human_time(eta).c_str());
+    std::fprintf(stderr, "%s[%5.1f%%] t = %.6g / %.6g s | %zu steps | %.0f steps/s | ETA %s%s",
+                 terminal_ ? "\r" : "floesim: ", 100 * frac, p.t, p.t_end, p.steps, rate, human_time(eta).c_str(),
+                 terminal_ ? "   " : "\n");
     std::fflush(stderr);
-    shown_ = true;
+    shown_ = terminal_;
   }
   void done() { if (shown_) std::fputs("\n", stderr); }
 
 private:
-  bool enabled_;
+  bool enabled_, terminal_;
+  double every_;
+  double last_;  // wall time of the last line (s)
   bool shown_ = false;
-  double last_ = -1.0;
 };
 
 struct Args {
   std::string config, output, restart;
   double until = -1.0;
   int threads = -1;
+  double log_every = 60.0;  // s of wall time between progress lines when stderr is not a terminal
   bool quiet = false, profile = false;
 };
 
@@ -145,6 +154,10 @@ void add_run_command(CLI::App& app, Registry& registry) {
                   "Continue this run file from its checkpoint, bit for bit (CONFIG: by default the run's own; "
                   "the output: by default the run file itself)");
   sub->add_flag("-q,--quiet", args->quiet, "No progress line");
+  sub->add_option("--log-every", args->log_every,
+                  "With stderr not a terminal (a batch job's log): a progress line every this many seconds of "
+                  "wall time (default 60; 0: none)")
+      ->check(finite_non_negative());
   sub->add_flag("--profile", args->profile, "Print the time spent in each phase of the step");
   registry[sub] = [args] {
     // Under mpirun every rank runs this command (docs/parallel.md); serial otherwise.
@@ -237,7 +250,7 @@ int run(const Args& args, const parallel::Session& session) {
   Simulation& sim = *simulation;
   for (const std::string& note : sim.notes()) std::cerr << "floesim: note: " << note << "\n";
 
-  ProgressLine progress(!args.quiet && comm.writer() && isatty(STDERR_FILENO));
+  ProgressLine progress(!args.quiet && comm.writer(), isatty(STDERR_FILENO) != 0, args.log_every);
   g_interrupted = false;
   auto previous = std::signal(SIGINT, on_signal);
   auto previous_term = std::signal(SIGTERM, on_signal);

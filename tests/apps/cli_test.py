@@ -53,6 +53,22 @@ def case_run_default():
         check(list(e.attrs["columns"])[-1] == "total", "energy columns end with total")
 
 
+def case_progress_log():
+    # stderr into a file (a batch job's log): a full progress line every --log-every
+    # seconds of wall time, none with -q, none in a short run at the default 60 s.
+    p = run("run", "--until", "5", "--log-every", "0.1", "-o", "log.h5")
+    lines = [l for l in p.stderr.splitlines() if l.startswith("floesim: [")]
+    check(len(lines) >= 1, f"progress lines in the log: {p.stderr}")
+    times = [float(l.split("t = ")[1].split(" /")[0]) for l in lines]
+    check(times == sorted(times) and all(0 < t <= 5 for t in times), f"times advance within the run: {times}")
+    check(all("/ 5 s" in l and "steps/s" in l and "ETA" in l for l in lines), f"line format: {lines[0]}")
+    check("\r" not in p.stderr, "no carriage returns in a log")
+    for quiet in (["-q", "--log-every", "0.1"], []):
+        p = run("run", "--until", "5", *quiet, "-o", "log.h5")
+        check(not any(l.startswith("floesim: [") for l in p.stderr.splitlines()), f"no progress lines with {quiet}")
+    run("run", "--until", "5", "--log-every", "-1", "-o", "log.h5", expect=2)
+
+
 def case_info_json():
     run("run", EXAMPLE, "-q", "--until", "120", "-o", "a.h5")
     info = json.loads(run("info", "a.h5", "--json").stdout)
