@@ -1,0 +1,131 @@
+// The floe–sea contact evaluated by owner on several ranks (docs/parallel.md,
+// stage three; FloeSeaContact::by_owner): the sums into the cells that the law
+// needs before it (the coverage Phi_c) and that it gives after it (the cells'
+// sum of a_k u_k^2 and the pressure), each rank summing its own floes' pieces,
+// then the ranks' parts summed in rank order.
+//
+// Each rank sends, for the cells its pieces lie in, its part of each sum: the
+// cells and their coverage (12 bytes a cell) before the law, the sums and
+// pressures (16 bytes a cell, the cells already known) after it. Every rank
+// receives every rank's parts (the sea, replicated, needs the whole pressure;
+// the horizontal loads need the sums of the cells their edges cross) and adds
+// them in rank order from zero, so every rank has the same bits, whatever the
+// timing. A cell where one rank's floes lie gets 0 + that rank's part: the
+// serial sum over the same pieces in the same order (order_ is the serial
+// order restricted to the rank's floes), to the bit. A cell shared by several
+// ranks' floes gets the parts' sum, which groups the pieces by rank: equal to
+// the serial sum up to round-off (a few ulps of the cell's value).
+#include <cstring>
+
+#include "coupling/floe_sea.hpp"
+
+namespace floesim {
+
+namespace {
+
+template <class T>
+void put(std::vector<std::byte>& out, const T* data, std::size_t count) {
+  const auto* b = reinterpret_cast<const std::byte*>(data);
+  out.insert(out.end(), b, b + count * sizeof(T));
+}
+template <class T>
+const std::byte* take(const std::byte* in, T* data, std::size_t count) {
+  std::memcpy(static_cast<void*>(data), in, count * sizeof(T));
+  return in + count * sizeof(T);
+}
+
+}  // namespace
+
+void FloeSeaContact::sum_coverage_by_owner() {
+  const Footprints& fp = footprints_.pieces();
+  OwnerCells& o = owner_;
+  // This rank's cells, in the order its floes' pieces meet them, and its
+  // part of each cell's coverage, summed as the serial loop sums it.
+  o.slot.resize(grid_.size(), 0);
+  for (std::uint32_t c : o.cells) o.slot[c] = 0;
+  o.cells.clear();
+  o.coverage.clear();
+  const double inv_cell_area = 1.0 / cell_area_;
+  for (std::uint32_t i : order_)
+    for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k) {
+      const std::uint32_t c = fp.cell[k];
+      if (o.slot[c] == 0) {
+        o.cells.push_back(c);
+        o.coverage.push_back(0.0);
+        o.slot[c] = static_cast<std::uint32_t>(o.cells.size());
+      }
+      o.coverage[o.slot[c] - 1] += fp.area[k] * inv_cell_area;
+    }
+  // Message: the cells, then their coverage.
+  std::vector<std::byte> message;
+  message.reserve(o.cells.size() * (sizeof(std::uint32_t) + sizeof(double)));
+  put(message, o.cells.data(), o.cells.size());
+  put(message, o.coverage.data(), o.coverage.size());
+  std::vector<std::size_t> bytes;
+  const std::vector<std::byte> all = comm_.allgather_bytes(message, bytes);
+  // clear_footprint_cells zeroed the last evaluation's cells; every other
+  // cell is zero, so the sums below start from zero.
+  constexpr std::size_t kCellBytes = sizeof(std::uint32_t) + sizeof(double);
+  o.touched.clear();
+  o.counts.assign(bytes.size(), 0);
+  std::vector<double> coverage;
+  const std::byte* in = all.data();
+  for (std::size_t r = 0; r < bytes.size(); ++r) {
+    const std::size_t n = bytes[r] / kCellBytes;
+    o.counts[r] = n;
+    const std::size_t at = o.touched.size();
+    o.touched.resize(at + n);
+    coverage.resize(n);
+    in = take(in, o.touched.data() + at, n);
+    in = take(in, coverage.data(), n);
+    for (std::size_t j = 0; j < n; ++j) cells_[o.touched[at + j]].coverage += coverage[j];
+  }
+}
+
+double FloeSeaContact::sum_cells_by_owner(std::span<const double> u, double energy) {
+  const Footprints& fp = footprints_.pieces();
+  const std::vector<double>& force = eval_.force;
+  OwnerCells& o = owner_;
+  o.sum.assign(o.cells.size(), 0.0);
+  o.pressure.assign(o.cells.size(), 0.0);
+  const double inv_cell_area = 1.0 / cell_area_;
+  for (std::uint32_t i : order_)
+    for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k) {
+      if (u[k] <= 0.0) continue;
+      const std::uint32_t j = o.slot[fp.cell[k]] - 1;
+      o.sum[j] += fp.area[k] * u[k] * u[k];
+      o.pressure[j] += force[k] * inv_cell_area;
+    }
+  // Message: the energy, then the sums and pressures of the cells sent
+  // before (every rank knows how many).
+  std::vector<std::byte> message;
+  message.reserve(sizeof(double) * (1 + 2 * o.cells.size()));
+  put(message, &energy, 1);
+  put(message, o.sum.data(), o.sum.size());
+  put(message, o.pressure.data(), o.pressure.size());
+  std::vector<std::size_t> bytes(o.counts.size());
+  for (std::size_t r = 0; r < o.counts.size(); ++r) bytes[r] = sizeof(double) * (1 + 2 * o.counts[r]);
+  const std::vector<std::byte> all = comm_.allgather_known(message, bytes);
+  double total = 0.0;
+  std::vector<double> sum, pressure;
+  const std::byte* in = all.data();
+  const std::uint32_t* cell = o.touched.data();
+  for (std::size_t r = 0; r < o.counts.size(); ++r) {
+    const std::size_t n = o.counts[r];
+    double part = 0.0;
+    sum.resize(n);
+    pressure.resize(n);
+    in = take(in, &part, 1);
+    in = take(in, sum.data(), n);
+    in = take(in, pressure.data(), n);
+    total += part;
+    for (std::size_t j = 0; j < n; ++j) {
+      cells_[cell[j]].sum += sum[j];
+      pressure_[cell[j]] += pressure[j];
+    }
+    cell += n;
+  }
+  return total;
+}
+
+}  // namespace floesim
