@@ -365,11 +365,9 @@ void FloeSeaContact::clear_footprint_cells() {
   if (pressure_.size() != grid_.size()) {
     pressure_.assign(grid_.size(), 0.0);
     cells_.assign(grid_.size(), {});
-  } else if (by_owner()) {  // every rank's last cells (this rank's pieces are only its own)
-    for (std::uint32_t c : owner_.touched) {
-      pressure_[c] = 0.0;
-      cells_[c] = {};
-    }
+  } else if (by_owner()) {  // every rank's last cells; the sums only in this rank's (floe_sea_owners.cpp)
+    for (std::uint32_t c : owner_.touched) pressure_[c] = 0.0;
+    for (std::uint32_t c : owner_.cells) cells_[c] = {};
   } else {
     for (std::uint32_t c : footprints_.pieces().cell) {
       pressure_[c] = 0.0;

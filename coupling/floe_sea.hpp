@@ -261,11 +261,13 @@ private:
   // The contact is evaluated by owner: several ranks, explicit kicks.
   bool by_owner() const { return !comm_.serial() && !implicit_; }
   // By owner (floe_sea_owners.cpp): this rank's pieces' coverage summed into
-  // its cells, then every rank's sums in rank order into cells_[c].coverage.
+  // its cells, then every rank's parts in rank order into cells_[c].coverage
+  // of this rank's cells (cells_ is zero in the others).
   void sum_coverage_by_owner();
   // By owner, after the law: this rank's pieces' a u^2 and pressure in its
-  // cells, then every rank's into cells_ and pressure_ in rank order; returns
-  // the penalty energy, the ranks' parts summed in rank order.
+  // cells, then every rank's parts in rank order into pressure_ (every cell)
+  // and cells_[c].sum (this rank's cells); returns the penalty energy, the
+  // ranks' parts summed in rank order.
   double sum_cells_by_owner(std::span<const double> u, double energy);
   // poses_ <- the floes' present poses.
   void pose_at_states(const Floes& floes);
@@ -318,13 +320,13 @@ private:
   };
   std::vector<CellSums> cells_;
   // The contact by owner: the cells of this rank's pieces and its partial
-  // sums there, and every rank's cells (where pressure_ and cells_ may be
-  // nonzero: what the next evaluation clears).
+  // sums there, and every rank's cells. The next evaluation clears pressure_
+  // in every rank's cells and cells_ in this rank's.
   struct OwnerCells {
     std::vector<std::uint32_t> slot;   // per grid cell: 1 + its index in `cells`, 0: none of this rank's pieces
     std::vector<std::uint32_t> cells;  // this rank's cells, in the order its pieces meet them
     std::vector<double> coverage, sum, pressure;  // per cell of `cells`: this rank's part
-    std::vector<std::uint32_t> touched;  // every rank's cells, in rank order
+    std::vector<std::uint32_t> touched;  // every rank's cells, in rank order (where pressure_ may be nonzero)
     std::vector<std::size_t> counts;     // cells per rank in `touched`
   } owner_;
   std::vector<std::uint32_t> order_;  // dynamic floes with pieces, by their first cell

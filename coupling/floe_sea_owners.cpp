@@ -7,10 +7,11 @@
 // Each rank sends, for the cells its pieces lie in, its part of each sum: the
 // cells and their coverage (12 bytes a cell) before the law, the sums and
 // pressures (16 bytes a cell, the cells already known) after it. Every rank
-// receives every rank's parts (the sea, replicated, needs the whole pressure;
-// the horizontal loads need the sums of the cells their edges cross) and adds
-// them in rank order from zero, so every rank has the same bits, whatever the
-// timing. A cell where one rank's floes lie gets 0 + that rank's part: the
+// receives every rank's parts and adds them in rank order from zero, so the
+// sums do not depend on timing: the pressure in every cell (the sea,
+// replicated, needs all of it), the coverage and the sums only in the cells
+// of its own pieces (the law and the horizontal loads read no other: an edge
+// piece's cell is its area piece's); cells_ elsewhere stays zero. A cell where one rank's floes lie gets 0 + that rank's part: the
 // serial sum over the same pieces in the same order (order_ is the serial
 // order restricted to the rank's floes), to the bit. A cell shared by several
 // ranks' floes gets the parts' sum, which groups the pieces by rank: equal to
@@ -78,7 +79,10 @@ void FloeSeaContact::sum_coverage_by_owner() {
     coverage.resize(n);
     in = take(in, o.touched.data() + at, n);
     in = take(in, coverage.data(), n);
-    for (std::size_t j = 0; j < n; ++j) cells_[o.touched[at + j]].coverage += coverage[j];
+    for (std::size_t j = 0; j < n; ++j) {
+      const std::uint32_t c = o.touched[at + j];
+      if (o.slot[c] != 0) cells_[c].coverage += coverage[j];
+    }
   }
 }
 
@@ -120,8 +124,8 @@ double FloeSeaContact::sum_cells_by_owner(std::span<const double> u, double ener
     in = take(in, pressure.data(), n);
     total += part;
     for (std::size_t j = 0; j < n; ++j) {
-      cells_[cell[j]].sum += sum[j];
       pressure_[cell[j]] += pressure[j];
+      if (o.slot[cell[j]] != 0) cells_[cell[j]].sum += sum[j];
     }
     cell += n;
   }
