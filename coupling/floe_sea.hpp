@@ -328,6 +328,7 @@ private:
     std::vector<double> coverage, sum, pressure;  // per cell of `cells`: this rank's part
     std::vector<std::uint32_t> touched;  // every rank's cells, in rank order (where pressure_ may be nonzero)
     std::vector<std::size_t> counts;     // cells per rank in `touched`
+    std::vector<std::byte> message, received;  // the exchanges' buffers, kept from one evaluation to the next
   } owner_;
   std::vector<std::uint32_t> order_;  // dynamic floes with pieces, by their first cell
   bool pressure_kicked_ = false;  // the sea's last kick was with pressure_ as it is

@@ -24,15 +24,18 @@ namespace floesim {
 
 namespace {
 
+// Copies count T's to `out` and returns the end of what it wrote.
 template <class T>
-void put(std::vector<std::byte>& out, const T* data, std::size_t count) {
-  const auto* b = reinterpret_cast<const std::byte*>(data);
-  out.insert(out.end(), b, b + count * sizeof(T));
+std::byte* put(std::byte* out, const T* data, std::size_t count) {
+  if (count > 0) std::memcpy(out, data, count * sizeof(T));
+  return out + count * sizeof(T);
 }
+// Element j of an array of T that starts at `in` (any alignment).
 template <class T>
-const std::byte* take(const std::byte* in, T* data, std::size_t count) {
-  std::memcpy(static_cast<void*>(data), in, count * sizeof(T));
-  return in + count * sizeof(T);
+T at(const std::byte* in, std::size_t j) {
+  T value;
+  std::memcpy(&value, in + j * sizeof(T), sizeof(T));
+  return value;
 }
 
 }  // namespace
@@ -58,31 +61,27 @@ void FloeSeaContact::sum_coverage_by_owner() {
       o.coverage[o.slot[c] - 1] += fp.area[k] * inv_cell_area;
     }
   // Message: the cells, then their coverage.
-  std::vector<std::byte> message;
-  message.reserve(o.cells.size() * (sizeof(std::uint32_t) + sizeof(double)));
-  put(message, o.cells.data(), o.cells.size());
-  put(message, o.coverage.data(), o.coverage.size());
+  o.message.resize(o.cells.size() * (sizeof(std::uint32_t) + sizeof(double)));
+  put(put(o.message.data(), o.cells.data(), o.cells.size()), o.coverage.data(), o.coverage.size());
   std::vector<std::size_t> bytes;
-  const std::vector<std::byte> all = comm_.allgather_bytes(message, bytes);
+  comm_.allgather_bytes(o.message, bytes, o.received);
   // clear_footprint_cells zeroed the last evaluation's cells; every other
   // cell is zero, so the sums below start from zero.
   constexpr std::size_t kCellBytes = sizeof(std::uint32_t) + sizeof(double);
   o.touched.clear();
   o.counts.assign(bytes.size(), 0);
-  std::vector<double> coverage;
-  const std::byte* in = all.data();
+  const std::byte* in = o.received.data();
   for (std::size_t r = 0; r < bytes.size(); ++r) {
-    const std::size_t n = bytes[r] / kCellBytes;
+    const std::size_t n = bytes[r] / kCellBytes, first = o.touched.size();
     o.counts[r] = n;
-    const std::size_t at = o.touched.size();
-    o.touched.resize(at + n);
-    coverage.resize(n);
-    in = take(in, o.touched.data() + at, n);
-    in = take(in, coverage.data(), n);
+    o.touched.resize(first + n);
+    std::memcpy(o.touched.data() + first, in, n * sizeof(std::uint32_t));
+    const std::byte* coverage = in + n * sizeof(std::uint32_t);
     for (std::size_t j = 0; j < n; ++j) {
-      const std::uint32_t c = o.touched[at + j];
-      if (o.slot[c] != 0) cells_[c].coverage += coverage[j];
+      const std::uint32_t c = o.touched[first + j];
+      if (o.slot[c] != 0) cells_[c].coverage += at<double>(coverage, j);
     }
+    in += bytes[r];
   }
 }
 
@@ -102,32 +101,25 @@ double FloeSeaContact::sum_cells_by_owner(std::span<const double> u, double ener
     }
   // Message: the energy, then the sums and pressures of the cells sent
   // before (every rank knows how many).
-  std::vector<std::byte> message;
-  message.reserve(sizeof(double) * (1 + 2 * o.cells.size()));
-  put(message, &energy, 1);
-  put(message, o.sum.data(), o.sum.size());
-  put(message, o.pressure.data(), o.pressure.size());
+  o.message.resize(sizeof(double) * (1 + 2 * o.cells.size()));
+  put(put(put(o.message.data(), &energy, 1), o.sum.data(), o.sum.size()), o.pressure.data(), o.pressure.size());
   std::vector<std::size_t> bytes(o.counts.size());
   for (std::size_t r = 0; r < o.counts.size(); ++r) bytes[r] = sizeof(double) * (1 + 2 * o.counts[r]);
-  const std::vector<std::byte> all = comm_.allgather_known(message, bytes);
+  comm_.allgather_known(o.message, bytes, o.received);
   double total = 0.0;
-  std::vector<double> sum, pressure;
-  const std::byte* in = all.data();
+  const std::byte* in = o.received.data();
   const std::uint32_t* cell = o.touched.data();
   for (std::size_t r = 0; r < o.counts.size(); ++r) {
     const std::size_t n = o.counts[r];
-    double part = 0.0;
-    sum.resize(n);
-    pressure.resize(n);
-    in = take(in, &part, 1);
-    in = take(in, sum.data(), n);
-    in = take(in, pressure.data(), n);
-    total += part;
+    total += at<double>(in, 0);
+    const std::byte* sum = in + sizeof(double);
+    const std::byte* pressure = sum + n * sizeof(double);
     for (std::size_t j = 0; j < n; ++j) {
-      pressure_[cell[j]] += pressure[j];
-      if (o.slot[cell[j]] != 0) cells_[cell[j]].sum += sum[j];
+      pressure_[cell[j]] += at<double>(pressure, j);
+      if (o.slot[cell[j]] != 0) cells_[cell[j]].sum += at<double>(sum, j);
     }
     cell += n;
+    in += bytes[r];
   }
   return total;
 }
