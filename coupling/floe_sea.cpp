@@ -525,30 +525,6 @@ void FloeSeaContact::horizontal_loads(std::span<const double> u) {
   }
 }
 
-void FloeSeaContact::share_owned(bool water) {
-  if (comm_.serial()) return;
-  // The vertical loads too: by owner only the owner has them (replicated,
-  // the owner's are every rank's, to the bit).
-  struct Owned {
-    double fx, fy, torque, u, v, fz, mx, my;
-  };
-  std::vector<Owned> owned(loads_.size());
-  const parallel::Range mine = comm_.share(owned.size());
-  for (std::size_t i = mine.begin; i < mine.end; ++i) {
-    const Eigen::Vector3d& f = loads_[i].horizontal;
-    const Eigen::Vector3d& v = loads_[i].vertical;
-    const Vec2 w = water ? water_[i] : Vec2::Zero();
-    owned[i] = {f[0], f[1], f[2], w.x(), w.y(), v[0], v[1], v[2]};
-  }
-  comm_.complete_shares(owned);
-  for (std::size_t i = 0; i < owned.size(); ++i) {
-    if (i >= mine.begin && i < mine.end) continue;
-    loads_[i].horizontal = {owned[i].fx, owned[i].fy, owned[i].torque};
-    loads_[i].vertical = {owned[i].fz, owned[i].mx, owned[i].my};
-    if (water) water_[i] = {owned[i].u, owned[i].v};
-  }
-}
-
 void FloeSeaContact::evaluate_loads(const Floes& floes, fluid::Sea& sea, IncidentSea* incident, double h) {
   evaluate(floes, sea, h);
   update_water(floes, sea, incident);

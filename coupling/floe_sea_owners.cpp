@@ -1,8 +1,9 @@
-// The floe–sea contact evaluated by owner on several ranks (docs/parallel.md,
-// stage three; FloeSeaContact::by_owner): the sums into the cells that the law
-// needs before it (the coverage Phi_c) and that it gives after it (the cells'
-// sum of a_k u_k^2 and the pressure), each rank summing its own floes' pieces,
-// then the ranks' parts summed in rank order.
+// The floe–sea contact on several ranks: the owners' loads and water
+// velocities to every rank (docs/parallel.md, stage two), and the contact
+// evaluated by owner (stage three; FloeSeaContact::by_owner): the sums into
+// the cells that the law needs before it (the coverage Phi_c) and that it
+// gives after it (the cells' sum of a_k u_k^2 and the pressure), each rank
+// summing its own floes' pieces, then the ranks' parts summed in rank order.
 //
 // Each rank sends, for the cells its pieces lie in, its part of each sum: the
 // cells and their coverage (12 bytes a cell) before the law, the sums and
@@ -122,6 +123,30 @@ double FloeSeaContact::sum_cells_by_owner(std::span<const double> u, double ener
     in += bytes[r];
   }
   return total;
+}
+
+void FloeSeaContact::share_owned(bool water) {
+  if (comm_.serial()) return;
+  // The vertical loads too: by owner only the owner has them (replicated,
+  // the owner's are every rank's, to the bit).
+  struct Owned {
+    double fx, fy, torque, u, v, fz, mx, my;
+  };
+  std::vector<Owned> owned(loads_.size());
+  const parallel::Range mine = comm_.share(owned.size());
+  for (std::size_t i = mine.begin; i < mine.end; ++i) {
+    const Eigen::Vector3d& f = loads_[i].horizontal;
+    const Eigen::Vector3d& v = loads_[i].vertical;
+    const Vec2 w = water ? water_[i] : Vec2::Zero();
+    owned[i] = {f[0], f[1], f[2], w.x(), w.y(), v[0], v[1], v[2]};
+  }
+  comm_.complete_shares(owned);
+  for (std::size_t i = 0; i < owned.size(); ++i) {
+    if (i >= mine.begin && i < mine.end) continue;
+    loads_[i].horizontal = {owned[i].fx, owned[i].fy, owned[i].torque};
+    loads_[i].vertical = {owned[i].fz, owned[i].mx, owned[i].my};
+    if (water) water_[i] = {owned[i].u, owned[i].v};
+  }
 }
 
 }  // namespace floesim
