@@ -225,9 +225,14 @@ void FloeSeaContact::start(Floes& floes, fluid::Sea& sea, bool given) {
   const std::size_t n = floes.size();
   pressure_.assign(grid.size(), 0.0);  // evaluate() clears only the footprints' cells
   cells_.assign(grid.size(), {});
+  owner_.touched.clear();
   pressure_kicked_ = false;
   pose_at_states(floes);
+  // The static problem couples every floe sharing a cell: it reads every
+  // floe's pieces, gathered to every rank for this once.
+  footprints_.set_gather(true);
   footprints_.rebuild_at(floes, dynamic_, poses_, threads_);
+  footprints_.set_gather(!by_owner());
   if (given) {
     free_level_ = 0.0;
     for (std::size_t i = 0; i < n; ++i) bottom0_[i] = -floes.draft(i, rho_) * (1.0 + 1.0 / K_);
@@ -360,6 +365,9 @@ void FloeSeaContact::clear_footprint_cells() {
   if (pressure_.size() != grid_.size()) {
     pressure_.assign(grid_.size(), 0.0);
     cells_.assign(grid_.size(), {});
+  } else if (by_owner()) {  // every rank's last cells; the sums only in this rank's (floe_sea_owners.cpp)
+    for (std::uint32_t c : owner_.touched) pressure_[c] = 0.0;
+    for (std::uint32_t c : owner_.cells) cells_[c] = {};
   } else {
     for (std::uint32_t c : footprints_.pieces().cell) {
       pressure_[c] = 0.0;
@@ -375,11 +383,14 @@ void FloeSeaContact::place_footprints(const Floes& floes) {
   // Floes in the order of their first cell, so that floes next to each
   // other on the grid come one after the other (the grid's arrays are
   // read and written where each floe lies: this keeps them in cache).
+  // By owner, this rank's floes only (the others' pieces are not here).
   order_.clear();
-  for (std::size_t i = 0; i < floes.size(); ++i)
+  const parallel::Range mine = by_owner() ? footprints_.owned(floes.size()) : parallel::Range{0, floes.size()};
+  for (std::size_t i = mine.begin; i < mine.end; ++i)
     if (dynamic_[i] && fp.offsets[i] < fp.offsets[i + 1]) order_.push_back(static_cast<std::uint32_t>(i));
   std::sort(order_.begin(), order_.end(),
             [&](std::uint32_t x, std::uint32_t y) { return fp.cell[fp.offsets[x]] < fp.cell[fp.offsets[y]]; });
+  if (by_owner()) return sum_coverage_by_owner();
   const double inv_cell_area = 1.0 / cell_area_;
   for (std::uint32_t i : order_)
     for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k) cells_[fp.cell[k]].coverage += fp.area[k] * inv_cell_area;
@@ -447,14 +458,21 @@ void FloeSeaContact::evaluate(const Floes& floes, fluid::Sea& sea, double h) {
     load.vertical = {fz - floes.mass[i] * weight, moment.x(), moment.y()};
   }
   double energy = 0.0;
-  for (std::uint32_t i : order_)
-    for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k) {
-      if (u[k] <= 0.0) continue;
-      const double area = fp.area[k], delta = u[k];
-      energy += 0.5 * ks * psi[k] * area * delta * delta;
-      cells_[fp.cell[k]].sum += area * delta * delta;
-      pressure_[fp.cell[k]] += force[k] * inv_cell_area;
-    }
+  if (by_owner()) {
+    for (std::uint32_t i : order_)
+      for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k)
+        if (u[k] > 0.0) energy += 0.5 * ks * psi[k] * fp.area[k] * u[k] * u[k];
+    energy = sum_cells_by_owner(u, energy);
+  } else {
+    for (std::uint32_t i : order_)
+      for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k) {
+        if (u[k] <= 0.0) continue;
+        const double area = fp.area[k], delta = u[k];
+        energy += 0.5 * ks * psi[k] * area * delta * delta;
+        cells_[fp.cell[k]].sum += area * delta * delta;
+        pressure_[fp.cell[k]] += force[k] * inv_cell_area;
+      }
+  }
   // Strong part, horizontal: -dV/dG and -dV/dyaw at the present slopes.
   slope_.resize(floes.size());
   for (std::uint32_t i : order_) slope_[i] = {floes.state[i].pitch, floes.state[i].roll};
@@ -504,26 +522,6 @@ void FloeSeaContact::horizontal_loads(std::span<const double> u) {
     // The explicit-G term of dV/dG: -psi_c a_c(P0) u a, summed over the area pieces.
     fh -= ks * wetted[i] * a;
     loads_[i].horizontal = {fh.x(), fh.y(), torque};
-  }
-}
-
-void FloeSeaContact::share_owned(bool water) {
-  if (comm_.serial()) return;
-  struct Owned {
-    double fx, fy, torque, u, v;
-  };
-  std::vector<Owned> owned(loads_.size());
-  const parallel::Range mine = comm_.share(owned.size());
-  for (std::size_t i = mine.begin; i < mine.end; ++i) {
-    const Eigen::Vector3d& f = loads_[i].horizontal;
-    const Vec2 w = water ? water_[i] : Vec2::Zero();
-    owned[i] = {f[0], f[1], f[2], w.x(), w.y()};
-  }
-  comm_.complete_shares(owned);
-  for (std::size_t i = 0; i < owned.size(); ++i) {
-    if (i >= mine.begin && i < mine.end) continue;
-    loads_[i].horizontal = {owned[i].fx, owned[i].fy, owned[i].torque};
-    if (water) water_[i] = {owned[i].u, owned[i].v};
   }
 }
 

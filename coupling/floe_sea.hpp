@@ -188,14 +188,20 @@ public:
   bool implicit() const { return implicit_; }
   // Threads for the per-floe and per-piece work (results do not depend on it).
   void set_threads(int threads) { threads_ = std::max(threads, 1); }
-  // Ranks that share the per-floe work (results do not depend on them:
-  // docs/parallel.md, stage two). Each rank builds its share's footprints
-  // and computes its share's horizontal loads and water velocities; the
-  // other ranks receive them. Every rank calls every method in the same
-  // order (they may exchange data).
+  // Ranks that share the per-floe work (docs/parallel.md, stages two and
+  // three). Each rank builds its share's footprints and computes its share's
+  // horizontal loads and water velocities; the other ranks receive them.
+  // With the explicit kicks each rank also runs the law on its own floes'
+  // pieces and sums them into the cells; the cells' coverage, sums and
+  // pressure are then summed over the ranks in rank order (by_owner()): the
+  // same to the bit as a serial run in cells where one rank's floes lie, to
+  // round-off where several ranks' floes share a cell. The implicit step
+  // stays replicated on every floe's pieces (gathered), to the bit. Every
+  // rank calls every method in the same order (they may exchange data).
   void set_communicator(const parallel::Communicator& comm) {
     comm_ = comm;
     footprints_.set_communicator(comm);
+    footprints_.set_gather(!by_owner());
   }
   struct ImplicitStats {
     long steps = 0, newton = 0, cg = 0, g_products = 0;  // totals over the run
@@ -216,6 +222,7 @@ public:
 
   // Height of floe i's bottom at its centroid, z_b(G) = zeta + z0 (m).
   double bottom(const Floes& floes, std::size_t i) const { return floes.state[i].heave + bottom0_[i]; }
+  // Evaluated by owner (above), this rank's floes' pieces only.
   const Footprints& footprints() const { return footprints_.pieces(); }
   // Placements of the footprints and how many of them were rebuilds
   // (coupling/moving_footprint.hpp; [coupling] footprint_reach).
@@ -251,6 +258,17 @@ private:
   void place_footprints(const Floes& floes);
   // Zeroes pressure_ and cells_ where the present footprints lie.
   void clear_footprint_cells();
+  // The contact is evaluated by owner: several ranks, explicit kicks.
+  bool by_owner() const { return !comm_.serial() && !implicit_; }
+  // By owner (floe_sea_owners.cpp): this rank's pieces' coverage summed into
+  // its cells, then every rank's parts in rank order into cells_[c].coverage
+  // of this rank's cells (cells_ is zero in the others).
+  void sum_coverage_by_owner();
+  // By owner, after the law: this rank's pieces' a u^2 and pressure in its
+  // cells, then every rank's parts in rank order into pressure_ (every cell)
+  // and cells_[c].sum (this rank's cells); returns the penalty energy, the
+  // ranks' parts summed in rank order.
+  double sum_cells_by_owner(std::span<const double> u, double energy);
   // poses_ <- the floes' present poses.
   void pose_at_states(const Floes& floes);
   // The contact at the present state for a kick of length h (see evaluate_loads).
@@ -301,6 +319,17 @@ private:
     double sum = 0.0;       // sum over the pieces in cell c of a_k [delta_k]^+^2
   };
   std::vector<CellSums> cells_;
+  // The contact by owner: the cells of this rank's pieces and its partial
+  // sums there, and every rank's cells. The next evaluation clears pressure_
+  // in every rank's cells and cells_ in this rank's.
+  struct OwnerCells {
+    std::vector<std::uint32_t> slot;   // per grid cell: 1 + its index in `cells`, 0: none of this rank's pieces
+    std::vector<std::uint32_t> cells;  // this rank's cells, in the order its pieces meet them
+    std::vector<double> coverage, sum, pressure;  // per cell of `cells`: this rank's part
+    std::vector<std::uint32_t> touched;  // every rank's cells, in rank order (where pressure_ may be nonzero)
+    std::vector<std::size_t> counts;     // cells per rank in `touched`
+    std::vector<std::byte> message, received;  // the exchanges' buffers, kept from one evaluation to the next
+  } owner_;
   std::vector<std::uint32_t> order_;  // dynamic floes with pieces, by their first cell
   bool pressure_kicked_ = false;  // the sea's last kick was with pressure_ as it is
   double loads_h_ = -1.0;         // the kick length of the last evaluation (< 0: stale)

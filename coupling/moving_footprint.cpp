@@ -58,7 +58,7 @@ void MovingFootprints::rebuild_at(const Floes& floes, std::span<const std::uint8
     const auto from = static_cast<std::ptrdiff_t>(mine.begin), to = static_cast<std::ptrdiff_t>(mine.end);
     std::copy(include.begin() + from, include.begin() + to, mask.begin() + from);
     build_footprints(floes, mask, grid_, pieces_, kernel_, threads, reference);
-    gather_built();
+    if (gather_) gather_built();
   }
   reference_.assign(reference.begin(), reference.end());
   include_.assign(include.begin(), include.end());
@@ -100,7 +100,7 @@ void MovingFootprints::move(std::span<const FloePose> poses, int threads) {
       }
     }
   }, static_cast<std::size_t>(parallel::kFloesPerThread));
-  if (!comm_.serial()) gather_moved();
+  if (!comm_.serial() && gather_) gather_moved();
 }
 
 namespace {

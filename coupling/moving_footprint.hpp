@@ -38,7 +38,11 @@
 // its owner, so every rank holds all area pieces, to the bit as a serial
 // run builds them (each floe's pieces depend on that floe alone). The edge
 // pieces stay with their floe's owner: only the horizontal loads read them,
-// and the owner computes those (owned()).
+// and the owner computes those (owned()). With set_gather(false) the area
+// pieces are not gathered either: each rank holds its own floes' pieces only
+// (the contact evaluated by owner, docs/parallel.md, stage three); the other
+// floes' entries are then empty, or left from the last gathered build, and
+// are not to be read.
 
 #include <cstdint>
 #include <span>
@@ -71,6 +75,9 @@ public:
                   int threads);
   // Share the work among these ranks (by default the serial run: one rank).
   void set_communicator(const parallel::Communicator& comm) { comm_ = comm; }
+  // Whether the next builds and moves send every floe's area pieces to every
+  // rank (true by default); false: each rank keeps its own floes' pieces.
+  void set_gather(bool all) { gather_ = all; }
   // The floes whose edge pieces this rank holds: all of them when serial.
   parallel::Range owned(std::size_t floes) const { return comm_.share(floes); }
 
@@ -107,6 +114,7 @@ private:
   std::vector<Vec2> moment0_;   // per area piece, m_c(P0)
   long placements_ = 0, rebuilds_ = 0;
   parallel::Communicator comm_;
+  bool gather_ = true;
 };
 
 }  // namespace floesim

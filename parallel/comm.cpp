@@ -113,9 +113,24 @@ Range share(std::size_t n, int rank, int ranks) {
 
 std::vector<std::byte> Communicator::allgather_bytes(std::span<const std::byte> mine,
                                                      std::vector<std::size_t>& counts) const {
+  std::vector<std::byte> out;
+  allgather_bytes(mine, counts, out);
+  return out;
+}
+
+std::vector<std::byte> Communicator::allgather_known(std::span<const std::byte> mine,
+                                                     const std::vector<std::size_t>& counts) const {
+  std::vector<std::byte> out;
+  allgather_known(mine, counts, out);
+  return out;
+}
+
+void Communicator::allgather_bytes(std::span<const std::byte> mine, std::vector<std::size_t>& counts,
+                                   std::vector<std::byte>& out) const {
   if (serial() || !impl_) {
     counts.assign(1, mine.size());
-    return {mine.begin(), mine.end()};
+    out.assign(mine.begin(), mine.end());
+    return;
   }
 #ifdef FLOESIM_HAVE_MPI
   std::vector<long long> all_counts(static_cast<std::size_t>(size_));
@@ -125,15 +140,16 @@ std::vector<std::byte> Communicator::allgather_bytes(std::span<const std::byte> 
     check(MPI_Allgather(&count, 1, MPI_LONG_LONG, all_counts.data(), 1, MPI_LONG_LONG, impl_->comm), "MPI_Allgather");
   }
   counts.assign(all_counts.begin(), all_counts.end());
-  return allgather_known(mine, counts);
-#else
-  return {};
+  allgather_known(mine, counts, out);
 #endif
 }
 
-std::vector<std::byte> Communicator::allgather_known(std::span<const std::byte> mine,
-                                                     const std::vector<std::size_t>& counts) const {
-  if (serial() || !impl_) return {mine.begin(), mine.end()};
+void Communicator::allgather_known(std::span<const std::byte> mine, const std::vector<std::size_t>& counts,
+                                   std::vector<std::byte>& out) const {
+  if (serial() || !impl_) {
+    out.assign(mine.begin(), mine.end());
+    return;
+  }
 #ifdef FLOESIM_HAVE_MPI
   std::vector<int> sizes(counts.size()), offsets(counts.size());
   std::size_t total = 0;
@@ -146,13 +162,10 @@ std::vector<std::byte> Communicator::allgather_known(std::span<const std::byte> 
     total += counts[r];
   }
   Counted counted(impl_->traffic, static_cast<long long>(total));
-  std::vector<std::byte> out(total);
+  out.resize(total);  // a buffer kept by the caller: filled only where it grows
   check(MPI_Allgatherv(mine.data(), static_cast<int>(mine.size()), MPI_BYTE, out.data(), sizes.data(),
                        offsets.data(), MPI_BYTE, impl_->comm),
         "MPI_Allgatherv");
-  return out;
-#else
-  return {};
 #endif
 }
 

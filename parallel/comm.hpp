@@ -96,6 +96,12 @@ public:
   std::vector<std::byte> allgather_bytes(std::span<const std::byte> mine, std::vector<std::size_t>& counts) const;
   // The same when every rank's count is known to all (`counts`): one call.
   std::vector<std::byte> allgather_known(std::span<const std::byte> mine, const std::vector<std::size_t>& counts) const;
+  // Both into `out`, whose memory is reused (a gather made at every step
+  // then allocates, and the system zeroes fresh pages, only when it grows).
+  void allgather_bytes(std::span<const std::byte> mine, std::vector<std::size_t>& counts,
+                       std::vector<std::byte>& out) const;
+  void allgather_known(std::span<const std::byte> mine, const std::vector<std::size_t>& counts,
+                       std::vector<std::byte>& out) const;
 
   // The sum of one integer over the ranks (in rank order; exact).
   long long sum(long long value) const;

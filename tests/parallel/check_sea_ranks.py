@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """Distributed runs of floes on a spectral sea against the serial run
-(docs/parallel.md, stage two).
+(docs/parallel.md, stages two and three).
 
 usage: check_sea_ranks.py FLOESIM MPIEXEC WORKDIR [--ranks 1 2 3] [--t-end T]
        check_sea_ranks.py --no-mpi    (MPI not built: says so and exits 77, ctest's skip code)
@@ -9,17 +9,33 @@ A small ocean like bench/ocean/ocean.toml: a 200 m x 200 m periodic box,
 128 x 128 cells, a JONSWAP sea (Hs = 1 m, Tp = 6 s), 60 floes of 10 to 30 m
 (`floesim pack`, 30 % cover) under wind, colliding in the periodic box,
 riding on the sea through the strong penalty law with the tent footprint.
-Stage two shares the footprints, the horizontal loads and the water
-velocity under the floes among the ranks by floe; each floe's pieces and
-loads depend on that floe alone, and the gathered lists are concatenated in
-floe order, so every run file must equal the serial one bit for bit
-(`floesim compare --rtol 0 --atol 0`), for three variants of the coupling:
-footprints rebuilt at every evaluation, footprints moved between rebuilds
-(footprint_reach: the pieces are moved by their owner and gathered), and the
-implicit integrator (its step-mean horizontal loads). Then floes that split
-on a sea (the floe count, and so the shares, change during the run) on 2 and
-3 ranks, and a restart across rank counts: the first half on 2 ranks, the rest from its checkpoint on 3
-ranks and serially, both equal to the serial run.
+The ranks share the footprints, the horizontal loads and the water velocity
+under the floes by floe (stage two); with the explicit kicks each rank also
+runs the law on its own floes' pieces, and the cells' coverage, sums and
+pressure are its parts summed over the ranks in rank order (stage three).
+Three variants of the coupling: footprints rebuilt at every evaluation,
+footprints moved between rebuilds (footprint_reach: moved by their owner),
+and the implicit integrator (its step-mean horizontal loads).
+
+Where the answer must be bit for bit (`floesim compare --rtol 0 --atol 0`):
+one rank (nothing is shared), and the implicit integrator on any number of
+ranks (its step stays replicated on every floe's pieces, gathered in floe
+order). Where not: the explicit kicks on 2 and 3 ranks, where a cell holding
+pieces of floes of several ranks sums them grouped by rank, not in the
+serial order: those run files must equal the serial one within the relative
+1e-6 of issue 21 (`--rtol 1e-6 --atol 0`). A run on 2 ranks continued from
+its own checkpoint on 2 ranks must still equal the uninterrupted run on 2
+ranks bit for bit (the rank-order sums are fixed: the answer does not depend
+on timing).
+
+Then floes that split on a sea (the floe count, and so the shares, change
+during the run): with the implicit integrator to 4 s on 2 and 3 ranks, bit
+for bit; with the explicit kicks to 2.237 s (6 splits) within 1e-6. Later
+splits are not compared with the explicit kicks: at 2.2387 s the 7th split
+chooses between two nearly equal contact points, and round-off (1e-11
+relative in the blow's energy) picks the other one on 2 and 3 ranks. Last, a
+restart across rank counts: the first half on 2 ranks, the rest from its
+checkpoint on 3 ranks and serially, both within 1e-6 of the serial run.
 """
 import argparse
 import os
@@ -47,6 +63,19 @@ run, mpirun = harness.run, harness.mpirun
 
 def same(a, b):
     return run([args.floesim, "compare", a, b, "--rtol", "0", "--atol", "0"])
+
+
+def close(a, b):
+    """Within issue 21's relative 1e-6, everywhere (no absolute slack)."""
+    return run([args.floesim, "compare", a, b, "--rtol", "1e-6", "--atol", "0"])
+
+
+def check(out, ref, exact):
+    return same(out, ref) if exact else close(out, ref)
+
+
+def how(exact):
+    return "bit for bit" if exact else "within 1e-6"
 
 
 need(run([args.floesim, "pack", "--floes", "60", "--concentration", "0.3", "--box", "200", "200", "--seed", "3",
@@ -103,10 +132,11 @@ for name, extra in VARIANTS.items():
         failures.append("moved: every placement rebuilt the footprints: the check would not test the moves")
     for n in args.ranks:
         out = f"{name}_{n}.h5"
+        exact = n == 1 or name == "implicit"
         p = mpirun(n, "run", config, "-o", out, "-q")
-        c = same(out, f"{name}_serial.h5") if p.returncode == 0 else p
+        c = check(out, f"{name}_serial.h5", exact) if p.returncode == 0 else p
         verdict = "equal" if c.returncode == 0 else "DIFFERENT"
-        print(f"{name}: {n} ranks {verdict} to the serial run (bit for bit)")
+        print(f"{name}: {n} ranks {verdict} to the serial run ({how(exact)})")
         if c.returncode != 0:
             failures.append(f"{name} on {n} ranks: exit {p.returncode}\n{p.stderr}\n{c.stdout}")
 
@@ -118,34 +148,46 @@ with open(os.path.join(ROOT, "tests", "regression", "floes_on_sea.toml")) as f:
     text = f.read()
 if "velocity = [0.6, 0.0]" not in text:
     sys.exit("FAILED: tests/regression/floes_on_sea.toml changed: the split case needs its moving floe")
-config = os.path.join(W, "sea_splits.toml")
-with open(config, "w") as f:
-    f.write(text.replace("velocity = [0.6, 0.0]", "velocity = [3.0, 0.0]") +
-            "\n[fracture]\nenabled = true\nsplit = true\nstrength = 2.0e4\nmesh_size = 0.5\n")
-serial = need(run([args.floesim, "run", config, "-o", "splits_serial.h5", "-q", "--until", "4"]), "splits: serial run")
-summary = dict(l.split(": ", 1) for l in serial.stdout.splitlines() if ": " in l)
-print(f"splits: serial to 4 s, {summary.get('fracture.splits')} splits, {summary.get('floes')} floes at the end")
-if summary.get("fracture.splits", "0") == "0":
-    failures.append("splits: no floe split: the check would not test a changing floe count")
-for n in (2, 3):
-    p = mpirun(n, "run", config, "-o", f"splits_{n}.h5", "-q", "--until", "4")
-    c = same(f"splits_{n}.h5", "splits_serial.h5") if p.returncode == 0 else p
-    print(f"splits: {n} ranks {'equal' if c.returncode == 0 else 'DIFFERENT'} to the serial run (bit for bit)")
-    if c.returncode != 0:
-        failures.append(f"splits on {n} ranks: exit {p.returncode}\n{p.stderr}\n{c.stdout}")
+split_text = (text.replace("velocity = [0.6, 0.0]", "velocity = [3.0, 0.0]") +
+              "\n[fracture]\nenabled = true\nsplit = true\nstrength = 2.0e4\nmesh_size = 0.5\n")
+if "[coupling]" in split_text:
+    sys.exit("FAILED: tests/regression/floes_on_sea.toml has a [coupling] table: the implicit split case adds its own")
+for name, until, extra in (("splits", "2.237", ""), ("splits_implicit", "4", '\n[coupling]\nintegrator = "implicit"\n')):
+    config = os.path.join(W, f"sea_{name}.toml")
+    with open(config, "w") as f:
+        f.write(split_text + extra)
+    serial = need(run([args.floesim, "run", config, "-o", f"{name}_serial.h5", "-q", "--until", until]),
+                  f"{name}: serial run")
+    summary = dict(l.split(": ", 1) for l in serial.stdout.splitlines() if ": " in l)
+    print(f"{name}: serial to {until} s, {summary.get('fracture.splits')} splits, {summary.get('floes')} floes at the end")
+    if summary.get("fracture.splits", "0") == "0":
+        failures.append(f"{name}: no floe split: the check would not test a changing floe count")
+    exact = bool(extra)
+    for n in (2, 3):
+        p = mpirun(n, "run", config, "-o", f"{name}_{n}.h5", "-q", "--until", until)
+        c = check(f"{name}_{n}.h5", f"{name}_serial.h5", exact) if p.returncode == 0 else p
+        print(f"{name}: {n} ranks {'equal' if c.returncode == 0 else 'DIFFERENT'} to the serial run ({how(exact)})")
+        if c.returncode != 0:
+            failures.append(f"{name} on {n} ranks: exit {p.returncode}\n{p.stderr}\n{c.stdout}")
 
 # A restart across rank counts: stopped half-way on 2 ranks, continued on 3
 # ranks and serially from the checkpoint rank 0 wrote.
 config = os.path.join(W, "sea_rebuilt.toml")
 half = args.t_end / 2
 need(mpirun(2, "run", config, "-o", "half.h5", "-q", "--until", str(half)), "the first half on 2 ranks")
-for n, cmd in ((3, lambda: mpirun(3, "run", "--restart", "half.h5", "-o", "rest3.h5", "-q")),
-               (1, lambda: run([args.floesim, "run", "--restart", "half.h5", "-o", "rest1.h5", "-q"]))):
+for n, ref, cmd in ((2, "rebuilt_2.h5", lambda: mpirun(2, "run", "--restart", "half.h5", "-o", "rest2.h5", "-q")),
+                    (3, "rebuilt_serial.h5", lambda: mpirun(3, "run", "--restart", "half.h5", "-o", "rest3.h5", "-q")),
+                    (1, "rebuilt_serial.h5",
+                     lambda: run([args.floesim, "run", "--restart", "half.h5", "-o", "rest1.h5", "-q"]))):
+    if not os.path.exists(os.path.join(W, ref)):
+        continue  # rebuilt_2.h5 is made only when --ranks has 2
     p = cmd()
-    c = same(f"rest{n}.h5", "rebuilt_serial.h5") if p.returncode == 0 else p
+    exact = n == 2
+    c = check(f"rest{n}.h5", ref, exact) if p.returncode == 0 else p
     where = "serially" if n == 1 else f"on {n} ranks"
+    against = "the uninterrupted run on 2 ranks" if n == 2 else "the serial run"
     print(f"restart at {half} s from 2 ranks, continued {where}: {'equal' if c.returncode == 0 else 'DIFFERENT'} "
-          "to the serial run")
+          f"to {against} ({how(exact)})")
     if c.returncode != 0:
         failures.append(f"restart continued {where}: exit {p.returncode}\n{p.stderr}\n{c.stdout}")
 

@@ -50,6 +50,19 @@ TEST_CASE("the serial communicator is rank 0 of 1: gathers copy and sums are the
   const parallel::Range r = comm.share(9);
   CHECK(r.begin == 0);
   CHECK(r.end == 9);
+  // Into a kept buffer: a longer message, then a shorter one, are each
+  // copied whole, and nothing of the longer one is left past the shorter.
+  std::vector<std::byte> buffer;
+  std::vector<std::size_t> counts;
+  const std::vector<std::byte> longer(100, std::byte{7}), shorter(3, std::byte{1});
+  comm.allgather_bytes(longer, counts, buffer);
+  CHECK(buffer == longer);
+  CHECK(counts == std::vector<std::size_t>{100});
+  comm.allgather_bytes(shorter, counts, buffer);
+  CHECK(buffer == shorter);
+  CHECK(counts == std::vector<std::size_t>{3});
+  comm.allgather_known(longer, {100}, buffer);
+  CHECK(buffer == longer);
 }
 
 TEST_CASE("together_any on one rank gives the flag, or the error with its type") {

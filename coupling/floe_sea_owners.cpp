@@ -1,0 +1,152 @@
+// The floe–sea contact on several ranks: the owners' loads and water
+// velocities to every rank (docs/parallel.md, stage two), and the contact
+// evaluated by owner (stage three; FloeSeaContact::by_owner): the sums into
+// the cells that the law needs before it (the coverage Phi_c) and that it
+// gives after it (the cells' sum of a_k u_k^2 and the pressure), each rank
+// summing its own floes' pieces, then the ranks' parts summed in rank order.
+//
+// Each rank sends, for the cells its pieces lie in, its part of each sum: the
+// cells and their coverage (12 bytes a cell) before the law, the sums and
+// pressures (16 bytes a cell, the cells already known) after it. Every rank
+// receives every rank's parts and adds them in rank order from zero, so the
+// sums do not depend on timing: the pressure in every cell (the sea,
+// replicated, needs all of it), the coverage and the sums only in the cells
+// of its own pieces (the law and the horizontal loads read no other: an edge
+// piece's cell is its area piece's); cells_ elsewhere stays zero. A cell where one rank's floes lie gets 0 + that rank's part: the
+// serial sum over the same pieces in the same order (order_ is the serial
+// order restricted to the rank's floes), to the bit. A cell shared by several
+// ranks' floes gets the parts' sum, which groups the pieces by rank: equal to
+// the serial sum up to round-off (a few ulps of the cell's value).
+#include <cstring>
+
+#include "coupling/floe_sea.hpp"
+
+namespace floesim {
+
+namespace {
+
+// Copies count T's to `out` and returns the end of what it wrote.
+template <class T>
+std::byte* put(std::byte* out, const T* data, std::size_t count) {
+  if (count > 0) std::memcpy(out, data, count * sizeof(T));
+  return out + count * sizeof(T);
+}
+// Element j of an array of T that starts at `in` (any alignment).
+template <class T>
+T at(const std::byte* in, std::size_t j) {
+  T value;
+  std::memcpy(&value, in + j * sizeof(T), sizeof(T));
+  return value;
+}
+
+}  // namespace
+
+void FloeSeaContact::sum_coverage_by_owner() {
+  const Footprints& fp = footprints_.pieces();
+  OwnerCells& o = owner_;
+  // This rank's cells, in the order its floes' pieces meet them, and its
+  // part of each cell's coverage, summed as the serial loop sums it.
+  o.slot.resize(grid_.size(), 0);
+  for (std::uint32_t c : o.cells) o.slot[c] = 0;
+  o.cells.clear();
+  o.coverage.clear();
+  const double inv_cell_area = 1.0 / cell_area_;
+  for (std::uint32_t i : order_)
+    for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k) {
+      const std::uint32_t c = fp.cell[k];
+      if (o.slot[c] == 0) {
+        o.cells.push_back(c);
+        o.coverage.push_back(0.0);
+        o.slot[c] = static_cast<std::uint32_t>(o.cells.size());
+      }
+      o.coverage[o.slot[c] - 1] += fp.area[k] * inv_cell_area;
+    }
+  // Message: the cells, then their coverage.
+  o.message.resize(o.cells.size() * (sizeof(std::uint32_t) + sizeof(double)));
+  put(put(o.message.data(), o.cells.data(), o.cells.size()), o.coverage.data(), o.coverage.size());
+  std::vector<std::size_t> bytes;
+  comm_.allgather_bytes(o.message, bytes, o.received);
+  // clear_footprint_cells zeroed the last evaluation's cells; every other
+  // cell is zero, so the sums below start from zero.
+  constexpr std::size_t kCellBytes = sizeof(std::uint32_t) + sizeof(double);
+  o.touched.clear();
+  o.counts.assign(bytes.size(), 0);
+  const std::byte* in = o.received.data();
+  for (std::size_t r = 0; r < bytes.size(); ++r) {
+    const std::size_t n = bytes[r] / kCellBytes, first = o.touched.size();
+    o.counts[r] = n;
+    o.touched.resize(first + n);
+    std::memcpy(o.touched.data() + first, in, n * sizeof(std::uint32_t));
+    const std::byte* coverage = in + n * sizeof(std::uint32_t);
+    for (std::size_t j = 0; j < n; ++j) {
+      const std::uint32_t c = o.touched[first + j];
+      if (o.slot[c] != 0) cells_[c].coverage += at<double>(coverage, j);
+    }
+    in += bytes[r];
+  }
+}
+
+double FloeSeaContact::sum_cells_by_owner(std::span<const double> u, double energy) {
+  const Footprints& fp = footprints_.pieces();
+  const std::vector<double>& force = eval_.force;
+  OwnerCells& o = owner_;
+  o.sum.assign(o.cells.size(), 0.0);
+  o.pressure.assign(o.cells.size(), 0.0);
+  const double inv_cell_area = 1.0 / cell_area_;
+  for (std::uint32_t i : order_)
+    for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k) {
+      if (u[k] <= 0.0) continue;
+      const std::uint32_t j = o.slot[fp.cell[k]] - 1;
+      o.sum[j] += fp.area[k] * u[k] * u[k];
+      o.pressure[j] += force[k] * inv_cell_area;
+    }
+  // Message: the energy, then the sums and pressures of the cells sent
+  // before (every rank knows how many).
+  o.message.resize(sizeof(double) * (1 + 2 * o.cells.size()));
+  put(put(put(o.message.data(), &energy, 1), o.sum.data(), o.sum.size()), o.pressure.data(), o.pressure.size());
+  std::vector<std::size_t> bytes(o.counts.size());
+  for (std::size_t r = 0; r < o.counts.size(); ++r) bytes[r] = sizeof(double) * (1 + 2 * o.counts[r]);
+  comm_.allgather_known(o.message, bytes, o.received);
+  double total = 0.0;
+  const std::byte* in = o.received.data();
+  const std::uint32_t* cell = o.touched.data();
+  for (std::size_t r = 0; r < o.counts.size(); ++r) {
+    const std::size_t n = o.counts[r];
+    total += at<double>(in, 0);
+    const std::byte* sum = in + sizeof(double);
+    const std::byte* pressure = sum + n * sizeof(double);
+    for (std::size_t j = 0; j < n; ++j) {
+      pressure_[cell[j]] += at<double>(pressure, j);
+      if (o.slot[cell[j]] != 0) cells_[cell[j]].sum += at<double>(sum, j);
+    }
+    cell += n;
+    in += bytes[r];
+  }
+  return total;
+}
+
+void FloeSeaContact::share_owned(bool water) {
+  if (comm_.serial()) return;
+  // The vertical loads too: by owner only the owner has them (replicated,
+  // the owner's are every rank's, to the bit).
+  struct Owned {
+    double fx, fy, torque, u, v, fz, mx, my;
+  };
+  std::vector<Owned> owned(loads_.size());
+  const parallel::Range mine = comm_.share(owned.size());
+  for (std::size_t i = mine.begin; i < mine.end; ++i) {
+    const Eigen::Vector3d& f = loads_[i].horizontal;
+    const Eigen::Vector3d& v = loads_[i].vertical;
+    const Vec2 w = water ? water_[i] : Vec2::Zero();
+    owned[i] = {f[0], f[1], f[2], w.x(), w.y(), v[0], v[1], v[2]};
+  }
+  comm_.complete_shares(owned);
+  for (std::size_t i = 0; i < owned.size(); ++i) {
+    if (i >= mine.begin && i < mine.end) continue;
+    loads_[i].horizontal = {owned[i].fx, owned[i].fy, owned[i].torque};
+    loads_[i].vertical = {owned[i].fz, owned[i].mx, owned[i].my};
+    if (water) water_[i] = {owned[i].u, owned[i].v};
+  }
+}
+
+}  // namespace floesim
