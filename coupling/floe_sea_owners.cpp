@@ -12,11 +12,12 @@
 // sums do not depend on timing: the pressure in every cell (the sea,
 // replicated, needs all of it), the coverage and the sums only in the cells
 // of its own pieces (the law and the horizontal loads read no other: an edge
-// piece's cell is its area piece's); cells_ elsewhere stays zero. A cell where one rank's floes lie gets 0 + that rank's part: the
-// serial sum over the same pieces in the same order (order_ is the serial
-// order restricted to the rank's floes), to the bit. A cell shared by several
-// ranks' floes gets the parts' sum, which groups the pieces by rank: equal to
-// the serial sum up to round-off (a few ulps of the cell's value).
+// piece's cell is its area piece's); cells_ elsewhere stays zero. A cell
+// where one rank's floes lie gets 0 + that rank's part: the serial sum over
+// the same pieces in the same order (order_ is the serial order restricted to
+// the rank's floes), to the bit. A cell shared by several ranks' floes gets
+// the parts' sum, which groups the pieces by rank: equal to the serial sum up
+// to round-off (a few ulps of the cell's value).
 #include <cstring>
 
 #include "coupling/floe_sea.hpp"
