@@ -270,18 +270,6 @@ Result Lemke::run() {
         }
         if (best <= opt_.ray_accept_residual) {
           end.status = Status::solved;
-          // A complementary basis for warm starts (Result::z_basic): the
-          // basis reached, z0 dropped, is not one, and completed by either
-          // variable of the pair z0 leaves without it is singular on jam
-          // LCPs (redundant contacts). So: z_j basic where z_j > 0, w_j
-          // elsewhere, made regular by basis_repair.hpp. Were M_PP regular
-          // (P = {j : z_j > 0}) it would solve the LCP at once (B^-1 q is
-          // the answer's (z_P, w)); the repair drops the z's that make it
-          // singular, so it is a start near the answer.
-          const double positive = opt_.zero_tolerance * end.z.cwiseAbs().maxCoeff();
-          end.z_basic.assign(static_cast<std::size_t>(n_), 0);
-          for (Index j = 0; j < n_; ++j) end.z_basic[static_cast<std::size_t>(j)] = end.z(j) > positive;
-          end.z_basic = repair_basis(M_, end.z_basic);
           result = end;
         }
       }

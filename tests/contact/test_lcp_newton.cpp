@@ -178,33 +178,6 @@ TEST_CASE("lcp fallback: a jam LCP of 1400 unknowns is solved from its warm star
   }
 }
 
-TEST_CASE("lcp lemke: a warm start that ends with z0 at about 0 returns a regular basis near its answer") {
-  // data/lcp/jam/jam500_n2396 from its warm start: Lemke ends where no column
-  // may enter while z0 sits at about 0 in the basis (a degenerate end), and
-  // the point reached, z0 dropped, is accepted on its residual (lemke.hpp).
-  // The basis it returns (z_j basic where z_j > 0, made regular by
-  // basis_repair.hpp) is the warm start of the next LCP of these contacts
-  // (contact/impulse.hpp, WarmStart); without one, the next solves started
-  // from older flags. From it, Lemke solves the same LCP in fewer pivots
-  // than from its own start (769 against 1195, measured).
-  const Lcp lcp = read_siconos_lcp(lcp_data("jam/jam500_n2396.dat"));
-  REQUIRE(lcp.size() == 2396);
-  const std::vector<std::uint8_t> guess = read_guess(lcp_data("jam/jam500_n2396.guess"));
-  REQUIRE(guess.size() == 2396);
-  LemkeOptions options;
-  options.start = &guess;
-  const Result first = solve_lemke(lcp, options);
-  REQUIRE(first.status == Status::solved);
-  CHECK(first.residual <= 1e-9);
-  REQUIRE(first.z_basic.size() == 2396);
-  options.start = &first.z_basic;
-  const Result again = solve_lemke(lcp, options);
-  REQUIRE(again.status == Status::solved);
-  CHECK(again.residual <= 1e-9);
-  CHECK(again.pivots < first.pivots);
-  check_complementary(lcp, again.z, 1e-9);
-}
-
 TEST_CASE("lcp fallback: a warm start that ends on a ray is followed by Lemke from its normal flags") {
   // data/lcp/jam/jam500_n864_ray: an LCP of bench jam_500 whose warm start
   // ends on a secondary ray after 2 pivots. The chain then starts Lemke
