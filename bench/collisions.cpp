@@ -396,6 +396,10 @@ int main(int argc, char** argv) {
     const BenchScenario* s = find_scenario(child);
     if (!s) return 3;
     const RunResult r = run_once(scenario_config(*s, pack_dir_arg), s->t_end, time_limit);
+    // For a profiled run: where it got, on stderr (the parent reads stdout).
+    std::fprintf(stderr, "%s: %s, t = %g s in %.1f s, %ld LCPs, %ld pivots, %ld warm (%ld missed), %ld failures\n",
+                 s->name.c_str(), r.status.c_str(), r.simulated, r.wall, r.stats.lcps, r.stats.pivots, r.stats.warm,
+                 r.stats.warm_missed, r.stats.failures);
     print_own_peak_rss();
     return r.status == "ok" ? 0 : 2;
   }

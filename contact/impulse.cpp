@@ -379,6 +379,7 @@ lcp::FallbackResult solve(const ComponentLcp& a, const Floes& floes, const std::
     warm_store(*opt.warm, floes, contacts, a.list, res.result.z_basic);
   for (const lcp::Attempt& at : res.attempts) {
     if (at.method == lcp::Method::lemke_warm) ++(at.status == lcp::Status::solved ? stats.warm : stats.warm_missed);
+    if (at.method == lcp::Method::lemke_warm_normal && at.status == lcp::Status::solved) ++stats.warm;
     // Lemke's pivots, of every attempt (the others count iterations or sweeps).
     if (at.method != lcp::Method::newton && at.method != lcp::Method::contact_newton &&
         at.method != lcp::Method::coulomb_gs && at.method != lcp::Method::pgs)
@@ -392,7 +393,7 @@ lcp::FallbackResult solve(const ComponentLcp& a, const Floes& floes, const std::
   // start are first tries, not fallbacks).
   const auto first_tries = std::count_if(res.attempts.begin(), res.attempts.end(), [](const lcp::Attempt& at) {
     return at.method == lcp::Method::newton || at.method == lcp::Method::contact_newton ||
-           at.method == lcp::Method::lemke_warm;
+           at.method == lcp::Method::lemke_warm || at.method == lcp::Method::lemke_warm_normal;
   });
   if (res.attempts.size() - static_cast<std::size_t>(first_tries) > 1) ++stats.fallbacks;
   if (res.flagged) ++stats.flagged;

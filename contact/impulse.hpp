@@ -289,7 +289,7 @@ struct CollisionStats {
   long tolerated = 0;     // answers the chain did not accept, taken within velocity_tolerance
   long largest = 0;       // largest LCP size
   long total_size = 0;    // sum of LCP sizes
-  long warm = 0;          // of lcps, solved by Lemke warm-started from the last basis
+  long warm = 0;          // of lcps, solved by Lemke warm-started from the last basis (or its normal flags alone)
   long warm_missed = 0;   // warm starts that ended without an accepted solution (then solved from scratch)
 };
 

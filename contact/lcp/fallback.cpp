@@ -10,6 +10,7 @@ std::string_view to_string(Method method) {
     case Method::newton: return "newton";
     case Method::contact_newton: return "contact_newton";
     case Method::lemke_warm: return "lemke_warm";
+    case Method::lemke_warm_normal: return "lemke_warm_normal";
     case Method::lemke: return "lemke";
     case Method::lemke_other_covering: return "lemke_other_covering";
     case Method::lemke_regularised: return "lemke_regularised";
@@ -50,7 +51,8 @@ FallbackResult solve_with_fallbacks(const Lcp& lcp, const FallbackOptions& optio
                             result.residual});
     const bool accepted = result.status == Status::solved;
     const bool first_try =
-        method == Method::newton || method == Method::contact_newton || method == Method::lemke_warm;
+        method == Method::newton || method == Method::contact_newton || method == Method::lemke_warm ||
+        method == Method::lemke_warm_normal;
     if (accepted || out.attempts.size() == 1 || (!first_try && !from_scratch) ||
         result.residual < out.result.residual) {
       from_scratch = from_scratch || !first_try;
@@ -75,6 +77,16 @@ FallbackResult solve_with_fallbacks(const Lcp& lcp, const FallbackOptions& optio
   LemkeOptions cold = options.lemke;
   if (cold.start) {
     if (record(Method::lemke_warm, solve_lemke(lcp, options.lemke))) return out;
+    const std::size_t m = options.friction.contacts;
+    if (options.warm_normal_retry && m > 0 && lcp.size() == static_cast<Index>(4 * m)) {
+      std::vector<std::uint8_t> normal(cold.start->begin(), cold.start->end());
+      std::fill(normal.begin() + static_cast<std::ptrdiff_t>(m), normal.end(), std::uint8_t{0});
+      if (normal != *cold.start && std::find(normal.begin(), normal.end(), 1) != normal.end()) {
+        LemkeOptions again = options.lemke;
+        again.start = &normal;
+        if (record(Method::lemke_warm_normal, solve_lemke(lcp, again))) return out;
+      }
+    }
     cold.start = nullptr;
   }
   if (record(Method::lemke, solve_lemke(lcp, cold))) return out;

@@ -153,3 +153,59 @@ TEST_CASE("jam: a warm start finds a contact's basis by its vertex and edge afte
   CHECK(stats.failures == 0);
   for (const contact::ContactPoint& c : moved.contacts) CHECK(contact::target_shortfall(f, c, o) <= 1e-12);
 }
+
+TEST_CASE("jam: a time step whose LCP Lemke cannot finish within its pivot budget is answered by the fallback chain") {
+  // The pushed row of the first test case, with Lemke's pivot limit cut to 3
+  // (ImpulseOptions::solver.lemke.max_pivots; the default is
+  // lemke_pivots_per_unknown n + 1000): Lemke stops at its limit on the jam's
+  // LCP (200 unknowns, 51 pivots with the default), the chain goes on (the
+  // contact-wise Gauss–Seidel from Lemke's end point, lcp/coulomb_gs.hpp), and
+  // its answer is taken within ImpulseOptions::velocity_tolerance: no failed
+  // LCP, the row stopped against the wall (x and turning) to that tolerance,
+  // no overlap, and the x positions those of the default budget's answer to
+  // velocity_tolerance dt. Along the wall (y) the fallback's answer is not
+  // Lemke's: the row slides at about 1.2e-5 m/s (measured; each contact within
+  // the velocity tolerance of Signorini and Coulomb), so y is bounded by
+  // 1e-4 m/s only.
+  const int n = 25;
+  const double v = 1e-3, dt = 10.0;
+  std::vector<FloeState> answer[2];
+  for (const bool small_budget : {false, true}) {
+    CAPTURE(small_budget);
+    Floes f = pushed_row(n, v);
+    const contact::CollisionShapes shapes = contact::build_collision_shapes(f);
+    const contact::Detection det = contact::detect(f, shapes, detection_options(f, dt));
+    contact::SubstepOptions o;
+    o.impulse.restitution = 0.4;
+    o.impulse.friction = 0.7;
+    if (small_budget) o.impulse.solver.lemke.max_pivots = 3;
+    const double tolerance = small_budget ? o.impulse.velocity_tolerance : 1e-9;
+    contact::CollisionStats stats;
+    contact::SubstepReport report;
+    contact::advance_with_collisions(f, shapes, det, dt, o, stats, report);
+    CHECK(report.time_steps == 1);
+    CHECK(stats.lcps == 1);
+    CHECK(stats.failures == 0);
+    if (small_budget) {
+      CHECK(stats.fallbacks == 1);
+      CHECK(stats.gauss_seidel + stats.tolerated == 1);
+    } else {
+      CHECK(stats.fallbacks == 0);
+      CHECK(stats.pivots > 3);
+    }
+    // Analytic, as in the first test case: the wall stops the whole row.
+    for (int i = 0; i < n; ++i) {
+      const FloeState& s = f.state[static_cast<std::size_t>(i)];
+      CHECK(std::abs(s.vx) < tolerance);
+      CHECK(std::abs(s.vy) < (small_budget ? 1e-4 : tolerance));
+      CHECK(std::abs(s.yaw_rate) < tolerance);
+    }
+    const contact::Detection after = contact::detect(f, shapes, detection_options(f, dt));
+    for (const contact::NearPair& p : after.pairs) CHECK(!p.overlap);
+    answer[small_budget ? 1 : 0] = f.state;
+  }
+  const double apart = contact::ImpulseOptions{}.velocity_tolerance * dt;
+  for (std::size_t i = 0; i < static_cast<std::size_t>(n); ++i) {
+    CHECK(std::abs(answer[1][i].x - answer[0][i].x) < apart);
+  }
+}

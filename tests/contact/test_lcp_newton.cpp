@@ -178,6 +178,37 @@ TEST_CASE("lcp fallback: a jam LCP of 1400 unknowns is solved from its warm star
   }
 }
 
+TEST_CASE("lcp fallback: a warm start that ends on a ray is followed by Lemke from its normal flags") {
+  // data/lcp/jam/jam500_n864_ray: an LCP of bench jam_500 whose warm start
+  // ends on a secondary ray after 2 pivots. The chain then starts Lemke
+  // from the start's normal flags alone (Method::lemke_warm_normal), which
+  // solves it in fewer pivots than Lemke from scratch (391 against 602,
+  // measured); without that step the chain goes on from scratch.
+  const Lcp lcp = read_siconos_lcp(lcp_data("jam/jam500_n864_ray.dat"));
+  REQUIRE(lcp.size() == 864);
+  const std::vector<std::uint8_t> guess = read_guess(lcp_data("jam/jam500_n864_ray.guess"));
+  REQUIRE(guess.size() == 864);
+  long pivots[2] = {0, 0};
+  for (const bool retry : {true, false}) {
+    CAPTURE(retry);
+    FallbackOptions options;
+    options.friction = {216, 0.7};
+    options.lemke.start = &guess;
+    options.lemke.max_pivots = 15 * 864 + 1000;  // the collision LCPs' limit (contact/impulse.hpp)
+    options.warm_normal_retry = retry;
+    const FallbackResult r = solve_with_fallbacks(lcp, options);
+    REQUIRE(r.solved());
+    REQUIRE(r.attempts.size() == 2u);
+    CHECK(r.attempts[0].method == Method::lemke_warm);
+    CHECK(r.attempts[0].status != Status::solved);
+    CHECK(r.method == (retry ? Method::lemke_warm_normal : Method::lemke));
+    CHECK(r.result.residual <= 1e-9);
+    check_complementary(lcp, r.result.z, 1e-9);
+    pivots[retry ? 0 : 1] = r.attempts[1].pivots;
+  }
+  CHECK(pivots[0] < pivots[1]);
+}
+
 TEST_SUITE_END();
 
 }  // namespace
