@@ -47,6 +47,12 @@ Mesh mesh_polygon(std::span<const Vec2> polygon, const MeshOptions& options) {
   // Refinement to edges <= s gives about one triangle per 0.2 s^2 (measured
   // on squares and discs: 0.18 to 0.22 s^2); keep the count bounded.
   double size = options.size;
+  if (options.across > 0.0) {
+    double diameter = 0.0;
+    for (std::size_t i = 0; i < polygon.size(); ++i)
+      for (std::size_t j = i + 1; j < polygon.size(); ++j) diameter = std::max(diameter, (polygon[i] - polygon[j]).norm());
+    size = std::min(size, diameter / options.across);
+  }
   const double cap = static_cast<double>(std::max<std::size_t>(options.max_triangles, 16));
   if (area / (0.2 * size * size) > cap) size = std::sqrt(area / (0.2 * cap));
 
