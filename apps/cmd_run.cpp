@@ -304,7 +304,9 @@ int run(const Args& args, const parallel::Session& session) {
       << "\nfracture.bounded: " << f->bounded << "\nfracture.cut_short: " << f->cut_short
       << "\nfracture.loop_steps: " << f->loop_steps
       << "\nfracture.sustained: " << f->sustained << "\nfracture.initiations: " << f->initiations
-      << "\nfracture.splits: " << f->splits << "\nfracture.seconds: " << f->seconds << "\nfracture.models: " << f->models
+      << "\nfracture.splits: " << f->splits << "\nfracture.failed_splits: " << f->failed_splits
+      << "\nfracture.refused_small: " << f->refused_small << "\nfracture.refused_overlap: " << f->refused_overlap
+      << "\nfracture.seconds: " << f->seconds << "\nfracture.models: " << f->models
       << "\nfracture.model_seconds: " << f->model_seconds
       << "\nfracture.split_seconds: " << f->split_seconds << "\n";
   if (const FloeSeaContact* fs = sim.floe_sea())

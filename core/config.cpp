@@ -427,6 +427,8 @@ void read_fracture(Section s, FractureParams& f, const std::string& file) {
   f.load_radius = s.number("load_radius", f.load_radius, non_negative, "a radius >= 0 (m; 0: the floe's thickness)");
   f.min_fragment_area = s.number("min_fragment_area", f.min_fragment_area, non_negative,
                                  "an area >= 0 (m^2; 0: mesh_size^2)");
+  f.elements_across = s.number("elements_across", f.elements_across, non_negative,
+                               "a number of elements >= 0 (0: mesh_size alone)");
   if (const toml::array* a = s.table_array("load")) {
     for (std::size_t i = 0; i < a->size(); ++i) {
       Section l((*a)[i].as_table(), "fracture.load", file);

@@ -173,6 +173,7 @@ struct FractureParams {
   double duration = 0.01;         // s
   double load_radius = 0.0;       // m, loads spread over this radius; 0: the floe's thickness
   double min_fragment_area = 0.0; // m^2, no split leaves a piece smaller; 0: mesh_size^2
+  double elements_across = 0.0;   // a floe's mesh size is at most its diameter / this; 0: mesh_size only
   std::vector<FractureLoad> loads;
 };
 

@@ -248,6 +248,11 @@ bool Percussion::split(Floes& floes, std::size_t i, const Vec2& point, double di
     return true;
   }
   ++stats_.failed_splits;
+  if (fracture::plan_split(floes, i, chord, gap_, 0.0)) {
+    // Two valid pieces: refused for the area of one, or by the neighbours.
+    if (fracture::plan_split(floes, i, chord, gap_, min_area)) ++stats_.refused_overlap;
+    else ++stats_.refused_small;
+  }
   return false;
 }
 

@@ -86,6 +86,9 @@ struct PercussionStats {
   long initiations = 0;   // events (a crack whose line leaves the floe at once, from a corner, is not split)
   long splits = 0;
   long failed_splits = 0;  // cracked through but not split (sliver, or the pieces would overlap)
+  long refused_small = 0;    // of failed_splits, a piece below min_fragment_area
+  long refused_overlap = 0;  // of failed_splits, a piece would overlap a neighbour however narrow the opening
+                             // (the rest: the chord does not cut two valid polygons)
   double seconds = 0.0;    // wall time in analyses and bounds, models included
   long models = 0;         // floe models built (mesh, elastic model), on a floe's first case past the screen
   double model_seconds = 0.0;  // of seconds, wall time building them

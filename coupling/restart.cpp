@@ -99,6 +99,8 @@ Checkpoint Simulation::save() {
       k.add(std::string("fracture.") + name, static_cast<double>(v));
     k.add("fracture.bounded", static_cast<double>(p.bounded));
     k.add("fracture.cut_short", static_cast<double>(p.cut_short));
+    k.add("fracture.refused_small", static_cast<double>(p.refused_small));
+    k.add("fracture.refused_overlap", static_cast<double>(p.refused_overlap));
     k.add("fracture.loop_steps", static_cast<double>(p.loop_steps));
     k.add("fracture.models", static_cast<double>(p.models));
     k.add("fracture.model_seconds", p.model_seconds);
@@ -171,6 +173,11 @@ void Simulation::restore(const Checkpoint& c) {
       p.loop_steps = count("fracture.loop_steps");
       p.models = count("fracture.models");
       p.model_seconds = counter("fracture.model_seconds");
+    }
+    // Absent from checkpoints written before the refusals were told apart.
+    if (std::find(c.counter_names.begin(), c.counter_names.end(), "fracture.refused_small") != c.counter_names.end()) {
+      p.refused_small = count("fracture.refused_small");
+      p.refused_overlap = count("fracture.refused_overlap");
     }
     p.seconds = counter("fracture.seconds");
     p.split_seconds = counter("fracture.split_seconds");

@@ -5,7 +5,6 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <map>
 
 #include "core/error.hpp"
 
@@ -33,40 +32,16 @@ ElasticModel::ElasticModel(Mesh mesh, const Material& material) : mesh_(std::mov
   const Eigen::Index n = dofs();
   m_ = Eigen::VectorXd::Zero(n);
   node_area_.assign(nn, 0.0);
-  b_.resize(mesh_.triangles.size());
-  std::vector<Eigen::Triplet<double>> trip;
-  trip.reserve(36 * mesh_.triangles.size());
   for (std::size_t t = 0; t < mesh_.triangles.size(); ++t) {
-    const auto& tri = mesh_.triangles[t];
     const double area = mesh_.area(t);
     if (!(area > 0.0)) throw RunError("fracture: a mesh triangle has no area");
-    // Shape function gradients: dN_i/dx = (y_j - y_k) / 2A, dN_i/dy = (x_k - x_j) / 2A.
-    Eigen::Matrix<double, 3, 6> b = Eigen::Matrix<double, 3, 6>::Zero();
-    for (int i = 0; i < 3; ++i) {
-      const Vec2& pj = mesh_.nodes[static_cast<std::size_t>(tri[static_cast<std::size_t>((i + 1) % 3)])];
-      const Vec2& pk = mesh_.nodes[static_cast<std::size_t>(tri[static_cast<std::size_t>((i + 2) % 3)])];
-      const double bx = (pj.y() - pk.y()) / (2.0 * area), by = (pk.x() - pj.x()) / (2.0 * area);
-      b(0, 2 * i) = bx;
-      b(1, 2 * i + 1) = by;
-      b(2, 2 * i) = by;
-      b(2, 2 * i + 1) = bx;
-    }
-    b_[t] = b;
-    const Eigen::Matrix<double, 6, 6> ke = h * area * b.transpose() * d_ * b;
-    for (int i = 0; i < 6; ++i)
-      for (int j = 0; j < 6; ++j)
-        trip.emplace_back(2 * tri[static_cast<std::size_t>(i / 2)] + i % 2, 2 * tri[static_cast<std::size_t>(j / 2)] + j % 2,
-                          ke(i, j));
-    for (int i : tri) {
+    for (int i : mesh_.triangles[t]) {
       node_area_[static_cast<std::size_t>(i)] += area / 3.0;
       const double mass = material.density * h * area / 3.0;
       m_[2 * i] += mass;
       m_[2 * i + 1] += mass;
     }
   }
-  k_.resize(n, n);
-  k_.setFromTriplets(trip.begin(), trip.end());
-  k_.makeCompressed();
 
   // Mass centre, rigid modes and (Phi^T M Phi)^-1.
   double total = 0.0;
@@ -86,20 +61,28 @@ ElasticModel::ElasticModel(Mesh mesh, const Material& material) : mesh_(std::mov
   }
   rigid_inv_ = (phi_.transpose() * m_.asDiagonal() * phi_).inverse();
 
-  // Outline edges (in one triangle only) and each node's share of their length.
-  std::map<std::pair<int, int>, int> edges;
+  // Outline edges (in one triangle only) and each node's share of their
+  // length; the edges in increasing (low, high) node order.
+  std::vector<std::pair<int, int>> edges;
+  edges.reserve(3 * mesh_.triangles.size());
   for (const auto& tri : mesh_.triangles)
     for (int k = 0; k < 3; ++k) {
       const int a = tri[static_cast<std::size_t>(k)], b = tri[static_cast<std::size_t>((k + 1) % 3)];
-      ++edges[{std::min(a, b), std::max(a, b)}];
+      edges.emplace_back(std::min(a, b), std::max(a, b));
     }
+  std::sort(edges.begin(), edges.end());
   node_outline_.assign(nn, 0.0);
-  for (const auto& [edge, count] : edges) {
-    if (count != 1) continue;
-    outline_edges_.push_back({edge.first, edge.second});
-    const double len = (mesh_.nodes[static_cast<std::size_t>(edge.first)] - mesh_.nodes[static_cast<std::size_t>(edge.second)]).norm();
-    node_outline_[static_cast<std::size_t>(edge.first)] += 0.5 * len;
-    node_outline_[static_cast<std::size_t>(edge.second)] += 0.5 * len;
+  for (std::size_t k = 0; k < edges.size();) {
+    std::size_t next = k + 1;
+    while (next < edges.size() && edges[next] == edges[k]) ++next;
+    if (next - k == 1) {
+      const auto [a, b] = edges[k];
+      outline_edges_.push_back({a, b});
+      const double len = (mesh_.nodes[static_cast<std::size_t>(a)] - mesh_.nodes[static_cast<std::size_t>(b)]).norm();
+      node_outline_[static_cast<std::size_t>(a)] += 0.5 * len;
+      node_outline_[static_cast<std::size_t>(b)] += 0.5 * len;
+    }
+    k = next;
   }
 
   // Diameter: the outline's nodes bound it.
@@ -117,7 +100,47 @@ double ElasticModel::wave_speed() const {
 
 double ElasticModel::bar_speed() const { return std::sqrt(material_.young / material_.density); }
 
+void ElasticModel::assemble_stiffness() const {
+  if (!b_.empty()) return;
+  const double h = material_.thickness;
+  const Eigen::Index n = dofs();
+  std::vector<Eigen::Matrix<double, 3, 6>> bs(mesh_.triangles.size());
+  std::vector<Eigen::Triplet<double>> trip;
+  trip.reserve(36 * mesh_.triangles.size());
+  for (std::size_t t = 0; t < mesh_.triangles.size(); ++t) {
+    const auto& tri = mesh_.triangles[t];
+    const double area = mesh_.area(t);
+    // Shape function gradients: dN_i/dx = (y_j - y_k) / 2A, dN_i/dy = (x_k - x_j) / 2A.
+    Eigen::Matrix<double, 3, 6> b = Eigen::Matrix<double, 3, 6>::Zero();
+    for (int i = 0; i < 3; ++i) {
+      const Vec2& pj = mesh_.nodes[static_cast<std::size_t>(tri[static_cast<std::size_t>((i + 1) % 3)])];
+      const Vec2& pk = mesh_.nodes[static_cast<std::size_t>(tri[static_cast<std::size_t>((i + 2) % 3)])];
+      const double bx = (pj.y() - pk.y()) / (2.0 * area), by = (pk.x() - pj.x()) / (2.0 * area);
+      b(0, 2 * i) = bx;
+      b(1, 2 * i + 1) = by;
+      b(2, 2 * i) = by;
+      b(2, 2 * i + 1) = bx;
+    }
+    bs[t] = b;
+    const Eigen::Matrix<double, 6, 6> ke = h * area * b.transpose() * d_ * b;
+    for (int i = 0; i < 6; ++i)
+      for (int j = 0; j < 6; ++j)
+        trip.emplace_back(2 * tri[static_cast<std::size_t>(i / 2)] + i % 2, 2 * tri[static_cast<std::size_t>(j / 2)] + j % 2,
+                          ke(i, j));
+  }
+  k_.resize(n, n);
+  k_.setFromTriplets(trip.begin(), trip.end());
+  k_.makeCompressed();
+  b_ = std::move(bs);
+}
+
+const Eigen::SparseMatrix<double>& ElasticModel::stiffness() const {
+  assemble_stiffness();
+  return k_;
+}
+
 Eigen::SparseMatrix<double> ElasticModel::element_factors(std::span<const int> triangles) const {
+  assemble_stiffness();
   std::vector<Eigen::Triplet<double>> trip;
   trip.reserve(18 * triangles.size());
   int col = 0;
@@ -137,6 +160,7 @@ Eigen::SparseMatrix<double> ElasticModel::element_factors(std::span<const int> t
 }
 
 Eigen::SparseMatrix<double> ElasticModel::crack_factors(std::span<const int> triangles, double angle) const {
+  assemble_stiffness();
   const double e = material_.young, nu = material_.poisson;
   const double c = std::cos(angle), s = std::sin(angle);
   // Strain in the crack frame: (eps_tt, eps_nn, gamma_tn) = T (exx, eyy, gxy).
@@ -165,6 +189,7 @@ Eigen::SparseMatrix<double> ElasticModel::crack_factors(std::span<const int> tri
 }
 
 std::vector<Eigen::Vector3d> ElasticModel::element_stress(const Eigen::VectorXd& u) const {
+  assemble_stiffness();
   std::vector<Eigen::Vector3d> s(mesh_.triangles.size());
   for (std::size_t t = 0; t < mesh_.triangles.size(); ++t) {
     const auto& tri = mesh_.triangles[t];
@@ -189,7 +214,7 @@ std::vector<Eigen::Vector3d> ElasticModel::nodal_stress(const Eigen::VectorXd& u
   return sn;
 }
 
-double ElasticModel::strain_energy(const Eigen::VectorXd& u) const { return 0.5 * u.dot(k_ * u); }
+double ElasticModel::strain_energy(const Eigen::VectorXd& u) const { return 0.5 * u.dot(stiffness() * u); }
 
 Eigen::VectorXd ElasticModel::relieve(const Eigen::VectorXd& f) const {
   const Eigen::Vector3d q = rigid_inv_ * (phi_.transpose() * f);

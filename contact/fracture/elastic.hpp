@@ -18,6 +18,15 @@
 // along y, in the frame of the mesh. Strain (exx, eyy, gxy) = B u;
 // stress (sxx, syy, sxy) = D (exx, eyy, gxy) with
 //   D = E / (1 - nu^2) [[1, nu, 0], [nu, 1, 0], [0, 0, (1 - nu) / 2]].
+//
+// Setup in two parts. The constructor builds what the loads and the stress
+// bound need (lumped masses, rigid modes, outline shares); the element
+// matrices B_e and K are assembled on the first call that needs them
+// (stiffness, element or nodal stress, strain energy, element or crack
+// factors): a floe whose load cases the stress bound clears
+// (response.hpp) never pays for K. The assembly is the same whenever it
+// runs, so results do not depend on it. Not for concurrent first use from
+// several threads (a model belongs to one floe, checked by one thread).
 
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
@@ -50,7 +59,7 @@ public:
   const Mesh& mesh() const { return mesh_; }
   const Material& material() const { return material_; }
   Eigen::Index dofs() const { return 2 * static_cast<Eigen::Index>(mesh_.node_count()); }
-  const Eigen::SparseMatrix<double>& stiffness() const { return k_; }  // N/m
+  const Eigen::SparseMatrix<double>& stiffness() const;               // N/m (assembled on first use)
   const Eigen::VectorXd& lumped_mass() const { return m_; }           // kg, per dof
   const Eigen::Matrix3d& elasticity() const { return d_; }            // D, Pa
   double wave_speed() const;  // m/s, plate longitudinal speed sqrt(E / (rho (1 - nu^2)))
@@ -98,12 +107,15 @@ public:
   bool interpolate(const std::vector<Eigen::Vector3d>& nodal, const Vec2& point, Eigen::Vector3d& out) const;
 
 private:
+  // B_e per triangle and K (a cache: the same values whenever it is built).
+  void assemble_stiffness() const;
+
   Mesh mesh_;
   Material material_;
   Eigen::Matrix3d d_;
   Eigen::Matrix3d d_factor_;  // L, D = L L^T
-  std::vector<Eigen::Matrix<double, 3, 6>> b_;  // per triangle
-  Eigen::SparseMatrix<double> k_;
+  mutable std::vector<Eigen::Matrix<double, 3, 6>> b_;  // per triangle; empty until assembled
+  mutable Eigen::SparseMatrix<double> k_;
   Eigen::VectorXd m_;
   std::vector<double> node_area_;
   std::vector<double> node_outline_;                 // share of outline length per node (m)

@@ -7,6 +7,7 @@ namespace floesim::fracture {
 MeshOptions mesh_options(const FractureParams& p) {
   MeshOptions o;
   o.size = p.mesh_size;
+  o.across = p.elements_across;
   return o;
 }
 

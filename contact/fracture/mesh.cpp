@@ -7,10 +7,10 @@
 #include <CGAL/Delaunay_mesh_vertex_base_2.h>
 #include <CGAL/Delaunay_mesher_2.h>
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/Triangulation_vertex_base_with_info_2.h>
 
 #include <algorithm>
 #include <cmath>
-#include <map>
 #include <string>
 
 #include "core/error.hpp"
@@ -20,7 +20,8 @@ namespace floesim::fracture {
 namespace {
 
 using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
-using Vb = CGAL::Delaunay_mesh_vertex_base_2<Kernel>;
+// Each vertex carries its node number (-1 until numbered).
+using Vb = CGAL::Delaunay_mesh_vertex_base_2<Kernel, CGAL::Triangulation_vertex_base_with_info_2<int, Kernel>>;
 using Fb = CGAL::Delaunay_mesh_face_base_2<Kernel>;
 using Tds = CGAL::Triangulation_data_structure_2<Vb, Fb>;
 using Cdt = CGAL::Constrained_Delaunay_triangulation_2<Kernel, Tds>;
@@ -46,6 +47,12 @@ Mesh mesh_polygon(std::span<const Vec2> polygon, const MeshOptions& options) {
   // Refinement to edges <= s gives about one triangle per 0.2 s^2 (measured
   // on squares and discs: 0.18 to 0.22 s^2); keep the count bounded.
   double size = options.size;
+  if (options.across > 0.0) {
+    double diameter = 0.0;
+    for (std::size_t i = 0; i < polygon.size(); ++i)
+      for (std::size_t j = i + 1; j < polygon.size(); ++j) diameter = std::max(diameter, (polygon[i] - polygon[j]).norm());
+    size = std::min(size, diameter / options.across);
+  }
   const double cap = static_cast<double>(std::max<std::size_t>(options.max_triangles, 16));
   if (area / (0.2 * size * size) > cap) size = std::sqrt(area / (0.2 * cap));
 
@@ -59,15 +66,18 @@ Mesh mesh_polygon(std::span<const Vec2> polygon, const MeshOptions& options) {
 
   Mesh mesh;
   mesh.size = size;
-  std::map<Cdt::Vertex_handle, int> index;
+  // Nodes are numbered in the order the domain's faces first meet them.
+  for (Cdt::Vertex_handle v : cdt.finite_vertex_handles()) v->info() = -1;
   for (Cdt::Face_handle f : cdt.finite_face_handles()) {
     if (!f->is_in_domain()) continue;
     std::array<int, 3> tri{};
     for (int k = 0; k < 3; ++k) {
       const Cdt::Vertex_handle v = f->vertex(k);
-      auto [it, fresh] = index.emplace(v, static_cast<int>(mesh.nodes.size()));
-      if (fresh) mesh.nodes.emplace_back(v->point().x(), v->point().y());
-      tri[static_cast<std::size_t>(k)] = it->second;
+      if (v->info() < 0) {
+        v->info() = static_cast<int>(mesh.nodes.size());
+        mesh.nodes.emplace_back(v->point().x(), v->point().y());
+      }
+      tri[static_cast<std::size_t>(k)] = v->info();
     }
     mesh.triangles.push_back(tri);
   }
@@ -75,18 +85,16 @@ Mesh mesh_polygon(std::span<const Vec2> polygon, const MeshOptions& options) {
   for (std::size_t t = 0; t < mesh.triangles.size(); ++t)
     if (mesh.area(t) < 0.0) std::swap(mesh.triangles[t][1], mesh.triangles[t][2]);
 
-  // Boundary nodes: the ends of edges that belong to one triangle only.
+  // Boundary nodes: the ends of edges that belong to one triangle of the
+  // domain only (the face across is outside it, or infinite).
   mesh.on_boundary.assign(mesh.nodes.size(), 0);
-  std::map<std::pair<int, int>, int> edge_count;
-  for (const auto& tri : mesh.triangles)
-    for (int k = 0; k < 3; ++k) {
-      int a = tri[static_cast<std::size_t>(k)], b = tri[static_cast<std::size_t>((k + 1) % 3)];
-      if (a > b) std::swap(a, b);
-      ++edge_count[{a, b}];
-    }
-  for (const auto& [edge, count] : edge_count)
-    if (count == 1) mesh.on_boundary[static_cast<std::size_t>(edge.first)] =
-                        mesh.on_boundary[static_cast<std::size_t>(edge.second)] = 1;
+  for (Cdt::Face_handle f : cdt.finite_face_handles()) {
+    if (!f->is_in_domain()) continue;
+    for (int k = 0; k < 3; ++k)
+      if (!f->neighbor(k)->is_in_domain())
+        mesh.on_boundary[static_cast<std::size_t>(f->vertex(Cdt::cw(k))->info())] =
+            mesh.on_boundary[static_cast<std::size_t>(f->vertex(Cdt::ccw(k))->info())] = 1;
+  }
   if (mesh.triangles.empty()) throw RunError("fracture mesh: CGAL returned no triangle for the polygon");
   return mesh;
 }

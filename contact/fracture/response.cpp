@@ -67,8 +67,11 @@ Responder::Responder(const ElasticModel& model, const ResponseOptions& options) 
   }
   t_end_ = steps_ * dt_;
   beta_ = 2.0 * options.damping * model.mesh().size / (M_PI * c);
-  min_area_ = std::numeric_limits<double>::infinity();
-  for (std::size_t t = 0; t < model.mesh().triangles.size(); ++t) min_area_ = std::min(min_area_, model.mesh().area(t));
+  // The smallest patch of triangles around a node (the area its nodal stress averages over).
+  std::vector<double> patch(model.mesh().node_count(), 0.0);
+  for (std::size_t t = 0; t < model.mesh().triangles.size(); ++t)
+    for (int i : model.mesh().triangles[t]) patch[static_cast<std::size_t>(i)] += model.mesh().area(t);
+  min_patch_ = *std::min_element(patch.begin(), patch.end());
   eps_ = 1e-6 * (c / d) * (c / d);
 }
 
@@ -96,7 +99,7 @@ double Responder::stress_bound(std::span<const PointLoad> loads) {
 double Responder::stress_of_energy(double energy) const {
   const Material& mat = model_.material();
   return std::sqrt(2.0 * mat.young * std::max(energy, 0.0) /
-                   ((1.0 - mat.poisson * mat.poisson) * mat.thickness * min_area_));
+                   ((1.0 - mat.poisson * mat.poisson) * mat.thickness * min_patch_));
 }
 
 Eigen::VectorXd Responder::nodal_loads(std::span<const PointLoad> loads, bool impulses) const {

@@ -129,12 +129,17 @@ public:
   // steps can have. The strain energy of u_m is at most E_m, and a linear
   // triangle of area A whose largest principal stress is s holds at least
   // A h s^2 (1 - nu^2) / (2 E) (the least of (s^2 + s2^2 - 2 nu s s2) / (2 E)
-  // over the other principal stress s2, at s2 = nu s), so no triangle has
-  // sigma_1 above sqrt(2 E E_m / ((1 - nu^2) h A_min)). A nodal stress is an
-  // area-weighted mean of its triangles' (sigma_1 is convex) and sigma_1 of a
-  // sum is at most the sum of the sigma_1 (subadditive), so the static
-  // forces' largest nodal sigma_1 plus that bounds every later step. The
-  // loop stops when that bound, raised by 1e-6 of itself (round-off), and
+  // over the other principal stress s2, at s2 = nu s). The nodal stress of
+  // node n is the mean of its triangles' stresses weighted by A_t / A_n
+  // (A_n = sum of the A_t around n, its patch); sigma_1 is convex, so by
+  // Jensen's inequality
+  //   sigma_1(n) <= sum (A_t / A_n) sigma_1(t) <= sqrt(sum (A_t / A_n) sigma_1(t)^2)
+  //              <= sqrt(2 E E_m / ((1 - nu^2) h A_n)),
+  // and no node has sigma_1 above that with A_n the smallest patch of the
+  // mesh (at least the smallest triangle, usually several times it).
+  // sigma_1 of a sum is at most the sum of the sigma_1 (subadditive), so the
+  // static forces' largest nodal sigma_1 plus that bounds every later step.
+  // The loop stops when that bound, raised by 1e-6 of itself (round-off), and
   // the largest sigma_1 so far are below the level.
   Response respond(std::span<const PointLoad> loads, const Observer& observe = {},
                    double level = -std::numeric_limits<double>::infinity());
@@ -145,7 +150,7 @@ public:
   // the stress criterion, so skipping it changes nothing. It is the energy
   // bound of respond() taken before the first step (E_0 = 0, the whole
   // pulse to come):
-  //   bound = max over nodes of sigma_1(u_static) + sqrt(2 E U / ((1 - nu^2) h A_min)),
+  //   bound = max over nodes of sigma_1(u_static) + sqrt(2 E U / ((1 - nu^2) h A_patch)),
   //   U = j_r^T M^-1 j_r / 2,  j_r = relieve(nodal impulses)
   // (U is also the energy the elastic modes would take from the impulses
   // given at once: each mode, driven by a pulse of one sign, never holds more).
@@ -155,9 +160,9 @@ private:
   const ElasticModel& model_;
   ResponseOptions options_;
   double dt_ = 0.0, t_end_ = 0.0, beta_ = 0.0, eps_ = 0.0;
-  double min_area_ = 0.0;  // m^2, the smallest triangle (stress_bound)
+  double min_patch_ = 0.0;  // m^2, the smallest area of the triangles around a node (stress_bound)
   int steps_ = 0;
-  // Pa: the largest sigma_1 a triangle can have with strain energy `energy` (J).
+  // Pa: the largest nodal sigma_1 the mesh can have with strain energy `energy` (J).
   double stress_of_energy(double energy) const;
   std::unique_ptr<SpdFactor> static_, dynamic_;
 };

@@ -186,7 +186,8 @@ TEST_CASE("percussion, sustained contact: a floe pressed by wind against two sup
 
 // [fracture] min_fragment_area: the weak beam cracks across at mid-span into
 // two pieces of about 2000 m^2; a minimum above that keeps it whole (counted
-// as a failed split), one below lets it split with both pieces above it.
+// as a failed split, refused for a small piece), one below lets it split with
+// both pieces above it.
 TEST_CASE("percussion: no split leaves a piece below min_fragment_area") {
   const double strength = 0.85 * beam_stress();
   for (const double min_area : {2500.0, 1000.0}) {
@@ -199,9 +200,12 @@ TEST_CASE("percussion: no split leaves a piece below min_fragment_area") {
     if (min_area > 2000.0) {
       CHECK(st.splits == 0);
       CHECK(st.failed_splits >= 1);
+      CHECK(st.refused_small == st.failed_splits);  // the rule that refused it: the area, not the neighbours
+      CHECK(st.refused_overlap == 0);
       CHECK(sim.floes().size() == 3);
     } else {
       CHECK(st.splits == 1);
+      CHECK(st.failed_splits == 0);
       REQUIRE(sim.floes().size() == 4);
       for (std::size_t i = 0; i < sim.floes().size(); ++i)
         if (!sim.floes().is_static[i]) CHECK(sim.floes().area[i] >= min_area);
