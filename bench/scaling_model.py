@@ -124,7 +124,7 @@ def halo_time(neighbours, state, straddle, beta):
     return 2 * neighbours * alpha + (state * args.state_bytes + straddle * args.pieces_per_floe * args.piece_bytes) / beta
 
 
-def model(P, step_ms, transforms, c, r, window):
+def model(P, step_ms, transforms, r, block_halo):
     """Per rank and step (s): compute, the transforms' work, and for slabs and for
     blocks the transposes and the halo; the reductions."""
     alpha = args.alpha_us * 1e-6
@@ -141,7 +141,7 @@ def model(P, step_ms, transforms, c, r, window):
     # blocks: a transform is two all-to-alls among sqrt(P) ranks; squares, 8 neighbours
     groups = math.sqrt(P)
     block_x = transforms * 2 * all_to_all(groups, spectrum, beta)
-    block_h = halo_time(8, *halo_blocks(c, r, window), beta)
+    block_h = halo_time(8, *block_halo, beta)
     reductions = args.reductions * alpha * math.ceil(math.log2(P))
     return compute, fft_p, slab_x, slab_h, block_x, block_h, reductions
 
@@ -153,7 +153,7 @@ for kind, step_ms, transforms in (("explicit", args.step_ms, TRANSFORMS_EXPLICIT
                                   ("implicit", args.implicit_step_ms, 2 * args.implicit_responses)):
     base = None
     for P in (1, 4, 16, 64, 256, 1024):
-        compute, fft_p, slab_x, slab_h, block_x, block_h, red = model(P, step_ms, transforms, c, r, window)
+        compute, fft_p, slab_x, slab_h, block_x, block_h, red = model(P, step_ms, transforms, r, (state, straddle))
         slab = compute + fft_p + slab_x + slab_h + red
         block = compute + fft_p + block_x + block_h + red
         base = base or slab

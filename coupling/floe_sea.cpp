@@ -459,10 +459,7 @@ void FloeSeaContact::evaluate(const Floes& floes, fluid::Sea& sea, double h) {
   }
   double energy = 0.0;
   if (by_owner()) {
-    for (std::uint32_t i : order_)
-      for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k)
-        if (u[k] > 0.0) energy += 0.5 * ks * psi[k] * fp.area[k] * u[k] * u[k];
-    energy = sum_cells_by_owner(u, energy);
+    energy = sum_cells_by_owner(ks);
   } else {
     for (std::uint32_t i : order_)
       for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k) {

@@ -264,11 +264,12 @@ private:
   // its cells, then every rank's parts in rank order into cells_[c].coverage
   // of this rank's cells (cells_ is zero in the others).
   void sum_coverage_by_owner();
-  // By owner, after the law: this rank's pieces' a u^2 and pressure in its
-  // cells, then every rank's parts in rank order into pressure_ (every cell)
-  // and cells_[c].sum (this rank's cells); returns the penalty energy, the
-  // ranks' parts summed in rank order.
-  double sum_cells_by_owner(std::span<const double> u, double energy);
+  // By owner, after the law (eval_: penetrations u, weights psi, forces):
+  // this rank's pieces' a u^2 and pressure in its cells and its part of the
+  // penalty energy ks psi a u^2 / 2, in one pass; then every rank's parts in
+  // rank order into pressure_ (every cell) and cells_[c].sum (this rank's
+  // cells); returns the energy, the ranks' parts summed in rank order.
+  double sum_cells_by_owner(double ks);
   // poses_ <- the floes' present poses.
   void pose_at_states(const Floes& floes);
   // The contact at the present state for a kick of length h (see evaluate_loads).

@@ -87,17 +87,21 @@ void FloeSeaContact::sum_coverage_by_owner() {
   }
 }
 
-double FloeSeaContact::sum_cells_by_owner(std::span<const double> u, double energy) {
+double FloeSeaContact::sum_cells_by_owner(double ks) {
   const Footprints& fp = footprints_.pieces();
+  const std::vector<double>& u = eval_.penetration;
+  const std::vector<double>& psi = eval_.psi;
   const std::vector<double>& force = eval_.force;
   OwnerCells& o = owner_;
   o.sum.assign(o.cells.size(), 0.0);
   o.pressure.assign(o.cells.size(), 0.0);
   const double inv_cell_area = 1.0 / cell_area_;
+  double energy = 0.0;
   for (std::uint32_t i : order_)
     for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k) {
       if (u[k] <= 0.0) continue;
       const std::uint32_t j = o.slot[fp.cell[k]] - 1;
+      energy += 0.5 * ks * psi[k] * fp.area[k] * u[k] * u[k];
       o.sum[j] += fp.area[k] * u[k] * u[k];
       o.pressure[j] += force[k] * inv_cell_area;
     }

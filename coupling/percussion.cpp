@@ -230,9 +230,11 @@ bool Percussion::split(Floes& floes, std::size_t i, const Vec2& point, double di
     if (d <= ri + radius_of(floes, j) + gap_) near.push_back(j);
   }
   // Open the crack by gap, or less if that would push a piece into a neighbour.
+  bool planned = false;  // two pieces of at least min_area at the full gap
   for (double gap = gap_; gap >= 1e-3 * gap_; gap *= 0.25) {
     const auto plan = fracture::plan_split(floes, i, chord, gap, min_area);
     if (!plan) break;
+    planned = true;
     const auto states = fracture::piece_states(*plan, floes.state[i], floes.inertia_z[i]);
     Floes trial = floes.select(near);
     fracture::apply_split(trial, 0, *plan, states);
@@ -248,11 +250,9 @@ bool Percussion::split(Floes& floes, std::size_t i, const Vec2& point, double di
     return true;
   }
   ++stats_.failed_splits;
-  if (fracture::plan_split(floes, i, chord, gap_, 0.0)) {
-    // Two valid pieces: refused for the area of one, or by the neighbours.
-    if (fracture::plan_split(floes, i, chord, gap_, min_area)) ++stats_.refused_overlap;
-    else ++stats_.refused_small;
-  }
+  // Two valid pieces refused by the neighbours at every gap, or for the area of one.
+  if (planned) ++stats_.refused_overlap;
+  else if (fracture::plan_split(floes, i, chord, gap_, 0.0)) ++stats_.refused_small;
   return false;
 }
 
