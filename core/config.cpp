@@ -429,6 +429,7 @@ void read_fracture(Section s, FractureParams& f, const std::string& file) {
                                  "an area >= 0 (m^2; 0: mesh_size^2)");
   f.elements_across = s.number("elements_across", f.elements_across, non_negative,
                                "a number of elements >= 0 (0: mesh_size alone)");
+  f.mesher = s.choice("mesher", f.mesher, kFractureMeshers);
   if (const toml::array* a = s.table_array("load")) {
     for (std::size_t i = 0; i < a->size(); ++i) {
       Section l((*a)[i].as_table(), "fracture.load", file);

@@ -104,7 +104,8 @@ std::string resolved_toml(const Config& c) {
                        {"strength", fr.strength}, {"toughness", fr.toughness}, {"young", fr.young},
                        {"poisson", fr.poisson}, {"split", fr.split}, {"mesh_size", fr.mesh_size},
                        {"duration", fr.duration}, {"load_radius", fr.load_radius},
-                       {"min_fragment_area", fr.min_fragment_area}, {"elements_across", fr.elements_across}};
+                       {"min_fragment_area", fr.min_fragment_area}, {"elements_across", fr.elements_across},
+                       {"mesher", name_of(fr.mesher, kFractureMeshers)}};
   if (!loads.empty()) fracture.insert("load", loads);
 
   toml::table root{{"run", run}, {"sea", sea}, {"floes", floes}, {"contact", contact},

@@ -153,6 +153,10 @@ struct ForcingParams {
 };
 
 enum class FractureCriterion { stress, griffith };
+// How floes are meshed (contact/fracture/mesh.hpp): auto, the lattice mesher
+// for convex floes whose lattice mesh meets the size and angle bounds and
+// CGAL's refinement for the rest; cgal, CGAL's refinement for every floe.
+enum class FractureMesher { automatic, cgal };
 
 struct FractureLoad {
   std::array<double, 2> point = {0.0, 0.0};    // m, world
@@ -174,6 +178,7 @@ struct FractureParams {
   double load_radius = 0.0;       // m, loads spread over this radius; 0: the floe's thickness
   double min_fragment_area = 0.0; // m^2, no split leaves a piece smaller; 0: mesh_size^2
   double elements_across = 0.0;   // a floe's mesh size is at most its diameter / this; 0: mesh_size only
+  FractureMesher mesher = FractureMesher::automatic;
   std::vector<FractureLoad> loads;
 };
 

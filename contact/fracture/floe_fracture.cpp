@@ -8,6 +8,7 @@ MeshOptions mesh_options(const FractureParams& p) {
   MeshOptions o;
   o.size = p.mesh_size;
   o.across = p.elements_across;
+  o.mesher = p.mesher == FractureMesher::cgal ? Mesher::cgal : Mesher::automatic;
   return o;
 }
 

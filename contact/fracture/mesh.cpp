@@ -1,4 +1,4 @@
-// Floe meshing through CGAL's Delaunay_mesher_2. CGAL types stay in this file.
+// Floe meshing: the choice of mesher, and CGAL's Delaunay_mesher_2. CGAL types stay in this file.
 #include "contact/fracture/mesh.hpp"
 
 #include <CGAL/Constrained_Delaunay_triangulation_2.h>
@@ -55,6 +55,9 @@ Mesh mesh_polygon(std::span<const Vec2> polygon, const MeshOptions& options) {
   }
   const double cap = static_cast<double>(std::max<std::size_t>(options.max_triangles, 16));
   if (area / (0.2 * size * size) > cap) size = std::sqrt(area / (0.2 * cap));
+
+  if (options.mesher != Mesher::cgal)
+    if (std::optional<Mesh> lattice = mesh_lattice(polygon, size, options)) return std::move(*lattice);
 
   Cdt cdt;
   std::vector<Cdt::Point> pts;

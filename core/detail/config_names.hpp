@@ -34,6 +34,8 @@ inline const Names<SeriesInterpolation> kSeriesInterpolations = {{"linear", Seri
                                                                  {"previous", SeriesInterpolation::previous}};
 inline const Names<FractureCriterion> kFractureCriteria = {{"stress", FractureCriterion::stress},
                                                            {"griffith", FractureCriterion::griffith}};
+inline const Names<FractureMesher> kFractureMeshers = {{"auto", FractureMesher::automatic},
+                                                      {"cgal", FractureMesher::cgal}};
 // Two choices stored as flags: [contact] domain and [coupling] start.
 inline const Names<bool> kDomains = {{"open", false}, {"periodic", true}};
 inline const Names<bool> kStarts = {{"equilibrium", false}, {"given", true}};

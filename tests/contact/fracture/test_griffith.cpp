@@ -40,9 +40,14 @@ TEST_CASE("fracture griffith: crack energy by downdates equals refactorisation a
   const double w = 40.0, sigma = 1.0e5, a = 4.0;
   Material mat{6.0e9, 0.3, 917.0, 1.0};
   const double exact = griffith_energy(sigma, a, w, mat.young, mat.thickness);
+  // On CGAL's meshes: the smeared crack's energy depends on how the band of
+  // triangles it cuts lies on the mesh, and the lattice mesher's rows run
+  // along this crack (there: 100.1 J at mesh 1 m and 95.4 J at 0.5 m,
+  // 16.6% and 11.1% high, converging more slowly; docs/fracture.md).
   double previous_error = 1.0;
   for (double size : {1.0, 0.5}) {
     MeshOptions mo;
+    mo.mesher = Mesher::cgal;
     mo.size = size;
     mo.max_triangles = 40000;
     const ElasticModel model(mesh_polygon(rectangle(w, w), mo), mat);
@@ -81,6 +86,7 @@ TEST_CASE("fracture griffith: the Brazilian disc cracks along its loaded diamete
   fp.mesh_size = 1.0;
   fp.criterion = FractureCriterion::griffith;
   fp.toughness = 1.5;
+  fp.mesher = FractureMesher::cgal;  // as the energy test above
   FloeFracture floe(disc(d / 2, 120), 1.0, 917.0, fp);
   auto at = [&](double p) {
     const PointLoad loads[2] = {{{0.0, d / 2}, {0.0, -p}, false}, {{0.0, -d / 2}, {0.0, p}, false}};
