@@ -308,7 +308,10 @@ int run(const Args& args, const parallel::Session& session) {
       << "\nfracture.refused_small: " << f->refused_small << "\nfracture.refused_overlap: " << f->refused_overlap
       << "\nfracture.seconds: " << f->seconds << "\nfracture.models: " << f->models
       << "\nfracture.model_seconds: " << f->model_seconds
-      << "\nfracture.split_seconds: " << f->split_seconds << "\n";
+      << "\nfracture.split_seconds: " << f->split_seconds << "\nfracture.phase_seconds: " << f->phase_seconds
+      << "\nfracture.mesh_seconds: " << f->mesh_seconds << "\nfracture.bound_seconds: " << f->bound_seconds
+      << "\nfracture.factor_seconds: " << f->factor_seconds << "\nfracture.lattice_meshes: " << f->lattice_meshes
+      << "\n";
   if (const FloeSeaContact* fs = sim.floe_sea())
     o << "footprints.placements: " << fs->footprint_placements() << "\nfootprints.rebuilds: " << fs->footprint_rebuilds()
       << "\n";

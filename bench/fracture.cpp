@@ -8,14 +8,22 @@
 //  2. What a percussion analysis costs: the model (mesh, matrices), the first
 //     analysis (which also factorises) and the next ones, for square floes
 //     of growing size (mesh 2 m, at most 12000 triangles).
-// usage: floesim_bench_fracture [--repeat R]   (minimum over R runs of part 2)
+//  3. The meshers per floe: every cell of the drift_500 bench's pack (500
+//     floes, 50% of a 2 km box, seed 1) meshed at 20, 10 and 5 m by CGAL's
+//     refinement, by the default (the lattice where it meets its bounds,
+//     else CGAL) and by the lattice mesher alone (its attempts that miss the
+//     bounds included), the median over R runs of the time per floe.
+// usage: floesim_bench_fracture [--repeat R] [--meshers]   (R runs of parts 2 and 3;
+// --meshers: part 3 only)
 #include <Eigen/Dense>
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstring>
 #include <map>
 
 #include "contact/fracture/floe_fracture.hpp"
+#include "core/pack_generator.hpp"
 
 using namespace floesim;
 using namespace floesim::fracture;
@@ -30,6 +38,7 @@ void lattice_study() {
   for (double size : {1.3, 0.65, 0.45}) {
     MeshOptions o;
     o.size = size;
+    o.mesher = Mesher::cgal;  // irregular meshes: on a regular lattice the springs would pass
     const ElasticModel fe(mesh_polygon(poly, o), mat);
     const Mesh& mesh = fe.mesh();
     const auto n = static_cast<Eigen::Index>(2 * mesh.node_count());
@@ -120,12 +129,59 @@ void cost_study(int repeat) {
   }
 }
 
+void mesher_study(int repeat) {
+  PackOptions po;
+  po.floes = 500;
+  po.width = po.height = 2000.0;
+  po.concentration = 0.5;
+  const GeneratedPack pack = generate_pack(po);
+  std::printf("# meshers per floe: the %zu cells of a 500-floe pack (drift_500), median of %d runs\n",
+              pack.floes.size(), repeat);
+  std::printf("mesh_size,mesher,us_per_floe,lattice_meshes,triangles_per_floe\n");
+  for (double size : {20.0, 10.0, 5.0})
+    for (Mesher mesher : {Mesher::cgal, Mesher::automatic, Mesher::lattice}) {
+      std::vector<double> times;
+      std::size_t lattice = 0, triangles = 0;
+      for (int r = 0; r < repeat; ++r) {
+        MeshOptions o;
+        o.size = size;
+        o.mesher = mesher;
+        lattice = triangles = 0;
+        const auto t0 = std::chrono::steady_clock::now();
+        for (std::size_t i = 0; i < pack.floes.size(); ++i) {
+          if (mesher == Mesher::lattice) {
+            const std::optional<Mesh> m = mesh_lattice(pack.floes.vertices(i), size, o);
+            lattice += m.has_value();
+            triangles += m ? m->triangles.size() : 0;
+            continue;
+          }
+          const Mesh m = mesh_polygon(pack.floes.vertices(i), o);
+          lattice += m.mesher == Mesher::lattice;
+          triangles += m.triangles.size();
+        }
+        times.push_back(std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - t0).count() /
+                        static_cast<double>(pack.floes.size()));
+      }
+      std::sort(times.begin(), times.end());
+      const char* name = mesher == Mesher::cgal ? "cgal" : mesher == Mesher::automatic ? "auto" : "lattice_alone";
+      std::printf("%g,%s,%.1f,%zu,%.1f\n", size, name, times[times.size() / 2], lattice,
+                  static_cast<double>(triangles) / static_cast<double>(mesher == Mesher::lattice ? std::max<std::size_t>(lattice, 1)
+                                                                                               : pack.floes.size()));
+    }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   int repeat = 3;
-  for (int i = 1; i + 1 < argc; ++i)
-    if (std::strcmp(argv[i], "--repeat") == 0) repeat = std::max(1, std::atoi(argv[i + 1]));
-  lattice_study();
-  cost_study(repeat);
+  bool meshers_only = false;
+  for (int i = 1; i < argc; ++i) {
+    if (std::strcmp(argv[i], "--repeat") == 0 && i + 1 < argc) repeat = std::max(1, std::atoi(argv[i + 1]));
+    if (std::strcmp(argv[i], "--meshers") == 0) meshers_only = true;
+  }
+  if (!meshers_only) {
+    lattice_study();
+    cost_study(repeat);
+  }
+  mesher_study(repeat);
 }

@@ -81,6 +81,8 @@ fracture::FloeFracture& Percussion::model_of(const Floes& floes, std::size_t i) 
     const auto begin = std::chrono::steady_clock::now();
     slot = std::make_unique<fracture::FloeFracture>(floes.vertices(i), floes.thickness[i], floes.density[i], params_);
     ++stats_.models;
+    stats_.mesh_seconds += slot->mesh_seconds();
+    if (slot->model().mesh().mesher == fracture::Mesher::lattice) ++stats_.lattice_meshes;
     stats_.model_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
   }
   return *slot;
@@ -100,6 +102,12 @@ struct FloeLoads {
 };
 
 bool Percussion::check(Floes& floes, const contact::ImpulseRecord& record, double t, double dt) {
+  const auto phase_begin = std::chrono::steady_clock::now();
+  struct PhaseClock {  // adds the phase's wall time on every return
+    std::chrono::steady_clock::time_point begin;
+    double& total;
+    ~PhaseClock() { total += std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count(); }
+  } phase_clock{phase_begin, stats_.phase_seconds};
   if (t != fresh_time_) {
     fresh_.clear();
     fresh_time_ = t;
@@ -164,15 +172,24 @@ bool Percussion::check(Floes& floes, const contact::ImpulseRecord& record, doubl
       if (e) loads.insert(loads.end(), e->impulses.begin(), e->impulses.end());
       const auto begin = std::chrono::steady_clock::now();
       fracture::FloeFracture& model = model_of(floes, i);
+      const double factor_before = model.responder().factor_seconds();
       // The stress criterion cannot initiate below the strength: a case whose
       // bound (Responder::stress_bound) is below it needs no time loop.
-      if (params_.criterion == FractureCriterion::stress && model.responder().stress_bound(loads) < params_.strength) {
-        stats_.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
-        ++stats_.bounded;
-        continue;
+      if (params_.criterion == FractureCriterion::stress) {
+        const auto bound_begin = std::chrono::steady_clock::now();
+        const bool below = model.responder().stress_bound(loads) < params_.strength;
+        const auto bound_end = std::chrono::steady_clock::now();
+        stats_.bound_seconds += std::chrono::duration<double>(bound_end - bound_begin).count();
+        if (below) {
+          stats_.seconds += std::chrono::duration<double>(bound_end - begin).count();
+          stats_.factor_seconds += model.responder().factor_seconds() - factor_before;
+          ++stats_.bounded;
+          continue;
+        }
       }
       const fracture::FloeFracture::Result result = model.decide(loads);
       stats_.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
+      stats_.factor_seconds += model.responder().factor_seconds() - factor_before;
       ++stats_.checks;
       if (!e) ++stats_.sustained;
       if (result.response.cut_short) ++stats_.cut_short;

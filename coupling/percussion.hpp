@@ -93,6 +93,12 @@ struct PercussionStats {
   long models = 0;         // floe models built (mesh, elastic model), on a floe's first case past the screen
   double model_seconds = 0.0;  // of seconds, wall time building them
   double split_seconds = 0.0;  // wall time in splits (cut, overlap checks), without the rebuild after them
+  // Where the time of the phase goes (docs/fracture.md, "In packs"):
+  double phase_seconds = 0.0;   // the whole phase (check), screen and splits included
+  double mesh_seconds = 0.0;    // of model_seconds, meshing the floes
+  double bound_seconds = 0.0;   // of seconds, the stress bounds (factorisations they start included)
+  double factor_seconds = 0.0;  // of seconds, assembling K and factorising (in bounds or analyses)
+  long lattice_meshes = 0;      // of models, meshed by the lattice mesher (the rest by CGAL)
 };
 
 class Percussion {

@@ -106,6 +106,11 @@ Checkpoint Simulation::save() {
     k.add("fracture.model_seconds", p.model_seconds);
     k.add("fracture.seconds", p.seconds);
     k.add("fracture.split_seconds", p.split_seconds);
+    k.add("fracture.phase_seconds", p.phase_seconds);
+    k.add("fracture.mesh_seconds", p.mesh_seconds);
+    k.add("fracture.bound_seconds", p.bound_seconds);
+    k.add("fracture.factor_seconds", p.factor_seconds);
+    k.add("fracture.lattice_meshes", static_cast<double>(p.lattice_meshes));
   }
   c.counter_names = std::move(k.names);
   c.counters = std::move(k.values);
@@ -178,6 +183,14 @@ void Simulation::restore(const Checkpoint& c) {
     if (std::find(c.counter_names.begin(), c.counter_names.end(), "fracture.refused_small") != c.counter_names.end()) {
       p.refused_small = count("fracture.refused_small");
       p.refused_overlap = count("fracture.refused_overlap");
+    }
+    // Absent from checkpoints written before the phase's time was split up.
+    if (std::find(c.counter_names.begin(), c.counter_names.end(), "fracture.phase_seconds") != c.counter_names.end()) {
+      p.phase_seconds = counter("fracture.phase_seconds");
+      p.mesh_seconds = counter("fracture.mesh_seconds");
+      p.bound_seconds = counter("fracture.bound_seconds");
+      p.factor_seconds = counter("fracture.factor_seconds");
+      p.lattice_meshes = count("fracture.lattice_meshes");
     }
     p.seconds = counter("fracture.seconds");
     p.split_seconds = counter("fracture.split_seconds");

@@ -1,5 +1,6 @@
 #include "contact/fracture/floe_fracture.hpp"
 
+#include <chrono>
 #include <limits>
 
 namespace floesim::fracture {
@@ -27,10 +28,20 @@ CriterionOptions criterion_options(const FractureParams& p) {
   return o;
 }
 
+namespace {
+Mesh timed_mesh(std::span<const Vec2> polygon, const MeshOptions& options, double& seconds) {
+  const auto begin = std::chrono::steady_clock::now();
+  Mesh mesh = mesh_polygon(polygon, options);
+  seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
+  return mesh;
+}
+}  // namespace
+
 FloeFracture::FloeFracture(std::span<const Vec2> polygon, double thickness, double density,
                            const FractureParams& params)
     : polygon_(polygon.begin(), polygon.end()),
-      model_(mesh_polygon(polygon, mesh_options(params)), Material{params.young, params.poisson, density, thickness}),
+      model_(timed_mesh(polygon, mesh_options(params), mesh_seconds_),
+             Material{params.young, params.poisson, density, thickness}),
       responder_(model_, response_options(params, thickness)),
       criterion_(criterion_options(params)) {}
 

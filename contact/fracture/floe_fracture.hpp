@@ -24,6 +24,7 @@ public:
   FloeFracture& operator=(const FloeFracture&) = delete;
 
   const std::vector<Vec2>& polygon() const { return polygon_; }
+  double mesh_seconds() const { return mesh_seconds_; }  // wall time meshing the polygon
   const ElasticModel& model() const { return model_; }
   Responder& responder() { return responder_; }
   const CriterionOptions& criterion() const { return criterion_; }
@@ -45,6 +46,7 @@ private:
   Result judged(std::span<const PointLoad> loads, const Observer& observe, double level);
 
   std::vector<Vec2> polygon_;
+  double mesh_seconds_ = 0.0;
   ElasticModel model_;
   Responder responder_;
   CriterionOptions criterion_;

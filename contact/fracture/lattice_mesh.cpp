@@ -2,6 +2,7 @@
 // triangular lattice inside, and their constrained Delaunay triangulation.
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <optional>
 
 #include "contact/fracture/mesh.hpp"
@@ -127,7 +128,8 @@ public:
       }
     }
     // New triangles (a, b, q): reuse the cavity's slots, then append.
-    std::vector<int> made(rim_.size());
+    made_.resize(rim_.size());
+    std::vector<int>& made = made_;
     for (std::size_t r = 0; r < rim_.size(); ++r) {
       int t;
       if (r < cavity_.size()) {
@@ -148,13 +150,14 @@ public:
       }
     }
     // The fan's own edges: (b, q) of the triangle from a to b is (q, b) of
-    // the one that starts at b.
-    for (std::size_t r = 0; r < rim_.size(); ++r)
-      for (std::size_t s = 0; s < rim_.size(); ++s)
-        if (rim_[s][0] == rim_[r][1]) {
-          t_[static_cast<std::size_t>(made[r])].n[0] = made[s];  // across (b, q), opposite a
-          t_[static_cast<std::size_t>(made[s])].n[1] = made[r];  // across (q, a'), opposite b' = its a's next
-        }
+    // the one that starts at b (found through a per-point slot).
+    if (starts_.size() < p_.size()) starts_.resize(p_.size(), -1);
+    for (std::size_t r = 0; r < rim_.size(); ++r) starts_[static_cast<std::size_t>(rim_[r][0])] = made[r];
+    for (std::size_t r = 0; r < rim_.size(); ++r) {
+      const int s = starts_[static_cast<std::size_t>(rim_[r][1])];
+      t_[static_cast<std::size_t>(made[r])].n[0] = s;  // across (b, q), opposite a
+      t_[static_cast<std::size_t>(s)].n[1] = made[r];  // across (q, b), opposite its own second vertex
+    }
     last_ = made[0];
     return true;
   }
@@ -237,6 +240,8 @@ private:
   std::vector<int> stamp_;  // per triangle: the point whose cavity holds it
   std::vector<int> cavity_;
   std::vector<std::array<int, 3>> rim_;
+  std::vector<int> made_;
+  std::vector<int> starts_;  // per point: the new triangle whose rim edge starts there
   int last_ = 0;
 };
 
@@ -301,6 +306,15 @@ std::optional<Mesh> mesh_lattice(std::span<const Vec2> polygon, double size, con
     sides.emplace_back(n, n.dot(polygon[i]));
   }
   const double margin = options.lattice_margin * a, row = a * std::sqrt(3.0) / 2.0;
+  // The six neighbours of a lattice point lie on one circle, so exact
+  // in-circle ties would be met at every insertion (and decided by the slow
+  // exact arithmetic); each point is moved by at most 1e-7 a, a fixed
+  // pseudo-random offset, which breaks them and changes no element measurably.
+  std::uint64_t state = 0x9E3779B97F4A7C15ull;
+  auto jitter = [&state, a]() {
+    state = state * 6364136223846793005ull + 1442695040888963407ull;
+    return 1e-7 * a * (static_cast<double>(state >> 11) / 9007199254740992.0 * 2.0 - 1.0);
+  };
   std::vector<Vec2> inside;
   for (int j = 1; j * row < top; ++j) {
     const double shift = (j % 2) * 0.5 * a;
@@ -314,7 +328,7 @@ std::optional<Mesh> mesh_lattice(std::span<const Vec2> polygon, double size, con
           keep = false;
           break;
         }
-      if (keep) line.push_back(x);
+      if (keep) line.push_back(x + Vec2{jitter(), jitter()});
     }
     if (j % 2 == 0) std::reverse(line.begin(), line.end());  // a serpentine: each point next to the last
     inside.insert(inside.end(), line.begin(), line.end());

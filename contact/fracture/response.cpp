@@ -1,6 +1,7 @@
 #include "contact/fracture/response.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 
 #include "core/error.hpp"
@@ -111,9 +112,11 @@ Eigen::VectorXd Responder::nodal_loads(std::span<const PointLoad> loads, bool im
 
 const SpdFactor& Responder::static_factor() {
   if (!static_) {
+    const auto begin = std::chrono::steady_clock::now();
     Eigen::SparseMatrix<double> a = model_.stiffness();
     for (Eigen::Index i = 0; i < a.rows(); ++i) a.coeffRef(i, i) += eps_ * model_.lumped_mass()[i];
     static_ = std::make_unique<SpdFactor>(a);
+    factor_seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
   }
   return *static_;
 }
@@ -142,6 +145,7 @@ Response Responder::respond(std::span<const PointLoad> loads, const Observer& ob
   const Eigen::VectorXd j = model_.relieve(nodal_loads(loads, true));
   const Eigen::VectorXd& m = model_.lumped_mass();
   const double root_blow = std::sqrt(blow_energy(j, m));  // sqrt(U), sqrt(J)
+  const auto begin = std::chrono::steady_clock::now();
   const Eigen::SparseMatrix<double>& k = model_.stiffness();
   const double dt = dt_, tau = options_.duration;
   if (!dynamic_) {
@@ -149,6 +153,7 @@ Response Responder::respond(std::span<const PointLoad> loads, const Observer& ob
     for (Eigen::Index i = 0; i < a.rows(); ++i) a.coeffRef(i, i) += 4.0 / (dt * dt) * m[i];
     dynamic_ = std::make_unique<SpdFactor>(a);
   }
+  factor_seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
   const Eigen::Index n = model_.dofs();
   Eigen::VectorXd u = Eigen::VectorXd::Zero(n), v = u, acc = u, rhs(n);
   r.steps = steps_;

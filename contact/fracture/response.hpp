@@ -98,6 +98,8 @@ public:
   double time_step() const { return dt_; }
   double end_time() const { return t_end_; }
   double shift() const { return eps_; }
+  // Wall time (s) so far in assembling K and factorising (both factors, on their first use).
+  double factor_seconds() const { return factor_seconds_; }
 
   // Nodal loads (N or N s per dof) of a set of point loads of one kind.
   Eigen::VectorXd nodal_loads(std::span<const PointLoad> loads, bool impulses) const;
@@ -162,6 +164,7 @@ private:
   double dt_ = 0.0, t_end_ = 0.0, beta_ = 0.0, eps_ = 0.0;
   double min_patch_ = 0.0;  // m^2, the smallest area of the triangles around a node (stress_bound)
   int steps_ = 0;
+  double factor_seconds_ = 0.0;
   // Pa: the largest nodal sigma_1 the mesh can have with strain energy `energy` (J).
   double stress_of_energy(double energy) const;
   std::unique_ptr<SpdFactor> static_, dynamic_;
