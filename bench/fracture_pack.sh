@@ -5,11 +5,13 @@
 # ("ice": floes break and split), run alternately, REPEATS rounds, one
 # thread. Writes CSV on stdout:
 #   scenario,variant,round,wall_s,steps,checks,screened,bounded,sustained,initiations,splits,analysis_s,split_s,
-#   cut_short,loop_steps,models,model_s
+#   cut_short,loop_steps,models,model_s,phase_s,mesh_s,bound_s,factor_s,lattice_meshes
 # (bounded: cases skipped by the stress bound; analysis_s: wall time in the analyses and bounds, models included;
 # split_s: in the splits, without the rebuild of the per-floe structures after them; cut_short: analyses whose time
 # loop stopped once it could no longer initiate; loop_steps: time steps the analyses ran; models: floe models built,
-# model_s their wall time. A baseline binary older than these counters leaves them empty.)
+# model_s their wall time; phase_s: the whole percussion phase, screen and splits included; mesh_s: of model_s, the
+# meshing; bound_s: the stress bounds; factor_s: assembling K and factorising, in bounds or analyses; lattice_meshes:
+# of models, meshed by the lattice mesher. A baseline binary older than these counters leaves them empty.)
 # Scenarios: wall_100 (examples/pack_against_wall.h5, 15 m/s wind against the
 # wall, 3000 s) and drift_500 (500 floes of 0.5 to 2 m at 50% in a periodic
 # 2 km box, 15 m/s wind: floes of different thickness drift at different
@@ -55,13 +57,13 @@ for v in off strong ice; do
   write drift_500 "$DIR/drift_500.h5" 1000 "domain = \"periodic\"
 box = [0.0, 2000.0, 0.0, 2000.0]" $v
 done
-echo "scenario,variant,round,wall_s,steps,checks,screened,bounded,sustained,initiations,splits,analysis_s,split_s,cut_short,loop_steps,models,model_s"
+echo "scenario,variant,round,wall_s,steps,checks,screened,bounded,sustained,initiations,splits,analysis_s,split_s,cut_short,loop_steps,models,model_s,phase_s,mesh_s,bound_s,factor_s,lattice_meshes"
 one() {  # scenario variant round binary name
   start=$(date +%s.%N)
   out=$(OMP_NUM_THREADS=1 "$4" run "$DIR/${1}_$2.toml" -q -o "$DIR/out.h5")
   end=$(date +%s.%N)
   get() { printf '%s\n' "$out" | awk -F': ' -v k="$1" '$1 == k { print $2 }'; }
-  echo "$1,$5,$3,$(echo "$end - $start" | bc),$(get steps),$(get fracture.checks),$(get fracture.screened),$(get fracture.bounded),$(get fracture.sustained),$(get fracture.initiations),$(get fracture.splits),$(get fracture.seconds),$(get fracture.split_seconds),$(get fracture.cut_short),$(get fracture.loop_steps),$(get fracture.models),$(get fracture.model_seconds)"
+  echo "$1,$5,$3,$(echo "$end - $start" | bc),$(get steps),$(get fracture.checks),$(get fracture.screened),$(get fracture.bounded),$(get fracture.sustained),$(get fracture.initiations),$(get fracture.splits),$(get fracture.seconds),$(get fracture.split_seconds),$(get fracture.cut_short),$(get fracture.loop_steps),$(get fracture.models),$(get fracture.model_seconds),$(get fracture.phase_seconds),$(get fracture.mesh_seconds),$(get fracture.bound_seconds),$(get fracture.factor_seconds),$(get fracture.lattice_meshes)"
 }
 for r in $(seq 1 "$REPEATS"); do
   for s in ${SCENARIOS:-wall_100 drift_500}; do
