@@ -153,9 +153,10 @@ struct ForcingParams {
 };
 
 enum class FractureCriterion { stress, griffith };
-// How floes are meshed (contact/fracture/mesh.hpp): auto, the lattice mesher
-// for convex floes whose lattice mesh meets the size and angle bounds and
-// CGAL's refinement for the rest; cgal, CGAL's refinement for every floe.
+// How floes are meshed (contact/fracture/mesh.hpp): cgal (the default),
+// CGAL's refinement for every floe; auto, the lattice mesher for convex floes
+// whose lattice mesh meets the size and angle bounds and CGAL's refinement for
+// the rest (faster meshing; a lattice has directions, docs/fracture.md).
 enum class FractureMesher { automatic, cgal };
 
 struct FractureLoad {
@@ -178,7 +179,7 @@ struct FractureParams {
   double load_radius = 0.0;       // m, loads spread over this radius; 0: the floe's thickness
   double min_fragment_area = 0.0; // m^2, no split leaves a piece smaller; 0: mesh_size^2
   double elements_across = 0.0;   // a floe's mesh size is at most its diameter / this; 0: mesh_size only
-  FractureMesher mesher = FractureMesher::automatic;
+  FractureMesher mesher = FractureMesher::cgal;
   std::vector<FractureLoad> loads;
 };
 

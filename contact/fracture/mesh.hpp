@@ -56,7 +56,7 @@ enum class Mesher {
 };
 
 struct MeshOptions {
-  Mesher mesher = Mesher::automatic;
+  Mesher mesher = Mesher::cgal;     // CGAL's irregular meshes unless asked (docs/fracture.md, "Mesh")
   double size = 2.0;                // m, upper bound on the triangles' edge length
   double shape_bound = 0.125;       // CGAL's B = sin^2(smallest angle allowed)
   double lattice_spacing = 0.6;     // the lattice's spacing and the outline's parts, over size

@@ -154,6 +154,7 @@ TEST_CASE("lattice mesh: tiles convex floes within its size and angle bounds, on
   for (std::size_t c = 0; c < cases.size(); ++c) {
     const auto& [poly, size] = cases[c];
     MeshOptions o;
+    o.mesher = Mesher::automatic;
     o.size = size;
     const Mesh m = mesh_polygon(poly, o);
     CAPTURE(c);
@@ -179,6 +180,7 @@ TEST_CASE("lattice mesh: tiles convex floes within its size and angle bounds, on
 TEST_CASE("lattice mesh: non-convex floes and mesher = cgal go to CGAL") {
   const std::vector<Vec2> ell{{0, 0}, {30, 0}, {30, 10}, {10, 10}, {10, 25}, {0, 25}};
   MeshOptions o;
+  o.mesher = Mesher::automatic;
   o.size = 3.0;
   CHECK(mesh_polygon(ell, o).mesher == Mesher::cgal);
   CHECK_FALSE(mesh_lattice(ell, 3.0, o).has_value());
@@ -190,6 +192,7 @@ TEST_CASE("lattice mesh: non-convex floes and mesher = cgal go to CGAL") {
 TEST_CASE("lattice mesh: about one triangle per 0.2 size^2, as CGAL's") {
   for (double size : {1.0, 2.0, 4.0}) {
     MeshOptions o;
+    o.mesher = Mesher::automatic;
     o.size = size;
     const Mesh lattice = mesh_polygon(rectangle(60.0, 40.0), o);
     o.mesher = Mesher::cgal;
