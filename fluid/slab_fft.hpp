@@ -26,17 +26,14 @@
 #include <vector>
 
 #include "fluid/fft2d.hpp"
+#include "fluid/ranks.hpp"
 
 namespace floesim::fluid {
 
 class SlabFft2d {
 public:
-  // Every rank's bytes to every rank: send holds the parts for ranks 0..N-1
-  // in order, send_counts[s] bytes for rank s; receive gets the parts from
-  // ranks 0..N-1 in order, receive_counts[s] bytes from rank s (both known
-  // to both sides). Collective: every rank calls it.
-  using Exchange = std::function<void(std::span<const std::byte> send, const std::vector<std::size_t>& send_counts,
-                                      std::span<std::byte> receive, const std::vector<std::size_t>& receive_counts)>;
+  // The transposes' all-to-all (fluid/ranks.hpp); collective.
+  using Exchange = decltype(SeaRanks::alltoall);
 
   // `fft` is the whole transform (planned on arrays of the alignment the
   // callers use); rank `rank` of `ranks`; `exchange` may be empty when ranks = 1.

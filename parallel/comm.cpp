@@ -170,6 +170,26 @@ void Communicator::allgather_known(std::span<const std::byte> mine, const std::v
 #endif
 }
 
+void Communicator::allgather_in_place(std::span<std::byte> all, const std::vector<std::size_t>& counts) const {
+  if (serial() || !impl_) return;
+#ifdef FLOESIM_HAVE_MPI
+  std::vector<int> sizes(counts.size()), offsets(counts.size());
+  std::size_t total = 0;
+  for (std::size_t r = 0; r < counts.size(); ++r) {
+    if (total + counts[r] > static_cast<std::size_t>(INT_MAX))
+      throw RunError("MPI: a gather of more than 2 GiB (" + std::to_string(total + counts[r]) +
+                     " bytes) is not supported");
+    sizes[r] = static_cast<int>(counts[r]);
+    offsets[r] = static_cast<int>(total);
+    total += counts[r];
+  }
+  FLOESIM_ASSERT(total <= all.size());
+  Counted counted(impl_->traffic, static_cast<long long>(total - counts[static_cast<std::size_t>(rank_)]));
+  check(MPI_Allgatherv(MPI_IN_PLACE, 0, MPI_BYTE, all.data(), sizes.data(), offsets.data(), MPI_BYTE, impl_->comm),
+        "MPI_Allgatherv");
+#endif
+}
+
 void Communicator::alltoall(std::span<const std::byte> send, const std::vector<std::size_t>& send_counts,
                             std::span<std::byte> receive, const std::vector<std::size_t>& receive_counts) const {
   if (serial() || !impl_) {

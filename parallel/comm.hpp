@@ -103,6 +103,11 @@ public:
   void allgather_known(std::span<const std::byte> mine, const std::vector<std::size_t>& counts,
                        std::vector<std::byte>& out) const;
 
+  // Bytes, in place: `all` holds the ranks' parts in rank order, counts[r]
+  // bytes for rank r (known to all); this rank's part is in place on entry,
+  // every rank's on exit. One collective call.
+  void allgather_in_place(std::span<std::byte> all, const std::vector<std::size_t>& counts) const;
+
   // Bytes from every rank to every rank (a transpose): `send` holds this
   // rank's parts for ranks 0..N-1 in order, send_counts[s] bytes for rank s;
   // `receive` gets the parts from ranks 0..N-1 in order, receive_counts[s]
