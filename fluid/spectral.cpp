@@ -149,31 +149,31 @@ struct SpectralSea::Impl {
       return;
     }
     for_own_modes([&](std::size_t begin, std::size_t end) {
-    for (std::size_t c = begin; c < end; ++c) {
-      double a0 = a[2 * c], a1 = a[2 * c + 1];
-      for (int i = 0; i < kicks; ++i) {
-        const double g = kick_h[i] * gain[c];
-        const double* s = kick_data(i);
-        a0 += g * s[2 * c];
-        a1 += g * s[2 * c + 1];
+      for (std::size_t c = begin; c < end; ++c) {
+        double a0 = a[2 * c], a1 = a[2 * c + 1];
+        for (int i = 0; i < kicks; ++i) {
+          const double g = kick_h[i] * gain[c];
+          const double* s = kick_data(i);
+          a0 += g * s[2 * c];
+          a1 += g * s[2 * c + 1];
+        }
+        double s = 1.0;
+        if (factor) s *= (*factor)[c];
+        const double re = a0 * s, im = a1 * s;
+        if (deriv_vy) {
+          const double k = (*deriv_vy)[c];
+          spec_vy[c][0] = -k * im;
+          spec_vy[c][1] = k * re;
+        }
+        if (deriv) {
+          const double k = (*deriv)[c];
+          spec[c][0] = -k * im;
+          spec[c][1] = k * re;
+        } else {
+          spec[c][0] = re;
+          spec[c][1] = im;
+        }
       }
-      double s = 1.0;
-      if (factor) s *= (*factor)[c];
-      const double re = a0 * s, im = a1 * s;
-      if (deriv_vy) {
-        const double k = (*deriv_vy)[c];
-        spec_vy[c][0] = -k * im;
-        spec_vy[c][1] = k * re;
-      }
-      if (deriv) {
-        const double k = (*deriv)[c];
-        spec[c][0] = -k * im;
-        spec[c][1] = k * re;
-      } else {
-        spec[c][0] = re;
-        spec[c][1] = im;
-      }
-    }
     });
   }
 
