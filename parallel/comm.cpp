@@ -187,6 +187,9 @@ void Communicator::allgather_in_place(std::span<std::byte> all, const std::vecto
   Counted counted(impl_->traffic, static_cast<long long>(total - counts[static_cast<std::size_t>(rank_)]));
   check(MPI_Allgatherv(MPI_IN_PLACE, 0, MPI_BYTE, all.data(), sizes.data(), offsets.data(), MPI_BYTE, impl_->comm),
         "MPI_Allgatherv");
+#else
+  (void)all;
+  (void)counts;
 #endif
 }
 
@@ -221,6 +224,9 @@ void Communicator::alltoall(std::span<const std::byte> send, const std::vector<s
   check(MPI_Alltoallv(send.data(), send_sizes.data(), send_offsets.data(), MPI_BYTE, receive.data(),
                       receive_sizes.data(), receive_offsets.data(), MPI_BYTE, impl_->comm),
         "MPI_Alltoallv");
+#else
+  (void)send_counts;
+  (void)receive_counts;
 #endif
 }
 
