@@ -102,6 +102,24 @@ Simulation::Simulation(Scenario scenario, parallel::Communicator comm)
   sea_options.tank = {c.sea.tank.enabled, c.sea.tank.generation_length, c.sea.tank.absorption_length,
                       c.sea.tank.rate, c.sea.tank.ramp_periods};
   sea_options.threads = resolve_threads(c.run.threads);
+  // The incident waves' sea (below) stays whole on every rank.
+  const fluid::SeaOptions incident_options = sea_options;
+  // On several ranks the spectral sea runs in slabs (docs/parallel.md, stage
+  // four) with the explicit kicks; the implicit step and a tank keep it
+  // whole on every rank.
+  if (!comm_.serial() && c.sea.model == SeaModel::spectral && c.sea.dims == 2 && !c.sea.tank.enabled &&
+      c.coupling.integrator == CouplingIntegrator::explicit_kicks) {
+    const parallel::Communicator ranks = comm_;
+    sea_options.ranks.rank = ranks.rank();
+    sea_options.ranks.ranks = ranks.size();
+    sea_options.ranks.alltoall = [ranks](std::span<const std::byte> send, const std::vector<std::size_t>& send_counts,
+                                        std::span<std::byte> receive, const std::vector<std::size_t>& receive_counts) {
+      ranks.alltoall(send, send_counts, receive, receive_counts);
+    };
+    sea_options.ranks.allgather = [ranks](std::span<std::byte> all, const std::vector<std::size_t>& counts) {
+      ranks.allgather_in_place(all, counts);
+    };
+  }
   try {
     sea_ = fluid::make_sea(c.sea, c.run.seed, sea_options);  // its input errors name the [sea] key; add the file
   } catch (const InputError& e) {
@@ -114,7 +132,7 @@ Simulation::Simulation(Scenario scenario, parallel::Communicator comm)
     floe_sea_->set_threads(resolve_threads(c.run.threads));
     floe_sea_->set_communicator(comm_);
     if (c.sea.waves.kind != WaveKind::none || c.sea.tank.enabled)
-      incident_ = std::make_unique<IncidentSea>(fluid::make_sea(c.sea, c.run.seed, sea_options),
+      incident_ = std::make_unique<IncidentSea>(fluid::make_sea(c.sea, c.run.seed, incident_options),
                                                 IncidentSea::interval_for(c.sea));
     floe_sea_->start(scenario_.floes, *sea_, c.coupling.start_given);
     floe_sea_->ready_loads(scenario_.floes, *sea_, incident_.get(), 0.5 * c.run.dt_max);

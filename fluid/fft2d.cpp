@@ -51,29 +51,43 @@ bool RealFft2d::valid() const {
 }
 
 void RealFft2d::forward(const double* in, fftw_complex* out, int threads) const {
-  const int row_blocks = (ny_ + kRows - 1) / kRows, column_blocks = (hx_ + kColumns - 1) / kColumns;
-  for_each_block(row_blocks, threads, [&](int b) {
-    const int r0 = b * kRows;
+  forward_rows(in, out, 0, row_blocks(), threads);
+  forward_columns(out, 0, column_blocks(), threads);
+}
+
+void RealFft2d::backward(fftw_complex* in, double* out, int threads) const {
+  backward_columns(in, 0, column_blocks(), threads);
+  backward_rows(in, out, 0, row_blocks(), threads);
+}
+
+void RealFft2d::forward_rows(const double* in, fftw_complex* out, int first, int last, int threads) const {
+  for_each_block(last - first, threads, [&](int j) {
+    const int r0 = (first + j) * kRows;
     const fftw_plan p = r0 + kRows <= ny_ || ny_ < kRows ? rows_r2c_[0] : rows_r2c_[1];
     fftw_execute_dft_r2c(p, const_cast<double*>(in) + static_cast<std::ptrdiff_t>(r0) * nx_,
                          out + static_cast<std::ptrdiff_t>(r0) * hx_);
   });
-  for_each_block(column_blocks, threads, [&](int b) {
-    const int c0 = b * kColumns;
+}
+
+void RealFft2d::forward_columns(fftw_complex* spec, int first, int last, int threads) const {
+  for_each_block(last - first, threads, [&](int j) {
+    const int c0 = (first + j) * kColumns;
     const fftw_plan p = c0 + kColumns <= hx_ || hx_ < kColumns ? columns_forward_[0] : columns_forward_[1];
-    fftw_execute_dft(p, out + c0, out + c0);
+    fftw_execute_dft(p, spec + c0, spec + c0);
   });
 }
 
-void RealFft2d::backward(fftw_complex* in, double* out, int threads) const {
-  const int row_blocks = (ny_ + kRows - 1) / kRows, column_blocks = (hx_ + kColumns - 1) / kColumns;
-  for_each_block(column_blocks, threads, [&](int b) {
-    const int c0 = b * kColumns;
+void RealFft2d::backward_columns(fftw_complex* spec, int first, int last, int threads) const {
+  for_each_block(last - first, threads, [&](int j) {
+    const int c0 = (first + j) * kColumns;
     const fftw_plan p = c0 + kColumns <= hx_ || hx_ < kColumns ? columns_backward_[0] : columns_backward_[1];
-    fftw_execute_dft(p, in + c0, in + c0);
+    fftw_execute_dft(p, spec + c0, spec + c0);
   });
-  for_each_block(row_blocks, threads, [&](int b) {
-    const int r0 = b * kRows;
+}
+
+void RealFft2d::backward_rows(fftw_complex* in, double* out, int first, int last, int threads) const {
+  for_each_block(last - first, threads, [&](int j) {
+    const int r0 = (first + j) * kRows;
     const fftw_plan p = r0 + kRows <= ny_ || ny_ < kRows ? rows_c2r_[0] : rows_c2r_[1];
     fftw_execute_dft_c2r(p, in + static_cast<std::ptrdiff_t>(r0) * hx_, out + static_cast<std::ptrdiff_t>(r0) * nx_);
   });

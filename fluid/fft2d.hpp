@@ -10,6 +10,11 @@
 // the thread count. Blocks start at multiples of 64 bytes from the arrays'
 // starts, so every block has the alignment of the arrays the plans were
 // made on; callers pass arrays of that alignment (fftw_alloc_*).
+//
+// Each pass can also be run on a range of its blocks alone ([first, last) of
+// row_blocks() or column_blocks()): a block's result depends on its input
+// alone, so a transform spread over ranks by blocks (fluid/slab_fft.hpp)
+// gives the same bits as the whole one.
 
 #include <fftw3.h>
 
@@ -30,8 +35,19 @@ public:
   // out <- IFFT(in), unnormalised; in is destroyed.
   void backward(fftw_complex* in, double* out, int threads) const;
 
-private:
+  // The passes on blocks [first, last): forward = forward_rows then
+  // forward_columns on every block; backward = backward_columns then
+  // backward_rows. A row block is rows [kRows b, min(kRows (b + 1), ny)) of
+  // both arrays, a column block columns [kColumns b, ...) of the half spectrum.
   static constexpr int kRows = 8, kColumns = 4;
+  int row_blocks() const { return (ny_ + kRows - 1) / kRows; }
+  int column_blocks() const { return (hx_ + kColumns - 1) / kColumns; }
+  void forward_rows(const double* in, fftw_complex* out, int first, int last, int threads) const;
+  void forward_columns(fftw_complex* spec, int first, int last, int threads) const;
+  void backward_columns(fftw_complex* spec, int first, int last, int threads) const;
+  void backward_rows(fftw_complex* in, double* out, int first, int last, int threads) const;
+
+private:
   int nx_ = 0, ny_ = 0, hx_ = 0;
   // [0]: a full block, [1]: the remainder (nullptr when none).
   fftw_plan rows_r2c_[2] = {nullptr, nullptr}, rows_c2r_[2] = {nullptr, nullptr};

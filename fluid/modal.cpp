@@ -91,8 +91,12 @@ void ModalBank::kick_flow(std::span<const Kick> kicks, double dt, double* q_out)
     if (q_out) std::copy(q_.begin(), q_.end(), q_out);
     return;
   }
+  kick_flow(kicks, dt, q_out, 0, omega_.size());
+}
+
+void ModalBank::kick_flow(std::span<const Kick> kicks, double dt, double* q_out, std::size_t first, std::size_t last) {
+  FLOESIM_ASSERT(components_ == 2 && kicks.size() <= 2 && first <= last && last <= omega_.size());
   prepare(dt);
-  const std::size_t n = omega_.size();
   double* q = q_.data();
   double* v = v_.data();
   const double* c = c_.data();
@@ -104,7 +108,7 @@ void ModalBank::kick_flow(std::span<const Kick> kicks, double dt, double* q_out)
   const double* s1 = kicks.size() > 1 ? kicks[1].s : s0;
   const double h0 = kicks.size() > 0 ? kicks[0].h : 0.0;
   const double h1 = kicks.size() > 1 ? kicks[1].h : 0.0;
-  for (std::size_t j = 0; j < n; ++j) {
+  for (std::size_t j = first; j < last; ++j) {
     const double a0 = h0 * g[j], a1 = h1 * g[j];
     const double q0 = q[2 * j], q1 = q[2 * j + 1];
     const double v0 = v[2 * j] + a0 * s0[2 * j] + a1 * s1[2 * j];

@@ -65,6 +65,10 @@ public:
     double h;
   };
   void kick_flow(std::span<const Kick> kicks, double dt, double* q_out = nullptr);
+  // The same on modes [first, last) only (components = 2, at most two
+  // kicks); the other modes are left as they were. Each mode's arithmetic
+  // is kick_flow's, so a bank stepped in ranges equals one stepped whole.
+  void kick_flow(std::span<const Kick> kicks, double dt, double* q_out, std::size_t first, std::size_t last);
 
   // The implicit midpoint rule (for this linear bank, the trapezoidal rule)
   // over h with the load s held over the step (laid out like v; empty: none):

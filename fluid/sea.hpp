@@ -30,6 +30,7 @@
 #include "fluid/aligned.hpp"
 #include "fluid/grid.hpp"
 #include "fluid/modal.hpp"
+#include "fluid/ranks.hpp"
 #include "fluid/tank.hpp"
 
 namespace floesim::fluid {
@@ -68,6 +69,9 @@ struct SeaOptions {
   // (relative error O((1 / bem_near_field)^4); docs/sea.md). inf: all exact.
   double bem_near_field = 3.0;
   int threads = 1;                 // spectral, dims = 2: threads of the transforms (the bits do not depend on it)
+  // spectral, dims = 2, no tank: on several ranks, the sea in slabs (each
+  // rank transforms and steps a share; spectral.hpp). Ignored otherwise.
+  SeaRanks ranks;
 };
 
 class Sea {

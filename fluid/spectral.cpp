@@ -4,11 +4,13 @@
 
 #include <array>
 #include <cmath>
+#include <cstring>
 #include <numbers>
 #include <optional>
 
 #include "core/error.hpp"
 #include "fluid/fft2d.hpp"
+#include "fluid/slab_fft.hpp"
 #include "fluid/waves.hpp"
 
 namespace floesim::fluid {
@@ -60,6 +62,26 @@ struct SpectralSea::Impl {
   bool staged = false;
   std::optional<TankZones> tank;
   AlignedVector tank_eta, tank_rate;
+  // The sea in slabs (ranks.distributed(); spectral.hpp): this rank's rows
+  // of the fields and columns of the modes. `gathered`: every rank's bank
+  // holds every mode's present state (else only its own columns' are).
+  SeaRanks ranks;
+  std::unique_ptr<SlabFft2d> slab;
+  SlabFft2d::Span rows, columns;
+  bool gathered = true;
+  std::vector<std::size_t> row_bytes, mode_bytes;  // each rank's part of a field and of the bank (q and v)
+  std::vector<std::byte> modes_buffer;
+
+  // f(first, last) for each range of this rank's modes (its columns of each
+  // row of the half spectrum); every mode when not in slabs.
+  template <class F>
+  void for_own_modes(F&& f) const {
+    if (!slab) return f(std::size_t{0}, nc);
+    for (int iy = 0; iy < ny; ++iy) {
+      const std::size_t row = static_cast<std::size_t>(iy) * hx;
+      f(row + columns.begin, row + columns.end);
+    }
+  }
 
   ~Impl() {
     if (r2c) fftw_destroy_plan(r2c);
@@ -74,7 +96,18 @@ struct SpectralSea::Impl {
     return fftw_alignment_of(const_cast<double*>(p)) == fftw_alignment_of(real);
   }
 
-  // to <- FFT(field); `to` is spec or a kick buffer (same alignment).
+  // to <- FFT(field) on this rank's columns (in slabs: reading the
+  // field's rows of this rank only), to a kick buffer.
+  void forward_kick(std::span<const double> field, fftw_complex* to) {
+    if (!slab) return forward(field, to);
+    const double* in = field.data();
+    if (!aligned(in)) {
+      std::copy(field.begin(), field.end(), real);
+      in = real;
+    }
+    slab->forward(in, to, threads);
+  }
+  // to <- FFT(field), every mode on every rank; `to` is spec or a kick buffer (same alignment).
   void forward(std::span<const double> field, fftw_complex* to) {
     const double* in = field.data();
     if (!aligned(in)) {
@@ -85,9 +118,18 @@ struct SpectralSea::Impl {
     if (fft2) fft2->forward(in, to, threads);
     else fftw_execute_dft_r2c(r2c, const_cast<double*>(in), to);
   }
-  // out <- IFFT(from) (unnormalised; `from`, spec or spec_vy, is destroyed)
+  // out <- IFFT(from) (unnormalised; `from`, spec or spec_vy, is destroyed).
+  // In slabs: from this rank's columns of `from` to its rows of out, then
+  // every rank's rows gathered into out.
   void backward(std::span<double> out, fftw_complex* from) {
     double* to = aligned(out.data()) ? out.data() : real;
+    if (slab) {
+      slab->backward(from, to, threads);
+      const std::size_t begin = static_cast<std::size_t>(rows.begin) * nx, end = static_cast<std::size_t>(rows.end) * nx;
+      if (to == real) std::copy(real + begin, real + end, out.begin() + static_cast<std::ptrdiff_t>(begin));
+      ranks.allgather(std::as_writable_bytes(out), row_bytes);
+      return;
+    }
     if (fft2) fft2->backward(from, to, threads);
     else fftw_execute_dft_c2r(c2r, from, to);
     if (to == real) std::copy(real, real + n, out.begin());
@@ -106,31 +148,66 @@ struct SpectralSea::Impl {
       std::copy(a.begin(), a.end(), reinterpret_cast<double*>(spec));
       return;
     }
-    for (std::size_t c = 0; c < nc; ++c) {
-      double a0 = a[2 * c], a1 = a[2 * c + 1];
-      for (int i = 0; i < kicks; ++i) {
-        const double g = kick_h[i] * gain[c];
-        const double* s = kick_data(i);
-        a0 += g * s[2 * c];
-        a1 += g * s[2 * c + 1];
+    for_own_modes([&](std::size_t begin, std::size_t end) {
+      for (std::size_t c = begin; c < end; ++c) {
+        double a0 = a[2 * c], a1 = a[2 * c + 1];
+        for (int i = 0; i < kicks; ++i) {
+          const double g = kick_h[i] * gain[c];
+          const double* s = kick_data(i);
+          a0 += g * s[2 * c];
+          a1 += g * s[2 * c + 1];
+        }
+        double s = 1.0;
+        if (factor) s *= (*factor)[c];
+        const double re = a0 * s, im = a1 * s;
+        if (deriv_vy) {
+          const double k = (*deriv_vy)[c];
+          spec_vy[c][0] = -k * im;
+          spec_vy[c][1] = k * re;
+        }
+        if (deriv) {
+          const double k = (*deriv)[c];
+          spec[c][0] = -k * im;
+          spec[c][1] = k * re;
+        } else {
+          spec[c][0] = re;
+          spec[c][1] = im;
+        }
       }
-      double s = 1.0;
-      if (factor) s *= (*factor)[c];
-      const double re = a0 * s, im = a1 * s;
-      if (deriv_vy) {
-        const double k = (*deriv_vy)[c];
-        spec_vy[c][0] = -k * im;
-        spec_vy[c][1] = k * re;
-      }
-      if (deriv) {
-        const double k = (*deriv)[c];
-        spec[c][0] = -k * im;
-        spec[c][1] = k * re;
-      } else {
-        spec[c][0] = re;
-        spec[c][1] = im;
-      }
+    });
+  }
+
+  // Every rank's columns of the bank (q and v) to every rank: the bank whole
+  // and current everywhere (each rank's modes as that rank stepped them).
+  void gather_modes(ModalBank& bank) {
+    if (!slab || gathered) return;
+    std::size_t offset = 0;
+    for (int r = 0; r < ranks.rank; ++r) offset += mode_bytes[static_cast<std::size_t>(r)];
+    std::size_t total = offset;
+    for (std::size_t r = static_cast<std::size_t>(ranks.rank); r < mode_bytes.size(); ++r) total += mode_bytes[r];
+    modes_buffer.resize(total);
+    // A rank's part: its columns of q, row by row, then of v.
+    auto walk = [&](int rank, std::byte* at, bool pack) {
+      const SlabFft2d::Span cols = slab->columns_of(rank);
+      const std::size_t bytes = 2 * sizeof(double) * static_cast<std::size_t>(cols.end - cols.begin);
+      for (std::span<double> a : {bank.q(), bank.v()})
+        for (int iy = 0; iy < ny; ++iy) {
+          auto* mode = reinterpret_cast<std::byte*>(a.data() + 2 * (static_cast<std::size_t>(iy) * hx + cols.begin));
+          if (bytes > 0) {
+            if (pack) std::memcpy(at, mode, bytes);
+            else std::memcpy(mode, at, bytes);
+          }
+          at += bytes;
+        }
+    };
+    walk(ranks.rank, modes_buffer.data() + offset, true);
+    ranks.allgather(modes_buffer, mode_bytes);
+    std::byte* at = modes_buffer.data();
+    for (int r = 0; r < ranks.ranks; ++r) {
+      if (r != ranks.rank) walk(r, at, false);
+      at += mode_bytes[static_cast<std::size_t>(r)];
     }
+    gathered = true;
   }
 };
 
@@ -162,6 +239,17 @@ SpectralSea::SpectralSea(const SeaParams& params, const SeaOptions& options)
     planned = m.r2c && m.c2r;
   }
   if (!planned) throw RunError("fluid: FFTW could not plan the spectral sea transforms");
+  if (m.fft2 && options.ranks.distributed() && !options.tank.enabled) {
+    m.ranks = options.ranks;
+    m.slab = std::make_unique<SlabFft2d>(*m.fft2, m.nx, m.ny, m.ranks.rank, m.ranks.ranks, m.ranks.alltoall);
+    m.rows = m.slab->rows();
+    m.columns = m.slab->columns();
+    for (int r = 0; r < m.ranks.ranks; ++r) {
+      const SlabFft2d::Span rows = m.slab->rows_of(r), cols = m.slab->columns_of(r);
+      m.row_bytes.push_back(sizeof(double) * static_cast<std::size_t>(rows.end - rows.begin) * m.nx);
+      m.mode_bytes.push_back(2 * 2 * sizeof(double) * static_cast<std::size_t>(cols.end - cols.begin) * m.ny);
+    }
+  }
 
   // Oscillator bank on the normalised coefficients eta_k = FFT(eta) / n, so that
   // a field is the plain c2r of its coefficients. Parseval on the half spectrum:
@@ -220,7 +308,7 @@ void SpectralSea::kick(std::span<const double> pressure, double h) {
   FLOESIM_ASSERT(pressure.size() == m.n);
   if (m.pending == 2) settle();
   const int buf = m.pending == 1 ? 1 - m.kick_buf[0] : 0;  // one not in use
-  m.forward(pressure, m.kick_spec[buf]);
+  m.forward_kick(pressure, m.kick_spec[buf]);
   m.kick_buf[m.pending] = buf;
   m.kick_h[m.pending] = h;
   m.last = buf;
@@ -245,8 +333,12 @@ void SpectralSea::repeat_kick(double h) {
 
 void SpectralSea::settle() {
   Impl& m = *impl_;
+  // In slabs the kicks' spectra hold this rank's columns only: the other
+  // modes' sums are overwritten by their owners' in the gather.
+  if (m.slab && m.pending > 0) m.gathered = false;
   for (int i = 0; i < m.pending; ++i) bank_.kick(std::span<const double>(m.kick_data(i), 2 * m.nc), m.kick_h[i]);
   m.pending = 0;
+  m.gather_modes(bank_);
   // Base::modes() settles before handing out the state to be changed: the
   // staged spectra may not outlive that.
   m.staged = false;
@@ -268,6 +360,7 @@ void SpectralSea::set_surface(std::span<const double> eta, std::span<const doubl
   };
   copy_in(eta, bank_.q());
   copy_in(eta_t, bank_.v());
+  m.gathered = true;  // the whole transform, on every rank
   invalidate();
 }
 
@@ -278,8 +371,15 @@ void SpectralSea::flow(double dt) {
     std::array<ModalBank::Kick, 2> kicks{};
     for (int i = 0; i < m.pending; ++i)
       kicks[i] = {m.kick_data(i), m.kick_h[i]};
-    bank_.kick_flow(std::span(kicks.data(), static_cast<std::size_t>(m.pending)), dt,
-                    reinterpret_cast<double*>(m.spec));
+    const std::span<const ModalBank::Kick> pending(kicks.data(), static_cast<std::size_t>(m.pending));
+    if (m.slab) {
+      m.for_own_modes([&](std::size_t begin, std::size_t end) {
+        bank_.kick_flow(pending, dt, reinterpret_cast<double*>(m.spec), begin, end);
+      });
+      m.gathered = false;
+    } else {
+      bank_.kick_flow(pending, dt, reinterpret_cast<double*>(m.spec));
+    }
     m.pending = 0;
     m.staged = true;
   } else {

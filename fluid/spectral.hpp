@@ -19,6 +19,18 @@
 // kicks as they load the rates, energy() and modes() settle them first. A
 // repeated kick costs no FFT: it defers the spectrum of the last kick again,
 // as a kick of its own, so a query that settles in between changes no bit.
+//
+// On several ranks (SeaOptions::ranks; dims = 2, no tank) the sea runs in
+// slabs (fluid/slab_fft.hpp): a kick transforms the rows of this rank's
+// slab of the pressure (the rest of the pressure is not read) into its
+// columns of modes; flow steps those modes only; a field is transformed
+// from them back to this rank's rows, and every rank's rows are then
+// gathered, so fields are whole on every rank. The bank is whole on every
+// rank but only this rank's columns are current after a flow; settle()
+// (energy(), modes(): collective then) gathers every rank's columns first.
+// Each mode and each block of the transforms is computed with the serial
+// arithmetic, so the state and the fields are the serial ones to the bit.
+// The whole transforms stay for set_surface, project and synthesize.
 
 #include <memory>
 

@@ -1,5 +1,6 @@
 #include "parallel/comm.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <climits>
 #include <cstdio>
@@ -166,6 +167,66 @@ void Communicator::allgather_known(std::span<const std::byte> mine, const std::v
   check(MPI_Allgatherv(mine.data(), static_cast<int>(mine.size()), MPI_BYTE, out.data(), sizes.data(),
                        offsets.data(), MPI_BYTE, impl_->comm),
         "MPI_Allgatherv");
+#endif
+}
+
+void Communicator::allgather_in_place(std::span<std::byte> all, const std::vector<std::size_t>& counts) const {
+  if (serial() || !impl_) return;
+#ifdef FLOESIM_HAVE_MPI
+  std::vector<int> sizes(counts.size()), offsets(counts.size());
+  std::size_t total = 0;
+  for (std::size_t r = 0; r < counts.size(); ++r) {
+    if (total + counts[r] > static_cast<std::size_t>(INT_MAX))
+      throw RunError("MPI: a gather of more than 2 GiB (" + std::to_string(total + counts[r]) +
+                     " bytes) is not supported");
+    sizes[r] = static_cast<int>(counts[r]);
+    offsets[r] = static_cast<int>(total);
+    total += counts[r];
+  }
+  FLOESIM_ASSERT(total <= all.size());
+  Counted counted(impl_->traffic, static_cast<long long>(total - counts[static_cast<std::size_t>(rank_)]));
+  check(MPI_Allgatherv(MPI_IN_PLACE, 0, MPI_BYTE, all.data(), sizes.data(), offsets.data(), MPI_BYTE, impl_->comm),
+        "MPI_Allgatherv");
+#else
+  (void)all;
+  (void)counts;
+#endif
+}
+
+void Communicator::alltoall(std::span<const std::byte> send, const std::vector<std::size_t>& send_counts,
+                            std::span<std::byte> receive, const std::vector<std::size_t>& receive_counts) const {
+  if (serial() || !impl_) {
+    std::copy(send.begin(), send.end(), receive.begin());
+    return;
+  }
+#ifdef FLOESIM_HAVE_MPI
+  auto displace = [](const std::vector<std::size_t>& counts, std::vector<int>& sizes, std::vector<int>& offsets) {
+    sizes.resize(counts.size());
+    offsets.resize(counts.size());
+    std::size_t total = 0;
+    for (std::size_t r = 0; r < counts.size(); ++r) {
+      if (total + counts[r] > static_cast<std::size_t>(INT_MAX))
+        throw RunError("MPI: an all-to-all of more than 2 GiB (" + std::to_string(total + counts[r]) +
+                       " bytes) is not supported");
+      sizes[r] = static_cast<int>(counts[r]);
+      offsets[r] = static_cast<int>(total);
+      total += counts[r];
+    }
+    return total;
+  };
+  std::vector<int> send_sizes, send_offsets, receive_sizes, receive_offsets;
+  const std::size_t sent = displace(send_counts, send_sizes, send_offsets);
+  FLOESIM_ASSERT(sent <= send.size());
+  (void)sent;
+  const std::size_t received = displace(receive_counts, receive_sizes, receive_offsets);
+  FLOESIM_ASSERT(received <= receive.size());
+  Counted counted(impl_->traffic, static_cast<long long>(received));
+  check(MPI_Alltoallv(send.data(), send_sizes.data(), send_offsets.data(), MPI_BYTE, receive.data(),
+                      receive_sizes.data(), receive_offsets.data(), MPI_BYTE, impl_->comm),
+        "MPI_Alltoallv");
+#else
+  (void)send_counts;
+  (void)receive_counts;
 #endif
 }
 

@@ -103,6 +103,18 @@ public:
   void allgather_known(std::span<const std::byte> mine, const std::vector<std::size_t>& counts,
                        std::vector<std::byte>& out) const;
 
+  // Bytes, in place: `all` holds the ranks' parts in rank order, counts[r]
+  // bytes for rank r (known to all); this rank's part is in place on entry,
+  // every rank's on exit. One collective call.
+  void allgather_in_place(std::span<std::byte> all, const std::vector<std::size_t>& counts) const;
+
+  // Bytes from every rank to every rank (a transpose): `send` holds this
+  // rank's parts for ranks 0..N-1 in order, send_counts[s] bytes for rank s;
+  // `receive` gets the parts from ranks 0..N-1 in order, receive_counts[s]
+  // bytes from rank s. Both sides know every count. One collective call.
+  void alltoall(std::span<const std::byte> send, const std::vector<std::size_t>& send_counts,
+                std::span<std::byte> receive, const std::vector<std::size_t>& receive_counts) const;
+
   // The sum of one integer over the ranks (in rank order; exact).
   long long sum(long long value) const;
   // True on every rank when it is true on any.
