@@ -192,14 +192,41 @@ void LemkeBasis::solve(Vector& x) {
   for (Index c = 0; c < covered; ++c) x(w_positions_[c]) = w_values_(c);
   for (Index s = 0; s < k; ++s) x(s_positions_[s]) = reduced_(s);
   // The etas, oldest first: x <- E^-1 x with x_r / u_r at r, x_i - u_i x_r' elsewhere.
-  for (std::size_t e = 0; e < eta_pos_.size(); ++e) {
-    const Index r = eta_pos_[e];
-    const auto u = eta_u_.col(static_cast<Index>(e)).head(n_);
-    const double xr = x(r) / u(r);
-    if (xr != 0.0) {
-      x.noalias() -= xr * u;
-      x(r) = xr;
+  // Two at a time where both act: x_r2 after the first is found alone, then
+  // one pass does x_i <- (x_i - x_r1' u1_i) - x_r2' u2_i, the same operations
+  // in the same order as two passes, with half the passes over x.
+  const std::size_t etas = eta_pos_.size();
+  std::size_t e = 0;
+  while (e < etas) {
+    const Index r1 = eta_pos_[e];
+    const auto u1 = eta_u_.col(static_cast<Index>(e)).head(n_);
+    const double xr1 = x(r1) / u1(r1);
+    if (xr1 == 0.0) {
+      ++e;
+      continue;
     }
+    if (e + 1 < etas) {
+      const Index r2 = eta_pos_[e + 1];
+      const auto u2 = eta_u_.col(static_cast<Index>(e + 1)).head(n_);
+      const double x2 = r2 == r1 ? xr1 : x(r2) - xr1 * u1(r2);
+      const double xr2 = x2 / u2(r2);
+      if (xr2 != 0.0) {
+        const double x1 = r1 == r2 ? xr2 : xr1 - xr2 * u2(r1);
+        x.noalias() = (x - xr1 * u1) - xr2 * u2;
+        x(r1) = x1;
+        x(r2) = xr2;
+        e += 2;
+        continue;
+      }
+      // The second does nothing: the first alone.
+      x.noalias() -= xr1 * u1;
+      x(r1) = xr1;
+      e += 2;
+      continue;
+    }
+    x.noalias() -= xr1 * u1;
+    x(r1) = xr1;
+    ++e;
   }
 }
 
