@@ -192,41 +192,45 @@ void LemkeBasis::solve(Vector& x) {
   for (Index c = 0; c < covered; ++c) x(w_positions_[c]) = w_values_(c);
   for (Index s = 0; s < k; ++s) x(s_positions_[s]) = reduced_(s);
   // The etas, oldest first: x <- E^-1 x with x_r / u_r at r, x_i - u_i x_r' elsewhere.
-  // Two at a time where both act: x_r2 after the first is found alone, then
-  // one pass does x_i <- (x_i - x_r1' u1_i) - x_r2' u2_i, the same operations
-  // in the same order as two passes, with half the passes over x.
+  // Up to four at a time: each one's x_r' is found from the entry x_r as the
+  // etas before it in the group left it (an eta with x_r' = 0 does nothing
+  // and is dropped), then one pass over x does x_i <- ((x_i - x_r1' u1_i) -
+  // x_r2' u2_i) - ..., and the group's entries r are set to what the etas in
+  // turn leave there: the same operations in the same order as one pass per
+  // eta, with a quarter of the passes over x.
+  constexpr int kGroup = 4;
   const std::size_t etas = eta_pos_.size();
   std::size_t e = 0;
   while (e < etas) {
-    const Index r1 = eta_pos_[e];
-    const auto u1 = eta_u_.col(static_cast<Index>(e)).head(n_);
-    const double xr1 = x(r1) / u1(r1);
-    if (xr1 == 0.0) {
-      ++e;
-      continue;
+    Index r[kGroup], col[kGroup];
+    double xr[kGroup], at_r[kGroup];
+    int m = 0;
+    for (; m < kGroup && e < etas; ++e) {
+      const Index re = eta_pos_[e];
+      const auto u = eta_u_.col(static_cast<Index>(e));
+      double v = x(re);
+      for (int i = 0; i < m; ++i) v = re == r[i] ? xr[i] : v - xr[i] * eta_u_(re, col[i]);
+      const double xe = v / u(re);
+      if (xe == 0.0) continue;
+      r[m] = re;
+      col[m] = static_cast<Index>(e);
+      xr[m] = xe;
+      ++m;
     }
-    if (e + 1 < etas) {
-      const Index r2 = eta_pos_[e + 1];
-      const auto u2 = eta_u_.col(static_cast<Index>(e + 1)).head(n_);
-      const double x2 = r2 == r1 ? xr1 : x(r2) - xr1 * u1(r2);
-      const double xr2 = x2 / u2(r2);
-      if (xr2 != 0.0) {
-        const double x1 = r1 == r2 ? xr2 : xr1 - xr2 * u2(r1);
-        x.noalias() = (x - xr1 * u1) - xr2 * u2;
-        x(r1) = x1;
-        x(r2) = xr2;
-        e += 2;
-        continue;
-      }
-      // The second does nothing: the first alone.
-      x.noalias() -= xr1 * u1;
-      x(r1) = xr1;
-      e += 2;
-      continue;
+    for (int j = 0; j < m; ++j) {
+      double v = x(r[j]);
+      for (int i = 0; i < m; ++i) v = r[j] == r[i] ? xr[i] : v - xr[i] * eta_u_(r[j], col[i]);
+      at_r[j] = v;
     }
-    x.noalias() -= xr1 * u1;
-    x(r1) = xr1;
-    ++e;
+    auto u = [&](int i) { return eta_u_.col(col[i]).head(n_); };
+    switch (m) {
+      case 0: break;
+      case 1: x.noalias() -= xr[0] * u(0); break;
+      case 2: x.noalias() = (x - xr[0] * u(0)) - xr[1] * u(1); break;
+      case 3: x.noalias() = ((x - xr[0] * u(0)) - xr[1] * u(1)) - xr[2] * u(2); break;
+      default: x.noalias() = (((x - xr[0] * u(0)) - xr[1] * u(1)) - xr[2] * u(2)) - xr[3] * u(3); break;
+    }
+    for (int j = 0; j < m; ++j) x(r[j]) = at_r[j];
   }
 }
 
