@@ -31,8 +31,8 @@
 //
 // Cost of a solve B^-1 b (n unknowns, k basic z's, E etas): the reduced solve
 // (the factors of C), the covered rows (one pass over the entries of A(W, S),
-// kept row by row from the last refactorisation) and E passes over n for the
-// etas. In a jam u = B^-1 a is dense (a jam is one connected component, so C^-1
+// kept row by row from the last refactorisation) and the etas (E columns of n
+// read, in one pass over x per group of up to four etas). In a jam u = B^-1 a is dense (a jam is one connected component, so C^-1
 // spreads a column over all of it), so the etas are stored dense, in one block
 // allocated once. A refactorisation of an unchanged basis (no eta since the
 // last one) is skipped: it would give the same factors.
