@@ -46,6 +46,8 @@
 //                                 [--floedyn BIN [--floedyn-dir DIR] [--floedyn-arg ARG...]]
 // To profile one scenario: run once with --pack-dir DIR --only NAME, then
 //   perf record -g floesim_bench_collisions --child NAME --pack-dir DIR
+// (--t-end S stops that child at S simulated seconds: a fixed piece of work
+// for timing two builds against each other).
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -362,6 +364,7 @@ int main(int argc, char** argv) {
   double time_limit = 600.0;
   std::vector<std::string> only, notes;
   std::string csv, child, pack_dir_arg;
+  double child_t_end = 0.0;
   FloedynCommand floedyn;
   app.add_option("--repeats", repeats, "timed runs per scenario after the warm-up (minimum kept)")
       ->check(CLI::PositiveNumber);
@@ -372,6 +375,9 @@ int main(int argc, char** argv) {
   app.add_option("--time-limit", time_limit, "wall seconds after which a run is stopped and reported");
   app.add_option("--note", notes, "extra comment lines for the CSV header");
   app.add_option("--child", child, "internal: run one scenario once (peak memory)");
+  app.add_option("--t-end", child_t_end, "with --child: simulated seconds to run (default: the scenario's end), "
+                 "so that two builds can be timed on the same piece of a scenario")
+      ->check(CLI::PositiveNumber);
   app.add_option("--pack-dir", pack_dir_arg, "keep the generated packs in this folder (default: a temporary one)");
   app.add_option("--floedyn", floedyn.bin, "FloeDyn's FLOE program: time it side by side on floedyn_100")
       ->check(CLI::ExistingFile);
@@ -395,7 +401,8 @@ int main(int argc, char** argv) {
   if (!child.empty()) {
     const BenchScenario* s = find_scenario(child);
     if (!s) return 3;
-    const RunResult r = run_once(scenario_config(*s, pack_dir_arg), s->t_end, time_limit);
+    const double t_end = child_t_end > 0.0 ? std::min(child_t_end, s->t_end) : s->t_end;
+    const RunResult r = run_once(scenario_config(*s, pack_dir_arg), t_end, time_limit);
     // For a profiled run: where it got, on stderr (the parent reads stdout).
     std::fprintf(stderr, "%s: %s, t = %g s in %.1f s, %ld LCPs, %ld pivots, %ld warm (%ld missed), %ld failures\n",
                  s->name.c_str(), r.status.c_str(), r.simulated, r.wall, r.stats.lcps, r.stats.pivots, r.stats.warm,

@@ -46,7 +46,7 @@ public:
 private:
   detail::FactorPolicy factor_policy() const;
   Index first_leaving() const;
-  Index ratio_test(const Vector& u);
+  Index ratio_test(const Vector& u, double x_zero);
   Index lexicographic(std::vector<Index> tied, const Vector& u);
   Result finish_solved(LemkeBasis& basis);
   Vector read_z(const LemkeBasis& basis, const Vector& x) const;
@@ -59,6 +59,10 @@ private:
   Vector d_;
   LemkeBasis* basis_ = nullptr;
   Vector x_;  // basic values x_B = B^-1 q, by position
+  // The ratio test's candidates (positions) and their ratios, kept between
+  // pivots so that a pivot allocates nothing.
+  std::vector<Index> rows_;
+  std::vector<double> ratios_;
 };
 
 detail::FactorPolicy Lemke::factor_policy() const {
@@ -85,14 +89,15 @@ Index Lemke::first_leaving() const {
 }
 
 // Minimum-ratio test on the entering column u = B^-1 a: returns the leaving
-// position, or -1 for a ray.
-Index Lemke::ratio_test(const Vector& u) {
+// position, or -1 for a ray. x_zero: basic values up to it count as 0.
+Index Lemke::ratio_test(const Vector& u, double x_zero) {
   const double umax = u.cwiseAbs().maxCoeff();
   if (!(umax > 0.0) || !std::isfinite(umax)) return -1;
   const double pivot_min = opt_.pivot_tolerance * umax;
-  const double x_zero = opt_.zero_tolerance * x_.cwiseAbs().maxCoeff();
-  std::vector<Index> rows;
-  std::vector<double> ratios;
+  std::vector<Index>& rows = rows_;
+  std::vector<double>& ratios = ratios_;
+  rows.clear();
+  ratios.clear();
   for (Index p = 0; p < n_; ++p) {
     if (u(p) <= pivot_min) continue;
     const double x = x_(p) <= x_zero ? 0.0 : x_(p);  // degenerate rows are exactly 0
@@ -105,7 +110,7 @@ Index Lemke::ratio_test(const Vector& u) {
   const Index z0_pos = basis_->position_of(basis_->z0_var());
   if (std::find(rows.begin(), rows.end(), z0_pos) != rows.end()) return z0_pos;
   ++stats_.tie_breaks;
-  return lexicographic(std::move(rows), u);
+  return lexicographic(rows, u);
 }
 
 // Lexicographic rule on the tied positions: compare (B^-1)_{p, j} / u_p for
@@ -235,16 +240,17 @@ Result Lemke::run() {
   x_(r) = theta0;
   long pivots = 1;
 
-  Vector a;
+  rows_.reserve(static_cast<std::size_t>(n_));
+  ratios_.reserve(static_cast<std::size_t>(n_));
   while (ok) {
     if (pivots >= max_pivots) {
       result.status = Status::pivot_limit;
       break;
     }
-    basis.column(entering, a);
-    u = a;
+    basis.column(entering, u);
     basis.solve(u);
-    const Index p = ratio_test(u);
+    const double x_zero = opt_.zero_tolerance * x_.cwiseAbs().maxCoeff();
+    const Index p = ratio_test(u, x_zero);
     if (p < 0) {
       // A degenerate end: z0 is still basic but (nearly) at zero, so the
       // almost-complementary point reached, with z0 dropped, solves the LCP
@@ -277,7 +283,6 @@ Result Lemke::run() {
     }
     const int leaving = basis.variable_at(p);
     // x <- E^-1 x: the entering variable takes the ratio, the others move along u.
-    const double x_zero = opt_.zero_tolerance * x_.cwiseAbs().maxCoeff();
     const double theta = x_(p) <= x_zero ? 0.0 : x_(p) / u(p);
     x_ -= theta * u;
     x_(p) = theta;

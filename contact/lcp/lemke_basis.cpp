@@ -1,6 +1,7 @@
 #include "contact/lcp/lemke_basis.hpp"
 
 #include <Eigen/LU>
+#include <algorithm>
 #include <cmath>
 #include <umfpack.h>
 
@@ -115,7 +116,11 @@ LemkeBasis::LemkeBasis(const SparseMatrix& M, const Vector& d, FactorPolicy poli
                        int refactor_interval)
     : M_(M), d_(d), n_(M.rows()), policy_(policy), refactor_interval_(refactor_interval),
       basis_(static_cast<std::size_t>(n_)), position_(static_cast<std::size_t>(2 * n_ + 1), -1),
-      scratch_(n_) {
+      eta_u_(n_ + (n_ & 1), std::max(1, refactor_interval)), scratch_(n_) {
+  // The eta block's leading dimension is even, so every column starts on a
+  // 16-byte boundary, as a vector of its own would: the dot products of the
+  // transposed etas then add in the same order.
+  eta_pos_.reserve(static_cast<std::size_t>(std::max(1, refactor_interval)));
   for (Index i = 0; i < n_; ++i) {
     basis_[i] = w_var(i);
     position_[w_var(i)] = i;
@@ -129,6 +134,7 @@ bool LemkeBasis::start_from(const std::vector<std::uint8_t>& z_basic) {
     basis_[i] = z_basic[static_cast<std::size_t>(i)] ? z_var(i) : w_var(i);
     position_[basis_[i]] = i;
   }
+  factored_ = false;
   return refactor();
 }
 
@@ -169,22 +175,62 @@ void LemkeBasis::multiply(const Vector& x, Vector& out) const {
 
 void LemkeBasis::solve(Vector& x) {
   ++solves_;
-  // B0^-1: reduced solve on the uncovered rows, then the covered rows.
+  // B0^-1: reduced solve on the uncovered rows, then the covered rows
+  // x_W = b_W - A(W, S) x_S, with A = -[M, d] (so each entry adds x_s v).
   const Index k = static_cast<Index>(r_rows_.size());
   for (Index s = 0; s < k; ++s) reduced_(s) = x(r_rows_[s]);
   lu_->solve(reduced_.data());
-  scratch_ = x;
-  for (Index s = 0; s < k; ++s)
-    if (reduced_(s) != 0.0) add_column(s_vars_[s], -reduced_(s), scratch_);
-  for (std::size_t c = 0; c < w_rows_.size(); ++c) x(w_positions_[c]) = scratch_(w_rows_[c]);
+  const Index covered = static_cast<Index>(w_rows_.size());
+  for (Index c = 0; c < covered; ++c) {
+    double t = x(w_rows_[c]);
+    for (Index e = w_start_[c]; e < w_start_[c + 1]; ++e) {
+      const double xs = reduced_(w_s_[e]);
+      if (xs != 0.0) t -= (-xs) * w_v_[e];
+    }
+    w_values_(c) = t;
+  }
+  for (Index c = 0; c < covered; ++c) x(w_positions_[c]) = w_values_(c);
   for (Index s = 0; s < k; ++s) x(s_positions_[s]) = reduced_(s);
   // The etas, oldest first: x <- E^-1 x with x_r / u_r at r, x_i - u_i x_r' elsewhere.
-  for (const Eta& eta : etas_) {
-    const double xr = x(eta.pos) / eta.u(eta.pos);
-    if (xr != 0.0) {
-      x.noalias() -= xr * eta.u;
-      x(eta.pos) = xr;
+  // Up to four at a time: each one's x_r' is found from the entry x_r as the
+  // etas before it in the group left it (an eta with x_r' = 0 does nothing
+  // and is dropped), then one pass over x does x_i <- ((x_i - x_r1' u1_i) -
+  // x_r2' u2_i) - ..., and the group's entries r are set to what the etas in
+  // turn leave there: the same operations in the same order as one pass per
+  // eta, with a quarter of the passes over x.
+  constexpr int kGroup = 4;
+  const std::size_t etas = eta_pos_.size();
+  std::size_t e = 0;
+  while (e < etas) {
+    Index r[kGroup], col[kGroup];
+    double xr[kGroup], at_r[kGroup];
+    int m = 0;
+    for (; m < kGroup && e < etas; ++e) {
+      const Index re = eta_pos_[e];
+      const auto u = eta_u_.col(static_cast<Index>(e));
+      double v = x(re);
+      for (int i = 0; i < m; ++i) v = re == r[i] ? xr[i] : v - xr[i] * eta_u_(re, col[i]);
+      const double xe = v / u(re);
+      if (xe == 0.0) continue;
+      r[m] = re;
+      col[m] = static_cast<Index>(e);
+      xr[m] = xe;
+      ++m;
     }
+    for (int j = 0; j < m; ++j) {
+      double v = x(r[j]);
+      for (int i = 0; i < m; ++i) v = r[j] == r[i] ? xr[i] : v - xr[i] * eta_u_(r[j], col[i]);
+      at_r[j] = v;
+    }
+    auto u = [&](int i) { return eta_u_.col(col[i]).head(n_); };
+    switch (m) {
+      case 0: break;
+      case 1: x.noalias() -= xr[0] * u(0); break;
+      case 2: x.noalias() = (x - xr[0] * u(0)) - xr[1] * u(1); break;
+      case 3: x.noalias() = ((x - xr[0] * u(0)) - xr[1] * u(1)) - xr[2] * u(2); break;
+      default: x.noalias() = (((x - xr[0] * u(0)) - xr[1] * u(1)) - xr[2] * u(2)) - xr[3] * u(3); break;
+    }
+    for (int j = 0; j < m; ++j) x(r[j]) = at_r[j];
   }
 }
 
@@ -192,10 +238,12 @@ void LemkeBasis::solve_transposed(Vector& y) {
   ++solves_;
   // The etas transposed, newest first: E^-T changes only entry r,
   // y_r <- y_r - ((u . y) - y_r) / u_r.
-  for (auto eta = etas_.rbegin(); eta != etas_.rend(); ++eta) {
-    const double ur = eta->u(eta->pos);
-    const double yr = y(eta->pos);
-    y(eta->pos) = yr - (eta->u.dot(y) - yr) / ur;
+  for (std::size_t e = eta_pos_.size(); e-- > 0;) {
+    const Index r = eta_pos_[e];
+    const auto u = eta_u_.col(static_cast<Index>(e)).head(n_);
+    const double ur = u(r);
+    const double yr = y(r);
+    y(r) = yr - (u.dot(y) - yr) / ur;
   }
   // B0^T t = y: a covered row i (w_i at position p) has t_i = y_p; the uncovered
   // rows solve C^T t_R = y_S - A(W, S)^T t_W.
@@ -213,25 +261,33 @@ bool LemkeBasis::replace(Index pos, int var, const Vector& u) {
   position_[basis_[pos]] = -1;
   basis_[pos] = var;
   position_[var] = pos;
-  etas_.push_back({pos, u});
-  if (static_cast<int>(etas_.size()) >= refactor_interval_) return refactor();
+  factored_ = false;
+  eta_u_.col(static_cast<Index>(eta_pos_.size())).head(n_) = u;
+  eta_pos_.push_back(pos);
+  if (static_cast<int>(eta_pos_.size()) >= refactor_interval_) return refactor();
   return true;
 }
 
 bool LemkeBasis::refactor() {
+  if (factored_) return true;
+  factored_ = factorise();
+  return factored_;
+}
+
+bool LemkeBasis::factorise() {
   ++refactorisations_;
-  etas_.clear();
+  eta_pos_.clear();
   s_positions_.clear();
   s_vars_.clear();
   r_rows_.clear();
   w_rows_.clear();
   w_positions_.clear();
-  std::vector<Index> reduced_row(static_cast<std::size_t>(n_), -1);
-  std::vector<char> covered(static_cast<std::size_t>(n_), 0);
+  reduced_row_.assign(static_cast<std::size_t>(n_), -1);
+  covered_row_.assign(static_cast<std::size_t>(n_), -1);
   for (Index p = 0; p < n_; ++p) {
     const int var = basis_[p];
     if (is_w(var)) {
-      covered[var] = 1;
+      covered_row_[var] = static_cast<Index>(w_rows_.size());
       w_rows_.push_back(var);
       w_positions_.push_back(p);
     } else {
@@ -240,37 +296,66 @@ bool LemkeBasis::refactor() {
     }
   }
   for (Index i = 0; i < n_; ++i)
-    if (!covered[i]) {
-      reduced_row[i] = static_cast<Index>(r_rows_.size());
+    if (covered_row_[i] < 0) {
+      reduced_row_[i] = static_cast<Index>(r_rows_.size());
       r_rows_.push_back(i);
     }
   const Index k = static_cast<Index>(r_rows_.size());
+  const Index covered = static_cast<Index>(w_rows_.size());
   reduced_.resize(k);
+  w_values_.resize(covered);
 
-  // C = [-M, -d](R, vars(S)), column by column.
-  std::vector<Eigen::Triplet<double, int>> entries;
+  // C = [-M, -d](R, vars(S)), column by column, its rows increasing (M's
+  // columns are stored with increasing rows, and R is increasing); and the
+  // covered rows' entries A(W, S), counted per row then filled in increasing s.
+  C_.resize(k, k);
+  C_.setZero();
+  w_start_.assign(static_cast<std::size_t>(covered) + 1, 0);
   for (Index s = 0; s < k; ++s) {
     const int var = s_vars_[s];
-    const int col = static_cast<int>(s);
     if (var == z0_var()) {
-      for (Index r = 0; r < k; ++r)
-        if (d_(r_rows_[r]) != 0.0) entries.emplace_back(static_cast<int>(r), col, -d_(r_rows_[r]));
+      for (Index c = 0; c < covered; ++c) ++w_start_[c + 1];
     } else {
       for (SparseMatrix::InnerIterator it(M_, var - n_); it; ++it)
-        if (reduced_row[it.index()] >= 0)
-          entries.emplace_back(static_cast<int>(reduced_row[it.index()]), col, -it.value());
+        if (covered_row_[it.index()] >= 0) ++w_start_[covered_row_[it.index()] + 1];
     }
   }
-  SparseMatrix C(k, k);
-  C.setFromTriplets(entries.begin(), entries.end());
+  for (Index c = 0; c < covered; ++c) w_start_[c + 1] += w_start_[c];
+  w_s_.resize(static_cast<std::size_t>(w_start_[covered]));
+  w_v_.resize(static_cast<std::size_t>(w_start_[covered]));
+  fill_.assign(w_start_.begin(), w_start_.end() - 1);
+  for (Index s = 0; s < k; ++s) {
+    const int var = s_vars_[s];
+    C_.startVec(s);
+    if (var == z0_var()) {
+      for (Index r = 0; r < k; ++r)
+        if (d_(r_rows_[r]) != 0.0) C_.insertBack(r, s) = -d_(r_rows_[r]);
+      for (Index c = 0; c < covered; ++c) {
+        w_s_[fill_[c]] = s;
+        w_v_[fill_[c]++] = d_(w_rows_[c]);
+      }
+    } else {
+      for (SparseMatrix::InnerIterator it(M_, var - n_); it; ++it) {
+        const Index i = it.index();
+        if (reduced_row_[i] >= 0) {
+          C_.insertBack(reduced_row_[i], s) = -it.value();
+        } else {
+          const Index c = covered_row_[i];
+          w_s_[fill_[c]] = s;
+          w_v_[fill_[c]++] = it.value();
+        }
+      }
+    }
+  }
+  C_.finalize();
   const double size = static_cast<double>(k);
   const bool sparse = k >= policy_.sparse_min_size &&
-                      static_cast<double>(C.nonZeros()) <= policy_.sparse_max_density * size * size;
+                      static_cast<double>(C_.nonZeros()) <= policy_.sparse_max_density * size * size;
   auto& factor = sparse ? sparse_lu_ : dense_lu_;
   if (!factor) factor = sparse ? make_sparse_factor() : make_dense_factor();
   lu_ = factor.get();
   if (sparse) ++sparse_refactorisations_;
-  return lu_->factor(C);
+  return lu_->factor(C_);
 }
 
 }  // namespace floesim::lcp::detail

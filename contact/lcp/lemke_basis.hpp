@@ -28,7 +28,14 @@
 // in reverse order, then the transposed reduced solve). After `refactor_interval` etas the
 // current basis is factorised afresh (bounds both the work per solve and the
 // growth of rounding errors).
-
+//
+// Cost of a solve B^-1 b (n unknowns, k basic z's, E etas): the reduced solve
+// (the factors of C), the covered rows (one pass over the entries of A(W, S),
+// kept row by row from the last refactorisation) and the etas (E columns of n
+// read, in one pass over x per group of up to four etas). In a jam u = B^-1 a is dense (a jam is one connected component, so C^-1
+// spreads a column over all of it), so the etas are stored dense, in one block
+// allocated once. A refactorisation of an unchanged basis (no eta since the
+// last one) is skipped: it would give the same factors.
 #include <cstdint>
 #include <memory>
 #include <vector>
@@ -89,7 +96,8 @@ public:
   // The pivot: `var` enters at position `pos`, u = B^-1 a_var (u(pos) != 0).
   // Returns false if a refactorisation it triggered found B singular.
   bool replace(Index pos, int var, const Vector& u);
-  // Factorises the current basis afresh, dropping the etas.
+  // Factorises the current basis afresh, dropping the etas (nothing to do when
+  // no eta was added since the last factorisation).
   bool refactor();
   // Starts over from the complementary basis with z_j at position j where
   // z_basic[j], w_j elsewhere; false if it is singular.
@@ -114,6 +122,8 @@ private:
   std::vector<int> basis_;       // variable at each position
   std::vector<Index> position_;  // position of each variable, -1 when non-basic
 
+  bool factorise();
+
   // The factorised basis B0: its positions holding z / z0, the uncovered rows R,
   // and for each covered row the position of its w.
   std::vector<Index> s_positions_;
@@ -121,12 +131,24 @@ private:
   std::vector<Index> r_rows_;
   std::vector<Index> w_rows_;        // rows covered by a basic w in B0
   std::vector<Index> w_positions_;   // ... and their positions
+  // The coupling of the covered rows to S in (1): covered row c (row
+  // w_rows_[c]) holds v_(c, s) for the z's or z0 at S-index s, in increasing s
+  // (v = M(i, j) for z_j, d_i for z0; the entry of -[M, d] is -v), compressed
+  // by rows.
+  std::vector<Index> w_start_;
+  std::vector<Index> w_s_;
+  std::vector<double> w_v_;
+  Vector w_values_;  // the covered rows' values during a solve
+  // Work of factorise(), kept to avoid allocating: C, each row's index in R
+  // and in W (-1 if not there), the fill pointers of A(W, S).
+  SparseMatrix C_;
+  std::vector<Index> reduced_row_, covered_row_, fill_;
 
-  struct Eta {
-    Index pos;
-    Vector u;
-  };
-  std::vector<Eta> etas_;
+  // The etas since B0: eta e is (eta_pos_[e], column e of eta_u_). The block
+  // holds refactor_interval columns, allocated once.
+  std::vector<Index> eta_pos_;
+  DenseMatrix eta_u_;
+  bool factored_ = false;  // B0 is the current basis (no eta since it was factorised)
   Vector scratch_;
   Vector reduced_;
   long solves_ = 0;

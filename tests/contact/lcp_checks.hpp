@@ -4,7 +4,10 @@
 
 #include <doctest/doctest.h>
 
+#include <cstdint>
+#include <fstream>
 #include <string>
+#include <vector>
 
 #include "contact/lcp/lcp.hpp"
 
@@ -12,6 +15,16 @@ namespace floesim::lcp::testing {
 
 inline std::string lcp_data(const std::string& name) {
   return std::string(FLOESIM_DATA_DIR) + "/lcp/" + name;
+}
+
+// A warm start of data/lcp/jam (NAME.guess: one 0/1 flag per unknown, which z
+// were basic in the previous LCP of the same contacts).
+inline std::vector<std::uint8_t> read_guess(const std::string& path) {
+  std::ifstream in(path);
+  REQUIRE(in.good());
+  std::vector<std::uint8_t> flags;
+  for (int v = 0; in >> v;) flags.push_back(static_cast<std::uint8_t>(v != 0));
+  return flags;
 }
 
 // Asserts z >= 0, w >= 0 and z_i w_i = 0 within `tol`, relative to the scale

@@ -18,6 +18,7 @@ TEST_SUITE_BEGIN("contact");
 
 using testing::check_complementary;
 using testing::lcp_data;
+using testing::read_guess;
 
 struct Expected {
   const char* file;
@@ -123,6 +124,60 @@ TEST_CASE("lcp: every rigid-body contact LCP is solved - friction ones included"
             << r.pivots << ", residual " << r.residual << ", tie-breaks " << stats.tie_breaks
             << ", solves " << stats.solves << ", UMFPACK refactorisations " << stats.sparse_refactorisations << " of "
             << stats.refactorisations);
+  }
+}
+
+// Lemke's pivot path on the contact and jam LCPs of data/lcp, as walked by
+// the revised method at 7c57e26 (before the pivot's work was cut down:
+// covered rows by rows of A(W, S), etas in one block, no refactorisation of
+// an unchanged basis, no allocation per pivot). That work must not change a
+// single rounding: a jam's LCP is so degenerate that a tie decided otherwise
+// walks another path. So the same pivots, the same number of basis solves
+// (the tie-breaks' included) and the same end.
+struct Path {
+  const char* file;
+  bool warm;  // from NAME.guess
+  Status status;
+  long pivots;
+  long solves;
+};
+constexpr Path kPaths[] = {
+    {"contact/delassus_m200_s1", false, Status::solved, 92, 93},
+    {"contact/delassus_red_m200_s1", false, Status::solved, 112, 114},
+    {"contact/friction_m100_s2", false, Status::solved, 293, 370},
+    {"contact/friction_m200_s1", false, Status::solved, 555, 665},
+    {"contact/friction_m200_s2", false, Status::solved, 549, 649},
+    {"jam/jam500_n1400", false, Status::solved, 1257, 1270},
+    {"jam/jam500_n1400", true, Status::solved, 1125, 1139},
+    {"jam/jam500_n2396", false, Status::solved, 1802, 2059},
+    {"jam/jam500_n2396", true, Status::solved, 1195, 5878},
+    {"jam/jam500_n864_ray", false, Status::solved, 602, 609},
+    {"jam/jam500_n864_ray", true, Status::ray, 2, 6},
+};
+
+TEST_CASE("lcp: Lemke walks the same pivot path as before its pivot was made cheaper") {
+  for (const Path& e : kPaths) {
+    const std::string file = e.file;
+    CAPTURE(file);
+    CAPTURE(e.warm);
+    const Lcp lcp = read_siconos_lcp(lcp_data(file + ".dat"));
+    std::vector<std::uint8_t> guess;
+    LemkeOptions options;
+    options.max_pivots = 15 * lcp.size() + 1000;  // the collision LCPs' limit (contact/impulse.hpp)
+    if (e.warm) {
+      guess = read_guess(lcp_data(file + ".guess"));
+      REQUIRE(static_cast<Index>(guess.size()) == lcp.size());
+      options.start = &guess;
+    }
+    LemkeStats stats;
+    const Result r = solve_lemke(lcp, options, &stats);
+    CHECK(to_string(r.status) == to_string(e.status));
+    CHECK(r.pivots == e.pivots);
+    CHECK(stats.solves == e.solves);
+    if (e.status == Status::solved) {
+      CHECK(r.residual <= 1e-12);
+      check_complementary(lcp, r.z, 1e-9);
+    }
   }
 }
 

@@ -21,15 +21,7 @@ TEST_SUITE_BEGIN("contact");
 
 using testing::check_complementary;
 using testing::lcp_data;
-
-// The jam LCP of data/lcp/jam and its warm start (one 0/1 flag per unknown).
-std::vector<std::uint8_t> read_guess(const std::string& path) {
-  std::ifstream in(path);
-  REQUIRE(in.good());
-  std::vector<std::uint8_t> flags;
-  for (int v = 0; in >> v;) flags.push_back(static_cast<std::uint8_t>(v != 0));
-  return flags;
-}
+using testing::read_guess;
 
 TEST_CASE("lcp newton: solves the frictionless contact LCPs of data/lcp from z = 0") {
   // Symmetric positive (semi)definite Delassus LCPs, 10 to 200 contacts, some
