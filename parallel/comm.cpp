@@ -90,6 +90,25 @@ void check(int code, const char* what) {
   throw RunError(std::string("MPI: ") + what + " failed: " + std::string(text, static_cast<std::size_t>(length)));
 }
 
+// MPI's v-collectives take int sizes and offsets: per-rank byte counts laid
+// end to end; returns the total. `what` names the collective in the error
+// for a total beyond INT_MAX (2 GiB).
+std::size_t displacements(const std::vector<std::size_t>& counts, std::vector<int>& sizes, std::vector<int>& offsets,
+                          const char* what) {
+  sizes.resize(counts.size());
+  offsets.resize(counts.size());
+  std::size_t total = 0;
+  for (std::size_t r = 0; r < counts.size(); ++r) {
+    if (total + counts[r] > static_cast<std::size_t>(INT_MAX))
+      throw RunError(std::string("MPI: ") + what + " of more than 2 GiB (" + std::to_string(total + counts[r]) +
+                     " bytes) is not supported");
+    sizes[r] = static_cast<int>(counts[r]);
+    offsets[r] = static_cast<int>(total);
+    total += counts[r];
+  }
+  return total;
+}
+
 // Set by mpirun (Open MPI), or by a PMI/PMIx launcher (srun, hydra).
 bool launched_by_mpi() {
   for (const char* name : {"OMPI_COMM_WORLD_SIZE", "PMIX_RANK", "PMI_RANK", "PMI_SIZE"})
@@ -152,16 +171,8 @@ void Communicator::allgather_known(std::span<const std::byte> mine, const std::v
     return;
   }
 #ifdef FLOESIM_HAVE_MPI
-  std::vector<int> sizes(counts.size()), offsets(counts.size());
-  std::size_t total = 0;
-  for (std::size_t r = 0; r < counts.size(); ++r) {
-    if (total + counts[r] > static_cast<std::size_t>(INT_MAX))
-      throw RunError("MPI: a gather of more than 2 GiB (" + std::to_string(total + counts[r]) +
-                     " bytes) is not supported");
-    sizes[r] = static_cast<int>(counts[r]);
-    offsets[r] = static_cast<int>(total);
-    total += counts[r];
-  }
+  std::vector<int> sizes, offsets;
+  const std::size_t total = displacements(counts, sizes, offsets, "a gather");
   Counted counted(impl_->traffic, static_cast<long long>(total));
   out.resize(total);  // a buffer kept by the caller: filled only where it grows
   check(MPI_Allgatherv(mine.data(), static_cast<int>(mine.size()), MPI_BYTE, out.data(), sizes.data(),
@@ -173,16 +184,8 @@ void Communicator::allgather_known(std::span<const std::byte> mine, const std::v
 void Communicator::allgather_in_place(std::span<std::byte> all, const std::vector<std::size_t>& counts) const {
   if (serial() || !impl_) return;
 #ifdef FLOESIM_HAVE_MPI
-  std::vector<int> sizes(counts.size()), offsets(counts.size());
-  std::size_t total = 0;
-  for (std::size_t r = 0; r < counts.size(); ++r) {
-    if (total + counts[r] > static_cast<std::size_t>(INT_MAX))
-      throw RunError("MPI: a gather of more than 2 GiB (" + std::to_string(total + counts[r]) +
-                     " bytes) is not supported");
-    sizes[r] = static_cast<int>(counts[r]);
-    offsets[r] = static_cast<int>(total);
-    total += counts[r];
-  }
+  std::vector<int> sizes, offsets;
+  const std::size_t total = displacements(counts, sizes, offsets, "a gather");
   FLOESIM_ASSERT(total <= all.size());
   Counted counted(impl_->traffic, static_cast<long long>(total - counts[static_cast<std::size_t>(rank_)]));
   check(MPI_Allgatherv(MPI_IN_PLACE, 0, MPI_BYTE, all.data(), sizes.data(), offsets.data(), MPI_BYTE, impl_->comm),
@@ -200,25 +203,11 @@ void Communicator::alltoall(std::span<const std::byte> send, const std::vector<s
     return;
   }
 #ifdef FLOESIM_HAVE_MPI
-  auto displace = [](const std::vector<std::size_t>& counts, std::vector<int>& sizes, std::vector<int>& offsets) {
-    sizes.resize(counts.size());
-    offsets.resize(counts.size());
-    std::size_t total = 0;
-    for (std::size_t r = 0; r < counts.size(); ++r) {
-      if (total + counts[r] > static_cast<std::size_t>(INT_MAX))
-        throw RunError("MPI: an all-to-all of more than 2 GiB (" + std::to_string(total + counts[r]) +
-                       " bytes) is not supported");
-      sizes[r] = static_cast<int>(counts[r]);
-      offsets[r] = static_cast<int>(total);
-      total += counts[r];
-    }
-    return total;
-  };
   std::vector<int> send_sizes, send_offsets, receive_sizes, receive_offsets;
-  const std::size_t sent = displace(send_counts, send_sizes, send_offsets);
+  const std::size_t sent = displacements(send_counts, send_sizes, send_offsets, "an all-to-all");
   FLOESIM_ASSERT(sent <= send.size());
   (void)sent;
-  const std::size_t received = displace(receive_counts, receive_sizes, receive_offsets);
+  const std::size_t received = displacements(receive_counts, receive_sizes, receive_offsets, "an all-to-all");
   FLOESIM_ASSERT(received <= receive.size());
   Counted counted(impl_->traffic, static_cast<long long>(received));
   check(MPI_Alltoallv(send.data(), send_sizes.data(), send_offsets.data(), MPI_BYTE, receive.data(),
