@@ -169,23 +169,27 @@ void Simulation::restore(const Checkpoint& c) {
                            {"initiations", &p.initiations}, {"splits", &p.splits},
                            {"failed_splits", &p.failed_splits}, {"sustained", &p.sustained}})
       *v = count(std::string("fracture.") + name);
-    // Absent from checkpoints written before the stress bound.
-    if (std::find(c.counter_names.begin(), c.counter_names.end(), "fracture.bounded") != c.counter_names.end())
+    // Counters that checkpoints written before them lack keep their zeros.
+    auto has = [&](const char* name) {
+      return std::find(c.counter_names.begin(), c.counter_names.end(), name) != c.counter_names.end();
+    };
+    // Absent before the stress bound.
+    if (has("fracture.bounded"))
       p.bounded = count("fracture.bounded");
-    // Absent from checkpoints written before the energy bound in the time loop.
-    if (std::find(c.counter_names.begin(), c.counter_names.end(), "fracture.cut_short") != c.counter_names.end()) {
+    // Absent before the energy bound in the time loop.
+    if (has("fracture.cut_short")) {
       p.cut_short = count("fracture.cut_short");
       p.loop_steps = count("fracture.loop_steps");
       p.models = count("fracture.models");
       p.model_seconds = counter("fracture.model_seconds");
     }
-    // Absent from checkpoints written before the refusals were told apart.
-    if (std::find(c.counter_names.begin(), c.counter_names.end(), "fracture.refused_small") != c.counter_names.end()) {
+    // Absent before the refusals were told apart.
+    if (has("fracture.refused_small")) {
       p.refused_small = count("fracture.refused_small");
       p.refused_overlap = count("fracture.refused_overlap");
     }
-    // Absent from checkpoints written before the phase's time was split up.
-    if (std::find(c.counter_names.begin(), c.counter_names.end(), "fracture.phase_seconds") != c.counter_names.end()) {
+    // Absent before the phase's time was split up.
+    if (has("fracture.phase_seconds")) {
       p.phase_seconds = counter("fracture.phase_seconds");
       p.mesh_seconds = counter("fracture.mesh_seconds");
       p.bound_seconds = counter("fracture.bound_seconds");
