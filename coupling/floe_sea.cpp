@@ -115,6 +115,7 @@ FloeSeaContact::FloeSeaContact(const CouplingParams& params, const SeaParams& se
   FLOESIM_ASSERT(params.footprint != FootprintChoice::tent || periodic);
   kernel_ = params.footprint == FootprintChoice::cell || !periodic ? FootprintKernel::cell : FootprintKernel::tent;
   footprints_ = MovingFootprints(grid, kernel_, {params.footprint_reach});
+  slab_rows_ = sea.slab_rows();
   cell_area_ = grid.dx() * (grid.dims == 2 ? grid.dy() : grid.ly);
   // The sea under the floes, as fast as it can answer: one cell, or the
   // grid's shortest wave, at a few places (a walled basin answers faster near
@@ -365,8 +366,8 @@ void FloeSeaContact::clear_footprint_cells() {
   if (pressure_.size() != grid_.size()) {
     pressure_.assign(grid_.size(), 0.0);
     cells_.assign(grid_.size(), {});
-  } else if (by_owner()) {  // every rank's last cells; the sums only in this rank's (floe_sea_owners.cpp)
-    for (std::uint32_t c : owner_.touched) pressure_[c] = 0.0;
+  } else if (by_owner()) {  // every rank's last cells (routed: its slab's); the sums only in this rank's (floe_sea_owners.cpp)
+    for (std::uint32_t c : routed() ? routes_.owned() : std::span<const std::uint32_t>(owner_.touched)) pressure_[c] = 0.0;
     for (std::uint32_t c : owner_.cells) cells_[c] = {};
   } else {
     for (std::uint32_t c : footprints_.pieces().cell) {

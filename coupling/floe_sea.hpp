@@ -127,6 +127,7 @@
 #include "coupling/footprint.hpp"
 #include "coupling/moving_footprint.hpp"
 #include "coupling/penalty_step.hpp"
+#include "parallel/cell_routes.hpp"
 
 namespace floesim {
 
@@ -198,10 +199,17 @@ public:
   // round-off where several ranks' floes share a cell. The implicit step
   // stays replicated on every floe's pieces (gathered), to the bit. Every
   // rank calls every method in the same order (they may exchange data).
+  // When the sea is in slabs (fluid::Sea::slab_rows), each cell's parts go
+  // to the rank whose slab holds its row, which sums them and sends the
+  // coverage and the sums back to the ranks with pieces there (stage five):
+  // pressure() then holds this rank's slab's rows only, which is what its
+  // sea's kick reads.
   void set_communicator(const parallel::Communicator& comm) {
     comm_ = comm;
     footprints_.set_communicator(comm);
     footprints_.set_gather(!by_owner());
+    routes_ = by_owner() && !slab_rows_.empty() ? parallel::CellRoutes(slab_rows_, static_cast<std::size_t>(grid_.nx))
+                                                 : parallel::CellRoutes();
   }
   struct ImplicitStats {
     long steps = 0, newton = 0, cg = 0, g_products = 0;  // totals over the run
@@ -260,6 +268,8 @@ private:
   void clear_footprint_cells();
   // The contact is evaluated by owner: several ranks, explicit kicks.
   bool by_owner() const { return !comm_.serial() && !implicit_; }
+  // The cells' sums by owner go to the slabs' ranks (the sea in slabs).
+  bool routed() const { return !routes_.empty(); }
   // By owner (floe_sea_owners.cpp): this rank's pieces' coverage summed into
   // its cells, then every rank's parts in rank order into cells_[c].coverage
   // of this rank's cells (cells_ is zero in the others).
@@ -267,8 +277,9 @@ private:
   // By owner, after the law (eval_: penetrations u, weights psi, forces):
   // this rank's pieces' a u^2 and pressure in its cells and its part of the
   // penalty energy ks psi a u^2 / 2, in one pass; then every rank's parts in
-  // rank order into pressure_ (every cell) and cells_[c].sum (this rank's
-  // cells); returns the energy, the ranks' parts summed in rank order.
+  // rank order into pressure_ (every cell; routed, the cells of this rank's
+  // slab) and cells_[c].sum (this rank's cells); returns the energy, the
+  // ranks' parts summed in rank order.
   double sum_cells_by_owner(double ks);
   // poses_ <- the floes' present poses.
   void pose_at_states(const Floes& floes);
@@ -330,7 +341,14 @@ private:
     std::vector<std::uint32_t> touched;  // every rank's cells, in rank order (where pressure_ may be nonzero)
     std::vector<std::size_t> counts;     // cells per rank in `touched`
     std::vector<std::byte> message, received;  // the exchanges' buffers, kept from one evaluation to the next
+    std::vector<double> parts;                 // routed: per cell of `cells`, its sum and pressure
   } owner_;
+  // The sea's slabs (fluid::Sea::slab_rows; empty: whole on every rank), and
+  // by owner on them, the routes of the cells' sums to the slabs' ranks;
+  // the next evaluation clears pressure_ in routes_.owned() (this rank's
+  // slab's cells of the last one) and cells_ in owner_.cells.
+  std::vector<int> slab_rows_;
+  parallel::CellRoutes routes_;
   std::vector<std::uint32_t> order_;  // dynamic floes with pieces, by their first cell
   bool pressure_kicked_ = false;  // the sea's last kick was with pressure_ as it is
   double loads_h_ = -1.0;         // the kick length of the last evaluation (< 0: stale)

@@ -18,6 +18,14 @@
 // the rank's floes), to the bit. A cell shared by several ranks' floes gets
 // the parts' sum, which groups the pieces by rank: equal to the serial sum up
 // to round-off (a few ulps of the cell's value).
+//
+// When the sea is in slabs (stage five, routed()), a rank's sea reads only
+// the pressure of its slab's rows, so each rank sends a cell's parts only to
+// the rank whose slab holds the cell's row (parallel::CellRoutes, an
+// all-to-all), which sums them in rank order from zero, as above, keeps the
+// pressure and sends the coverage and the sums back to the ranks that sent
+// the cell: the same totals to the bit, each summed once instead of on every
+// rank, and received only by the ranks that have pieces in the cell.
 #include <cstring>
 
 #include "coupling/floe_sea.hpp"
@@ -62,6 +70,12 @@ void FloeSeaContact::sum_coverage_by_owner() {
       }
       o.coverage[o.slot[c] - 1] += fp.area[k] * inv_cell_area;
     }
+  if (routed()) {
+    routes_.open(comm_, o.cells, o.coverage, 1);
+    routes_.reply(comm_, 0, o.coverage);  // the cells' totals, in place of this rank's parts
+    for (std::size_t j = 0; j < o.cells.size(); ++j) cells_[o.cells[j]].coverage = o.coverage[j];
+    return;
+  }
   // Message: the cells, then their coverage.
   o.message.resize(o.cells.size() * (sizeof(std::uint32_t) + sizeof(double)));
   put(put(o.message.data(), o.cells.data(), o.cells.size()), o.coverage.data(), o.coverage.size());
@@ -105,6 +119,19 @@ double FloeSeaContact::sum_cells_by_owner(double ks) {
       o.sum[j] += fp.area[k] * u[k] * u[k];
       o.pressure[j] += force[k] * inv_cell_area;
     }
+  if (routed()) {
+    o.parts.resize(2 * o.cells.size());
+    for (std::size_t j = 0; j < o.cells.size(); ++j) {
+      o.parts[2 * j] = o.sum[j];
+      o.parts[2 * j + 1] = o.pressure[j];
+    }
+    const double total = routes_.add(comm_, o.parts, 2, energy);
+    const std::span<const std::uint32_t> slab = routes_.owned();
+    for (std::size_t j = 0; j < slab.size(); ++j) pressure_[slab[j]] = routes_.total(j, 1);  // zero before: 0 + the total
+    routes_.reply(comm_, 0, o.sum);
+    for (std::size_t j = 0; j < o.cells.size(); ++j) cells_[o.cells[j]].sum = o.sum[j];
+    return total;
+  }
   // Message: the energy, then the sums and pressures of the cells sent
   // before (every rank knows how many).
   o.message.resize(sizeof(double) * (1 + 2 * o.cells.size()));

@@ -130,6 +130,12 @@ public:
   // Replaces the state by a surface given on the grid (its mean is removed).
   virtual void set_surface(std::span<const double> eta, std::span<const double> eta_t) = 0;
 
+  // In slabs (SeaOptions::ranks; spectral.hpp): the first row of each
+  // rank's slab, then the grid's row count (ranks + 1 values): kick() on rank
+  // r reads the pressure's rows [rows[r], rows[r + 1]) only. Empty when every
+  // rank reads the whole pressure.
+  virtual std::vector<int> slab_rows() const { return {}; }
+
   std::span<const double> field(Field f);
   std::span<const double> elevation() { return field(Field::elevation); }
   SurfaceSample sample(double x, double y = 0.0);

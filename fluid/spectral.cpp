@@ -301,6 +301,15 @@ double SpectralSea::omega(int mx, int my) const {
   return impl_->disp.omega(std::hypot(two_pi * mx / impl_->lx, two_pi * my / impl_->ly));
 }
 
+std::vector<int> SpectralSea::slab_rows() const {
+  const Impl& m = *impl_;
+  if (!m.slab) return {};
+  std::vector<int> rows;
+  for (int r = 0; r < m.ranks.ranks; ++r) rows.push_back(m.slab->rows_of(r).begin);
+  rows.push_back(m.ny);
+  return rows;
+}
+
 const TankZones* SpectralSea::tank() const { return impl_->tank ? &*impl_->tank : nullptr; }
 
 void SpectralSea::kick(std::span<const double> pressure, double h) {

@@ -49,6 +49,7 @@ public:
   void flow(double dt) override;
   void set_surface(std::span<const double> eta, std::span<const double> eta_t) override;
   void midpoint_step(std::span<const double> p, double h) override;
+  std::vector<int> slab_rows() const override;
 
   // omega of the Fourier mode with wave vector 2 pi (mx / lx, my / ly).
   double omega(int mx, int my = 0) const;

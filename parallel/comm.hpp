@@ -114,6 +114,12 @@ public:
   // bytes from rank s. Both sides know every count. One collective call.
   void alltoall(std::span<const std::byte> send, const std::vector<std::size_t>& send_counts,
                 std::span<std::byte> receive, const std::vector<std::size_t>& receive_counts) const;
+  // The same when the receiving side does not know its counts: they are
+  // exchanged first (receive_counts gets receive_counts[s] bytes from rank
+  // s), and `receive` is resized to their total (its memory reused, as in
+  // allgather_bytes). Two collective calls.
+  void alltoall_bytes(std::span<const std::byte> send, const std::vector<std::size_t>& send_counts,
+                      std::vector<std::byte>& receive, std::vector<std::size_t>& receive_counts) const;
 
   // The sum of one integer over the ranks (in rank order; exact).
   long long sum(long long value) const;
