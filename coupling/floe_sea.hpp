@@ -337,6 +337,7 @@ private:
   struct OwnerCells {
     std::vector<std::uint32_t> slot;   // per grid cell: 1 + its index in `cells`, 0: none of this rank's pieces
     std::vector<std::uint32_t> cells;  // this rank's cells, in the order its pieces meet them
+    std::vector<std::uint32_t> piece_slot;  // per area piece of this rank's floes: its cell's index in `cells`
     std::vector<double> coverage, sum, pressure;  // per cell of `cells`: this rank's part
     std::vector<std::uint32_t> touched;  // every rank's cells, in rank order (where pressure_ may be nonzero)
     std::vector<std::size_t> counts;     // cells per rank in `touched`

@@ -59,6 +59,7 @@ void FloeSeaContact::sum_coverage_by_owner() {
   for (std::uint32_t c : o.cells) o.slot[c] = 0;
   o.cells.clear();
   o.coverage.clear();
+  o.piece_slot.resize(fp.cell.size());
   const double inv_cell_area = 1.0 / cell_area_;
   for (std::uint32_t i : order_)
     for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k) {
@@ -68,7 +69,8 @@ void FloeSeaContact::sum_coverage_by_owner() {
         o.coverage.push_back(0.0);
         o.slot[c] = static_cast<std::uint32_t>(o.cells.size());
       }
-      o.coverage[o.slot[c] - 1] += fp.area[k] * inv_cell_area;
+      o.piece_slot[k] = o.slot[c] - 1;
+      o.coverage[o.piece_slot[k]] += fp.area[k] * inv_cell_area;
     }
   if (routed()) {
     routes_.open(comm_, o.cells, o.coverage, 1);
@@ -114,7 +116,7 @@ double FloeSeaContact::sum_cells_by_owner(double ks) {
   for (std::uint32_t i : order_)
     for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k) {
       if (u[k] <= 0.0) continue;
-      const std::uint32_t j = o.slot[fp.cell[k]] - 1;
+      const std::uint32_t j = o.piece_slot[k];
       energy += 0.5 * ks * psi[k] * fp.area[k] * u[k] * u[k];
       o.sum[j] += fp.area[k] * u[k] * u[k];
       o.pressure[j] += force[k] * inv_cell_area;
