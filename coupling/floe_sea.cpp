@@ -368,7 +368,10 @@ void FloeSeaContact::clear_footprint_cells() {
     cells_.assign(grid_.size(), {});
   } else if (by_owner()) {  // every rank's last cells (routed: its slab's); the sums only in this rank's (floe_sea_owners.cpp)
     for (std::uint32_t c : routed() ? routes_.owned() : std::span<const std::uint32_t>(owner_.touched)) pressure_[c] = 0.0;
-    for (std::uint32_t c : owner_.cells) cells_[c] = {};
+    for (std::uint32_t c : owner_.cells) {
+      pressure_[c] = 0.0;  // routed: the cells deep in this rank's slab (elsewhere already zero)
+      cells_[c] = {};
+    }
   } else {
     for (std::uint32_t c : footprints_.pieces().cell) {
       pressure_[c] = 0.0;
@@ -386,9 +389,14 @@ void FloeSeaContact::place_footprints(const Floes& floes) {
   // read and written where each floe lies: this keeps them in cache).
   // By owner, this rank's floes only (the others' pieces are not here).
   order_.clear();
-  const parallel::Range mine = by_owner() ? footprints_.owned(floes.size()) : parallel::Range{0, floes.size()};
-  for (std::size_t i = mine.begin; i < mine.end; ++i)
+  auto take = [&](std::size_t i) {
     if (dynamic_[i] && fp.offsets[i] < fp.offsets[i + 1]) order_.push_back(static_cast<std::uint32_t>(i));
+  };
+  if (by_owner()) {
+    for (std::uint32_t i : footprints_.mine()) take(i);
+  } else {
+    for (std::size_t i = 0; i < floes.size(); ++i) take(i);
+  }
   std::sort(order_.begin(), order_.end(),
             [&](std::uint32_t x, std::uint32_t y) { return fp.cell[fp.offsets[x]] < fp.cell[fp.offsets[y]]; });
   if (by_owner()) return sum_coverage_by_owner();
@@ -489,12 +497,11 @@ void FloeSeaContact::horizontal_loads(std::span<const double> u) {
   if (ks <= 0.0) return;
   // Each rank its own floes (their edge pieces are only there); the caller
   // shares the loads (share_owned).
-  const parallel::Range mine = footprints_.owned(loads_.size());
   const std::ptrdiff_t floes_in_order = static_cast<std::ptrdiff_t>(order_.size());
 #pragma omp parallel for num_threads(threads_) schedule(dynamic, 16) if (floes_in_order > kFloesPerThread)
   for (std::ptrdiff_t j = 0; j < floes_in_order; ++j) {
     const std::uint32_t i = order_[static_cast<std::size_t>(j)];
-    if (i < mine.begin || i >= mine.end) continue;
+    if (!footprints_.owns(i)) continue;
     const Vec2 a = slope_[i];
     Vec2 fh = Vec2::Zero();
     double torque = 0.0;
@@ -546,12 +553,13 @@ void FloeSeaContact::update_water(const Floes& floes, const fluid::Sea& sea, Inc
   const double w = incident->weight(sea.time());
   const std::span<const double> u0 = incident->u0(), v0 = incident->v0(), u1 = incident->u1(), v1 = incident->v1();
   const Footprints& fp = footprints_.pieces();
-  // Each rank its share of the floes; the caller shares them (share_owned).
-  const parallel::Range mine = comm_.share(water_.size());
-  const std::ptrdiff_t first = static_cast<std::ptrdiff_t>(mine.begin);
-  const std::ptrdiff_t count = static_cast<std::ptrdiff_t>(std::min(mine.end, fp.floes()));
-#pragma omp parallel for num_threads(threads_) schedule(static) if (count - first > kFloesPerThread)
-  for (std::ptrdiff_t i = first; i < count; ++i) {
+  // Each rank its own floes; the caller shares them (share_owned).
+  const std::span<const std::uint32_t> mine = footprints_.mine();
+  const std::ptrdiff_t count = static_cast<std::ptrdiff_t>(mine.size());
+#pragma omp parallel for num_threads(threads_) schedule(static) if (count > kFloesPerThread)
+  for (std::ptrdiff_t j = 0; j < count; ++j) {
+    const std::size_t i = mine[static_cast<std::size_t>(j)];
+    if (i >= fp.floes()) continue;
     double area = 0.0;
     Vec2 sum0 = Vec2::Zero(), sum1 = Vec2::Zero();
     for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k) {

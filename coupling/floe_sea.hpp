@@ -199,17 +199,21 @@ public:
   // round-off where several ranks' floes share a cell. The implicit step
   // stays replicated on every floe's pieces (gathered), to the bit. Every
   // rank calls every method in the same order (they may exchange data).
-  // When the sea is in slabs (fluid::Sea::slab_rows), each cell's parts go
-  // to the rank whose slab holds its row, which sums them and sends the
-  // coverage and the sums back to the ranks with pieces there (stage five):
-  // pressure() then holds this rank's slab's rows only, which is what its
-  // sea's kick reads.
+  // When the sea is in slabs (fluid::Sea::slab_rows; stage five), the floes
+  // are owned by place (the rank whose slab holds the row of a floe's
+  // centroid at the footprints' last rebuild: MovingFootprints::set_slabs),
+  // and each cell's parts go to the rank whose slab holds its row, which sums
+  // them and sends the coverage and the sums back to the ranks with pieces
+  // there; a cell deeper in a slab than any floe of another rank reaches is
+  // summed by its owner alone, with no exchange. pressure() then holds this
+  // rank's slab's rows only, which is what its sea's kick reads.
   void set_communicator(const parallel::Communicator& comm) {
     comm_ = comm;
     footprints_.set_communicator(comm);
     footprints_.set_gather(!by_owner());
-    routes_ = by_owner() && !slab_rows_.empty() ? parallel::CellRoutes(slab_rows_, static_cast<std::size_t>(grid_.nx))
-                                                 : parallel::CellRoutes();
+    const bool slabs = by_owner() && !slab_rows_.empty();
+    routes_ = slabs ? parallel::CellRoutes(slab_rows_, static_cast<std::size_t>(grid_.nx)) : parallel::CellRoutes();
+    footprints_.set_slabs(slabs ? slab_rows_ : std::vector<int>{});
   }
   struct ImplicitStats {
     long steps = 0, newton = 0, cg = 0, g_products = 0;  // totals over the run
@@ -342,7 +346,13 @@ private:
     std::vector<std::uint32_t> touched;  // every rank's cells, in rank order (where pressure_ may be nonzero)
     std::vector<std::size_t> counts;     // cells per rank in `touched`
     std::vector<std::byte> message, received;  // the exchanges' buffers, kept from one evaluation to the next
-    std::vector<double> parts;                 // routed: per cell of `cells`, its sum and pressure
+    // Routed: the cells of `cells` that go through routes_ (their index in
+    // `cells`, the cells, their parts), the others being deep in this
+    // rank's slab (`interior`, per grid row, for `interior_reach`).
+    std::vector<std::uint32_t> routed_index, routed_cells;
+    std::vector<double> parts;
+    std::vector<std::uint8_t> interior;
+    int interior_reach = -1;
   } owner_;
   // The sea's slabs (fluid::Sea::slab_rows; empty: whole on every rank), and
   // by owner on them, the routes of the cells' sums to the slabs' ranks;

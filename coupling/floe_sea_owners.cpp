@@ -30,6 +30,8 @@
 
 #include "coupling/floe_sea.hpp"
 
+#include "core/error.hpp"
+
 namespace floesim {
 
 namespace {
@@ -73,8 +75,30 @@ void FloeSeaContact::sum_coverage_by_owner() {
       o.coverage[o.piece_slot[k]] += fp.area[k] * inv_cell_area;
     }
   if (routed()) {
-    routes_.open(comm_, o.cells, o.coverage, 1);
-    routes_.reply(comm_, 0, o.coverage);  // the cells' totals, in place of this rank's parts
+    // The cells deep in this rank's slab (floes owned by place) get no
+    // other rank's parts: their totals are this rank's (0 + its part, as
+    // the merge would give). The others go to their owners.
+    const int reach = footprints_.by_place() ? footprints_.reach_rows() : grid_.ny;
+    if (reach != o.interior_reach) {
+      o.interior = routes_.interior_rows(reach);
+      o.interior_reach = reach;
+    }
+    o.routed_index.clear();
+    o.routed_cells.clear();
+    o.parts.clear();
+    const std::size_t nx = static_cast<std::size_t>(grid_.nx);
+    for (std::size_t j = 0; j < o.cells.size(); ++j) {
+      if (o.interior[o.cells[j] / nx]) {
+        FLOESIM_ASSERT(routes_.owner(o.cells[j]) == comm_.rank());
+        continue;
+      }
+      o.routed_index.push_back(static_cast<std::uint32_t>(j));
+      o.routed_cells.push_back(o.cells[j]);
+      o.parts.push_back(o.coverage[j]);
+    }
+    routes_.open(comm_, o.routed_cells, o.parts, 1);
+    routes_.reply(comm_, 0, o.parts);  // the cells' totals, in place of this rank's parts
+    for (std::size_t m = 0; m < o.routed_index.size(); ++m) o.coverage[o.routed_index[m]] = o.parts[m];
     for (std::size_t j = 0; j < o.cells.size(); ++j) cells_[o.cells[j]].coverage = o.coverage[j];
     return;
   }
@@ -122,15 +146,21 @@ double FloeSeaContact::sum_cells_by_owner(double ks) {
       o.pressure[j] += force[k] * inv_cell_area;
     }
   if (routed()) {
-    o.parts.resize(2 * o.cells.size());
-    for (std::size_t j = 0; j < o.cells.size(); ++j) {
-      o.parts[2 * j] = o.sum[j];
-      o.parts[2 * j + 1] = o.pressure[j];
+    // Cells deep in this rank's slab: its parts are the totals (zero before: 0 + the part).
+    for (std::size_t j = 0; j < o.cells.size(); ++j)
+      if (o.interior[o.cells[j] / static_cast<std::size_t>(grid_.nx)]) pressure_[o.cells[j]] = o.pressure[j];
+    const std::size_t routed = o.routed_index.size();
+    o.parts.resize(2 * routed);
+    for (std::size_t m = 0; m < routed; ++m) {
+      o.parts[2 * m] = o.sum[o.routed_index[m]];
+      o.parts[2 * m + 1] = o.pressure[o.routed_index[m]];
     }
     const double total = routes_.add(comm_, o.parts, 2, energy);
     const std::span<const std::uint32_t> slab = routes_.owned();
     for (std::size_t j = 0; j < slab.size(); ++j) pressure_[slab[j]] = routes_.total(j, 1);  // zero before: 0 + the total
-    routes_.reply(comm_, 0, o.sum);
+    o.parts.resize(routed);
+    routes_.reply(comm_, 0, o.parts);
+    for (std::size_t m = 0; m < routed; ++m) o.sum[o.routed_index[m]] = o.parts[m];
     for (std::size_t j = 0; j < o.cells.size(); ++j) cells_[o.cells[j]].sum = o.sum[j];
     return total;
   }
@@ -167,16 +197,15 @@ void FloeSeaContact::share_owned(bool water) {
     double fx, fy, torque, u, v, fz, mx, my;
   };
   std::vector<Owned> owned(loads_.size());
-  const parallel::Range mine = comm_.share(owned.size());
-  for (std::size_t i = mine.begin; i < mine.end; ++i) {
+  for (std::uint32_t i : footprints_.mine()) {
     const Eigen::Vector3d& f = loads_[i].horizontal;
     const Eigen::Vector3d& v = loads_[i].vertical;
     const Vec2 w = water ? water_[i] : Vec2::Zero();
     owned[i] = {f[0], f[1], f[2], w.x(), w.y(), v[0], v[1], v[2]};
   }
-  comm_.complete_shares(owned);
+  comm_.complete_owned(owned, footprints_.owners());
   for (std::size_t i = 0; i < owned.size(); ++i) {
-    if (i >= mine.begin && i < mine.end) continue;
+    if (footprints_.owns(i)) continue;
     loads_[i].horizontal = {owned[i].fx, owned[i].fy, owned[i].torque};
     loads_[i].vertical = {owned[i].fz, owned[i].mx, owned[i].my};
     if (water) water_[i] = {owned[i].u, owned[i].v};

@@ -32,6 +32,18 @@ CellRoutes::CellRoutes(std::vector<int> first_row, std::size_t columns)
   slot_.assign(row_owner_.size() * columns_, 0);
 }
 
+std::vector<std::uint8_t> CellRoutes::interior_rows(int reach) const {
+  const int rows = static_cast<int>(row_owner_.size());
+  std::vector<std::uint8_t> interior(row_owner_.size(), 0);
+  if (reach >= rows) return interior;
+  for (int y = 0; y < rows; ++y) {
+    bool inside = true;
+    for (int d = -reach; d <= reach && inside; ++d) inside = row_owner_[static_cast<std::size_t>(((y + d) % rows + rows) % rows)] == row_owner_[static_cast<std::size_t>(y)];
+    interior[static_cast<std::size_t>(y)] = inside ? 1 : 0;
+  }
+  return interior;
+}
+
 void CellRoutes::open(const Communicator& comm, std::span<const std::uint32_t> cells, std::span<const double> parts,
                       int width) {
   const std::size_t ranks = static_cast<std::size_t>(comm.size()), w = static_cast<std::size_t>(width);

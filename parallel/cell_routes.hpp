@@ -38,6 +38,11 @@ public:
   bool empty() const { return first_row_.empty(); }
   // The rank whose slab holds `cell`.
   int owner(std::uint32_t cell) const { return row_owner_[cell / columns_]; }
+  // Per row: whether every row within `reach` rows of it (the grid's seam
+  // crossed) lies in its slab. When every rank's cells lie within `reach`
+  // rows of its own slab, a cell in such a row gets parts from its owner
+  // alone: its total is the owner's part, with nothing to route.
+  std::vector<std::uint8_t> interior_rows(int reach) const;
 
   // Sends each of `cells` (distinct) with its `width` parts (parts[k * width
   // + w] for cells[k]) to its owner; the owner sums them (total()).
