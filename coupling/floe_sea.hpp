@@ -338,21 +338,22 @@ private:
   // The contact by owner: the cells of this rank's pieces and its partial
   // sums there, and every rank's cells. The next evaluation clears pressure_
   // in every rank's cells and cells_ in this rank's.
+  static constexpr std::uint32_t kInteriorCell = 0xffffffffu;
   struct OwnerCells {
     std::vector<std::uint32_t> slot;   // per grid cell: 1 + its index in `cells`, 0: none of this rank's pieces
     std::vector<std::uint32_t> cells;  // this rank's cells, in the order its pieces meet them
-    std::vector<std::uint32_t> piece_slot;  // per area piece of this rank's floes: its cell's index in `cells`
+    std::vector<std::uint32_t> piece_slot;  // per area piece of this rank's floes: its cell's index in `cells`, or kInteriorCell
     std::vector<double> coverage, sum, pressure;  // per cell of `cells`: this rank's part
     std::vector<std::uint32_t> touched;  // every rank's cells, in rank order (where pressure_ may be nonzero)
     std::vector<std::size_t> counts;     // cells per rank in `touched`
     std::vector<std::byte> message, received;  // the exchanges' buffers, kept from one evaluation to the next
-    // Routed: the cells of `cells` that go through routes_ (their index in
-    // `cells`, the cells, their parts), the others being deep in this
-    // rank's slab (`interior`, per grid row, for `interior_reach`).
-    std::vector<std::uint32_t> routed_index, routed_cells;
-    std::vector<double> parts;
+    // Routed: per grid cell, whether it lies deep in this rank's slab (for
+    // `interior_reach` rows), where this rank's pieces are summed into
+    // cells_ and pressure_ directly (piece_slot kInteriorCell; `cells` holds
+    // the others); and the parts sent, per cell of `cells`.
     std::vector<std::uint8_t> interior;
     int interior_reach = -1;
+    std::vector<double> parts;
   } owner_;
   // The sea's slabs (fluid::Sea::slab_rows; empty: whole on every rank), and
   // by owner on them, the routes of the cells' sums to the slabs' ranks;

@@ -55,8 +55,24 @@ T at(const std::byte* in, std::size_t j) {
 void FloeSeaContact::sum_coverage_by_owner() {
   const Footprints& fp = footprints_.pieces();
   OwnerCells& o = owner_;
-  // This rank's cells, in the order its floes' pieces meet them, and its
-  // part of each cell's coverage, summed as the serial loop sums it.
+  // Routed, the cells deep in this rank's slab (floes owned by place) get
+  // no other rank's parts: their sums are made in cells_ and pressure_
+  // directly, as the serial loop makes them (the totals are this rank's
+  // parts: 0 + its part, what the merge would give), and every other cell
+  // goes to its owner. Not routed, no cell is interior.
+  if (routed()) {
+    const int reach = footprints_.by_place() ? footprints_.reach_rows() : grid_.ny;
+    if (reach != o.interior_reach) {
+      const std::vector<std::uint8_t> rows = routes_.interior_rows(reach);
+      o.interior.resize(grid_.size());
+      for (std::size_t c = 0; c < grid_.size(); ++c) o.interior[c] = rows[c / static_cast<std::size_t>(grid_.nx)];
+      o.interior_reach = reach;
+    }
+  } else {
+    o.interior.assign(grid_.size(), 0);
+  }
+  // This rank's other cells, in the order its floes' pieces meet them, and
+  // its part of each cell's coverage, summed as the serial loop sums it.
   o.slot.resize(grid_.size(), 0);
   for (std::uint32_t c : o.cells) o.slot[c] = 0;
   o.cells.clear();
@@ -66,6 +82,11 @@ void FloeSeaContact::sum_coverage_by_owner() {
   for (std::uint32_t i : order_)
     for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k) {
       const std::uint32_t c = fp.cell[k];
+      if (o.interior[c]) {
+        o.piece_slot[k] = kInteriorCell;
+        cells_[c].coverage += fp.area[k] * inv_cell_area;
+        continue;
+      }
       if (o.slot[c] == 0) {
         o.cells.push_back(c);
         o.coverage.push_back(0.0);
@@ -75,30 +96,8 @@ void FloeSeaContact::sum_coverage_by_owner() {
       o.coverage[o.piece_slot[k]] += fp.area[k] * inv_cell_area;
     }
   if (routed()) {
-    // The cells deep in this rank's slab (floes owned by place) get no
-    // other rank's parts: their totals are this rank's (0 + its part, as
-    // the merge would give). The others go to their owners.
-    const int reach = footprints_.by_place() ? footprints_.reach_rows() : grid_.ny;
-    if (reach != o.interior_reach) {
-      o.interior = routes_.interior_rows(reach);
-      o.interior_reach = reach;
-    }
-    o.routed_index.clear();
-    o.routed_cells.clear();
-    o.parts.clear();
-    const std::size_t nx = static_cast<std::size_t>(grid_.nx);
-    for (std::size_t j = 0; j < o.cells.size(); ++j) {
-      if (o.interior[o.cells[j] / nx]) {
-        FLOESIM_ASSERT(routes_.owner(o.cells[j]) == comm_.rank());
-        continue;
-      }
-      o.routed_index.push_back(static_cast<std::uint32_t>(j));
-      o.routed_cells.push_back(o.cells[j]);
-      o.parts.push_back(o.coverage[j]);
-    }
-    routes_.open(comm_, o.routed_cells, o.parts, 1);
-    routes_.reply(comm_, 0, o.parts);  // the cells' totals, in place of this rank's parts
-    for (std::size_t m = 0; m < o.routed_index.size(); ++m) o.coverage[o.routed_index[m]] = o.parts[m];
+    routes_.open(comm_, o.cells, o.coverage, 1);
+    routes_.reply(comm_, 0, o.coverage);  // the cells' totals, in place of this rank's parts
     for (std::size_t j = 0; j < o.cells.size(); ++j) cells_[o.cells[j]].coverage = o.coverage[j];
     return;
   }
@@ -142,25 +141,24 @@ double FloeSeaContact::sum_cells_by_owner(double ks) {
       if (u[k] <= 0.0) continue;
       const std::uint32_t j = o.piece_slot[k];
       energy += 0.5 * ks * psi[k] * fp.area[k] * u[k] * u[k];
+      if (j == kInteriorCell) {
+        cells_[fp.cell[k]].sum += fp.area[k] * u[k] * u[k];
+        pressure_[fp.cell[k]] += force[k] * inv_cell_area;
+        continue;
+      }
       o.sum[j] += fp.area[k] * u[k] * u[k];
       o.pressure[j] += force[k] * inv_cell_area;
     }
   if (routed()) {
-    // Cells deep in this rank's slab: its parts are the totals (zero before: 0 + the part).
-    for (std::size_t j = 0; j < o.cells.size(); ++j)
-      if (o.interior[o.cells[j] / static_cast<std::size_t>(grid_.nx)]) pressure_[o.cells[j]] = o.pressure[j];
-    const std::size_t routed = o.routed_index.size();
-    o.parts.resize(2 * routed);
-    for (std::size_t m = 0; m < routed; ++m) {
-      o.parts[2 * m] = o.sum[o.routed_index[m]];
-      o.parts[2 * m + 1] = o.pressure[o.routed_index[m]];
+    o.parts.resize(2 * o.cells.size());
+    for (std::size_t j = 0; j < o.cells.size(); ++j) {
+      o.parts[2 * j] = o.sum[j];
+      o.parts[2 * j + 1] = o.pressure[j];
     }
     const double total = routes_.add(comm_, o.parts, 2, energy);
     const std::span<const std::uint32_t> slab = routes_.owned();
     for (std::size_t j = 0; j < slab.size(); ++j) pressure_[slab[j]] = routes_.total(j, 1);  // zero before: 0 + the total
-    o.parts.resize(routed);
-    routes_.reply(comm_, 0, o.parts);
-    for (std::size_t m = 0; m < routed; ++m) o.sum[o.routed_index[m]] = o.parts[m];
+    routes_.reply(comm_, 0, o.sum);
     for (std::size_t j = 0; j < o.cells.size(); ++j) cells_[o.cells[j]].sum = o.sum[j];
     return total;
   }
