@@ -418,9 +418,14 @@ void FloeSeaContact::evaluate(const Floes& floes, fluid::Sea& sea, double h) {
   place_footprints(floes);
   const Footprints& fp = footprints_.pieces();
   const std::span<const double> area0 = footprints_.reference_area();
+  // Routed with the floes owned by place, this rank's pieces lie within
+  // reach_rows() of its slab: the sea's fields are exchanged there only.
+  const bool halo = routed() && footprints_.by_place();
+  if (halo) sea.set_field_halo(footprints_.reach_rows());
   const std::span<const double> eta = sea.elevation();
   std::span<const double> w;
   if (s_ < 1.0) w = sea.field(fluid::Field::velocity_z);
+  if (halo) sea.set_field_halo(-1);
   const double ks = s_ * kappa_, inv_cell_area = 1.0 / cell_area_;
   // The implicit integrator applies the vertical law and the weight itself.
   const double spring_kick = implicit_ ? 0.0 : 1.0, weight = implicit_ ? 0.0 : g_;
