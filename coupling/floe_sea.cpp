@@ -366,18 +366,8 @@ void FloeSeaContact::clear_footprint_cells() {
   if (pressure_.size() != grid_.size()) {
     pressure_.assign(grid_.size(), 0.0);
     cells_.assign(grid_.size(), {});
-  } else if (by_owner()) {  // every rank's last cells (routed: its slab's); the sums only in this rank's (floe_sea_owners.cpp)
-    for (std::uint32_t c : routed() ? routes_.owned() : std::span<const std::uint32_t>(owner_.touched)) pressure_[c] = 0.0;
-    for (std::uint32_t c : owner_.cells) cells_[c] = {};
-    // The cells deep in this rank's slab (routed): its last pieces' cells.
-    const Footprints& fp = footprints_.pieces();
-    if (routed())
-      for (std::uint32_t i : order_)
-        for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k)
-          if (owner_.piece_slot[k] == kInteriorCell) {
-            pressure_[fp.cell[k]] = 0.0;
-            cells_[fp.cell[k]] = {};
-          }
+  } else if (by_owner()) {
+    clear_cells_by_owner();
   } else {
     for (std::uint32_t c : footprints_.pieces().cell) {
       pressure_[c] = 0.0;

@@ -274,6 +274,9 @@ private:
   bool by_owner() const { return !comm_.serial() && !implicit_; }
   // The cells' sums by owner go to the slabs' ranks (the sea in slabs).
   bool routed() const { return !routes_.empty(); }
+  // By owner (floe_sea_owners.cpp): zeroes pressure_ and cells_ where the
+  // last evaluation by owner wrote them.
+  void clear_cells_by_owner();
   // By owner (floe_sea_owners.cpp): this rank's pieces' coverage summed into
   // its cells, then every rank's parts in rank order into cells_[c].coverage
   // of this rank's cells (cells_ is zero in the others).

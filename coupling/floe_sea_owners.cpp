@@ -52,6 +52,23 @@ T at(const std::byte* in, std::size_t j) {
 
 }  // namespace
 
+void FloeSeaContact::clear_cells_by_owner() {
+  // The pressure where the last evaluation put it: every rank's cells (not
+  // routed) or this rank's slab's routed cells; the coverage and sums in
+  // this rank's cells; and, routed, the cells deep in its slab, where its
+  // last pieces lie.
+  for (std::uint32_t c : routed() ? routes_.owned() : std::span<const std::uint32_t>(owner_.touched)) pressure_[c] = 0.0;
+  for (std::uint32_t c : owner_.cells) cells_[c] = {};
+  if (!routed()) return;
+  const Footprints& fp = footprints_.pieces();
+  for (std::uint32_t i : order_)
+    for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k)
+      if (owner_.piece_slot[k] == kInteriorCell) {
+        pressure_[fp.cell[k]] = 0.0;
+        cells_[fp.cell[k]] = {};
+      }
+}
+
 void FloeSeaContact::sum_coverage_by_owner() {
   const Footprints& fp = footprints_.pieces();
   OwnerCells& o = owner_;
