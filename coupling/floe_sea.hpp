@@ -190,8 +190,9 @@ public:
   // Threads for the per-floe and per-piece work (results do not depend on it).
   void set_threads(int threads) { threads_ = std::max(threads, 1); }
   // Ranks that share the per-floe work (docs/parallel.md, stages two and
-  // three). Each rank builds its share's footprints and computes its share's
-  // horizontal loads and water velocities; the other ranks receive them.
+  // three). Each rank builds its floes' footprints (MovingFootprints::mine)
+  // and computes their horizontal loads and water velocities; the other
+  // ranks receive them.
   // With the explicit kicks each rank also runs the law on its own floes'
   // pieces and sums them into the cells; the cells' coverage, sums and
   // pressure are then summed over the ranks in rank order (by_owner()): the
@@ -350,10 +351,11 @@ private:
     std::vector<std::uint32_t> touched;  // every rank's cells, in rank order (where pressure_ may be nonzero)
     std::vector<std::size_t> counts;     // cells per rank in `touched`
     std::vector<std::byte> message, received;  // the exchanges' buffers, kept from one evaluation to the next
-    // Routed: per grid cell, whether it lies deep in this rank's slab (for
-    // `interior_reach` rows), where this rank's pieces are summed into
-    // cells_ and pressure_ directly (piece_slot kInteriorCell; `cells` holds
-    // the others); and the parts sent, per cell of `cells`.
+    // Routed: per grid cell, whether it lies deep in its slab (every row
+    // within `interior_reach` rows is the slab's), where only the slab's
+    // rank has pieces, summed into cells_ and pressure_ directly (piece_slot
+    // kInteriorCell; `cells` holds the others); and the parts sent, per
+    // cell of `cells`.
     std::vector<std::uint8_t> interior;
     int interior_reach = -1;
     std::vector<double> parts;
