@@ -115,6 +115,7 @@ FloeSeaContact::FloeSeaContact(const CouplingParams& params, const SeaParams& se
   FLOESIM_ASSERT(params.footprint != FootprintChoice::tent || periodic);
   kernel_ = params.footprint == FootprintChoice::cell || !periodic ? FootprintKernel::cell : FootprintKernel::tent;
   footprints_ = MovingFootprints(grid, kernel_, {params.footprint_reach});
+  slab_rows_ = sea.slab_rows();
   cell_area_ = grid.dx() * (grid.dims == 2 ? grid.dy() : grid.ly);
   // The sea under the floes, as fast as it can answer: one cell, or the
   // grid's shortest wave, at a few places (a walled basin answers faster near
@@ -365,9 +366,8 @@ void FloeSeaContact::clear_footprint_cells() {
   if (pressure_.size() != grid_.size()) {
     pressure_.assign(grid_.size(), 0.0);
     cells_.assign(grid_.size(), {});
-  } else if (by_owner()) {  // every rank's last cells; the sums only in this rank's (floe_sea_owners.cpp)
-    for (std::uint32_t c : owner_.touched) pressure_[c] = 0.0;
-    for (std::uint32_t c : owner_.cells) cells_[c] = {};
+  } else if (by_owner()) {
+    clear_cells_by_owner();
   } else {
     for (std::uint32_t c : footprints_.pieces().cell) {
       pressure_[c] = 0.0;
@@ -385,9 +385,14 @@ void FloeSeaContact::place_footprints(const Floes& floes) {
   // read and written where each floe lies: this keeps them in cache).
   // By owner, this rank's floes only (the others' pieces are not here).
   order_.clear();
-  const parallel::Range mine = by_owner() ? footprints_.owned(floes.size()) : parallel::Range{0, floes.size()};
-  for (std::size_t i = mine.begin; i < mine.end; ++i)
+  auto take = [&](std::size_t i) {
     if (dynamic_[i] && fp.offsets[i] < fp.offsets[i + 1]) order_.push_back(static_cast<std::uint32_t>(i));
+  };
+  if (by_owner()) {
+    for (std::uint32_t i : footprints_.mine()) take(i);
+  } else {
+    for (std::size_t i = 0; i < floes.size(); ++i) take(i);
+  }
   std::sort(order_.begin(), order_.end(),
             [&](std::uint32_t x, std::uint32_t y) { return fp.cell[fp.offsets[x]] < fp.cell[fp.offsets[y]]; });
   if (by_owner()) return sum_coverage_by_owner();
@@ -403,9 +408,14 @@ void FloeSeaContact::evaluate(const Floes& floes, fluid::Sea& sea, double h) {
   place_footprints(floes);
   const Footprints& fp = footprints_.pieces();
   const std::span<const double> area0 = footprints_.reference_area();
+  // Routed with the floes owned by place, this rank's pieces lie within
+  // reach_rows() of its slab: the sea's fields are exchanged there only.
+  const bool halo = routed() && footprints_.by_place();
+  if (halo) sea.set_field_halo(footprints_.reach_rows());
   const std::span<const double> eta = sea.elevation();
   std::span<const double> w;
   if (s_ < 1.0) w = sea.field(fluid::Field::velocity_z);
+  if (halo) sea.set_field_halo(-1);
   const double ks = s_ * kappa_, inv_cell_area = 1.0 / cell_area_;
   // The implicit integrator applies the vertical law and the weight itself.
   const double spring_kick = implicit_ ? 0.0 : 1.0, weight = implicit_ ? 0.0 : g_;
@@ -488,12 +498,11 @@ void FloeSeaContact::horizontal_loads(std::span<const double> u) {
   if (ks <= 0.0) return;
   // Each rank its own floes (their edge pieces are only there); the caller
   // shares the loads (share_owned).
-  const parallel::Range mine = footprints_.owned(loads_.size());
   const std::ptrdiff_t floes_in_order = static_cast<std::ptrdiff_t>(order_.size());
 #pragma omp parallel for num_threads(threads_) schedule(dynamic, 16) if (floes_in_order > kFloesPerThread)
   for (std::ptrdiff_t j = 0; j < floes_in_order; ++j) {
     const std::uint32_t i = order_[static_cast<std::size_t>(j)];
-    if (i < mine.begin || i >= mine.end) continue;
+    if (!footprints_.owns(i)) continue;
     const Vec2 a = slope_[i];
     Vec2 fh = Vec2::Zero();
     double torque = 0.0;
@@ -545,12 +554,13 @@ void FloeSeaContact::update_water(const Floes& floes, const fluid::Sea& sea, Inc
   const double w = incident->weight(sea.time());
   const std::span<const double> u0 = incident->u0(), v0 = incident->v0(), u1 = incident->u1(), v1 = incident->v1();
   const Footprints& fp = footprints_.pieces();
-  // Each rank its share of the floes; the caller shares them (share_owned).
-  const parallel::Range mine = comm_.share(water_.size());
-  const std::ptrdiff_t first = static_cast<std::ptrdiff_t>(mine.begin);
-  const std::ptrdiff_t count = static_cast<std::ptrdiff_t>(std::min(mine.end, fp.floes()));
-#pragma omp parallel for num_threads(threads_) schedule(static) if (count - first > kFloesPerThread)
-  for (std::ptrdiff_t i = first; i < count; ++i) {
+  // Each rank its own floes; the caller shares them (share_owned).
+  const std::span<const std::uint32_t> mine = footprints_.mine();
+  const std::ptrdiff_t count = static_cast<std::ptrdiff_t>(mine.size());
+#pragma omp parallel for num_threads(threads_) schedule(static) if (count > kFloesPerThread)
+  for (std::ptrdiff_t j = 0; j < count; ++j) {
+    const std::size_t i = mine[static_cast<std::size_t>(j)];
+    if (i >= fp.floes()) continue;
     double area = 0.0;
     Vec2 sum0 = Vec2::Zero(), sum1 = Vec2::Zero();
     for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k) {

@@ -127,6 +127,7 @@
 #include "coupling/footprint.hpp"
 #include "coupling/moving_footprint.hpp"
 #include "coupling/penalty_step.hpp"
+#include "parallel/cell_routes.hpp"
 
 namespace floesim {
 
@@ -189,8 +190,9 @@ public:
   // Threads for the per-floe and per-piece work (results do not depend on it).
   void set_threads(int threads) { threads_ = std::max(threads, 1); }
   // Ranks that share the per-floe work (docs/parallel.md, stages two and
-  // three). Each rank builds its share's footprints and computes its share's
-  // horizontal loads and water velocities; the other ranks receive them.
+  // three). Each rank builds its floes' footprints (MovingFootprints::mine)
+  // and computes their horizontal loads and water velocities; the other
+  // ranks receive them.
   // With the explicit kicks each rank also runs the law on its own floes'
   // pieces and sums them into the cells; the cells' coverage, sums and
   // pressure are then summed over the ranks in rank order (by_owner()): the
@@ -198,10 +200,21 @@ public:
   // round-off where several ranks' floes share a cell. The implicit step
   // stays replicated on every floe's pieces (gathered), to the bit. Every
   // rank calls every method in the same order (they may exchange data).
+  // When the sea is in slabs (fluid::Sea::slab_rows; stage five), the floes
+  // are owned by place (the rank whose slab holds the row of a floe's
+  // centroid at the footprints' last rebuild: MovingFootprints::set_slabs),
+  // and each cell's parts go to the rank whose slab holds its row, which sums
+  // them and sends the coverage and the sums back to the ranks with pieces
+  // there; a cell deeper in a slab than any floe of another rank reaches is
+  // summed by its owner alone, with no exchange. pressure() then holds this
+  // rank's slab's rows only, which is what its sea's kick reads.
   void set_communicator(const parallel::Communicator& comm) {
     comm_ = comm;
     footprints_.set_communicator(comm);
     footprints_.set_gather(!by_owner());
+    const bool slabs = by_owner() && !slab_rows_.empty();
+    routes_ = slabs ? parallel::CellRoutes(slab_rows_, static_cast<std::size_t>(grid_.nx)) : parallel::CellRoutes();
+    footprints_.set_slabs(slabs ? slab_rows_ : std::vector<int>{});
   }
   struct ImplicitStats {
     long steps = 0, newton = 0, cg = 0, g_products = 0;  // totals over the run
@@ -260,6 +273,11 @@ private:
   void clear_footprint_cells();
   // The contact is evaluated by owner: several ranks, explicit kicks.
   bool by_owner() const { return !comm_.serial() && !implicit_; }
+  // The cells' sums by owner go to the slabs' ranks (the sea in slabs).
+  bool routed() const { return !routes_.empty(); }
+  // By owner (floe_sea_owners.cpp): zeroes pressure_ and cells_ where the
+  // last evaluation by owner wrote them.
+  void clear_cells_by_owner();
   // By owner (floe_sea_owners.cpp): this rank's pieces' coverage summed into
   // its cells, then every rank's parts in rank order into cells_[c].coverage
   // of this rank's cells (cells_ is zero in the others).
@@ -267,8 +285,9 @@ private:
   // By owner, after the law (eval_: penetrations u, weights psi, forces):
   // this rank's pieces' a u^2 and pressure in its cells and its part of the
   // penalty energy ks psi a u^2 / 2, in one pass; then every rank's parts in
-  // rank order into pressure_ (every cell) and cells_[c].sum (this rank's
-  // cells); returns the energy, the ranks' parts summed in rank order.
+  // rank order into pressure_ (every cell; routed, the cells of this rank's
+  // slab) and cells_[c].sum (this rank's cells); returns the energy, the
+  // ranks' parts summed in rank order.
   double sum_cells_by_owner(double ks);
   // poses_ <- the floes' present poses.
   void pose_at_states(const Floes& floes);
@@ -323,14 +342,30 @@ private:
   // The contact by owner: the cells of this rank's pieces and its partial
   // sums there, and every rank's cells. The next evaluation clears pressure_
   // in every rank's cells and cells_ in this rank's.
+  static constexpr std::uint32_t kInteriorCell = 0xffffffffu;
   struct OwnerCells {
     std::vector<std::uint32_t> slot;   // per grid cell: 1 + its index in `cells`, 0: none of this rank's pieces
     std::vector<std::uint32_t> cells;  // this rank's cells, in the order its pieces meet them
+    std::vector<std::uint32_t> piece_slot;  // per area piece of this rank's floes: its cell's index in `cells`, or kInteriorCell
     std::vector<double> coverage, sum, pressure;  // per cell of `cells`: this rank's part
     std::vector<std::uint32_t> touched;  // every rank's cells, in rank order (where pressure_ may be nonzero)
     std::vector<std::size_t> counts;     // cells per rank in `touched`
     std::vector<std::byte> message, received;  // the exchanges' buffers, kept from one evaluation to the next
+    // Routed: per grid cell, whether it lies deep in its slab (every row
+    // within `interior_reach` rows is the slab's), where only the slab's
+    // rank has pieces, summed into cells_ and pressure_ directly (piece_slot
+    // kInteriorCell; `cells` holds the others); and the parts sent, per
+    // cell of `cells`.
+    std::vector<std::uint8_t> interior;
+    int interior_reach = -1;
+    std::vector<double> parts;
   } owner_;
+  // The sea's slabs (fluid::Sea::slab_rows; empty: whole on every rank), and
+  // by owner on them, the routes of the cells' sums to the slabs' ranks;
+  // the next evaluation clears pressure_ in routes_.owned() (this rank's
+  // slab's cells of the last one) and cells_ in owner_.cells.
+  std::vector<int> slab_rows_;
+  parallel::CellRoutes routes_;
   std::vector<std::uint32_t> order_;  // dynamic floes with pieces, by their first cell
   bool pressure_kicked_ = false;  // the sea's last kick was with pressure_ as it is
   double loads_h_ = -1.0;         // the kick length of the last evaluation (< 0: stale)

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstring>
 
+#include "core/error.hpp"
 #include "coupling/parallel.hpp"
 
 namespace floesim {
@@ -47,24 +48,57 @@ bool MovingFootprints::place(const Floes& floes, std::span<const std::uint8_t> i
   return true;
 }
 
+void MovingFootprints::set_slabs(std::vector<int> first_row) {
+  row_owner_.clear();
+  for (std::size_t r = 0; r + 1 < first_row.size(); ++r)
+    for (int row = first_row[r]; row < first_row[r + 1]; ++row) row_owner_.push_back(static_cast<int>(r));
+  FLOESIM_ASSERT(row_owner_.empty() || static_cast<int>(row_owner_.size()) == grid_.ny);
+}
+
+void MovingFootprints::set_owners(std::span<const FloePose> poses) {
+  const std::size_t n = poses.size();
+  owner_.assign(n, 0);
+  by_place_ = !comm_.serial() && !row_owner_.empty();
+  if (by_place_) {
+    // The row of the centroid, the grid's seam crossed (periodic).
+    const double dy = grid_.dy();
+    for (std::size_t i = 0; i < n; ++i) {
+      const double row = std::floor(poses[i].y / dy);
+      const double wrapped = row - static_cast<double>(grid_.ny) * std::floor(row / grid_.ny);
+      owner_[i] = row_owner_[std::min(static_cast<std::size_t>(wrapped), row_owner_.size() - 1)];
+    }
+  } else if (!comm_.serial()) {
+    for (int r = 0; r < comm_.size(); ++r) {
+      const parallel::Range share = parallel::share(n, r, comm_.size());
+      std::fill(owner_.begin() + static_cast<std::ptrdiff_t>(share.begin), owner_.begin() + static_cast<std::ptrdiff_t>(share.end), r);
+    }
+  }
+  mine_.clear();
+  for (std::size_t i = 0; i < n; ++i)
+    if (owner_[i] == comm_.rank()) mine_.push_back(static_cast<std::uint32_t>(i));
+}
+
 void MovingFootprints::rebuild_at(const Floes& floes, std::span<const std::uint8_t> include,
                                   std::span<const FloePose> reference, int threads) {
   ++rebuilds_;
+  set_owners(reference);
   if (comm_.serial()) {
     build_footprints(floes, include, grid_, pieces_, kernel_, threads, reference);
   } else {
-    const parallel::Range mine = owned(floes.size());
     std::vector<std::uint8_t> mask(include.size(), 0);
-    const auto from = static_cast<std::ptrdiff_t>(mine.begin), to = static_cast<std::ptrdiff_t>(mine.end);
-    std::copy(include.begin() + from, include.begin() + to, mask.begin() + from);
+    for (std::uint32_t i : mine_) mask[i] = include[i];
     build_footprints(floes, mask, grid_, pieces_, kernel_, threads, reference);
     if (gather_) gather_built();
   }
   reference_.assign(reference.begin(), reference.end());
   include_.assign(include.begin(), include.end());
   radius_.assign(floes.size(), 0.0);
-  for (std::size_t i = 0; i < floes.size(); ++i)
+  double largest = 0.0;
+  for (std::size_t i = 0; i < floes.size(); ++i) {
     for (const Vec2& v : floes.vertices(i)) radius_[i] = std::max(radius_[i], v.norm());
+    if (include[i]) largest = std::max(largest, radius_[i]);
+  }
+  reach_rows_ = static_cast<int>(std::ceil((largest + (1.0 + options_.reach) * grid_.dy()) / grid_.dy())) + 1;
   area0_ = pieces_.area;
   moment0_.resize(area0_.size());
   for (std::size_t k = 0; k < area0_.size(); ++k) moment0_[k] = area0_[k] * pieces_.centroid[k];
@@ -72,9 +106,8 @@ void MovingFootprints::rebuild_at(const Floes& floes, std::span<const std::uint8
 
 void MovingFootprints::move(std::span<const FloePose> poses, int threads) {
   Footprints& fp = pieces_;
-  const parallel::Range mine = owned(fp.floes());
-  parallel::for_each_index(mine.size(), threads, [&](std::size_t j) {
-    const std::size_t i = mine.begin + j;
+  parallel::for_each_index(mine_.size(), threads, [&](std::size_t j) {
+    const std::size_t i = mine_[j];
     if (fp.offsets[i] == fp.offsets[i + 1]) return;
     const FloePose d = displacement(i, poses[i]);
     const Vec2 delta{d.x, d.y};
@@ -120,49 +153,70 @@ const std::byte* take(const std::byte* in, T* data, std::size_t count) {
 }  // namespace
 
 void MovingFootprints::gather_built() {
-  // pieces_ holds this rank's floes' pieces only (the other floes have none).
-  // Message: the pieces per floe of the share, then their cells, areas and
-  // centroids; the ranks' messages come back in rank order = floe order.
+  // pieces_ holds this rank's floes' pieces only (the other floes have none),
+  // in floe order. Message: the pieces per floe of mine_, then their cells,
+  // areas and centroids. Every rank knows every floe's owner: each floe's
+  // pieces are taken from its owner's message, in floe order.
   Footprints& fp = pieces_;
-  const std::size_t n = fp.floes();
-  const parallel::Range mine = owned(n);
-  const std::size_t first = fp.offsets[mine.begin], count = fp.offsets[mine.end] - first;
-  std::vector<std::uint64_t> per_floe(mine.size());
-  for (std::size_t j = 0; j < mine.size(); ++j)
-    per_floe[j] = fp.offsets[mine.begin + j + 1] - fp.offsets[mine.begin + j];
+  const std::size_t n = fp.floes(), count = fp.cell.size();
+  std::vector<std::uint64_t> per_floe(mine_.size());
+  for (std::size_t j = 0; j < mine_.size(); ++j) per_floe[j] = fp.offsets[mine_[j] + 1] - fp.offsets[mine_[j]];
   std::vector<std::byte> message;
   message.reserve(per_floe.size() * 8 + count * (4 + 8 + 16));
   put(message, per_floe.data(), per_floe.size());
-  put(message, fp.cell.data() + first, count);
-  put(message, fp.area.data() + first, count);
-  put(message, fp.centroid.data() + first, count);
+  put(message, fp.cell.data(), count);
+  put(message, fp.area.data(), count);
+  put(message, fp.centroid.data(), count);
   std::vector<std::size_t> sizes;
   const std::vector<std::byte> all = comm_.allgather_bytes(message, sizes);
 
-  Footprints full;
-  full.offsets.assign(1, 0);
+  // Each rank's message: its floes' counts, and where its cells, areas and centroids start.
+  const std::size_t ranks = sizes.size();
+  std::vector<std::size_t> floes_of(ranks, 0);
+  for (int o : owner_) ++floes_of[static_cast<std::size_t>(o)];
+  struct Stream {
+    const std::byte* counts;
+    const std::byte* cell;
+    const std::byte* area;
+    const std::byte* centroid;
+    std::size_t floe = 0, piece = 0;  // cursors
+  };
+  std::vector<Stream> stream(ranks);
   const std::byte* in = all.data();
-  for (int r = 0; r < comm_.size(); ++r) {
-    const parallel::Range share = parallel::share(n, r, comm_.size());
-    per_floe.resize(share.size());
-    in = take(in, per_floe.data(), per_floe.size());
-    std::size_t pieces = 0;
-    for (std::uint64_t c : per_floe) {
-      pieces += c;
-      full.offsets.push_back(full.offsets.back() + c);
-    }
-    const std::size_t at = full.cell.size();
-    full.cell.resize(at + pieces);
-    full.area.resize(at + pieces);
-    full.centroid.resize(at + pieces);
-    in = take(in, full.cell.data() + at, pieces);
-    in = take(in, full.area.data() + at, pieces);
-    in = take(in, full.centroid.data() + at, pieces);
+  for (std::size_t r = 0; r < ranks; ++r) {
+    const std::size_t pieces = (sizes[r] - floes_of[r] * sizeof(std::uint64_t)) / (sizeof(std::uint32_t) + sizeof(double) + sizeof(Vec2));
+    stream[r].counts = in;
+    stream[r].cell = in + floes_of[r] * sizeof(std::uint64_t);
+    stream[r].area = stream[r].cell + pieces * sizeof(std::uint32_t);
+    stream[r].centroid = stream[r].area + pieces * sizeof(double);
+    in += sizes[r];
+  }
+  Footprints full;
+  full.offsets.assign(n + 1, 0);
+  for (std::size_t i = 0; i < n; ++i) {
+    Stream& s = stream[static_cast<std::size_t>(owner_[i])];
+    std::uint64_t c = 0;
+    std::memcpy(&c, s.counts + s.floe++ * sizeof(std::uint64_t), sizeof(c));
+    full.offsets[i + 1] = full.offsets[i] + c;
+  }
+  const std::size_t total = full.offsets[n];
+  full.cell.resize(total);
+  full.area.resize(total);
+  full.centroid.resize(total);
+  for (std::size_t i = 0; i < n; ++i) {
+    Stream& s = stream[static_cast<std::size_t>(owner_[i])];
+    const std::size_t at = full.offsets[i], pieces = full.offsets[i + 1] - at;
+    take(s.cell + s.piece * sizeof(std::uint32_t), full.cell.data() + at, pieces);
+    take(s.area + s.piece * sizeof(double), full.area.data() + at, pieces);
+    take(s.centroid + s.piece * sizeof(Vec2), full.centroid.data() + at, pieces);
+    s.piece += pieces;
   }
   // This rank's edge pieces point into the full list of area pieces.
-  const auto shift = static_cast<std::ptrdiff_t>(full.offsets[mine.begin]) - static_cast<std::ptrdiff_t>(first);
-  for (std::ptrdiff_t& p : fp.edge_piece)
-    if (p >= 0) p += shift;
+  for (std::uint32_t i : mine_) {
+    const auto shift = static_cast<std::ptrdiff_t>(full.offsets[i]) - static_cast<std::ptrdiff_t>(fp.offsets[i]);
+    for (std::size_t e = fp.edge_offsets[i]; e < fp.edge_offsets[i + 1]; ++e)
+      if (fp.edge_piece[e] >= 0) fp.edge_piece[e] += shift;
+  }
   fp.offsets = std::move(full.offsets);
   fp.cell = std::move(full.cell);
   fp.area = std::move(full.area);
@@ -170,29 +224,29 @@ void MovingFootprints::gather_built() {
 }
 
 void MovingFootprints::gather_moved() {
-  // Every rank knows where each floe's pieces lie (the last build's layout):
-  // one call, the shares' areas then centroids.
+  // Every rank knows where each floe's pieces lie (the last build's layout)
+  // and each floe's owner: one call, each rank's floes' areas then centroids.
   Footprints& fp = pieces_;
-  const std::size_t n = fp.floes();
-  std::vector<std::size_t> sizes(static_cast<std::size_t>(comm_.size()));
-  for (int r = 0; r < comm_.size(); ++r) {
-    const parallel::Range share = parallel::share(n, r, comm_.size());
-    const std::size_t pieces = fp.offsets[share.end] - fp.offsets[share.begin];
-    sizes[static_cast<std::size_t>(r)] = pieces * (sizeof(double) + sizeof(Vec2));
-  }
-  const parallel::Range mine = owned(n);
-  const std::size_t first = fp.offsets[mine.begin], count = fp.offsets[mine.end] - first;
+  const std::size_t n = fp.floes(), ranks = static_cast<std::size_t>(comm_.size());
+  std::vector<std::size_t> pieces_of(ranks, 0), sizes(ranks);
+  for (std::size_t i = 0; i < n; ++i) pieces_of[static_cast<std::size_t>(owner_[i])] += fp.offsets[i + 1] - fp.offsets[i];
+  for (std::size_t r = 0; r < ranks; ++r) sizes[r] = pieces_of[r] * (sizeof(double) + sizeof(Vec2));
   std::vector<std::byte> message;
-  message.reserve(count * (sizeof(double) + sizeof(Vec2)));
-  put(message, fp.area.data() + first, count);
-  put(message, fp.centroid.data() + first, count);
+  message.reserve(sizes[static_cast<std::size_t>(comm_.rank())]);
+  for (std::uint32_t i : mine_) put(message, fp.area.data() + fp.offsets[i], fp.offsets[i + 1] - fp.offsets[i]);
+  for (std::uint32_t i : mine_) put(message, fp.centroid.data() + fp.offsets[i], fp.offsets[i + 1] - fp.offsets[i]);
   const std::vector<std::byte> all = comm_.allgather_known(message, sizes);
+  std::vector<const std::byte*> area(ranks), centroid(ranks);
   const std::byte* in = all.data();
-  for (int r = 0; r < comm_.size(); ++r) {
-    const parallel::Range share = parallel::share(n, r, comm_.size());
-    const std::size_t at = fp.offsets[share.begin], pieces = fp.offsets[share.end] - at;
-    in = take(in, fp.area.data() + at, pieces);
-    in = take(in, fp.centroid.data() + at, pieces);
+  for (std::size_t r = 0; r < ranks; ++r) {
+    area[r] = in;
+    centroid[r] = in + pieces_of[r] * sizeof(double);
+    in += sizes[r];
+  }
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::size_t r = static_cast<std::size_t>(owner_[i]), at = fp.offsets[i], pieces = fp.offsets[i + 1] - at;
+    area[r] = take(area[r], fp.area.data() + at, pieces);
+    centroid[r] = take(centroid[r], fp.centroid.data() + at, pieces);
   }
 }
 

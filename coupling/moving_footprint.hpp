@@ -33,12 +33,16 @@
 // at every placement (the exact pieces).
 //
 // On several ranks (a parallel::Communicator, docs/parallel.md) each rank
-// builds or moves the pieces of its own share of the floes
-// (Communicator::share) and receives every other floe's area pieces from
-// its owner, so every rank holds all area pieces, to the bit as a serial
-// run builds them (each floe's pieces depend on that floe alone). The edge
-// pieces stay with their floe's owner: only the horizontal loads read them,
-// and the owner computes those (owned()). With set_gather(false) the area
+// builds or moves the pieces of the floes it owns (mine()) and receives
+// every other floe's area pieces from its owner, so every rank holds all
+// area pieces, to the bit as a serial run builds them (each floe's pieces
+// depend on that floe alone). The owners are set at each rebuild, from the
+// poses it builds at, and kept until the next one (the pieces stay with
+// their builder): by index (Communicator::share) by default; by place
+// (set_slabs, stage five) the rank whose slab of the sea's rows holds the row
+// of the floe's centroid owns it. The edge pieces stay with their floe's
+// owner: only the horizontal loads read them, and the owner computes those.
+// With set_gather(false) the area
 // pieces are not gathered either: each rank holds its own floes' pieces only
 // (the contact evaluated by owner, docs/parallel.md, stage three); the other
 // floes' entries are then empty, or left from the last gathered build, and
@@ -78,8 +82,21 @@ public:
   // Whether the next builds and moves send every floe's area pieces to every
   // rank (true by default); false: each rank keeps its own floes' pieces.
   void set_gather(bool all) { gather_ = all; }
-  // The floes whose edge pieces this rank holds: all of them when serial.
-  parallel::Range owned(std::size_t floes) const { return comm_.share(floes); }
+  // Own the floes by place from the next rebuild on: first_row as
+  // fluid::Sea::slab_rows gives it (rank r's slab holds rows [first_row[r],
+  // first_row[r + 1]) of the grid); empty: by index.
+  void set_slabs(std::vector<int> first_row);
+  // This rank's floes, in floe order, and each floe's owner (the same on
+  // every rank), as set by the last rebuild: all floes when serial.
+  std::span<const std::uint32_t> mine() const { return mine_; }
+  std::span<const int> owners() const { return owner_; }
+  bool owns(std::size_t i) const { return owner_[i] == comm_.rank(); }
+  // Whether the last rebuild set the owners by place, and then how many rows
+  // of the grid a floe's pieces may lie from the row of its centroid there,
+  // until the next rebuild: its largest radius, the tent's spread of one
+  // node and the window's reach, in rows, rounded up, plus one.
+  bool by_place() const { return by_place_; }
+  int reach_rows() const { return reach_rows_; }
 
   // The next placement rebuilds (the floes changed).
   void forget() { reference_.clear(); }
@@ -97,6 +114,8 @@ private:
   void move(std::span<const FloePose> poses, int threads);
   // (delta, phi) of floe i from its reference, the grid's seam crossed the short way.
   FloePose displacement(std::size_t i, const FloePose& at) const;
+  // owner_ and mine_ for floes at `poses` (the rebuild's).
+  void set_owners(std::span<const FloePose> poses);
   // After this rank built its floes' pieces alone: every floe's area pieces
   // from their owners, in floe order; the edge pieces are this rank's.
   void gather_built();
@@ -115,6 +134,11 @@ private:
   long placements_ = 0, rebuilds_ = 0;
   parallel::Communicator comm_;
   bool gather_ = true;
+  std::vector<int> row_owner_;  // by place: per grid row, the rank whose slab holds it; empty: by index
+  std::vector<int> owner_;      // per floe
+  std::vector<std::uint32_t> mine_;
+  bool by_place_ = false;
+  int reach_rows_ = 0;
 };
 
 }  // namespace floesim

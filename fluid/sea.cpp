@@ -66,10 +66,12 @@ void Sea::invalidate_rates() {
 
 std::span<const double> Sea::field(Field f) {
   const auto i = static_cast<std::size_t>(f);
-  if (!valid_[i]) {
+  const bool covers = computed_halo_[i] < 0 || computed_halo_[i] == field_halo_;
+  if (!valid_[i] || !covers) {
     if (fields_[i].size() != grid_.size()) fields_[i].assign(grid_.size(), 0.0);
     compute_field(f, fields_[i]);
     valid_[i] = true;
+    computed_halo_[i] = field_halo_;
   }
   return fields_[i];
 }

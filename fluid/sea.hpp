@@ -130,6 +130,18 @@ public:
   // Replaces the state by a surface given on the grid (its mean is removed).
   virtual void set_surface(std::span<const double> eta, std::span<const double> eta_t) = 0;
 
+  // In slabs (SeaOptions::ranks; spectral.hpp): the first row of each
+  // rank's slab, then the grid's row count (ranks + 1 values): kick() on rank
+  // r reads the pressure's rows [rows[r], rows[r + 1]) only. Empty when every
+  // rank reads the whole pressure.
+  virtual std::vector<int> slab_rows() const { return {}; }
+  // In slabs, the fields computed from now on hold the present values only
+  // in this rank's slab and `halo` rows either side of it (the grid's seam
+  // crossed; the other rows are stale): an exchange of those rows instead of
+  // a gather of every row. halo < 0 (the default): whole fields. A field
+  // computed whole serves any halo. A sea not in slabs ignores it.
+  void set_field_halo(int halo) { field_halo_ = halo; }
+
   std::span<const double> field(Field f);
   std::span<const double> elevation() { return field(Field::elevation); }
   SurfaceSample sample(double x, double y = 0.0);
@@ -163,6 +175,8 @@ protected:
                                    std::span<double> /*eta*/) {}
   virtual double static_potential() const { return 0.0; }
   void invalidate() { valid_.fill(false); }
+  // The rows the field being computed must hold (set_field_halo).
+  int field_halo() const { return field_halo_; }
   void invalidate_rates();  // only the fields that depend on eta' (after a kick)
 
   SurfaceGrid grid_;
@@ -172,6 +186,8 @@ protected:
 private:
   std::array<AlignedVector, field_count> fields_;
   std::array<bool, field_count> valid_{};
+  std::array<int, field_count> computed_halo_{};  // the halo each valid field was computed for
+  int field_halo_ = -1;
   AlignedVector p_scratch_;
   AlignedVector modal_a_, modal_b_;  // scratch for the midpoint operations
 };

@@ -71,6 +71,11 @@ struct SpectralSea::Impl {
   bool gathered = true;
   std::vector<std::size_t> row_bytes, mode_bytes;  // each rank's part of a field and of the bank (q and v)
   std::vector<std::byte> modes_buffer;
+  struct Halo {
+    int rows = -1;                                    // the halo the lists are for
+    std::vector<std::vector<int>> send, receive;      // per rank: the rows sent to it, received from it
+    std::vector<std::byte> out, in;
+  } halo_exchange;
 
   // f(first, last) for each range of this rank's modes (its columns of each
   // row of the half spectrum); every mode when not in slabs.
@@ -120,14 +125,16 @@ struct SpectralSea::Impl {
   }
   // out <- IFFT(from) (unnormalised; `from`, spec or spec_vy, is destroyed).
   // In slabs: from this rank's columns of `from` to its rows of out, then
-  // every rank's rows gathered into out.
-  void backward(std::span<double> out, fftw_complex* from) {
+  // every rank's rows gathered into out, or with halo >= 0 (Sea::
+  // set_field_halo) only the halo's rows exchanged.
+  void backward(std::span<double> out, fftw_complex* from, int halo = -1) {
     double* to = aligned(out.data()) ? out.data() : real;
     if (slab) {
       slab->backward(from, to, threads);
       const std::size_t begin = static_cast<std::size_t>(rows.begin) * nx, end = static_cast<std::size_t>(rows.end) * nx;
       if (to == real) std::copy(real + begin, real + end, out.begin() + static_cast<std::ptrdiff_t>(begin));
-      ranks.allgather(std::as_writable_bytes(out), row_bytes);
+      if (halo < 0) ranks.allgather(std::as_writable_bytes(out), row_bytes);
+      else exchange_halo(out, halo);
       return;
     }
     if (fft2) fft2->backward(from, to, threads);
@@ -175,6 +182,70 @@ struct SpectralSea::Impl {
         }
       }
     });
+  }
+
+  // The rows rank r's fields hold beyond its slab for a halo of h rows: the
+  // h rows before its slab and the h after it, the grid's seam crossed, in
+  // that order, without its own rows or repeats; none for an empty slab.
+  std::vector<int> halo_rows(int r, int h) const {
+    const SlabFft2d::Span own = slab->rows_of(r);
+    std::vector<int> list;
+    if (own.begin == own.end) return list;
+    std::vector<std::uint8_t> seen(static_cast<std::size_t>(ny), 0);
+    for (int y = own.begin; y < own.end; ++y) seen[static_cast<std::size_t>(y)] = 1;
+    auto add = [&](int y) {
+      y = ((y % ny) + ny) % ny;
+      if (!seen[static_cast<std::size_t>(y)]) {
+        seen[static_cast<std::size_t>(y)] = 1;
+        list.push_back(y);
+      }
+    };
+    for (int d = h; d >= 1; --d) add(own.begin - d);
+    for (int d = 0; d < h; ++d) add(own.end + d);
+    return list;
+  }
+  // out's rows in this rank's halo of h rows <- their slabs' owners' (one
+  // all-to-all; each side knows what the other sends: the rows of the
+  // receiver's halo_rows that lie in the sender's slab, in that order).
+  void exchange_halo(std::span<double> out, int h) {
+    if (h != halo_exchange.rows) {
+      halo_exchange.rows = h;
+      halo_exchange.send.assign(static_cast<std::size_t>(ranks.ranks), {});
+      halo_exchange.receive.assign(static_cast<std::size_t>(ranks.ranks), {});
+      std::vector<int> owner(static_cast<std::size_t>(ny), 0);
+      for (int r = 0; r < ranks.ranks; ++r)
+        for (int y = slab->rows_of(r).begin; y < slab->rows_of(r).end; ++y) owner[static_cast<std::size_t>(y)] = r;
+      for (int r = 0; r < ranks.ranks; ++r)
+        for (int y : halo_rows(r, h)) {
+          const int from = owner[static_cast<std::size_t>(y)];
+          if (r == ranks.rank) halo_exchange.receive[static_cast<std::size_t>(from)].push_back(y);
+          if (from == ranks.rank) halo_exchange.send[static_cast<std::size_t>(r)].push_back(y);
+        }
+    }
+    const std::size_t row = sizeof(double) * static_cast<std::size_t>(nx);
+    std::vector<std::size_t> send_counts(halo_exchange.send.size()), receive_counts(halo_exchange.receive.size());
+    std::size_t sent = 0, received = 0;
+    for (std::size_t r = 0; r < halo_exchange.send.size(); ++r) {
+      send_counts[r] = halo_exchange.send[r].size() * row;
+      receive_counts[r] = halo_exchange.receive[r].size() * row;
+      sent += send_counts[r];
+      received += receive_counts[r];
+    }
+    halo_exchange.out.resize(sent);
+    halo_exchange.in.resize(received);
+    std::byte* at = halo_exchange.out.data();
+    for (const std::vector<int>& rows_to : halo_exchange.send)
+      for (int y : rows_to) {
+        std::memcpy(at, out.data() + static_cast<std::size_t>(y) * nx, row);
+        at += row;
+      }
+    ranks.alltoall(halo_exchange.out, send_counts, halo_exchange.in, receive_counts);
+    const std::byte* in = halo_exchange.in.data();
+    for (const std::vector<int>& rows_from : halo_exchange.receive)
+      for (int y : rows_from) {
+        std::memcpy(out.data() + static_cast<std::size_t>(y) * nx, in, row);
+        in += row;
+      }
   }
 
   // Every rank's columns of the bank (q and v) to every rank: the bank whole
@@ -299,6 +370,15 @@ SpectralSea::~SpectralSea() = default;
 double SpectralSea::omega(int mx, int my) const {
   const double two_pi = 2.0 * std::numbers::pi;
   return impl_->disp.omega(std::hypot(two_pi * mx / impl_->lx, two_pi * my / impl_->ly));
+}
+
+std::vector<int> SpectralSea::slab_rows() const {
+  const Impl& m = *impl_;
+  if (!m.slab) return {};
+  std::vector<int> rows;
+  for (int r = 0; r < m.ranks.ranks; ++r) rows.push_back(m.slab->rows_of(r).begin);
+  rows.push_back(m.ny);
+  return rows;
 }
 
 const TankZones* SpectralSea::tank() const { return impl_->tank ? &*impl_->tank : nullptr; }
@@ -455,7 +535,7 @@ void SpectralSea::compute_field(Field f, std::span<double> out) {
     case Field::velocity_y:
       if (one_d) return std::fill(out.begin(), out.end(), 0.0);
       if (m.staged_vy) {
-        m.backward(out, m.spec_vy);
+        m.backward(out, m.spec_vy, field_halo());
         m.staged_vy = false;
         return;
       }
@@ -463,7 +543,7 @@ void SpectralSea::compute_field(Field f, std::span<double> out) {
       break;
     case Field::velocity_z: m.load(bank_.v(), nullptr, nullptr, gain); break;
   }
-  m.backward(out, m.spec);  // destroys spec
+  m.backward(out, m.spec, field_halo());  // destroys spec
   m.staged = false;
 }
 

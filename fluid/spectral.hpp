@@ -25,7 +25,8 @@
 // slab of the pressure (the rest of the pressure is not read) into its
 // columns of modes; flow steps those modes only; a field is transformed
 // from them back to this rank's rows, and every rank's rows are then
-// gathered, so fields are whole on every rank. The bank is whole on every
+// gathered, so fields are whole on every rank; or, with a halo
+// (Sea::set_field_halo, stage five), only the rows within it are exchanged. The bank is whole on every
 // rank but only this rank's columns are current after a flow; settle()
 // (energy(), modes(): collective then) gathers every rank's columns first.
 // Each mode and each block of the transforms is computed with the serial
@@ -49,6 +50,7 @@ public:
   void flow(double dt) override;
   void set_surface(std::span<const double> eta, std::span<const double> eta_t) override;
   void midpoint_step(std::span<const double> p, double h) override;
+  std::vector<int> slab_rows() const override;
 
   // omega of the Fourier mode with wave vector 2 pi (mx / lx, my / ly).
   double omega(int mx, int my = 0) const;

@@ -219,6 +219,26 @@ void Communicator::alltoall(std::span<const std::byte> send, const std::vector<s
 #endif
 }
 
+void Communicator::alltoall_bytes(std::span<const std::byte> send, const std::vector<std::size_t>& send_counts,
+                                  std::vector<std::byte>& receive, std::vector<std::size_t>& receive_counts) const {
+  if (serial() || !impl_) {
+    receive_counts.assign(1, send.size());
+    receive.assign(send.begin(), send.end());
+    return;
+  }
+  // The counts: one long long from every rank to every rank.
+  const std::size_t n = static_cast<std::size_t>(size_);
+  std::vector<long long> out(n), in(n);
+  for (std::size_t r = 0; r < n; ++r) out[r] = static_cast<long long>(send_counts[r]);
+  const std::vector<std::size_t> one(n, sizeof(long long));
+  alltoall(std::as_bytes(std::span<const long long>(out)), one, std::as_writable_bytes(std::span<long long>(in)), one);
+  receive_counts.assign(in.begin(), in.end());
+  std::size_t total = 0;
+  for (std::size_t c : receive_counts) total += c;
+  receive.resize(total);  // a buffer kept by the caller: filled only where it grows
+  alltoall(send, send_counts, receive, receive_counts);
+}
+
 long long Communicator::sum(long long value) const {
   if (serial() || !impl_) return value;
 #ifdef FLOESIM_HAVE_MPI

@@ -91,6 +91,30 @@ public:
     std::memcpy(static_cast<void*>(values.data()), all.data(), all.size());
   }
 
+  // The same for values owned by any rank: owner[i] (known to all) holds
+  // values[i] up to date; on exit every rank's copy holds the owners'
+  // values everywhere. One collective call.
+  template <class T>
+  void complete_owned(std::vector<T>& values, std::span<const int> owner) const {
+    static_assert(kSentAsBytes<T>);
+    if (serial()) return;
+    std::vector<std::size_t> counts(static_cast<std::size_t>(size_), 0);
+    std::vector<T> mine;
+    for (std::size_t i = 0; i < values.size(); ++i) {
+      counts[static_cast<std::size_t>(owner[i])] += sizeof(T);
+      if (owner[i] == rank_) mine.push_back(values[i]);
+    }
+    const std::vector<std::byte> all = allgather_known(std::as_bytes(std::span<const T>(mine)), counts);
+    // Rank r's values come in the order of its items.
+    std::vector<std::size_t> at(counts.size(), 0);
+    for (std::size_t r = 1; r < counts.size(); ++r) at[r] = at[r - 1] + counts[r - 1];
+    for (std::size_t i = 0; i < values.size(); ++i) {
+      std::size_t& from = at[static_cast<std::size_t>(owner[i])];
+      std::memcpy(static_cast<void*>(&values[i]), all.data() + from, sizeof(T));
+      from += sizeof(T);
+    }
+  }
+
   // Bytes: every rank's `mine` concatenated in rank order; `counts` gets
   // each rank's byte count. Two collective calls (the counts, then the bytes).
   std::vector<std::byte> allgather_bytes(std::span<const std::byte> mine, std::vector<std::size_t>& counts) const;
@@ -114,6 +138,12 @@ public:
   // bytes from rank s. Both sides know every count. One collective call.
   void alltoall(std::span<const std::byte> send, const std::vector<std::size_t>& send_counts,
                 std::span<std::byte> receive, const std::vector<std::size_t>& receive_counts) const;
+  // The same when the receiving side does not know its counts: they are
+  // exchanged first (receive_counts gets receive_counts[s] bytes from rank
+  // s), and `receive` is resized to their total (its memory reused, as in
+  // allgather_bytes). Two collective calls.
+  void alltoall_bytes(std::span<const std::byte> send, const std::vector<std::size_t>& send_counts,
+                      std::vector<std::byte>& receive, std::vector<std::size_t>& receive_counts) const;
 
   // The sum of one integer over the ranks (in rank order; exact).
   long long sum(long long value) const;

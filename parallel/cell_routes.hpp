@@ -1,0 +1,78 @@
+#pragma once
+// Sums per grid cell over the ranks, made by each cell's owner
+// (docs/parallel.md, stage five). The rows of the grid are shared among the
+// ranks in slabs (the spectral sea's: rank r holds rows [first_row[r],
+// first_row[r + 1])), and the rank whose slab holds a cell's row owns the
+// cell. Each rank has parts (numbers to be summed over the ranks) for a list
+// of distinct cells; the owner receives every rank's parts for its cells and
+// adds them in rank order, from zero. So a total does not depend on timing,
+// and it is, to the bit, what a rank adding every rank's parts in rank order
+// gets (stage three's merge, where every rank received every rank's cells):
+// a cell where one rank has parts gets 0 + that rank's part. The totals go
+// back only to the ranks that sent parts for the cell.
+//
+// One round of sums (one contact evaluation), every call collective:
+//   open(cells, parts)  this rank's cells with a first set of parts, each cell
+//                       to its owner: two calls (the counts, then the lists)
+//   reply(w, out)       the owners' totals of part w back to the senders, in
+//                       the order of their cells: one call
+//   add(parts, extra)   a new set of parts for the same cells, and one number
+//                       from every rank summed over all ranks: one call
+// Between the calls, owned() and total() give the owner's cells and totals.
+
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "parallel/comm.hpp"
+
+namespace floesim::parallel {
+
+class CellRoutes {
+public:
+  CellRoutes() = default;
+  // first_row: ranks + 1 values, rank r's slab holds rows [first_row[r],
+  // first_row[r + 1]); cell c lies in row c / columns.
+  CellRoutes(std::vector<int> first_row, std::size_t columns);
+  bool empty() const { return first_row_.empty(); }
+  // The rank whose slab holds `cell`.
+  int owner(std::uint32_t cell) const { return row_owner_[cell / columns_]; }
+  // Per row: whether every row within `reach` rows of it (the grid's seam
+  // crossed) lies in its slab. When every rank's cells lie within `reach`
+  // rows of its own slab, a cell in such a row gets parts from its owner
+  // alone: its total is the owner's part, with nothing to route.
+  std::vector<std::uint8_t> interior_rows(int reach) const;
+
+  // Sends each of `cells` (distinct) with its `width` parts (parts[k * width
+  // + w] for cells[k]) to its owner; the owner sums them (total()).
+  void open(const Communicator& comm, std::span<const std::uint32_t> cells, std::span<const double> parts, int width);
+  // The owners' totals of part w back to the ranks that sent the cells:
+  // out[k] for this rank's cells[k] of the last open().
+  void reply(const Communicator& comm, int w, std::span<double> out);
+  // New parts (`width` a cell) for the last open()'s cells, summed by their
+  // owners as open() sums them; returns the sum of `extra` over the ranks, in
+  // rank order from zero (the same on every rank).
+  double add(const Communicator& comm, std::span<const double> parts, int width, double extra);
+
+  // The cells this rank owns that some rank sent parts for in the last open(),
+  // in the order they first arrived (rank order), and their totals.
+  std::span<const std::uint32_t> owned() const { return owned_; }
+  double total(std::size_t j, int w) const { return totals_[j * static_cast<std::size_t>(width_) + static_cast<std::size_t>(w)]; }
+
+private:
+  std::vector<int> first_row_, row_owner_;
+  std::size_t columns_ = 1;
+  // This rank's cells grouped by owner (route_[k]: the index in open()'s
+  // cells of the k-th sent), and the counts each way.
+  std::vector<std::uint32_t> route_;
+  std::vector<std::size_t> sent_, received_;
+  std::vector<std::uint32_t> from_;   // per received cell, in rank order: its index in owned_
+  std::vector<std::uint32_t> owned_;
+  std::vector<std::uint32_t> slot_;   // per grid cell: 1 + its index in owned_, 0: none
+  std::vector<double> totals_;
+  int width_ = 0;
+  std::vector<std::byte> send_, receive_;  // kept from one round to the next
+};
+
+}  // namespace floesim::parallel

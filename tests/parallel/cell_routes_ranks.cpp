@@ -1,0 +1,110 @@
+// Sums per cell routed to the cells' owners (parallel::CellRoutes, stage
+// five) against stage three's merge, over the ranks mpirun started: every
+// rank receives every rank's cells and parts (an allgather) and adds them in
+// rank order from zero into the whole grid. The owners' totals of their
+// slabs' cells, the totals sent back to each rank for its cells, and the
+// summed extra must equal that merge to the bit (memcmp), and an owner must
+// hold exactly the cells of its slab that some rank sent. Each rank has
+// random distinct cells all over the grid (many shared by several ranks),
+// parts of random sign and size; slabs of uneven height, one empty on 3
+// ranks. Run by ctest as mpi.cell_routes_ranks_N under `mpirun
+// --oversubscribe -np N` (N = 1, 2, 3), and serially without MPI.
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <random>
+#include <vector>
+
+#include "parallel/cell_routes.hpp"
+#include "parallel/comm.hpp"
+
+using namespace floesim;
+
+namespace {
+
+bool same_bits(double a, double b) { return std::memcmp(&a, &b, sizeof(double)) == 0; }
+
+// One round on an nx x ny grid whose rows are cut at `cut` (ranks + 1 values).
+bool routes_equal_merge(const parallel::Communicator& comm, int nx, int ny, const std::vector<int>& cut, unsigned seed) {
+  const std::size_t n = static_cast<std::size_t>(nx) * static_cast<std::size_t>(ny);
+  std::mt19937_64 rng(seed * 100 + static_cast<unsigned>(comm.rank()));
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  // This rank's distinct cells, in a random order, about 40 % of the grid.
+  std::vector<std::uint32_t> cells;
+  for (std::uint32_t c = 0; c < n; ++c)
+    if (u(rng) < -0.2) cells.push_back(c);
+  std::shuffle(cells.begin(), cells.end(), rng);
+  std::vector<double> first(cells.size()), second(2 * cells.size());
+  for (double& x : first) x = u(rng) * std::exp(10.0 * u(rng));
+  for (double& x : second) x = u(rng) * std::exp(10.0 * u(rng));
+  const double extra = u(rng) * 1e3;
+
+  // Stage three's merge: every rank's parts, added in rank order from zero.
+  const std::vector<std::uint32_t> all_cells = comm.allgather<std::uint32_t>(cells);
+  const std::vector<double> all_first = comm.allgather<double>(first), all_second = comm.allgather<double>(second);
+  const std::vector<double> extras = comm.allgather<double>(std::span<const double>(&extra, 1));
+  std::vector<double> merged1(n, 0.0), merged2(2 * n, 0.0);
+  std::vector<std::uint8_t> sent(n, 0);
+  for (std::size_t k = 0; k < all_cells.size(); ++k) {
+    merged1[all_cells[k]] += all_first[k];
+    merged2[2 * all_cells[k]] += all_second[2 * k];
+    merged2[2 * all_cells[k] + 1] += all_second[2 * k + 1];
+    sent[all_cells[k]] = 1;
+  }
+  double merged_extra = 0.0;
+  for (double e : extras) merged_extra += e;
+
+  parallel::CellRoutes routes(cut, static_cast<std::size_t>(nx));
+  bool equal = true;
+  auto owns_the_sent = [&] {
+    std::vector<std::uint32_t> expected, got(routes.owned().begin(), routes.owned().end());
+    for (int row = cut[static_cast<std::size_t>(comm.rank())]; row < cut[static_cast<std::size_t>(comm.rank()) + 1]; ++row)
+      for (int x = 0; x < nx; ++x) {
+        const std::uint32_t c = static_cast<std::uint32_t>(row * nx + x);
+        if (sent[c]) expected.push_back(c);
+      }
+    std::sort(got.begin(), got.end());
+    return got == expected;
+  };
+  routes.open(comm, cells, first, 1);
+  equal = equal && owns_the_sent();
+  for (std::size_t j = 0; j < routes.owned().size(); ++j) equal = equal && same_bits(routes.total(j, 0), merged1[routes.owned()[j]]);
+  std::vector<double> back(cells.size());
+  routes.reply(comm, 0, back);
+  for (std::size_t k = 0; k < cells.size(); ++k) equal = equal && same_bits(back[k], merged1[cells[k]]);
+  equal = equal && same_bits(routes.add(comm, second, 2, extra), merged_extra);
+  equal = equal && owns_the_sent();
+  for (std::size_t j = 0; j < routes.owned().size(); ++j)
+    for (int w = 0; w < 2; ++w) equal = equal && same_bits(routes.total(j, w), merged2[2 * routes.owned()[j] + w]);
+  routes.reply(comm, 1, back);
+  for (std::size_t k = 0; k < cells.size(); ++k) equal = equal && same_bits(back[k], merged2[2 * cells[k] + 1]);
+  std::printf("rank %d of %d, %d x %d, %zu cells, %zu owned: %s\n", comm.rank(), comm.size(), nx, ny, cells.size(),
+              routes.owned().size(), equal ? "equal to the merge of every rank's parts, bit for bit" : "DIFFERENT");
+  return equal;
+}
+
+}  // namespace
+
+int main() {
+  parallel::Session session;
+  const parallel::Communicator& comm = session.world();
+  const int ranks = comm.size();
+  long long failed = 0;
+  // Slabs of uneven height: rank r holds (r + 1) shares of the rows; and on 3
+  // ranks or more, rank 1 holds none.
+  for (auto [nx, ny] : {std::pair{37, 23}, std::pair{64, 64}}) {
+    std::vector<int> cut{0};
+    int weights = 0;
+    for (int r = 0; r < ranks; ++r) weights += r + 1;
+    for (int r = 0, acc = 0; r < ranks; ++r) {
+      acc += r + 1;
+      cut.push_back(r + 1 == ranks ? ny : ny * acc / weights);
+    }
+    if (ranks >= 3) cut[2] = cut[1];
+    if (!routes_equal_merge(comm, nx, ny, cut, static_cast<unsigned>(nx))) ++failed;
+  }
+  failed = comm.sum(failed);
+  if (comm.writer()) std::printf("%s on %d ranks\n", failed == 0 ? "passed" : "FAILED", ranks);
+  return failed == 0 ? 0 : 1;
+}
