@@ -67,11 +67,11 @@ private:
 
 detail::FactorPolicy Lemke::factor_policy() const {
   switch (opt_.factorization) {
-    case Factorization::dense: return {std::numeric_limits<Index>::max(), 0.0};
-    case Factorization::sparse: return {0, 1.0};
+    case Factorization::dense: return {std::numeric_limits<Index>::max(), 0.0, opt_.sparse_lu};
+    case Factorization::sparse: return {0, 1.0, opt_.sparse_lu};
     case Factorization::automatic: break;
   }
-  return {opt_.sparse_min_size, opt_.sparse_max_density};
+  return {opt_.sparse_min_size, opt_.sparse_max_density, opt_.sparse_lu};
 }
 
 // z0 enters at max_i (-q_i / d_i); the row attaining it leaves. Ties: with q
