@@ -91,7 +91,7 @@ struct LemkeOptions {
   // refactor_interval pivots and another quarter solving with its factors,
   // and KLU did both about 1.7 times faster than UMFPACK on a jam's C's
   // (docs/contact.md, sixth and seventh rounds).
-  SparseLu sparse_lu = SparseLu::umfpack;
+  SparseLu sparse_lu = SparseLu::klu;
   // Etas (pivots) between refactorisations of the basis.
   int refactor_interval = 100;
   // Warm start (null: none): the complementary basis to start from, z_j
