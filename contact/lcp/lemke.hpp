@@ -87,10 +87,10 @@ struct LemkeOptions {
   Index sparse_min_size = 120;
   double sparse_max_density = 0.1;
   // The sparse LU (above). KLU is there because a Lemke pivot in a creeping
-  // jam spends about a quarter of its time refactorising C every
-  // refactor_interval pivots and another quarter solving with its factors,
-  // and KLU did both about 1.7 times faster than UMFPACK on a jam's C's
-  // (docs/contact.md, sixth and seventh rounds).
+  // jam spends about half its time refactorising C every refactor_interval
+  // pivots and solving with its factors, both of which KLU does faster than
+  // UMFPACK on a jam's C's (measured: docs/contact.md, sixth and seventh
+  // rounds).
   SparseLu sparse_lu = SparseLu::klu;
   // Etas (pivots) between refactorisations of the basis.
   int refactor_interval = 100;
