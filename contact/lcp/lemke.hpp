@@ -60,8 +60,8 @@ enum class Factorization { automatic, dense, sparse };
 // Which sparse LU factorises a sparse reduced basis (lemke_basis.cpp):
 //   * umfpack: UMFPACK (multifrontal, its automatic ordering strategy);
 //   * klu:     KLU (left-looking Gilbert–Peierls after a block triangular
-//              form and AMD; no supernodes, hence cheaper on the reduced bases
-//              of a jam, a few non-zeros per column).
+//              form and AMD; no supernodes: faster on the reduced bases of a
+//              jam, a few tens of non-zeros per column).
 // Both give the same answers up to rounding, but a jam's LCP is so
 // degenerate that a different rounding may decide a tie otherwise and walk
 // another pivot path (to another, equally valid, answer).

@@ -107,11 +107,11 @@ private:
 
 // KLU (SuiteSparse; Davis and Palamadai Natarajan, ACM TOMS 37(3), 2010): a
 // left-looking (Gilbert–Peierls) sparse LU after a block triangular form and an
-// AMD ordering of each block, with row scaling by the largest entry. It has no
-// supernodes: on the reduced bases of a jam (k ~ 1300, a few non-zeros per
-// column) that costs less than UMFPACK's frontal matrices (docs/contact.md,
-// seventh round). Its rounding differs from UMFPACK's, so a degenerate LCP may
-// walk another pivot path.
+// AMD ordering of each block, with row scaling by the largest entry; no
+// supernodes or frontal matrices. On the reduced bases of a jam (k ~ 1300, a
+// few tens of non-zeros per column) it factorises and solves faster than
+// UMFPACK (docs/contact.md, sixth and seventh rounds). Its rounding differs
+// from UMFPACK's, so a degenerate LCP may walk another pivot path.
 class KluFactor final : public ReducedFactor {
 public:
   // Threshold partial pivoting: the diagonal is kept as the pivot while it is
