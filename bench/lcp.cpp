@@ -2,7 +2,7 @@
 // built with it) on the rigid-body contact LCPs of data/lcp/contact/.
 //
 //   floesim_bench_lcp [--data DIR] [--repeat R] [--factorization auto|dense|sparse]
-//                     [--refactor K] [--csv OUT.csv] [--filter SUBSTRING] [--no-siconos]
+//                     [--sparse-lu umfpack|klu] [--refactor K] [--csv OUT.csv] [--filter SUBSTRING] [--no-siconos]
 //
 // Per file: warm-up solve, then R timed solves of each solver in this process;
 // the median is kept. Both answers are judged by the same residual
@@ -117,6 +117,9 @@ int main(int argc, char** argv) {
   app.add_option("--repeat", repeat, "Timed solves per file (median kept)")->check(CLI::Range(1, 1000));
   app.add_option("--factorization", factorization, "auto, dense or sparse")
       ->check(CLI::IsMember({"auto", "dense", "sparse"}));
+  std::string sparse_lu = LemkeOptions{}.sparse_lu == SparseLu::klu ? "klu" : "umfpack";
+  app.add_option("--sparse-lu", sparse_lu, "the sparse LU of the reduced basis: umfpack or klu")
+      ->check(CLI::IsMember({"umfpack", "klu"}));
   app.add_option("--refactor", refactor_interval, "Pivots between basis refactorisations")
       ->check(CLI::Range(1, 100000));
   app.add_option("--csv", csv, "Also write the table as CSV here");
@@ -126,6 +129,7 @@ int main(int argc, char** argv) {
 
   LemkeOptions options;
   options.refactor_interval = refactor_interval;
+  options.sparse_lu = sparse_lu == "klu" ? SparseLu::klu : SparseLu::umfpack;
   if (factorization == "dense") options.factorization = Factorization::dense;
   if (factorization == "sparse") options.factorization = Factorization::sparse;
 #ifdef FLOESIM_HAVE_SICONOS

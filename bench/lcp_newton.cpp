@@ -3,6 +3,7 @@
 // against Lemke (lemke.hpp) on the LCPs of a folder, alternating per file.
 //
 //   floesim_bench_lcp_newton DIR [--repeat R] [--csv OUT.csv] [--note TEXT] [--gs-sweeps S]
+//                            [--sparse-lu umfpack|klu] [--refactor K]
 //
 // Every DIR/*.dat (Siconos format) is solved cold by all; when DIR/NAME.guess
 // exists (one 0/1 flag per unknown, a warm start: which z were basic in the
@@ -79,6 +80,12 @@ int main(int argc, char** argv) {
   app.add_option("--csv", csv, "write the results as CSV");
   app.add_option("--note", notes, "comment lines for the CSV header");
   app.add_option("--gs-sweeps", gs_sweeps, "contact-wise Gauss–Seidel sweeps before the contact Newton method");
+  std::string sparse_lu = LemkeOptions{}.sparse_lu == SparseLu::klu ? "klu" : "umfpack";
+  app.add_option("--sparse-lu", sparse_lu, "Lemke's sparse LU of the reduced basis: umfpack or klu")
+      ->check(CLI::IsMember({"umfpack", "klu"}));
+  int refactor_interval = LemkeOptions{}.refactor_interval;
+  app.add_option("--refactor", refactor_interval, "Lemke's pivots between basis refactorisations")
+      ->check(CLI::Range(1, 100000));
   CLI11_PARSE(app, argc, argv);
 
   std::vector<std::filesystem::path> files;
@@ -107,6 +114,8 @@ int main(int argc, char** argv) {
       co.gs_sweeps = gs_sweeps;
       LemkeOptions lo;
       lo.max_pivots = 15 * n + 1000;  // the collision LCPs' limit (contact/impulse.hpp)
+      lo.sparse_lu = sparse_lu == "klu" ? SparseLu::klu : SparseLu::umfpack;
+      lo.refactor_interval = refactor_interval;
       if (warm) {
         no.start = &guess;
         lo.start = &guess;

@@ -16,9 +16,10 @@ find_path(CHOLMOD_INCLUDE_DIR cholmod.h PATH_SUFFIXES suitesparse REQUIRED)
 find_library(CHOLMOD_LIBRARY cholmod REQUIRED)
 find_library(SUITESPARSECONFIG_LIBRARY suitesparseconfig REQUIRED)
 find_library(UMFPACK_LIBRARY umfpack REQUIRED)
+find_library(KLU_LIBRARY klu REQUIRED)  # Lemke's reduced basis (contact/lcp/lemke.hpp)
 add_library(floesim_suitesparse INTERFACE)
 target_include_directories(floesim_suitesparse SYSTEM INTERFACE ${CHOLMOD_INCLUDE_DIR})
-target_link_libraries(floesim_suitesparse INTERFACE ${UMFPACK_LIBRARY} ${CHOLMOD_LIBRARY}
+target_link_libraries(floesim_suitesparse INTERFACE ${UMFPACK_LIBRARY} ${KLU_LIBRARY} ${CHOLMOD_LIBRARY}
                       ${SUITESPARSECONFIG_LIBRARY})
 
 # CGAL is header-only; only the layers that mesh or partition polygons use it.

@@ -67,11 +67,11 @@ private:
 
 detail::FactorPolicy Lemke::factor_policy() const {
   switch (opt_.factorization) {
-    case Factorization::dense: return {std::numeric_limits<Index>::max(), 0.0};
-    case Factorization::sparse: return {0, 1.0};
+    case Factorization::dense: return {std::numeric_limits<Index>::max(), 0.0, opt_.sparse_lu};
+    case Factorization::sparse: return {0, 1.0, opt_.sparse_lu};
     case Factorization::automatic: break;
   }
-  return {opt_.sparse_min_size, opt_.sparse_max_density};
+  return {opt_.sparse_min_size, opt_.sparse_max_density, opt_.sparse_lu};
 }
 
 // z0 enters at max_i (-q_i / d_i); the row attaining it leaves. Ties: with q
@@ -98,11 +98,23 @@ Index Lemke::ratio_test(const Vector& u, double x_zero) {
   std::vector<double>& ratios = ratios_;
   rows.clear();
   ratios.clear();
+  // A candidate whose ratio t exceeds the smallest so far, m, beyond the tie
+  // tolerance can never tie with the final minimum lo <= m: the ratios are >= 0,
+  // so t - lo >= t - m and max(t, lo) <= max(t, m) (in floating point too, each
+  // operation being monotone). It is dropped as it comes; keep_minimal then
+  // sorts out the few left and keeps the same rows, in the same order, as it
+  // would from every candidate.
+  const double tol = opt_.tie_tolerance;
+  double smallest = std::numeric_limits<double>::infinity();
   for (Index p = 0; p < n_; ++p) {
-    if (u(p) <= pivot_min) continue;
+    const double up = u(p);
+    if (up <= pivot_min) continue;
     const double x = x_(p) <= x_zero ? 0.0 : x_(p);  // degenerate rows are exactly 0
+    const double t = x / up;
+    if (t - smallest > tol * std::max(std::abs(t), std::abs(smallest))) continue;
+    smallest = std::min(smallest, t);
     rows.push_back(p);
-    ratios.push_back(x / u(p));
+    ratios.push_back(t);
   }
   if (rows.empty()) return -1;
   keep_minimal(rows, ratios, opt_.tie_tolerance);

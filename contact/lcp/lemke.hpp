@@ -54,8 +54,18 @@
 
 namespace floesim::lcp {
 
-// How the reduced basis is factorised: dense LU or sparse LU (UMFPACK).
+// How the reduced basis is factorised: dense LU or sparse LU.
 enum class Factorization { automatic, dense, sparse };
+
+// Which sparse LU factorises a sparse reduced basis (lemke_basis.cpp):
+//   * umfpack: UMFPACK (multifrontal, its automatic ordering strategy);
+//   * klu:     KLU (left-looking Gilbert–Peierls after a block triangular
+//              form and AMD; no supernodes: faster on the reduced bases of a
+//              jam, a few tens of non-zeros per column).
+// Both give the same answers up to rounding, but a jam's LCP is so
+// degenerate that a different rounding may decide a tie otherwise and walk
+// another pivot path (to another, equally valid, answer).
+enum class SparseLu { umfpack, klu };
 
 struct LemkeOptions {
   // d > 0, n entries; empty means all ones.
@@ -71,11 +81,17 @@ struct LemkeOptions {
   double ray_accept_residual = 1e-9;
   Factorization factorization = Factorization::automatic;
   // automatic: at each refactorisation, the reduced basis C (k x k, k = number
-  // of basic z's) goes to UMFPACK when k >= sparse_min_size and C has at most
+  // of basic z's) goes to the sparse LU when k >= sparse_min_size and C has at most
   // sparse_max_density k^2 non-zeros, to dense LU otherwise (measured, see
   // docs/lcp.md).
   Index sparse_min_size = 120;
   double sparse_max_density = 0.1;
+  // The sparse LU (above). KLU is there because a Lemke pivot in a creeping
+  // jam spends about half its time refactorising C every refactor_interval
+  // pivots and solving with its factors, both of which KLU does faster than
+  // UMFPACK on a jam's C's (measured: docs/contact.md, sixth and seventh
+  // rounds).
+  SparseLu sparse_lu = SparseLu::klu;
   // Etas (pivots) between refactorisations of the basis.
   int refactor_interval = 100;
   // Warm start (null: none): the complementary basis to start from, z_j
@@ -94,7 +110,7 @@ struct LemkeOptions {
 
 // What the revised method did, for benchmarks and diagnostics.
 struct LemkeStats {
-  long sparse_refactorisations = 0;  // of `refactorisations`, how many used UMFPACK
+  long sparse_refactorisations = 0;  // of `refactorisations`, how many used the sparse LU
   long solves = 0;            // solves with the basis (entering columns + tie-breaks)
   long tie_breaks = 0;        // pivots whose ratio test needed the lexicographic rule
   long refactorisations = 0;

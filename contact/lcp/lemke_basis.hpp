@@ -17,7 +17,7 @@
 //     x_{pos(w_i)} = b_i - sum_{s in S} a_{var(s)}(i) x_s   for the covered rows i,
 //
 // so only C is factorised: densely (Eigen partial-pivoting LU) or sparsely
-// (UMFPACK), chosen at each refactorisation from k and the density of C (or
+// (UMFPACK or KLU), chosen at each refactorisation from k and the density of C (or
 // fixed by the caller). k is the number of basic z's (plus z0), usually well
 // below n.
 //
@@ -41,6 +41,7 @@
 #include <vector>
 
 #include "contact/lcp/lcp.hpp"
+#include "contact/lcp/lemke.hpp"
 
 namespace floesim::lcp::detail {
 
@@ -57,13 +58,16 @@ public:
 };
 std::unique_ptr<ReducedFactor> make_dense_factor();
 std::unique_ptr<ReducedFactor> make_sparse_factor();  // UMFPACK
+std::unique_ptr<ReducedFactor> make_klu_factor();     // KLU
 
 // Which factorisation a refactorisation uses: `sparse_min_size` = 0 forces
-// UMFPACK, a huge value forces dense LU; otherwise UMFPACK when k >=
-// sparse_min_size and nnz(C) <= sparse_max_density k^2.
+// the sparse LU, a huge value forces dense LU; otherwise the sparse LU when k
+// >= sparse_min_size and nnz(C) <= sparse_max_density k^2. The sparse LU is
+// UMFPACK or KLU (`sparse_lu`).
 struct FactorPolicy {
   Index sparse_min_size = 0;
   double sparse_max_density = 1.0;
+  SparseLu sparse_lu = SparseLu::umfpack;
 };
 
 class LemkeBasis {

@@ -5,6 +5,7 @@
 #include <doctest/doctest.h>
 
 #include <random>
+#include <utility>
 
 #include "contact/lcp/lemke.hpp"
 #include "core/error.hpp"
@@ -37,10 +38,16 @@ Vector feasible_q(std::mt19937_64& rng, const DenseMatrix& M) {
   return w - M * z;
 }
 
+// Dense LU, then each sparse LU (lemke.hpp's SparseLu) forced on every basis.
 void check_solved(const Lcp& lcp, double tol = 1e-9) {
-  for (const Factorization f : {Factorization::dense, Factorization::sparse}) {
+  for (const auto& [f, lu] : {std::pair{Factorization::dense, SparseLu::umfpack},
+                              std::pair{Factorization::sparse, SparseLu::umfpack},
+                              std::pair{Factorization::sparse, SparseLu::klu}}) {
+    CAPTURE(static_cast<int>(f));
+    CAPTURE(static_cast<int>(lu));
     LemkeOptions options;
     options.factorization = f;
+    options.sparse_lu = lu;
     const Result r = solve_lemke(lcp, options);
     REQUIRE(r.status == Status::solved);
     CHECK(r.residual <= tol);
