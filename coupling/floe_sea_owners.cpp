@@ -31,26 +31,12 @@
 #include "coupling/floe_sea.hpp"
 
 #include "core/error.hpp"
+#include "parallel/bytes.hpp"
 
 namespace floesim {
 
-namespace {
-
-// Copies count T's to `out` and returns the end of what it wrote.
-template <class T>
-std::byte* put(std::byte* out, const T* data, std::size_t count) {
-  if (count > 0) std::memcpy(out, data, count * sizeof(T));
-  return out + count * sizeof(T);
-}
-// Element j of an array of T that starts at `in` (any alignment).
-template <class T>
-T at(const std::byte* in, std::size_t j) {
-  T value;
-  std::memcpy(&value, in + j * sizeof(T), sizeof(T));
-  return value;
-}
-
-}  // namespace
+using parallel::at;
+using parallel::put;
 
 void FloeSeaContact::clear_cells_by_owner() {
   // The pressure where the last evaluation put it: every rank's cells (not

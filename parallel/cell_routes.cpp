@@ -3,26 +3,9 @@
 #include <cstring>
 
 #include "core/error.hpp"
+#include "parallel/bytes.hpp"
 
 namespace floesim::parallel {
-
-namespace {
-
-// Copies count T's to `out` and returns the end of what it wrote.
-template <class T>
-std::byte* put(std::byte* out, const T* data, std::size_t count) {
-  if (count > 0) std::memcpy(out, data, count * sizeof(T));
-  return out + count * sizeof(T);
-}
-// Element j of an array of T that starts at `in` (any alignment).
-template <class T>
-T at(const std::byte* in, std::size_t j) {
-  T value;
-  std::memcpy(&value, in + j * sizeof(T), sizeof(T));
-  return value;
-}
-
-}  // namespace
 
 CellRoutes::CellRoutes(std::vector<int> first_row, std::size_t columns)
     : first_row_(std::move(first_row)), columns_(columns) {

@@ -164,6 +164,19 @@ constexpr Path kPaths[] = {
     {"jam/jam500_n864_ray", true, Status::ray, 2, 6},
 };
 
+// The collision solver's Lemke settings for the collection's entry `e`: its
+// pivot limit and, for a warm entry, its .guess read into `guess` as the start.
+LemkeOptions collision_options(const Lcp& lcp, const Path& e, std::vector<std::uint8_t>& guess) {
+  LemkeOptions options;
+  options.max_pivots = 15 * lcp.size() + 1000;  // the collision LCPs' limit (contact/impulse.hpp)
+  if (e.warm) {
+    guess = read_guess(lcp_data(std::string(e.file) + ".guess"));
+    REQUIRE(static_cast<Index>(guess.size()) == lcp.size());
+    options.start = &guess;
+  }
+  return options;
+}
+
 TEST_CASE("lcp: Lemke walks the same pivot path as before its pivot was made cheaper") {
   for (const Path& e : kPaths) {
     const std::string file = e.file;
@@ -171,15 +184,9 @@ TEST_CASE("lcp: Lemke walks the same pivot path as before its pivot was made che
     CAPTURE(e.warm);
     const Lcp lcp = read_siconos_lcp(lcp_data(file + ".dat"));
     std::vector<std::uint8_t> guess;
-    LemkeOptions options;
-    options.max_pivots = 15 * lcp.size() + 1000;  // the collision LCPs' limit (contact/impulse.hpp)
+    LemkeOptions options = collision_options(lcp, e, guess);
     options.sparse_lu = SparseLu::umfpack;
     options.refactor_interval = 100;
-    if (e.warm) {
-      guess = read_guess(lcp_data(file + ".guess"));
-      REQUIRE(static_cast<Index>(guess.size()) == lcp.size());
-      options.start = &guess;
-    }
     LemkeStats stats;
     const Result r = solve_lemke(lcp, options, &stats);
     CHECK(to_string(r.status) == to_string(e.status));
@@ -208,14 +215,8 @@ TEST_CASE("lcp: Lemke with KLU solves the contact and jam LCPs of the collection
     CAPTURE(e.warm);
     const Lcp lcp = read_siconos_lcp(lcp_data(file + ".dat"));
     std::vector<std::uint8_t> guess;
-    LemkeOptions options;
-    options.max_pivots = 15 * lcp.size() + 1000;  // the collision LCPs' limit (contact/impulse.hpp)
+    LemkeOptions options = collision_options(lcp, e, guess);
     options.sparse_lu = SparseLu::klu;
-    if (e.warm) {
-      guess = read_guess(lcp_data(file + ".guess"));
-      REQUIRE(static_cast<Index>(guess.size()) == lcp.size());
-      options.start = &guess;
-    }
     LemkeStats stats;
     const Result r = solve_lemke(lcp, options, &stats);
     klu_factorisations += stats.sparse_refactorisations;

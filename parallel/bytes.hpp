@@ -1,0 +1,25 @@
+#pragma once
+// Packing typed arrays into the byte messages of parallel::Communicator's
+// exchanges and reading them back, with memcpy: a message's arrays follow one
+// another, so an element need not be aligned for its type.
+#include <cstddef>
+#include <cstring>
+
+namespace floesim::parallel {
+
+// Copies count T's to `out` and returns the end of what it wrote.
+template <class T>
+std::byte* put(std::byte* out, const T* data, std::size_t count) {
+  if (count > 0) std::memcpy(out, data, count * sizeof(T));
+  return out + count * sizeof(T);
+}
+
+// Element j of an array of T that starts at `in` (any alignment).
+template <class T>
+T at(const std::byte* in, std::size_t j) {
+  T value;
+  std::memcpy(&value, in + j * sizeof(T), sizeof(T));
+  return value;
+}
+
+}  // namespace floesim::parallel
