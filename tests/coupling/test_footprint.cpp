@@ -560,3 +560,44 @@ TEST_CASE("moved footprints: rebuilt exactly when a floe's vertices may leave th
   CHECK(exact.place(floes, include, p, 1));
   CHECK(exact.place(floes, include, p, 1));
 }
+
+TEST_CASE("moved footprints: every piece lies within reach_rows() rows of its floe's centroid at the rebuild") {
+  // MovingFootprints::reach_rows() is the halo of the sea's fields that a
+  // rank reads when the floes are owned by place (docs/parallel.md, stage
+  // five): a piece beyond it would read a stale row. The bound is the
+  // largest radius, the tent's one node and the window, in rows, plus one;
+  // it must hold for every floe, including those across the grid's seam,
+  // and not be loose by more than those margins (the largest floe, turned
+  // across the rows, has pieces within 4 rows of it). The grid is taller
+  // than box_grid's so that the 100 m floe's reach is below half of it.
+  fluid::SurfaceGrid grid = box_grid();
+  grid.ny = 120;
+  grid.ly = 180.0;
+  std::mt19937_64 rng(23);
+  Floes floes = mixed_floes(rng, 12);
+  const std::vector<std::uint8_t> include(floes.size(), 1);
+  for (FootprintKernel kernel : {FootprintKernel::tent, FootprintKernel::cell}) {
+    for (int trial = 0; trial < 4; ++trial) {
+      INFO((kernel == FootprintKernel::tent ? "tent" : "cell") << " kernel, trial " << trial);
+      scatter(floes, grid, rng);  // near the seam too
+      floes.state.back().yaw = 0.5 * std::numbers::pi;  // the 100 m floe along y
+      MovingFootprints moving(grid, kernel, {0.5});
+      const std::vector<FloePose> p0 = poses_of(floes);
+      REQUIRE(moving.place(floes, include, p0, 1));
+      const int reach = moving.reach_rows();
+      const Footprints& fp = moving.pieces();
+      int farthest = 0;
+      for (std::size_t i = 0; i < floes.size(); ++i) {
+        const int centre = static_cast<int>(std::floor(p0[i].y / grid.dy()));
+        for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k) {
+          const int row = static_cast<int>(fp.cell[k] / static_cast<std::uint32_t>(grid.nx));
+          int d = std::abs(row - ((centre % grid.ny) + grid.ny) % grid.ny);
+          d = std::min(d, grid.ny - d);  // periodic
+          CHECK(d <= reach);
+          farthest = std::max(farthest, d);
+        }
+      }
+      CHECK(farthest >= reach - 4);
+    }
+  }
+}
