@@ -215,6 +215,7 @@ public:
     const bool slabs = by_owner() && !slab_rows_.empty();
     routes_ = slabs ? parallel::CellRoutes(slab_rows_, static_cast<std::size_t>(grid_.nx)) : parallel::CellRoutes();
     footprints_.set_slabs(slabs ? slab_rows_ : std::vector<int>{});
+    owner_.interior_reach = -1;  // the interior cells are those of the new routes
   }
   struct ImplicitStats {
     long steps = 0, newton = 0, cg = 0, g_products = 0;  // totals over the run

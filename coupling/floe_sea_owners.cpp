@@ -63,7 +63,8 @@ void FloeSeaContact::sum_coverage_by_owner() {
   // directly, as the serial loop makes them (the totals are this rank's
   // parts: 0 + its part, what the merge would give), and every other cell
   // goes to its owner. Not routed, no cell is interior.
-  if (routed()) {
+  const bool routed_cells = routed();
+  if (routed_cells) {
     const int reach = footprints_.by_place() ? footprints_.reach_rows() : grid_.ny;
     if (reach != o.interior_reach) {
       const std::vector<std::uint8_t> rows = routes_.interior_rows(reach);
@@ -71,8 +72,6 @@ void FloeSeaContact::sum_coverage_by_owner() {
       for (std::size_t c = 0; c < grid_.size(); ++c) o.interior[c] = rows[c / static_cast<std::size_t>(grid_.nx)];
       o.interior_reach = reach;
     }
-  } else {
-    o.interior.assign(grid_.size(), 0);
   }
   // This rank's other cells, in the order its floes' pieces meet them, and
   // its part of each cell's coverage, summed as the serial loop sums it.
@@ -85,7 +84,7 @@ void FloeSeaContact::sum_coverage_by_owner() {
   for (std::uint32_t i : order_)
     for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k) {
       const std::uint32_t c = fp.cell[k];
-      if (o.interior[c]) {
+      if (routed_cells && o.interior[c]) {
         o.piece_slot[k] = kInteriorCell;
         cells_[c].coverage += fp.area[k] * inv_cell_area;
         continue;

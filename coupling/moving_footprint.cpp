@@ -6,6 +6,7 @@
 
 #include "core/error.hpp"
 #include "coupling/parallel.hpp"
+#include "parallel/cell_routes.hpp"
 
 namespace floesim {
 
@@ -49,9 +50,7 @@ bool MovingFootprints::place(const Floes& floes, std::span<const std::uint8_t> i
 }
 
 void MovingFootprints::set_slabs(std::vector<int> first_row) {
-  row_owner_.clear();
-  for (std::size_t r = 0; r + 1 < first_row.size(); ++r)
-    for (int row = first_row[r]; row < first_row[r + 1]; ++row) row_owner_.push_back(static_cast<int>(r));
+  row_owner_ = parallel::row_owners(first_row);
   FLOESIM_ASSERT(row_owner_.empty() || static_cast<int>(row_owner_.size()) == grid_.ny);
 }
 

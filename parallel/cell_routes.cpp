@@ -7,11 +7,17 @@
 
 namespace floesim::parallel {
 
+std::vector<int> row_owners(std::span<const int> first_row) {
+  std::vector<int> owner;
+  for (std::size_t r = 0; r + 1 < first_row.size(); ++r)
+    for (int row = first_row[r]; row < first_row[r + 1]; ++row) owner.push_back(static_cast<int>(r));
+  return owner;
+}
+
 CellRoutes::CellRoutes(std::vector<int> first_row, std::size_t columns)
     : first_row_(std::move(first_row)), columns_(columns) {
   FLOESIM_ASSERT(first_row_.size() >= 2 && columns_ > 0);
-  for (std::size_t r = 0; r + 1 < first_row_.size(); ++r)
-    for (int row = first_row_[r]; row < first_row_[r + 1]; ++row) row_owner_.push_back(static_cast<int>(r));
+  row_owner_ = row_owners(first_row_);
   slot_.assign(row_owner_.size() * columns_, 0);
 }
 

@@ -29,6 +29,11 @@
 
 namespace floesim::parallel {
 
+// Per row of the grid, the rank whose slab holds it, for slabs given by
+// their first rows (ranks + 1 values, the last the row count): rank r's slab
+// is rows [first_row[r], first_row[r + 1]).
+std::vector<int> row_owners(std::span<const int> first_row);
+
 class CellRoutes {
 public:
   CellRoutes() = default;

@@ -164,17 +164,28 @@ constexpr Path kPaths[] = {
     {"jam/jam500_n864_ray", true, Status::ray, 2, 6},
 };
 
-// The collision solver's Lemke settings for the collection's entry `e`: its
-// pivot limit and, for a warm entry, its .guess read into `guess` as the start.
-LemkeOptions collision_options(const Lcp& lcp, const Path& e, std::vector<std::uint8_t>& guess) {
+// The collection's entry `e` solved by Lemke with the collision solver's
+// pivot limit, from its .guess when warm, with the sparse LU `lu` and
+// `refactor_interval` pivots between refactorisations.
+struct Solved {
+  Lcp lcp;
+  Result result;
+  LemkeStats stats;
+};
+Solved solve_entry(const Path& e, SparseLu lu, int refactor_interval = LemkeOptions{}.refactor_interval) {
+  Solved s{read_siconos_lcp(lcp_data(std::string(e.file) + ".dat")), {}, {}};
+  std::vector<std::uint8_t> guess;
   LemkeOptions options;
-  options.max_pivots = 15 * lcp.size() + 1000;  // the collision LCPs' limit (contact/impulse.hpp)
+  options.max_pivots = 15 * s.lcp.size() + 1000;  // the collision LCPs' limit (contact/impulse.hpp)
+  options.sparse_lu = lu;
+  options.refactor_interval = refactor_interval;
   if (e.warm) {
     guess = read_guess(lcp_data(std::string(e.file) + ".guess"));
-    REQUIRE(static_cast<Index>(guess.size()) == lcp.size());
+    REQUIRE(static_cast<Index>(guess.size()) == s.lcp.size());
     options.start = &guess;
   }
-  return options;
+  s.result = solve_lemke(s.lcp, options, &s.stats);
+  return s;
 }
 
 TEST_CASE("lcp: Lemke walks the same pivot path as before its pivot was made cheaper") {
@@ -182,13 +193,10 @@ TEST_CASE("lcp: Lemke walks the same pivot path as before its pivot was made che
     const std::string file = e.file;
     CAPTURE(file);
     CAPTURE(e.warm);
-    const Lcp lcp = read_siconos_lcp(lcp_data(file + ".dat"));
-    std::vector<std::uint8_t> guess;
-    LemkeOptions options = collision_options(lcp, e, guess);
-    options.sparse_lu = SparseLu::umfpack;
-    options.refactor_interval = 100;
-    LemkeStats stats;
-    const Result r = solve_lemke(lcp, options, &stats);
+    const Solved solved = solve_entry(e, SparseLu::umfpack, 100);
+    const Lcp& lcp = solved.lcp;
+    const Result& r = solved.result;
+    const LemkeStats& stats = solved.stats;
     CHECK(to_string(r.status) == to_string(e.status));
     CHECK(r.pivots == e.pivots);
     CHECK(stats.solves == e.solves);
@@ -213,12 +221,10 @@ TEST_CASE("lcp: Lemke with KLU solves the contact and jam LCPs of the collection
     const std::string file = e.file;
     CAPTURE(file);
     CAPTURE(e.warm);
-    const Lcp lcp = read_siconos_lcp(lcp_data(file + ".dat"));
-    std::vector<std::uint8_t> guess;
-    LemkeOptions options = collision_options(lcp, e, guess);
-    options.sparse_lu = SparseLu::klu;
-    LemkeStats stats;
-    const Result r = solve_lemke(lcp, options, &stats);
+    const Solved solved = solve_entry(e, SparseLu::klu);
+    const Lcp& lcp = solved.lcp;
+    const Result& r = solved.result;
+    const LemkeStats& stats = solved.stats;
     klu_factorisations += stats.sparse_refactorisations;
     MESSAGE(file << (e.warm ? " warm" : " cold") << ": " << to_string(r.status) << ", " << r.pivots
                  << " pivots (UMFPACK " << e.pivots << "), residual " << r.residual << ", KLU refactorisations "
