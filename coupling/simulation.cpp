@@ -252,10 +252,10 @@ void Simulation::drift(StepContext& ctx) {
     // Each rank drifts the floes in its strip (each floe's drift is its own),
     // charged to the load balance, then every rank takes the others' floes.
     owners_.update(comm_, scenario_.floes, steps_);  // floes migrate; every few steps the strips move
-    const auto start = std::chrono::steady_clock::now();
+    const double start = parallel::thread_seconds();
     for (const std::uint32_t i : owners_.mine())
       drift_velocities(scenario_.floes, quadrature_, drift_params_, current, wind, ctx.dt, i, i + 1, water);
-    owners_.charge(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+    owners_.charge(parallel::thread_seconds() - start);
     comm_.complete_owned(scenario_.floes.state, owners_.owner());
   }
   ctx.momentum = momentum();

@@ -1,6 +1,5 @@
 #include "parallel/detect.hpp"
 
-#include <chrono>
 #include <cstdint>
 #include <cstring>
 
@@ -73,9 +72,9 @@ std::vector<T> take(const std::byte*& at, std::uint64_t count) {
 contact::Detection detect(const Communicator& comm, FloeOwners& owners, const Floes& floes,
                           const contact::CollisionShapes& shapes, contact::DetectionOptions options) {
   if (comm.serial()) return contact::detect(floes, shapes, options);
-  const auto start = std::chrono::steady_clock::now();
+  const double start = thread_seconds();
   contact::Detection mine = detect_part(owners, comm.rank(), floes, shapes, std::move(options));
-  owners.charge(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+  owners.charge(thread_seconds() - start);
   const std::uint64_t sizes[3] = {mine.pairs.size(), mine.contacts.size(), mine.witnesses.size()};
   std::vector<std::byte> message(reinterpret_cast<const std::byte*>(sizes),
                                  reinterpret_cast<const std::byte*>(sizes) + sizeof(sizes));

@@ -5,6 +5,8 @@
 #include <limits>
 #include <numeric>
 
+#include <time.h>
+
 #include "core/error.hpp"
 
 namespace floesim::parallel {
@@ -33,9 +35,16 @@ std::vector<double> cut_by_cost(std::span<const double> y, std::span<const doubl
   return cuts;
 }
 
+double thread_seconds() {
+  timespec t{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
+}
+
 FloeOwners::FloeOwners(int rank, int ranks, const contact::Domain& domain, StripOptions options)
     : rank_(rank), ranks_(ranks), domain_(domain), options_(options) {
-  FLOESIM_ASSERT(ranks >= 1 && rank >= 0 && rank < ranks && options.rebalance_steps >= 1);
+  FLOESIM_ASSERT(ranks >= 1 && rank >= 0 && rank < ranks && options.rebalance_steps >= 1 &&
+                 options.relaxation > 0.0 && options.relaxation <= 1.0);
 }
 
 double FloeOwners::place(const FloeState& s) const {
@@ -71,6 +80,8 @@ void FloeOwners::update(const Communicator& comm, const Floes& floes, std::size_
     next_move_ = step + static_cast<std::size_t>(options_.rebalance_steps);
     window_seconds_ = comm.allgather<double>(std::span<const double>(&charged_, 1));
     charged_ = 0.0;
+    total_seconds_.resize(window_seconds_.size(), 0.0);
+    for (std::size_t r = 0; r < window_seconds_.size(); ++r) total_seconds_[r] += window_seconds_[r];
     assign(floes);  // the floes as the window left them, in the strips they were charged in
     std::vector<double> count(static_cast<std::size_t>(ranks_), 0.0);
     for (const int r : owner_) count[static_cast<std::size_t>(r)] += 1.0;
@@ -84,7 +95,11 @@ void FloeOwners::update(const Communicator& comm, const Floes& floes, std::size_
         y[i] = place(floes.state[i]);
         cost[i] = std::max(window_seconds_[r] / count[r], floor);  // count[r] >= 1: floe i is r's
       }
-      set_cuts(cut_by_cost(y, cost, ranks_));
+      std::vector<double> cuts = cut_by_cost(y, cost, ranks_);
+      for (std::size_t k = 0; k < cuts.size(); ++k)  // part way (an infinite cut, an empty strip: all the way)
+        if (std::isfinite(cuts[k]) && std::isfinite(cuts_[k])) cuts[k] = cuts_[k] + options_.relaxation * (cuts[k] - cuts_[k]);
+      std::sort(cuts.begin(), cuts.end());  // already ascending but for round-off
+      set_cuts(std::move(cuts));
       ++moves_;
     }
   }

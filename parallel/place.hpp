@@ -13,10 +13,11 @@
 //
 // Load balance by measured cost: each rank charges the wall time of its
 // by-place work (its floes' drift, its part of detection: no waits, no
-// copies) to its FloeOwners; every StripOptions::rebalance_steps steps the
-// ranks all-gather their charged times and move the cuts so that every strip
-// gets an equal share of the estimated cost (cut_by_cost), each floe's cost
-// being its owner's time per floe over the window. The cost density in y is
+// copies; CPU time of the thread) to its FloeOwners; every
+// StripOptions::rebalance_steps steps the ranks all-gather their charged
+// times and move the cuts toward those that give every strip an equal share
+// of the estimated cost (cut_by_cost), each floe's cost being its owner's
+// time per floe over the window. The cost density in y is
 // thus estimated as piecewise constant over the old strips; when it is
 // steady, one move balances the ranks to within one floe's cost, and a
 // window of several steps averages the timing noise. Every rank computes the
@@ -44,7 +45,19 @@ struct StripOptions {
   // floe: a rank that measured (almost) nothing, e.g. whose floes are all
   // static, would otherwise be given every floe at the next move.
   double cost_floor = 0.01;
+  // How far a move goes from the present cuts toward the equal-cost cuts
+  // (1: all the way). The estimate of a window is noisy (a rank's time
+  // varies by 10 to 20 % from window to window on a shared machine); half
+  // way halves the cuts' jitter and still closes a steady imbalance by half
+  // at every move.
+  double relaxation = 0.5;
 };
+
+// The CPU time of the calling thread (s): what a rank charges for its
+// by-place work. Unlike the wall clock it leaves out the time the thread was
+// not running (another process on the core), which says nothing of the
+// work's cost.
+double thread_seconds();
 
 // Cuts items at positions y into `ranks` strips of equal total cost: returns
 // ranks - 1 ascending cuts; strip r holds the items with
@@ -81,9 +94,11 @@ public:
 
   const std::vector<double>& cuts() const { return cuts_; }
   void set_cuts(std::vector<double> cuts);  // ranks - 1 ascending values
-  // The moves so far, and each rank's charged seconds over the last window.
+  // The moves so far, each rank's charged seconds over the last window, and
+  // over every window so far.
   int moves() const { return moves_; }
   const std::vector<double>& window_seconds() const { return window_seconds_; }
+  const std::vector<double>& charged_seconds() const { return total_seconds_; }
 
 private:
   int rank_ = 0, ranks_ = 1;
@@ -97,7 +112,7 @@ private:
   std::size_t next_move_ = 0;
   bool started_ = false;
   int moves_ = 0;
-  std::vector<double> window_seconds_;
+  std::vector<double> window_seconds_, total_seconds_;
 };
 
 // The halo rule: the part of the detection that `rank` makes. It keeps the
