@@ -327,6 +327,21 @@ int run(const Args& args, const parallel::Session& session) {
     const parallel::Communicator::Traffic t = comm.traffic();
     o << "parallel.ranks: " << comm.size() << "\nparallel.collectives: " << t.calls << "\nparallel.bytes_received: " << t.bytes
       << "\nparallel.collective_seconds: " << t.seconds << "\n";
+    // The floes' strips (stage six): the cuts in y, the floes in each strip
+    // now, the cuts' moves by measured cost and each rank's by-place seconds
+    // (CPU) over the window before the last move and over all windows.
+    const parallel::FloeOwners& owners = sim.floe_owners();
+    std::vector<std::size_t> in_strip(static_cast<std::size_t>(comm.size()), 0);
+    for (const int r : owners.owner()) ++in_strip[static_cast<std::size_t>(r)];
+    o << "parallel.strip_cuts:";
+    for (const double cut : owners.cuts()) o << " " << cut;
+    o << "\nparallel.strip_floes:";
+    for (const std::size_t k : in_strip) o << " " << k;
+    o << "\nparallel.strip_moves: " << owners.moves() << "\nparallel.strip_seconds:";
+    for (const double x : owners.window_seconds()) o << " " << x;
+    o << "\nparallel.strip_seconds_total:";
+    for (const double x : owners.charged_seconds()) o << " " << x;
+    o << "\n";
   }
   o << "notes: " << s.notes.size() << "\n";
   for (const auto& n : s.notes) o << "  " << n << "\n";

@@ -10,8 +10,16 @@ steps and records, not the set-up) and its profile per phase. One CSV row per
 run; the first comment lines say the command, the commit, the machine and its
 load. The speed-up is the least wall time on 1 rank over the least on R.
 
-usage: bench/mpi_pack.py [--build build] [--floes 10000] [--t-end 1000] [--ranks 0 1 2]
-                         [--rounds 3] [--csv FILE | -] [--note TEXT]
+Several --build directories (e.g. main's and a branch's) are run in each
+round one after the other, so that both meet the same load; rows then name
+their build (the last column; least times per build). --half packs the floes
+in the lower half of the periodic box only (open water above): the case for
+the load balance by measured cost (stage six of docs/parallel.md); the rows
+give rank 0's strip cuts, the floes in each strip at the end and each rank's
+by-place seconds over the last balance window (parallel.strip_* keys).
+
+usage: bench/mpi_pack.py [--build build [build2 ...]] [--floes 10000] [--t-end 1000] [--ranks 0 1 2]
+                         [--rounds 3] [--half] [--csv FILE | -] [--note TEXT]
 """
 import argparse
 import os
@@ -24,34 +32,44 @@ import moving_pack  # noqa: E402  (the pack shared with tests/parallel/check_ran
 import ranks_bench  # noqa: E402  (the timing shared with bench/ocean/ranks.py)
 
 ap = argparse.ArgumentParser()
-ap.add_argument("--build", default=os.path.join(ROOT, "build"))
+ap.add_argument("--build", nargs="+", default=[os.path.join(ROOT, "build")])
 ap.add_argument("--floes", type=int, default=10000)
 ap.add_argument("--t-end", type=float, default=1000.0)
 ap.add_argument("--ranks", type=int, nargs="+", default=[0, 1, 2])
 ap.add_argument("--rounds", type=int, default=3)
 ap.add_argument("--csv", default="-")
+ap.add_argument("--half", action="store_true", help="floes in the lower half of the box only")
 ap.add_argument("--note", default="")
 args = ap.parse_args()
 
-floesim = os.path.join(args.build, "bin", "floesim")
+builds = [os.path.abspath(b) for b in args.build]
+floesims = [os.path.join(b, "bin", "floesim") for b in builds]
 work = tempfile.mkdtemp(prefix="floesim_mpi_bench_")
-config = moving_pack.write(floesim, work, args.floes, args.t_end, seed=1, output_interval=args.t_end)
+config = moving_pack.write(floesims[0], work, args.floes, args.t_end, seed=1, output_interval=args.t_end,
+                           half=args.half)
 phases = ["drift", "collide", "advance", "detect", "record", "choose_dt", "check"]
+strips = ["strip_cuts", "strip_floes", "strip_seconds", "strip_seconds_total"]
 rows = []
 load_before = ranks_bench.load()
 for r in range(args.rounds):
     for ranks in args.ranks:
-        s = ranks_bench.timed(floesim, config, os.path.join(work, f"r{ranks}.h5"), ranks, work)
-        cpu = f"{sum(s['cpu']) / len(s['cpu']):.3f}" if s["cpu"] else ""  # the mean over the ranks
-        rows.append([str(ranks), str(r), s["wall_time"], s["steps"], s["collisions.lcps"],
-                     s.get("parallel.bytes_received", "0"), s.get("parallel.collective_seconds", "0"),
-                     cpu] + [s.get("profile." + ph, "") for ph in phases])
+        for build, floesim in zip(builds, floesims):
+            s = ranks_bench.timed(floesim, config, os.path.join(work, f"r{ranks}.h5"), ranks, work)
+            cpu = f"{sum(s['cpu']) / len(s['cpu']):.3f}" if s["cpu"] else ""  # the mean over the ranks
+            rows.append([str(ranks), str(r), s["wall_time"], s["steps"], s["collisions.lcps"],
+                         s.get("parallel.bytes_received", "0"), s.get("parallel.collective_seconds", "0"),
+                         cpu] + [s.get("profile." + ph, "") for ph in phases] +
+                        [s["raw"].get("parallel." + k, "") for k in strips] + [build])
 ranks_bench.write_table(
     args.csv, f"bench/mpi_pack.py {' '.join(sys.argv[1:])}", args.note,
-    f"{args.floes} floes, 50 % cover, periodic, to {args.t_end} s; ranks 0 = serial binary without mpirun; "
+    f"{args.floes} floes, 50 % cover{' in the lower half of the box' if args.half else ''}, periodic, "
+    f"to {args.t_end} s; ranks 0 = serial binary without mpirun; "
     "one thread per rank; wall_s = the run loop (summary wall_time); bytes_received and collective_s: "
     "rank 0's collectives over the run (the transfers and the waits for the other ranks); cpu_s: CPU time "
     "(user + system) of a rank's process, mean over the ranks, set-up included; phases: rank 0's profile (s), "
-    "waits in collectives included",
+    "waits in collectives included; strip_*: rank 0's parallel.strip_* summary keys (the cuts in y, m; floes "
+    "per strip at the end; each rank's by-place CPU seconds over the last balance window and over all windows), "
+    "blank before stage six",
     load_before, ranks_bench.load(),
-    "ranks,round,wall_s,steps,lcps,bytes_received,collective_s,cpu_s," + ",".join(p + "_s" for p in phases), rows)
+    "ranks,round,wall_s,steps,lcps,bytes_received,collective_s,cpu_s," + ",".join(p + "_s" for p in phases) + "," +
+    ",".join(strips) + ",build", rows, group=(lambda row: row[-1]) if len(builds) > 1 else None)

@@ -170,6 +170,12 @@ PosedShapes::PosedShapes(const Floes& floes, const CollisionShapes& shapes)
   for (std::size_t i = 0; i < floes.size(); ++i) update(floes, i);
 }
 
+PosedShapes::PosedShapes(const Floes& floes, const CollisionShapes& shapes, std::span<const std::uint32_t> which)
+    : shapes_(&shapes), world_(shapes.vertices.size()), part_box_(shapes.vertex_offsets.size() - 1),
+      floe_box_(floes.size()) {
+  for (const std::uint32_t i : which) update(floes, i);
+}
+
 void PosedShapes::update(const Floes& floes, std::size_t i) {
   const CollisionShapes& shapes = *shapes_;
   const FloeState& s = floes.state[i];
@@ -302,18 +308,20 @@ Detection detect(const Floes& floes, const CollisionShapes& shapes, const Detect
   Detection out;
   const std::size_t n = floes.size();
   const double xi = opt.collision_distance;
-  const PosedShapes posed(floes, shapes);
+  const DetectionSubset& subset = opt.subset;
+  const PosedShapes posed = subset.everything() ? PosedShapes(floes, shapes) : PosedShapes(floes, shapes, subset.posed);
 
   out.reach.resize(n);
-  for (std::size_t i = 0; i < n; ++i)
-    out.reach[i] = opt.reach.empty() ? std::max(0.0, 0.5 * opt.search_margin - 0.5 * xi) : opt.reach[i];
+  for (std::size_t i = 0; i < n; ++i) out.reach[i] = opt.reach_of(i);
 
   // Broad phase entries, boxes padded by reach + xi/2 (with periodic images of
   // floes that cross an edge).
+  const std::size_t entered = subset.everything() ? n : subset.posed.size();
   std::vector<Entry> entries;
-  entries.reserve(n + n / 4);
+  entries.reserve(entered + entered / 4);
   const Domain& d = opt.domain;
-  for (std::uint32_t i = 0; i < n; ++i) {
+  for (std::size_t k = 0; k < entered; ++k) {
+    const std::uint32_t i = subset.everything() ? static_cast<std::uint32_t>(k) : subset.posed[k];
     const double pad = out.reach[i] + 0.5 * xi;
     const Box& f = posed.floe_box(i);
     const Box b{f.xmin - pad, f.xmax + pad, f.ymin - pad, f.ymax + pad};
@@ -330,26 +338,15 @@ Detection detect(const Floes& floes, const CollisionShapes& shapes, const Detect
       }
   }
   std::vector<Candidate> candidates = broad_phase(entries, floes.is_static);
+  if (!subset.everything())
+    std::erase_if(candidates, [&](const Candidate& c) { return subset.keep[c.a] == 0; });
   // A pair may be found through several images: keep each (a, b, shift) once.
-  auto key_less = [](const Candidate& x, const Candidate& y) {
-    if (x.a != y.a) return x.a < y.a;
-    if (x.b != y.b) return x.b < y.b;
-    if (x.shift.x() != y.shift.x()) return x.shift.x() < y.shift.x();
-    return x.shift.y() < y.shift.y();
-  };
-  std::sort(candidates.begin(), candidates.end(), key_less);
+  std::sort(candidates.begin(), candidates.end(), pair_before<Candidate>);
   candidates.erase(std::unique(candidates.begin(), candidates.end(),
                                [](const Candidate& x, const Candidate& y) {
                                  return x.a == y.a && x.b == y.b && x.shift == y.shift;
                                }),
                    candidates.end());
-
-  // This call's share of the pairs (all unless a distributed run split them).
-  const std::size_t count = candidates.size(), base = count / opt.parts, extra = count % opt.parts;
-  const std::size_t first = opt.part * base + std::min(opt.part, extra);
-  candidates.erase(candidates.begin() + static_cast<std::ptrdiff_t>(first + base + (opt.part < extra ? 1 : 0)),
-                   candidates.end());
-  candidates.erase(candidates.begin(), candidates.begin() + static_cast<std::ptrdiff_t>(first));
 
   out.pairs.reserve(candidates.size());
   for (const Candidate& c : candidates)

@@ -33,6 +33,7 @@
 //     floe b). An edge–edge contact thus gives its two end points; a
 //     vertex–vertex contact found from both sides is kept once.
 
+#include <algorithm>
 #include <cstdint>
 #include <limits>
 #include <vector>
@@ -49,6 +50,18 @@ struct Domain {
   double height() const { return ymax - ymin; }
 };
 
+// Which floes a detection poses (and enters in the broad phase), and which of
+// the pairs found among them it keeps and measures: those whose floe a (the
+// lower index) has keep[a] != 0. A pair is found only when both its floes are
+// posed, so a caller that keeps the pairs of floe a must pose every floe whose
+// padded box can reach a's (parallel/place.hpp's halo). The pairs kept are
+// then the serial detection's pairs of those floes, measured the same way.
+struct DetectionSubset {
+  std::vector<std::uint32_t> posed;  // ascending floe indices
+  std::vector<std::uint8_t> keep;    // per floe; empty: the whole detection (posed is ignored)
+  bool everything() const { return keep.empty(); }
+};
+
 struct DetectionOptions {
   double collision_distance = 0.01;  // xi, m: contact points below this gap
   // How far each floe may move before the pair list must be rebuilt (m): per
@@ -56,12 +69,14 @@ struct DetectionOptions {
   // for all.
   double search_margin = 0.01;       // m
   std::vector<double> reach;         // m, per floe (optional)
+  double reach_of(std::size_t floe) const {
+    return reach.empty() ? std::max(0.0, 0.5 * search_margin - 0.5 * collision_distance) : reach[floe];
+  }
   double horizon = 0.0;              // s: pairs are measured vertex by vertex within exact_range(horizon)
   Domain domain;
-  // Measure only share `part` of `parts` (contiguous, in pair order) of the
-  // candidate pairs: a distributed run's ranks each measure one share and
-  // concatenate them in order (parallel/detect.hpp). The default is all.
-  std::size_t part = 0, parts = 1;
+  // A part of the detection (parallel/place.hpp: a rank detects by place).
+  // Default: every floe posed, every pair kept.
+  DetectionSubset subset;
 };
 
 // A vertex of one floe and its closest point on the other (world; b's shifted).
@@ -96,6 +111,16 @@ struct NearPair {
   std::uint32_t first_contact = 0, contact_count = 0;
 };
 
+// The order of detect()'s pairs: by floe a, then b, then b's shift (x, then
+// y). For anything with fields a, b and shift (the candidates, NearPair).
+template <class P>
+bool pair_before(const P& x, const P& y) {
+  if (x.a != y.a) return x.a < y.a;
+  if (x.b != y.b) return x.b < y.b;
+  if (x.shift.x() != y.shift.x()) return x.shift.x() < y.shift.x();
+  return x.shift.y() < y.shift.y();
+}
+
 struct ContactPoint {
   std::uint32_t a = 0, b = 0;  // floes, a < b; the normal points from a to b
   Vec2 point = Vec2::Zero();   // m, world (in a's image of the domain)
@@ -128,6 +153,8 @@ class PosedShapes {
 public:
   PosedShapes() = default;
   PosedShapes(const Floes& floes, const CollisionShapes& shapes);  // all floes posed
+  // Only `which` posed (the others' parts and boxes are not set: not to be read).
+  PosedShapes(const Floes& floes, const CollisionShapes& shapes, std::span<const std::uint32_t> which);
   void update(const Floes& floes, std::size_t floe);
   std::span<const Vec2> part(std::size_t p) const {
     return {world_.data() + shapes_->vertex_offsets[p], shapes_->vertex_offsets[p + 1] - shapes_->vertex_offsets[p]};

@@ -83,6 +83,7 @@ Simulation::Simulation(Scenario scenario, parallel::Communicator comm)
   detection_options_.collision_distance = c.contact.collision_distance;
   detection_options_.domain = make_domain(scenario_);
   detection_options_.horizon = c.run.dt_max;
+  owners_ = parallel::FloeOwners(comm_.rank(), comm_.size(), detection_options_.domain);
   impulse_options_.restitution = c.contact.restitution;
   impulse_options_.friction = c.contact.friction;
   impulse_options_.rest_speed = c.contact.rest_speed;
@@ -244,11 +245,19 @@ void Simulation::drift(StepContext& ctx) {
     for (Vec2& w : water) w += current;
   }
   moorings_.kick(scenario_.floes, ctx.dt);
-  // Each rank drifts its share of the floes (each floe's drift is its own),
-  // then every rank takes the others' shares.
-  const parallel::Range mine = comm_.share(scenario_.floes.size());
-  drift_velocities(scenario_.floes, quadrature_, drift_params_, current, wind, ctx.dt, mine.begin, mine.end, water);
-  comm_.complete_shares(scenario_.floes.state);
+  if (comm_.serial()) {
+    drift_velocities(scenario_.floes, quadrature_, drift_params_, current, wind, ctx.dt, 0, scenario_.floes.size(),
+                     water);
+  } else {
+    // Each rank drifts the floes in its strip (each floe's drift is its own),
+    // charged to the load balance, then every rank takes the others' floes.
+    owners_.update(comm_, scenario_.floes, steps_);  // floes migrate; every few steps the strips move
+    const double start = parallel::thread_seconds();
+    for (const std::uint32_t i : owners_.mine())
+      drift_velocities(scenario_.floes, quadrature_, drift_params_, current, wind, ctx.dt, i, i + 1, water);
+    owners_.charge(parallel::thread_seconds() - start);
+    comm_.complete_owned(scenario_.floes.state, owners_.owner());
+  }
   ctx.momentum = momentum();
   step_budget_.external = ctx.momentum - ctx_momentum_before_;
 }
@@ -344,7 +353,8 @@ void Simulation::set_reach() {
 
 bool Simulation::detect_and_check(StepContext& ctx) {
   set_reach();
-  contact::Detection next = parallel::detect(comm_, scenario_.floes, shapes_, detection_options_);
+  if (!comm_.serial()) owners_.assign(scenario_.floes);  // the owners at the advanced places
+  contact::Detection next = parallel::detect(comm_, owners_, scenario_.floes, shapes_, detection_options_);
   for (const contact::NearPair& p : next.pairs) {
     if (!p.overlap) continue;
     // Redo the step with half the time.

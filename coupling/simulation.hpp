@@ -59,6 +59,7 @@
 #include "core/run_file.hpp"
 #include "coupling/scenario.hpp"
 #include "parallel/comm.hpp"
+#include "parallel/place.hpp"
 
 namespace floesim {
 
@@ -95,9 +96,9 @@ class Simulation {
 public:
   // `comm`: the ranks of a distributed run (parallel/comm.hpp; default: serial).
   // Every rank holds the whole state and steps it the same way; the ranks
-  // share the drift and the narrow phase of detection and gather their
-  // results, so every rank ends each step with the serial run's state, bit
-  // for bit (docs/parallel.md, stage one). step() is then collective.
+  // share the drift and detection by place (each its floes, stage six of
+  // docs/parallel.md) and gather their results, so every rank ends each
+  // step with the serial run's state, bit for bit. step() is then collective.
   explicit Simulation(Scenario scenario, parallel::Communicator comm = {});
   ~Simulation();
   Simulation(Simulation&&) noexcept;
@@ -138,6 +139,8 @@ public:
   Vec2 momentum() const;  // of the dynamic floes now
   LcpCounters lcp_counters() const;
   const contact::Detection& detection() const { return detection_; }
+  // The floes' owners by place for the drift and detection (one rank: all 0).
+  const parallel::FloeOwners& floe_owners() const { return owners_; }
   const contact::SubstepReport& substep_report() const { return substeps_; }
   long rejected_steps() const { return rejected_steps_; }
   // Things a user should hear about once, with a count (e.g. steps cut to the floor).
@@ -188,6 +191,7 @@ private:
   Moorings moorings_;  // [[floes.floe]] mooring_period
   contact::CollisionShapes shapes_;
   contact::DetectionOptions detection_options_;
+  parallel::FloeOwners owners_;  // drift and detection by place (stage six)
   contact::ImpulseOptions impulse_options_;
   std::unique_ptr<contact::WarmStart> warm_ = std::make_unique<contact::WarmStart>();  // jam LCPs' last bases
   contact::Detection detection_;  // at the present positions

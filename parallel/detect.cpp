@@ -2,7 +2,6 @@
 
 #include <cstdint>
 #include <cstring>
-#include <type_traits>
 
 namespace floesim::parallel {
 
@@ -10,22 +9,45 @@ static_assert(kSentAsBytes<contact::NearPair>);
 static_assert(kSentAsBytes<contact::ContactPoint>);
 static_assert(kSentAsBytes<contact::Witness>);
 
-contact::Detection concatenate(std::vector<contact::Detection> parts) {
+contact::Detection merge(std::vector<contact::Detection> parts) {
   contact::Detection out;
   if (parts.empty()) return out;
   out.reach = std::move(parts.front().reach);
-  for (contact::Detection& part : parts) {
-    const auto contacts = static_cast<std::uint32_t>(out.contacts.size());
-    const auto witnesses = static_cast<std::uint32_t>(out.witnesses.size());
-    for (contact::NearPair& p : part.pairs) {
-      p.first_contact += contacts;
-      p.first_witness += witnesses;
-      out.pairs.push_back(p);
-    }
-    out.contacts.insert(out.contacts.end(), part.contacts.begin(), part.contacts.end());
-    out.witnesses.insert(out.witnesses.end(), part.witnesses.begin(), part.witnesses.end());
+  std::size_t pairs = 0, contacts = 0, witnesses = 0;
+  for (const contact::Detection& part : parts) {
+    pairs += part.pairs.size();
+    contacts += part.contacts.size();
+    witnesses += part.witnesses.size();
+  }
+  out.pairs.reserve(pairs);
+  out.contacts.reserve(contacts);
+  out.witnesses.reserve(witnesses);
+  // A merge of sorted lists: the next pair is the first of the parts' next
+  // ones (a scan of the parts: few ranks).
+  std::vector<std::size_t> next(parts.size(), 0);
+  for (std::size_t taken = 0; taken < pairs; ++taken) {
+    std::size_t from = parts.size();
+    for (std::size_t k = 0; k < parts.size(); ++k)
+      if (next[k] < parts[k].pairs.size() &&
+          (from == parts.size() || contact::pair_before(parts[k].pairs[next[k]], parts[from].pairs[next[from]])))
+        from = k;
+    const contact::Detection& part = parts[from];
+    contact::NearPair p = part.pairs[next[from]++];
+    const auto c0 = part.contacts.begin() + p.first_contact;
+    const auto w0 = part.witnesses.begin() + p.first_witness;
+    p.first_contact = static_cast<std::uint32_t>(out.contacts.size());
+    p.first_witness = static_cast<std::uint32_t>(out.witnesses.size());
+    out.contacts.insert(out.contacts.end(), c0, c0 + p.contact_count);
+    out.witnesses.insert(out.witnesses.end(), w0, w0 + p.witness_count);
+    out.pairs.push_back(p);
   }
   return out;
+}
+
+contact::Detection detect_part(const FloeOwners& owners, int rank, const Floes& floes,
+                               const contact::CollisionShapes& shapes, contact::DetectionOptions options) {
+  options.subset = detection_subset(owners, rank, floes, shapes, options);
+  return contact::detect(floes, shapes, options);
 }
 
 namespace {
@@ -47,12 +69,12 @@ std::vector<T> take(const std::byte*& at, std::uint64_t count) {
 }
 }  // namespace
 
-contact::Detection detect(const Communicator& comm, const Floes& floes, const contact::CollisionShapes& shapes,
-                          contact::DetectionOptions options) {
+contact::Detection detect(const Communicator& comm, FloeOwners& owners, const Floes& floes,
+                          const contact::CollisionShapes& shapes, contact::DetectionOptions options) {
   if (comm.serial()) return contact::detect(floes, shapes, options);
-  options.part = static_cast<std::size_t>(comm.rank());
-  options.parts = static_cast<std::size_t>(comm.size());
-  contact::Detection mine = contact::detect(floes, shapes, options);
+  const double start = thread_seconds();
+  contact::Detection mine = detect_part(owners, comm.rank(), floes, shapes, std::move(options));
+  owners.charge(thread_seconds() - start);
   const std::uint64_t sizes[3] = {mine.pairs.size(), mine.contacts.size(), mine.witnesses.size()};
   std::vector<std::byte> message(reinterpret_cast<const std::byte*>(sizes),
                                  reinterpret_cast<const std::byte*>(sizes) + sizeof(sizes));
@@ -72,7 +94,7 @@ contact::Detection detect(const Communicator& comm, const Floes& floes, const co
     part.witnesses = take<contact::Witness>(at, n[2]);
   }
   parts.front().reach = std::move(mine.reach);  // the same on every rank
-  return concatenate(std::move(parts));
+  return merge(std::move(parts));
 }
 
 }  // namespace floesim::parallel

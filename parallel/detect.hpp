@@ -1,31 +1,40 @@
 #pragma once
-// Contact detection (contact/detection.hpp) with its narrow phase shared
-// among the ranks. Every rank holds every floe (stage one of
-// docs/parallel.md: the state is replicated), runs the broad phase, and
-// measures one contiguous share of the candidate pairs
-// (DetectionOptions::part of parts); the shares are gathered in rank order
-// (one message a rank: the counts and the three lists).
-// The pairs are sorted by (a, b, shift) before they are shared, so the
-// concatenation is the serial pair list, and each pair is measured by the
-// same code on the same data: the result is the serial one, bit for bit, on
-// any number of ranks.
+// Contact detection (contact/detection.hpp) by place among the ranks (stage
+// six of docs/parallel.md). Every rank holds every floe; rank r poses only
+// its own floes (parallel::FloeOwners) and their halo, runs the broad phase
+// on those, and measures the pairs whose floe a it owns
+// (parallel::detection_subset). The ranks' lists are gathered (one message a
+// rank: the counts and the three lists) and merged into the serial order:
+// pairs by (a, b, shift), each pair's contact points and witnesses moved with
+// it. Each pair is found once, on one rank, and measured by the same code on
+// the same data, so the result is the serial one, field by field, on any
+// number of ranks and whatever the strips.
 
 #include <vector>
 
 #include "contact/detection.hpp"
 #include "parallel/comm.hpp"
+#include "parallel/place.hpp"
 
 namespace floesim::parallel {
 
-// Collective: every rank calls it with the same floes and options (part and
-// parts are set here).
-contact::Detection detect(const Communicator& comm, const Floes& floes, const contact::CollisionShapes& shapes,
-                          contact::DetectionOptions options);
+// Collective: every rank calls it with the same floes, options and owners
+// (assigned for these floes). options.subset is set here. Charges this
+// rank's own work (its subset, pose, broad and narrow phases; not the
+// gather) to `owners`, for the load balance.
+contact::Detection detect(const Communicator& comm, FloeOwners& owners, const Floes& floes,
+                          const contact::CollisionShapes& shapes, contact::DetectionOptions options);
 
-// The detections of parts 0, 1, ... of one detection, concatenated: pairs,
-// contacts and witnesses in order, each pair's first_contact and
-// first_witness moved to where its part's lists start. The reach is the
-// first part's (every part has the whole reach).
-contact::Detection concatenate(std::vector<contact::Detection> parts);
+// Rank `rank`'s part of the detection by place (no communication): the
+// serial detection's pairs whose floe a `rank` owns, with their contact
+// points and witnesses.
+contact::Detection detect_part(const FloeOwners& owners, int rank, const Floes& floes,
+                               const contact::CollisionShapes& shapes, contact::DetectionOptions options);
+
+// The parts of one detection (each in pair order, no pair in two parts)
+// merged into pair order: pairs, and each pair's contact points and
+// witnesses, its first_contact and first_witness moved to where they now
+// start. The reach is the first part's (every part has the whole reach).
+contact::Detection merge(std::vector<contact::Detection> parts);
 
 }  // namespace floesim::parallel

@@ -29,13 +29,17 @@ def start_moving(path, seed):
         f["floes/velocity"][...] = v
 
 
-def write(floesim, workdir, floes, t_end, seed, output_interval, wind=(10.0, 0.0)):
+def write(floesim, workdir, floes, t_end, seed, output_interval, wind=(10.0, 0.0), half=False):
     """Writes WORKDIR/pack.h5 and WORKDIR/pack.toml; returns the toml's path.
+    half: the floes packed (at 50 % cover) in the lower half of the periodic
+    box only, the upper half open water (a case for the ranks' load balance).
     Raises RuntimeError with floesim's message if `floesim pack` fails."""
     side = box_side(floes)
+    pack_height = side / 2 if half else side
+    box = f"box = [0.0, {side}, 0.0, {side}]\n" if half else ""
     pack = os.path.join(workdir, "pack.h5")
     p = subprocess.run([floesim, "pack", "--floes", str(floes), "--concentration", "0.5", "--box", str(side),
-                        str(side), "--thickness-range", "0.5", "2.0", "--seed", str(seed), "-o", pack],
+                        str(pack_height), "--thickness-range", "0.5", "2.0", "--seed", str(seed), "-o", pack],
                        capture_output=True, text=True)
     if p.returncode != 0:
         raise RuntimeError(f"floesim pack: exit {p.returncode}\n{p.stdout}\n{p.stderr}")
@@ -55,7 +59,7 @@ model = "none"
 domain = "periodic"
 restitution = 0.4
 friction = 0.7
-
+{box}
 [forcing]
 wind = [{wind[0]}, {wind[1]}]
 current = [0.0, 0.05]

@@ -41,11 +41,13 @@ def timed(floesim, config, out_file, ranks, cwd, extra=()):
     p = subprocess.run(cmd, capture_output=True, text=True, env=ENV, cwd=cwd)
     if p.returncode != 0:
         sys.exit(f"{' '.join(run)} on {ranks} rank(s): exit {p.returncode}\n{p.stderr}")
-    out = {}
+    out, raw = {}, {}
     for line in p.stdout.splitlines():
         if ": " in line:
             k, v = line.split(": ", 1)
-            out[k.strip()] = v.split()[0]
+            out[k.strip()] = v.split()[0] if v.split() else ""
+            raw[k.strip()] = v.strip()
+    out["raw"] = raw  # whole values (keys with several, e.g. parallel.strip_cuts)
     processes = []
     for name in sorted(os.listdir(times), key=lambda n: int(n.split(".")[1])):
         with open(os.path.join(times, name)) as f:
@@ -59,8 +61,9 @@ def timed(floesim, config, out_file, ranks, cwd, extra=()):
     return out
 
 
-def write_table(path, command, note, scenario, load_before, load_after, header, rows):
-    """The CSV text (also printed); rows' first column is the rank count, the third the wall time."""
+def write_table(path, command, note, scenario, load_before, load_after, header, rows, group=None):
+    """The CSV text (also printed); rows' first column is the rank count, the third the wall time.
+    group(row), if given, names the build a row ran (least times and speed-ups are per group)."""
     commit = subprocess.run(["git", "-C", ROOT, "rev-parse", "--short", "HEAD"], capture_output=True,
                             text=True).stdout.strip()
     lines = [f"# command: {command}",
@@ -68,13 +71,15 @@ def write_table(path, command, note, scenario, load_before, load_after, header, 
              f"# machine: {platform.processor() or platform.machine()}, {os.cpu_count()} cores (shared); "
              f"load before {load_before}, after {load_after}; {time.strftime('%Y-%m-%d %H:%M', time.gmtime())} UTC",
              f"# scenario: {scenario}"]
+    group = group or (lambda row: "")
     best = {}
     for row in rows:
-        best[row[0]] = min(best.get(row[0], float("inf")), float(row[2]))
-    ref = best.get("1") or best.get("0")
-    for k in sorted(best):
-        lines.append(f"# least wall_s on {k} rank(s): {best[k]:.3f} s" +
-                     (f" (speed-up over 1 rank: {ref / best[k]:.2f}x)" if ref and k not in ("0", "1") else ""))
+        key = (group(row), row[0])
+        best[key] = min(best.get(key, float("inf")), float(row[2]))
+    for g, k in sorted(best):
+        ref = best.get((g, "1")) or best.get((g, "0"))
+        lines.append(f"# least wall_s{' of ' + g if g else ''} on {k} rank(s): {best[(g, k)]:.3f} s" +
+                     (f" (speed-up over 1 rank: {ref / best[(g, k)]:.2f}x)" if ref and k not in ("0", "1") else ""))
     lines.append(header)
     lines += [",".join(r) for r in rows]
     text = "\n".join(lines) + "\n"

@@ -77,6 +77,11 @@ for n in args.ranks:
         failures.append(f"{n} ranks differ from the serial run:\n{c.stdout}")
     if p.stdout.count("status: complete") != 1:
         failures.append(f"{n} ranks: the summary should be printed once (by rank 0):\n{p.stdout}")
+    # Stage six: the strips moved by measured cost during the run, so the
+    # equality above holds with the drift and detection split by changing strips.
+    moves = [int(l.split()[1]) for l in p.stdout.splitlines() if l.startswith("parallel.strip_moves:")]
+    if n > 1 and not (moves and moves[0] > 0):
+        failures.append(f"{n} ranks: the strips never moved (parallel.strip_moves: {moves})")
 
 # A restart on 2 ranks: the first half, then --restart from its checkpoint
 # (written by rank 0, read by every rank), equals the serial run.

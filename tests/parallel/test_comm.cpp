@@ -1,9 +1,10 @@
 // The communicator layer on one rank, and the pieces of the distributed step
 // that can be checked without launching ranks: shares, the agreement's
-// rethrow, and that detection measured in parts and concatenated is the
-// serial detection (what parallel::detect gathers on N ranks).
+// rethrow, and that detection by place, merged, is the serial detection
+// (what parallel::detect gathers on N ranks).
 #include <doctest/doctest.h>
 
+#include <algorithm>
 #include <random>
 
 #include "contact/detection.hpp"
@@ -12,6 +13,7 @@
 #include "core/pack_generator.hpp"
 #include "parallel/comm.hpp"
 #include "parallel/detect.hpp"
+#include "parallel/place.hpp"
 
 TEST_SUITE_BEGIN("mpi");
 
@@ -112,9 +114,10 @@ bool same_lists(const std::vector<T>& a, const std::vector<T>& b) {
 }
 }  // namespace
 
-TEST_CASE("detection in parts and concatenated is the serial detection bit for bit") {
-  // A dense periodic pack with floes moved towards their neighbours, so that
-  // some pairs have contact points and witnesses (offsets to rebase).
+TEST_CASE("detection by place over 1, 2, 3 and 7 strips, merged, is the serial detection field by field") {
+  // A dense pack with floes moved towards their neighbours, so that some
+  // pairs have contact points and witnesses (offsets to rebase), in a
+  // periodic box (pairs across the seam) and in the open plane.
   PackOptions o;
   o.floes = 300;
   o.concentration = 0.8;
@@ -129,31 +132,56 @@ TEST_CASE("detection in parts and concatenated is the serial detection bit for b
     s.vy = u(rng);
   }
   const contact::CollisionShapes shapes = contact::build_collision_shapes(g.floes);
-  contact::DetectionOptions d;
-  d.collision_distance = 20.0;  // m: wide, so that many pairs have contact points
-  d.horizon = 10.0;
-  d.domain = {true, g.window[0], g.window[1], g.window[2], g.window[3]};
-  d.reach.assign(g.floes.size(), 10.0);
-  const contact::Detection serial = contact::detect(g.floes, shapes, d);
-  MESSAGE("serial: " << serial.pairs.size() << " pairs, " << serial.contacts.size() << " contacts, "
-                     << serial.witnesses.size() << " witnesses");
-  REQUIRE(serial.pairs.size() > 100);
-  REQUIRE(serial.contacts.size() > 10);
-  REQUIRE(serial.witnesses.size() > 10);
-  for (std::size_t parts : {1u, 2u, 3u, 7u}) {
-    CAPTURE(parts);
-    std::vector<contact::Detection> pieces;
-    for (std::size_t p = 0; p < parts; ++p) {
-      d.part = p;
-      d.parts = parts;
-      pieces.push_back(contact::detect(g.floes, shapes, d));
+  const std::size_t n = g.floes.size();
+  for (const bool periodic : {true, false}) {
+    CAPTURE(periodic);
+    contact::DetectionOptions d;
+    d.collision_distance = 20.0;  // m: wide, so that many pairs have contact points
+    d.horizon = 10.0;
+    d.domain = {periodic, g.window[0], g.window[1], g.window[2], g.window[3]};
+    d.reach.assign(n, 10.0);
+    const contact::Detection serial = contact::detect(g.floes, shapes, d);
+    MESSAGE("serial: " << serial.pairs.size() << " pairs, " << serial.contacts.size() << " contacts, "
+                       << serial.witnesses.size() << " witnesses");
+    REQUIRE(serial.pairs.size() > 100);
+    REQUIRE(serial.contacts.size() > 10);
+    REQUIRE(serial.witnesses.size() > 10);
+    std::size_t seam = 0;
+    for (const contact::NearPair& p : serial.pairs) seam += p.shift.y() != 0.0 ? 1 : 0;
+    if (periodic) REQUIRE(seam > 0);  // pairs across the seam in y, which the strips cut
+    // Strips of equal counts (as a run starts), and uneven ones with an
+    // empty strip (two equal cuts) and one beyond the pack.
+    const double y0 = g.window[2], h = g.window[3] - g.window[2];
+    const std::vector<std::vector<double>> uneven = {
+        {}, {y0 + 0.2 * h}, {y0 + 0.3 * h, y0 + 0.3 * h}, {y0 + 0.1 * h, y0 + 0.15 * h, y0 + 0.5 * h, y0 + 0.5 * h,
+                                                           y0 + 0.9 * h, y0 + 2.0 * h}};
+    for (const bool equal : {true, false}) {
+      std::size_t layout = 0;
+      for (const int ranks : {1, 2, 3, 7}) {
+        CAPTURE(ranks);
+        CAPTURE(equal);
+        parallel::FloeOwners owners(0, ranks, d.domain);
+        if (!equal) owners.set_cuts(uneven[layout]);
+        ++layout;
+        owners.assign(g.floes);
+        std::vector<contact::Detection> parts;
+        std::size_t across = 0, empty = 0;
+        for (int r = 0; r < ranks; ++r) {
+          const contact::DetectionSubset subset = parallel::detection_subset(owners, r, g.floes, shapes, d);
+          if (ranks > 1) CHECK(subset.posed.size() < n);  // a strip poses its floes and a halo only
+          if (std::count(subset.keep.begin(), subset.keep.end(), 1) == 0) ++empty;
+          parts.push_back(parallel::detect_part(owners, r, g.floes, shapes, d));
+        }
+        for (const contact::NearPair& p : serial.pairs) across += owners.owner()[p.a] != owners.owner()[p.b] ? 1 : 0;
+        if (ranks > 1) CHECK(across > 0);  // pairs whose floes lie in different strips
+        if (!equal && ranks > 2) CHECK(empty > 0);
+        const contact::Detection merged = parallel::merge(std::move(parts));
+        CHECK(same_lists(merged.pairs, serial.pairs));
+        CHECK(same_lists(merged.contacts, serial.contacts));
+        CHECK(same_lists(merged.witnesses, serial.witnesses));
+        CHECK(merged.reach == serial.reach);
+      }
     }
-    if (parts > 1) CHECK(pieces[1].pairs.size() < serial.pairs.size());  // the parts do share the work
-    const contact::Detection joined = parallel::concatenate(std::move(pieces));
-    CHECK(same_lists(joined.pairs, serial.pairs));
-    CHECK(same_lists(joined.contacts, serial.contacts));
-    CHECK(same_lists(joined.witnesses, serial.witnesses));
-    CHECK(joined.reach == serial.reach);
   }
 }
 
@@ -165,7 +193,9 @@ TEST_CASE("parallel::detect on one rank is contact::detect") {
   const contact::CollisionShapes shapes = contact::build_collision_shapes(g.floes);
   contact::DetectionOptions d;
   d.reach.assign(g.floes.size(), 5.0);
-  const contact::Detection a = parallel::detect(parallel::Communicator{}, g.floes, shapes, d);
+  parallel::FloeOwners owners;
+  owners.assign(g.floes);
+  const contact::Detection a = parallel::detect(parallel::Communicator{}, owners, g.floes, shapes, d);
   const contact::Detection b = contact::detect(g.floes, shapes, d);
   CHECK(same_lists(a.pairs, b.pairs));
   CHECK(same_lists(a.contacts, b.contacts));

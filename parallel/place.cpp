@@ -1,0 +1,148 @@
+#include "parallel/place.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numeric>
+
+#include <time.h>
+
+#include "core/error.hpp"
+
+namespace floesim::parallel {
+
+std::vector<double> cut_by_cost(std::span<const double> y, std::span<const double> cost, int ranks) {
+  FLOESIM_ASSERT(y.size() == cost.size() && ranks >= 1);
+  const std::size_t n = y.size();
+  std::vector<std::uint32_t> order(n);
+  std::iota(order.begin(), order.end(), 0u);
+  std::sort(order.begin(), order.end(), [&](std::uint32_t i, std::uint32_t j) { return y[i] != y[j] ? y[i] < y[j] : i < j; });
+  // prefix[k]: the cost of the k first items by y.
+  std::vector<double> prefix(n + 1, 0.0);
+  for (std::size_t k = 0; k < n; ++k) prefix[k + 1] = prefix[k] + cost[order[k]];
+  const double total = prefix[n];
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  std::vector<double> cuts;
+  std::size_t k = 0;  // strips 0..r-1 hold the k first items
+  for (int r = 1; r < ranks; ++r) {
+    const double target = total * r / ranks;
+    // |prefix[k] - target| falls, then rises, with k: walk to its least.
+    while (k < n && std::abs(prefix[k + 1] - target) <= std::abs(prefix[k] - target)) ++k;
+    double cut = k == 0 ? -kInf : k == n ? kInf : 0.5 * (y[order[k - 1]] + y[order[k]]);
+    if (k > 0 && k < n && cut <= y[order[k - 1]]) cut = y[order[k]];  // adjacent doubles: the midpoint rounds down
+    cuts.push_back(cut);
+  }
+  return cuts;
+}
+
+double thread_seconds() {
+  timespec t{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
+}
+
+FloeOwners::FloeOwners(int rank, int ranks, const contact::Domain& domain, StripOptions options)
+    : rank_(rank), ranks_(ranks), domain_(domain), options_(options) {
+  FLOESIM_ASSERT(ranks >= 1 && rank >= 0 && rank < ranks && options.rebalance_steps >= 1 &&
+                 options.relaxation > 0.0 && options.relaxation <= 1.0);
+}
+
+double FloeOwners::place(const FloeState& s) const {
+  if (!domain_.periodic) return s.y;
+  const double h = domain_.height();
+  return domain_.ymin + std::fmod(std::fmod(s.y - domain_.ymin, h) + h, h);
+}
+
+void FloeOwners::set_cuts(std::vector<double> cuts) {
+  FLOESIM_ASSERT(cuts.size() == static_cast<std::size_t>(ranks_ - 1) && std::is_sorted(cuts.begin(), cuts.end()));
+  cuts_ = std::move(cuts);
+  cut_ = true;
+}
+
+void FloeOwners::assign(const Floes& floes) {
+  const std::size_t n = floes.size();
+  std::vector<double> y(n);
+  for (std::size_t i = 0; i < n; ++i) y[i] = place(floes.state[i]);
+  if (!cut_) set_cuts(cut_by_cost(y, std::vector<double>(n, 1.0), ranks_));
+  owner_.resize(n);
+  mine_.clear();
+  for (std::size_t i = 0; i < n; ++i) {
+    owner_[i] = static_cast<int>(std::upper_bound(cuts_.begin(), cuts_.end(), y[i]) - cuts_.begin());
+    if (owner_[i] == rank_) mine_.push_back(static_cast<std::uint32_t>(i));
+  }
+}
+
+void FloeOwners::update(const Communicator& comm, const Floes& floes, std::size_t step) {
+  if (!started_) {
+    started_ = true;
+    next_move_ = step + static_cast<std::size_t>(options_.rebalance_steps);
+  } else if (step >= next_move_) {
+    next_move_ = step + static_cast<std::size_t>(options_.rebalance_steps);
+    window_seconds_ = comm.allgather<double>(std::span<const double>(&charged_, 1));
+    charged_ = 0.0;
+    total_seconds_.resize(window_seconds_.size(), 0.0);
+    for (std::size_t r = 0; r < window_seconds_.size(); ++r) total_seconds_[r] += window_seconds_[r];
+    assign(floes);  // the floes as the window left them, in the strips they were charged in
+    std::vector<double> count(static_cast<std::size_t>(ranks_), 0.0);
+    for (const int r : owner_) count[static_cast<std::size_t>(r)] += 1.0;
+    const double seconds = std::accumulate(window_seconds_.begin(), window_seconds_.end(), 0.0);
+    const std::size_t n = floes.size();
+    if (seconds > 0.0 && n > 0) {
+      const double floor = options_.cost_floor * seconds / static_cast<double>(n);
+      std::vector<double> y(n), cost(n);
+      for (std::size_t i = 0; i < n; ++i) {
+        const auto r = static_cast<std::size_t>(owner_[i]);
+        y[i] = place(floes.state[i]);
+        cost[i] = std::max(window_seconds_[r] / count[r], floor);  // count[r] >= 1: floe i is r's
+      }
+      std::vector<double> cuts = cut_by_cost(y, cost, ranks_);
+      for (std::size_t k = 0; k < cuts.size(); ++k)  // part way (an infinite cut, an empty strip: all the way)
+        if (std::isfinite(cuts[k]) && std::isfinite(cuts_[k])) cuts[k] = cuts_[k] + options_.relaxation * (cuts[k] - cuts_[k]);
+      std::sort(cuts.begin(), cuts.end());  // already ascending but for round-off
+      set_cuts(std::move(cuts));
+      ++moves_;
+    }
+  }
+  assign(floes);
+}
+
+contact::DetectionSubset detection_subset(const FloeOwners& owners, int rank, const Floes& floes,
+                                          const contact::CollisionShapes& shapes,
+                                          const contact::DetectionOptions& options) {
+  const std::size_t n = floes.size();
+  const std::span<const int> owner = owners.owner();
+  FLOESIM_ASSERT(owner.size() == n);
+  const contact::Domain& d = options.domain;
+  contact::DetectionSubset subset;
+  subset.keep.assign(n, 0);
+  // Each floe's band: centre y (wrapped), half width R + reach + xi/2, widened
+  // by a round-off margin (posing rounds; a floe posed in excess costs only time).
+  std::vector<double> y(n), half(n);
+  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+  for (std::size_t i = 0; i < n; ++i) {
+    y[i] = owners.place(floes.state[i]);
+    const double h = shapes.radius[i] + options.reach_of(i) + 0.5 * options.collision_distance;
+    half[i] = h + 1e-9 * (1.0 + std::abs(y[i]) + h);
+    if (owner[i] != rank) continue;
+    subset.keep[i] = 1;
+    lo = std::min(lo, y[i] - half[i]);
+    hi = std::max(hi, y[i] + half[i]);
+  }
+  if (!(lo <= hi)) return subset;  // no floe of its own: nothing to pose
+  const double centre = 0.5 * (lo + hi), width = 0.5 * (hi - lo);
+  for (std::size_t i = 0; i < n; ++i) {
+    bool near = subset.keep[i] != 0;
+    if (!near && d.periodic) {
+      // The nearest image of the floe's centre (any whole number of periods).
+      double gap = y[i] - centre;
+      gap -= d.height() * std::round(gap / d.height());
+      near = std::abs(gap) <= width + half[i];
+    } else if (!near) {
+      near = y[i] + half[i] >= lo && y[i] - half[i] <= hi;
+    }
+    if (near) subset.posed.push_back(static_cast<std::uint32_t>(i));
+  }
+  return subset;
+}
+
+}  // namespace floesim::parallel

@@ -1,0 +1,130 @@
+#pragma once
+// Stage six of docs/parallel.md: the floes owned by place, for the work that
+// is per floe (the drift) and per pair (detection).
+//
+// The state stays replicated on every rank; what is split by place is the
+// work. Rank r owns the floes whose centroid lies in its strip, a band
+// [cut[r-1], cut[r]) along y (cut[-1] = -inf, cut[ranks-1] = +inf), y wrapped
+// into a periodic box first. Strips run along y because the spectral sea's
+// slabs do (stage four), so that a floe's neighbours across a strip boundary
+// are few. The owners are recomputed from the replicated state (assign()) at
+// every step: a floe whose centroid crosses a cut "migrates", which costs
+// nothing since every rank holds every floe.
+//
+// Load balance by measured cost: each rank charges the wall time of its
+// by-place work (its floes' drift, its part of detection: no waits, no
+// copies; CPU time of the thread) to its FloeOwners; every
+// StripOptions::rebalance_steps steps the ranks all-gather their charged
+// times and move the cuts toward those that give every strip an equal share
+// of the estimated cost (cut_by_cost), each floe's cost being its owner's
+// time per floe over the window. The cost density in y is
+// thus estimated as piecewise constant over the old strips; when it is
+// steady, one move balances the ranks to within one floe's cost, and a
+// window of several steps averages the timing noise. Every rank computes the
+// same cuts from the same gathered times (the same code on the same data),
+// so the ranks agree on the owners without another message. The answer does
+// not depend on the cuts: every phase by place gives the serial result.
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "contact/detection.hpp"
+#include "contact/shapes.hpp"
+#include "core/floes.hpp"
+#include "parallel/comm.hpp"
+
+namespace floesim::parallel {
+
+struct StripOptions {
+  // Steps between two moves of the cuts by measured cost (each move is one
+  // collective call of 8 bytes a rank). Ten steps average out the scheduler's
+  // noise in a window of a 10 000-floe pack (about 0.1 s of by-place work).
+  int rebalance_steps = 10;
+  // A floor on a floe's estimated cost, as a fraction of the mean cost per
+  // floe: a rank that measured (almost) nothing, e.g. whose floes are all
+  // static, would otherwise be given every floe at the next move.
+  double cost_floor = 0.01;
+  // How far a move goes from the present cuts toward the equal-cost cuts
+  // (1: all the way). The estimate of a window is noisy (a rank's time
+  // varies by 10 to 20 % from window to window on a shared machine); half
+  // way halves the cuts' jitter and still closes a steady imbalance by half
+  // at every move.
+  double relaxation = 0.5;
+};
+
+// The CPU time of the calling thread (s): what a rank charges for its
+// by-place work. Unlike the wall clock it leaves out the time the thread was
+// not running (another process on the core), which says nothing of the
+// work's cost.
+double thread_seconds();
+
+// Cuts items at positions y into `ranks` strips of equal total cost: returns
+// ranks - 1 ascending cuts; strip r holds the items with
+// cut[r-1] <= y < cut[r]. Each cut lies midway between two items adjacent in
+// y (or at +-infinity when a strip gets none), placed where the running sum of
+// the costs, items taken by ascending y, comes nearest to r/ranks of the
+// total: each strip's cost is within one item's cost of total/ranks, items
+// with equal y excepted (they stay together).
+std::vector<double> cut_by_cost(std::span<const double> y, std::span<const double> cost, int ranks);
+
+class FloeOwners {
+public:
+  FloeOwners() = default;  // one rank: owns every floe
+  FloeOwners(int rank, int ranks, const contact::Domain& domain, StripOptions options = {});
+
+  int rank() const { return rank_; }
+  int ranks() const { return ranks_; }
+
+  // The owners of the floes at their present places. Until cuts are set
+  // (set_cuts, update), the strips hold equal numbers of floes.
+  void assign(const Floes& floes);
+  // Collective (every rank at the same `step`): every options.rebalance_steps
+  // steps, the cuts move by the ranks' charged times (above); then assign().
+  // A step redone after an overlap calls it again with the same `step`: no
+  // second move.
+  void update(const Communicator& comm, const Floes& floes, std::size_t step);
+  // This rank's wall time (s) in by-place work since the last move.
+  void charge(double seconds) { charged_ += seconds; }
+
+  std::span<const int> owner() const { return owner_; }  // per floe, after assign()
+  const std::vector<std::uint32_t>& mine() const { return mine_; }  // this rank's floes, ascending
+  // A floe's place: its centroid's y, wrapped into the box when periodic.
+  double place(const FloeState& s) const;
+
+  const std::vector<double>& cuts() const { return cuts_; }
+  void set_cuts(std::vector<double> cuts);  // ranks - 1 ascending values
+  // The moves so far, each rank's charged seconds over the last window, and
+  // over every window so far.
+  int moves() const { return moves_; }
+  const std::vector<double>& window_seconds() const { return window_seconds_; }
+  const std::vector<double>& charged_seconds() const { return total_seconds_; }
+
+private:
+  int rank_ = 0, ranks_ = 1;
+  contact::Domain domain_;
+  StripOptions options_;
+  std::vector<double> cuts_;
+  bool cut_ = false;  // cuts_ set (else equal counts at the next assign)
+  std::vector<int> owner_;
+  std::vector<std::uint32_t> mine_;
+  double charged_ = 0.0;
+  std::size_t next_move_ = 0;
+  bool started_ = false;
+  int moves_ = 0;
+  std::vector<double> window_seconds_, total_seconds_;
+};
+
+// The halo rule: the part of the detection that `rank` makes. It keeps the
+// pairs whose floe a it owns, and poses its floes and every floe whose padded
+// box can reach one of theirs: the floes whose band
+// [y - R - p, y + R + p] (R: the bounding radius about the centroid, p =
+// reach + xi/2, the broad phase's pad) meets the union of the owned floes'
+// bands, across the periodic seam too. A pair is a candidate only when its
+// padded boxes overlap, so both floes of every kept pair are posed, and the
+// kept pairs are the serial detection's pairs of the owned floes.
+contact::DetectionSubset detection_subset(const FloeOwners& owners, int rank, const Floes& floes,
+                                          const contact::CollisionShapes& shapes,
+                                          const contact::DetectionOptions& options);
+
+}  // namespace floesim::parallel

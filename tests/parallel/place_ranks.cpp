@@ -1,0 +1,101 @@
+// The load balance by measured cost (parallel::FloeOwners, stage six) over
+// the ranks mpirun started. 3000 floes spread along y in a periodic box, a
+// floe above y = 700 m costing 20 times one below (very unequal costs, the
+// equal counts of the start are far from balanced), drifting 0.7 m a step so
+// that they migrate across the cuts. Each rank charges the cost of the
+// floes it owns (a known cost, not a clock, so that the test is
+// deterministic), and FloeOwners::update moves the cuts every 10 steps from
+// the gathered charges. The ranks' charges must become equal (below); the
+// ranks must agree on the cuts and owners to the bit, and own every floe
+// once. Run by ctest as
+// mpi.place_ranks_N under `mpirun --oversubscribe -np N` (N = 1, 2, 3), and
+// serially without MPI.
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <numeric>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "parallel/comm.hpp"
+#include "parallel/place.hpp"
+
+using namespace floesim;
+
+int main() {
+  parallel::Session session;
+  const parallel::Communicator& comm = session.world();
+  const int ranks = comm.size();
+  std::vector<std::string> failures;
+  const std::size_t n = 3000;
+  Floes floes;
+  std::mt19937_64 rng(5);  // the same floes on every rank
+  std::uniform_real_distribution<double> u(0.0, 1000.0);
+  for (std::size_t i = 0; i < n; ++i) {
+    FloeState s{};
+    s.y = u(rng);
+    floes.state.push_back(s);
+    floes.thickness.push_back(1.0);
+  }
+  const contact::Domain box{true, 0.0, 1000.0, 0.0, 1000.0};
+  parallel::FloeOwners owners(comm.rank(), ranks, box);
+  auto cost = [&](std::size_t i) { return owners.place(floes.state[i]) >= 700.0 ? 20e-6 : 1e-6; };
+  std::vector<std::vector<double>> windows;  // each window's charges, by rank
+  for (std::size_t step = 0; step < 300; ++step) {
+    owners.update(comm, floes, step);
+    if (step % 10 == 0 && step > 0) windows.push_back(owners.window_seconds());  // the window just closed
+    if (step == 150) owners.update(comm, floes, step);  // a step redone: no second move
+    double charged = 0.0;
+    for (const std::uint32_t i : owners.mine()) charged += cost(i);
+    owners.charge(charged);
+    for (FloeState& s : floes.state) s.y += 0.7;  // not wrapped: place() wraps
+  }
+  // The strips start with equal counts: the first window is far from
+  // balanced (its costliest rank charges 3 times the mean or more). From
+  // step 100 on, the ranks' mean charges are equal within 2 %, and every
+  // window's within 10 % (a strip's cost varies as the random floes drift
+  // through it: some 25 costly floes make a strip's cost).
+  auto spread = [](const std::vector<double>& x) {
+    const double mean = std::accumulate(x.begin(), x.end(), 0.0) / static_cast<double>(x.size());
+    return *std::max_element(x.begin(), x.end()) / mean - 1.0;
+  };
+  std::vector<double> late(static_cast<std::size_t>(ranks), 0.0);
+  double worst = 0.0;
+  for (std::size_t k = 9; k < windows.size(); ++k) {
+    for (int r = 0; r < ranks; ++r) late[static_cast<std::size_t>(r)] += windows[k][static_cast<std::size_t>(r)];
+    worst = std::max(worst, spread(windows[k]));
+  }
+  if (ranks > 1 && !(spread(windows.front()) > 0.5)) failures.push_back("the first window was balanced: no test");
+  if (!(spread(late) <= 0.02)) failures.push_back("the mean charges from step 100 differ by more than 2 %");
+  if (!(worst <= 0.10)) failures.push_back("a window's charges from step 100 differ by more than 10 %");
+  if (ranks > 1 && owners.moves() != 29) failures.push_back("expected 29 moves in 300 steps");
+  // Every rank the same cuts and owners, to the bit; every floe owned once.
+  const std::vector<double> cuts = comm.allgather<double>(owners.cuts());
+  for (int r = 0; r < ranks; ++r)
+    if (std::memcmp(cuts.data() + r * (ranks - 1), owners.cuts().data(), (ranks - 1) * sizeof(double)) != 0)
+      failures.push_back("the ranks' cuts differ");
+  const std::vector<int> owner = comm.allgather<int>(owners.owner());
+  for (int r = 0; r < ranks; ++r)
+    if (!std::equal(owners.owner().begin(), owners.owner().end(), owner.begin() + r * static_cast<long>(n)))
+      failures.push_back("the ranks' owners differ");
+  std::vector<std::uint32_t> all = comm.allgather<std::uint32_t>(owners.mine());
+  std::sort(all.begin(), all.end());
+  for (std::size_t i = 0; i < n; ++i)
+    if (all.size() != n || all[i] != i) {
+      failures.push_back("the floes are not owned once each");
+      break;
+    }
+  if (comm.writer()) {
+    std::printf("%d ranks, %d moves; the first window's charges exceed their mean by %.3f, from step 100 on "
+                "the worst window's by %.3f, the mean charges by %.4f; cuts:",
+                ranks, owners.moves(), spread(windows.front()), worst, spread(late));
+    for (const double c : owners.cuts()) std::printf(" %.3f", c);
+    std::printf("\n");
+  }
+  for (const std::string& f : failures) std::printf("rank %d: %s\n", comm.rank(), f.c_str());
+  const long long failed = comm.sum(static_cast<long long>(failures.size()));
+  if (comm.writer()) std::printf("%s on %d ranks\n", failed == 0 ? "passed" : "FAILED", ranks);
+  return failed == 0 ? 0 : 1;
+}
