@@ -35,10 +35,14 @@ struct SpectralSea::Impl {
   std::size_t n = 0, nc = 0;
   Dispersion disp;
   double lx = 0.0, ly = 0.0;
-  // Per mode: derivative wavenumbers (0 on the Nyquist line of that axis, where
-  // an odd derivative of a real field is not representable) and the factor
-  // coth(|k| H) / |k| that maps eta' to the surface potential phi.
+  // Per mode of the bank: derivative wavenumbers (0 on the Nyquist line of
+  // that axis, where an odd derivative of a real field is not representable)
+  // and the factor coth(|k| H) / |k| that maps eta' to the surface potential phi.
   std::vector<double> kx, ky, phi;
+  // The bank's modes: every mode of the half spectrum (nc), or in slabs this
+  // rank's columns [columns.begin, columns.end) of each row, row by row
+  // (ny x width). Mode j of row iy is the spectrum's entry iy hx + columns.begin + j - iy width.
+  std::size_t modes = 0, width = 0;
   double* real = nullptr;         // n reals, scratch
   fftw_complex* spec = nullptr;   // nc complex, scratch
   // dims = 2: the y-velocity's spectrum, made in the same pass over the modes
@@ -49,11 +53,13 @@ struct SpectralSea::Impl {
   std::unique_ptr<RealFft2d> fft2;         // dims = 2: the same bits on any number of threads
   int threads = 1;
   // Deferred kicks: up to two (spectrum, h), applied fused with the next flow,
-  // in order. kick_spec holds the FFTs of up to two pressures; pending kick i
+  // in order. kick_spec holds the FFTs of up to two pressures, laid out like
+  // the bank's modes (in slabs: this rank's columns only); pending kick i
   // uses kick_spec[kick_buf[i]] (a repeated kick uses the buffer of the last
   // one again). `staged`: spec holds the current q (written by that flow), so
   // the elevation needs no copy before its c2r.
   std::array<fftw_complex*, 2> kick_spec{nullptr, nullptr};
+  std::size_t kick_capacity = 0;  // complex entries of each kick buffer
   std::array<int, 2> kick_buf{0, 0};
   std::array<double, 2> kick_h{0.0, 0.0};
   int pending = 0;
@@ -63,29 +69,32 @@ struct SpectralSea::Impl {
   std::optional<TankZones> tank;
   AlignedVector tank_eta, tank_rate;
   // The sea in slabs (ranks.distributed(); spectral.hpp): this rank's rows
-  // of the fields and columns of the modes. `gathered`: every rank's bank
-  // holds every mode's present state (else only its own columns' are).
+  // of the fields and columns of the modes.
   SeaRanks ranks;
   std::unique_ptr<SlabFft2d> slab;
-  SlabFft2d::Span rows, columns;
-  bool gathered = true;
-  std::vector<std::size_t> row_bytes, mode_bytes;  // each rank's part of a field and of the bank (q and v)
-  std::vector<std::byte> modes_buffer;
+  SlabFft2d::Span rows{0, 0}, columns{0, 0};
+  std::vector<std::size_t> row_bytes;  // each rank's part of a field
   struct Halo {
     int rows = -1;                                    // the halo the lists are for
     std::vector<std::vector<int>> send, receive;      // per rank: the rows sent to it, received from it
     std::vector<std::byte> out, in;
   } halo_exchange;
 
-  // f(first, last) for each range of this rank's modes (its columns of each
-  // row of the half spectrum); every mode when not in slabs.
+  // f(first, stop, mode) for each range [first, stop) of the half spectrum
+  // the bank holds, `mode` the bank's index of `first`: every mode at once
+  // when not in slabs, else this rank's columns of each row.
   template <class F>
   void for_own_modes(F&& f) const {
-    if (!slab) return f(std::size_t{0}, nc);
+    if (!slab) return f(std::size_t{0}, nc, std::size_t{0});
     for (int iy = 0; iy < ny; ++iy) {
       const std::size_t row = static_cast<std::size_t>(iy) * hx;
-      f(row + columns.begin, row + columns.end);
+      f(row + columns.begin, row + columns.end, static_cast<std::size_t>(iy) * width);
     }
+  }
+  // The columns and the bank's mode count of rank r.
+  std::size_t width_of(int r) const {
+    const SlabFft2d::Span c = slab->columns_of(r);
+    return static_cast<std::size_t>(c.end - c.begin);
   }
 
   ~Impl() {
@@ -101,8 +110,10 @@ struct SpectralSea::Impl {
     return fftw_alignment_of(const_cast<double*>(p)) == fftw_alignment_of(real);
   }
 
-  // to <- FFT(field) on this rank's columns (in slabs: reading the
-  // field's rows of this rank only), to a kick buffer.
+  // to <- FFT(field) on the bank's modes, to a kick buffer. In slabs the
+  // field's rows of this rank only are read, and its columns of the
+  // transform, made in spec_vy (scratch: a kick voids its staging), are
+  // copied to the buffer in the bank's layout.
   void forward_kick(std::span<const double> field, fftw_complex* to) {
     if (!slab) return forward(field, to);
     const double* in = field.data();
@@ -110,7 +121,10 @@ struct SpectralSea::Impl {
       std::copy(field.begin(), field.end(), real);
       in = real;
     }
-    slab->forward(in, to, threads);
+    slab->forward(in, spec_vy, threads);
+    for_own_modes([&](std::size_t first, std::size_t stop, std::size_t mode) {
+      std::copy(spec_vy[first], spec_vy[first] + 2 * (stop - first), to[mode]);
+    });
   }
   // to <- FFT(field), every mode on every rank; `to` is spec or a kick buffer (same alignment).
   void forward(std::span<const double> field, fftw_complex* to) {
@@ -151,29 +165,29 @@ struct SpectralSea::Impl {
     staged = false;
     staged_vy = deriv_vy != nullptr;
     const int kicks = gain.empty() ? 0 : pending;
-    if (!deriv && !factor && kicks == 0) {
+    if (!slab && !deriv && !factor && kicks == 0) {
       std::copy(a.begin(), a.end(), reinterpret_cast<double*>(spec));
       return;
     }
-    for_own_modes([&](std::size_t begin, std::size_t end) {
-      for (std::size_t c = begin; c < end; ++c) {
-        double a0 = a[2 * c], a1 = a[2 * c + 1];
+    for_own_modes([&](std::size_t first, std::size_t stop, std::size_t mode) {
+      for (std::size_t c = first, j = mode; c < stop; ++c, ++j) {
+        double a0 = a[2 * j], a1 = a[2 * j + 1];
         for (int i = 0; i < kicks; ++i) {
-          const double g = kick_h[i] * gain[c];
+          const double g = kick_h[i] * gain[j];
           const double* s = kick_data(i);
-          a0 += g * s[2 * c];
-          a1 += g * s[2 * c + 1];
+          a0 += g * s[2 * j];
+          a1 += g * s[2 * j + 1];
         }
         double s = 1.0;
-        if (factor) s *= (*factor)[c];
+        if (factor) s *= (*factor)[j];
         const double re = a0 * s, im = a1 * s;
         if (deriv_vy) {
-          const double k = (*deriv_vy)[c];
+          const double k = (*deriv_vy)[j];
           spec_vy[c][0] = -k * im;
           spec_vy[c][1] = k * re;
         }
         if (deriv) {
-          const double k = (*deriv)[c];
+          const double k = (*deriv)[j];
           spec[c][0] = -k * im;
           spec[c][1] = k * re;
         } else {
@@ -248,38 +262,6 @@ struct SpectralSea::Impl {
       }
   }
 
-  // Every rank's columns of the bank (q and v) to every rank: the bank whole
-  // and current everywhere (each rank's modes as that rank stepped them).
-  void gather_modes(ModalBank& bank) {
-    if (!slab || gathered) return;
-    std::size_t offset = 0;
-    for (int r = 0; r < ranks.rank; ++r) offset += mode_bytes[static_cast<std::size_t>(r)];
-    std::size_t total = offset;
-    for (std::size_t r = static_cast<std::size_t>(ranks.rank); r < mode_bytes.size(); ++r) total += mode_bytes[r];
-    modes_buffer.resize(total);
-    // A rank's part: its columns of q, row by row, then of v.
-    auto walk = [&](int rank, std::byte* at, bool pack) {
-      const SlabFft2d::Span cols = slab->columns_of(rank);
-      const std::size_t bytes = 2 * sizeof(double) * static_cast<std::size_t>(cols.end - cols.begin);
-      for (std::span<double> a : {bank.q(), bank.v()})
-        for (int iy = 0; iy < ny; ++iy) {
-          auto* mode = reinterpret_cast<std::byte*>(a.data() + 2 * (static_cast<std::size_t>(iy) * hx + cols.begin));
-          if (bytes > 0) {
-            if (pack) std::memcpy(at, mode, bytes);
-            else std::memcpy(mode, at, bytes);
-          }
-          at += bytes;
-        }
-    };
-    walk(ranks.rank, modes_buffer.data() + offset, true);
-    ranks.allgather(modes_buffer, mode_bytes);
-    std::byte* at = modes_buffer.data();
-    for (int r = 0; r < ranks.ranks; ++r) {
-      if (r != ranks.rank) walk(r, at, false);
-      at += mode_bytes[static_cast<std::size_t>(r)];
-    }
-    gathered = true;
-  }
 };
 
 SpectralSea::SpectralSea(const SeaParams& params, const SeaOptions& options)
@@ -297,7 +279,6 @@ SpectralSea::SpectralSea(const SeaParams& params, const SeaOptions& options)
   m.real = fftw_alloc_real(m.n);
   m.spec = fftw_alloc_complex(m.nc);
   if (m.ny > 1) m.spec_vy = fftw_alloc_complex(m.nc);
-  for (auto*& k : m.kick_spec) k = fftw_alloc_complex(m.nc);
   const unsigned flags = options.measure_fft_plans ? FFTW_MEASURE : FFTW_ESTIMATE;
   m.threads = std::max(options.threads, 1);
   bool planned = false;
@@ -316,28 +297,35 @@ SpectralSea::SpectralSea(const SeaParams& params, const SeaOptions& options)
     m.rows = m.slab->rows();
     m.columns = m.slab->columns();
     for (int r = 0; r < m.ranks.ranks; ++r) {
-      const SlabFft2d::Span rows = m.slab->rows_of(r), cols = m.slab->columns_of(r);
+      const SlabFft2d::Span rows = m.slab->rows_of(r);
       m.row_bytes.push_back(sizeof(double) * static_cast<std::size_t>(rows.end - rows.begin) * m.nx);
-      m.mode_bytes.push_back(2 * 2 * sizeof(double) * static_cast<std::size_t>(cols.end - cols.begin) * m.ny);
     }
+  } else {
+    m.columns = {0, m.hx};
   }
+  m.width = static_cast<std::size_t>(m.columns.end - m.columns.begin);
+  m.modes = static_cast<std::size_t>(m.ny) * m.width;
+  // fftw_alloc_complex(0) may return nullptr: a rank without columns holds one.
+  m.kick_capacity = std::max<std::size_t>(m.modes, 1);
+  for (auto*& k : m.kick_spec) k = fftw_alloc_complex(m.kick_capacity);
 
   // Oscillator bank on the normalised coefficients eta_k = FFT(eta) / n, so that
   // a field is the plain c2r of its coefficients. Parseval on the half spectrum:
   // ∫ f g = dA n sum_full f_k conj(g_k), and a coefficient with 0 < ix < nx/2
   // stands for itself and its conjugate (weight 2). A kick receives the
   // unnormalised FFT of p, hence gain = -1 / (mu n).
-  std::vector<double> omega(m.nc), mass(m.nc), gain(m.nc);
-  m.kx.assign(m.nc, 0.0);
-  m.ky.assign(m.nc, 0.0);
-  m.phi.assign(m.nc, 0.0);
+  // In slabs only this rank's modes (Impl::modes).
+  std::vector<double> omega(m.modes), mass(m.modes), gain(m.modes);
+  m.kx.assign(m.modes, 0.0);
+  m.ky.assign(m.modes, 0.0);
+  m.phi.assign(m.modes, 0.0);
   const double da_n = grid_.cell_area() * static_cast<double>(m.n);
   const double inv_n = 1.0 / static_cast<double>(m.n);
   const double two_pi = 2.0 * std::numbers::pi;
   for (int iy = 0; iy < m.ny; ++iy) {
     const int my = iy <= m.ny / 2 ? iy : iy - m.ny;
-    for (int ix = 0; ix < m.hx; ++ix) {
-      const std::size_t c = static_cast<std::size_t>(iy) * m.hx + ix;
+    for (int ix = m.columns.begin; ix < m.columns.end; ++ix) {
+      const std::size_t c = static_cast<std::size_t>(iy) * m.width + static_cast<std::size_t>(ix - m.columns.begin);
       const double kx = two_pi * ix / m.lx;
       const double ky = m.ny > 1 ? two_pi * my / m.ly : 0.0;
       const double k = std::hypot(kx, ky);
@@ -413,12 +401,8 @@ void SpectralSea::repeat_kick(double h) {
 
 void SpectralSea::settle() {
   Impl& m = *impl_;
-  // In slabs the kicks' spectra hold this rank's columns only: the other
-  // modes' sums are overwritten by their owners' in the gather.
-  if (m.slab && m.pending > 0) m.gathered = false;
-  for (int i = 0; i < m.pending; ++i) bank_.kick(std::span<const double>(m.kick_data(i), 2 * m.nc), m.kick_h[i]);
+  for (int i = 0; i < m.pending; ++i) bank_.kick(std::span<const double>(m.kick_data(i), 2 * m.modes), m.kick_h[i]);
   m.pending = 0;
-  m.gather_modes(bank_);
   // Base::modes() settles before handing out the state to be changed: the
   // staged spectra may not outlive that.
   m.staged = false;
@@ -431,16 +415,21 @@ void SpectralSea::set_surface(std::span<const double> eta, std::span<const doubl
   m.pending = 0;  // the state is replaced: deferred kicks are void
   m.staged = false;
   m.staged_vy = false;
+  // The whole transform on every rank; each keeps the bank's modes.
   auto copy_in = [&](std::span<const double> f, std::span<double> a) {
     m.forward(f, m.spec);
     const double* s = reinterpret_cast<const double*>(m.spec);
     const double inv_n = 1.0 / static_cast<double>(m.n);
-    for (std::size_t i = 0; i < 2 * m.nc; ++i) a[i] = s[i] * inv_n;
-    a[0] = a[1] = 0.0;  // zero mean
+    m.for_own_modes([&](std::size_t first, std::size_t last, std::size_t mode) {
+      for (std::size_t c = first, j = mode; c < last; ++c, ++j) {
+        a[2 * j] = s[2 * c] * inv_n;
+        a[2 * j + 1] = s[2 * c + 1] * inv_n;
+      }
+    });
+    if (m.columns.begin == 0 && m.modes > 0) a[0] = a[1] = 0.0;  // zero mean (mode 0, if this rank holds it)
   };
   copy_in(eta, bank_.q());
   copy_in(eta_t, bank_.v());
-  m.gathered = true;  // the whole transform, on every rank
   invalidate();
 }
 
@@ -453,10 +442,11 @@ void SpectralSea::flow(double dt) {
       kicks[i] = {m.kick_data(i), m.kick_h[i]};
     const std::span<const ModalBank::Kick> pending(kicks.data(), static_cast<std::size_t>(m.pending));
     if (m.slab) {
-      m.for_own_modes([&](std::size_t begin, std::size_t end) {
-        bank_.kick_flow(pending, dt, reinterpret_cast<double*>(m.spec), begin, end);
+      // Row by row: the bank's modes [mode, mode + last - first) are the
+      // spectrum's [first, last), so q_out is spec shifted by first - mode (>= 0).
+      m.for_own_modes([&](std::size_t first, std::size_t last, std::size_t mode) {
+        bank_.kick_flow(pending, dt, reinterpret_cast<double*>(m.spec + (first - mode)), mode, mode + (last - first));
       });
-      m.gathered = false;
     } else {
       bank_.kick_flow(pending, dt, reinterpret_cast<double*>(m.spec));
     }
@@ -499,7 +489,7 @@ void SpectralSea::midpoint_step(std::span<const double> p, double h) {
 
 void SpectralSea::project(std::span<const double> pressure, std::span<double> s) {
   Impl& m = *impl_;
-  FLOESIM_ASSERT(pressure.size() == m.n && s.size() == 2 * m.nc);
+  FLOESIM_ASSERT(!m.slab &&pressure.size() == m.n && s.size() == 2 * m.nc);
   m.forward(pressure, m.spec);
   m.staged = false;
   const double* f = reinterpret_cast<const double*>(m.spec);
@@ -508,10 +498,133 @@ void SpectralSea::project(std::span<const double> pressure, std::span<double> s)
 
 void SpectralSea::synthesize(std::span<const double> q, std::span<double> eta) {
   Impl& m = *impl_;
-  FLOESIM_ASSERT(q.size() == 2 * m.nc && eta.size() == m.n);
+  FLOESIM_ASSERT(!m.slab &&q.size() == 2 * m.nc && eta.size() == m.n);
   std::copy(q.begin(), q.end(), reinterpret_cast<double*>(m.spec));
   m.staged = false;
   m.backward(eta, m.spec);
+}
+
+std::size_t SpectralSea::modal_size() const { return 2 * impl_->nc; }
+
+void SpectralSea::gather_modal_state(std::vector<double>& q, std::vector<double>& v) {
+  Impl& m = *impl_;
+  if (!m.slab) return Sea::gather_modal_state(q, v);
+  settle();
+  // Each rank's q then v (its modes, row by row) to rank 0 alone, which puts
+  // them at their place in the whole bank's layout.
+  const auto size = static_cast<std::size_t>(m.ranks.ranks);
+  const auto rank = static_cast<std::size_t>(m.ranks.rank);
+  auto part_bytes = [&](int r) { return 2 * 2 * sizeof(double) * static_cast<std::size_t>(m.ny) * m.width_of(r); };
+  std::vector<std::size_t> send_counts(size, 0), receive_counts(size, 0);
+  std::vector<std::byte> send, receive;
+  if (rank != 0) {
+    send_counts[0] = part_bytes(m.ranks.rank);
+    send.resize(send_counts[0]);
+    const std::size_t half = send.size() / 2;
+    if (half > 0) {
+      std::memcpy(send.data(), bank_.q().data(), half);
+      std::memcpy(send.data() + half, bank_.v().data(), half);
+    }
+  } else {
+    std::size_t total = 0;
+    for (std::size_t r = 1; r < size; ++r) total += receive_counts[r] = part_bytes(static_cast<int>(r));
+    receive.resize(total);
+  }
+  m.ranks.alltoall(send, send_counts, receive, receive_counts);
+  q.clear();
+  v.clear();
+  if (rank != 0) return;
+  q.assign(2 * m.nc, 0.0);
+  v.assign(2 * m.nc, 0.0);
+  const std::byte* at = receive.data();
+  for (int r = 0; r < m.ranks.ranks; ++r) {
+    const SlabFft2d::Span cols = m.slab->columns_of(r);
+    const std::size_t width = m.width_of(r), values = 2 * width * static_cast<std::size_t>(m.ny);
+    const double* from_q = r == 0 ? bank_.q().data() : reinterpret_cast<const double*>(at);
+    const double* from_v = r == 0 ? bank_.v().data() : from_q + values;
+    for (int iy = 0; iy < m.ny; ++iy) {
+      const std::size_t to = 2 * (static_cast<std::size_t>(iy) * m.hx + static_cast<std::size_t>(cols.begin));
+      const std::size_t from = 2 * static_cast<std::size_t>(iy) * width;
+      std::copy(from_q + from, from_q + from + 2 * width, q.begin() + static_cast<std::ptrdiff_t>(to));
+      std::copy(from_v + from, from_v + from + 2 * width, v.begin() + static_cast<std::ptrdiff_t>(to));
+    }
+    if (r != 0) at += part_bytes(r);
+  }
+}
+
+void SpectralSea::set_modal_state(std::span<const double> q, std::span<const double> v) {
+  Impl& m = *impl_;
+  if (!m.slab) return Sea::set_modal_state(q, v);
+  FLOESIM_ASSERT(q.size() == 2 * m.nc && v.size() == 2 * m.nc);
+  settle();  // the state is replaced: the deferred kicks are applied, then overwritten
+  m.for_own_modes([&](std::size_t first, std::size_t last, std::size_t mode) {
+    std::copy(q.begin() + static_cast<std::ptrdiff_t>(2 * first), q.begin() + static_cast<std::ptrdiff_t>(2 * last),
+              bank_.q().begin() + static_cast<std::ptrdiff_t>(2 * mode));
+    std::copy(v.begin() + static_cast<std::ptrdiff_t>(2 * first), v.begin() + static_cast<std::ptrdiff_t>(2 * last),
+              bank_.v().begin() + static_cast<std::ptrdiff_t>(2 * mode));
+  });
+  invalidate();
+}
+
+SeaEnergy SpectralSea::bank_energy() {
+  Impl& m = *impl_;
+  if (!m.slab) return Sea::bank_energy();
+  // Each mode's terms to rank 0, which sums them in the whole bank's order
+  // (row by row, each row's columns in rank order): ModalBank::kinetic() and
+  // potential() of the whole bank, to the bit. Then its two sums to every rank.
+  const auto size = static_cast<std::size_t>(m.ranks.ranks);
+  const auto rank = static_cast<std::size_t>(m.ranks.rank);
+  std::vector<double> own(2 * m.modes);
+  bank_.energy_terms(std::span<double>(own.data(), m.modes), std::span<double>(own.data() + m.modes, m.modes));
+  std::vector<std::size_t> send_counts(size, 0), receive_counts(size, 0);
+  std::vector<double> receive;
+  if (rank != 0) {
+    send_counts[0] = sizeof(double) * own.size();
+  } else {
+    std::size_t total = 0;
+    for (std::size_t r = 1; r < size; ++r) {
+      receive_counts[r] = 2 * sizeof(double) * static_cast<std::size_t>(m.ny) * m.width_of(static_cast<int>(r));
+      total += receive_counts[r] / sizeof(double);
+    }
+    receive.resize(total);
+  }
+  const std::span<const double> send = rank != 0 ? std::span<const double>(own) : std::span<const double>();
+  m.ranks.alltoall(std::as_bytes(send), send_counts, std::as_writable_bytes(std::span<double>(receive)), receive_counts);
+  std::array<double, 2> sums{0.0, 0.0};
+  if (rank == 0) {
+    std::vector<const double*> parts(size);
+    parts[0] = own.data();
+    const double* at = receive.data();
+    for (std::size_t r = 1; r < size; ++r) {
+      parts[r] = at;
+      at += 2 * static_cast<std::size_t>(m.ny) * m.width_of(static_cast<int>(r));
+    }
+    for (int iy = 0; iy < m.ny; ++iy)
+      for (std::size_t r = 0; r < size; ++r) {
+        const std::size_t width = m.width_of(static_cast<int>(r)), modes = width * static_cast<std::size_t>(m.ny);
+        const double* kinetic = parts[r] + static_cast<std::size_t>(iy) * width;
+        const double* potential = kinetic + modes;
+        for (std::size_t k = 0; k < width; ++k) {
+          sums[0] += kinetic[k];
+          sums[1] += potential[k];
+        }
+      }
+  }
+  std::vector<std::size_t> counts(size, 0);
+  counts[0] = sizeof(sums);
+  m.ranks.allgather(std::as_writable_bytes(std::span<double>(sums)), counts);
+  return {0.5 * sums[0], 0.5 * sums[1]};
+}
+
+SpectralSea::Memory SpectralSea::memory() const {
+  const Impl& m = *impl_;
+  Memory r;
+  r.modes = bank_.modes();
+  r.mode_bytes = bank_.mode_bytes() + sizeof(double) * (m.kx.size() + m.ky.size() + m.phi.size()) +
+                 m.kick_spec.size() * sizeof(fftw_complex) * m.kick_capacity;
+  r.grid_bytes = sizeof(double) * m.n + sizeof(fftw_complex) * m.nc * (m.spec_vy ? 2 : 1) +
+                 sizeof(double) * (m.tank_eta.size() + m.tank_rate.size());
+  return r;
 }
 
 void SpectralSea::compute_field(Field f, std::span<double> out) {
