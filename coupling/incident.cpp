@@ -90,24 +90,22 @@ void IncidentSea::restore(const IncidentState& s) {
 }
 
 ModalState save_modal(fluid::Sea& sea) {
-  const fluid::ModalBank& bank = sea.modes();  // every deferred kick applied
   ModalState m;
   m.present = true;
   m.time = sea.time();
-  m.q.assign(bank.q().begin(), bank.q().end());
-  m.v.assign(bank.v().begin(), bank.v().end());
+  // Every deferred kick applied; in slabs collective, and q, v on rank 0
+  // only (the writer: the other ranks' saved state is not written).
+  sea.gather_modal_state(m.q, m.v);
   const std::span<const double> held = sea.held_pressure();
   m.held_pressure.assign(held.begin(), held.end());
   return m;
 }
 
 void restore_modal(fluid::Sea& sea, const ModalState& m, const std::string& what) {
-  fluid::ModalBank& bank = sea.modes();
-  if (!m.present || m.q.size() != bank.q().size() || m.v.size() != bank.v().size())
+  if (!m.present || m.q.size() != sea.modal_size() || m.v.size() != sea.modal_size())
     throw InputError("checkpoint: the modal state of " + what + " has " + std::to_string(m.q.size()) +
-                     " amplitudes, this run's sea has " + std::to_string(bank.q().size()));
-  std::copy(m.q.begin(), m.q.end(), bank.q().begin());
-  std::copy(m.v.begin(), m.v.end(), bank.v().begin());
+                     " amplitudes, this run's sea has " + std::to_string(sea.modal_size()));
+  sea.set_modal_state(m.q, m.v);  // in slabs each rank keeps its modes
   sea.set_time(m.time);
   if (!m.held_pressure.empty()) {
     if (!sea.has_static_part() || m.held_pressure.size() != sea.grid().size())

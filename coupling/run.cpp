@@ -55,12 +55,19 @@ RunSummary run_simulation(Simulation& sim, const RunOptions& options) {
   }
   // The state at the last record (a run error leaves the present state
   // half-stepped: that one is the checkpoint then), and the checkpoints.
+  // save() is collective (a sea in slabs gathers its modes to rank 0); only
+  // the writer keeps what it saved, the other ranks its step count.
   Checkpoint good;
   bool have_good = false;
+  long long good_steps = -1;
   auto take_good = [&] {
-    good = sim.save();
-    good.next_record = static_cast<long long>(next);
-    if (writer) writer->count_into(good);
+    Checkpoint saved = sim.save();
+    good_steps = saved.steps;
+    if (writer) {
+      good = std::move(saved);
+      good.next_record = static_cast<long long>(next);
+      writer->count_into(good);
+    }
     have_good = true;
   };
   auto next_checkpoint_after = [&](double t) -> double {
@@ -73,7 +80,7 @@ RunSummary run_simulation(Simulation& sim, const RunOptions& options) {
   std::size_t checkpoint_steps = static_cast<std::size_t>(-1);  // steps() at the last checkpoint
   auto checkpoint = [&] {
     PhaseTimer _(sim.profile(), Phase::record);
-    if (!(have_good && good.steps == static_cast<long long>(sim.steps()))) take_good();
+    if (!(have_good && good_steps == static_cast<long long>(sim.steps()))) take_good();
     if (writer) writer->write_checkpoint(good);
     checkpoint_steps = sim.steps();
     summary.checkpoint_time = sim.time();

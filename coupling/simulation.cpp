@@ -103,11 +103,11 @@ Simulation::Simulation(Scenario scenario, parallel::Communicator comm)
   sea_options.tank = {c.sea.tank.enabled, c.sea.tank.generation_length, c.sea.tank.absorption_length,
                       c.sea.tank.rate, c.sea.tank.ramp_periods};
   sea_options.threads = resolve_threads(c.run.threads);
-  // The incident waves' sea (below) stays whole on every rank.
-  const fluid::SeaOptions incident_options = sea_options;
   // On several ranks the spectral sea runs in slabs (docs/parallel.md, stage
   // four) with the explicit kicks; the implicit step and a tank keep it
-  // whole on every rank.
+  // whole on every rank. The incident waves' sea (below) runs in slabs
+  // alike (stage six: each rank holds its modes; its fields are gathered
+  // whole).
   if (!comm_.serial() && c.sea.model == SeaModel::spectral && c.sea.dims == 2 && !c.sea.tank.enabled &&
       c.coupling.integrator == CouplingIntegrator::explicit_kicks) {
     const parallel::Communicator ranks = comm_;
@@ -121,6 +121,7 @@ Simulation::Simulation(Scenario scenario, parallel::Communicator comm)
       ranks.allgather_in_place(all, counts);
     };
   }
+  const fluid::SeaOptions incident_options = sea_options;
   try {
     sea_ = fluid::make_sea(c.sea, c.run.seed, sea_options);  // its input errors name the [sea] key; add the file
   } catch (const InputError& e) {

@@ -181,16 +181,20 @@ void ModalBank::midpoint_response(std::span<const double> s, double h, std::span
 
 namespace {
 
+// Mode j's term of 1/2 sum_j weight_j |a_j|^2 (before the 1/2): its components' squares summed from 0.
+double weighted_norm2_term(const double* a, double weight, std::size_t components) {
+  double a2 = 0.0;
+  for (std::size_t c = 0; c < components; ++c) a2 += a[c] * a[c];
+  return weight * a2;
+}
+
 // 1/2 sum_j weight_j |a_j|^2 over the components of each mode.
 double half_weighted_norm2(std::span<const double> a, std::span<const double> weight, int components,
                            bool square_omega, std::span<const double> omega) {
   const auto m = static_cast<std::size_t>(components);
   double e = 0.0;
-  for (std::size_t j = 0; j < weight.size(); ++j) {
-    double a2 = 0.0;
-    for (std::size_t c = 0; c < m; ++c) a2 += a[j * m + c] * a[j * m + c];
-    e += (square_omega ? weight[j] * omega[j] * omega[j] : weight[j]) * a2;
-  }
+  for (std::size_t j = 0; j < weight.size(); ++j)
+    e += weighted_norm2_term(&a[j * m], square_omega ? weight[j] * omega[j] * omega[j] : weight[j], m);
   return 0.5 * e;
 }
 
@@ -202,6 +206,25 @@ double ModalBank::kinetic() const {
 
 double ModalBank::potential() const {
   return half_weighted_norm2(q_, mass_, components_, true, omega_);
+}
+
+void ModalBank::energy_terms(std::span<double> kinetic, std::span<double> potential) const {
+  FLOESIM_ASSERT(kinetic.size() == omega_.size() && potential.size() == omega_.size());
+  const auto m = static_cast<std::size_t>(components_);
+  for (std::size_t j = 0; j < omega_.size(); ++j) {
+    kinetic[j] = weighted_norm2_term(&v_[j * m], mass_[j], m);
+    potential[j] = weighted_norm2_term(&q_[j * m], mass_[j] * omega_[j] * omega_[j], m);
+  }
+}
+
+std::size_t ModalBank::mode_bytes() const {
+  return sizeof(double) * (omega_.size() + mass_.size() + gain_.size() + q_.size() + v_.size() + c_.size() +
+                           sw_.size() + ws_.size()) +
+         sizeof(std::uint32_t) * level_.size();
+}
+
+std::size_t ModalBank::frequency_bytes() const {
+  return sizeof(double) * (distinct_.size() + dc_.size() + dsw_.size() + dws_.size());
 }
 
 }  // namespace floesim::fluid

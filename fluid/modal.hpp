@@ -87,6 +87,14 @@ public:
 
   double kinetic() const;
   double potential() const;
+  // Each mode's term of the sums kinetic() and potential() (before the 1/2),
+  // in mode order: kinetic() == 0.5 * (0 + k_0 + k_1 + ...) to the bit, so a
+  // bank split between ranks can sum its modes in the whole bank's order.
+  void energy_terms(std::span<double> kinetic, std::span<double> potential) const;
+  // Bytes of the arrays indexed by mode (state, parameters, rotation cache),
+  // and of those indexed by distinct frequency.
+  std::size_t mode_bytes() const;
+  std::size_t frequency_bytes() const;
 
 private:
   void prepare(double dt);

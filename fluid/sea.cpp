@@ -1,5 +1,6 @@
 #include "fluid/sea.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
@@ -57,6 +58,19 @@ void Sea::hold_pressure(std::span<const double> p) {
   project(p, modal_a_);
   hold(p, modal_a_);
   invalidate();
+}
+
+void Sea::gather_modal_state(std::vector<double>& q, std::vector<double>& v) {
+  settle();
+  q.assign(bank_.q().begin(), bank_.q().end());
+  v.assign(bank_.v().begin(), bank_.v().end());
+}
+
+void Sea::set_modal_state(std::span<const double> q, std::span<const double> v) {
+  ModalBank& bank = modes();
+  FLOESIM_ASSERT(q.size() == bank.q().size() && v.size() == bank.v().size());
+  std::copy(q.begin(), q.end(), bank.q().begin());
+  std::copy(v.begin(), v.end(), bank.v().begin());
 }
 
 void Sea::invalidate_rates() {

@@ -145,17 +145,31 @@ public:
   std::span<const double> field(Field f);
   std::span<const double> elevation() { return field(Field::elevation); }
   SurfaceSample sample(double x, double y = 0.0);
+  // Collective in slabs (the modes' terms are summed in the whole bank's
+  // order on rank 0, whose sums every rank receives).
   SeaEnergy energy() {
     settle();
-    return {bank_.kinetic(), bank_.potential() + static_potential()};
+    SeaEnergy e = bank_energy();
+    e.potential += static_potential();
+    return e;
   }
 
-  // The modal state (settled: every kick applied).
+  // The modal state (settled: every kick applied). In slabs (spectral.hpp)
+  // this rank's modes only: its columns of the half spectrum, row by row.
   ModalBank& modes() {
     settle();
     invalidate();
     return bank_;
   }
+  // The whole modal state in the whole bank's layout, for checkpoints:
+  // modal_size() amplitudes q and as many rates v (settled). In slabs,
+  // collective: every rank's modes are gathered to rank 0, which alone
+  // receives them (q and v are left empty on the other ranks).
+  virtual std::size_t modal_size() const { return bank_.q().size(); }
+  virtual void gather_modal_state(std::vector<double>& q, std::vector<double>& v);
+  // Replaces the modal state by a whole one (modal_size() values each, on
+  // every rank; in slabs each rank keeps its modes).
+  virtual void set_modal_state(std::span<const double> q, std::span<const double> v);
 
 protected:
   explicit Sea(const SurfaceGrid& grid);
@@ -174,6 +188,8 @@ protected:
   virtual void add_static_response(std::span<const double> /*pressure*/, std::span<const double> /*s*/,
                                    std::span<double> /*eta*/) {}
   virtual double static_potential() const { return 0.0; }
+  // The bank's energies (kinetic, potential without the static part).
+  virtual SeaEnergy bank_energy() { return {bank_.kinetic(), bank_.potential()}; }
   void invalidate() { valid_.fill(false); }
   // The rows the field being computed must hold (set_field_halo).
   int field_halo() const { return field_halo_; }

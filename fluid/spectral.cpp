@@ -9,9 +9,7 @@
 #include <optional>
 
 #include "core/error.hpp"
-#include "fluid/fft2d.hpp"
-#include "fluid/slab_fft.hpp"
-#include "fluid/waves.hpp"
+#include "fluid/spectral_impl.hpp"
 
 namespace floesim::fluid {
 
@@ -30,257 +28,6 @@ SurfaceGrid periodic_grid(const SeaParams& p) {
 
 }  // namespace
 
-struct SpectralSea::Impl {
-  int nx = 0, ny = 1, hx = 0;
-  std::size_t n = 0, nc = 0;
-  Dispersion disp;
-  double lx = 0.0, ly = 0.0;
-  // Per mode: derivative wavenumbers (0 on the Nyquist line of that axis, where
-  // an odd derivative of a real field is not representable) and the factor
-  // coth(|k| H) / |k| that maps eta' to the surface potential phi.
-  std::vector<double> kx, ky, phi;
-  double* real = nullptr;         // n reals, scratch
-  fftw_complex* spec = nullptr;   // nc complex, scratch
-  // dims = 2: the y-velocity's spectrum, made in the same pass over the modes
-  // as the x-velocity's (staged_vy) and used by the next velocity_y query.
-  fftw_complex* spec_vy = nullptr;
-  bool staged_vy = false;
-  fftw_plan r2c = nullptr, c2r = nullptr;  // dims = 1
-  std::unique_ptr<RealFft2d> fft2;         // dims = 2: the same bits on any number of threads
-  int threads = 1;
-  // Deferred kicks: up to two (spectrum, h), applied fused with the next flow,
-  // in order. kick_spec holds the FFTs of up to two pressures; pending kick i
-  // uses kick_spec[kick_buf[i]] (a repeated kick uses the buffer of the last
-  // one again). `staged`: spec holds the current q (written by that flow), so
-  // the elevation needs no copy before its c2r.
-  std::array<fftw_complex*, 2> kick_spec{nullptr, nullptr};
-  std::array<int, 2> kick_buf{0, 0};
-  std::array<double, 2> kick_h{0.0, 0.0};
-  int pending = 0;
-  int last = -1;  // buffer holding the FFT of the last kick's pressure (-1: none yet)
-  const double* kick_data(int i) const { return reinterpret_cast<const double*>(kick_spec[kick_buf[i]]); }
-  bool staged = false;
-  std::optional<TankZones> tank;
-  AlignedVector tank_eta, tank_rate;
-  // The sea in slabs (ranks.distributed(); spectral.hpp): this rank's rows
-  // of the fields and columns of the modes. `gathered`: every rank's bank
-  // holds every mode's present state (else only its own columns' are).
-  SeaRanks ranks;
-  std::unique_ptr<SlabFft2d> slab;
-  SlabFft2d::Span rows, columns;
-  bool gathered = true;
-  std::vector<std::size_t> row_bytes, mode_bytes;  // each rank's part of a field and of the bank (q and v)
-  std::vector<std::byte> modes_buffer;
-  struct Halo {
-    int rows = -1;                                    // the halo the lists are for
-    std::vector<std::vector<int>> send, receive;      // per rank: the rows sent to it, received from it
-    std::vector<std::byte> out, in;
-  } halo_exchange;
-
-  // f(first, last) for each range of this rank's modes (its columns of each
-  // row of the half spectrum); every mode when not in slabs.
-  template <class F>
-  void for_own_modes(F&& f) const {
-    if (!slab) return f(std::size_t{0}, nc);
-    for (int iy = 0; iy < ny; ++iy) {
-      const std::size_t row = static_cast<std::size_t>(iy) * hx;
-      f(row + columns.begin, row + columns.end);
-    }
-  }
-
-  ~Impl() {
-    if (r2c) fftw_destroy_plan(r2c);
-    if (c2r) fftw_destroy_plan(c2r);
-    fftw_free(real);
-    fftw_free(spec);
-    fftw_free(spec_vy);
-    for (auto* k : kick_spec) fftw_free(k);
-  }
-
-  bool aligned(const double* p) const {
-    return fftw_alignment_of(const_cast<double*>(p)) == fftw_alignment_of(real);
-  }
-
-  // to <- FFT(field) on this rank's columns (in slabs: reading the
-  // field's rows of this rank only), to a kick buffer.
-  void forward_kick(std::span<const double> field, fftw_complex* to) {
-    if (!slab) return forward(field, to);
-    const double* in = field.data();
-    if (!aligned(in)) {
-      std::copy(field.begin(), field.end(), real);
-      in = real;
-    }
-    slab->forward(in, to, threads);
-  }
-  // to <- FFT(field), every mode on every rank; `to` is spec or a kick buffer (same alignment).
-  void forward(std::span<const double> field, fftw_complex* to) {
-    const double* in = field.data();
-    if (!aligned(in)) {
-      std::copy(field.begin(), field.end(), real);
-      in = real;
-    }
-    // r2c plans preserve their input (FFTW_PRESERVE_INPUT is the default).
-    if (fft2) fft2->forward(in, to, threads);
-    else fftw_execute_dft_r2c(r2c, const_cast<double*>(in), to);
-  }
-  // out <- IFFT(from) (unnormalised; `from`, spec or spec_vy, is destroyed).
-  // In slabs: from this rank's columns of `from` to its rows of out, then
-  // every rank's rows gathered into out, or with halo >= 0 (Sea::
-  // set_field_halo) only the halo's rows exchanged.
-  void backward(std::span<double> out, fftw_complex* from, int halo = -1) {
-    double* to = aligned(out.data()) ? out.data() : real;
-    if (slab) {
-      slab->backward(from, to, threads);
-      const std::size_t begin = static_cast<std::size_t>(rows.begin) * nx, end = static_cast<std::size_t>(rows.end) * nx;
-      if (to == real) std::copy(real + begin, real + end, out.begin() + static_cast<std::ptrdiff_t>(begin));
-      if (halo < 0) ranks.allgather(std::as_writable_bytes(out), row_bytes);
-      else exchange_halo(out, halo);
-      return;
-    }
-    if (fft2) fft2->backward(from, to, threads);
-    else fftw_execute_dft_c2r(c2r, from, to);
-    if (to == real) std::copy(real, real + n, out.begin());
-  }
-  // spec <- (i k)^d factor * a, for a = q or v (d = 0 or 1 via `deriv`); with
-  // `gain`, the deferred kicks are added to a on the way (a = v: the rates as
-  // settle() would leave them, in the same order of operations); with
-  // `deriv_vy`, spec_vy <- i deriv_vy factor * a in the same pass.
-  void load(std::span<const double> a, const std::vector<double>* deriv,
-            const std::vector<double>* factor, std::span<const double> gain = {},
-            const std::vector<double>* deriv_vy = nullptr) {
-    staged = false;
-    staged_vy = deriv_vy != nullptr;
-    const int kicks = gain.empty() ? 0 : pending;
-    if (!deriv && !factor && kicks == 0) {
-      std::copy(a.begin(), a.end(), reinterpret_cast<double*>(spec));
-      return;
-    }
-    for_own_modes([&](std::size_t begin, std::size_t end) {
-      for (std::size_t c = begin; c < end; ++c) {
-        double a0 = a[2 * c], a1 = a[2 * c + 1];
-        for (int i = 0; i < kicks; ++i) {
-          const double g = kick_h[i] * gain[c];
-          const double* s = kick_data(i);
-          a0 += g * s[2 * c];
-          a1 += g * s[2 * c + 1];
-        }
-        double s = 1.0;
-        if (factor) s *= (*factor)[c];
-        const double re = a0 * s, im = a1 * s;
-        if (deriv_vy) {
-          const double k = (*deriv_vy)[c];
-          spec_vy[c][0] = -k * im;
-          spec_vy[c][1] = k * re;
-        }
-        if (deriv) {
-          const double k = (*deriv)[c];
-          spec[c][0] = -k * im;
-          spec[c][1] = k * re;
-        } else {
-          spec[c][0] = re;
-          spec[c][1] = im;
-        }
-      }
-    });
-  }
-
-  // The rows rank r's fields hold beyond its slab for a halo of h rows: the
-  // h rows before its slab and the h after it, the grid's seam crossed, in
-  // that order, without its own rows or repeats; none for an empty slab.
-  std::vector<int> halo_rows(int r, int h) const {
-    const SlabFft2d::Span own = slab->rows_of(r);
-    std::vector<int> list;
-    if (own.begin == own.end) return list;
-    std::vector<std::uint8_t> seen(static_cast<std::size_t>(ny), 0);
-    for (int y = own.begin; y < own.end; ++y) seen[static_cast<std::size_t>(y)] = 1;
-    auto add = [&](int y) {
-      y = ((y % ny) + ny) % ny;
-      if (!seen[static_cast<std::size_t>(y)]) {
-        seen[static_cast<std::size_t>(y)] = 1;
-        list.push_back(y);
-      }
-    };
-    for (int d = h; d >= 1; --d) add(own.begin - d);
-    for (int d = 0; d < h; ++d) add(own.end + d);
-    return list;
-  }
-  // out's rows in this rank's halo of h rows <- their slabs' owners' (one
-  // all-to-all; each side knows what the other sends: the rows of the
-  // receiver's halo_rows that lie in the sender's slab, in that order).
-  void exchange_halo(std::span<double> out, int h) {
-    if (h != halo_exchange.rows) {
-      halo_exchange.rows = h;
-      halo_exchange.send.assign(static_cast<std::size_t>(ranks.ranks), {});
-      halo_exchange.receive.assign(static_cast<std::size_t>(ranks.ranks), {});
-      std::vector<int> owner(static_cast<std::size_t>(ny), 0);
-      for (int r = 0; r < ranks.ranks; ++r)
-        for (int y = slab->rows_of(r).begin; y < slab->rows_of(r).end; ++y) owner[static_cast<std::size_t>(y)] = r;
-      for (int r = 0; r < ranks.ranks; ++r)
-        for (int y : halo_rows(r, h)) {
-          const int from = owner[static_cast<std::size_t>(y)];
-          if (r == ranks.rank) halo_exchange.receive[static_cast<std::size_t>(from)].push_back(y);
-          if (from == ranks.rank) halo_exchange.send[static_cast<std::size_t>(r)].push_back(y);
-        }
-    }
-    const std::size_t row = sizeof(double) * static_cast<std::size_t>(nx);
-    std::vector<std::size_t> send_counts(halo_exchange.send.size()), receive_counts(halo_exchange.receive.size());
-    std::size_t sent = 0, received = 0;
-    for (std::size_t r = 0; r < halo_exchange.send.size(); ++r) {
-      send_counts[r] = halo_exchange.send[r].size() * row;
-      receive_counts[r] = halo_exchange.receive[r].size() * row;
-      sent += send_counts[r];
-      received += receive_counts[r];
-    }
-    halo_exchange.out.resize(sent);
-    halo_exchange.in.resize(received);
-    std::byte* at = halo_exchange.out.data();
-    for (const std::vector<int>& rows_to : halo_exchange.send)
-      for (int y : rows_to) {
-        std::memcpy(at, out.data() + static_cast<std::size_t>(y) * nx, row);
-        at += row;
-      }
-    ranks.alltoall(halo_exchange.out, send_counts, halo_exchange.in, receive_counts);
-    const std::byte* in = halo_exchange.in.data();
-    for (const std::vector<int>& rows_from : halo_exchange.receive)
-      for (int y : rows_from) {
-        std::memcpy(out.data() + static_cast<std::size_t>(y) * nx, in, row);
-        in += row;
-      }
-  }
-
-  // Every rank's columns of the bank (q and v) to every rank: the bank whole
-  // and current everywhere (each rank's modes as that rank stepped them).
-  void gather_modes(ModalBank& bank) {
-    if (!slab || gathered) return;
-    std::size_t offset = 0;
-    for (int r = 0; r < ranks.rank; ++r) offset += mode_bytes[static_cast<std::size_t>(r)];
-    std::size_t total = offset;
-    for (std::size_t r = static_cast<std::size_t>(ranks.rank); r < mode_bytes.size(); ++r) total += mode_bytes[r];
-    modes_buffer.resize(total);
-    // A rank's part: its columns of q, row by row, then of v.
-    auto walk = [&](int rank, std::byte* at, bool pack) {
-      const SlabFft2d::Span cols = slab->columns_of(rank);
-      const std::size_t bytes = 2 * sizeof(double) * static_cast<std::size_t>(cols.end - cols.begin);
-      for (std::span<double> a : {bank.q(), bank.v()})
-        for (int iy = 0; iy < ny; ++iy) {
-          auto* mode = reinterpret_cast<std::byte*>(a.data() + 2 * (static_cast<std::size_t>(iy) * hx + cols.begin));
-          if (bytes > 0) {
-            if (pack) std::memcpy(at, mode, bytes);
-            else std::memcpy(mode, at, bytes);
-          }
-          at += bytes;
-        }
-    };
-    walk(ranks.rank, modes_buffer.data() + offset, true);
-    ranks.allgather(modes_buffer, mode_bytes);
-    std::byte* at = modes_buffer.data();
-    for (int r = 0; r < ranks.ranks; ++r) {
-      if (r != ranks.rank) walk(r, at, false);
-      at += mode_bytes[static_cast<std::size_t>(r)];
-    }
-    gathered = true;
-  }
-};
 
 SpectralSea::SpectralSea(const SeaParams& params, const SeaOptions& options)
     : Sea(periodic_grid(params)), impl_(std::make_unique<Impl>()) {
@@ -297,7 +44,6 @@ SpectralSea::SpectralSea(const SeaParams& params, const SeaOptions& options)
   m.real = fftw_alloc_real(m.n);
   m.spec = fftw_alloc_complex(m.nc);
   if (m.ny > 1) m.spec_vy = fftw_alloc_complex(m.nc);
-  for (auto*& k : m.kick_spec) k = fftw_alloc_complex(m.nc);
   const unsigned flags = options.measure_fft_plans ? FFTW_MEASURE : FFTW_ESTIMATE;
   m.threads = std::max(options.threads, 1);
   bool planned = false;
@@ -316,28 +62,35 @@ SpectralSea::SpectralSea(const SeaParams& params, const SeaOptions& options)
     m.rows = m.slab->rows();
     m.columns = m.slab->columns();
     for (int r = 0; r < m.ranks.ranks; ++r) {
-      const SlabFft2d::Span rows = m.slab->rows_of(r), cols = m.slab->columns_of(r);
+      const SlabFft2d::Span rows = m.slab->rows_of(r);
       m.row_bytes.push_back(sizeof(double) * static_cast<std::size_t>(rows.end - rows.begin) * m.nx);
-      m.mode_bytes.push_back(2 * 2 * sizeof(double) * static_cast<std::size_t>(cols.end - cols.begin) * m.ny);
     }
+  } else {
+    m.columns = {0, m.hx};
   }
+  m.width = static_cast<std::size_t>(m.columns.end - m.columns.begin);
+  m.modes = static_cast<std::size_t>(m.ny) * m.width;
+  // fftw_alloc_complex(0) may return nullptr: a rank without columns holds one.
+  m.kick_capacity = std::max<std::size_t>(m.modes, 1);
+  for (auto*& k : m.kick_spec) k = fftw_alloc_complex(m.kick_capacity);
 
   // Oscillator bank on the normalised coefficients eta_k = FFT(eta) / n, so that
   // a field is the plain c2r of its coefficients. Parseval on the half spectrum:
   // ∫ f g = dA n sum_full f_k conj(g_k), and a coefficient with 0 < ix < nx/2
   // stands for itself and its conjugate (weight 2). A kick receives the
   // unnormalised FFT of p, hence gain = -1 / (mu n).
-  std::vector<double> omega(m.nc), mass(m.nc), gain(m.nc);
-  m.kx.assign(m.nc, 0.0);
-  m.ky.assign(m.nc, 0.0);
-  m.phi.assign(m.nc, 0.0);
+  // In slabs only this rank's modes (Impl::modes).
+  std::vector<double> omega(m.modes), mass(m.modes), gain(m.modes);
+  m.kx.assign(m.modes, 0.0);
+  m.ky.assign(m.modes, 0.0);
+  m.phi.assign(m.modes, 0.0);
   const double da_n = grid_.cell_area() * static_cast<double>(m.n);
   const double inv_n = 1.0 / static_cast<double>(m.n);
   const double two_pi = 2.0 * std::numbers::pi;
   for (int iy = 0; iy < m.ny; ++iy) {
     const int my = iy <= m.ny / 2 ? iy : iy - m.ny;
-    for (int ix = 0; ix < m.hx; ++ix) {
-      const std::size_t c = static_cast<std::size_t>(iy) * m.hx + ix;
+    for (int ix = m.columns.begin; ix < m.columns.end; ++ix) {
+      const std::size_t c = static_cast<std::size_t>(iy) * m.width + static_cast<std::size_t>(ix - m.columns.begin);
       const double kx = two_pi * ix / m.lx;
       const double ky = m.ny > 1 ? two_pi * my / m.ly : 0.0;
       const double k = std::hypot(kx, ky);
@@ -413,12 +166,8 @@ void SpectralSea::repeat_kick(double h) {
 
 void SpectralSea::settle() {
   Impl& m = *impl_;
-  // In slabs the kicks' spectra hold this rank's columns only: the other
-  // modes' sums are overwritten by their owners' in the gather.
-  if (m.slab && m.pending > 0) m.gathered = false;
-  for (int i = 0; i < m.pending; ++i) bank_.kick(std::span<const double>(m.kick_data(i), 2 * m.nc), m.kick_h[i]);
+  for (int i = 0; i < m.pending; ++i) bank_.kick(std::span<const double>(m.kick_data(i), 2 * m.modes), m.kick_h[i]);
   m.pending = 0;
-  m.gather_modes(bank_);
   // Base::modes() settles before handing out the state to be changed: the
   // staged spectra may not outlive that.
   m.staged = false;
@@ -431,16 +180,21 @@ void SpectralSea::set_surface(std::span<const double> eta, std::span<const doubl
   m.pending = 0;  // the state is replaced: deferred kicks are void
   m.staged = false;
   m.staged_vy = false;
+  // The whole transform on every rank; each keeps the bank's modes.
   auto copy_in = [&](std::span<const double> f, std::span<double> a) {
     m.forward(f, m.spec);
     const double* s = reinterpret_cast<const double*>(m.spec);
     const double inv_n = 1.0 / static_cast<double>(m.n);
-    for (std::size_t i = 0; i < 2 * m.nc; ++i) a[i] = s[i] * inv_n;
-    a[0] = a[1] = 0.0;  // zero mean
+    m.for_own_modes([&](std::size_t first, std::size_t last, std::size_t mode) {
+      for (std::size_t c = first, j = mode; c < last; ++c, ++j) {
+        a[2 * j] = s[2 * c] * inv_n;
+        a[2 * j + 1] = s[2 * c + 1] * inv_n;
+      }
+    });
+    if (m.columns.begin == 0 && m.modes > 0) a[0] = a[1] = 0.0;  // zero mean (mode 0, if this rank holds it)
   };
   copy_in(eta, bank_.q());
   copy_in(eta_t, bank_.v());
-  m.gathered = true;  // the whole transform, on every rank
   invalidate();
 }
 
@@ -453,10 +207,11 @@ void SpectralSea::flow(double dt) {
       kicks[i] = {m.kick_data(i), m.kick_h[i]};
     const std::span<const ModalBank::Kick> pending(kicks.data(), static_cast<std::size_t>(m.pending));
     if (m.slab) {
-      m.for_own_modes([&](std::size_t begin, std::size_t end) {
-        bank_.kick_flow(pending, dt, reinterpret_cast<double*>(m.spec), begin, end);
+      // Row by row: the bank's modes [mode, mode + last - first) are the
+      // spectrum's [first, last), so q_out is spec shifted by first - mode (>= 0).
+      m.for_own_modes([&](std::size_t first, std::size_t last, std::size_t mode) {
+        bank_.kick_flow(pending, dt, reinterpret_cast<double*>(m.spec + (first - mode)), mode, mode + (last - first));
       });
-      m.gathered = false;
     } else {
       bank_.kick_flow(pending, dt, reinterpret_cast<double*>(m.spec));
     }
@@ -499,7 +254,7 @@ void SpectralSea::midpoint_step(std::span<const double> p, double h) {
 
 void SpectralSea::project(std::span<const double> pressure, std::span<double> s) {
   Impl& m = *impl_;
-  FLOESIM_ASSERT(pressure.size() == m.n && s.size() == 2 * m.nc);
+  FLOESIM_ASSERT(!m.slab && pressure.size() == m.n && s.size() == 2 * m.nc);
   m.forward(pressure, m.spec);
   m.staged = false;
   const double* f = reinterpret_cast<const double*>(m.spec);
@@ -508,7 +263,7 @@ void SpectralSea::project(std::span<const double> pressure, std::span<double> s)
 
 void SpectralSea::synthesize(std::span<const double> q, std::span<double> eta) {
   Impl& m = *impl_;
-  FLOESIM_ASSERT(q.size() == 2 * m.nc && eta.size() == m.n);
+  FLOESIM_ASSERT(!m.slab && q.size() == 2 * m.nc && eta.size() == m.n);
   std::copy(q.begin(), q.end(), reinterpret_cast<double*>(m.spec));
   m.staged = false;
   m.backward(eta, m.spec);

@@ -26,12 +26,16 @@
 // columns of modes; flow steps those modes only; a field is transformed
 // from them back to this rank's rows, and every rank's rows are then
 // gathered, so fields are whole on every rank; or, with a halo
-// (Sea::set_field_halo, stage five), only the rows within it are exchanged. The bank is whole on every
-// rank but only this rank's columns are current after a flow; settle()
-// (energy(), modes(): collective then) gathers every rank's columns first.
+// (Sea::set_field_halo, stage five), only the rows within it are exchanged.
+// The bank, its per-mode factors and the kick spectra hold this rank's
+// modes only (its columns of each row, row by row: docs/parallel.md, stage
+// six), so modes() is this rank's part; energy() sums every rank's terms in
+// the whole bank's order on rank 0, and gather_modal_state() brings the
+// whole state to rank 0 (both collective, at records and checkpoints).
 // Each mode and each block of the transforms is computed with the serial
 // arithmetic, so the state and the fields are the serial ones to the bit.
-// The whole transforms stay for set_surface, project and synthesize.
+// The whole transforms stay for set_surface (each rank keeps its modes);
+// project and synthesize (the implicit step) are not used in slabs.
 
 #include <memory>
 
@@ -51,6 +55,21 @@ public:
   void set_surface(std::span<const double> eta, std::span<const double> eta_t) override;
   void midpoint_step(std::span<const double> p, double h) override;
   std::vector<int> slab_rows() const override;
+  std::size_t modal_size() const override;
+  void gather_modal_state(std::vector<double>& q, std::vector<double>& v) override;
+  void set_modal_state(std::span<const double> q, std::span<const double> v) override;
+
+  // What this sea allocates: `modes`, the modes its bank holds (every mode
+  // of the half spectrum, or in slabs this rank's columns of each row);
+  // `mode_bytes`, the arrays sized by them (the bank's state, parameters
+  // and rotation cache, the derivative and potential factors, the two kick
+  // spectra); `grid_bytes`, the transforms' whole-grid scratch (and a
+  // tank's fields). Not counted: the fields (Sea), the transposes' buffers,
+  // the bank's per-frequency cache.
+  struct Memory {
+    std::size_t modes = 0, mode_bytes = 0, grid_bytes = 0;
+  };
+  Memory memory() const;
 
   // omega of the Fourier mode with wave vector 2 pi (mx / lx, my / ly).
   double omega(int mx, int my = 0) const;
@@ -62,6 +81,7 @@ protected:
   void settle() override;
   void project(std::span<const double> pressure, std::span<double> s) override;
   void synthesize(std::span<const double> q, std::span<double> eta) override;
+  SeaEnergy bank_energy() override;
 
 private:
   // The tank's relaxation zones over [t0, t0 + h], in physical space.

@@ -1,0 +1,184 @@
+// The spectral sea in slabs over the ranks mpirun started (fluid/spectral.hpp,
+// docs/parallel.md stage six): each rank allocates only its share of the
+// modes, and the sea stays the serial one to the bit.
+//
+// Memory: the bank and every per-mode array hold this rank's columns of each
+// row (ny x its slab's column count) and nothing more: the bytes sized by
+// the modes are the whole sea's times that share, exactly; a regression to
+// whole arrays on any rank fails. The whole-grid scratch does not grow.
+//
+// Answers, against a serial sea (SeaOptions without ranks) stepped alike on
+// every rank: after kicks (pressures with structure in every row), repeated
+// kicks, flows and fields read in between, the energy (summed by rank 0 in
+// the whole bank's order) equals the serial energy on every rank, the whole
+// state gathered to rank 0 equals the serial bank, and the fields (whole,
+// and in a halo of 2 rows: the slab's and the halo's rows) equal the serial
+// fields, all with memcmp; a whole state set on every rank and gathered
+// back is unchanged. Grids with remainder blocks, ranks with empty row
+// slabs, and on 3 ranks a rank with no columns.
+// Run by ctest as mpi.sea_slab_ranks_N under `mpirun --oversubscribe -np N`
+// (N = 1, 2, 3), and serially without MPI.
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <vector>
+
+#include "fluid/spectral.hpp"
+#include "parallel/comm.hpp"
+
+using namespace floesim;
+
+namespace {
+
+fluid::SeaRanks sea_ranks(const parallel::Communicator& comm) {
+  fluid::SeaRanks r;
+  r.rank = comm.rank();
+  r.ranks = comm.size();
+  r.alltoall = [comm](std::span<const std::byte> send, const std::vector<std::size_t>& send_counts,
+                      std::span<std::byte> receive, const std::vector<std::size_t>& receive_counts) {
+    comm.alltoall(send, send_counts, receive, receive_counts);
+  };
+  r.allgather = [comm](std::span<std::byte> all, const std::vector<std::size_t>& counts) {
+    comm.allgather_in_place(all, counts);
+  };
+  return r;
+}
+
+SeaParams params(int nx, int ny) {
+  SeaParams p;
+  p.model = SeaModel::spectral;
+  p.dims = 2;
+  p.size = {8.0 * nx, 10.0 * ny};
+  p.cells = {nx, ny};
+  p.depth = 30.0;
+  p.waves.kind = WaveKind::jonswap;
+  p.waves.hs = 1.0;
+  p.waves.tp = 6.0;
+  p.waves.spreading = 4.0;
+  return p;
+}
+
+template <class T>
+bool same(std::span<const T> a, std::span<const T> b) {
+  return a.size() == b.size() && (a.empty() || std::memcmp(a.data(), b.data(), a.size_bytes()) == 0);
+}
+
+struct Check {
+  int failed = 0;
+  void operator()(bool ok, const char* what, const parallel::Communicator& comm, int nx, int ny) {
+    if (ok) return;
+    ++failed;
+    std::printf("rank %d of %d, %d x %d: %s\n", comm.rank(), comm.size(), nx, ny, what);
+  }
+};
+
+int check_grid(const parallel::Communicator& comm, int nx, int ny) {
+  Check check;
+  const SeaParams p = params(nx, ny);
+  fluid::SeaOptions options;
+  options.ranks = sea_ranks(comm);
+  auto whole_sea = fluid::make_sea(p, 11);
+  auto slab_sea = fluid::make_sea(p, 11, options);
+  auto& whole = dynamic_cast<fluid::SpectralSea&>(*whole_sea);
+  auto& slab = dynamic_cast<fluid::SpectralSea&>(*slab_sea);
+  const std::size_t hx = static_cast<std::size_t>(nx / 2 + 1), nc = hx * static_cast<std::size_t>(ny);
+
+  // Memory: this rank's columns of every row, nothing more.
+  const std::vector<int> rows = slab.slab_rows();
+  std::size_t columns = hx;
+  if (comm.size() > 1) {
+    // The columns this rank's bank holds: its mode count over the rows, and
+    // the shares of all ranks add up to the half spectrum's columns.
+    columns = slab.memory().modes / static_cast<std::size_t>(ny);
+    const long long total = comm.sum(static_cast<long long>(columns));
+    check(total == static_cast<long long>(hx), "the ranks' columns do not add up to the half spectrum's", comm, nx, ny);
+    check(rows.size() == static_cast<std::size_t>(comm.size()) + 1, "no slab rows", comm, nx, ny);
+  }
+  const fluid::SpectralSea::Memory w = whole.memory(), s = slab.memory();
+  check(w.modes == nc, "the whole sea does not hold every mode", comm, nx, ny);
+  check(s.modes == columns * static_cast<std::size_t>(ny) && slab.modes().modes() == s.modes &&
+            slab.modes().q().size() == 2 * s.modes,
+        "the bank does not hold this rank's columns of each row", comm, nx, ny);
+  // (A rank without columns keeps one entry in each kick buffer.)
+  check(w.mode_bytes % nc == 0 && (s.modes > 0 ? s.mode_bytes * nc == w.mode_bytes * s.modes
+                                               : s.mode_bytes <= 2 * 2 * sizeof(double)),
+        "the per-mode arrays are not this rank's share of the whole sea's", comm, nx, ny);
+  check(s.grid_bytes <= w.grid_bytes, "the whole-grid scratch grew", comm, nx, ny);
+  std::printf("rank %d of %d, %d x %d: %zu of %zu modes, %zu of %zu bytes by mode, %zu bytes of grid scratch\n",
+              comm.rank(), comm.size(), nx, ny, s.modes, w.modes, s.mode_bytes, w.mode_bytes, s.grid_bytes);
+
+  // The same steps on both seas: kicks with every row loaded, a repeated
+  // kick, flows, fields read between them (a field settles nothing).
+  const std::size_t n = static_cast<std::size_t>(nx) * static_cast<std::size_t>(ny);
+  std::vector<double> pressure(n);
+  auto compare_fields = [&](int halo, const char* what) {
+    whole.set_field_halo(-1);
+    slab.set_field_halo(halo);
+    for (fluid::Field f : {fluid::Field::elevation, fluid::Field::velocity_x, fluid::Field::velocity_y,
+                           fluid::Field::velocity_z, fluid::Field::slope_x}) {
+      const std::span<const double> a = whole.field(f), b = slab.field(f);
+      if (halo < 0 || comm.size() == 1) {
+        check(same(a, b), what, comm, nx, ny);
+        continue;
+      }
+      const int begin = rows[static_cast<std::size_t>(comm.rank())], end = rows[static_cast<std::size_t>(comm.rank()) + 1];
+      if (begin == end) continue;
+      for (int y = begin - halo; y < end + halo; ++y) {
+        const std::size_t row = static_cast<std::size_t>(((y % ny) + ny) % ny) * static_cast<std::size_t>(nx);
+        check(same(a.subspan(row, static_cast<std::size_t>(nx)), b.subspan(row, static_cast<std::size_t>(nx))), what,
+              comm, nx, ny);
+      }
+    }
+  };
+  for (int step = 0; step < 4; ++step) {
+    for (std::size_t c = 0; c < n; ++c)
+      pressure[c] = 1e3 * std::sin(0.37 * static_cast<double>(c % static_cast<std::size_t>(nx)) + 0.11 * step) *
+                    std::cos(0.23 * static_cast<double>(c / static_cast<std::size_t>(nx)));
+    for (fluid::SpectralSea* sea : {&whole, &slab}) sea->kick(pressure, 0.05);
+    compare_fields(step % 2 == 0 ? -1 : 2, "a field after a kick differs from the serial sea's");
+    for (fluid::SpectralSea* sea : {&whole, &slab}) {
+      sea->repeat_kick(0.05);
+      sea->flow(0.1);
+    }
+    compare_fields(step % 2 == 0 ? 2 : -1, "a field after a flow differs from the serial sea's");
+  }
+  for (fluid::SpectralSea* sea : {&whole, &slab}) sea->kick(pressure, 0.05);  // left deferred
+
+  const fluid::SeaEnergy ew = whole.energy(), es = slab.energy();
+  check(std::memcmp(&ew.kinetic, &es.kinetic, sizeof(double)) == 0 &&
+            std::memcmp(&ew.potential, &es.potential, sizeof(double)) == 0,
+        "the energy differs from the serial sea's", comm, nx, ny);
+  std::vector<double> qw, vw, qs, vs;
+  whole.gather_modal_state(qw, vw);
+  slab.gather_modal_state(qs, vs);
+  if (comm.writer() || comm.size() == 1) {
+    check(same<double>(qw, qs) && same<double>(vw, vs), "the gathered state differs from the serial bank", comm, nx, ny);
+  } else {
+    check(qs.empty() && vs.empty(), "a rank other than 0 received the whole state", comm, nx, ny);
+  }
+  // A whole state set on every rank (a checkpoint's) and gathered back.
+  for (double& x : qw) x *= -0.5;
+  slab.set_modal_state(qw, vw);
+  whole.set_modal_state(qw, vw);
+  slab.gather_modal_state(qs, vs);
+  if (comm.writer()) check(same<double>(qw, qs) && same<double>(vw, vs), "a set state does not gather back", comm, nx, ny);
+  compare_fields(-1, "a field after a set state differs from the serial sea's");
+  return check.failed;
+}
+
+}  // namespace
+
+int main() {
+  parallel::Session session;
+  const parallel::Communicator& comm = session.world();
+  long long failed = 0;
+  // 64 x 48: 33 columns (9 blocks of 4, the last short), 6 row blocks;
+  // 30 x 21: remainder blocks both ways; 40 x 8: one row block, so on 2 and
+  // 3 ranks the other ranks' row slabs are empty; 12 x 8: also only 2
+  // column blocks, so on 3 ranks rank 2 holds no mode and no row.
+  for (auto [nx, ny] : {std::pair{64, 48}, std::pair{30, 21}, std::pair{40, 8}, std::pair{12, 8}})
+    failed += check_grid(comm, nx, ny);
+  failed = comm.sum(failed);
+  if (comm.writer()) std::printf("%s on %d ranks\n", failed == 0 ? "passed" : "FAILED", comm.size());
+  return failed == 0 ? 0 : 1;
+}
