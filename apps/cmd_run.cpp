@@ -6,6 +6,7 @@
 // (docs/parallel.md).
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cerrno>
 #include <csignal>
@@ -103,9 +104,12 @@ public:
     if (!enabled_) return;
     if (p.wall_seconds - last_ < every_ && (p.t < p.t_end || !terminal_)) return;
     last_ = p.wall_seconds;
+    // The share done counts from t = 0; the rate and the time left from
+    // where this run started (a restart goes on from its checkpoint).
     const double frac = p.t_end > 0 ? p.t / p.t_end : 1.0;
-    const double rate = p.wall_seconds > 0 ? static_cast<double>(p.steps) / p.wall_seconds : 0.0;
-    const double eta = frac > 0 ? p.wall_seconds * (1 - frac) / frac : 0.0;
+    const double rate = p.wall_seconds > 0 ? static_cast<double>(p.steps - p.steps_start) / p.wall_seconds : 0.0;
+    const double done = p.t - p.t_start;
+    const double eta = done > 0 ? p.wall_seconds * std::max(0.0, p.t_end - p.t) / done : 0.0;
     std::fprintf(stderr, "%s[%5.1f%%] t = %.6g / %.6g s | %zu steps | %.0f steps/s | ETA %s%s",
                  terminal_ ? "\r" : "floesim: ", 100 * frac, p.t, p.t_end, p.steps, rate, human_time(eta).c_str(),
                  terminal_ ? "   " : "\n");

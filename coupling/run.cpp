@@ -43,6 +43,8 @@ RunSummary run_simulation(Simulation& sim, const RunOptions& options) {
     if (writer) writer->record(sim.time(), sim.floes(), e.values, sim.lcp_counters(), elevation);
   };
   auto wall = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); };
+  const double t_start = sim.time();
+  const std::size_t steps_start = sim.steps();
 
   // Index of the next scheduled record: the first multiple of the interval
   // after the start (a simulation may come here already advanced).
@@ -110,7 +112,7 @@ RunSummary run_simulation(Simulation& sim, const RunOptions& options) {
             writer->record_collisions(collisions);
             writer->record_fracture(events);
           }
-          if (options.progress) options.progress({sim.time(), t_end, sim.steps(), wall()});
+          if (options.progress) options.progress({sim.time(), t_end, sim.steps(), wall(), t_start, steps_start});
         }, [&] { return options.should_stop && options.should_stop(); });
         if (!stop && sim.time() < t_record && sim.time() >= next_checkpoint) comm.together(checkpoint);
       }

@@ -22,7 +22,11 @@ namespace floesim {
 struct RunProgress {
   double t = 0.0, t_end = 0.0;
   std::size_t steps = 0;
-  double wall_seconds = 0.0;
+  double wall_seconds = 0.0;  // since this run_simulation started
+  // Where this run_simulation started (a restart: its checkpoint), so that
+  // rates and the time left count this run's steps only.
+  double t_start = 0.0;
+  std::size_t steps_start = 0;
 };
 
 struct RunOptions {

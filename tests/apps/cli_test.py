@@ -69,6 +69,31 @@ def case_progress_log():
     run("run", "--until", "5", "--log-every", "-1", "-o", "log.h5", expect=2)
 
 
+def case_progress_after_restart():
+    # A restarted run's progress counts its own steps and time: its rate is the
+    # rate of the run it continues (same case, same machine), not the steps
+    # done before the checkpoint over its own short wall time, and its time
+    # left is that of the simulated time left at that rate.
+    def lines_of(p):
+        return [l for l in p.stderr.splitlines() if l.startswith("floesim: [")]
+
+    def rate(line):
+        return float(line.split(" steps | ")[1].split(" steps/s")[0])
+
+    def eta_seconds(line):
+        value, unit = line.split("ETA ")[1].split()[:2]
+        return float(value) * {"s": 1.0, "min": 60.0, "h": 3600.0}[unit]
+
+    first = lines_of(run("run", "--until", "10", "--log-every", "0.2", "-o", "first.h5"))
+    check(len(first) >= 3, f"progress lines of the first run: {first}")
+    continued = lines_of(run("run", "--restart", "first.h5", "--until", "20", "--log-every", "0.2", "-o", "next.h5"))
+    check(len(continued) >= 1, "progress lines of the restarted run")
+    fastest = max(rate(l) for l in first)
+    check(rate(continued[0]) <= 5 * fastest,
+          f"the restart's rate counts its own steps: {continued[0]} against the first run's {fastest:.0f} steps/s")
+    check(eta_seconds(continued[0]) >= 1.0, f"the time left is the rest of the run at this run's rate: {continued[0]}")
+
+
 def case_info_json():
     run("run", EXAMPLE, "-q", "--until", "120", "-o", "a.h5")
     info = json.loads(run("info", "a.h5", "--json").stdout)
