@@ -6,7 +6,6 @@
 #include <cmath>
 #include <cstring>
 #include <numbers>
-#include <optional>
 
 #include "core/error.hpp"
 #include "fluid/spectral_impl.hpp"
@@ -197,19 +196,16 @@ void SpectralSea::set_surface(std::span<const double> eta, std::span<const doubl
   m.pending = 0;  // the state is replaced: deferred kicks are void
   m.staged = false;
   m.staged_vy = false;
-  // The whole transform on every rank; each keeps the bank's modes. In slabs
-  // its whole-grid scratch is made here and freed after (set-up only: this
-  // is the one whole transform of a sea in slabs).
-  std::optional<Impl::WholeScratch> whole;
-  if (m.slab) whole.emplace(m.n, m.nc);
-  double* real = whole ? whole->real : m.real;
-  fftw_complex* spec = whole ? whole->spec : m.spec;
+  // Serially the whole transform. In slabs the slab transform (collective:
+  // every rank sets the surface, at set-up): its rows of the surface to its
+  // columns of the modes, the serial transform's bits.
   auto copy_in = [&](std::span<const double> f, std::span<double> a) {
-    m.forward(f, spec, real);
-    const double* s = reinterpret_cast<const double*>(spec);
+    if (m.slab) m.forward_slab(f, m.spec);
+    else m.forward(f, m.spec, m.real);
+    const double* s = reinterpret_cast<const double*>(m.spec);
     const double inv_n = 1.0 / static_cast<double>(m.n);
-    m.for_own_modes([&](std::size_t first, std::size_t last, std::size_t mode, std::size_t) {
-      for (std::size_t c = first, j = mode; c < last; ++c, ++j) {
+    m.for_own_modes([&](std::size_t first, std::size_t last, std::size_t mode, std::size_t at) {
+      for (std::size_t c = at, j = mode; j < mode + (last - first); ++c, ++j) {
         a[2 * j] = s[2 * c] * inv_n;
         a[2 * j + 1] = s[2 * c + 1] * inv_n;
       }

@@ -35,8 +35,8 @@
 // Each mode and each block of the transforms is computed with the serial
 // arithmetic, so the state and the fields are the serial ones to the bit.
 // The transforms' scratch is this rank's too (its rows of the real side,
-// its columns of the spectra); the one whole transform, set_surface's at
-// set-up, allocates its whole-grid scratch for the call. project and
+// its columns of the spectra); set_surface uses the slab transform as well
+// (collective: every rank sets the surface, at set-up). project and
 // synthesize (the implicit step) are not used in slabs.
 
 #include <memory>

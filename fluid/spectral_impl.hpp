@@ -110,8 +110,8 @@ struct SpectralSea::Impl {
   bool aligned(const double* p) const {
     return fftw_alignment_of(const_cast<double*>(p)) == fftw_alignment_of(real);
   }
-  // The whole transform's scratch, made for one call and freed after: in
-  // slabs set_surface (at set-up) is the only whole transform.
+  // Whole arrays for planning the whole transform of a sea in slabs, freed
+  // after (with FFTW_ESTIMATE the planner does not touch them).
   struct WholeScratch {
     WholeScratch(std::size_t n, std::size_t nc) : real(fftw_alloc_real(n)), spec(fftw_alloc_complex(nc)) {}
     WholeScratch(const WholeScratch&) = delete;
@@ -123,22 +123,25 @@ struct SpectralSea::Impl {
     double* real;
     fftw_complex* spec;
   };
-
-  // to <- FFT(field) on the bank's modes, to a kick buffer. In slabs the
-  // field's rows of this rank only are read, and its columns of the
-  // transform, made in spec_vy (scratch: a kick voids its staging), are
-  // copied to the buffer in the bank's layout.
+  // to <- FFT(field) on the bank's modes, to a kick buffer. In slabs its
+  // columns of the transform, made in spec_vy (scratch: a kick voids its
+  // staging), are copied to the buffer in the bank's layout.
   void forward_kick(std::span<const double> field, fftw_complex* to) {
     if (!slab) return forward(field, to, real);
+    forward_slab(field, spec_vy);
+    for_own_modes([&](std::size_t first, std::size_t stop, std::size_t mode, std::size_t at) {
+      std::copy(spec_vy[at], spec_vy[at] + 2 * (stop - first), to[mode]);
+    });
+  }
+  // In slabs: to (spec or spec_vy, a column slab) <- FFT(field) on this
+  // rank's columns, reading the field's rows of this rank only (collective).
+  void forward_slab(std::span<const double> field, fftw_complex* to) {
     const double* in = field.data() + row_offset();
     if (!aligned(in)) {
       std::copy(in, in + real_size, real);
       in = real;
     }
-    slab->forward(in, spec_vy, threads);
-    for_own_modes([&](std::size_t first, std::size_t stop, std::size_t mode, std::size_t at) {
-      std::copy(spec_vy[at], spec_vy[at] + 2 * (stop - first), to[mode]);
-    });
+    slab->forward(in, to, threads);
   }
   // to <- FFT(field), the whole transform; `to` is spec or a kick buffer (same
   // alignment), `scratch` n reals of that alignment (for a field that has not).
