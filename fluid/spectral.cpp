@@ -201,7 +201,7 @@ void SpectralSea::set_surface(std::span<const double> eta, std::span<const doubl
   // columns of the modes, the serial transform's bits.
   auto copy_in = [&](std::span<const double> f, std::span<double> a) {
     if (m.slab) m.forward_slab(f, m.spec);
-    else m.forward(f, m.spec, m.real);
+    else m.forward(f, m.spec);
     const double* s = reinterpret_cast<const double*>(m.spec);
     const double inv_n = 1.0 / static_cast<double>(m.n);
     m.for_own_modes([&](std::size_t first, std::size_t last, std::size_t mode, std::size_t at) {
@@ -274,7 +274,7 @@ void SpectralSea::midpoint_step(std::span<const double> p, double h) {
 void SpectralSea::project(std::span<const double> pressure, std::span<double> s) {
   Impl& m = *impl_;
   FLOESIM_ASSERT(!m.slab && pressure.size() == m.n && s.size() == 2 * m.nc);
-  m.forward(pressure, m.spec, m.real);
+  m.forward(pressure, m.spec);
   m.staged = false;
   const double* f = reinterpret_cast<const double*>(m.spec);
   std::copy(f, f + 2 * m.nc, s.begin());

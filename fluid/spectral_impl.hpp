@@ -127,7 +127,7 @@ struct SpectralSea::Impl {
   // columns of the transform, made in spec_vy (scratch: a kick voids its
   // staging), are copied to the buffer in the bank's layout.
   void forward_kick(std::span<const double> field, fftw_complex* to) {
-    if (!slab) return forward(field, to, real);
+    if (!slab) return forward(field, to);
     forward_slab(field, spec_vy);
     for_own_modes([&](std::size_t first, std::size_t stop, std::size_t mode, std::size_t at) {
       std::copy(spec_vy[at], spec_vy[at] + 2 * (stop - first), to[mode]);
@@ -143,13 +143,13 @@ struct SpectralSea::Impl {
     }
     slab->forward(in, to, threads);
   }
-  // to <- FFT(field), the whole transform; `to` is spec or a kick buffer (same
-  // alignment), `scratch` n reals of that alignment (for a field that has not).
-  void forward(std::span<const double> field, fftw_complex* to, double* scratch) {
+  // Not in slabs: to <- FFT(field), the whole transform; `to` is spec or a
+  // kick buffer (same alignment).
+  void forward(std::span<const double> field, fftw_complex* to) {
     const double* in = field.data();
     if (!aligned(in)) {
-      std::copy(field.begin(), field.end(), scratch);
-      in = scratch;
+      std::copy(field.begin(), field.end(), real);
+      in = real;
     }
     // r2c plans preserve their input (FFTW_PRESERVE_INPUT is the default).
     if (fft2) fft2->forward(in, to, threads);
