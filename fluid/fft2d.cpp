@@ -60,12 +60,12 @@ void RealFft2d::backward(fftw_complex* in, double* out, int threads) const {
   backward_rows(in, out, 0, row_blocks(), threads);
 }
 
-void RealFft2d::forward_rows(const double* in, fftw_complex* out, int first, int last, int threads) const {
+void RealFft2d::forward_rows(const double* in, fftw_complex* out, int first, int last, int threads, int origin) const {
   for_each_block(last - first, threads, [&](int j) {
     const int r0 = (first + j) * kRows;
     const fftw_plan p = r0 + kRows <= ny_ || ny_ < kRows ? rows_r2c_[0] : rows_r2c_[1];
-    fftw_execute_dft_r2c(p, const_cast<double*>(in) + static_cast<std::ptrdiff_t>(r0) * nx_,
-                         out + static_cast<std::ptrdiff_t>(r0) * hx_);
+    const std::ptrdiff_t row = r0 - origin;
+    fftw_execute_dft_r2c(p, const_cast<double*>(in) + row * nx_, out + row * hx_);
   });
 }
 
@@ -85,11 +85,12 @@ void RealFft2d::backward_columns(fftw_complex* spec, int first, int last, int th
   });
 }
 
-void RealFft2d::backward_rows(fftw_complex* in, double* out, int first, int last, int threads) const {
+void RealFft2d::backward_rows(fftw_complex* in, double* out, int first, int last, int threads, int origin) const {
   for_each_block(last - first, threads, [&](int j) {
     const int r0 = (first + j) * kRows;
     const fftw_plan p = r0 + kRows <= ny_ || ny_ < kRows ? rows_c2r_[0] : rows_c2r_[1];
-    fftw_execute_dft_c2r(p, in + static_cast<std::ptrdiff_t>(r0) * hx_, out + static_cast<std::ptrdiff_t>(r0) * nx_);
+    const std::ptrdiff_t row = r0 - origin;
+    fftw_execute_dft_c2r(p, in + row * hx_, out + row * nx_);
   });
 }
 

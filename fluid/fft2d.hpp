@@ -39,13 +39,15 @@ public:
   // forward_columns on every block; backward = backward_columns then
   // backward_rows. A row block is rows [kRows b, min(kRows (b + 1), ny)) of
   // both arrays, a column block columns [kColumns b, ...) of the half spectrum.
+  // The row passes' arrays may hold rows from `origin` on only (their
+  // pointers are to row `origin`; a slab of rows, fluid/slab_fft.hpp).
   static constexpr int kRows = 8, kColumns = 4;
   int row_blocks() const { return (ny_ + kRows - 1) / kRows; }
   int column_blocks() const { return (hx_ + kColumns - 1) / kColumns; }
-  void forward_rows(const double* in, fftw_complex* out, int first, int last, int threads) const;
+  void forward_rows(const double* in, fftw_complex* out, int first, int last, int threads, int origin = 0) const;
   void forward_columns(fftw_complex* spec, int first, int last, int threads) const;
   void backward_columns(fftw_complex* spec, int first, int last, int threads) const;
-  void backward_rows(fftw_complex* in, double* out, int first, int last, int threads) const;
+  void backward_rows(fftw_complex* in, double* out, int first, int last, int threads, int origin = 0) const;
 
 private:
   int nx_ = 0, ny_ = 0, hx_ = 0;

@@ -6,7 +6,6 @@
 #include <cmath>
 #include <cstring>
 #include <numbers>
-#include <optional>
 
 #include "core/error.hpp"
 #include "fluid/spectral_impl.hpp"
@@ -41,33 +40,50 @@ SpectralSea::SpectralSea(const SeaParams& params, const SeaOptions& options)
   m.lx = grid_.lx;
   m.ly = grid_.ly;
 
-  m.real = fftw_alloc_real(m.n);
-  m.spec = fftw_alloc_complex(m.nc);
-  if (m.ny > 1) m.spec_vy = fftw_alloc_complex(m.nc);
   const unsigned flags = options.measure_fft_plans ? FFTW_MEASURE : FFTW_ESTIMATE;
   m.threads = std::max(options.threads, 1);
+  const bool slabs = m.ny > 1 && options.ranks.distributed() && !options.tank.enabled;
   bool planned = false;
-  if (m.ny > 1) {
-    m.fft2 = std::make_unique<RealFft2d>(m.nx, m.ny, flags, m.real, m.spec);
+  if (slabs) {
+    // The whole transform's plans (the slab transform runs their row
+    // blocks), made on whole arrays freed after planning.
+    {
+      const Impl::WholeScratch whole(m.n, m.nc);
+      m.fft2 = std::make_unique<RealFft2d>(m.nx, m.ny, flags, whole.real, whole.spec);
+    }
     planned = m.fft2->valid();
-  } else {
-    m.r2c = fftw_plan_dft_r2c_1d(m.nx, m.real, m.spec, flags);
-    m.c2r = fftw_plan_dft_c2r_1d(m.nx, m.spec, m.real, flags);
-    planned = m.r2c && m.c2r;
-  }
-  if (!planned) throw RunError("fluid: FFTW could not plan the spectral sea transforms");
-  if (m.fft2 && options.ranks.distributed() && !options.tank.enabled) {
     m.ranks = options.ranks;
-    m.slab = std::make_unique<SlabFft2d>(*m.fft2, m.nx, m.ny, m.ranks.rank, m.ranks.ranks, m.ranks.alltoall);
+    m.slab = std::make_unique<SlabFft2d>(*m.fft2, m.nx, m.ny, m.ranks.rank, m.ranks.ranks, m.ranks.alltoall, flags);
     m.rows = m.slab->rows();
     m.columns = m.slab->columns();
     for (int r = 0; r < m.ranks.ranks; ++r) {
       const SlabFft2d::Span rows = m.slab->rows_of(r);
       m.row_bytes.push_back(sizeof(double) * static_cast<std::size_t>(rows.end - rows.begin) * m.nx);
     }
+    // This rank's rows and column slabs (fftw_alloc_*(0) may return nullptr:
+    // a rank without rows or columns holds one entry).
+    m.real_size = static_cast<std::size_t>(m.rows.end - m.rows.begin) * static_cast<std::size_t>(m.nx);
+    m.spec_size = m.slab->column_size();
+    m.real = fftw_alloc_real(std::max<std::size_t>(m.real_size, 1));
+    m.spec = fftw_alloc_complex(std::max<std::size_t>(m.spec_size, 1));
+    m.spec_vy = fftw_alloc_complex(std::max<std::size_t>(m.spec_size, 1));
   } else {
+    m.real_size = m.n;
+    m.spec_size = m.nc;
+    m.real = fftw_alloc_real(m.n);
+    m.spec = fftw_alloc_complex(m.nc);
+    if (m.ny > 1) m.spec_vy = fftw_alloc_complex(m.nc);
     m.columns = {0, m.hx};
   }
+  if (m.ny > 1 && !slabs) {
+    m.fft2 = std::make_unique<RealFft2d>(m.nx, m.ny, flags, m.real, m.spec);
+    planned = m.fft2->valid();
+  } else if (m.ny == 1) {
+    m.r2c = fftw_plan_dft_r2c_1d(m.nx, m.real, m.spec, flags);
+    m.c2r = fftw_plan_dft_c2r_1d(m.nx, m.spec, m.real, flags);
+    planned = m.r2c && m.c2r;
+  }
+  if (!planned) throw RunError("fluid: FFTW could not plan the spectral sea transforms");
   m.width = static_cast<std::size_t>(m.columns.end - m.columns.begin);
   m.modes = static_cast<std::size_t>(m.ny) * m.width;
   // fftw_alloc_complex(0) may return nullptr: a rank without columns holds one.
@@ -180,13 +196,16 @@ void SpectralSea::set_surface(std::span<const double> eta, std::span<const doubl
   m.pending = 0;  // the state is replaced: deferred kicks are void
   m.staged = false;
   m.staged_vy = false;
-  // The whole transform on every rank; each keeps the bank's modes.
+  // Serially the whole transform. In slabs the slab transform (collective:
+  // every rank sets the surface, at set-up): its rows of the surface to its
+  // columns of the modes, the serial transform's bits.
   auto copy_in = [&](std::span<const double> f, std::span<double> a) {
-    m.forward(f, m.spec);
+    if (m.slab) m.forward_slab(f, m.spec);
+    else m.forward(f, m.spec);
     const double* s = reinterpret_cast<const double*>(m.spec);
     const double inv_n = 1.0 / static_cast<double>(m.n);
-    m.for_own_modes([&](std::size_t first, std::size_t last, std::size_t mode) {
-      for (std::size_t c = first, j = mode; c < last; ++c, ++j) {
+    m.for_own_modes([&](std::size_t first, std::size_t last, std::size_t mode, std::size_t at) {
+      for (std::size_t c = at, j = mode; j < mode + (last - first); ++c, ++j) {
         a[2 * j] = s[2 * c] * inv_n;
         a[2 * j + 1] = s[2 * c + 1] * inv_n;
       }
@@ -207,10 +226,10 @@ void SpectralSea::flow(double dt) {
       kicks[i] = {m.kick_data(i), m.kick_h[i]};
     const std::span<const ModalBank::Kick> pending(kicks.data(), static_cast<std::size_t>(m.pending));
     if (m.slab) {
-      // Row by row: the bank's modes [mode, mode + last - first) are the
-      // spectrum's [first, last), so q_out is spec shifted by first - mode (>= 0).
-      m.for_own_modes([&](std::size_t first, std::size_t last, std::size_t mode) {
-        bank_.kick_flow(pending, dt, reinterpret_cast<double*>(m.spec + (first - mode)), mode, mode + (last - first));
+      // Row by row: the bank's modes [mode, mode + last - first) are spec's
+      // [at, at + last - first), so q_out is spec shifted by at - mode (>= 0).
+      m.for_own_modes([&](std::size_t first, std::size_t last, std::size_t mode, std::size_t at) {
+        bank_.kick_flow(pending, dt, reinterpret_cast<double*>(m.spec + (at - mode)), mode, mode + (last - first));
       });
     } else {
       bank_.kick_flow(pending, dt, reinterpret_cast<double*>(m.spec));

@@ -34,8 +34,10 @@
 // whole state to rank 0 (both collective, at records and checkpoints).
 // Each mode and each block of the transforms is computed with the serial
 // arithmetic, so the state and the fields are the serial ones to the bit.
-// The whole transforms stay for set_surface (each rank keeps its modes);
-// project and synthesize (the implicit step) are not used in slabs.
+// The transforms' scratch is this rank's too (its rows of the real side,
+// its columns of the spectra); set_surface uses the slab transform as well
+// (collective: every rank sets the surface, at set-up). project and
+// synthesize (the implicit step) are not used in slabs.
 
 #include <memory>
 
@@ -63,11 +65,13 @@ public:
   // of the half spectrum, or in slabs this rank's columns of each row);
   // `mode_bytes`, the arrays sized by them (the bank's state, parameters
   // and rotation cache, the derivative and potential factors, the two kick
-  // spectra); `grid_bytes`, the transforms' whole-grid scratch (and a
-  // tank's fields). Not counted: the fields (Sea), the transposes' buffers,
-  // the bank's per-frequency cache.
+  // spectra); `scratch_bytes`, the transforms' scratch: serially the whole
+  // grid's (and a tank's fields), in slabs this rank's rows of the real
+  // side, its column slab of each spectrum, and the slab transform's row
+  // scratch and transposes' buffers. Not counted:
+  // the fields (Sea), the bank's per-frequency cache.
   struct Memory {
-    std::size_t modes = 0, mode_bytes = 0, grid_bytes = 0;
+    std::size_t modes = 0, mode_bytes = 0, scratch_bytes = 0;
   };
   Memory memory() const;
 

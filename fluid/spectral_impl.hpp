@@ -35,11 +35,16 @@ struct SpectralSea::Impl {
   // rank's columns [columns.begin, columns.end) of each row, row by row
   // (ny x width). Mode j of row iy is the spectrum's entry iy hx + columns.begin + j - iy width.
   std::size_t modes = 0, width = 0;
-  double* real = nullptr;         // n reals, scratch
-  fftw_complex* spec = nullptr;   // nc complex, scratch
+  // The transforms' scratch: serially the whole grid (real: n reals; spec,
+  // spec_vy: the half spectrum, nc complex); in slabs this rank's rows of
+  // the real side (real_size reals, from its first row) and its column slab
+  // of each spectrum (spec_size complex, row iy at iy SlabFft2d::stride()).
+  double* real = nullptr;
+  fftw_complex* spec = nullptr;
   // dims = 2: the y-velocity's spectrum, made in the same pass over the modes
   // as the x-velocity's (staged_vy) and used by the next velocity_y query.
   fftw_complex* spec_vy = nullptr;
+  std::size_t real_size = 0, spec_size = 0;
   bool staged_vy = false;
   fftw_plan r2c = nullptr, c2r = nullptr;  // dims = 1
   std::unique_ptr<RealFft2d> fft2;         // dims = 2: the same bits on any number of threads
@@ -72,17 +77,21 @@ struct SpectralSea::Impl {
     std::vector<std::byte> out, in;
   } halo_exchange;
 
-  // f(first, stop, mode) for each range [first, stop) of the half spectrum
-  // the bank holds, `mode` the bank's index of `first`: every mode at once
-  // when not in slabs, else this rank's columns of each row.
+  // f(first, stop, mode, at) for each range [first, stop) of the half
+  // spectrum the bank holds, `mode` the bank's index of `first` and `at` its
+  // index in spec and spec_vy: every mode at once when not in slabs (at =
+  // first), else this rank's columns of each row (at = iy stride).
   template <class F>
   void for_own_modes(F&& f) const {
-    if (!slab) return f(std::size_t{0}, nc, std::size_t{0});
+    if (!slab) return f(std::size_t{0}, nc, std::size_t{0}, std::size_t{0});
+    const auto stride = static_cast<std::size_t>(slab->stride());
     for (int iy = 0; iy < ny; ++iy) {
       const std::size_t row = static_cast<std::size_t>(iy) * hx;
-      f(row + columns.begin, row + columns.end, static_cast<std::size_t>(iy) * width);
+      f(row + columns.begin, row + columns.end, static_cast<std::size_t>(iy) * width, static_cast<std::size_t>(iy) * stride);
     }
   }
+  // The first value of this rank's rows in a whole field (0 when not in slabs).
+  std::size_t row_offset() const { return static_cast<std::size_t>(rows.begin) * static_cast<std::size_t>(nx); }
   // The columns and the bank's mode count of rank r.
   std::size_t width_of(int r) const {
     const SlabFft2d::Span c = slab->columns_of(r);
@@ -101,24 +110,41 @@ struct SpectralSea::Impl {
   bool aligned(const double* p) const {
     return fftw_alignment_of(const_cast<double*>(p)) == fftw_alignment_of(real);
   }
-
-  // to <- FFT(field) on the bank's modes, to a kick buffer. In slabs the
-  // field's rows of this rank only are read, and its columns of the
-  // transform, made in spec_vy (scratch: a kick voids its staging), are
-  // copied to the buffer in the bank's layout.
+  // Whole arrays for planning the whole transform of a sea in slabs, freed
+  // after (with FFTW_ESTIMATE the planner does not touch them).
+  struct WholeScratch {
+    WholeScratch(std::size_t n, std::size_t nc) : real(fftw_alloc_real(n)), spec(fftw_alloc_complex(nc)) {}
+    WholeScratch(const WholeScratch&) = delete;
+    WholeScratch& operator=(const WholeScratch&) = delete;
+    ~WholeScratch() {
+      fftw_free(real);
+      fftw_free(spec);
+    }
+    double* real;
+    fftw_complex* spec;
+  };
+  // to <- FFT(field) on the bank's modes, to a kick buffer. In slabs its
+  // columns of the transform, made in spec_vy (scratch: a kick voids its
+  // staging), are copied to the buffer in the bank's layout.
   void forward_kick(std::span<const double> field, fftw_complex* to) {
     if (!slab) return forward(field, to);
-    const double* in = field.data();
-    if (!aligned(in)) {
-      std::copy(field.begin(), field.end(), real);
-      in = real;
-    }
-    slab->forward(in, spec_vy, threads);
-    for_own_modes([&](std::size_t first, std::size_t stop, std::size_t mode) {
-      std::copy(spec_vy[first], spec_vy[first] + 2 * (stop - first), to[mode]);
+    forward_slab(field, spec_vy);
+    for_own_modes([&](std::size_t first, std::size_t stop, std::size_t mode, std::size_t at) {
+      std::copy(spec_vy[at], spec_vy[at] + 2 * (stop - first), to[mode]);
     });
   }
-  // to <- FFT(field), every mode on every rank; `to` is spec or a kick buffer (same alignment).
+  // In slabs: to (spec or spec_vy, a column slab) <- FFT(field) on this
+  // rank's columns, reading the field's rows of this rank only (collective).
+  void forward_slab(std::span<const double> field, fftw_complex* to) {
+    const double* in = field.data() + row_offset();
+    if (!aligned(in)) {
+      std::copy(in, in + real_size, real);
+      in = real;
+    }
+    slab->forward(in, to, threads);
+  }
+  // Not in slabs: to <- FFT(field), the whole transform; `to` is spec or a
+  // kick buffer (same alignment).
   void forward(std::span<const double> field, fftw_complex* to) {
     const double* in = field.data();
     if (!aligned(in)) {
@@ -134,15 +160,16 @@ struct SpectralSea::Impl {
   // every rank's rows gathered into out, or with halo >= 0 (Sea::
   // set_field_halo) only the halo's rows exchanged.
   void backward(std::span<double> out, fftw_complex* from, int halo = -1) {
-    double* to = aligned(out.data()) ? out.data() : real;
     if (slab) {
+      double* own = out.data() + row_offset();
+      double* to = aligned(own) ? own : real;
       slab->backward(from, to, threads);
-      const std::size_t begin = static_cast<std::size_t>(rows.begin) * nx, end = static_cast<std::size_t>(rows.end) * nx;
-      if (to == real) std::copy(real + begin, real + end, out.begin() + static_cast<std::ptrdiff_t>(begin));
+      if (to == real) std::copy(real, real + real_size, own);
       if (halo < 0) ranks.allgather(std::as_writable_bytes(out), row_bytes);
       else exchange_halo(out, halo);
       return;
     }
+    double* to = aligned(out.data()) ? out.data() : real;
     if (fft2) fft2->backward(from, to, threads);
     else fftw_execute_dft_c2r(c2r, from, to);
     if (to == real) std::copy(real, real + n, out.begin());
@@ -161,8 +188,8 @@ struct SpectralSea::Impl {
       std::copy(a.begin(), a.end(), reinterpret_cast<double*>(spec));
       return;
     }
-    for_own_modes([&](std::size_t first, std::size_t stop, std::size_t mode) {
-      for (std::size_t c = first, j = mode; c < stop; ++c, ++j) {
+    for_own_modes([&](std::size_t first, std::size_t stop, std::size_t mode, std::size_t at) {
+      for (std::size_t c = at, j = mode; j < mode + (stop - first); ++c, ++j) {
         double a0 = a[2 * j], a1 = a[2 * j + 1];
         for (int i = 0; i < kicks; ++i) {
           const double g = kick_h[i] * gain[j];

@@ -65,7 +65,7 @@ void SpectralSea::set_modal_state(std::span<const double> q, std::span<const dou
   if (!m.slab) return Sea::set_modal_state(q, v);
   FLOESIM_ASSERT(q.size() == 2 * m.nc && v.size() == 2 * m.nc);
   settle();  // the state is replaced: the deferred kicks are applied, then overwritten
-  m.for_own_modes([&](std::size_t first, std::size_t last, std::size_t mode) {
+  m.for_own_modes([&](std::size_t first, std::size_t last, std::size_t mode, std::size_t) {
     std::copy(q.begin() + static_cast<std::ptrdiff_t>(2 * first), q.begin() + static_cast<std::ptrdiff_t>(2 * last),
               bank_.q().begin() + static_cast<std::ptrdiff_t>(2 * mode));
     std::copy(v.begin() + static_cast<std::ptrdiff_t>(2 * first), v.begin() + static_cast<std::ptrdiff_t>(2 * last),
@@ -130,8 +130,10 @@ SpectralSea::Memory SpectralSea::memory() const {
   r.modes = bank_.modes();
   r.mode_bytes = bank_.mode_bytes() + sizeof(double) * (m.kx.size() + m.ky.size() + m.phi.size()) +
                  m.kick_spec.size() * sizeof(fftw_complex) * m.kick_capacity;
-  r.grid_bytes = sizeof(double) * m.n + sizeof(fftw_complex) * m.nc * (m.spec_vy ? 2 : 1) +
-                 sizeof(double) * (m.tank_eta.size() + m.tank_rate.size());
+  const std::size_t allocated_real = m.slab ? std::max<std::size_t>(m.real_size, 1) : m.real_size;
+  const std::size_t allocated_spec = m.slab ? std::max<std::size_t>(m.spec_size, 1) : m.spec_size;
+  r.scratch_bytes = sizeof(double) * allocated_real + sizeof(fftw_complex) * allocated_spec * (m.spec_vy ? 2 : 1) +
+                    (m.slab ? m.slab->bytes() : 0) + sizeof(double) * (m.tank_eta.size() + m.tank_rate.size());
   return r;
 }
 

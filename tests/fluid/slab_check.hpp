@@ -57,39 +57,37 @@ struct SlabCheck {
   bool inverse_equal = false;   // the rank's rows of the backward transform
 };
 
-// Rank `rank` of `ranks`'s forward and backward slab transforms of `whole`'s
-// field and spectrum, through `exchange` (every rank must call it together).
-inline SlabCheck check_slab(const WholeTransform& whole, int rank, int ranks, SlabFft2d::Exchange exchange) {
-  const int nx = whole.nx, ny = whole.ny, hx = whole.hx;
-  SlabFft2d slab(whole.fft, nx, ny, rank, ranks, std::move(exchange));
+// One rank's forward and backward slab transforms of `whole`'s field and
+// spectrum (every rank must call it together, through the slab's exchange).
+// The rank holds its rows of the field only (a buffer of its rows) and its
+// columns of the spectrum only (a column slab, SlabFft2d::column_size()).
+inline SlabCheck check_slab(const WholeTransform& whole, SlabFft2d& slab) {
+  const int nx = whole.nx, ny = whole.ny;
   SlabCheck check{slab.rows(), slab.columns()};
-  FftwBuffer<double> in(whole.n), out(whole.n);
-  FftwBuffer<fftw_complex> s(whole.nc);
-  std::fill(in.data, in.data + whole.n, 0.0);
-  for (int y = check.rows.begin; y < check.rows.end; ++y)
-    std::memcpy(in.data + static_cast<std::size_t>(y) * nx, &whole.field[static_cast<std::size_t>(y) * nx],
-                sizeof(double) * static_cast<std::size_t>(nx));
+  const std::size_t rows = static_cast<std::size_t>(check.rows.end - check.rows.begin);
+  const std::size_t values = rows * static_cast<std::size_t>(nx);
+  FftwBuffer<double> in(std::max<std::size_t>(values, 1)), out(std::max<std::size_t>(values, 1));
+  FftwBuffer<fftw_complex> s(std::max<std::size_t>(slab.column_size(), 1));
+  std::memcpy(in.data, whole.field.data() + static_cast<std::size_t>(check.rows.begin) * nx, sizeof(double) * values);
   slab.forward(in.data, s.data, 1);
+  auto at = [&](int y, int x) { return static_cast<std::size_t>(y) * slab.stride() + (x - check.columns.begin); };
   bool equal = true;
   for (int y = 0; y < ny; ++y)
     for (int x = check.columns.begin; x < check.columns.end; ++x) {
-      const std::size_t c = static_cast<std::size_t>(y) * hx + x;
-      equal = equal && std::memcmp(s.data[c], &whole.spectrum[2 * c], sizeof(fftw_complex)) == 0;
+      const std::size_t c = static_cast<std::size_t>(y) * whole.hx + x;
+      equal = equal && std::memcmp(s.data[at(y, x)], &whole.spectrum[2 * c], sizeof(fftw_complex)) == 0;
     }
   check.spectrum_equal = equal;
-  std::fill(reinterpret_cast<double*>(s.data), reinterpret_cast<double*>(s.data) + 2 * whole.nc, 0.0);
+  std::fill(reinterpret_cast<double*>(s.data), reinterpret_cast<double*>(s.data) + 2 * slab.column_size(), 0.0);
   for (int y = 0; y < ny; ++y)
     for (int x = check.columns.begin; x < check.columns.end; ++x) {
-      const std::size_t c = static_cast<std::size_t>(y) * hx + x;
-      s.data[c][0] = whole.spectrum[2 * c];
-      s.data[c][1] = whole.spectrum[2 * c + 1];
+      const std::size_t c = static_cast<std::size_t>(y) * whole.hx + x;
+      s.data[at(y, x)][0] = whole.spectrum[2 * c];
+      s.data[at(y, x)][1] = whole.spectrum[2 * c + 1];
     }
   slab.backward(s.data, out.data, 1);
-  equal = true;
-  for (int y = check.rows.begin; y < check.rows.end; ++y)
-    equal = equal && std::memcmp(out.data + static_cast<std::size_t>(y) * nx, &whole.inverse[static_cast<std::size_t>(y) * nx],
-                                 sizeof(double) * static_cast<std::size_t>(nx)) == 0;
-  check.inverse_equal = equal;
+  check.inverse_equal = values == 0 || std::memcmp(out.data, whole.inverse.data() + static_cast<std::size_t>(check.rows.begin) * nx,
+                                                   sizeof(double) * values) == 0;
   return check;
 }
 

@@ -18,12 +18,12 @@ namespace {
 // Whether this rank's slabs equal the whole transform's bits on an nx x ny grid.
 bool slabs_equal(const parallel::Communicator& comm, int nx, int ny) {
   const fluid::testing::WholeTransform whole(nx, ny);
-  const fluid::testing::SlabCheck check =
-      fluid::testing::check_slab(whole, comm.rank(), comm.size(),
-                                 [&comm](std::span<const std::byte> send, const std::vector<std::size_t>& send_counts,
-                                         std::span<std::byte> receive, const std::vector<std::size_t>& receive_counts) {
-                                   comm.alltoall(send, send_counts, receive, receive_counts);
-                                 });
+  fluid::SlabFft2d slab(whole.fft, nx, ny, comm.rank(), comm.size(),
+                        [&comm](std::span<const std::byte> send, const std::vector<std::size_t>& send_counts,
+                                std::span<std::byte> receive, const std::vector<std::size_t>& receive_counts) {
+                          comm.alltoall(send, send_counts, receive, receive_counts);
+                        });
+  const fluid::testing::SlabCheck check = fluid::testing::check_slab(whole, slab);
   const bool equal = check.spectrum_equal && check.inverse_equal;
   std::printf("rank %d of %d, %d x %d: rows [%d, %d), columns [%d, %d): %s\n", comm.rank(), comm.size(), nx, ny,
               check.rows.begin, check.rows.end, check.columns.begin, check.columns.end,
