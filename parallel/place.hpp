@@ -11,9 +11,10 @@
 // every step: a floe whose centroid crosses a cut "migrates", which costs
 // nothing since every rank holds every floe.
 //
-// Load balance by measured cost: each rank charges the wall time of its
+// Load balance by measured cost: each rank charges the CPU time of its
 // by-place work (its floes' drift, its part of detection: no waits, no
-// copies; CPU time of the thread) to its FloeOwners; every
+// copies; the thread's CPU time, which leaves out other processes' time
+// slices) to its FloeOwners; every
 // StripOptions::rebalance_steps steps the ranks all-gather their charged
 // times and move the cuts toward those that give every strip an equal share
 // of the estimated cost (cut_by_cost), each floe's cost being its owner's
@@ -84,7 +85,7 @@ public:
   // A step redone after an overlap calls it again with the same `step`: no
   // second move.
   void update(const Communicator& comm, const Floes& floes, std::size_t step);
-  // This rank's wall time (s) in by-place work since the last move.
+  // Charges this rank's CPU time (s, thread_seconds()) in by-place work since the last move.
   void charge(double seconds) { charged_ += seconds; }
 
   std::span<const int> owner() const { return owner_; }  // per floe, after assign()
