@@ -4,6 +4,8 @@
 // another, so an element need not be aligned for its type.
 #include <cstddef>
 #include <cstring>
+#include <span>
+#include <vector>
 
 namespace floesim::parallel {
 
@@ -20,6 +22,22 @@ T at(const std::byte* in, std::size_t j) {
   T value;
   std::memcpy(&value, in + j * sizeof(T), sizeof(T));
   return value;
+}
+
+// Appends the bytes of `values` to a message being built.
+template <class T>
+void append(std::vector<std::byte>& out, std::span<const T> values) {
+  const auto* bytes = reinterpret_cast<const std::byte*>(values.data());
+  out.insert(out.end(), bytes, bytes + values.size() * sizeof(T));
+}
+
+// Reads `count` T's from `in` into a vector and moves `in` past them.
+template <class T>
+std::vector<T> take(const std::byte*& in, std::size_t count) {
+  std::vector<T> values(count);
+  if (count > 0) std::memcpy(static_cast<void*>(values.data()), in, count * sizeof(T));
+  in += count * sizeof(T);
+  return values;
 }
 
 }  // namespace floesim::parallel

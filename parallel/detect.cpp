@@ -1,7 +1,8 @@
 #include "parallel/detect.hpp"
 
 #include <cstdint>
-#include <cstring>
+
+#include "parallel/bytes.hpp"
 
 namespace floesim::parallel {
 
@@ -50,45 +51,26 @@ contact::Detection detect_part(const FloeOwners& owners, int rank, const Floes& 
   return contact::detect(floes, shapes, options);
 }
 
-namespace {
-// A rank's part as one message: three counts, then the pairs, contact points
-// and witnesses, each as bytes (copied in and out with memcpy, so the
-// buffer's alignment does not matter).
-template <class T>
-void put(std::vector<std::byte>& out, const std::vector<T>& values) {
-  const auto* bytes = reinterpret_cast<const std::byte*>(values.data());
-  out.insert(out.end(), bytes, bytes + values.size() * sizeof(T));
-}
-
-template <class T>
-std::vector<T> take(const std::byte*& at, std::uint64_t count) {
-  std::vector<T> values(count);
-  std::memcpy(static_cast<void*>(values.data()), at, count * sizeof(T));
-  at += count * sizeof(T);
-  return values;
-}
-}  // namespace
-
 contact::Detection detect(const Communicator& comm, FloeOwners& owners, const Floes& floes,
                           const contact::CollisionShapes& shapes, contact::DetectionOptions options) {
   if (comm.serial()) return contact::detect(floes, shapes, options);
   const double start = thread_seconds();
   contact::Detection mine = detect_part(owners, comm.rank(), floes, shapes, std::move(options));
   owners.charge(thread_seconds() - start);
+  // A rank's part as one message: three counts, then the pairs, contact
+  // points and witnesses.
   const std::uint64_t sizes[3] = {mine.pairs.size(), mine.contacts.size(), mine.witnesses.size()};
-  std::vector<std::byte> message(reinterpret_cast<const std::byte*>(sizes),
-                                 reinterpret_cast<const std::byte*>(sizes) + sizeof(sizes));
-  put(message, mine.pairs);
-  put(message, mine.contacts);
-  put(message, mine.witnesses);
+  std::vector<std::byte> message;
+  append<std::uint64_t>(message, sizes);
+  append<contact::NearPair>(message, mine.pairs);
+  append<contact::ContactPoint>(message, mine.contacts);
+  append<contact::Witness>(message, mine.witnesses);
   std::vector<std::size_t> counts;
   const std::vector<std::byte> all = comm.allgather_bytes(message, counts);
   std::vector<contact::Detection> parts(counts.size());
   const std::byte* at = all.data();
   for (contact::Detection& part : parts) {
-    std::uint64_t n[3];
-    std::memcpy(n, at, sizeof(n));
-    at += sizeof(n);
+    const std::vector<std::uint64_t> n = take<std::uint64_t>(at, 3);
     part.pairs = take<contact::NearPair>(at, n[0]);
     part.contacts = take<contact::ContactPoint>(at, n[1]);
     part.witnesses = take<contact::Witness>(at, n[2]);
