@@ -58,11 +58,16 @@ RunSummary run_simulation(Simulation& sim, const RunOptions& options) {
   // The state at the last record (a run error leaves the present state
   // half-stepped: that one is the checkpoint then), and the checkpoints.
   // save() is collective (a sea in slabs gathers its modes to rank 0); only
-  // the writer keeps what it saved, the other ranks its step count.
+  // the writer keeps what it saved, the other ranks its step count. The old
+  // state is let go before the new one is taken, so that the writer holds one
+  // (on a large sea it is 64 B a cell); a failure while taking it then leaves
+  // no state at a record, and the file keeps its last checkpoint.
   Checkpoint good;
   bool have_good = false;
   long long good_steps = -1;
   auto take_good = [&] {
+    have_good = false;
+    good = Checkpoint{};
     Checkpoint saved = sim.save();
     good_steps = saved.steps;
     if (writer) {
