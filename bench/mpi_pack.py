@@ -48,7 +48,8 @@ work = tempfile.mkdtemp(prefix="floesim_mpi_bench_")
 config = moving_pack.write(floesims[0], work, args.floes, args.t_end, seed=1, output_interval=args.t_end,
                            half=args.half)
 phases = ["drift", "collide", "advance", "detect", "record", "choose_dt", "check"]
-strips = ["strip_cuts", "strip_floes", "strip_seconds", "strip_seconds_total"]
+strips = ["strip_cuts", "strip_floes", "strip_seconds", "strip_seconds_total", "advance_steps", "advance_fallbacks",
+          "advance_clusters"]
 rows = []
 load_before = ranks_bench.load()
 for r in range(args.rounds):
