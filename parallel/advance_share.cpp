@@ -127,7 +127,14 @@ bool combine_parts(std::span<const AdvancePart> parts, Floes& floes, CollisionSt
 void advance_by_owner(const Communicator& comm, std::span<const int> owner, Floes& floes,
                       const contact::CollisionShapes& shapes, const contact::Detection& detection, double dt,
                       const contact::SubstepOptions& options, contact::CollisionStats& stats,
-                      contact::SubstepReport& report, AdvanceShareCounts& counts) {
+                      contact::SubstepReport& report, AdvanceShareCounts& counts,
+                      const AdvanceShareOptions& share_options) {
+  if (counts.wait > 0) {
+    --counts.wait;
+    ++counts.whole;
+    contact::advance_with_collisions(floes, shapes, detection, dt, options, stats, report);
+    return;
+  }
   const std::vector<FloeState> start = floes.state;
   const AdvancePart mine = run_share(floes, shapes, detection, dt, options, owner, comm.rank());
   std::vector<std::size_t> sizes;
@@ -142,10 +149,13 @@ void advance_by_owner(const Communicator& comm, std::span<const int> owner, Floe
   counts.clusters.resize(parts.size(), 0);
   if (combine_parts(parts, floes, stats, report)) {
     for (std::size_t r = 0; r < parts.size(); ++r) counts.clusters[r] += parts[r].outcome.clusters;
+    counts.next_wait = 1;
     return;
   }
   // A conflict: the whole advance from the step's states, as the serial run.
   ++counts.fallbacks;
+  counts.wait = counts.next_wait;
+  counts.next_wait = std::min(2 * counts.next_wait, share_options.max_wait);
   floes.state = start;
   contact::advance_with_collisions(floes, shapes, detection, dt, options, stats, report);
 }

@@ -44,14 +44,31 @@ AdvancePart run_share(Floes& floes, const contact::CollisionShapes& shapes, cons
 bool combine_parts(std::span<const AdvancePart> parts, Floes& floes, contact::CollisionStats& stats,
                    contact::SubstepReport& report);
 
-// How the advances by cluster owner went (the run's summary).
+// A step redone whole costs the share's work and the whole advance; packs
+// where ranks' clusters keep meeting (a jam across strips, a jam whose LCP
+// uses the warm store) would pay it at every step. So after a fallback the
+// next `wait` advances are whole at once (no share, no gather); `wait` is 1
+// after the first fallback and doubles with each fallback in a row, up to
+// max_wait; a combined advance resets it. Every rank sees the same
+// fallbacks, so all agree on the steps they skip (same collective calls).
+// Either way the answer is the serial one.
+struct AdvanceShareOptions {
+  long max_wait = 64;
+};
+
+// How the advances by cluster owner went (the run's summary), and the
+// back-off's state.
 struct AdvanceShareCounts {
   long steps = 0;               // advances tried by owner
   long fallbacks = 0;           // of those, redone whole
+  long whole = 0;               // advances done whole at once by the back-off
   std::vector<long> clusters;   // per rank: clusters it ran (steps not redone)
+  long wait = 0;                // advances still to do whole
+  long next_wait = 1;           // the wait after the next fallback
 };
 
-// The step's advance on every rank of `comm`: this rank's share, one
+// The step's advance on every rank of `comm` (or whole, while the back-off
+// above waits): this rank's share, one
 // exchange (allgather_bytes: two collective calls on every rank, every
 // step), then the combination or, on a conflict, the whole advance
 // (contact::advance_with_collisions) from the states on entry. Equal to the
@@ -59,6 +76,7 @@ struct AdvanceShareCounts {
 void advance_by_owner(const Communicator& comm, std::span<const int> owner, Floes& floes,
                       const contact::CollisionShapes& shapes, const contact::Detection& detection, double dt,
                       const contact::SubstepOptions& options, contact::CollisionStats& stats,
-                      contact::SubstepReport& report, AdvanceShareCounts& counts);
+                      contact::SubstepReport& report, AdvanceShareCounts& counts,
+                      const AdvanceShareOptions& share_options = {});
 
 }  // namespace floesim::parallel

@@ -183,3 +183,40 @@ TEST_CASE("clusters of different ranks that merge, or share a free floe, fall ba
   CHECK(same_stats(stats, serial.stats));
   CHECK(same_report(report, serial.report));
 }
+
+TEST_CASE("a share that would use the warm store falls back, and the next advances are whole for a while") {
+  // One rank (the serial communicator) owning every floe; every LCP starts
+  // from the warm store (warm_min = 0), which a share must not use: each
+  // advance by owner falls back, then waits 1, 2, 4 advances (the back-off,
+  // AdvanceShareOptions), every one equal to the serial advance with its own
+  // warm store (the stores stay alike through the fallbacks).
+  Case c = dense_pack(2.0, 3, 0.5);
+  contact::WarmStart serial_warm, shared_warm;
+  c.options.impulse.warm_min = 0;
+  const parallel::Communicator comm;
+  const std::vector<int> owner(c.floes.size(), 0);
+  parallel::AdvanceShareCounts counts;
+  parallel::AdvanceShareOptions share;
+  share.max_wait = 4;
+  std::vector<long> fallbacks;
+  for (int step = 0; step < 10; ++step) {
+    CAPTURE(step);
+    Floes s = c.floes, f = c.floes;
+    contact::SubstepOptions so = c.options, fo = c.options;
+    so.impulse.warm = &serial_warm;
+    fo.impulse.warm = &shared_warm;
+    contact::CollisionStats ss, fs;
+    contact::SubstepReport sr, fr;
+    contact::advance_with_collisions(s, c.shapes, c.detection, c.dt, so, ss, sr);
+    parallel::advance_by_owner(comm, owner, f, c.shapes, c.detection, c.dt, fo, fs, fr, counts, share);
+    CHECK(std::memcmp(f.state.data(), s.state.data(), f.state.size() * sizeof(FloeState)) == 0);
+    CHECK(same_stats(fs, ss));
+    CHECK(same_report(fr, sr));
+    fallbacks.push_back(counts.fallbacks);
+  }
+  // Tried at advances 0, 2 and 5 (then waits of 1, 2 and 4, the cap).
+  CHECK(counts.steps == 3);
+  CHECK(counts.fallbacks == 3);
+  CHECK(counts.whole == 7);
+  CHECK(serial_warm.uses > 0);
+}
