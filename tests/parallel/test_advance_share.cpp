@@ -184,6 +184,50 @@ TEST_CASE("clusters of different ranks that merge, or share a free floe, fall ba
   CHECK(same_report(report, serial.report));
 }
 
+TEST_CASE("two ranks' clusters that take the same free floe fall back to the serial advance") {
+  // In a row along x, 10 m squares: a1 (floe 0, 1 m/s) hits a2 (floe 1, at
+  // rest) 0.5 m ahead of it, and b1 (floe 2, -1 m/s) hits b2 (floe 3) the
+  // same way from the other side; j (floe 4, at rest) lies 7 m from a2 and
+  // from b2: free at the step's start (no hot pair), taken by both clusters
+  // once a2 and b2 rebound towards it (at 0.7 m/s: half the room, 3.5 m, at
+  // about 5.5 s; they would reach j after the 10 s step, so j never moves
+  // towards the other cluster). Serially the first cluster takes j
+  // and the second merges with it; as shares on two ranks, neither sees the
+  // other (no foreign cluster), both take j: only the floe moved twice says
+  // so, and the combination must refuse.
+  auto box = [](double x0, double vx) {
+    FloeInput f;
+    f.vertices = {{x0, 0.0}, {x0 + 10.0, 0.0}, {x0 + 10.0, 10.0}, {x0, 10.0}};
+    f.velocity = {vx, 0.0};
+    return f;
+  };
+  Case c;
+  for (const FloeInput& in : {box(0.0, 1.0), box(10.5, 0.0), box(55.0, -1.0), box(44.5, 0.0), box(27.5, 0.0)})
+    c.floes.add(make_floe_shape(in), in);
+  c.shapes = contact::build_collision_shapes(c.floes);
+  contact::DetectionOptions d;
+  d.horizon = c.dt;
+  d.reach.assign(c.floes.size(), 6.0);  // m: pairs within 12 m (a2-j and b2-j, not a2-b2)
+  c.detection = contact::detect(c.floes, c.shapes, d);
+  c.options.floor = 1e-3 * c.dt;
+  const Serial serial = serial_advance(c);
+  MESSAGE("serial: " << serial.report.clusters << " clusters, " << serial.report.joined << " joined, "
+                     << serial.report.merges << " merges");
+  REQUIRE(serial.report.merges == 1);
+  REQUIRE(serial.report.joined >= 1);
+  const std::vector<int> owner{0, 0, 1, 1, 0};  // a's cluster on rank 0, b's on rank 1
+  Floes f;
+  contact::CollisionStats stats;
+  contact::SubstepReport report;
+  std::vector<contact::ShareOutcome::Conflict> conflicts;
+  const bool ok = play(c, owner, 2, f, stats, report, conflicts);
+  CHECK(conflicts == std::vector<contact::ShareOutcome::Conflict>(2, contact::ShareOutcome::Conflict::none));
+  CHECK_FALSE(ok);
+  CHECK(std::memcmp(f.state.data(), serial.state.data(), f.state.size() * sizeof(FloeState)) == 0);
+  CHECK(same_stats(stats, serial.stats));
+  CHECK(same_report(report, serial.report));
+}
+
 TEST_CASE("a share that would use the warm store falls back, and the next advances are whole for a while") {
   // One rank (the serial communicator) owning every floe; every LCP starts
   // from the warm store (warm_min = 0), which a share must not use: each
