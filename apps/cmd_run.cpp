@@ -345,6 +345,13 @@ int run(const Args& args, const parallel::Session& session) {
     for (const double x : owners.window_seconds()) o << " " << x;
     o << "\nparallel.strip_seconds_total:";
     for (const double x : owners.charged_seconds()) o << " " << x;
+    // The advances by cluster owner (stage seven): tried, redone whole after
+    // a conflict, done whole at once after fallbacks (the back-off), and the
+    // clusters each rank ran in the steps not redone.
+    const parallel::AdvanceShareCounts& share = sim.advance_share();
+    o << "\nparallel.advance_steps: " << share.steps << "\nparallel.advance_fallbacks: " << share.fallbacks
+      << "\nparallel.advance_whole: " << share.whole << "\nparallel.advance_clusters:";
+    for (const long k : share.clusters) o << " " << k;
     o << "\n";
   }
   o << "notes: " << s.notes.size() << "\n";

@@ -48,7 +48,9 @@ work = tempfile.mkdtemp(prefix="floesim_mpi_bench_")
 config = moving_pack.write(floesims[0], work, args.floes, args.t_end, seed=1, output_interval=args.t_end,
                            half=args.half)
 phases = ["drift", "collide", "advance", "detect", "record", "choose_dt", "check"]
-strips = ["strip_cuts", "strip_floes", "strip_seconds", "strip_seconds_total"]
+strips = ["strip_cuts", "strip_floes", "strip_seconds", "strip_seconds_total", "advance_steps", "advance_fallbacks",
+          "advance_whole",
+          "advance_clusters"]
 rows = []
 load_before = ranks_bench.load()
 for r in range(args.rounds):
@@ -68,7 +70,9 @@ ranks_bench.write_table(
     "rank 0's collectives over the run (the transfers and the waits for the other ranks); cpu_s: CPU time "
     "(user + system) of a rank's process, mean over the ranks, set-up included; phases: rank 0's profile (s), "
     "waits in collectives included; strip_*: rank 0's parallel.strip_* summary keys (the cuts in y, m; floes "
-    "per strip at the end; each rank's by-place CPU seconds over the last balance window and over all windows), "
+    "per strip at the end; each rank's by-place CPU seconds over the last balance window and over all windows; "
+    "advance_*: the advances by cluster owner, stage seven: tried, redone whole, done whole by the back-off, "
+    "clusters run by each rank), "
     "blank before stage six",
     load_before, ranks_bench.load(),
     "ranks,round,wall_s,steps,lcps,bytes_received,collective_s,cpu_s," + ",".join(p + "_s" for p in phases) + "," +

@@ -368,6 +368,7 @@ lcp::FallbackResult solve(const ComponentLcp& a, const Floes& floes, const std::
   const bool use_warm = opt.warm != nullptr && n >= opt.warm_min;
   std::vector<std::uint8_t> guess;
   if (use_warm) {
+    ++opt.warm->uses;
     guess = warm_guess(*opt.warm, floes, contacts, a.list);
     if (std::find(guess.begin(), guess.end(), 1) != guess.end()) {
       solver.lemke.start = &guess;

@@ -7,6 +7,7 @@
 #include <numeric>
 #include <queue>
 #include <sstream>
+#include <stdexcept>
 
 #include "contact/step_limit.hpp"
 #include "core/error.hpp"
@@ -49,8 +50,25 @@ struct Cluster {
 class Stepper {
 public:
   Stepper(Floes& floes, const CollisionShapes& shapes, const Detection& detection, double dt,
-          const SubstepOptions& options, CollisionStats& stats, SubstepReport& report)
-      : floes_(floes), shapes_(shapes), det_(&detection), dt_(dt), opt_(options), stats_(stats), report_(report) {}
+          const SubstepOptions& options, CollisionStats& stats, SubstepReport& report,
+          const ClusterShare* share = nullptr)
+      : floes_(floes), shapes_(shapes), det_(&detection), dt_(dt), opt_(options), stats_(stats), report_(report),
+        share_(share) {}
+
+  // A share's run (advance_share): what it did.
+  ShareOutcome outcome() const {
+    ShareOutcome o;
+    o.conflict = conflict_;
+    o.floor_tau = floor_tau_;
+    o.floor_cluster = floor_cluster_;
+    for (std::size_t k = 0; k < clusters_.size(); ++k) {
+      if (!own_[k]) continue;
+      ++o.clusters;
+      if (clusters_[k].alive) o.moved.insert(o.moved.end(), clusters_[k].members.begin(), clusters_[k].members.end());
+    }
+    std::sort(o.moved.begin(), o.moved.end());
+    return o;
+  }
 
   void run() {
     const std::size_t n = floes_.size();
@@ -89,8 +107,12 @@ public:
     // Time order: a min-heap of (tau, cluster); stale entries are skipped.
     using Entry = std::pair<double, int>;
     std::priority_queue<Entry, std::vector<Entry>, std::greater<Entry>> queue;
+    own_.assign(clusters_.size(), 1);
     for (std::size_t k = 0; k < clusters_.size(); ++k) {
       Cluster& c = clusters_[k];
+      // A share runs the clusters whose lowest floe (members.front()) it owns.
+      if (share_) own_[k] = share_->owner[c.members.front()] == share_->rank;
+      if (!own_[k]) continue;
       compute_budgets(static_cast<int>(k));
       collect_internal(static_cast<int>(k));
       measure_internal(c);
@@ -103,10 +125,11 @@ public:
       Cluster& c = clusters_[static_cast<std::size_t>(k)];
       if (!c.alive || tau != c.tau || !(c.tau < dt_)) continue;
       advance_cluster(k);
+      if (conflict_ != ShareOutcome::Conflict::none) return;
       if (c.alive && c.tau < dt_) queue.push({c.tau, k});
     }
-    for (const Cluster& c : clusters_)
-      if (c.alive) {
+    for (std::size_t k = 0; k < clusters_.size(); ++k)
+      if (const Cluster& c = clusters_[k]; c.alive && own_[k]) {
         ++report_.clusters;
         report_.largest_cluster = std::max(report_.largest_cluster, static_cast<long>(c.members.size()));
       }
@@ -345,6 +368,8 @@ private:
     if (h < opt_.floor && dt_ - c.tau > opt_.floor) {
       h = opt_.floor;
       ++report_.floor_steps;
+      floor_tau_ = c.tau;
+      floor_cluster_ = k;
       std::ostringstream m;
       m << "floes " << by->a << " and " << by->b << " at distance " << by->distance << " m, " << c.tau
         << " s into the step";
@@ -587,6 +612,13 @@ private:
         else if (cluster_of_[f] != k) merging_.push_back(cluster_of_[f]);
       }
     }
+    // A share stops at a cluster it does not run: the serial advance merges
+    // the two at a time the share cannot know.
+    for (int l : merging_)
+      if (!own_[static_cast<std::size_t>(l)]) {
+        conflict_ = ShareOutcome::Conflict::foreign_cluster;
+        return;
+      }
     std::sort(joining_.begin(), joining_.end());
     joining_.erase(std::unique(joining_.begin(), joining_.end()), joining_.end());
     for (std::uint32_t j : joining_) {
@@ -631,6 +663,11 @@ private:
   const SubstepOptions& opt_;
   CollisionStats& stats_;
   SubstepReport& report_;
+  const ClusterShare* share_;          // null: every cluster (the serial advance)
+  std::vector<std::uint8_t> own_;      // per cluster: run by this call
+  ShareOutcome::Conflict conflict_ = ShareOutcome::Conflict::none;
+  double floor_tau_ = -1.0;            // the last floor step's key (tau, cluster)
+  long floor_cluster_ = -1;
 
   std::vector<FloeState> start_;       // at the start of the step: the straight paths
   std::vector<double> lin_;            // m, linear travel of each floe over the step
@@ -657,6 +694,31 @@ private:
 void advance_with_collisions(Floes& floes, const CollisionShapes& shapes, const Detection& detection, double dt,
                              const SubstepOptions& options, CollisionStats& stats, SubstepReport& report) {
   Stepper(floes, shapes, detection, dt, options, stats, report).run();
+}
+
+ShareOutcome advance_share(Floes& floes, const CollisionShapes& shapes, const Detection& detection, double dt,
+                           const SubstepOptions& options, const ClusterShare& share, CollisionStats& stats,
+                           SubstepReport& report) {
+  if (options.impulse.record) throw std::logic_error("advance_share: the impulse record needs the serial order");
+  // The warm store is replaced by an empty probe that only says whether a
+  // solve of the share would have used it (ClusterShare above).
+  SubstepOptions o = options;
+  WarmStart probe;
+  if (options.impulse.warm) o.impulse.warm = &probe;
+  const long failures = stats.failures;
+  Stepper stepper(floes, shapes, detection, dt, o, stats, report, &share);
+  ShareOutcome outcome;
+  try {
+    stepper.run();
+    outcome = stepper.outcome();
+  } catch (const RunError&) {
+    outcome.conflict = ShareOutcome::Conflict::error;
+  }
+  if (outcome.conflict == ShareOutcome::Conflict::none && probe.uses > 0)
+    outcome.conflict = ShareOutcome::Conflict::warm_start;
+  if (outcome.conflict == ShareOutcome::Conflict::none && stats.failures != failures)
+    outcome.conflict = ShareOutcome::Conflict::failed_lcp;
+  return outcome;
 }
 
 }  // namespace floesim::contact

@@ -49,7 +49,10 @@
 // With no collision in sight this is one step for every floe; the cost of a
 // collision is the cost of its cluster's sub-steps, not of the whole pack's.
 
+#include <cstdint>
+#include <span>
 #include <string>
+#include <vector>
 
 #include "contact/detection.hpp"
 #include "contact/impulse.hpp"
@@ -83,5 +86,55 @@ struct SubstepReport {
 // overlaps however short it is made.
 void advance_with_collisions(Floes& floes, const CollisionShapes& shapes, const Detection& detection, double dt,
                              const SubstepOptions& options, CollisionStats& stats, SubstepReport& report);
+
+// One share of the advance: the clusters whose lowest floe `owner` gives to
+// `rank` (a distributed run's cluster owner, docs/parallel.md stage seven).
+//
+// Why a share gives the serial bits. The clusters (step 1), the jams, the
+// rooms, the straight paths, the budgets' pairs and the reaches are functions
+// of the floes at the step's start and of the detection, the same on every
+// rank. A cluster's events read and write only: its members' states, the
+// fixed rooms and straight paths (budgets = half-rooms fixed at the start;
+// a floe joins at linear(j, tau), which no other cluster changes while j is
+// free), the obstacles, and the pair index. They touch another cluster only
+// by merging with it (collect_breaks -> bring_in), and another cluster's
+// work only through a free floe both take. So, as long as no cluster of the
+// share merges with a cluster outside it and no floe joins clusters of two
+// shares, each cluster runs the same sub-steps on the same numbers as in the
+// serial advance: the serial queue, ordered by (tau, cluster), pops the
+// share's entries in the same relative order, and the events of other
+// clusters in between change nothing the share reads. Collision counters
+// are sums (largest: a maximum); the last floor pair of the serial advance
+// is the one with the largest (tau, cluster) key, which each share reports.
+// The warm store (ImpulseOptions::warm) is shared across steps by pair, so
+// a share that would use it is a conflict too (the stores of the ranks
+// would part); so is a failed LCP (its dump is numbered in the run) and a
+// RunError (the serial advance throws it, or a different one, in its order).
+struct ClusterShare {
+  std::span<const int> owner;  // per floe: its rank
+  int rank = 0;
+};
+
+// What a share did. On `conflict` other than none the floes' states are
+// unusable and the caller redoes the advance whole from the step's states.
+struct ShareOutcome {
+  enum class Conflict { none, foreign_cluster, warm_start, failed_lcp, error };
+  Conflict conflict = Conflict::none;
+  std::vector<std::uint32_t> moved;  // ascending: the floes of the share's clusters (joined free floes included)
+  long clusters = 0;                 // clusters of the share at the start of the step
+  // The share's last floor step (floor_steps counted in its report): its key
+  // (tau, cluster) and pair text; the serial floor_pair is the largest key's.
+  double floor_tau = -1.0;
+  long floor_cluster = -1;
+};
+
+// Advances the free floes (all of them, linearly) and the clusters of
+// `share` only; `stats` and `report` get this share's counts (report.rebuilt,
+// the pair list's rebuild, is counted on every share: it is not the share's
+// own). The impulse record (options.impulse.record) must be null: its events'
+// order is the serial queue's, not a share's.
+ShareOutcome advance_share(Floes& floes, const CollisionShapes& shapes, const Detection& detection, double dt,
+                           const SubstepOptions& options, const ClusterShare& share, CollisionStats& stats,
+                           SubstepReport& report);
 
 }  // namespace floesim::contact

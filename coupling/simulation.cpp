@@ -10,6 +10,7 @@
 #include "contact/substep.hpp"
 #include "core/error.hpp"
 #include "fluid/sea.hpp"
+#include "parallel/advance_share.hpp"
 #include "parallel/detect.hpp"
 
 namespace floesim {
@@ -322,7 +323,15 @@ void Simulation::advance(const StepContext& ctx) {
   o.domain = detection_options_.domain;
   o.impulse = impulse_options_;
   const Vec2 before = momentum();
-  contact::advance_with_collisions(scenario_.floes, shapes_, detection_, ctx.dt, o, stats_, substeps_);
+  // On several ranks each rank advances the clusters it owns and the ranks
+  // exchange what moved (stage seven, parallel/advance_share.hpp); the
+  // impulse record's events are in the serial queue's order, so a run that
+  // records them (percussion, collision events) advances whole on every rank.
+  if (comm_.serial() || impulse_options_.record)
+    contact::advance_with_collisions(scenario_.floes, shapes_, detection_, ctx.dt, o, stats_, substeps_);
+  else
+    parallel::advance_by_owner(comm_, owners_.owner(), scenario_.floes, shapes_, detection_, ctx.dt, o, stats_,
+                               substeps_, advance_share_);
   step_budget_.collisions += momentum() - before;
   wrap_periodic();
 }

@@ -59,6 +59,7 @@
 #include "core/run_file.hpp"
 #include "coupling/scenario.hpp"
 #include "parallel/comm.hpp"
+#include "parallel/advance_share.hpp"
 #include "parallel/place.hpp"
 
 namespace floesim {
@@ -142,6 +143,7 @@ public:
   // The floes' owners by place for the drift and detection (one rank: all 0).
   const parallel::FloeOwners& floe_owners() const { return owners_; }
   const contact::SubstepReport& substep_report() const { return substeps_; }
+  const parallel::AdvanceShareCounts& advance_share() const { return advance_share_; }  // stage seven
   long rejected_steps() const { return rejected_steps_; }
   // Things a user should hear about once, with a count (e.g. steps cut to the floor).
   std::vector<std::string> warnings() const;
@@ -204,6 +206,7 @@ private:
   std::vector<CollisionEventRow> collision_events_;  // since take_collision_events()
   MomentumBudget budget_, step_budget_;  // run total; this step's (redone steps do not count)
   contact::SubstepReport substeps_;  // collision sub-steps (floors, merges, ...)
+  parallel::AdvanceShareCounts advance_share_;  // the advances by cluster owner (stage seven)
   long rejected_steps_ = 0;       // steps redone after an overlap
   Profile profile_;
   double t_ = 0.0;

@@ -82,6 +82,15 @@ for n in args.ranks:
     moves = [int(l.split()[1]) for l in p.stdout.splitlines() if l.startswith("parallel.strip_moves:")]
     if n > 1 and not (moves and moves[0] > 0):
         failures.append(f"{n} ranks: the strips never moved (parallel.strip_moves: {moves})")
+    # Stage seven: the advance ran by cluster owner, so the equality above
+    # holds with each rank advancing its own clusters (a step redone whole
+    # after a conflict between ranks is the serial advance: not all may be).
+    key = lambda k: next((l.split(":", 1)[1].split() for l in p.stdout.splitlines() if l.startswith(k + ":")), [])
+    steps, fallbacks, clusters = key("parallel.advance_steps"), key("parallel.advance_fallbacks"), key("parallel.advance_clusters")
+    if n > 1:
+        print(f"{n} ranks: {steps} advances by cluster owner, {fallbacks} redone whole, clusters by rank {clusters}")
+        if not (steps and fallbacks and int(steps[0]) > int(fallbacks[0]) and sum(map(int, clusters)) > 0):
+            failures.append(f"{n} ranks: no advance by cluster owner was kept ({steps}, {fallbacks}, {clusters})")
 
 # A restart on 2 ranks: the first half, then --restart from its checkpoint
 # (written by rank 0, read by every rank), equals the serial run.

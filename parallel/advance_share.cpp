@@ -1,0 +1,163 @@
+#include "parallel/advance_share.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cstring>
+
+#include "parallel/bytes.hpp"
+
+namespace floesim::parallel {
+
+namespace {
+
+using contact::CollisionStats;
+using contact::ShareOutcome;
+using contact::SubstepReport;
+
+constexpr std::size_t kStats = 12, kReport = 10;
+
+std::array<long*, kStats> fields(CollisionStats& s) {
+  return {&s.contacts, &s.lcps,     &s.pivots,  &s.failures,   &s.fallbacks, &s.flagged,
+          &s.gauss_seidel, &s.tolerated, &s.largest, &s.total_size, &s.warm, &s.warm_missed};
+}
+std::array<long*, kReport> fields(SubstepReport& r) {
+  return {&r.clusters, &r.substeps, &r.time_steps, &r.largest_cluster, &r.joined,
+          &r.merges,   &r.rejected, &r.floor_steps, &r.rebuilt,        &r.reach_exceeded};
+}
+
+// The header's longs: conflict, moved, clusters, floor_cluster, the floor
+// pair's length, the stats, the report; then floor_tau, the moved floes,
+// their states and the floor pair's text.
+constexpr std::size_t kHeader = 5 + kStats + kReport;
+
+}  // namespace
+
+std::vector<std::byte> pack(const AdvancePart& part) {
+  AdvancePart p = part;  // fields() takes non-const members
+  std::array<long, kHeader> head{};
+  head[0] = static_cast<long>(p.outcome.conflict);
+  head[1] = static_cast<long>(p.outcome.moved.size());
+  head[2] = p.outcome.clusters;
+  head[3] = p.outcome.floor_cluster;
+  head[4] = static_cast<long>(p.report.floor_pair.size());
+  std::size_t k = 5;
+  for (long* f : fields(p.stats)) head[k++] = *f;
+  for (long* f : fields(p.report)) head[k++] = *f;
+  std::vector<std::byte> out(sizeof(head) + sizeof(double) + p.outcome.moved.size() * sizeof(std::uint32_t) +
+                             p.states.size() * sizeof(FloeState) + p.report.floor_pair.size());
+  std::byte* at = put(out.data(), head.data(), head.size());
+  at = put(at, &p.outcome.floor_tau, 1);
+  at = put(at, p.outcome.moved.data(), p.outcome.moved.size());
+  at = put(at, p.states.data(), p.states.size());
+  put(at, p.report.floor_pair.data(), p.report.floor_pair.size());
+  return out;
+}
+
+AdvancePart unpack_advance_part(std::span<const std::byte> bytes) {
+  AdvancePart p;
+  const std::byte* in = bytes.data();
+  std::array<long, kHeader> head{};
+  for (std::size_t j = 0; j < kHeader; ++j) head[j] = at<long>(in, j);
+  in += sizeof(head);
+  p.outcome.conflict = static_cast<ShareOutcome::Conflict>(head[0]);
+  const auto moved = static_cast<std::size_t>(head[1]);
+  p.outcome.clusters = head[2];
+  p.outcome.floor_cluster = head[3];
+  const auto text = static_cast<std::size_t>(head[4]);
+  std::size_t k = 5;
+  for (long* f : fields(p.stats)) *f = head[k++];
+  for (long* f : fields(p.report)) *f = head[k++];
+  p.outcome.floor_tau = at<double>(in, 0);
+  in += sizeof(double);
+  p.outcome.moved.resize(moved);
+  for (std::size_t j = 0; j < moved; ++j) p.outcome.moved[j] = at<std::uint32_t>(in, j);
+  in += moved * sizeof(std::uint32_t);
+  p.states.resize(moved);
+  for (std::size_t j = 0; j < moved; ++j) p.states[j] = at<FloeState>(in, j);
+  in += moved * sizeof(FloeState);
+  p.report.floor_pair.assign(reinterpret_cast<const char*>(in), text);
+  return p;
+}
+
+AdvancePart run_share(Floes& floes, const contact::CollisionShapes& shapes, const contact::Detection& detection,
+                      double dt, const contact::SubstepOptions& options, std::span<const int> owner, int rank) {
+  AdvancePart part;
+  part.outcome =
+      contact::advance_share(floes, shapes, detection, dt, options, {owner, rank}, part.stats, part.report);
+  if (part.outcome.conflict == ShareOutcome::Conflict::none)
+    for (const std::uint32_t i : part.outcome.moved) part.states.push_back(floes.state[i]);
+  return part;
+}
+
+bool combine_parts(std::span<const AdvancePart> parts, Floes& floes, CollisionStats& stats, SubstepReport& report) {
+  std::vector<std::uint8_t> taken(floes.size(), 0);
+  for (const AdvancePart& p : parts) {
+    if (p.outcome.conflict != ShareOutcome::Conflict::none) return false;
+    for (const std::uint32_t i : p.outcome.moved) {
+      if (taken[i]) return false;  // a free floe two ranks' clusters took: the serial advance merges them
+      taken[i] = 1;
+    }
+  }
+  for (const AdvancePart& p : parts)
+    for (std::size_t j = 0; j < p.states.size(); ++j) floes.state[p.outcome.moved[j]] = p.states[j];
+  // Counts: sums, but the largest LCP and cluster (maxima) and the pair
+  // list's rebuild, which every share did alike (taken once).
+  const AdvancePart* floor = nullptr;
+  for (const AdvancePart& p : parts) {
+    AdvancePart q = p;
+    const std::array<long*, kStats> to = fields(stats), from = fields(q.stats);
+    for (std::size_t k = 0; k < kStats; ++k)
+      *to[k] = from[k] == &q.stats.largest ? std::max(*to[k], *from[k]) : *to[k] + *from[k];
+    const std::array<long*, kReport> rto = fields(report), rfrom = fields(q.report);
+    for (std::size_t k = 0; k < kReport; ++k) {
+      if (rfrom[k] == &q.report.rebuilt) continue;
+      *rto[k] = rfrom[k] == &q.report.largest_cluster ? std::max(*rto[k], *rfrom[k]) : *rto[k] + *rfrom[k];
+    }
+    // The serial queue's last floor step: the largest key (tau, cluster).
+    if (p.report.floor_steps > 0 &&
+        (!floor || std::pair(p.outcome.floor_tau, p.outcome.floor_cluster) >
+                       std::pair(floor->outcome.floor_tau, floor->outcome.floor_cluster)))
+      floor = &p;
+  }
+  if (!parts.empty()) report.rebuilt += parts.front().report.rebuilt;
+  if (floor) report.floor_pair = floor->report.floor_pair;
+  return true;
+}
+
+void advance_by_owner(const Communicator& comm, std::span<const int> owner, Floes& floes,
+                      const contact::CollisionShapes& shapes, const contact::Detection& detection, double dt,
+                      const contact::SubstepOptions& options, contact::CollisionStats& stats,
+                      contact::SubstepReport& report, AdvanceShareCounts& counts,
+                      const AdvanceShareOptions& share_options) {
+  if (counts.wait > 0) {
+    --counts.wait;
+    ++counts.whole;
+    contact::advance_with_collisions(floes, shapes, detection, dt, options, stats, report);
+    return;
+  }
+  const std::vector<FloeState> start = floes.state;
+  const AdvancePart mine = run_share(floes, shapes, detection, dt, options, owner, comm.rank());
+  std::vector<std::size_t> sizes;
+  const std::vector<std::byte> all = comm.allgather_bytes(pack(mine), sizes);
+  std::vector<AdvancePart> parts;
+  std::size_t from = 0;
+  for (const std::size_t n : sizes) {
+    parts.push_back(unpack_advance_part({all.data() + from, n}));
+    from += n;
+  }
+  ++counts.steps;
+  counts.clusters.resize(parts.size(), 0);
+  if (combine_parts(parts, floes, stats, report)) {
+    for (std::size_t r = 0; r < parts.size(); ++r) counts.clusters[r] += parts[r].outcome.clusters;
+    counts.next_wait = 1;
+    return;
+  }
+  // A conflict: the whole advance from the step's states, as the serial run.
+  ++counts.fallbacks;
+  counts.wait = counts.next_wait;
+  counts.next_wait = std::min(2 * counts.next_wait, share_options.max_wait);
+  floes.state = start;
+  contact::advance_with_collisions(floes, shapes, detection, dt, options, stats, report);
+}
+
+}  // namespace floesim::parallel

@@ -1,0 +1,82 @@
+#pragma once
+// Stage seven (docs/parallel.md): the multirate advance of the floes by
+// cluster owner. Every rank finds the step's clusters from the replicated
+// detection (contact/substep.hpp); each cluster belongs to the owner by place
+// (FloeOwners) of its lowest floe; each rank advances its own clusters and
+// every free floe (linear motion), and the ranks then exchange the states of
+// the floes their clusters moved (index + state) and their collision counts.
+// A step where a rank's cluster met another rank's cluster, where two ranks
+// took the same free floe, or where a share could not run alone
+// (ShareOutcome::Conflict) is advanced again whole on every rank from the
+// step's states: the serial advance, so the answer is the serial one bit for
+// bit either way.
+
+#include <cstddef>
+#include <span>
+#include <vector>
+
+#include "contact/substep.hpp"
+#include "parallel/comm.hpp"
+
+namespace floesim::parallel {
+
+// One rank's part of a step's advance: what its share did, the states of the
+// floes it moved (outcome.moved's order) and its counts.
+struct AdvancePart {
+  contact::ShareOutcome outcome;
+  std::vector<FloeState> states;
+  contact::CollisionStats stats;
+  contact::SubstepReport report;
+};
+
+std::vector<std::byte> pack(const AdvancePart& part);
+AdvancePart unpack_advance_part(std::span<const std::byte> bytes);
+
+// Runs rank `rank`'s share (contact::advance_share) on `floes` (the step's
+// states on entry) and returns its part; `floes` is left with the share's states.
+AdvancePart run_share(Floes& floes, const contact::CollisionShapes& shapes, const contact::Detection& detection,
+                      double dt, const contact::SubstepOptions& options, std::span<const int> owner, int rank);
+
+// Combines every rank's part (rank order) into `floes` (each rank's moved
+// floes get its states; the free floes are already at the end of the step on
+// every rank), `stats` and `report`, and returns true; or returns false,
+// changing nothing, when a part has a conflict or two parts moved one floe.
+bool combine_parts(std::span<const AdvancePart> parts, Floes& floes, contact::CollisionStats& stats,
+                   contact::SubstepReport& report);
+
+// A step redone whole costs the share's work and the whole advance; packs
+// where ranks' clusters keep meeting (a jam across strips, a jam whose LCP
+// uses the warm store) would pay it at every step. So after a fallback the
+// next `wait` advances are whole at once (no share, no gather); `wait` is 1
+// after the first fallback and doubles with each fallback in a row, up to
+// max_wait; a combined advance resets it. Every rank sees the same
+// fallbacks, so all agree on the steps they skip (same collective calls).
+// Either way the answer is the serial one.
+struct AdvanceShareOptions {
+  long max_wait = 64;
+};
+
+// How the advances by cluster owner went (the run's summary), and the
+// back-off's state.
+struct AdvanceShareCounts {
+  long steps = 0;               // advances tried by owner
+  long fallbacks = 0;           // of those, redone whole
+  long whole = 0;               // advances done whole at once by the back-off
+  std::vector<long> clusters;   // per rank: clusters it ran (steps not redone)
+  long wait = 0;                // advances still to do whole
+  long next_wait = 1;           // the wait after the next fallback
+};
+
+// The step's advance on every rank of `comm` (or whole, while the back-off
+// above waits): this rank's share, one
+// exchange (allgather_bytes: two collective calls on every rank, every
+// step), then the combination or, on a conflict, the whole advance
+// (contact::advance_with_collisions) from the states on entry. Equal to the
+// serial advance bit for bit, states and counts.
+void advance_by_owner(const Communicator& comm, std::span<const int> owner, Floes& floes,
+                      const contact::CollisionShapes& shapes, const contact::Detection& detection, double dt,
+                      const contact::SubstepOptions& options, contact::CollisionStats& stats,
+                      contact::SubstepReport& report, AdvanceShareCounts& counts,
+                      const AdvanceShareOptions& share_options = {});
+
+}  // namespace floesim::parallel

@@ -1,0 +1,266 @@
+// Stage seven without ranks: the multirate advance split by cluster owner
+// over 1, 2, 3 and 7 "ranks" (each share run on its own copy of the floes,
+// as each rank runs it), combined as parallel::advance_by_owner combines the
+// gathered parts, is the serial advance (contact::advance_with_collisions)
+// bit for bit: the floes' states (memcmp), the collision counts and the
+// sub-step report. Where the shares interact (a cluster of one merges with a
+// cluster of another, or two take one free floe) the combination refuses and
+// the step is redone whole, which is the serial advance.
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <cstring>
+#include <numeric>
+#include <random>
+#include <string>
+
+#include "contact/detection.hpp"
+#include "contact/shapes.hpp"
+#include "contact/substep.hpp"
+#include "core/pack_generator.hpp"
+#include "parallel/advance_share.hpp"
+#include "parallel/place.hpp"
+
+TEST_SUITE_BEGIN("mpi");
+
+using namespace floesim;
+
+namespace {
+
+struct Case {
+  Floes floes;
+  contact::CollisionShapes shapes;
+  contact::Detection detection;
+  contact::SubstepOptions options;
+  contact::Domain domain;
+  double dt = 10.0;
+};
+
+// A dense periodic pack whose floes move at up to `speed` towards random
+// neighbours: many small clusters, some merging, some floes joining.
+Case dense_pack(double speed, unsigned seed, double concentration = 0.75) {
+  PackOptions o;
+  o.floes = 400;
+  o.concentration = concentration;
+  o.min_gap = 0.05;
+  o.width = o.height = 2000.0;
+  o.seed = seed;
+  GeneratedPack g = generate_pack(o);
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u(-speed, speed);
+  for (FloeState& s : g.floes.state) {
+    s.vx = u(rng);
+    s.vy = u(rng);
+    s.yaw_rate = 1e-3 * u(rng);
+  }
+  Case c;
+  c.floes = std::move(g.floes);
+  c.shapes = contact::build_collision_shapes(c.floes);
+  c.domain = {true, g.window[0], g.window[1], g.window[2], g.window[3]};
+  contact::DetectionOptions d;
+  d.domain = c.domain;
+  d.horizon = c.dt;
+  d.reach.assign(c.floes.size(), 0.0);
+  for (std::size_t i = 0; i < c.floes.size(); ++i) {  // as Simulation::set_reach
+    const FloeState& s = c.floes.state[i];
+    d.reach[i] = c.dt * (1.5 * (std::hypot(s.vx, s.vy) + std::abs(s.yaw_rate) * c.shapes.radius[i]) + 0.5 * speed) +
+                 d.collision_distance;
+  }
+  c.detection = contact::detect(c.floes, c.shapes, d);
+  c.options.collision_distance = d.collision_distance;
+  c.options.floor = 1e-3 * c.dt;
+  c.options.domain = c.domain;
+  c.options.impulse.collision_distance = d.collision_distance;
+  c.options.impulse.min_gap = 0.1 * d.collision_distance;
+  return c;
+}
+
+bool same_stats(const contact::CollisionStats& a, const contact::CollisionStats& b) {
+  return a.contacts == b.contacts && a.lcps == b.lcps && a.pivots == b.pivots && a.failures == b.failures &&
+         a.fallbacks == b.fallbacks && a.flagged == b.flagged && a.gauss_seidel == b.gauss_seidel &&
+         a.tolerated == b.tolerated && a.largest == b.largest && a.total_size == b.total_size && a.warm == b.warm &&
+         a.warm_missed == b.warm_missed;
+}
+bool same_report(const contact::SubstepReport& a, const contact::SubstepReport& b) {
+  return a.clusters == b.clusters && a.substeps == b.substeps && a.time_steps == b.time_steps &&
+         a.largest_cluster == b.largest_cluster && a.joined == b.joined && a.merges == b.merges &&
+         a.rejected == b.rejected && a.floor_steps == b.floor_steps && a.rebuilt == b.rebuilt &&
+         a.reach_exceeded == b.reach_exceeded && a.floor_pair == b.floor_pair;
+}
+
+struct Serial {
+  std::vector<FloeState> state;
+  contact::CollisionStats stats;
+  contact::SubstepReport report;
+};
+Serial serial_advance(const Case& c) {
+  Floes f = c.floes;
+  Serial s;
+  contact::advance_with_collisions(f, c.shapes, c.detection, c.dt, c.options, s.stats, s.report);
+  s.state = f.state;
+  return s;
+}
+
+// Plays `ranks` ranks: each runs its share on its own copy, the parts go
+// through pack/unpack (the bytes every rank gathers), and rank 0's copy
+// combines them. Returns whether they combined; `f` and the counts hold the
+// combined answer, or, when not, the whole advance redone (the fallback).
+bool play(const Case& c, std::span<const int> owner, int ranks, Floes& f, contact::CollisionStats& stats,
+          contact::SubstepReport& report, std::vector<contact::ShareOutcome::Conflict>& conflicts) {
+  std::vector<parallel::AdvancePart> parts;
+  Floes first;
+  for (int r = 0; r < ranks; ++r) {
+    Floes mine = c.floes;
+    const parallel::AdvancePart part =
+        parallel::run_share(mine, c.shapes, c.detection, c.dt, c.options, owner, r);
+    conflicts.push_back(part.outcome.conflict);
+    parts.push_back(parallel::unpack_advance_part(parallel::pack(part)));
+    if (r == 0) first = std::move(mine);
+  }
+  f = std::move(first);
+  if (parallel::combine_parts(parts, f, stats, report)) return true;
+  f.state = c.floes.state;
+  contact::advance_with_collisions(f, c.shapes, c.detection, c.dt, c.options, stats, report);
+  return false;
+}
+
+}  // namespace
+
+TEST_CASE("the advance by cluster owner over 1, 2, 3 and 7 strips is the serial advance bit for bit") {
+  int combined = 0;
+  for (const unsigned seed : {3u, 11u}) {
+    CAPTURE(seed);
+    const Case c = dense_pack(2.0, seed, 0.5);
+    const Serial serial = serial_advance(c);
+    MESSAGE("serial: " << serial.report.clusters << " clusters, " << serial.report.substeps << " sub-steps, "
+                       << serial.report.joined << " joined, " << serial.report.merges << " merges, "
+                       << serial.stats.lcps << " LCPs");
+    REQUIRE(serial.report.clusters > 20);  // many clusters to share
+    REQUIRE(serial.stats.lcps > 0);
+    for (const int ranks : {1, 2, 3, 7}) {
+      CAPTURE(ranks);
+      parallel::FloeOwners owners(0, ranks, c.domain);
+      owners.assign(c.floes);
+      Floes f;
+      contact::CollisionStats stats;
+      contact::SubstepReport report;
+      std::vector<contact::ShareOutcome::Conflict> conflicts;
+      const bool ok = play(c, owners.owner(), ranks, f, stats, report, conflicts);
+      MESSAGE(ranks << " ranks: " << std::string(ok ? "combined" : "fell back"));
+      if (ranks > 1) combined += ok ? 1 : 0;
+      if (ranks == 1) CHECK(ok);  // one rank owns every cluster: nothing to conflict with
+      REQUIRE(f.state.size() == serial.state.size());
+      CHECK(std::memcmp(f.state.data(), serial.state.data(), f.state.size() * sizeof(FloeState)) == 0);
+      CHECK(same_stats(stats, serial.stats));
+      CHECK(same_report(report, serial.report));
+    }
+  }
+  // Splits over several ranks that combined (a fallback is the serial
+  // advance itself and proves nothing about the shares): 3 of the 6 here.
+  CHECK(combined >= 2);
+}
+
+TEST_CASE("clusters of different ranks that merge, or share a free floe, fall back to the serial advance") {
+  // Every floe its own rank (owner[i] = i): each cluster is alone on its
+  // rank, so every merge and every free floe taken by two clusters of the
+  // serial advance is between ranks.
+  const Case c = dense_pack(2.0, 3, 0.5);
+  const Serial serial = serial_advance(c);
+  REQUIRE(serial.report.merges + serial.report.joined > 0);
+  std::vector<int> owner(c.floes.size());
+  std::iota(owner.begin(), owner.end(), 0);
+  Floes f;
+  contact::CollisionStats stats;
+  contact::SubstepReport report;
+  std::vector<contact::ShareOutcome::Conflict> conflicts;
+  const bool ok = play(c, owner, static_cast<int>(owner.size()), f, stats, report, conflicts);
+  const long foreign = std::count(conflicts.begin(), conflicts.end(), contact::ShareOutcome::Conflict::foreign_cluster);
+  MESSAGE("serial: " << serial.report.merges << " merges, " << serial.report.joined << " joined; shares: " << foreign
+                     << " met another rank's cluster");
+  if (serial.report.merges > 0) CHECK(foreign > 0);
+  CHECK_FALSE(ok);
+  CHECK(std::memcmp(f.state.data(), serial.state.data(), f.state.size() * sizeof(FloeState)) == 0);
+  CHECK(same_stats(stats, serial.stats));
+  CHECK(same_report(report, serial.report));
+}
+
+TEST_CASE("two ranks' clusters that take the same free floe fall back to the serial advance") {
+  // In a row along x, 10 m squares: a1 (floe 0, 1 m/s) hits a2 (floe 1, at
+  // rest) 0.5 m ahead of it, and b1 (floe 2, -1 m/s) hits b2 (floe 3) the
+  // same way from the other side; j (floe 4, at rest) lies 7 m from a2 and
+  // from b2: free at the step's start (no hot pair), taken by both clusters
+  // once a2 and b2 rebound towards it (at 0.7 m/s: half the room, 3.5 m, at
+  // about 5.5 s; they would reach j after the 10 s step, so j never moves
+  // towards the other cluster). Serially the first cluster takes j
+  // and the second merges with it; as shares on two ranks, neither sees the
+  // other (no foreign cluster), both take j: only the floe moved twice says
+  // so, and the combination must refuse.
+  auto box = [](double x0, double vx) {
+    FloeInput f;
+    f.vertices = {{x0, 0.0}, {x0 + 10.0, 0.0}, {x0 + 10.0, 10.0}, {x0, 10.0}};
+    f.velocity = {vx, 0.0};
+    return f;
+  };
+  Case c;
+  for (const FloeInput& in : {box(0.0, 1.0), box(10.5, 0.0), box(55.0, -1.0), box(44.5, 0.0), box(27.5, 0.0)})
+    c.floes.add(make_floe_shape(in), in);
+  c.shapes = contact::build_collision_shapes(c.floes);
+  contact::DetectionOptions d;
+  d.horizon = c.dt;
+  d.reach.assign(c.floes.size(), 6.0);  // m: pairs within 12 m (a2-j and b2-j, not a2-b2)
+  c.detection = contact::detect(c.floes, c.shapes, d);
+  c.options.floor = 1e-3 * c.dt;
+  const Serial serial = serial_advance(c);
+  MESSAGE("serial: " << serial.report.clusters << " clusters, " << serial.report.joined << " joined, "
+                     << serial.report.merges << " merges");
+  REQUIRE(serial.report.merges == 1);
+  REQUIRE(serial.report.joined >= 1);
+  const std::vector<int> owner{0, 0, 1, 1, 0};  // a's cluster on rank 0, b's on rank 1
+  Floes f;
+  contact::CollisionStats stats;
+  contact::SubstepReport report;
+  std::vector<contact::ShareOutcome::Conflict> conflicts;
+  const bool ok = play(c, owner, 2, f, stats, report, conflicts);
+  CHECK(conflicts == std::vector<contact::ShareOutcome::Conflict>(2, contact::ShareOutcome::Conflict::none));
+  CHECK_FALSE(ok);
+  CHECK(std::memcmp(f.state.data(), serial.state.data(), f.state.size() * sizeof(FloeState)) == 0);
+  CHECK(same_stats(stats, serial.stats));
+  CHECK(same_report(report, serial.report));
+}
+
+TEST_CASE("a share that would use the warm store falls back, and the next advances are whole for a while") {
+  // One rank (the serial communicator) owning every floe; every LCP starts
+  // from the warm store (warm_min = 0), which a share must not use: each
+  // advance by owner falls back, then waits 1, 2, 4 advances (the back-off,
+  // AdvanceShareOptions), every one equal to the serial advance with its own
+  // warm store (the stores stay alike through the fallbacks).
+  Case c = dense_pack(2.0, 3, 0.5);
+  contact::WarmStart serial_warm, shared_warm;
+  c.options.impulse.warm_min = 0;
+  const parallel::Communicator comm;
+  const std::vector<int> owner(c.floes.size(), 0);
+  parallel::AdvanceShareCounts counts;
+  parallel::AdvanceShareOptions share;
+  share.max_wait = 4;
+  std::vector<long> fallbacks;
+  for (int step = 0; step < 10; ++step) {
+    CAPTURE(step);
+    Floes s = c.floes, f = c.floes;
+    contact::SubstepOptions so = c.options, fo = c.options;
+    so.impulse.warm = &serial_warm;
+    fo.impulse.warm = &shared_warm;
+    contact::CollisionStats ss, fs;
+    contact::SubstepReport sr, fr;
+    contact::advance_with_collisions(s, c.shapes, c.detection, c.dt, so, ss, sr);
+    parallel::advance_by_owner(comm, owner, f, c.shapes, c.detection, c.dt, fo, fs, fr, counts, share);
+    CHECK(std::memcmp(f.state.data(), s.state.data(), f.state.size() * sizeof(FloeState)) == 0);
+    CHECK(same_stats(fs, ss));
+    CHECK(same_report(fr, sr));
+    fallbacks.push_back(counts.fallbacks);
+  }
+  // Tried at advances 0, 2 and 5 (then waits of 1, 2 and 4, the cap).
+  CHECK(counts.steps == 3);
+  CHECK(counts.fallbacks == 3);
+  CHECK(counts.whole == 7);
+  CHECK(serial_warm.uses > 0);
+}
