@@ -25,6 +25,11 @@
 // same cuts from the same gathered times (the same code on the same data),
 // so the ranks agree on the owners without another message. The answer does
 // not depend on the cuts: every phase by place gives the serial result.
+//
+// Stage seven: with a spectral sea in slabs the strips are the sea's slabs
+// (set_slabs): the cuts are whole blocks of the transform's rows, a floe's
+// owner is the slab of its centroid's row, and the moves are by the cost of
+// the drift, detection and the sea's row passes, per row (set_slabs' comment).
 
 #include <cstdint>
 #include <span>
