@@ -353,6 +353,13 @@ int run(const Args& args, const parallel::Session& session) {
       << "\nparallel.advance_whole: " << share.whole << "\nparallel.advance_clusters:";
     for (const long k : share.clusters) o << " " << k;
     o << "\n";
+    // Stage seven: with a sea in slabs the strips are its slabs, their first
+    // rows (then the row count) now.
+    if (owners.has_slabs()) {
+      o << "parallel.slab_rows:";
+      for (const int row : owners.slabs().first_row) o << " " << row;
+      o << "\n";
+    }
   }
   o << "notes: " << s.notes.size() << "\n";
   for (const auto& n : s.notes) o << "  " << n << "\n";

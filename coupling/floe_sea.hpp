@@ -217,6 +217,17 @@ public:
     footprints_.set_slabs(slabs ? slab_rows_ : std::vector<int>{});
     owner_.interior_reach = -1;  // the interior cells are those of the new routes
   }
+  // The sea's slabs moved (issue 21 stage seven; first_row as
+  // fluid::Sea::slab_rows gives it, the same on every rank, at the start of
+  // a step, after the last evaluation's pressure was kicked): the cells'
+  // routes go to the new slabs' ranks, and the pressure this rank summed for
+  // its old slab's cells is cleared (the next evaluation writes its new
+  // slab's). The floes' owners stay on the slabs of set_communicator (the
+  // first ones): which rank sums which pieces fixes the round-off of a cell
+  // shared by several ranks' floes, so the answer does not depend on the
+  // timings that moved the slabs (docs/parallel.md, stage seven); their
+  // pieces' reach in rows grows by the move (MovingFootprints::reach_rows).
+  void set_slabs(std::vector<int> first_row);
   struct ImplicitStats {
     long steps = 0, newton = 0, cg = 0, g_products = 0;  // totals over the run
     double last_residual = 0.0;  // m, the last step's largest piece residual

@@ -38,6 +38,20 @@ namespace floesim {
 using parallel::at;
 using parallel::put;
 
+void FloeSeaContact::set_slabs(std::vector<int> first_row) {
+  FLOESIM_ASSERT(!slab_rows_.empty() && first_row.size() == slab_rows_.size());
+  if (first_row == slab_rows_) return;
+  // The old routes' cells: this rank's sums there are no longer read by
+  // its sea, and clear_cells_by_owner() will clear the new routes' cells.
+  if (routed() && pressure_.size() == grid_.size())
+    for (std::uint32_t c : routes_.owned()) pressure_[c] = 0.0;
+  slab_rows_ = std::move(first_row);
+  if (!routed()) return;
+  routes_ = parallel::CellRoutes(slab_rows_, static_cast<std::size_t>(grid_.nx));
+  footprints_.set_sea_slabs(slab_rows_);
+  owner_.interior_reach = -1;  // the interior cells are those of the new routes
+}
+
 void FloeSeaContact::clear_cells_by_owner() {
   // The pressure where the last evaluation put it: every rank's cells (not
   // routed) or this rank's slab's routed cells; the coverage and sums in

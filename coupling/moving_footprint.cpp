@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
 
 #include "core/error.hpp"
@@ -51,7 +52,19 @@ bool MovingFootprints::place(const Floes& floes, std::span<const std::uint8_t> i
 
 void MovingFootprints::set_slabs(std::vector<int> first_row) {
   row_owner_ = parallel::row_owners(first_row);
+  owner_rows_ = first_row;
+  sea_rows_ = std::move(first_row);
   FLOESIM_ASSERT(row_owner_.empty() || static_cast<int>(row_owner_.size()) == grid_.ny);
+}
+
+int MovingFootprints::reach_rows() const {
+  // The sea's slabs moved away from the owners' (stage seven): a floe's
+  // pieces lie within piece_rows_ of its owner's slab, which is at most the
+  // largest move of a cut away from the owner's slab in the sea now.
+  int moved = 0;
+  if (sea_rows_.size() == owner_rows_.size())
+    for (std::size_t r = 0; r < sea_rows_.size(); ++r) moved = std::max(moved, std::abs(sea_rows_[r] - owner_rows_[r]));
+  return piece_rows_ + moved;
 }
 
 void MovingFootprints::set_owners(std::span<const FloePose> poses) {
@@ -61,11 +74,7 @@ void MovingFootprints::set_owners(std::span<const FloePose> poses) {
   if (by_place_) {
     // The row of the centroid, the grid's seam crossed (periodic).
     const double dy = grid_.dy();
-    for (std::size_t i = 0; i < n; ++i) {
-      const double row = std::floor(poses[i].y / dy);
-      const double wrapped = row - static_cast<double>(grid_.ny) * std::floor(row / grid_.ny);
-      owner_[i] = row_owner_[std::min(static_cast<std::size_t>(wrapped), row_owner_.size() - 1)];
-    }
+    for (std::size_t i = 0; i < n; ++i) owner_[i] = row_owner_[static_cast<std::size_t>(parallel::grid_row(poses[i].y, dy, grid_.ny))];
   } else if (!comm_.serial()) {
     for (int r = 0; r < comm_.size(); ++r) {
       const parallel::Range share = parallel::share(n, r, comm_.size());
@@ -97,7 +106,7 @@ void MovingFootprints::rebuild_at(const Floes& floes, std::span<const std::uint8
     for (const Vec2& v : floes.vertices(i)) radius_[i] = std::max(radius_[i], v.norm());
     if (include[i]) largest = std::max(largest, radius_[i]);
   }
-  reach_rows_ = static_cast<int>(std::ceil((largest + (1.0 + options_.reach) * grid_.dy()) / grid_.dy())) + 1;
+  piece_rows_ = static_cast<int>(std::ceil((largest + (1.0 + options_.reach) * grid_.dy()) / grid_.dy())) + 1;
   area0_ = pieces_.area;
   moment0_.resize(area0_.size());
   for (std::size_t k = 0; k < area0_.size(); ++k) moment0_[k] = area0_[k] * pieces_.centroid[k];

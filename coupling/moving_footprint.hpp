@@ -52,6 +52,7 @@
 #include <span>
 #include <vector>
 
+#include "core/error.hpp"
 #include "coupling/footprint.hpp"
 #include "parallel/comm.hpp"
 
@@ -86,6 +87,14 @@ public:
   // fluid::Sea::slab_rows gives it (rank r's slab holds rows [first_row[r],
   // first_row[r + 1]) of the grid); empty: by index.
   void set_slabs(std::vector<int> first_row);
+  // The sea's slabs moved (issue 21 stage seven) while the owners stay on
+  // set_slabs' slabs: reach_rows() grows by the largest move of a cut, so
+  // that the pieces of a rank's floes still lie within reach_rows() of its
+  // slab of the sea.
+  void set_sea_slabs(std::vector<int> first_row) {
+    FLOESIM_ASSERT(first_row.size() == owner_rows_.size());
+    sea_rows_ = std::move(first_row);
+  }
   // This rank's floes, in floe order, and each floe's owner (the same on
   // every rank), as set by the last rebuild: all floes when serial.
   std::span<const std::uint32_t> mine() const { return mine_; }
@@ -95,8 +104,11 @@ public:
   // of the grid a floe's pieces may lie from the row of its centroid there,
   // until the next rebuild: its largest radius, the tent's spread of one
   // node and the window's reach, in rows, rounded up, plus one.
+  // When the sea's slabs moved away from the owners' (set_sea_slabs), the
+  // largest move of a cut is added: the pieces then lie within that many
+  // rows of their owner's slab of the sea.
   bool by_place() const { return by_place_; }
-  int reach_rows() const { return reach_rows_; }
+  int reach_rows() const;
 
   // The next placement rebuilds (the floes changed).
   void forget() { reference_.clear(); }
@@ -138,7 +150,8 @@ private:
   std::vector<int> owner_;      // per floe
   std::vector<std::uint32_t> mine_;
   bool by_place_ = false;
-  int reach_rows_ = 0;
+  int piece_rows_ = 0;  // the rows a floe's pieces may lie from its centroid's row (last rebuild)
+  std::vector<int> owner_rows_, sea_rows_;  // the slabs that give the owners (set_slabs), the sea's now (set_sea_slabs)
 };
 
 }  // namespace floesim

@@ -9,6 +9,7 @@
 
 #include "contact/substep.hpp"
 #include "core/error.hpp"
+#include "fluid/fft2d.hpp"
 #include "fluid/sea.hpp"
 #include "parallel/advance_share.hpp"
 #include "parallel/detect.hpp"
@@ -140,6 +141,11 @@ Simulation::Simulation(Scenario scenario, parallel::Communicator comm)
     floe_sea_->start(scenario_.floes, *sea_, c.coupling.start_given);
     floe_sea_->ready_loads(scenario_.floes, *sea_, incident_.get(), 0.5 * c.run.dt_max);
   }
+  // One decomposition (docs/parallel.md, stage seven): with a sea in slabs
+  // the floes' strips are its slabs, moved by whole blocks of the
+  // transform's rows (drift()); otherwise the strips' cuts are free in y.
+  if (sea_ && !sea_->slab_rows().empty())
+    owners_.set_slabs({sea_->slab_rows(), sea_->grid().dy(), fluid::RealFft2d::kRows});
   // Pieces of a split are opened by the gap that collisions keep between floes.
   if (c.fracture.enabled) percussion_ = std::make_unique<Percussion>(c.fracture, impulse_options_.min_gap);
   record_collisions_ = c.run.record_collisions;
@@ -253,7 +259,9 @@ void Simulation::drift(StepContext& ctx) {
   } else {
     // Each rank drifts the floes in its strip (each floe's drift is its own),
     // charged to the load balance, then every rank takes the others' floes.
-    owners_.update(comm_, scenario_.floes, steps_);  // floes migrate; every few steps the strips move
+    if (owners_.has_slabs()) owners_.charge_rows(sea_->take_row_seconds());  // the sea's row work, by place too
+    // Floes migrate; every few steps the strips move (with slabs, the sea's and the coupling's too).
+    if (owners_.update(comm_, scenario_.floes, steps_) && owners_.has_slabs()) follow_slabs();
     const double start = parallel::thread_seconds();
     for (const std::uint32_t i : owners_.mine())
       drift_velocities(scenario_.floes, quadrature_, drift_params_, current, wind, ctx.dt, i, i + 1, water);
@@ -262,6 +270,15 @@ void Simulation::drift(StepContext& ctx) {
   }
   ctx.momentum = momentum();
   step_budget_.external = ctx.momentum - ctx_momentum_before_;
+}
+
+void Simulation::follow_slabs() {
+  // Every rank, at the same step (the cuts are computed from the same
+  // gathered charges): the sea's row scratch and halo, the coupling's
+  // routes and owners are remade for the new slabs.
+  const std::vector<int>& first_row = owners_.slabs().first_row;
+  sea_->set_slab_rows(first_row);
+  if (floe_sea_) floe_sea_->set_slabs(first_row);
 }
 
 void Simulation::collide(StepContext& ctx) {

@@ -169,6 +169,7 @@ private:
   void floes_half_kick(const StepContext& ctx);
   void sea_half_kick(const StepContext& ctx);
   void drift(StepContext& ctx);
+  void follow_slabs();  // the sea and the coupling take the owners' moved slabs
   void collide(StepContext& ctx);
   void note_collisions();
   void percussion(const StepContext& ctx);

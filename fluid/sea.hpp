@@ -135,6 +135,14 @@ public:
   // r reads the pressure's rows [rows[r], rows[r + 1]) only. Empty when every
   // rank reads the whole pressure.
   virtual std::vector<int> slab_rows() const { return {}; }
+  // In slabs, moves the row cuts (first_row as slab_rows() gives it; whole
+  // blocks of the transform's rows; the same on every rank, before the next
+  // collective call; issue 21 stage seven). The fields become stale (their
+  // rows are the old slab's). Not in slabs: nothing.
+  virtual void set_slab_rows(std::vector<int> /*first_row*/) {}
+  // In slabs, the thread CPU seconds spent in the transforms' row passes
+  // since the last call (the part of the sea's work that follows the rows).
+  virtual double take_row_seconds() { return 0.0; }
   // In slabs, the fields computed from now on hold the present values only
   // in this rank's slab and `halo` rows either side of it (the grid's seam
   // crossed; the other rows are stale): an exchange of those rows instead of

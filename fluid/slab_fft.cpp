@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cstring>
 
+#include <time.h>
+
 #include "core/error.hpp"
 
 namespace floesim::fluid {
@@ -17,12 +19,27 @@ SlabFft2d::Span block_share(int n, int rank, int ranks) {
   return {begin, begin + base + (rank < extra ? 1 : 0)};
 }
 
+double thread_cpu_seconds() {
+  timespec t{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
+}
+
 }  // namespace
 
-SlabFft2d::SlabFft2d(const RealFft2d& fft, int nx, int ny, int rank, int ranks, Exchange exchange, unsigned flags)
+std::vector<int> SlabFft2d::equal_rows(int ny, int ranks) {
+  const int blocks = (ny + RealFft2d::kRows - 1) / RealFft2d::kRows;
+  std::vector<int> first;
+  for (int r = 0; r < ranks; ++r) first.push_back(std::min(block_share(blocks, r, ranks).begin * RealFft2d::kRows, ny));
+  first.push_back(ny);
+  return first;
+}
+
+SlabFft2d::SlabFft2d(const RealFft2d& fft, int nx, int ny, int rank, int ranks, Exchange exchange, unsigned flags,
+                     std::vector<int> first_row)
     : fft_(fft), nx_(nx), ny_(ny), hx_(nx / 2 + 1), rank_(rank), ranks_(ranks), exchange_(std::move(exchange)) {
   FLOESIM_ASSERT(ranks >= 1 && rank >= 0 && rank < ranks && (ranks == 1 || exchange_));
-  const Span own_rows = rows(), own_columns = columns();
+  const Span own_columns = columns();
   const int width = own_columns.end - own_columns.begin;
   // The smallest stride >= width with stride = hx (mod 4): row y of the slab
   // then starts at the alignment modulo 64 bytes of row y of the whole array.
@@ -30,21 +47,7 @@ SlabFft2d::SlabFft2d(const RealFft2d& fft, int nx, int ny, int rank, int ranks, 
   // columns that are contiguous (stride 1) otherwise than strided ones.
   stride_ = width + (((hx_ - width) % RealFft2d::kColumns) + RealFft2d::kColumns) % RealFft2d::kColumns;
   while (stride_ <= RealFft2d::kColumns && stride_ < hx_) stride_ += RealFft2d::kColumns;
-  row_entries_ = static_cast<std::size_t>(own_rows.end - own_rows.begin) * static_cast<std::size_t>(hx_);
-  row_spec_ = fftw_alloc_complex(std::max<std::size_t>(row_entries_, 1));
-  // The transposes' buffers at their size, once: the blocks of its rows
-  // and others' columns, and of others' rows and its columns, each sent one
-  // way and received the other.
-  std::size_t to_others = 0, from_others = 0;
-  for (int s = 0; s < ranks_; ++s) {
-    if (s == rank_) continue;
-    const Span r = rows_of(s), c = columns_of(s);
-    to_others += static_cast<std::size_t>(own_rows.end - own_rows.begin) * static_cast<std::size_t>(c.end - c.begin);
-    from_others += static_cast<std::size_t>(r.end - r.begin) * static_cast<std::size_t>(own_columns.end - own_columns.begin);
-  }
-  const std::size_t buffer = sizeof(fftw_complex) * std::max(to_others, from_others);
-  send_.reserve(buffer);
-  receive_.reserve(buffer);
+  set_rows(first_row.empty() ? equal_rows(ny_, ranks_) : std::move(first_row));
   if (width == 0) return;
   // The column plans, made on a scratch slab (planning may overwrite it) and
   // run on the callers' slabs of the same alignment (fftw_alloc_*).
@@ -61,6 +64,38 @@ SlabFft2d::SlabFft2d(const RealFft2d& fft, int nx, int ny, int rank, int ranks, 
   if (!columns_forward_[0] || !columns_backward_[0]) throw RunError("fluid: FFTW could not plan the slab transform's columns");
 }
 
+void SlabFft2d::set_rows(std::vector<int> first_row) {
+  FLOESIM_ASSERT(first_row.size() == static_cast<std::size_t>(ranks_) + 1 && first_row.front() == 0 &&
+                 first_row.back() == ny_ && std::is_sorted(first_row.begin(), first_row.end()));
+  for (int r = 1; r < ranks_; ++r) FLOESIM_ASSERT(first_row[static_cast<std::size_t>(r)] % RealFft2d::kRows == 0 || first_row[static_cast<std::size_t>(r)] == ny_);
+  first_row_ = std::move(first_row);
+  const Span own_rows = rows(), own_columns = columns();
+  fftw_free(row_spec_);
+  row_entries_ = static_cast<std::size_t>(own_rows.end - own_rows.begin) * static_cast<std::size_t>(hx_);
+  row_spec_ = fftw_alloc_complex(std::max<std::size_t>(row_entries_, 1));
+  // The transposes' buffers at their size: the blocks of its rows and
+  // others' columns, and of others' rows and its columns, each sent one
+  // way and received the other.
+  std::size_t to_others = 0, from_others = 0;
+  for (int s = 0; s < ranks_; ++s) {
+    if (s == rank_) continue;
+    const Span r = rows_of(s), c = columns_of(s);
+    to_others += static_cast<std::size_t>(own_rows.end - own_rows.begin) * static_cast<std::size_t>(c.end - c.begin);
+    from_others += static_cast<std::size_t>(r.end - r.begin) * static_cast<std::size_t>(own_columns.end - own_columns.begin);
+  }
+  const std::size_t buffer = sizeof(fftw_complex) * std::max(to_others, from_others);
+  std::vector<std::byte>().swap(send_);
+  std::vector<std::byte>().swap(receive_);
+  send_.reserve(buffer);
+  receive_.reserve(buffer);
+}
+
+double SlabFft2d::take_row_seconds() {
+  const double s = row_seconds_;
+  row_seconds_ = 0.0;
+  return s;
+}
+
 SlabFft2d::~SlabFft2d() {
   for (fftw_plan* set : {columns_forward_, columns_backward_})
     for (int k = 0; k < 2; ++k)
@@ -69,8 +104,7 @@ SlabFft2d::~SlabFft2d() {
 }
 
 SlabFft2d::Span SlabFft2d::rows_of(int rank) const {
-  const Span b = block_share(fft_.row_blocks(), rank, ranks_);
-  return {std::min(b.begin * RealFft2d::kRows, ny_), std::min(b.end * RealFft2d::kRows, ny_)};
+  return {first_row_[static_cast<std::size_t>(rank)], first_row_[static_cast<std::size_t>(rank) + 1]};
 }
 
 SlabFft2d::Span SlabFft2d::columns_of(int rank) const {
@@ -83,17 +117,23 @@ std::size_t SlabFft2d::bytes() const {
 }
 
 void SlabFft2d::forward(const double* in, fftw_complex* spec, int threads) {
-  const Span r = block_share(fft_.row_blocks(), rank_, ranks_);
-  fft_.forward_rows(in, row_spec_, r.begin, r.end, threads, rows().begin);
+  const Span r = rows();
+  const double start = thread_cpu_seconds();
+  fft_.forward_rows(in, row_spec_, (r.begin + RealFft2d::kRows - 1) / RealFft2d::kRows, (r.end + RealFft2d::kRows - 1) / RealFft2d::kRows, threads,
+                    r.begin);
+  row_seconds_ += thread_cpu_seconds() - start;
   transpose(spec, true);
   columns_pass(spec, true, threads);
 }
 
 void SlabFft2d::backward(fftw_complex* spec, double* out, int threads) {
-  const Span r = block_share(fft_.row_blocks(), rank_, ranks_);
+  const Span r = rows();
   columns_pass(spec, false, threads);
   transpose(spec, false);
-  fft_.backward_rows(row_spec_, out, r.begin, r.end, threads, rows().begin);
+  const double start = thread_cpu_seconds();
+  fft_.backward_rows(row_spec_, out, (r.begin + RealFft2d::kRows - 1) / RealFft2d::kRows, (r.end + RealFft2d::kRows - 1) / RealFft2d::kRows, threads,
+                     r.begin);
+  row_seconds_ += thread_cpu_seconds() - start;
 }
 
 void SlabFft2d::columns_pass(fftw_complex* spec, bool forward, int threads) {

@@ -8,8 +8,14 @@
 //   backward: its columns of the spectrum  ->  transpose  ->  its rows of the field (c2r)
 //
 // The shares are contiguous blocks in rank order (RealFft2d's blocks of 8
-// rows and 4 columns, shared as parallel::share shares items). Each rank
-// holds its slabs only:
+// rows and 4 columns). The columns are equal shares (parallel::share's
+// rule), fixed for the run: the modes the sea's bank holds are its columns,
+// so moving them would move the sea's state between ranks. The rows are
+// given by their cuts (first_row, whole blocks; by default equal shares) and
+// may move during a run (set_rows, issue 21 stage seven): a row slab holds
+// no state between two transforms, only scratch, and each row block is
+// transformed by the whole transform's plans wherever it lies, so the bits
+// do not depend on the cuts. Each rank holds its slabs only:
 //  - the real side is its rows, nx reals apart (the callers give a pointer to
 //    its first row: the rest of a whole field is neither read nor written);
 //  - the row pass's half spectrum is its rows, in a scratch of its own
@@ -48,8 +54,11 @@ public:
   // `fft` is the whole transform (planned on arrays of the alignment the
   // callers use); rank `rank` of `ranks`; `exchange` may be empty when
   // ranks = 1; `flags` the column plans' (FFTW_ESTIMATE or FFTW_MEASURE).
+  // `first_row`: the row cuts (ranks + 1 values, rank r's rows
+  // [first_row[r], first_row[r + 1]), each a multiple of RealFft2d::kRows
+  // but the last, ny); empty: equal shares of the row blocks.
   SlabFft2d(const RealFft2d& fft, int nx, int ny, int rank, int ranks, Exchange exchange,
-            unsigned flags = FFTW_ESTIMATE);
+            unsigned flags = FFTW_ESTIMATE, std::vector<int> first_row = {});
   ~SlabFft2d();
   SlabFft2d(const SlabFft2d&) = delete;
   SlabFft2d& operator=(const SlabFft2d&) = delete;
@@ -74,6 +83,17 @@ public:
   // first row; spec (a column slab) is destroyed.
   void backward(fftw_complex* spec, double* out, int threads);
 
+  // Moves the row cuts (as the constructor's first_row; not collective,
+  // but every rank must give the same cuts before the next transform): the
+  // row pass's scratch and the transposes' buffers are remade for them.
+  void set_rows(std::vector<int> first_row);
+  // The row cuts (ranks + 1 values) and the equal shares of the row blocks.
+  const std::vector<int>& first_rows() const { return first_row_; }
+  static std::vector<int> equal_rows(int ny, int ranks);
+  // The thread CPU seconds spent in the row passes since the last call
+  // (the rows' share of the transforms' work, for the load balance).
+  double take_row_seconds();
+
   // The bytes this transform holds: the row pass's scratch and the
   // transposes' buffers.
   std::size_t bytes() const;
@@ -92,6 +112,8 @@ private:
   // [0]: a full block of columns, [1]: the remainder (nullptr when none).
   fftw_plan columns_forward_[2] = {nullptr, nullptr}, columns_backward_[2] = {nullptr, nullptr};
   std::vector<std::byte> send_, receive_;
+  std::vector<int> first_row_;  // the row cuts, ranks + 1 values
+  double row_seconds_ = 0.0;
 };
 
 }  // namespace floesim::fluid

@@ -54,17 +54,11 @@ SpectralSea::SpectralSea(const SeaParams& params, const SeaOptions& options)
     planned = m.fft2->valid();
     m.ranks = options.ranks;
     m.slab = std::make_unique<SlabFft2d>(*m.fft2, m.nx, m.ny, m.ranks.rank, m.ranks.ranks, m.ranks.alltoall, flags);
-    m.rows = m.slab->rows();
     m.columns = m.slab->columns();
-    for (int r = 0; r < m.ranks.ranks; ++r) {
-      const SlabFft2d::Span rows = m.slab->rows_of(r);
-      m.row_bytes.push_back(sizeof(double) * static_cast<std::size_t>(rows.end - rows.begin) * m.nx);
-    }
-    // This rank's rows and column slabs (fftw_alloc_*(0) may return nullptr:
-    // a rank without rows or columns holds one entry).
-    m.real_size = static_cast<std::size_t>(m.rows.end - m.rows.begin) * static_cast<std::size_t>(m.nx);
+    m.set_rows();
+    // This rank's column slabs (fftw_alloc_*(0) may return nullptr: a rank
+    // without columns holds one entry).
     m.spec_size = m.slab->column_size();
-    m.real = fftw_alloc_real(std::max<std::size_t>(m.real_size, 1));
     m.spec = fftw_alloc_complex(std::max<std::size_t>(m.spec_size, 1));
     m.spec_vy = fftw_alloc_complex(std::max<std::size_t>(m.spec_size, 1));
   } else {
@@ -149,6 +143,16 @@ std::vector<int> SpectralSea::slab_rows() const {
   rows.push_back(m.ny);
   return rows;
 }
+
+void SpectralSea::set_slab_rows(std::vector<int> first_row) {
+  Impl& m = *impl_;
+  if (!m.slab || first_row == m.slab->first_rows()) return;
+  m.slab->set_rows(std::move(first_row));
+  m.set_rows();
+  invalidate();  // the fields' present rows were the old slab's and halo's
+}
+
+double SpectralSea::take_row_seconds() { return impl_->slab ? impl_->slab->take_row_seconds() : 0.0; }
 
 const TankZones* SpectralSea::tank() const { return impl_->tank ? &*impl_->tank : nullptr; }
 

@@ -57,6 +57,8 @@ public:
   void set_surface(std::span<const double> eta, std::span<const double> eta_t) override;
   void midpoint_step(std::span<const double> p, double h) override;
   std::vector<int> slab_rows() const override;
+  void set_slab_rows(std::vector<int> first_row) override;
+  double take_row_seconds() override;
   std::size_t modal_size() const override;
   void gather_modal_state(std::vector<double>& q, std::vector<double>& v) override;
   void set_modal_state(std::span<const double> q, std::span<const double> v) override;

@@ -90,6 +90,21 @@ struct SpectralSea::Impl {
       f(row + columns.begin, row + columns.end, static_cast<std::size_t>(iy) * width, static_cast<std::size_t>(iy) * stride);
     }
   }
+  // In slabs, after the slab transform's row cuts were set: this rank's
+  // rows, each rank's part of a field, the row scratch `real` (its rows),
+  // and the halo's lists (remade at the next exchange).
+  void set_rows() {
+    rows = slab->rows();
+    row_bytes.clear();
+    for (int r = 0; r < ranks.ranks; ++r) {
+      const SlabFft2d::Span s = slab->rows_of(r);
+      row_bytes.push_back(sizeof(double) * static_cast<std::size_t>(s.end - s.begin) * nx);
+    }
+    fftw_free(real);
+    real_size = static_cast<std::size_t>(rows.end - rows.begin) * static_cast<std::size_t>(nx);
+    real = fftw_alloc_real(std::max<std::size_t>(real_size, 1));  // fftw_alloc_*(0) may return nullptr
+    halo_exchange.rows = -1;
+  }
   // The first value of this rank's rows in a whole field (0 when not in slabs).
   std::size_t row_offset() const { return static_cast<std::size_t>(rows.begin) * static_cast<std::size_t>(nx); }
   // The columns and the bank's mode count of rank r.

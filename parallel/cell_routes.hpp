@@ -20,6 +20,8 @@
 //                       from every rank summed over all ranks: one call
 // Between the calls, owned() and total() give the owner's cells and totals.
 
+#include <algorithm>
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <span>
@@ -33,6 +35,17 @@ namespace floesim::parallel {
 // their first rows (ranks + 1 values, the last the row count): rank r's slab
 // is rows [first_row[r], first_row[r + 1]).
 std::vector<int> row_owners(std::span<const int> first_row);
+
+// The row of a periodic grid of `rows` rows of height dy (its first row at
+// y = 0) that holds y, the grid's seam crossed: floor(y / dy) modulo rows.
+// The one rule that places a floe's centroid in a slab, for the coupling's
+// owners (MovingFootprints) and the drift's and detection's
+// (FloeOwners with slabs), so that the two agree to the bit.
+inline int grid_row(double y, double dy, int rows) {
+  const double row = std::floor(y / dy);
+  const double wrapped = row - static_cast<double>(rows) * std::floor(row / rows);
+  return std::min(static_cast<int>(wrapped), rows - 1);
+}
 
 class CellRoutes {
 public:

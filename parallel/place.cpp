@@ -8,6 +8,7 @@
 #include <time.h>
 
 #include "core/error.hpp"
+#include "parallel/cell_routes.hpp"
 
 namespace floesim::parallel {
 
@@ -35,6 +36,32 @@ std::vector<double> cut_by_cost(std::span<const double> y, std::span<const doubl
   return cuts;
 }
 
+std::vector<int> cut_rows_by_cost(std::span<const double> row_cost, int block, int ranks) {
+  const int rows = static_cast<int>(row_cost.size());
+  const int blocks = (rows + block - 1) / block;
+  FLOESIM_ASSERT(block >= 1 && ranks >= 1 && blocks >= ranks);
+  // prefix[b]: the cost of the b first blocks.
+  std::vector<double> prefix(static_cast<std::size_t>(blocks) + 1, 0.0);
+  for (int b = 0; b < blocks; ++b) {
+    double c = 0.0;
+    for (int y = b * block; y < std::min(rows, (b + 1) * block); ++y) c += row_cost[static_cast<std::size_t>(y)];
+    prefix[static_cast<std::size_t>(b) + 1] = prefix[static_cast<std::size_t>(b)] + c;
+  }
+  const double total = prefix.back();
+  std::vector<int> first{0};
+  int k = 0;  // slabs 0..r-1 hold the k first blocks
+  for (int r = 1; r < ranks; ++r) {
+    const double target = total * r / ranks;
+    // At least one block for this slab and for each of the later ones.
+    const int last = blocks - (ranks - r);
+    k += 1;
+    while (k < last && std::abs(prefix[static_cast<std::size_t>(k) + 1] - target) <= std::abs(prefix[static_cast<std::size_t>(k)] - target)) ++k;
+    first.push_back(k * block);
+  }
+  first.push_back(rows);
+  return first;
+}
+
 double thread_seconds() {
   timespec t{};
   clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
@@ -59,8 +86,27 @@ void FloeOwners::set_cuts(std::vector<double> cuts) {
   cut_ = true;
 }
 
+void FloeOwners::set_slabs(RowSlabs slabs) {
+  FLOESIM_ASSERT(slabs.first_row.size() == static_cast<std::size_t>(ranks_) + 1 && slabs.dy > 0.0 && slabs.block >= 1);
+  slabs_ = std::move(slabs);
+  row_owner_ = row_owners(slabs_.first_row);
+  // The cuts in y: the slabs' boundaries (the grid's first row at y = 0).
+  std::vector<double> cuts;
+  for (int r = 1; r < ranks_; ++r) cuts.push_back(slabs_.dy * slabs_.first_row[static_cast<std::size_t>(r)]);
+  set_cuts(std::move(cuts));
+}
+
 void FloeOwners::assign(const Floes& floes) {
   const std::size_t n = floes.size();
+  if (has_slabs()) {
+    owner_.resize(n);
+    mine_.clear();
+    for (std::size_t i = 0; i < n; ++i) {
+      owner_[i] = row_owner_[static_cast<std::size_t>(grid_row(floes.state[i].y, slabs_.dy, slabs_.rows()))];
+      if (owner_[i] == rank_) mine_.push_back(static_cast<std::uint32_t>(i));
+    }
+    return;
+  }
   std::vector<double> y(n);
   for (std::size_t i = 0; i < n; ++i) y[i] = place(floes.state[i]);
   if (!cut_) set_cuts(cut_by_cost(y, std::vector<double>(n, 1.0), ranks_));
@@ -72,10 +118,63 @@ void FloeOwners::assign(const Floes& floes) {
   }
 }
 
-void FloeOwners::update(const Communicator& comm, const Floes& floes, std::size_t step) {
+bool FloeOwners::move_slabs(const Communicator& comm, const Floes& floes) {
+  // One call: each rank's (by-place seconds, row seconds) of the window.
+  const double mine[2] = {charged_, row_charged_};
+  const std::vector<double> both = comm.allgather<double>(std::span<const double>(mine, 2));
+  charged_ = row_charged_ = 0.0;
+  window_seconds_.assign(static_cast<std::size_t>(ranks_), 0.0);
+  double row_seconds = 0.0;
+  for (int r = 0; r < ranks_; ++r) {
+    window_seconds_[static_cast<std::size_t>(r)] = both[2 * static_cast<std::size_t>(r)] + both[2 * static_cast<std::size_t>(r) + 1];
+    row_seconds += both[2 * static_cast<std::size_t>(r) + 1];
+  }
+  total_seconds_.resize(window_seconds_.size(), 0.0);
+  for (std::size_t r = 0; r < window_seconds_.size(); ++r) total_seconds_[r] += window_seconds_[r];
+  const int rows = slabs_.rows();
+  const int blocks = (rows + slabs_.block - 1) / slabs_.block;
+  assign(floes);  // the floes as the window left them, in the slabs they were charged in
+  const double seconds = std::accumulate(window_seconds_.begin(), window_seconds_.end(), 0.0);
+  if (!(seconds > 0.0) || blocks < ranks_) return false;
+  // Per row: the sea's uniform row cost, plus its floes' costs (above).
+  std::vector<double> count(static_cast<std::size_t>(ranks_), 0.0);
+  for (const int r : owner_) count[static_cast<std::size_t>(r)] += 1.0;
+  std::vector<double> row_cost(static_cast<std::size_t>(rows), row_seconds / rows);
+  const std::size_t n = floes.size();
+  const double floor = n > 0 ? options_.cost_floor * (seconds - row_seconds) / static_cast<double>(n) : 0.0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const auto r = static_cast<std::size_t>(owner_[i]);
+    const double floe_seconds = both[2 * r];
+    row_cost[static_cast<std::size_t>(grid_row(floes.state[i].y, slabs_.dy, rows))] += std::max(floe_seconds / count[r], floor);
+  }
+  const std::vector<int> target = cut_rows_by_cost(row_cost, slabs_.block, ranks_);
+  // Part way, in whole blocks (half a block or more of the way rounds to a
+  // block), each slab keeping at least one block.
+  std::vector<int> first = slabs_.first_row;
+  for (int r = 1; r < ranks_; ++r) {
+    const auto k = static_cast<std::size_t>(r);
+    const double step = options_.relaxation * (target[k] - first[k]) / slabs_.block;
+    int b = first[k] / slabs_.block + static_cast<int>(std::lround(step));
+    b = std::max(b, first[k - 1] / slabs_.block + 1);
+    b = std::min(b, blocks - (ranks_ - r));
+    first[k] = b * slabs_.block;
+  }
+  if (first == slabs_.first_row) return false;
+  RowSlabs moved = slabs_;
+  moved.first_row = std::move(first);
+  set_slabs(std::move(moved));
+  ++moves_;
+  return true;
+}
+
+bool FloeOwners::update(const Communicator& comm, const Floes& floes, std::size_t step) {
+  bool moved = false;
   if (!started_) {
     started_ = true;
     next_move_ = step + static_cast<std::size_t>(options_.rebalance_steps);
+  } else if (step >= next_move_ && has_slabs()) {
+    next_move_ = step + static_cast<std::size_t>(options_.rebalance_steps);
+    moved = move_slabs(comm, floes);
   } else if (step >= next_move_) {
     next_move_ = step + static_cast<std::size_t>(options_.rebalance_steps);
     window_seconds_ = comm.allgather<double>(std::span<const double>(&charged_, 1));
@@ -99,11 +198,13 @@ void FloeOwners::update(const Communicator& comm, const Floes& floes, std::size_
       for (std::size_t k = 0; k < cuts.size(); ++k)  // part way (an infinite cut, an empty strip: all the way)
         if (std::isfinite(cuts[k]) && std::isfinite(cuts_[k])) cuts[k] = cuts_[k] + options_.relaxation * (cuts[k] - cuts_[k]);
       std::sort(cuts.begin(), cuts.end());  // already ascending but for round-off
+      moved = cuts != cuts_;
       set_cuts(std::move(cuts));
       ++moves_;
     }
   }
   assign(floes);
+  return moved;
 }
 
 contact::DetectionSubset detection_subset(const FloeOwners& owners, int rank, const Floes& floes,

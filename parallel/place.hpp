@@ -25,6 +25,11 @@
 // same cuts from the same gathered times (the same code on the same data),
 // so the ranks agree on the owners without another message. The answer does
 // not depend on the cuts: every phase by place gives the serial result.
+//
+// Stage seven: with a spectral sea in slabs the strips are the sea's slabs
+// (set_slabs): the cuts are whole blocks of the transform's rows, a floe's
+// owner is the slab of its centroid's row, and the moves are by the cost of
+// the drift, detection and the sea's row passes, per row (set_slabs' comment).
 
 #include <cstdint>
 #include <span>
@@ -69,10 +74,43 @@ double thread_seconds();
 // with equal y excepted (they stay together).
 std::vector<double> cut_by_cost(std::span<const double> y, std::span<const double> cost, int ranks);
 
+// Cuts the rows of a grid into `ranks` slabs of whole blocks of `block` rows
+// (the last block may be shorter) of equal total cost: returns the first row
+// of each slab then the row count (ranks + 1 values, as
+// fluid::Sea::slab_rows). Each cut is the block boundary where the running
+// cost, blocks taken in order, comes nearest to r/ranks of the total, so
+// that each slab's cost is within one block's cost of the mean; every slab
+// holds at least one block (there must be at least `ranks` blocks).
+std::vector<int> cut_rows_by_cost(std::span<const double> row_cost, int block, int ranks);
+
+// The spectral sea's slabs as the floes' strips (issue 21 stage seven): the
+// slabs' first rows (ranks + 1 values), the grid's row height (its first row
+// at y = 0) and the transform's block of rows, the unit a cut moves by.
+struct RowSlabs {
+  std::vector<int> first_row;
+  double dy = 1.0;
+  int block = 8;
+  int rows() const { return first_row.empty() ? 0 : first_row.back(); }
+};
+
 class FloeOwners {
 public:
   FloeOwners() = default;  // one rank: owns every floe
   FloeOwners(int rank, int ranks, const contact::Domain& domain, StripOptions options = {});
+
+  // The strips are the sea's slabs from now on (stage seven): rank r owns
+  // the floes whose centroid's row (parallel::grid_row, the rule the
+  // coupling's owners use) lies in its slab, and the moves by measured cost
+  // move the slabs' cuts by whole blocks (update()). The cost model: a row
+  // costs the sea's row work, the same for every row (the transforms' row
+  // passes: the ranks' charged row seconds summed, over the rows), plus the
+  // by-place cost of the floes whose centroid lies in it, each floe costing
+  // its owner's charged seconds over its owner's floe count (a density
+  // piecewise constant over the old slabs, floored as without slabs). The
+  // columns, and so the sea's modes, do not move.
+  void set_slabs(RowSlabs slabs);
+  bool has_slabs() const { return !slabs_.first_row.empty(); }
+  const RowSlabs& slabs() const { return slabs_; }
 
   int rank() const { return rank_; }
   int ranks() const { return ranks_; }
@@ -84,9 +122,13 @@ public:
   // steps, the cuts move by the ranks' charged times (above); then assign().
   // A step redone after an overlap calls it again with the same `step`: no
   // second move.
-  void update(const Communicator& comm, const Floes& floes, std::size_t step);
+  // Returns whether the cuts moved (with slabs: the slabs, which the sea and
+  // the coupling must then be given, on every rank alike).
+  bool update(const Communicator& comm, const Floes& floes, std::size_t step);
   // Charges this rank's CPU time (s, thread_seconds()) in by-place work since the last move.
   void charge(double seconds) { charged_ += seconds; }
+  // With slabs: charges this rank's CPU time in the sea's row work.
+  void charge_rows(double seconds) { row_charged_ += seconds; }
 
   std::span<const int> owner() const { return owner_; }  // per floe, after assign()
   const std::vector<std::uint32_t>& mine() const { return mine_; }  // this rank's floes, ascending
@@ -109,7 +151,10 @@ private:
   bool cut_ = false;  // cuts_ set (else equal counts at the next assign)
   std::vector<int> owner_;
   std::vector<std::uint32_t> mine_;
-  double charged_ = 0.0;
+  double charged_ = 0.0, row_charged_ = 0.0;
+  RowSlabs slabs_;                 // empty: free cuts in y
+  std::vector<int> row_owner_;     // with slabs: per grid row, its slab's rank
+  bool move_slabs(const Communicator& comm, const Floes& floes);
   std::size_t next_move_ = 0;
   bool started_ = false;
   int moves_ = 0;

@@ -15,8 +15,16 @@ issue 21's relative 1e-6 (`--rtol 1e-6 --atol 0`; the explicit kicks on
 several ranks sum the cells shared by ranks grouped by rank: docs/parallel.md,
 stage three).
 
+With --half, the uneven case of docs/parallel.md's stage seven: 500 floes
+of the same sizes at the same cover packed in the lower half of the box
+(`floesim pack --box 1000 500`, seed 1; the periodic contact box stays
+[0, 1000]^2), so the floes' by-place work lies in the rows 0 to 255 of the
+sea's 512. The columns slab_rows and strip_moves are the summary's
+parallel.slab_rows (the slabs' first rows at the end; stage seven) and
+parallel.strip_moves.
+
 usage: bench/ocean/ranks.py [--build build] [--until 10] [--ranks 0 1 2] [--rounds 3]
-                            [--csv FILE | -] [--note TEXT]
+                            [--half] [--csv FILE | -] [--note TEXT]
 """
 import argparse
 import os
@@ -37,16 +45,30 @@ ap.add_argument("--ranks", type=int, nargs="+", default=[0, 1, 2])
 ap.add_argument("--rounds", type=int, default=3)
 ap.add_argument("--csv", default="-")
 ap.add_argument("--note", default="")
+ap.add_argument("--half", action="store_true", help="500 floes in the lower half of the box")
 args = ap.parse_args()
 
 floesim = os.path.join(args.build, "bin", "floesim")
 work = tempfile.mkdtemp(prefix="floesim_ocean_ranks_")
-pack = os.path.join(HERE, "ocean_pack.h5")
-ocean_pack.write(floesim, pack)
 config = os.path.join(work, "ocean.toml")
+if args.half:
+    pack = os.path.join(work, "half_pack.h5")
+    cmd = [floesim, "pack", "--floes", "500", "--concentration", "0.3", "--box", "1000", "500", "--seed", "1",
+           "--min-size", "10", "--max-size", "30", "--thickness", "1", "-o", pack]
+    p = subprocess.run(cmd, capture_output=True, text=True)
+    if p.returncode != 0:
+        sys.exit(f"{' '.join(cmd)}: exit {p.returncode}\n{p.stderr}")
+else:
+    pack = os.path.join(HERE, "ocean_pack.h5")
+    ocean_pack.write(floesim, pack)
 with open(os.path.join(HERE, "ocean.toml")) as f, open(config, "w") as g:
     for line in f:
-        g.write(f'pack = "{pack}"\n' if line.startswith("pack = ") else line)
+        if line.startswith("pack = "):
+            g.write(f'pack = "{pack}"\n')
+        elif args.half and line.startswith('domain = "periodic"'):
+            g.write('domain = "periodic"\nbox = [0.0, 1000.0, 0.0, 1000.0]\n')
+        else:
+            g.write(line)
 
 reference = None
 
@@ -80,14 +102,15 @@ for r in range(args.rounds):
         print(f"round {r}, ranks {ranks}: loop {s['wall_time']} s, cpu {s['cpu_s']}", file=sys.stderr)
         rows.append([str(ranks), str(r), s["wall_time"], s["steps"], s.get("parallel.collectives", "0"),
                      s.get("parallel.bytes_received", "0"), s.get("parallel.collective_seconds", "0"), s["cpu_s"],
-                     s["equal"]] + [s.get("profile." + ph, "") for ph in phases])
+                     s["equal"]] + [s.get("profile." + ph, "") for ph in phases] +
+                    [s["raw"].get("parallel.slab_rows", ""), s.get("parallel.strip_moves", "")])
 ranks_bench.write_table(
     args.csv, f"bench/ocean/ranks.py {' '.join(sys.argv[1:])}", args.note,
-    f"bench/ocean/ocean.toml (1000 floes, 512^2 spectral sea, K = 100) to {args.until} s; ranks 0 = "
+    f"bench/ocean/ocean.toml ({'500 floes in the lower half' if args.half else '1000 floes'}, 512^2 spectral sea, K = 100) to {args.until} s; ranks 0 = "
     "the binary without mpirun; one thread per rank; wall_s = the run loop (summary wall_time); collectives, "
     "bytes_received, collective_s: rank 0's over the run (transfers and waits for the other ranks); cpu_s: CPU "
     "time (user + system) of each process, set-up (about 0.3 s) included, waits that yield the core included; "
     "equal: the run file against the first run's (bits: bit for bit; 1e-6: within rtol 1e-6, atol 0); phases: rank 0's profile (s), waits included",
     load_before, ranks_bench.load(),
     "ranks,round,wall_s,steps,collectives,bytes_received,collective_s,cpu_s,equal," +
-    ",".join(p + "_s" for p in phases), rows)
+    ",".join(p + "_s" for p in phases) + ",slab_rows,strip_moves", rows)

@@ -88,3 +88,48 @@ TEST_CASE("2D transform in slabs: each rank's slab equals the whole transform's 
     }
   }
 }
+
+// Stage seven (docs/parallel.md): the row cuts move during a run
+// (SlabFft2d::set_rows, whole blocks of 8 rows, uneven); each rank's slabs
+// are still the whole transform's bits, after every move, and the moved
+// slabs cover the rows once. Fails if a rank kept the old row scratch or the
+// transposes counted the old rows (the exchange's counts then mismatch).
+TEST_CASE("2D transform in slabs: moved row cuts keep every rank's bits") {
+  const int nx = 64, ny = 48;  // 6 blocks of rows
+  const testing::WholeTransform whole(nx, ny);
+  REQUIRE(whole.fft.valid());
+  const std::vector<std::vector<int>> moves[] = {
+      {{0, 8, 48}, {0, 40, 48}, {0, 24, 48}},             // 2 ranks: one block, then five, then equal
+      {{0, 8, 16, 48}, {0, 32, 40, 48}, {0, 16, 32, 48}},  // 3 ranks
+  };
+  for (const auto& cuts : moves) {
+    const int ranks = static_cast<int>(cuts.front().size()) - 1;
+    ThreadExchange exchange(ranks);
+    std::vector<std::unique_ptr<SlabFft2d>> slabs;
+    for (int r = 0; r < ranks; ++r)
+      slabs.push_back(std::make_unique<SlabFft2d>(whole.fft, nx, ny, r, ranks, exchange.of(r), FFTW_ESTIMATE, cuts.front()));
+    for (const std::vector<int>& first_row : cuts) {
+      INFO(ranks << " ranks, cut at rows " << first_row[1]);
+      std::vector<testing::SlabCheck> checks(static_cast<std::size_t>(ranks));
+      std::vector<std::thread> threads;
+      for (int r = 0; r < ranks; ++r)
+        threads.emplace_back([&, r] {
+          SlabFft2d& slab = *slabs[static_cast<std::size_t>(r)];
+          slab.set_rows(first_row);
+          checks[static_cast<std::size_t>(r)] = testing::check_slab(whole, slab);
+        });
+      for (std::thread& t : threads) t.join();
+      CHECK_FALSE(exchange.mismatched);
+      std::vector<int> covered(static_cast<std::size_t>(ny), 0);
+      for (int r = 0; r < ranks; ++r) {
+        const testing::SlabCheck& check = checks[static_cast<std::size_t>(r)];
+        CHECK(check.rows.begin == first_row[static_cast<std::size_t>(r)]);
+        CHECK(check.rows.end == first_row[static_cast<std::size_t>(r) + 1]);
+        CHECK(check.spectrum_equal);
+        CHECK(check.inverse_equal);
+        for (int y = check.rows.begin; y < check.rows.end; ++y) covered[static_cast<std::size_t>(y)] += 1;
+      }
+      CHECK(std::all_of(covered.begin(), covered.end(), [](int k) { return k == 1; }));
+    }
+  }
+}

@@ -11,6 +11,7 @@
 #include <numeric>
 #include <random>
 
+#include "parallel/cell_routes.hpp"
 #include "parallel/place.hpp"
 
 TEST_SUITE_BEGIN("mpi");
@@ -85,5 +86,81 @@ TEST_CASE("floe owners: equal counts at the start, the cuts' strips after, wrapp
   owners.assign(floes);
   CHECK(owners.owner()[1] == 1);
   CHECK(owners.mine() == std::vector<std::uint32_t>{0, 1, 3, 4, 5});
+}
+// Stage seven: the rows cut in whole blocks by cost (parallel::cut_rows_by_cost).
+TEST_CASE("the rows cut in blocks by cost: whole blocks, every block once, one block at least a rank, equal within a block") {
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  for (const int rows : {16, 45, 128, 512}) {
+    // A uniform cost a row (the sea) plus a heavy band (floes packed there).
+    std::vector<double> cost(static_cast<std::size_t>(rows));
+    for (int y = 0; y < rows; ++y) cost[static_cast<std::size_t>(y)] = 1.0 + (y < rows / 3 ? 6.0 * unit(rng) : 0.0);
+    const int blocks = (rows + 7) / 8;
+    for (const int ranks : {1, 2, 3, 5}) {
+      if (ranks > blocks) continue;
+      INFO(rows << " rows, " << ranks << " ranks");
+      const std::vector<int> first = parallel::cut_rows_by_cost(cost, 8, ranks);
+      REQUIRE(first.size() == static_cast<std::size_t>(ranks) + 1);
+      CHECK(first.front() == 0);
+      CHECK(first.back() == rows);
+      double total = 0.0, block_cost = 0.0;
+      for (int b = 0; b < blocks; ++b) {
+        double c = 0.0;
+        for (int y = 8 * b; y < std::min(rows, 8 * b + 8); ++y) c += cost[static_cast<std::size_t>(y)];
+        block_cost = std::max(block_cost, c);
+        total += c;
+      }
+      for (int r = 0; r < ranks; ++r) {
+        const int a = first[static_cast<std::size_t>(r)], e = first[static_cast<std::size_t>(r) + 1];
+        CHECK(e - a >= std::min(8, rows - a));  // one block at least
+        if (r > 0) CHECK(a % 8 == 0);           // whole blocks
+        const double slab = std::accumulate(cost.begin() + a, cost.begin() + e, 0.0);
+        CHECK(std::abs(slab - total / ranks) <= block_cost);
+      }
+      // The heavy third holds more than its share of the rows on 2 ranks:
+      // the first slab is narrower than half.
+      if (ranks == 2 && rows >= 128) CHECK(first[1] < rows / 2);
+    }
+  }
+  // All the cost in one block: every slab still gets a block.
+  std::vector<double> spike(64, 0.0);
+  spike[20] = 1.0;
+  const std::vector<int> first = parallel::cut_rows_by_cost(spike, 8, 4);
+  REQUIRE(first.size() == 5);
+  for (std::size_t r = 0; r < 4; ++r) {
+    CHECK(first[r] % 8 == 0);
+    CHECK(first[r + 1] - first[r] >= 8);
+  }
+  CHECK(first.back() == 64);
+}
+
+// Stage seven: with slabs, a floe's owner is its centroid's row's slab
+// (parallel::grid_row, the rule MovingFootprints::set_owners applies for the
+// coupling, so the two agree on every floe), and the strips' cuts in y are
+// the slabs' boundaries.
+TEST_CASE("floe owners with slabs: the owner is the slab of the centroid's row, the cuts its boundaries") {
+  Floes floes;
+  // Grid: 32 rows of 6.25 m (200 m, periodic); slabs {0, 8, 24, 32}.
+  const double ys[] = {0.0, 49.999, 50.0, 149.99, 150.0, 199.99, -1.0, 201.0, 55.0};
+  for (const double y : ys) {
+    FloeState s{};
+    s.y = y;
+    floes.state.push_back(s);
+    floes.thickness.push_back(1.0);
+  }
+  contact::Domain box{true, 0.0, 200.0, 0.0, 200.0};
+  parallel::FloeOwners owners(1, 3, box);
+  owners.set_slabs({{0, 8, 24, 32}, 6.25, 8});
+  CHECK(owners.cuts() == std::vector<double>{50.0, 150.0});
+  owners.assign(floes);
+  const std::vector<int> rows = parallel::row_owners(std::vector<int>{0, 8, 24, 32});
+  for (std::size_t i = 0; i < floes.size(); ++i) {
+    INFO("y = " << ys[i]);
+    CHECK(owners.owner()[i] == rows[static_cast<std::size_t>(parallel::grid_row(ys[i], 6.25, 32))]);
+    // The same as the strip of the wrapped y between the cuts.
+    CHECK(owners.owner()[i] == strip(owners.cuts(), owners.place(floes.state[i])));
+  }
+  CHECK(std::vector<int>(owners.owner().begin(), owners.owner().end()) == std::vector<int>{0, 0, 1, 1, 2, 2, 2, 0, 1});
+  CHECK(owners.mine() == std::vector<std::uint32_t>{2, 3, 8});
 }
 TEST_SUITE_END();

@@ -1,0 +1,106 @@
+#!/usr/bin/env python3
+"""The sea's slabs moved by measured cost during a run (docs/parallel.md,
+stage seven) against the serial run.
+
+usage: check_slab_moves.py FLOESIM MPIEXEC WORKDIR
+       check_slab_moves.py --no-mpi    (MPI not built: exits 77, ctest's skip code)
+
+120 floes of 6 to 15 m packed in the lower half of a 200 m x 200 m periodic
+box on a 128^2 spectral sea (JONSWAP, Hs = 1 m, Tp = 6 s) under wind,
+footprints moved between rebuilds: the floes' drift and detection cost is
+all in rows 0 to 63, the sea's row work is the same in every row, so the
+cuts move from the equal shares toward the floes (parallel.slab_rows, every
+10 steps by the gathered CPU times). Checked:
+  - the slabs moved (parallel.strip_moves > 0 and parallel.slab_rows not the
+    equal shares) on 2 and 3 ranks;
+  - the run files equal the serial one within issue 21's relative 1e-6 (as
+    mpi.sea_ranks_equal_serial: a cell with pieces of floes of several ranks
+    sums them grouped by rank);
+  - two runs on 2 ranks are equal bit for bit: the slabs' moves follow the
+    timings, but the answer does not depend on them (the sea's row blocks
+    are transformed by the same plans wherever they lie, and the coupling's
+    floe owners, which fix the round-off grouping, stay on the first slabs).
+"""
+import os
+import sys
+
+from ranks_harness import Ranks, need
+
+if "--no-mpi" in sys.argv:
+    print("floesim was built without MPI (FLOESIM_MPI=OFF): the moving slabs are not checked")
+    sys.exit(77)
+
+floesim, mpiexec, W = sys.argv[1:4]
+harness = Ranks(floesim, mpiexec, W)
+run, mpirun = harness.run, harness.mpirun
+failures = []
+
+need(run([floesim, "pack", "--floes", "120", "--concentration", "0.5", "--box", "200", "100", "--seed", "3",
+          "--min-size", "6", "--max-size", "15", "--thickness", "1", "-o", "half_pack.h5"]), "floesim pack")
+config = os.path.join(W, "half.toml")
+with open(config, "w") as f:
+    f.write("""[run]
+t_end = 3.0
+dt_max = 0.05
+output_interval = 0.5
+seed = 2
+threads = 1
+
+[sea]
+model = "spectral"
+dims = 2
+size = [200.0, 200.0]
+cells = [128, 128]
+depth = 50.0
+
+[sea.waves]
+kind = "jonswap"
+hs = 1.0
+tp = 6.0
+
+[floes]
+pack = "half_pack.h5"
+
+[contact]
+domain = "periodic"
+box = [0.0, 200.0, 0.0, 200.0]
+
+[forcing]
+wind = [15.0, 5.0]
+
+[coupling]
+law = "strong"
+stiffness = 100.0
+footprint_reach = 0.3
+""")
+
+
+def summary(p):
+    return dict(l.split(": ", 1) for l in p.stdout.splitlines() if ": " in l)
+
+
+def compare(a, b, rtol):
+    return run([floesim, "compare", a, b, "--rtol", rtol, "--atol", "0"])
+
+
+need(run([floesim, "run", config, "-o", "serial.h5", "-q"]), "the serial run")
+EQUAL = {2: [0, 64, 128], 3: [0, 48, 88, 128]}  # SlabFft2d::equal_rows: 16 blocks of 8 rows
+for n, out in ((2, "ranks2.h5"), (3, "ranks3.h5"), (2, "ranks2_again.h5")):
+    s = summary(need(mpirun(n, "run", config, "-o", out), f"the run on {n} ranks"))
+    rows = [int(x) for x in s.get("parallel.slab_rows", "").split()]
+    moves = int(s.get("parallel.strip_moves", "0"))
+    print(f"{n} ranks ({out}): slabs {rows}, {moves} moves, floes by strip {s.get('parallel.strip_floes')}")
+    if moves == 0 or rows == EQUAL[n]:
+        failures.append(f"{n} ranks: the slabs did not move ({rows}, {moves} moves): the check would not test the moves")
+    p = compare(out, "serial.h5", "1e-6")
+    print(f"{n} ranks ({out}): {'equal' if p.returncode == 0 else 'DIFFERENT'} to the serial run (within 1e-6)")
+    if p.returncode != 0:
+        failures.append(f"{out} against the serial run:\n{p.stdout}")
+p = compare("ranks2.h5", "ranks2_again.h5", "0")
+print(f"two runs on 2 ranks: {'equal' if p.returncode == 0 else 'DIFFERENT'} (bit for bit)")
+if p.returncode != 0:
+    failures.append(f"two runs on 2 ranks:\n{p.stdout}")
+
+if failures:
+    print("FAILED:\n" + "\n".join(failures))
+    sys.exit(1)
