@@ -281,13 +281,17 @@ int run(const Args& args, const parallel::Session& session) {
   const int status = s.status == "complete" ? 0 : kInterruptedExit;
   if (!comm.writer()) return status;  // rank 0 reports the run
 
+  // steps counts the run's steps from its start; the rate, this process's
+  // (a restart's steps before its checkpoint took none of its wall time).
+  const std::size_t before = restart ? static_cast<std::size_t>(checkpoint.steps) : 0;
+  const std::size_t run_steps = s.steps >= before ? s.steps - before : 0;
   std::ostream& o = std::cout;
   o << "status: " << s.status << "\nconfig: " << (config_path.empty() ? args.restart + " (its config)" : config_path);
   if (restart) o << "\nrestarted_from: " << args.restart << " at t = " << checkpoint.time << " s";
   o << "\ncheckpoint: " << (s.checkpoint_time >= 0.0 ? std::to_string(s.checkpoint_time) + " s" : "none") << "\noutput: " << fs::absolute(s.output).string()
     << "\nparaview: " << fs::absolute(s.xdmf).string() << "\nfloes: " << sim.floes().size() << "\nsteps: " << s.steps
     << "\nrecords: " << s.records << "\nsimulated: " << s.t_end << " s\nwall_time: " << std::setprecision(4)
-    << s.wall_seconds << " s\nsteps_per_second: " << (s.wall_seconds > 0 ? static_cast<double>(s.steps) / s.wall_seconds : 0.0)
+    << s.wall_seconds << " s\nsteps_per_second: " << (s.wall_seconds > 0 ? static_cast<double>(run_steps) / s.wall_seconds : 0.0)
     << "\n";
   o << std::setprecision(8);
   for (std::size_t k = 0; k < s.energy_last.names.size(); ++k)

@@ -84,10 +84,20 @@ def case_progress_after_restart():
         value, unit = line.split("ETA ")[1].split()[:2]
         return float(value) * {"s": 1.0, "min": 60.0, "h": 3600.0}[unit]
 
-    first = lines_of(run("run", "--until", "10", "--log-every", "0.2", "-o", "first.h5"))
+    p = run("run", "--until", "10", "--log-every", "0.2", "-o", "first.h5")
+    first = lines_of(p)
+    at_checkpoint = int(dict(l.split(": ", 1) for l in p.stdout.splitlines() if ": " in l)["steps"])  # its end
     check(len(first) >= 3, f"progress lines of the first run: {first}")
-    continued = lines_of(run("run", "--restart", "first.h5", "--until", "20", "--log-every", "0.2", "-o", "next.h5"))
+    p = run("run", "--restart", "first.h5", "--until", "20", "--log-every", "0.2", "-o", "next.h5")
+    continued = lines_of(p)
     check(len(continued) >= 1, "progress lines of the restarted run")
+    # The summary's rate too: steps_per_second times wall_time is this run's
+    # steps (the total less the checkpoint's), not the total.
+    summary = dict(l.split(": ", 1) for l in p.stdout.splitlines() if ": " in l)
+    total = int(summary["steps"])
+    own = float(summary["steps_per_second"]) * float(summary["wall_time"].split()[0])
+    check(abs(own - (total - at_checkpoint)) <= 0.01 * total + 1,
+          f"the summary's rate counts this run's {total - at_checkpoint} steps, not {total}: {own:.1f}")
     fastest = max(rate(l) for l in first)
     check(rate(continued[0]) <= 5 * fastest,
           f"the restart's rate counts its own steps: {continued[0]} against the first run's {fastest:.0f} steps/s")
