@@ -94,29 +94,42 @@ DragLoad drag_load(const Floes& floes, const FootprintQuadrature& q, std::size_t
   return load;
 }
 
+namespace {
+// W_n -> W_{n+1} of dynamic floe i (drift_velocities).
+void drift_velocity(Floes& floes, const FootprintQuadrature& q, const DriftParams& p, const Vec2& current,
+                    const Vec2& wind, double dt, std::size_t i, std::span<const Vec2> floe_current) {
+  FloeState& s = floes.state[i];
+  const double m = floes.mass[i];
+  const DragLoad load = drag_load(floes, q, i, p, floe_current.empty() ? current : floe_current[i], wind);
+  // Coriolis -f k x (m V) = f m (vy, -vx).
+  const double fm = p.coriolis * m;
+  Eigen::Vector3d F = load.force;
+  F.x() += fm * s.vy;
+  F.y() -= fm * s.vx;
+  Eigen::Matrix3d Jc = Eigen::Matrix3d::Zero();
+  Jc(0, 1) = fm;
+  Jc(1, 0) = -fm;
+  Eigen::Matrix3d A = Eigen::Vector3d(m, m, floes.inertia_z[i]).asDiagonal();
+  A -= dt * load.jacobian + 0.5 * dt * Jc;
+  const Eigen::Vector3d dW = A.partialPivLu().solve(dt * F);
+  s.vx += dW.x();
+  s.vy += dW.y();
+  s.yaw_rate += dW.z();
+}
+}  // namespace
+
 void drift_velocities(Floes& floes, const FootprintQuadrature& q, const DriftParams& p,
                       const Vec2& current, const Vec2& wind, double dt, std::size_t begin, std::size_t end,
                       std::span<const Vec2> floe_current) {
-  for (std::size_t i = begin; i < end; ++i) {
-    if (floes.is_static[i]) continue;
-    FloeState& s = floes.state[i];
-    const double m = floes.mass[i];
-    const DragLoad load = drag_load(floes, q, i, p, floe_current.empty() ? current : floe_current[i], wind);
-    // Coriolis -f k x (m V) = f m (vy, -vx).
-    const double fm = p.coriolis * m;
-    Eigen::Vector3d F = load.force;
-    F.x() += fm * s.vy;
-    F.y() -= fm * s.vx;
-    Eigen::Matrix3d Jc = Eigen::Matrix3d::Zero();
-    Jc(0, 1) = fm;
-    Jc(1, 0) = -fm;
-    Eigen::Matrix3d A = Eigen::Vector3d(m, m, floes.inertia_z[i]).asDiagonal();
-    A -= dt * load.jacobian + 0.5 * dt * Jc;
-    const Eigen::Vector3d dW = A.partialPivLu().solve(dt * F);
-    s.vx += dW.x();
-    s.vy += dW.y();
-    s.yaw_rate += dW.z();
-  }
+  for (std::size_t i = begin; i < end; ++i)
+    if (!floes.is_static[i]) drift_velocity(floes, q, p, current, wind, dt, i, floe_current);
+}
+
+void drift_velocities(Floes& floes, const FootprintQuadrature& q, const DriftParams& p,
+                      const Vec2& current, const Vec2& wind, double dt, std::span<const std::uint32_t> which,
+                      std::span<const Vec2> floe_current) {
+  for (const std::uint32_t i : which)
+    if (!floes.is_static[i]) drift_velocity(floes, q, p, current, wind, dt, i, floe_current);
 }
 
 void advance_positions(Floes& floes, double dt, std::size_t begin, std::size_t end) {

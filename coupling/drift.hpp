@@ -25,6 +25,7 @@
 // each split into 4^level sub-triangles (level 0 by default: the fan
 // triangles themselves) with the 6-point degree-4 rule.
 
+#include <cstdint>
 #include <span>
 #include <vector>
 
@@ -68,6 +69,10 @@ DragLoad drag_load(const Floes& floes, const FootprintQuadrature& q, std::size_t
 // floe by floe (the current plus the waves' orbital velocity under each floe).
 void drift_velocities(Floes& floes, const FootprintQuadrature& q, const DriftParams& p,
                       const Vec2& current, const Vec2& wind, double dt, std::size_t begin, std::size_t end,
+                      std::span<const Vec2> floe_current = {});
+// The same for the floes listed in `which` (e.g. a rank's own floes).
+void drift_velocities(Floes& floes, const FootprintQuadrature& q, const DriftParams& p,
+                      const Vec2& current, const Vec2& wind, double dt, std::span<const std::uint32_t> which,
                       std::span<const Vec2> floe_current = {});
 
 // x_{n+1} = x_n + dt W for floes [begin, end).

@@ -263,8 +263,7 @@ void Simulation::drift(StepContext& ctx) {
     // Floes migrate; every few steps the strips move (with slabs, the sea's and the coupling's too).
     if (owners_.update(comm_, scenario_.floes, steps_) && owners_.has_slabs()) follow_slabs();
     const double start = parallel::thread_seconds();
-    for (const std::uint32_t i : owners_.mine())
-      drift_velocities(scenario_.floes, quadrature_, drift_params_, current, wind, ctx.dt, i, i + 1, water);
+    drift_velocities(scenario_.floes, quadrature_, drift_params_, current, wind, ctx.dt, owners_.mine(), water);
     owners_.charge(parallel::thread_seconds() - start);
     comm_.complete_owned(scenario_.floes.state, owners_.owner());
   }
