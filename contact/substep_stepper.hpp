@@ -1,0 +1,202 @@
+#pragma once
+// The multirate advance's stepper (contact/substep.hpp): internal to
+// substep.cpp and substep_jam.cpp, which define its members (the jams' time
+// steps in the latter).
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <span>
+#include <vector>
+
+#include "contact/detection.hpp"
+#include "contact/impulse.hpp"
+#include "contact/substep.hpp"
+
+namespace floesim::contact::detail {
+
+inline constexpr double kInf = std::numeric_limits<double>::infinity();
+inline constexpr int kFree = -1;
+// A sub-step is halved after an overlap down to this fraction of the floor.
+inline constexpr double kHalvingFloor = 0x1.0p-20;
+
+// Pairs measured with their contact points and witnesses.
+struct Measured {
+  std::vector<NearPair> pairs;
+  std::vector<ContactPoint> contacts;
+  std::vector<Witness> witnesses;
+};
+
+// A cluster being sub-stepped. Its floes move on straight lines between its
+// sub-step ends (tau_snap -> tau), where its collisions are resolved.
+struct Cluster {
+  std::vector<std::uint32_t> members;  // dynamic floes
+  double tau = 0.0;                    // s into the step: where the cluster is
+  double tau_snap = 0.0;               // start of its last sub-step
+  std::vector<FloeState> snap;         // members' states at tau_snap (velocities of that sub-step)
+  std::vector<std::uint32_t> internal; // pairs: members with members, and with obstacles
+  Measured cur;                        // the internal pairs measured at tau
+  bool alive = true;                   // false once merged into another cluster
+  bool events_only = false;            // its time step overlapped: events for the rest of the step
+  double jam_h = std::numeric_limits<double>::infinity();  // s, its time step (halved when one overlaps)
+};
+
+// One call of advance_with_collisions (the steps of substep.hpp). Clusters
+// are advanced in time order, one sub-step at a time (the cluster furthest
+// behind goes next), so when one must merge with another, that one has a
+// sub-step in progress that started no later than now: its floes are put
+// where their straight paths take them now, and the two go on together.
+class Stepper {
+public:
+  Stepper(Floes& floes, const CollisionShapes& shapes, const Detection& detection, double dt,
+          const SubstepOptions& options, CollisionStats& stats, SubstepReport& report,
+          const ClusterShare* share = nullptr)
+      : floes_(floes), shapes_(shapes), det_(&detection), dt_(dt), opt_(options), stats_(stats), report_(report),
+        share_(share) {}
+
+  // A share's run (advance_share): what it did.
+  ShareOutcome outcome() const {
+    ShareOutcome o;
+    o.conflict = conflict_;
+    o.floor_tau = floor_tau_;
+    o.floor_cluster = floor_cluster_;
+    for (std::size_t k = 0; k < clusters_.size(); ++k) {
+      if (!own_[k]) continue;
+      ++o.clusters;
+      if (clusters_[k].alive) o.moved.insert(o.moved.end(), clusters_[k].members.begin(), clusters_[k].members.end());
+    }
+    std::sort(o.moved.begin(), o.moved.end());
+    return o;
+  }
+
+  // The advance over dt (substep.hpp, steps 1 to 5), of the share's clusters
+  // only when given one.
+  void run();
+
+private:
+  std::uint32_t other(std::uint32_t p, std::uint32_t i) const {
+    const NearPair& q = det_->pairs[p];
+    return q.a == i ? q.b : q.a;
+  }
+
+  // The floe on its straight path, tau after the start of the step.
+  FloeState linear(std::uint32_t i, double tau) const {
+    return drifted(start_[i], tau);
+  }
+
+  // How far any point of floe i is from where its straight path would put it.
+  double deviation(std::uint32_t i, double tau) const {
+    const FloeState l = linear(i, tau);
+    const FloeState& s = floes_.state[i];
+    return std::hypot(s.x - l.x, s.y - l.y) + shapes_.radius[i] * std::abs(s.yaw - l.yaw);
+  }
+
+  void rebuild_pairs();
+
+  // pairs_of(i): indices of the candidate pairs of floe i (compressed rows).
+  void build_pair_index();
+  std::span<const std::uint32_t> pairs_of(std::uint32_t i) const {
+    return {pair_list_.data() + pair_offsets_[i], pair_offsets_[i + 1] - pair_offsets_[i]};
+  }
+
+  // Clusters: connected components of the hot pairs between dynamic floes,
+  // grown through tight pairs (room below xi: a floe of the cluster that
+  // collides would soon bring the other in anyway, one at a time), numbered
+  // by their lowest floe.
+  void make_clusters();
+
+  // jam_of_[i]: the jam of floe i (-1: none), jams_: their floes.
+  void find_jams();
+
+  // Budget of each member: half the room of each pair with a floe outside
+  // the cluster (obstacles do not move: their pairs are internal).
+  void compute_budgets(int k);
+
+  void collect_internal(int k);
+
+  // Measures a cluster's internal pairs at the present poses into m; true if
+  // one overlaps.
+  bool measure(const Cluster& c, Measured& m) const;
+  void measure_internal(Cluster& c);
+
+  void snapshot(Cluster& c) {
+    c.snap.clear();
+    for (std::uint32_t i : c.members) c.snap.push_back(floes_.state[i]);
+    c.tau_snap = c.tau;
+  }
+  void restore(Cluster& c) {
+    for (std::size_t m = 0; m < c.snap.size(); ++m) floes_.state[c.members[m]] = c.snap[m];
+  }
+
+  // The speculative contact of witness w of pair q (impulse.hpp).
+  static ContactPoint speculative(const NearPair& q, const Witness& w) {
+    return {q.a, q.b, 0.5 * (w.pa + w.pb), w.normal, w.distance, q.shift, true, w.vertex_of_b};
+  }
+
+  // One event of cluster k: a sub-step, or floes joining it at its time.
+  void advance_cluster(int k);
+
+  // The floes outside cluster k whose pairs with its members, now at time t1,
+  // are past the members' budgets: free ones to joining_, clusters to merging_.
+  void collect_breaks(int k, double t1);
+
+  // A dense cluster (jam.floes floes or more) takes the rest of the step in
+  // one go: its contacts rest and every point of its pairs beyond xi is a
+  // speculative contact for that time (impulse.hpp), one LCP instead of an
+  // event, and an LCP of the whole cluster, each time one of its many pairs
+  // meets. If that overlaps after all (a pair turning faster than its
+  // linearised witness gaps tell: an error in h^2), the time step is redone
+  // with half the length; below jam.step_floor dt the cluster goes back to
+  // events for the rest of the step.
+  void time_step(int k);
+
+  // The floes in joining_ (free) and the clusters in merging_ join cluster k
+  // at its time: a free floe where its straight path puts it, a cluster's
+  // floes where its sub-step in progress puts them (it started no later than
+  // now: time order). Then the collisions at that time are resolved.
+  void bring_in(int k);
+
+  // An event's collisions: contacts approaching no faster than rest_speed
+  // rest (restitution 0, impulse.hpp), the others are impacts.
+  void collide(const std::vector<ContactPoint>& contacts) {
+    resolve_collisions(floes_, contacts, opt_.impulse, stats_,
+                       slow_contacts(floes_, contacts, opt_.impulse.rest_speed));
+  }
+
+  Floes& floes_;
+  const CollisionShapes& shapes_;
+  const Detection* det_;
+  Detection rebuilt_;  // when the pair list had to be rebuilt
+  double dt_;
+  const SubstepOptions& opt_;
+  CollisionStats& stats_;
+  SubstepReport& report_;
+  const ClusterShare* share_;          // null: every cluster (the serial advance)
+  std::vector<std::uint8_t> own_;      // per cluster: run by this call
+  ShareOutcome::Conflict conflict_ = ShareOutcome::Conflict::none;
+  double floor_tau_ = -1.0;            // the last floor step's key (tau, cluster)
+  long floor_cluster_ = -1;
+
+  std::vector<FloeState> start_;       // at the start of the step: the straight paths
+  std::vector<double> lin_;            // m, linear travel of each floe over the step
+  std::vector<double> room_;           // m, per pair, over the step on straight paths
+  std::vector<std::size_t> pair_offsets_;
+  std::vector<std::uint32_t> pair_list_;
+  std::vector<int> cluster_of_;        // kFree or a cluster
+  std::vector<Cluster> clusters_;
+  std::vector<double> budget_, reach_left_;  // m, per floe
+  std::vector<std::uint8_t> outran_;
+  PosedShapes posed_;
+  std::vector<std::uint32_t> stamp_;
+  std::uint32_t epoch_ = 0;
+  Measured next_;                      // a cluster's pairs after the sub-step being tried
+  std::vector<std::uint32_t> joining_;
+  std::vector<int> merging_;
+  std::array<Measured, 2> wide_;                 // time_step: the pairs measured within wider ranges (two rounds)
+  std::vector<int> jam_of_;                      // per floe: its jam, or -1
+  std::vector<std::vector<std::uint32_t>> jams_; // the floes of each jam
+};
+
+}  // namespace floesim::contact::detail
