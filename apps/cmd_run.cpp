@@ -243,6 +243,7 @@ int run(const Args& args, const parallel::Session& session) {
     simulation = std::make_unique<Simulation>(build_scenario(config), comm);
     if (restart) {
       simulation->restore(checkpoint);
+      release_restored(checkpoint);  // the simulation holds that state now; the run keeps the marks
       // A new output starts as a copy of the run; the records after the checkpoint are dropped from it.
       if (comm.writer() && !(path_exists(output) && fs::equivalent(output, args.restart))) {
         std::error_code ec;

@@ -288,4 +288,11 @@ Checkpoint read_checkpoint(const std::string& path) {
   return c;
 }
 
+void release_restored(Checkpoint& c) {
+  c.sea = ModalState{};
+  c.incident = IncidentState{};
+  c.floe_sea = FloeSeaState{};
+  c.warm = WarmStartState{};
+}
+
 }  // namespace floesim

@@ -99,6 +99,12 @@ struct Checkpoint {
   std::vector<long long> record_floes;  // floes numbered at each of those records (/floes tables' sizes)
 };
 
+// Lets go of the state a Simulation has taken in restore(): the seas', the
+// contact's and the warm starts' parts (on a large sea, 64 B a cell). What a
+// continued run still reads is kept: the marks above, the counters and the
+// floes' numbering (RunWriter's Resume).
+void release_restored(Checkpoint& c);
+
 // Written by RunWriter::write_checkpoint (core/run_file.hpp).
 // Reads the checkpoint of a run file. Throws InputError naming the file when
 // it has none ("the run has no checkpoint"), or one of another version, or a
