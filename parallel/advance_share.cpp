@@ -4,6 +4,7 @@
 #include <array>
 #include <cstring>
 
+#include "core/error.hpp"
 #include "parallel/bytes.hpp"
 
 namespace floesim::parallel {
@@ -26,9 +27,10 @@ std::array<long*, kReport> fields(SubstepReport& r) {
 }
 
 // The header's longs: conflict, moved, clusters, floor_cluster, the floor
-// pair's length, the stats, the report; then floor_tau, the moved floes,
-// their states and the floor pair's text.
-constexpr std::size_t kHeader = 5 + kStats + kReport;
+// pair's length, the states' count (the moved floes' when the share had no
+// conflict, else none), the stats, the report; then floor_tau, the moved
+// floes, their states and the floor pair's text.
+constexpr std::size_t kHeader = 6 + kStats + kReport;
 
 }  // namespace
 
@@ -40,7 +42,8 @@ std::vector<std::byte> pack(const AdvancePart& part) {
   head[2] = p.outcome.clusters;
   head[3] = p.outcome.floor_cluster;
   head[4] = static_cast<long>(p.report.floor_pair.size());
-  std::size_t k = 5;
+  head[5] = static_cast<long>(p.states.size());
+  std::size_t k = 6;
   for (long* f : fields(p.stats)) head[k++] = *f;
   for (long* f : fields(p.report)) head[k++] = *f;
   std::vector<std::byte> out(sizeof(head) + sizeof(double) + p.outcome.moved.size() * sizeof(std::uint32_t) +
@@ -64,7 +67,10 @@ AdvancePart unpack_advance_part(std::span<const std::byte> bytes) {
   p.outcome.clusters = head[2];
   p.outcome.floor_cluster = head[3];
   const auto text = static_cast<std::size_t>(head[4]);
-  std::size_t k = 5;
+  const auto states = static_cast<std::size_t>(head[5]);
+  FLOESIM_ASSERT(bytes.size() == sizeof(head) + sizeof(double) + moved * sizeof(std::uint32_t) +
+                                     states * sizeof(FloeState) + text);
+  std::size_t k = 6;
   for (long* f : fields(p.stats)) *f = head[k++];
   for (long* f : fields(p.report)) *f = head[k++];
   p.outcome.floor_tau = at<double>(in, 0);
@@ -72,9 +78,9 @@ AdvancePart unpack_advance_part(std::span<const std::byte> bytes) {
   p.outcome.moved.resize(moved);
   for (std::size_t j = 0; j < moved; ++j) p.outcome.moved[j] = at<std::uint32_t>(in, j);
   in += moved * sizeof(std::uint32_t);
-  p.states.resize(moved);
-  for (std::size_t j = 0; j < moved; ++j) p.states[j] = at<FloeState>(in, j);
-  in += moved * sizeof(FloeState);
+  p.states.resize(states);
+  for (std::size_t j = 0; j < states; ++j) p.states[j] = at<FloeState>(in, j);
+  in += states * sizeof(FloeState);
   p.report.floor_pair.assign(reinterpret_cast<const char*>(in), text);
   return p;
 }
