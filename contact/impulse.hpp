@@ -96,6 +96,7 @@
 #include <span>
 #include <string>
 #include <unordered_map>
+#include <utility>
 #include <vector>
 
 #include "contact/detection.hpp"
@@ -293,6 +294,18 @@ struct CollisionStats {
   long warm = 0;          // of lcps, solved by Lemke warm-started from the last basis (or its normal flags alone)
   long warm_missed = 0;   // warm starts that ended without an accepted solution (then solved from scratch)
 };
+
+// The counts of `s` by name, in one list (checkpoints, sums over ranks):
+// pointers into s (const or not, as s is).
+template <class Stats>
+auto collision_counts(Stats& s) {
+  return std::array{std::pair{"contacts", &s.contacts}, std::pair{"lcps", &s.lcps},
+                    std::pair{"pivots", &s.pivots}, std::pair{"failures", &s.failures},
+                    std::pair{"fallbacks", &s.fallbacks}, std::pair{"flagged", &s.flagged},
+                    std::pair{"gauss_seidel", &s.gauss_seidel}, std::pair{"tolerated", &s.tolerated},
+                    std::pair{"largest", &s.largest}, std::pair{"total_size", &s.total_size},
+                    std::pair{"warm", &s.warm}, std::pair{"warm_missed", &s.warm_missed}};
+}
 
 // The normal relative velocity (m/s, > 0: separating) contact c must reach
 // in its LCP (above): 0, the gap stabilisation's, a speculative contact's

@@ -49,9 +49,11 @@
 // With no collision in sight this is one step for every floe; the cost of a
 // collision is the cost of its cluster's sub-steps, not of the whole pack's.
 
+#include <array>
 #include <cstdint>
 #include <span>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "contact/detection.hpp"
@@ -81,6 +83,17 @@ struct SubstepReport {
   long reach_exceeded = 0;  // cluster floes that went past their reach (left to the caller's check)
   std::string floor_pair;   // the last pair that held a sub-step at the floor
 };
+
+// The counts of `r` by name, in one list (checkpoints, sums over ranks):
+// pointers into r (const or not, as r is); floor_pair is not a count.
+template <class Report>
+auto substep_counts(Report& r) {
+  return std::array{std::pair{"clusters", &r.clusters}, std::pair{"substeps", &r.substeps},
+                    std::pair{"time_steps", &r.time_steps}, std::pair{"largest_cluster", &r.largest_cluster},
+                    std::pair{"joined", &r.joined}, std::pair{"merges", &r.merges},
+                    std::pair{"rejected", &r.rejected}, std::pair{"floor_steps", &r.floor_steps},
+                    std::pair{"rebuilt", &r.rebuilt}, std::pair{"reach_exceeded", &r.reach_exceeded}};
+}
 
 // Advances the floes over dt as stated above. Throws RunError when a sub-step
 // overlaps however short it is made.

@@ -73,18 +73,10 @@ Checkpoint Simulation::save() {
   if (floe_sea_) c.floe_sea = floe_sea_->saved_state();
   c.warm = save_warm(*warm_);
   Counters k;
-  const contact::CollisionStats& s = stats_;
-  for (auto [name, v] : {std::pair{"contacts", s.contacts}, {"lcps", s.lcps}, {"pivots", s.pivots},
-                         {"failures", s.failures}, {"fallbacks", s.fallbacks}, {"flagged", s.flagged},
-                         {"gauss_seidel", s.gauss_seidel}, {"tolerated", s.tolerated}, {"largest", s.largest},
-                         {"total_size", s.total_size}, {"warm", s.warm}, {"warm_missed", s.warm_missed}})
-    k.add(std::string("collisions.") + name, static_cast<double>(v));
+  for (const auto& [name, v] : contact::collision_counts(stats_))
+    k.add(std::string("collisions.") + name, static_cast<double>(*v));
   const contact::SubstepReport& r = substeps_;
-  for (auto [name, v] : {std::pair{"clusters", r.clusters}, {"substeps", r.substeps}, {"time_steps", r.time_steps},
-                         {"largest_cluster", r.largest_cluster}, {"joined", r.joined}, {"merges", r.merges},
-                         {"rejected", r.rejected}, {"floor_steps", r.floor_steps}, {"rebuilt", r.rebuilt},
-                         {"reach_exceeded", r.reach_exceeded}})
-    k.add(std::string("substeps.") + name, static_cast<double>(v));
+  for (const auto& [name, v] : contact::substep_counts(r)) k.add(std::string("substeps.") + name, static_cast<double>(*v));
   c.floor_pair = r.floor_pair;
   k.add("rejected_steps", static_cast<double>(rejected_steps_));
   k.add("budget.external_x", budget_.external.x());
@@ -147,18 +139,9 @@ void Simulation::restore(const Checkpoint& c) {
   if (floe_sea_) floe_sea_->restore(c.floe_sea, scenario_.floes, *sea_, incident_.get());
   restore_warm(c.warm, *warm_);
 
-  contact::CollisionStats& s = stats_;
-  for (auto [name, v] : {std::pair{"contacts", &s.contacts}, {"lcps", &s.lcps}, {"pivots", &s.pivots},
-                         {"failures", &s.failures}, {"fallbacks", &s.fallbacks}, {"flagged", &s.flagged},
-                         {"gauss_seidel", &s.gauss_seidel}, {"tolerated", &s.tolerated}, {"largest", &s.largest},
-                         {"total_size", &s.total_size}, {"warm", &s.warm}, {"warm_missed", &s.warm_missed}})
-    *v = count(std::string("collisions.") + name);
+  for (const auto& [name, v] : contact::collision_counts(stats_)) *v = count(std::string("collisions.") + name);
   contact::SubstepReport& r = substeps_;
-  for (auto [name, v] : {std::pair{"clusters", &r.clusters}, {"substeps", &r.substeps}, {"time_steps", &r.time_steps},
-                         {"largest_cluster", &r.largest_cluster}, {"joined", &r.joined}, {"merges", &r.merges},
-                         {"rejected", &r.rejected}, {"floor_steps", &r.floor_steps}, {"rebuilt", &r.rebuilt},
-                         {"reach_exceeded", &r.reach_exceeded}})
-    *v = count(std::string("substeps.") + name);
+  for (const auto& [name, v] : contact::substep_counts(r)) *v = count(std::string("substeps.") + name);
   r.floor_pair = c.floor_pair;
   rejected_steps_ = count("rejected_steps");
   budget_.external = Vec2{counter("budget.external_x"), counter("budget.external_y")};

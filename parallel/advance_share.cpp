@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <array>
 #include <cstring>
+#include <tuple>
+#include <utility>
 
 #include "core/error.hpp"
 #include "parallel/bytes.hpp"
@@ -15,16 +17,8 @@ using contact::CollisionStats;
 using contact::ShareOutcome;
 using contact::SubstepReport;
 
-constexpr std::size_t kStats = 12, kReport = 10;
-
-std::array<long*, kStats> fields(CollisionStats& s) {
-  return {&s.contacts, &s.lcps,     &s.pivots,  &s.failures,   &s.fallbacks, &s.flagged,
-          &s.gauss_seidel, &s.tolerated, &s.largest, &s.total_size, &s.warm, &s.warm_missed};
-}
-std::array<long*, kReport> fields(SubstepReport& r) {
-  return {&r.clusters, &r.substeps, &r.time_steps, &r.largest_cluster, &r.joined,
-          &r.merges,   &r.rejected, &r.floor_steps, &r.rebuilt,        &r.reach_exceeded};
-}
+constexpr std::size_t kStats = std::tuple_size_v<decltype(contact::collision_counts(std::declval<CollisionStats&>()))>;
+constexpr std::size_t kReport = std::tuple_size_v<decltype(contact::substep_counts(std::declval<SubstepReport&>()))>;
 
 // The header's longs: conflict, moved, clusters, floor_cluster, the floor
 // pair's length, the states' count (the moved floes' when the share had no
@@ -34,8 +28,7 @@ constexpr std::size_t kHeader = 6 + kStats + kReport;
 
 }  // namespace
 
-std::vector<std::byte> pack(const AdvancePart& part) {
-  AdvancePart p = part;  // fields() takes non-const members
+std::vector<std::byte> pack(const AdvancePart& p) {
   std::array<long, kHeader> head{};
   head[0] = static_cast<long>(p.outcome.conflict);
   head[1] = static_cast<long>(p.outcome.moved.size());
@@ -44,8 +37,8 @@ std::vector<std::byte> pack(const AdvancePart& part) {
   head[4] = static_cast<long>(p.report.floor_pair.size());
   head[5] = static_cast<long>(p.states.size());
   std::size_t k = 6;
-  for (long* f : fields(p.stats)) head[k++] = *f;
-  for (long* f : fields(p.report)) head[k++] = *f;
+  for (const auto& [name, f] : contact::collision_counts(p.stats)) head[k++] = *f;
+  for (const auto& [name, f] : contact::substep_counts(p.report)) head[k++] = *f;
   std::vector<std::byte> out(sizeof(head) + sizeof(double) + p.outcome.moved.size() * sizeof(std::uint32_t) +
                              p.states.size() * sizeof(FloeState) + p.report.floor_pair.size());
   std::byte* at = put(out.data(), head.data(), head.size());
@@ -71,8 +64,8 @@ AdvancePart unpack_advance_part(std::span<const std::byte> bytes) {
   FLOESIM_ASSERT(bytes.size() == sizeof(head) + sizeof(double) + moved * sizeof(std::uint32_t) +
                                      states * sizeof(FloeState) + text);
   std::size_t k = 6;
-  for (long* f : fields(p.stats)) *f = head[k++];
-  for (long* f : fields(p.report)) *f = head[k++];
+  for (const auto& [name, f] : contact::collision_counts(p.stats)) *f = head[k++];
+  for (const auto& [name, f] : contact::substep_counts(p.report)) *f = head[k++];
   p.outcome.floor_tau = at<double>(in, 0);
   in += sizeof(double);
   p.outcome.moved.resize(moved);
@@ -110,14 +103,17 @@ bool combine_parts(std::span<const AdvancePart> parts, Floes& floes, CollisionSt
   // list's rebuild, which every share did alike (taken once).
   const AdvancePart* floor = nullptr;
   for (const AdvancePart& p : parts) {
-    AdvancePart q = p;
-    const std::array<long*, kStats> to = fields(stats), from = fields(q.stats);
+    const auto to = contact::collision_counts(stats);
+    const auto from = contact::collision_counts(p.stats);
     for (std::size_t k = 0; k < kStats; ++k)
-      *to[k] = from[k] == &q.stats.largest ? std::max(*to[k], *from[k]) : *to[k] + *from[k];
-    const std::array<long*, kReport> rto = fields(report), rfrom = fields(q.report);
+      *to[k].second = from[k].second == &p.stats.largest ? std::max(*to[k].second, *from[k].second)
+                                                          : *to[k].second + *from[k].second;
+    const auto rto = contact::substep_counts(report);
+    const auto rfrom = contact::substep_counts(p.report);
     for (std::size_t k = 0; k < kReport; ++k) {
-      if (rfrom[k] == &q.report.rebuilt) continue;
-      *rto[k] = rfrom[k] == &q.report.largest_cluster ? std::max(*rto[k], *rfrom[k]) : *rto[k] + *rfrom[k];
+      if (rfrom[k].second == &p.report.rebuilt) continue;
+      *rto[k].second = rfrom[k].second == &p.report.largest_cluster ? std::max(*rto[k].second, *rfrom[k].second)
+                                                                    : *rto[k].second + *rfrom[k].second;
     }
     // The serial queue's last floor step: the largest key (tau, cluster).
     if (p.report.floor_steps > 0 &&
