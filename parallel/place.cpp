@@ -118,35 +118,54 @@ void FloeOwners::assign(const Floes& floes) {
   }
 }
 
-bool FloeOwners::move_slabs(const Communicator& comm, const Floes& floes) {
-  // One call: each rank's (by-place seconds, row seconds) of the window.
+FloeOwners::WindowCharges FloeOwners::close_window(const Communicator& comm) {
+  // One call: each rank's by-place seconds (and with slabs its row seconds) of the window.
+  WindowCharges w;
+  const int per_rank = has_slabs() ? 2 : 1;
   const double mine[2] = {charged_, row_charged_};
-  const std::vector<double> both = comm.allgather<double>(std::span<const double>(mine, 2));
+  const std::vector<double> all = comm.allgather<double>(std::span<const double>(mine, static_cast<std::size_t>(per_rank)));
   charged_ = row_charged_ = 0.0;
   window_seconds_.assign(static_cast<std::size_t>(ranks_), 0.0);
-  double row_seconds = 0.0;
-  for (int r = 0; r < ranks_; ++r) {
-    window_seconds_[static_cast<std::size_t>(r)] = both[2 * static_cast<std::size_t>(r)] + both[2 * static_cast<std::size_t>(r) + 1];
-    row_seconds += both[2 * static_cast<std::size_t>(r) + 1];
+  w.floe.assign(static_cast<std::size_t>(ranks_), 0.0);
+  for (std::size_t r = 0; r < static_cast<std::size_t>(ranks_); ++r) {
+    const double row = per_rank == 2 ? all[2 * r + 1] : 0.0;
+    w.floe[r] = all[static_cast<std::size_t>(per_rank) * r];
+    w.rows += row;
+    window_seconds_[r] = w.floe[r] + row;
   }
   total_seconds_.resize(window_seconds_.size(), 0.0);
   for (std::size_t r = 0; r < window_seconds_.size(); ++r) total_seconds_[r] += window_seconds_[r];
+  return w;
+}
+
+std::vector<double> FloeOwners::floe_costs(std::span<const double> floe_seconds) const {
+  // A floe costs its owner's by-place seconds over its owner's floe count,
+  // floored at cost_floor of the mean (StripOptions).
+  std::vector<double> count(static_cast<std::size_t>(ranks_), 0.0);
+  for (const int r : owner_) count[static_cast<std::size_t>(r)] += 1.0;
+  const std::size_t n = owner_.size();
+  const double seconds = std::accumulate(floe_seconds.begin(), floe_seconds.end(), 0.0);
+  const double floor = n > 0 ? options_.cost_floor * seconds / static_cast<double>(n) : 0.0;
+  std::vector<double> cost(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const auto r = static_cast<std::size_t>(owner_[i]);
+    cost[i] = std::max(floe_seconds[r] / count[r], floor);  // count[r] >= 1: floe i is r's
+  }
+  return cost;
+}
+
+bool FloeOwners::move_slabs(const Communicator& comm, const Floes& floes) {
+  const WindowCharges w = close_window(comm);
   const int rows = slabs_.rows();
   const int blocks = (rows + slabs_.block - 1) / slabs_.block;
   assign(floes);  // the floes as the window left them, in the slabs they were charged in
   const double seconds = std::accumulate(window_seconds_.begin(), window_seconds_.end(), 0.0);
   if (!(seconds > 0.0) || blocks < ranks_) return false;
   // Per row: the sea's uniform row cost, plus its floes' costs (above).
-  std::vector<double> count(static_cast<std::size_t>(ranks_), 0.0);
-  for (const int r : owner_) count[static_cast<std::size_t>(r)] += 1.0;
-  std::vector<double> row_cost(static_cast<std::size_t>(rows), row_seconds / rows);
-  const std::size_t n = floes.size();
-  const double floor = n > 0 ? options_.cost_floor * (seconds - row_seconds) / static_cast<double>(n) : 0.0;
-  for (std::size_t i = 0; i < n; ++i) {
-    const auto r = static_cast<std::size_t>(owner_[i]);
-    const double floe_seconds = both[2 * r];
-    row_cost[static_cast<std::size_t>(grid_row(floes.state[i].y, slabs_.dy, rows))] += std::max(floe_seconds / count[r], floor);
-  }
+  std::vector<double> row_cost(static_cast<std::size_t>(rows), w.rows / rows);
+  const std::vector<double> cost = floe_costs(w.floe);
+  for (std::size_t i = 0; i < floes.size(); ++i)
+    row_cost[static_cast<std::size_t>(grid_row(floes.state[i].y, slabs_.dy, rows))] += cost[i];
   const std::vector<int> target = cut_rows_by_cost(row_cost, slabs_.block, ranks_);
   // Part way, in whole blocks (half a block or more of the way rounds to a
   // block), each slab keeping at least one block.
@@ -167,41 +186,32 @@ bool FloeOwners::move_slabs(const Communicator& comm, const Floes& floes) {
   return true;
 }
 
+bool FloeOwners::move_cuts(const Communicator& comm, const Floes& floes) {
+  const WindowCharges w = close_window(comm);
+  assign(floes);  // the floes as the window left them, in the strips they were charged in
+  const double seconds = std::accumulate(w.floe.begin(), w.floe.end(), 0.0);
+  const std::size_t n = floes.size();
+  if (!(seconds > 0.0) || n == 0) return false;
+  std::vector<double> y(n);
+  for (std::size_t i = 0; i < n; ++i) y[i] = place(floes.state[i]);
+  std::vector<double> cuts = cut_by_cost(y, floe_costs(w.floe), ranks_);
+  for (std::size_t k = 0; k < cuts.size(); ++k)  // part way (an infinite cut, an empty strip: all the way)
+    if (std::isfinite(cuts[k]) && std::isfinite(cuts_[k])) cuts[k] = cuts_[k] + options_.relaxation * (cuts[k] - cuts_[k]);
+  std::sort(cuts.begin(), cuts.end());  // already ascending but for round-off
+  const bool moved = cuts != cuts_;
+  set_cuts(std::move(cuts));
+  ++moves_;
+  return moved;
+}
+
 bool FloeOwners::update(const Communicator& comm, const Floes& floes, std::size_t step) {
   bool moved = false;
   if (!started_) {
     started_ = true;
     next_move_ = step + static_cast<std::size_t>(options_.rebalance_steps);
-  } else if (step >= next_move_ && has_slabs()) {
-    next_move_ = step + static_cast<std::size_t>(options_.rebalance_steps);
-    moved = move_slabs(comm, floes);
   } else if (step >= next_move_) {
     next_move_ = step + static_cast<std::size_t>(options_.rebalance_steps);
-    window_seconds_ = comm.allgather<double>(std::span<const double>(&charged_, 1));
-    charged_ = 0.0;
-    total_seconds_.resize(window_seconds_.size(), 0.0);
-    for (std::size_t r = 0; r < window_seconds_.size(); ++r) total_seconds_[r] += window_seconds_[r];
-    assign(floes);  // the floes as the window left them, in the strips they were charged in
-    std::vector<double> count(static_cast<std::size_t>(ranks_), 0.0);
-    for (const int r : owner_) count[static_cast<std::size_t>(r)] += 1.0;
-    const double seconds = std::accumulate(window_seconds_.begin(), window_seconds_.end(), 0.0);
-    const std::size_t n = floes.size();
-    if (seconds > 0.0 && n > 0) {
-      const double floor = options_.cost_floor * seconds / static_cast<double>(n);
-      std::vector<double> y(n), cost(n);
-      for (std::size_t i = 0; i < n; ++i) {
-        const auto r = static_cast<std::size_t>(owner_[i]);
-        y[i] = place(floes.state[i]);
-        cost[i] = std::max(window_seconds_[r] / count[r], floor);  // count[r] >= 1: floe i is r's
-      }
-      std::vector<double> cuts = cut_by_cost(y, cost, ranks_);
-      for (std::size_t k = 0; k < cuts.size(); ++k)  // part way (an infinite cut, an empty strip: all the way)
-        if (std::isfinite(cuts[k]) && std::isfinite(cuts_[k])) cuts[k] = cuts_[k] + options_.relaxation * (cuts[k] - cuts_[k]);
-      std::sort(cuts.begin(), cuts.end());  // already ascending but for round-off
-      moved = cuts != cuts_;
-      set_cuts(std::move(cuts));
-      ++moves_;
-    }
+    moved = has_slabs() ? move_slabs(comm, floes) : move_cuts(comm, floes);
   }
   assign(floes);
   return moved;

@@ -154,7 +154,16 @@ private:
   double charged_ = 0.0, row_charged_ = 0.0;
   RowSlabs slabs_;                 // empty: free cuts in y
   std::vector<int> row_owner_;     // with slabs: per grid row, its slab's rank
+  // A window's charged seconds, gathered (one collective call): per rank
+  // its by-place seconds, and the ranks' row seconds summed.
+  struct WindowCharges {
+    std::vector<double> floe;
+    double rows = 0.0;
+  };
+  WindowCharges close_window(const Communicator& comm);
+  std::vector<double> floe_costs(std::span<const double> floe_seconds) const;  // per floe, after assign()
   bool move_slabs(const Communicator& comm, const Floes& floes);
+  bool move_cuts(const Communicator& comm, const Floes& floes);
   std::size_t next_move_ = 0;
   bool started_ = false;
   int moves_ = 0;
