@@ -41,7 +41,7 @@ import argparse
 import os
 import sys
 
-from ranks_harness import Ranks, need
+from ranks_harness import Ranks, need, ocean_toml, summary
 
 if "--no-mpi" in sys.argv:
     print("floesim was built without MPI (FLOESIM_MPI=OFF): the distributed sea runs are not checked")
@@ -62,12 +62,12 @@ run, mpirun = harness.run, harness.mpirun
 
 
 def same(a, b):
-    return run([args.floesim, "compare", a, b, "--rtol", "0", "--atol", "0"])
+    return harness.compare(a, b, 0)
 
 
 def close(a, b):
     """Within issue 21's relative 1e-6, everywhere (no absolute slack)."""
-    return run([args.floesim, "compare", a, b, "--rtol", "1e-6", "--atol", "0"])
+    return harness.compare(a, b, "1e-6")
 
 
 def check(out, ref, exact):
@@ -81,38 +81,7 @@ def how(exact):
 need(run([args.floesim, "pack", "--floes", "60", "--concentration", "0.3", "--box", "200", "200", "--seed", "3",
           "--min-size", "10", "--max-size", "30", "--thickness", "1", "-o", "sea_pack.h5"]), "floesim pack")
 
-BASE = f"""[run]
-t_end = {args.t_end}
-dt_max = 0.05
-output_interval = {args.t_end / 4}
-seed = 2
-threads = 1
-
-[sea]
-model = "spectral"
-dims = 2
-size = [200.0, 200.0]
-cells = [128, 128]
-depth = 50.0
-
-[sea.waves]
-kind = "jonswap"
-hs = 1.0
-tp = 6.0
-
-[floes]
-pack = "sea_pack.h5"
-
-[contact]
-domain = "periodic"
-
-[forcing]
-wind = [15.0, 5.0]
-
-[coupling]
-law = "strong"
-stiffness = 100.0
-"""
+BASE = ocean_toml("sea_pack.h5", args.t_end, args.t_end / 4)
 VARIANTS = {
     "rebuilt": "",
     "moved": "footprint_reach = 0.3\n",
@@ -124,11 +93,11 @@ for name, extra in VARIANTS.items():
     with open(config, "w") as f:
         f.write(BASE + extra)
     serial = need(run([args.floesim, "run", config, "-o", f"{name}_serial.h5", "-q"]), f"{name}: serial run")
-    summary = dict(l.split(": ", 1) for l in serial.stdout.splitlines() if ": " in l)
-    print(f"{name}: serial to {args.t_end} s, {summary.get('steps')} steps, "
-          f"{summary.get('footprints.rebuilds')} footprint rebuilds of {summary.get('footprints.placements')} "
-          f"placements, {summary.get('collisions.lcps')} collision LCPs")
-    if name == "moved" and summary.get("footprints.rebuilds") == summary.get("footprints.placements"):
+    s = summary(serial)
+    print(f"{name}: serial to {args.t_end} s, {s.get('steps')} steps, "
+          f"{s.get('footprints.rebuilds')} footprint rebuilds of {s.get('footprints.placements')} "
+          f"placements, {s.get('collisions.lcps')} collision LCPs")
+    if name == "moved" and s.get("footprints.rebuilds") == s.get("footprints.placements"):
         failures.append("moved: every placement rebuilt the footprints: the check would not test the moves")
     for n in args.ranks:
         out = f"{name}_{n}.h5"
@@ -158,9 +127,9 @@ for name, until, extra in (("splits", "2.237", ""), ("splits_implicit", "4", '\n
         f.write(split_text + extra)
     serial = need(run([args.floesim, "run", config, "-o", f"{name}_serial.h5", "-q", "--until", until]),
                   f"{name}: serial run")
-    summary = dict(l.split(": ", 1) for l in serial.stdout.splitlines() if ": " in l)
-    print(f"{name}: serial to {until} s, {summary.get('fracture.splits')} splits, {summary.get('floes')} floes at the end")
-    if summary.get("fracture.splits", "0") == "0":
+    s = summary(serial)
+    print(f"{name}: serial to {until} s, {s.get('fracture.splits')} splits, {s.get('floes')} floes at the end")
+    if s.get("fracture.splits", "0") == "0":
         failures.append(f"{name}: no floe split: the check would not test a changing floe count")
     exact = bool(extra)
     for n in (2, 3):

@@ -24,7 +24,7 @@ cuts move from the equal shares toward the floes (parallel.slab_rows, every
 import os
 import sys
 
-from ranks_harness import Ranks, need
+from ranks_harness import Ranks, need, ocean_toml, summary
 
 if "--no-mpi" in sys.argv:
     print("floesim was built without MPI (FLOESIM_MPI=OFF): the moving slabs are not checked")
@@ -39,48 +39,12 @@ need(run([floesim, "pack", "--floes", "120", "--concentration", "0.5", "--box", 
           "--min-size", "6", "--max-size", "15", "--thickness", "1", "-o", "half_pack.h5"]), "floesim pack")
 config = os.path.join(W, "half.toml")
 with open(config, "w") as f:
-    f.write("""[run]
-t_end = 3.0
-dt_max = 0.05
-output_interval = 0.5
-seed = 2
-threads = 1
-
-[sea]
-model = "spectral"
-dims = 2
-size = [200.0, 200.0]
-cells = [128, 128]
-depth = 50.0
-
-[sea.waves]
-kind = "jonswap"
-hs = 1.0
-tp = 6.0
-
-[floes]
-pack = "half_pack.h5"
-
-[contact]
-domain = "periodic"
-box = [0.0, 200.0, 0.0, 200.0]
-
-[forcing]
-wind = [15.0, 5.0]
-
-[coupling]
-law = "strong"
-stiffness = 100.0
-footprint_reach = 0.3
-""")
-
-
-def summary(p):
-    return dict(l.split(": ", 1) for l in p.stdout.splitlines() if ": " in l)
+    f.write(ocean_toml("half_pack.h5", 3.0, 0.5, contact="box = [0.0, 200.0, 0.0, 200.0]\n",
+                       coupling="footprint_reach = 0.3\n"))
 
 
 def compare(a, b, rtol):
-    return run([floesim, "compare", a, b, "--rtol", rtol, "--atol", "0"])
+    return harness.compare(a, b, rtol)
 
 
 need(run([floesim, "run", config, "-o", "serial.h5", "-q"]), "the serial run")

@@ -1,7 +1,9 @@
-"""What the distributed-run checks share (check_ranks.py, check_sea_ranks.py):
-commands run in the work folder with MPI allowed as root (CI containers) and
-one thread per rank, `mpirun --oversubscribe`, and a stop with the command's
-output when a step that must work fails."""
+"""What the distributed-run checks share (check_ranks.py, check_sea_ranks.py,
+check_slab_moves.py, check_rank_killed.py): commands run in the work folder
+with MPI allowed as root (CI containers) and one thread per rank, `mpirun
+--oversubscribe`, `floesim compare`, the run summary as a dict, the small
+ocean the sea checks run on, and a stop with the command's output when a
+step that must work fails."""
 import os
 import subprocess
 import sys
@@ -19,6 +21,54 @@ class Ranks:
 
     def mpirun(self, n, *floesim_args):
         return self.run([self.mpiexec, "--oversubscribe", "-np", str(n), self.floesim, *floesim_args])
+
+    def compare(self, a, b, rtol):
+        """`floesim compare` of two run files within the relative `rtol` (no absolute slack)."""
+        return self.run([self.floesim, "compare", a, b, "--rtol", str(rtol), "--atol", "0"])
+
+
+def summary(p):
+    """The run summary a finished `floesim run` printed, key -> text."""
+    return dict(l.split(": ", 1) for l in p.stdout.splitlines() if ": " in l)
+
+
+def ocean_toml(pack, t_end, output_interval, contact="", coupling=""):
+    """A small ocean like bench/ocean/ocean.toml: the floes of `pack` in a
+    200 m x 200 m periodic box on a 128^2 spectral sea (JONSWAP, Hs = 1 m,
+    Tp = 6 s, 50 m deep) under wind, riding on it through the strong penalty
+    law (K = 100); `contact` and `coupling` are lines added to those tables."""
+    return f"""[run]
+t_end = {t_end}
+dt_max = 0.05
+output_interval = {output_interval}
+seed = 2
+threads = 1
+
+[sea]
+model = "spectral"
+dims = 2
+size = [200.0, 200.0]
+cells = [128, 128]
+depth = 50.0
+
+[sea.waves]
+kind = "jonswap"
+hs = 1.0
+tp = 6.0
+
+[floes]
+pack = "{pack}"
+
+[contact]
+domain = "periodic"
+{contact}
+[forcing]
+wind = [15.0, 5.0]
+
+[coupling]
+law = "strong"
+stiffness = 100.0
+{coupling}"""
 
 
 def need(p, what):
