@@ -247,8 +247,10 @@ void FloeSeaContact::evaluate(const Floes& floes, fluid::Sea& sea, double h) {
   // reach_rows() of its slab: the sea's fields are exchanged there only.
   const bool halo = routed() && footprints_.by_place();
   if (halo) sea.set_field_halo(footprints_.reach_rows());
-  const std::span<const double> eta = sea.elevation();
-  std::span<const double> w;
+  // Windows of the rows held (by place: the slab and that halo; else whole),
+  // read by global cell.
+  const fluid::RowWindow eta = sea.field(fluid::Field::elevation);
+  fluid::RowWindow w;
   if (s_ < 1.0) w = sea.field(fluid::Field::velocity_z);
   if (halo) sea.set_field_halo(-1);
   const double ks = s_ * kappa_, inv_cell_area = 1.0 / cell_area_;

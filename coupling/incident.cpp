@@ -35,9 +35,9 @@ double IncidentSea::interval_for(const SeaParams& params) {
 }
 
 void IncidentSea::take(std::vector<double>& u, std::vector<double>& v) {
-  const std::span<const double> fu = sea_->field(fluid::Field::velocity_x);
+  const std::span<const double> fu = sea_->field(fluid::Field::velocity_x).all();
   u.assign(fu.begin(), fu.end());
-  const std::span<const double> fv = sea_->field(fluid::Field::velocity_y);
+  const std::span<const double> fv = sea_->field(fluid::Field::velocity_y).all();
   v.assign(fv.begin(), fv.end());
 }
 

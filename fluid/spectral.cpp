@@ -152,6 +152,10 @@ void SpectralSea::set_slab_rows(std::vector<int> first_row) {
   invalidate();  // the fields' present rows were the old slab's and halo's
 }
 
+Sea::WindowRows SpectralSea::field_rows(int halo) const { return impl_->window(halo); }
+
+bool SpectralSea::in_slabs() const { return impl_->slab != nullptr; }
+
 double SpectralSea::take_row_seconds() { return impl_->slab ? impl_->slab->take_row_seconds() : 0.0; }
 
 const TankZones* SpectralSea::tank() const { return impl_->tank ? &*impl_->tank : nullptr; }
