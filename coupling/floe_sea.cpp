@@ -387,9 +387,14 @@ void FloeSeaContact::ready_loads(const Floes& floes, fluid::Sea& sea, IncidentSe
 void FloeSeaContact::update_water(const Floes& floes, const fluid::Sea& sea, IncidentSea* incident) {
   water_.assign(floes.size(), Vec2::Zero());
   if (!incident) return;
-  incident->advance_to(sea.time());
+  // Routed with the floes owned by place, this rank's floes' pieces lie
+  // within reach_rows() of its first slab (the coupling's owners keep the
+  // first slabs), which is the incident sea's slab (it keeps its first,
+  // equal, shares): the snapshots are windows of that slab and halo.
+  const int halo = routed() && footprints_.by_place() ? footprints_.reach_rows() : -1;
+  incident->advance_to(sea.time(), halo);
   const double w = incident->weight(sea.time());
-  const std::span<const double> u0 = incident->u0(), v0 = incident->v0(), u1 = incident->u1(), v1 = incident->v1();
+  const fluid::RowWindow u0 = incident->u0(), v0 = incident->v0(), u1 = incident->u1(), v1 = incident->v1();
   const Footprints& fp = footprints_.pieces();
   // Each rank its own floes; the caller shares them (share_owned).
   const std::span<const std::uint32_t> mine = footprints_.mine();

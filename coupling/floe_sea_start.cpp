@@ -141,8 +141,10 @@ void FloeSeaContact::start(Floes& floes, fluid::Sea& sea, bool given) {
   // halo). Copied: set_surface below changes the state they were of.
   const std::span<const double> wave = sea.field(fluid::Field::elevation).all();
   const std::vector<double> wave_eta(wave.begin(), wave.end());
+  sea.release_field(fluid::Field::elevation);
   const std::span<const double> wave_w = sea.field(fluid::Field::velocity_z).all();
   const std::vector<double> eta_t(wave_w.begin(), wave_w.end());
+  sea.release_field(fluid::Field::velocity_z);
   for (std::size_t i = 0; i < n; ++i) {
     if (!dynamic_[i]) continue;
     FloeState& st = floes.state[i];

@@ -100,6 +100,17 @@ RowWindow Sea::field(Field f) {
   return RowWindow(windows_[i].first, windows_[i].rows, grid_.nx, grid_.ny, fields_[i]);
 }
 
+void Sea::release_field(Field f) {
+  const auto i = static_cast<std::size_t>(f);
+  valid_[i] = false;
+  AlignedVector().swap(fields_[i]);
+}
+
+void Sea::gather_to_writer_rows(const RowWindow& w, std::vector<double>& whole) {
+  const std::span<const double> all = w.all();
+  whole.assign(all.begin(), all.end());
+}
+
 std::span<const double> Sea::field_on_writer(Field f) {
   if (!in_slabs()) return field(f).all();
   const int halo = field_halo_;

@@ -211,6 +211,23 @@ public:
   // Its storage is the field's: kept until the state changes, then sized to
   // the next window asked for.
   std::span<const double> field_on_writer(Field f);
+  // The rows a field computed for `halo` holds on this rank (first row,
+  // rows): whole unless in slabs. halo is set_field_halo's, or
+  // gather_to_writer (field_on_writer: whole on rank 0, this rank's slab on
+  // the others).
+  struct WindowRows {
+    int first = 0, rows = 0;
+  };
+  virtual WindowRows field_rows(int /*halo*/) const { return {0, grid_.ny}; }
+  // Whether the fields are windows that differ by rank (a sea in slabs).
+  virtual bool in_slabs() const { return false; }
+  // Gives back the storage of field f (it is computed again when asked for).
+  void release_field(Field f);
+  // The whole field on rank 0 of a window w of it (which holds this rank's
+  // slab): each rank's slab rows of w sent to rank 0, which puts them in
+  // `whole`; the other ranks get `whole` empty. Collective in slabs (every
+  // rank calls it); not in slabs, w's values (w whole).
+  virtual void gather_to_writer_rows(const RowWindow& w, std::vector<double>& whole);
   // The whole fields' point values (a sea not in slabs, or halo < 0).
   SurfaceSample sample(double x, double y = 0.0);
   // Collective in slabs (the modes' terms are summed in the whole bank's
@@ -244,16 +261,6 @@ protected:
   // out <- field f in the window field_rows(field_halo()) (rows x nx values,
   // the window's first row first).
   virtual void compute_field(Field f, std::span<double> out) = 0;
-  // The rows a field computed for `halo` holds on this rank (first row,
-  // rows): whole unless in slabs. halo is set_field_halo's or
-  // gather_to_writer (field_on_writer: whole on rank 0, this rank's slab on
-  // the others).
-  struct WindowRows {
-    int first = 0, rows = 0;
-  };
-  virtual WindowRows field_rows(int /*halo*/) const { return {0, grid_.ny}; }
-  // Whether the fields are windows that differ by rank (a sea in slabs).
-  virtual bool in_slabs() const { return false; }
   static constexpr int gather_to_writer = -2;
   // A backend may defer kicks (to fuse them into the next flow); settle()
   // applies the deferred ones. The state seen through the public API is always

@@ -65,6 +65,9 @@ public:
   std::size_t modal_size() const override;
   void gather_modal_state(std::vector<double>& q, std::vector<double>& v) override;
   void set_modal_state(std::span<const double> q, std::span<const double> v) override;
+  WindowRows field_rows(int halo) const override;
+  bool in_slabs() const override;
+  void gather_to_writer_rows(const RowWindow& w, std::vector<double>& whole) override;
 
   // What this sea allocates: `modes`, the modes its bank holds (every mode
   // of the half spectrum, or in slabs this rank's columns of each row);
@@ -87,8 +90,6 @@ public:
 
 protected:
   void compute_field(Field f, std::span<double> out) override;
-  WindowRows field_rows(int halo) const override;
-  bool in_slabs() const override;
   void settle() override;
   void project(std::span<const double> pressure, std::span<double> s) override;
   void synthesize(std::span<const double> q, std::span<double> eta) override;

@@ -214,20 +214,27 @@ struct SpectralSea::Impl {
   }
   // Every rank's rows to rank 0, whose whole window `out` receives them in
   // place (the slabs are consecutive, rank 0's first); the other ranks send
-  // theirs and receive nothing (one all-to-all).
+  // theirs (out: their slab's window) and receive nothing.
   void gather_rows(std::span<double> out) {
+    gather_rows(out.data(), ranks.rank == 0 ? out.data() : nullptr);
+  }
+  // `own`: this rank's slab rows; on rank 0, `whole` (n values) receives
+  // every rank's (rank 0's own copied unless already in place): one
+  // all-to-all to rank 0.
+  void gather_rows(const double* own, double* whole) {
     const auto size = static_cast<std::size_t>(ranks.ranks);
     std::vector<std::size_t> send_counts(size, 0), receive_counts(size, 0);
     std::span<const std::byte> send;
     std::span<std::byte> receive;
     if (ranks.rank == 0) {
       FLOESIM_ASSERT(slab->rows_of(0).begin == 0);
-      for (std::size_t r = 1; r < size; ++r) receive_counts[r] = row_bytes[r];
       const std::size_t first = static_cast<std::size_t>(rows.end) * static_cast<std::size_t>(nx);
-      receive = std::as_writable_bytes(out.subspan(first));
+      if (own != whole && first > 0) std::copy(own, own + first, whole);
+      for (std::size_t r = 1; r < size; ++r) receive_counts[r] = row_bytes[r];
+      receive = std::as_writable_bytes(std::span<double>(whole + first, n - first));
     } else {
       send_counts[0] = row_bytes[static_cast<std::size_t>(ranks.rank)];
-      send = std::as_bytes(std::span<const double>(out));
+      if (send_counts[0] > 0) send = std::as_bytes(std::span<const double>(own, send_counts[0] / sizeof(double)));
     }
     ranks.alltoall(send, send_counts, receive, receive_counts);
   }

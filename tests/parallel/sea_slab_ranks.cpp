@@ -15,7 +15,8 @@
 // state gathered to rank 0 equals the serial bank, and the fields (whole,
 // and in a halo of 2 rows: a window holding the slab's and the halo's rows
 // only, read by global cell) equal the serial fields, a record's field
-// gathered to rank 0 alone equals the serial one there, all with memcmp; a whole state set on every rank and gathered
+// gathered to rank 0 alone equals the serial one there, and so do a
+// window's slab rows gathered to rank 0, all with memcmp; a whole state set on every rank and gathered
 // back is unchanged. Grids with remainder blocks, ranks with empty row
 // slabs, and on 3 ranks a rank with no columns.
 // Run by ctest as mpi.sea_slab_ranks_N under `mpirun --oversubscribe -np N`
@@ -151,6 +152,12 @@ int check_grid(const parallel::Communicator& comm, int nx, int ny) {
       const int held = begin == end ? 0 : std::min(end - begin + 2 * halo, ny);
       check(b.rows() == held && b.values().size() == static_cast<std::size_t>(held) * static_cast<std::size_t>(nx),
             "a field in a halo holds other rows than its slab's and the halo's", comm, nx, ny);
+      // Its slab rows gathered back to rank 0 (the incident sea's snapshots
+      // at a checkpoint): the whole field there, nothing elsewhere.
+      std::vector<double> gathered;
+      slab.gather_to_writer_rows(b, gathered);
+      if (comm.writer()) check(same<double>(a, gathered), "a window's rows gathered to rank 0 differ from the serial field", comm, nx, ny);
+      else check(gathered.empty(), "a rank other than 0 received a window's rows gathered", comm, nx, ny);
       if (begin == end) continue;
       for (int y = begin - halo; y < end + halo; ++y) {
         const int gy = ((y % ny) + ny) % ny;
