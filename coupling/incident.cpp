@@ -35,11 +35,15 @@ double IncidentSea::interval_for(const SeaParams& params) {
 }
 
 void IncidentSea::take(Snapshot& u, Snapshot& v) {
+  // The sea's fields are read here only: their storage is given back once
+  // copied (the y-velocity's spectrum, made with the x-velocity's, stays
+  // staged in the sea).
   sea_->set_field_halo(halo_);
   for (auto [field, s] : {std::pair{fluid::Field::velocity_x, &u}, std::pair{fluid::Field::velocity_y, &v}}) {
     const fluid::RowWindow w = sea_->field(field);
     s->rows = {w.first_row(), w.rows()};
     s->values.assign(w.values().begin(), w.values().end());
+    sea_->release_field(field);
   }
   sea_->set_field_halo(-1);
 }
