@@ -195,7 +195,7 @@ public:
   // those rows only. halo < 0 (the default): whole fields (every rank's rows
   // gathered to every rank). A field computed whole serves any halo. A sea
   // not in slabs ignores it (its fields are whole).
-  void set_field_halo(int halo) { field_halo_ = halo; }
+  void set_field_halo(int halo) { field_halo_ = halo < 0 ? -1 : halo; }
 
   // A field on the grid: the window set_field_halo asks for (whole when not
   // in slabs). Valid until the state changes or the field is computed for
@@ -261,6 +261,8 @@ protected:
   // out <- field f in the window field_rows(field_halo()) (rows x nx values,
   // the window's first row first).
   virtual void compute_field(Field f, std::span<double> out) = 0;
+  // The halo value of field_on_writer's fields (set_field_halo keeps
+  // halos < 0 as -1, a whole field, so this one is never asked for by it).
   static constexpr int gather_to_writer = -2;
   // A backend may defer kicks (to fuse them into the next flow); settle()
   // applies the deferred ones. The state seen through the public API is always
