@@ -247,8 +247,10 @@ void FloeSeaContact::evaluate(const Floes& floes, fluid::Sea& sea, double h) {
   // reach_rows() of its slab: the sea's fields are exchanged there only.
   const bool halo = routed() && footprints_.by_place();
   if (halo) sea.set_field_halo(footprints_.reach_rows());
-  const std::span<const double> eta = sea.elevation();
-  std::span<const double> w;
+  // Windows of the rows held (by place: the slab and that halo; else whole),
+  // read by global cell.
+  const fluid::RowWindow eta = sea.field(fluid::Field::elevation);
+  fluid::RowWindow w;
   if (s_ < 1.0) w = sea.field(fluid::Field::velocity_z);
   if (halo) sea.set_field_halo(-1);
   const double ks = s_ * kappa_, inv_cell_area = 1.0 / cell_area_;
@@ -385,9 +387,14 @@ void FloeSeaContact::ready_loads(const Floes& floes, fluid::Sea& sea, IncidentSe
 void FloeSeaContact::update_water(const Floes& floes, const fluid::Sea& sea, IncidentSea* incident) {
   water_.assign(floes.size(), Vec2::Zero());
   if (!incident) return;
-  incident->advance_to(sea.time());
+  // Routed with the floes owned by place, this rank's floes' pieces lie
+  // within reach_rows() of its first slab (the coupling's owners keep the
+  // first slabs), which is the incident sea's slab (it keeps its first,
+  // equal, shares): the snapshots are windows of that slab and halo.
+  const int halo = routed() && footprints_.by_place() ? footprints_.reach_rows() : -1;
+  incident->advance_to(sea.time(), halo);
   const double w = incident->weight(sea.time());
-  const std::span<const double> u0 = incident->u0(), v0 = incident->v0(), u1 = incident->u1(), v1 = incident->v1();
+  const fluid::RowWindow u0 = incident->u0(), v0 = incident->v0(), u1 = incident->u1(), v1 = incident->v1();
   const Footprints& fp = footprints_.pieces();
   // Each rank its own floes; the caller shares them (share_owned).
   const std::span<const std::uint32_t> mine = footprints_.mine();

@@ -136,10 +136,15 @@ void FloeSeaContact::start(Floes& floes, fluid::Sea& sea, bool given) {
   // The waves in the sea: the floes start from the least-squares plane of the
   // waves under them (and take the plane of the waves' rates as theirs),
   // then settle on the waves.
-  const std::span<const double> wave = sea.elevation();
+  // Whole fields (every floe's pieces are read; in slabs gathered for this
+  // call, their storage given back when the fields are next computed with a
+  // halo). Copied: set_surface below changes the state they were of.
+  const std::span<const double> wave = sea.field(fluid::Field::elevation).all();
   const std::vector<double> wave_eta(wave.begin(), wave.end());
-  const std::span<const double> wave_w = sea.field(fluid::Field::velocity_z);
+  sea.release_field(fluid::Field::elevation);
+  const std::span<const double> wave_w = sea.field(fluid::Field::velocity_z).all();
   const std::vector<double> eta_t(wave_w.begin(), wave_w.end());
+  sea.release_field(fluid::Field::velocity_z);
   for (std::size_t i = 0; i < n; ++i) {
     if (!dynamic_[i]) continue;
     FloeState& st = floes.state[i];

@@ -34,14 +34,40 @@ double IncidentSea::interval_for(const SeaParams& params) {
   return period > 0.0 ? period / 40.0 : 0.0;
 }
 
-void IncidentSea::take(std::vector<double>& u, std::vector<double>& v) {
-  const std::span<const double> fu = sea_->field(fluid::Field::velocity_x);
-  u.assign(fu.begin(), fu.end());
-  const std::span<const double> fv = sea_->field(fluid::Field::velocity_y);
-  v.assign(fv.begin(), fv.end());
+void IncidentSea::take(Snapshot& u, Snapshot& v) {
+  // The sea's fields are read here only: their storage is given back once
+  // copied (the y-velocity's spectrum, made with the x-velocity's, stays
+  // staged in the sea).
+  sea_->set_field_halo(halo_);
+  for (auto [field, s] : {std::pair{fluid::Field::velocity_x, &u}, std::pair{fluid::Field::velocity_y, &v}}) {
+    const fluid::RowWindow w = sea_->field(field);
+    s->rows = {w.first_row(), w.rows()};
+    s->values.assign(w.values().begin(), w.values().end());
+    sea_->release_field(field);
+  }
+  sea_->set_field_halo(-1);
 }
 
-void IncidentSea::advance_to(double t) {
+void IncidentSea::cut(Snapshot& s, const fluid::Sea::WindowRows& rows) const {
+  const fluid::SurfaceGrid& g = sea_->grid();
+  if (!(s.rows.first == 0 && s.rows.rows == g.ny) || rows.rows == g.ny) return;  // only whole ones are cut
+  const auto nx = static_cast<std::size_t>(g.nx);
+  std::vector<double> kept(static_cast<std::size_t>(rows.rows) * nx);
+  for (int j = 0; j < rows.rows; ++j) {
+    const auto y = static_cast<std::size_t>((rows.first + j) % g.ny);
+    std::copy_n(s.values.begin() + static_cast<std::ptrdiff_t>(y * nx), nx,
+                kept.begin() + static_cast<std::ptrdiff_t>(static_cast<std::size_t>(j) * nx));
+  }
+  s.values = std::move(kept);
+  s.rows = rows;
+}
+
+void IncidentSea::advance_to(double t, int halo) {
+  halo_ = halo;
+  if (sea_->in_slabs() && halo >= 0) {
+    const fluid::Sea::WindowRows rows = sea_->field_rows(halo);
+    for (Snapshot* s : {&u0_, &v0_, &u1_, &v1_}) cut(*s, rows);
+  }
   if (!(tau_ > 0.0)) {
     if (t > t1_) sea_->flow(t - t1_);
     t0_ = t1_ = std::max(t, t1_);
@@ -69,24 +95,26 @@ IncidentState IncidentSea::saved_state() {
   s.sea = save_modal(*sea_);
   s.t0 = t0_;
   s.t1 = t1_;
-  s.u0 = u0_;
-  s.v0 = v0_;
-  s.u1 = u1_;
-  s.v1 = v1_;
+  // Whole on rank 0 (in slabs each rank's slab rows gathered there).
+  sea_->gather_to_writer_rows(u0(), s.u0);
+  sea_->gather_to_writer_rows(v0(), s.v0);
+  sea_->gather_to_writer_rows(u1(), s.u1);
+  sea_->gather_to_writer_rows(v1(), s.v1);
   return s;
 }
 
 void IncidentSea::restore(const IncidentState& s) {
-  if (!s.present || s.u0.size() != u0_.size() || s.u1.size() != u1_.size() || s.v0.size() != v0_.size() ||
-      s.v1.size() != v1_.size())
+  const std::size_t n = sea_->grid().size();
+  if (!s.present || s.u0.size() != n || s.u1.size() != n || s.v0.size() != n || s.v1.size() != n)
     throw InputError("checkpoint: the incident waves' snapshots do not match this run's sea grid");
   restore_modal(*sea_, s.sea, "the incident waves");
   t0_ = s.t0;
   t1_ = s.t1;
-  u0_ = s.u0;
-  v0_ = s.v0;
-  u1_ = s.u1;
-  v1_ = s.v1;
+  const fluid::Sea::WindowRows whole{0, sea_->grid().ny};
+  u0_ = {whole, s.u0};
+  v0_ = {whole, s.v0};
+  u1_ = {whole, s.u1};
+  v1_ = {whole, s.v1};
 }
 
 ModalState save_modal(fluid::Sea& sea) {

@@ -34,27 +34,47 @@ public:
   static double interval_for(const SeaParams& params);
 
   // Brings the snapshots to t0 <= t <= t1. t may not decrease from one call
-  // to the next.
-  void advance_to(double t);
+  // to the next. With a sea in slabs, `halo` is as fluid::Sea::
+  // set_field_halo: the snapshots taken from now on are windows of this
+  // rank's slab of the incident sea and `halo` rows either side, and whole
+  // ones (taken at construction or restored) are cut to that window (a
+  // copy of its rows); halo < 0, whole snapshots. Collective in slabs:
+  // every rank calls it with the same t and halo.
+  void advance_to(double t, int halo = -1);
   // The weight w of the t1 snapshot at time t.
   double weight(double t) const;
-  std::span<const double> u0() const { return u0_; }
-  std::span<const double> v0() const { return v0_; }
-  std::span<const double> u1() const { return u1_; }
-  std::span<const double> v1() const { return v1_; }
+  // The snapshots, read by global cell (fluid::RowWindow).
+  fluid::RowWindow u0() const { return u0_.window(*sea_); }
+  fluid::RowWindow v0() const { return v0_.window(*sea_); }
+  fluid::RowWindow u1() const { return u1_.window(*sea_); }
+  fluid::RowWindow v1() const { return v1_.window(*sea_); }
 
   // Restart (core/checkpoint.hpp): the sea's modal state and the snapshots.
+  // In slabs saved_state() is collective and the snapshots are whole on
+  // rank 0 alone (each rank's slab rows gathered there), empty elsewhere;
+  // restore() takes whole ones on every rank (cut at the next advance_to).
   // restore() throws InputError if the state is not of this sea's size.
   IncidentState saved_state();
   void restore(const IncidentState& state);
 
 private:
-  void take(std::vector<double>& u, std::vector<double>& v);
+  // A field's rows [rows.first, rows.first + rows.rows) (modulo ny), x fastest.
+  struct Snapshot {
+    fluid::Sea::WindowRows rows;
+    std::vector<double> values;
+    fluid::RowWindow window(const fluid::Sea& sea) const {
+      return fluid::RowWindow(rows.first, rows.rows, sea.grid().nx, sea.grid().ny, values);
+    }
+  };
+  void take(Snapshot& u, Snapshot& v);
+  // A whole snapshot cut to `rows` (a copy of those rows).
+  void cut(Snapshot& s, const fluid::Sea::WindowRows& rows) const;
 
   std::unique_ptr<fluid::Sea> sea_;
   double tau_ = 0.0;
   double t0_ = 0.0, t1_ = 0.0;
-  std::vector<double> u0_, v0_, u1_, v1_;
+  int halo_ = -1;
+  Snapshot u0_, v0_, u1_, v1_;
 };
 
 // A sea's modal state (every deferred kick applied) and back; restore_modal

@@ -515,7 +515,9 @@ SeaGridInfo Simulation::sea_grid() const {
 
 std::span<const double> Simulation::sea_elevation() {
   if (!sea_) return {};
-  return sea_->elevation();
+  // In slabs every rank's rows go to the writer alone (the other ranks get
+  // an empty span); every rank calls it.
+  return sea_->field_on_writer(fluid::Field::elevation);
 }
 
 }  // namespace floesim

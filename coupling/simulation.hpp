@@ -157,7 +157,10 @@ public:
   // The sea surface, if the run has one ([sea] model != "none").
   bool has_sea() const { return sea_ != nullptr; }
   SeaGridInfo sea_grid() const;
-  std::span<const double> sea_elevation();  // on the grid, x fastest; empty without a sea
+  // On the grid, x fastest; empty without a sea. A sea in slabs gathers it
+  // to the writer (rank 0) alone and the other ranks get an empty span;
+  // every rank calls it (collective).
+  std::span<const double> sea_elevation();
   // The floe–sea contact, if the run has a sea and floes that move.
   const FloeSeaContact* floe_sea() const { return floe_sea_.get(); }
   std::vector<std::string> notes() const;  // said once at the start (e.g. calibrated blend)

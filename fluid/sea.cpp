@@ -78,22 +78,55 @@ void Sea::invalidate_rates() {
     valid_[static_cast<std::size_t>(f)] = false;
 }
 
-std::span<const double> Sea::field(Field f) {
+RowWindow Sea::field(Field f) {
   const auto i = static_cast<std::size_t>(f);
-  const bool covers = computed_halo_[i] < 0 || computed_halo_[i] == field_halo_;
+  // A field computed whole on every rank serves any window. The test is on
+  // the halos alone, which every rank has alike, so that every rank makes
+  // the same collective calls (a window that happens to be whole on one
+  // rank is not whole on another).
+  const bool whole_everywhere = !in_slabs() || computed_halo_[i] == -1;
+  const bool covers = whole_everywhere || computed_halo_[i] == field_halo_;
   if (!valid_[i] || !covers) {
-    if (fields_[i].size() != grid_.size()) fields_[i].assign(grid_.size(), 0.0);
+    const WindowRows w = field_rows(field_halo_);
+    const std::size_t size = static_cast<std::size_t>(w.rows) * static_cast<std::size_t>(grid_.nx);
+    // A new array when the window's size changes, so that a whole field's
+    // storage is given back when a smaller window follows.
+    if (fields_[i].size() != size) AlignedVector(size, 0.0).swap(fields_[i]);
     compute_field(f, fields_[i]);
     valid_[i] = true;
     computed_halo_[i] = field_halo_;
+    windows_[i] = w;
   }
-  return fields_[i];
+  return RowWindow(windows_[i].first, windows_[i].rows, grid_.nx, grid_.ny, fields_[i]);
+}
+
+void Sea::release_field(Field f) {
+  const auto i = static_cast<std::size_t>(f);
+  valid_[i] = false;
+  AlignedVector().swap(fields_[i]);
+}
+
+void Sea::gather_to_writer_rows(const RowWindow& w, std::vector<double>& whole) {
+  const std::span<const double> all = w.all();
+  whole.assign(all.begin(), all.end());
+}
+
+std::span<const double> Sea::field_on_writer(Field f) {
+  if (!in_slabs()) return field(f).all();
+  const int halo = field_halo_;
+  field_halo_ = gather_to_writer;
+  const RowWindow w = field(f);  // may be a whole field computed before
+  field_halo_ = halo;
+  const WindowRows mine = field_rows(gather_to_writer);
+  const bool writer = mine.first == 0 && mine.rows == grid_.ny;
+  FLOESIM_ASSERT(!writer || w.whole());
+  return writer ? w.values() : std::span<const double>();
 }
 
 SurfaceSample Sea::sample(double x, double y) {
   // Parities at the walls x = const (then y = const): a derivative across a wall is odd.
   auto at = [&](Field f, Parity parity, Parity parity_y = Parity::even) {
-    return interpolate(grid_, field(f), x, y, parity, parity_y);
+    return interpolate(grid_, field(f).all(), x, y, parity, parity_y);
   };
   SurfaceSample s;
   s.eta = at(Field::elevation, Parity::even);

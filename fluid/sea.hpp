@@ -26,6 +26,7 @@
 #include <span>
 #include <vector>
 
+#include "core/error.hpp"
 #include "core/params.hpp"
 #include "fluid/aligned.hpp"
 #include "fluid/grid.hpp"
@@ -45,6 +46,50 @@ enum class Field {
   velocity_z,  // d phi / dz = eta'
 };
 inline constexpr int field_count = 6;
+
+// Rows [first_row, first_row + rows) of a field on the grid (x fastest), the
+// row index taken modulo ny, so that a window may cross the grid's periodic
+// seam; read by global cell (row iy, column ix: cell iy nx + ix). A whole
+// field is the window of every row, first_row = 0: then the window's values
+// are the field in cell order. A sea in slabs keeps its slab's rows and the
+// halo's (Sea::set_field_halo); docs/parallel.md, "A row window for the
+// fields".
+class RowWindow {
+public:
+  RowWindow() = default;
+  RowWindow(int first_row, int rows, int nx, int ny, std::span<const double> values)
+      : first_row_(first_row), rows_(rows), nx_(nx), ny_(ny),
+        offset_(static_cast<std::ptrdiff_t>(first_row) * nx), cells_(static_cast<std::ptrdiff_t>(nx) * ny),
+        values_(values) {}
+
+  int first_row() const { return first_row_; }
+  int rows() const { return rows_; }
+  bool whole() const { return first_row_ == 0 && rows_ == ny_; }
+  // Whether the window holds row y (any integer: taken modulo ny).
+  bool holds_row(int y) const { return ny_ > 0 && (((y - first_row_) % ny_) + ny_) % ny_ < rows_; }
+  // The value at a global cell of a row the window holds: the cell's offset
+  // from the window's first row, wrapped once across the seam (a window has
+  // at most ny rows, so one wrap is all there can be).
+  double operator[](std::size_t cell) const {
+    std::ptrdiff_t i = static_cast<std::ptrdiff_t>(cell) - offset_;
+    if (i < 0) i += cells_;
+    FLOESIM_ASSERT(i < static_cast<std::ptrdiff_t>(values_.size()));
+    return values_[static_cast<std::size_t>(i)];
+  }
+  // The values held, the window's first row first (for a whole window, the
+  // field in cell order).
+  std::span<const double> values() const { return values_; }
+  // The whole field (asserted whole).
+  std::span<const double> all() const {
+    FLOESIM_ASSERT(whole());
+    return values_;
+  }
+
+private:
+  int first_row_ = 0, rows_ = 0, nx_ = 0, ny_ = 0;
+  std::ptrdiff_t offset_ = 0, cells_ = 0;
+  std::span<const double> values_;
+};
 
 struct SurfaceSample {
   double eta = 0.0;                       // m
@@ -143,15 +188,47 @@ public:
   // In slabs, the thread CPU seconds spent in the transforms' row passes
   // since the last call (the part of the sea's work that follows the rows).
   virtual double take_row_seconds() { return 0.0; }
-  // In slabs, the fields computed from now on hold the present values only
-  // in this rank's slab and `halo` rows either side of it (the grid's seam
-  // crossed; the other rows are stale): an exchange of those rows instead of
-  // a gather of every row. halo < 0 (the default): whole fields. A field
-  // computed whole serves any halo. A sea not in slabs ignores it.
-  void set_field_halo(int halo) { field_halo_ = halo; }
+  // In slabs, the fields computed from now on are windows of this rank's
+  // slab and `halo` rows either side of it (the grid's seam crossed; fewer
+  // when the slab and its halo make every row, then the whole field): an
+  // exchange of those rows instead of a gather of every row, and storage for
+  // those rows only. halo < 0 (the default): whole fields (every rank's rows
+  // gathered to every rank). A field computed whole serves any halo. A sea
+  // not in slabs ignores it (its fields are whole).
+  void set_field_halo(int halo) { field_halo_ = halo < 0 ? -1 : halo; }
 
-  std::span<const double> field(Field f);
-  std::span<const double> elevation() { return field(Field::elevation); }
+  // A field on the grid: the window set_field_halo asks for (whole when not
+  // in slabs). Valid until the state changes or the field is computed for
+  // another window. In slabs collective when it is computed: every rank asks
+  // for the same fields with the same halo, in the same order.
+  RowWindow field(Field f);
+  // The whole elevation (a sea not in slabs, or halo < 0).
+  std::span<const double> elevation() { return field(Field::elevation).all(); }
+  // The whole field on rank 0 of the sea's ranks (the run's writer), every
+  // rank's rows gathered there alone; an empty span on the other ranks,
+  // which keep their rows only (unless the field was already whole there).
+  // Collective in slabs: every rank calls it. Not in slabs: the whole field.
+  // Its storage is the field's: kept until the state changes, then sized to
+  // the next window asked for.
+  std::span<const double> field_on_writer(Field f);
+  // The rows a field computed for `halo` holds on this rank (first row,
+  // rows): whole unless in slabs. halo is set_field_halo's, or
+  // gather_to_writer (field_on_writer: whole on rank 0, this rank's slab on
+  // the others).
+  struct WindowRows {
+    int first = 0, rows = 0;
+  };
+  virtual WindowRows field_rows(int /*halo*/) const { return {0, grid_.ny}; }
+  // Whether the fields are windows that differ by rank (a sea in slabs).
+  virtual bool in_slabs() const { return false; }
+  // Gives back the storage of field f (it is computed again when asked for).
+  void release_field(Field f);
+  // The whole field on rank 0 of a window w of it (which holds this rank's
+  // slab): each rank's slab rows of w sent to rank 0, which puts them in
+  // `whole`; the other ranks get `whole` empty. Collective in slabs (every
+  // rank calls it); not in slabs, w's values (w whole).
+  virtual void gather_to_writer_rows(const RowWindow& w, std::vector<double>& whole);
+  // The whole fields' point values (a sea not in slabs, or halo < 0).
   SurfaceSample sample(double x, double y = 0.0);
   // Collective in slabs (the modes' terms are summed in the whole bank's
   // order on rank 0, whose sums every rank receives).
@@ -181,7 +258,12 @@ public:
 
 protected:
   explicit Sea(const SurfaceGrid& grid);
+  // out <- field f in the window field_rows(field_halo()) (rows x nx values,
+  // the window's first row first).
   virtual void compute_field(Field f, std::span<double> out) = 0;
+  // The halo value of field_on_writer's fields (set_field_halo keeps
+  // halos < 0 as -1, a whole field, so this one is never asked for by it).
+  static constexpr int gather_to_writer = -2;
   // A backend may defer kicks (to fuse them into the next flow); settle()
   // applies the deferred ones. The state seen through the public API is always
   // the settled one.
@@ -211,6 +293,7 @@ private:
   std::array<AlignedVector, field_count> fields_;
   std::array<bool, field_count> valid_{};
   std::array<int, field_count> computed_halo_{};  // the halo each valid field was computed for
+  std::array<WindowRows, field_count> windows_{};  // the rows each valid field holds
   int field_halo_ = -1;
   AlignedVector p_scratch_;
   AlignedVector modal_a_, modal_b_;  // scratch for the midpoint operations

@@ -152,6 +152,25 @@ void SpectralSea::set_slab_rows(std::vector<int> first_row) {
   invalidate();  // the fields' present rows were the old slab's and halo's
 }
 
+Sea::WindowRows SpectralSea::field_rows(int halo) const { return impl_->window(halo); }
+
+bool SpectralSea::in_slabs() const { return impl_->slab != nullptr; }
+
+void SpectralSea::gather_to_writer_rows(const RowWindow& w, std::vector<double>& whole) {
+  Impl& m = *impl_;
+  if (!m.slab) return Sea::gather_to_writer_rows(w, whole);
+  FLOESIM_ASSERT(m.rows.begin == m.rows.end || (w.holds_row(m.rows.begin) && w.holds_row(m.rows.end - 1)));
+  // This rank's slab rows are consecutive in w (a window's rows are, the
+  // seam crossed, and a slab does not cross it).
+  const std::span<const double> values = w.values();
+  const double* own = m.rows.begin < m.rows.end
+                          ? values.data() + m.at_row({w.first_row(), w.rows()}, m.rows.begin)
+                          : nullptr;
+  whole.clear();
+  if (m.ranks.rank == 0) whole.resize(m.n);
+  m.gather_rows(own, m.ranks.rank == 0 ? whole.data() : nullptr);
+}
+
 double SpectralSea::take_row_seconds() { return impl_->slab ? impl_->slab->take_row_seconds() : 0.0; }
 
 const TankZones* SpectralSea::tank() const { return impl_->tank ? &*impl_->tank : nullptr; }

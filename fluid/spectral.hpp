@@ -26,7 +26,10 @@
 // columns of modes; flow steps those modes only; a field is transformed
 // from them back to this rank's rows, and every rank's rows are then
 // gathered, so fields are whole on every rank; or, with a halo
-// (Sea::set_field_halo, stage five), only the rows within it are exchanged.
+// (Sea::set_field_halo, stage five), the field is a window of this rank's
+// slab and the halo (Sea::field's RowWindow), whose halo rows alone are
+// exchanged; or (Sea::field_on_writer, records) every rank's rows are sent
+// to rank 0 alone.
 // The bank, its per-mode factors and the kick spectra hold this rank's
 // modes only (its columns of each row, row by row: docs/parallel.md, stage
 // six), so modes() is this rank's part; energy() sums every rank's terms in
@@ -62,6 +65,9 @@ public:
   std::size_t modal_size() const override;
   void gather_modal_state(std::vector<double>& q, std::vector<double>& v) override;
   void set_modal_state(std::span<const double> q, std::span<const double> v) override;
+  WindowRows field_rows(int halo) const override;
+  bool in_slabs() const override;
+  void gather_to_writer_rows(const RowWindow& w, std::vector<double>& whole) override;
 
   // What this sea allocates: `modes`, the modes its bank holds (every mode
   // of the half spectrum, or in slabs this rank's columns of each row);

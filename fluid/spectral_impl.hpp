@@ -170,24 +170,73 @@ struct SpectralSea::Impl {
     if (fft2) fft2->forward(in, to, threads);
     else fftw_execute_dft_r2c(r2c, const_cast<double*>(in), to);
   }
+  // The rows this rank's fields hold for a halo (Sea::field_rows): in slabs
+  // its slab and `halo` rows either side (a first row before the seam is
+  // taken modulo ny), the whole grid when that makes every row; with
+  // gather_to_writer the whole grid on rank 0 and its slab on the others;
+  // halo < 0 or not in slabs, the whole grid.
+  Sea::WindowRows window(int halo) const {
+    const Sea::WindowRows whole{0, ny};
+    if (!slab || halo == -1 || (halo == Sea::gather_to_writer && ranks.rank == 0)) return whole;
+    const int h = halo == Sea::gather_to_writer ? 0 : halo;
+    if (rows.begin == rows.end) return {rows.begin, 0};
+    const int count = rows.end - rows.begin + 2 * h;
+    if (count >= ny) return whole;
+    return {((rows.begin - h) % ny + ny) % ny, count};
+  }
+  // The offset in a window of `w`'s rows of row y (which it holds).
+  std::size_t at_row(const Sea::WindowRows& w, int y) const {
+    return static_cast<std::size_t>(((y - w.first) % ny + ny) % ny) * static_cast<std::size_t>(nx);
+  }
   // out <- IFFT(from) (unnormalised; `from`, spec or spec_vy, is destroyed).
-  // In slabs: from this rank's columns of `from` to its rows of out, then
-  // every rank's rows gathered into out, or with halo >= 0 (Sea::
-  // set_field_halo) only the halo's rows exchanged.
+  // In slabs: from this rank's columns of `from` to its rows of out, the
+  // window of `halo` (window() above; out holds its rows x nx values), then
+  // every rank's rows gathered into out (halo < 0: a whole field), or only
+  // the halo's rows exchanged (halo >= 0: Sea::set_field_halo), or every
+  // rank's rows sent to rank 0 (gather_to_writer).
   void backward(std::span<double> out, fftw_complex* from, int halo = -1) {
     if (slab) {
-      double* own = out.data() + row_offset();
-      double* to = aligned(own) ? own : real;
+      const Sea::WindowRows w = window(halo);
+      FLOESIM_ASSERT(out.size() == static_cast<std::size_t>(w.rows) * static_cast<std::size_t>(nx));
+      double* own = rows.begin < rows.end ? out.data() + at_row(w, rows.begin) : nullptr;
+      double* to = own && aligned(own) ? own : real;
       slab->backward(from, to, threads);
-      if (to == real) std::copy(real, real + real_size, own);
-      if (halo < 0) ranks.allgather(std::as_writable_bytes(out), row_bytes);
-      else exchange_halo(out, halo);
+      if (own && to == real) std::copy(real, real + real_size, own);
+      if (halo == -1) ranks.allgather(std::as_writable_bytes(out), row_bytes);
+      else if (halo == Sea::gather_to_writer) gather_rows(out);
+      else exchange_halo(out, halo, w);
       return;
     }
     double* to = aligned(out.data()) ? out.data() : real;
     if (fft2) fft2->backward(from, to, threads);
     else fftw_execute_dft_c2r(c2r, from, to);
     if (to == real) std::copy(real, real + n, out.begin());
+  }
+  // Every rank's rows to rank 0, whose whole window `out` receives them in
+  // place (the slabs are consecutive, rank 0's first); the other ranks send
+  // theirs (out: their slab's window) and receive nothing.
+  void gather_rows(std::span<double> out) {
+    gather_rows(out.data(), ranks.rank == 0 ? out.data() : nullptr);
+  }
+  // `own`: this rank's slab rows; on rank 0, `whole` (n values) receives
+  // every rank's (rank 0's own copied unless already in place): one
+  // all-to-all to rank 0.
+  void gather_rows(const double* own, double* whole) {
+    const auto size = static_cast<std::size_t>(ranks.ranks);
+    std::vector<std::size_t> send_counts(size, 0), receive_counts(size, 0);
+    std::span<const std::byte> send;
+    std::span<std::byte> receive;
+    if (ranks.rank == 0) {
+      FLOESIM_ASSERT(slab->rows_of(0).begin == 0);
+      const std::size_t first = static_cast<std::size_t>(rows.end) * static_cast<std::size_t>(nx);
+      if (own != whole && first > 0) std::copy(own, own + first, whole);
+      for (std::size_t r = 1; r < size; ++r) receive_counts[r] = row_bytes[r];
+      receive = std::as_writable_bytes(std::span<double>(whole + first, n - first));
+    } else {
+      send_counts[0] = row_bytes[static_cast<std::size_t>(ranks.rank)];
+      if (send_counts[0] > 0) send = std::as_bytes(std::span<const double>(own, send_counts[0] / sizeof(double)));
+    }
+    ranks.alltoall(send, send_counts, receive, receive_counts);
   }
   // spec <- (i k)^d factor * a, for a = q or v (d = 0 or 1 via `deriv`); with
   // `gain`, the deferred kicks are added to a on the way (a = v: the rates as
@@ -254,8 +303,9 @@ struct SpectralSea::Impl {
   }
   // out's rows in this rank's halo of h rows <- their slabs' owners' (one
   // all-to-all; each side knows what the other sends: the rows of the
-  // receiver's halo_rows that lie in the sender's slab, in that order).
-  void exchange_halo(std::span<double> out, int h) {
+  // receiver's halo_rows that lie in the sender's slab, in that order). out
+  // is the window w of the slab and that halo (window(h)).
+  void exchange_halo(std::span<double> out, int h, const Sea::WindowRows& w) {
     if (h != halo_exchange.rows) {
       halo_exchange.rows = h;
       halo_exchange.send.assign(static_cast<std::size_t>(ranks.ranks), {});
@@ -284,14 +334,14 @@ struct SpectralSea::Impl {
     std::byte* at = halo_exchange.out.data();
     for (const std::vector<int>& rows_to : halo_exchange.send)
       for (int y : rows_to) {
-        std::memcpy(at, out.data() + static_cast<std::size_t>(y) * nx, row);
+        std::memcpy(at, out.data() + at_row(w, y), row);
         at += row;
       }
     ranks.alltoall(halo_exchange.out, send_counts, halo_exchange.in, receive_counts);
     const std::byte* in = halo_exchange.in.data();
     for (const std::vector<int>& rows_from : halo_exchange.receive)
       for (int y : rows_from) {
-        std::memcpy(out.data() + static_cast<std::size_t>(y) * nx, in, row);
+        std::memcpy(out.data() + at_row(w, y), in, row);
         in += row;
       }
   }

@@ -42,7 +42,7 @@ TEST_CASE("incident waves: snapshots tau apart, read in between, within (omega t
     if (t > 0.0) exact->flow(h);
     incident.advance_to(t);
     const double w = incident.weight(t);
-    const auto u = exact->field(fluid::Field::velocity_x);
+    const auto u = exact->field(fluid::Field::velocity_x).all();
     for (std::size_t c = 0; c < u.size(); c += 7)
       worst = std::max(worst, std::abs((1.0 - w) * incident.u0()[c] + w * incident.u1()[c] - u[c]));
     intervals = static_cast<int>(t / tau);

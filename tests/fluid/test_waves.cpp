@@ -113,8 +113,8 @@ TEST_CASE("a spread JONSWAP sea travels in its mean direction") {
   p.waves.spreading = 10.0;
   auto sea = make_sea(p, 21);
   const auto eta = sea->elevation();
-  std::vector<double> u(sea->field(Field::velocity_x).begin(), sea->field(Field::velocity_x).end());
-  const auto v = sea->field(Field::velocity_y);
+  std::vector<double> u(sea->field(Field::velocity_x).all().begin(), sea->field(Field::velocity_x).all().end());
+  const auto v = sea->field(Field::velocity_y).all();
   double mx = 0.0, my = 0.0;
   for (std::size_t i = 0; i < eta.size(); ++i) {
     mx += eta[i] * u[i];

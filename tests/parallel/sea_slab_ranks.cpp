@@ -13,8 +13,10 @@
 // kicks, flows and fields read in between, the energy (summed by rank 0 in
 // the whole bank's order) equals the serial energy on every rank, the whole
 // state gathered to rank 0 equals the serial bank, and the fields (whole,
-// and in a halo of 2 rows: the slab's and the halo's rows) equal the serial
-// fields, all with memcmp; a whole state set on every rank and gathered
+// and in a halo of 2 rows: a window holding the slab's and the halo's rows
+// only, read by global cell) equal the serial fields, a record's field
+// gathered to rank 0 alone equals the serial one there, and so do a
+// window's slab rows gathered to rank 0, all with memcmp; a whole state set on every rank and gathered
 // back is unchanged. Grids with remainder blocks, ranks with empty row
 // slabs, and on 3 ranks a rank with no columns.
 // Run by ctest as mpi.sea_slab_ranks_N under `mpirun --oversubscribe -np N`
@@ -132,23 +134,48 @@ int check_grid(const parallel::Communicator& comm, int nx, int ny) {
   // kick, flows, fields read between them (a field settles nothing).
   const std::size_t n = static_cast<std::size_t>(nx) * static_cast<std::size_t>(ny);
   std::vector<double> pressure(n);
+  // A halo's field is a window of the slab and the halo's rows and holds
+  // those rows only (a whole array on a rank whose slab and halo lack some
+  // rows fails), each equal to the serial field's row.
   auto compare_fields = [&](int halo, const char* what) {
     whole.set_field_halo(-1);
     slab.set_field_halo(halo);
     for (fluid::Field f : {fluid::Field::elevation, fluid::Field::velocity_x, fluid::Field::velocity_y,
                            fluid::Field::velocity_z, fluid::Field::slope_x}) {
-      const std::span<const double> a = whole.field(f), b = slab.field(f);
+      const std::span<const double> a = whole.field(f).all();
+      const fluid::RowWindow b = slab.field(f);
       if (halo < 0 || comm.size() == 1) {
-        check(same(a, b), what, comm, nx, ny);
+        check(b.whole() && same(a, b.values()), what, comm, nx, ny);
         continue;
       }
       const int begin = rows[static_cast<std::size_t>(comm.rank())], end = rows[static_cast<std::size_t>(comm.rank()) + 1];
+      const int held = begin == end ? 0 : std::min(end - begin + 2 * halo, ny);
+      check(b.rows() == held && b.values().size() == static_cast<std::size_t>(held) * static_cast<std::size_t>(nx),
+            "a field in a halo holds other rows than its slab's and the halo's", comm, nx, ny);
+      // Its slab rows gathered back to rank 0 (the incident sea's snapshots
+      // at a checkpoint): the whole field there, nothing elsewhere.
+      std::vector<double> gathered;
+      slab.gather_to_writer_rows(b, gathered);
+      if (comm.writer()) check(same<double>(a, gathered), "a window's rows gathered to rank 0 differ from the serial field", comm, nx, ny);
+      else check(gathered.empty(), "a rank other than 0 received a window's rows gathered", comm, nx, ny);
       if (begin == end) continue;
       for (int y = begin - halo; y < end + halo; ++y) {
-        const std::size_t row = static_cast<std::size_t>(((y % ny) + ny) % ny) * static_cast<std::size_t>(nx);
-        check(same(a.subspan(row, static_cast<std::size_t>(nx)), b.subspan(row, static_cast<std::size_t>(nx))), what,
-              comm, nx, ny);
+        const int gy = ((y % ny) + ny) % ny;
+        const std::size_t row = static_cast<std::size_t>(gy) * static_cast<std::size_t>(nx);
+        const std::size_t local = static_cast<std::size_t>(((gy - b.first_row()) % ny + ny) % ny) * static_cast<std::size_t>(nx);
+        check(b.holds_row(y) && b[row] == a[row] && b[row + static_cast<std::size_t>(nx) - 1] == a[row + static_cast<std::size_t>(nx) - 1] &&
+                  same(a.subspan(row, static_cast<std::size_t>(nx)), b.values().subspan(local, static_cast<std::size_t>(nx))),
+              what, comm, nx, ny);
       }
+    }
+    slab.set_field_halo(-1);
+  };
+  // A record's field: whole on rank 0 (the writer) alone, the serial one.
+  auto compare_on_writer = [&](const char* what) {
+    for (fluid::Field f : {fluid::Field::elevation, fluid::Field::velocity_z}) {
+      const std::span<const double> a = whole.field(f).all(), b = slab.field_on_writer(f);
+      if (comm.writer() || comm.size() == 1) check(same(a, b), what, comm, nx, ny);
+      else check(b.empty(), "a rank other than 0 received a record's whole field", comm, nx, ny);
     }
   };
   for (int step = 0; step < 4; ++step) {
@@ -162,6 +189,8 @@ int check_grid(const parallel::Communicator& comm, int nx, int ny) {
       sea->flow(0.1);
     }
     compare_fields(step % 2 == 0 ? 2 : -1, "a field after a flow differs from the serial sea's");
+    compare_on_writer("a record's field differs from the serial sea's");
+    compare_fields(step % 2 == 0 ? 2 : -1, "a field after a record differs from the serial sea's");
   }
   for (fluid::SpectralSea* sea : {&whole, &slab}) sea->kick(pressure, 0.05);  // left deferred
 
