@@ -91,6 +91,14 @@ for n in args.ranks:
         print(f"{n} ranks: {steps} advances by cluster owner, {fallbacks} redone whole, clusters by rank {clusters}")
         if not (steps and fallbacks and int(steps[0]) > int(fallbacks[0]) and sum(map(int, clusters)) > 0):
             failures.append(f"{n} ranks: no advance by cluster owner was kept ({steps}, {fallbacks}, {clusters})")
+    # The collisions at the step's start by owner too: every try kept here
+    # (no warm store at step start in this pack), step groups on every rank.
+    tried, fell, groups = key("parallel.collide_steps"), key("parallel.collide_fallbacks"), key("parallel.collide_groups")
+    if n > 1:
+        print(f"{n} ranks: {tried} step-start collisions by owner, {fell} redone whole, groups by rank {groups}")
+        if not (tried and fell and int(tried[0]) > 0 and int(fell[0]) == 0 and len(groups) == n
+                and all(int(g) > 0 for g in groups)):
+            failures.append(f"{n} ranks: the step-start collisions did not run by owner ({tried}, {fell}, {groups})")
 
 # A restart on 2 ranks: the first half, then --restart from its checkpoint
 # (written by rank 0, read by every rank), equals the serial run.
