@@ -140,17 +140,11 @@ std::size_t step_collisions(Floes& floes, std::span<const FloeState> start, cons
   // jam.at_step_start) and where each came from in detection.contacts.
   std::vector<ContactPoint> contacts;
   std::vector<std::size_t> from;
-  std::vector<std::uint8_t> resting;
   for (std::size_t k = 0; k < detection.contacts.size(); ++k) {
     const ContactPoint& c = detection.contacts[k];
     if (!opt.jam.at_step_start && jammed(c.a, c.b)) continue;
     contacts.push_back(c);
     from.push_back(k);
-    const Vec2 pb = c.point - c.shift;  // in b's own image
-    resting.push_back(jammed(c.a, c.b) || made_by_step(approach(floes, floes.state, c.a, c.b, c.point, pb, c.normal),
-                                                  approach(floes, start, c.a, c.b, c.point, pb, c.normal),
-                                                  smooth_kick(floes, start, floes.state, c.a, c.b, c.point, pb),
-                                                  opt.rest_speed));
   }
   std::size_t detected = contacts.size();
   // In a jam every point beyond xi is speculative from the start (or left,
@@ -164,7 +158,6 @@ std::size_t step_collisions(Floes& floes, std::span<const FloeState> start, cons
       taken[k] = 1;
       if (!opt.jam.at_step_start) continue;
       contacts.push_back({p.a, p.b, 0.5 * (w.pa + w.pb), w.normal, w.distance, p.shift, true, w.vertex_of_b});
-      resting.push_back(1);
     }
   }
   // A share keeps the contacts and witnesses of its step groups only.
@@ -180,13 +173,22 @@ std::size_t step_collisions(Floes& floes, std::span<const FloeState> start, cons
     for (std::size_t k = 0; k < contacts.size(); ++k) {
       if (!kept(contacts[k].a, contacts[k].b)) continue;
       if (k < detected) from[kept_detected++] = from[k];
-      contacts[to] = contacts[k];
-      resting[to++] = resting[k];
+      contacts[to++] = contacts[k];
     }
     contacts.resize(to);
-    resting.resize(to);
     from.resize(kept_detected);
     detected = kept_detected;
+  }
+  // Resting (restitution 0): a jam's contacts and speculative points, and
+  // the contacts the step made (impulse.hpp).
+  std::vector<std::uint8_t> resting(contacts.size(), 1);
+  for (std::size_t k = 0; k < detected; ++k) {
+    const ContactPoint& c = contacts[k];
+    const Vec2 pb = c.point - c.shift;  // in b's own image
+    resting[k] = jammed(c.a, c.b) || made_by_step(approach(floes, floes.state, c.a, c.b, c.point, pb, c.normal),
+                                                  approach(floes, start, c.a, c.b, c.point, pb, c.normal),
+                                                  smooth_kick(floes, start, floes.state, c.a, c.b, c.point, pb),
+                                                  opt.rest_speed);
   }
   std::size_t added = contacts.size() - detected;  // a jam's speculative points
   const std::vector<FloeState> before = floes.state;  // W^-
