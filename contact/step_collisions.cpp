@@ -37,6 +37,24 @@ bool made_by_step(double now, double at_start, double kick, double rest_speed) {
   return at_start <= std::max({rest_speed, kick, now / 3.0});
 }
 
+// Per floe, 1 if it is in a jam: a component of at least `size` dynamic
+// floes joined by `contacts`.
+std::vector<std::uint8_t> jam_floes(const Floes& floes, const std::vector<ContactPoint>& contacts, std::size_t size) {
+  const std::size_t n = floes.size();
+  DisjointSets sets(n);
+  std::vector<std::uint8_t> joined(n, 0), jam(n, 0);
+  for (const ContactPoint& c : contacts)
+    if (!floes.is_static[c.a] && !floes.is_static[c.b]) {
+      sets.join(c.a, c.b);
+      joined[c.a] = joined[c.b] = 1;
+    }
+  std::vector<std::uint32_t> count(n, 0);
+  for (std::uint32_t f = 0; f < n; ++f)
+    if (joined[f]) ++count[sets.find(f)];
+  for (std::uint32_t f = 0; f < n; ++f) jam[f] = joined[f] && count[sets.find(f)] >= size;
+  return jam;
+}
+
 // Whether witness w of the non-overlapping pair p becomes a speculative
 // contact with the floes' present velocities (impulse.hpp, "Speculative
 // contacts"): its points would close below xi/2 within the step, and the
@@ -124,18 +142,10 @@ std::size_t step_collisions(Floes& floes, std::span<const FloeState> start, cons
   // applied are recorded, at the end.
   ImpulseRecord* record = std::exchange(opt.record, nullptr);
   // Jams: contact components (dynamic floes joined by contact points) of at
-  // least opt.jam.floes floes.
-  Components jam;
-  for (const ContactPoint& c : detection.contacts)
-    if (!floes.is_static[c.a] && !floes.is_static[c.b]) jam.join(jam.node(c.a), jam.node(c.b));
-  std::vector<std::uint32_t> jam_size(jam.size(), 0);
-  for (const auto& [f, local] : jam.local) ++jam_size[jam.find(local)];
-  auto in_jam = [&](std::uint32_t f) {
-    if (floes.is_static[f]) return false;
-    const auto it = jam.local.find(f);
-    return it != jam.local.end() && jam_size[jam.find(it->second)] >= opt.jam.floes;
-  };
-  auto jammed = [&](std::uint32_t a, std::uint32_t b) { return in_jam(a) || in_jam(b); };
+  // least opt.jam.floes floes. Per floe, as every pair asks (an array, not
+  // a hash of the contacts' floes: O(floes) a step, the lookups O(1)).
+  const std::vector<std::uint8_t> in_jam = jam_floes(floes, detection.contacts, opt.jam.floes);
+  auto jammed = [&](std::uint32_t a, std::uint32_t b) { return in_jam[a] || in_jam[b]; };
   // The contacts solved here (a jam's are left to its time step unless
   // jam.at_step_start) and where each came from in detection.contacts.
   std::vector<ContactPoint> contacts;
