@@ -68,26 +68,40 @@ bool becomes_speculative(const Floes& floes, std::span<const FloeState> start, s
                       smooth_kick(floes, start, before, p.a, p.b, w.pa, pb), rest_speed);
 }
 
-// The witnesses the rounds of resolve_step_collisions may take: of the
-// pairs that do not overlap, those at or beyond xi not taken already (a
-// jam's). visit(pair, witness, index).
-template <class Visit>
-void each_candidate(const Detection& detection, const std::vector<std::uint8_t>& taken, double xi, Visit&& visit) {
-  for (const NearPair& p : detection.pairs) {
+// The witnesses the rounds of resolve_step_collisions may take, listed once
+// a step (pair and witness indices, in the detection's order): of the pairs
+// that do not overlap, those at or beyond xi not taken already (a jam's).
+struct Candidate {
+  std::uint32_t pair, witness;
+};
+std::vector<Candidate> candidate_witnesses(const Detection& detection, const std::vector<std::uint8_t>& taken,
+                                           double xi) {
+  std::vector<Candidate> out;
+  for (std::uint32_t i = 0; i < detection.pairs.size(); ++i) {
+    const NearPair& p = detection.pairs[i];
     if (p.overlap) continue;
     for (std::uint32_t k = p.first_witness; k < p.first_witness + p.witness_count; ++k)
-      if (!taken[k] && !(detection.witnesses[k].distance < xi)) visit(p, detection.witnesses[k], k);
+      if (!taken[k] && !(detection.witnesses[k].distance < xi)) out.push_back({i, k});
   }
+  return out;
+}
+// visit(pair, witness, index) for the candidates not taken since.
+template <class Visit>
+void each_candidate(const Detection& detection, const std::vector<Candidate>& candidates,
+                    const std::vector<std::uint8_t>& taken, Visit&& visit) {
+  for (const Candidate& c : candidates)
+    if (!taken[c.witness]) visit(detection.pairs[c.pair], detection.witnesses[c.witness], c.witness);
 }
 
 // Per floe, 1 if it is in a step group (resolve_step_collisions_share,
 // impulse.hpp) whose lowest floe `share` gives to share.rank; `groups`
 // counts those groups. `contacts`: the step's contacts before any solve,
-// with the floes at W^-; `taken`: the witnesses already used.
+// with the floes at W^-; `candidates`: the witnesses the rounds may take.
 std::vector<std::uint8_t> share_floes(const Floes& floes, std::span<const FloeState> start, const Detection& detection,
                                       const std::vector<ContactPoint>& contacts,
-                                      const std::vector<std::uint8_t>& taken, double step, const ImpulseOptions& opt,
-                                      const ClusterShare& share, long& groups) {
+                                      const std::vector<Candidate>& candidates, const std::vector<std::uint8_t>& taken,
+                                      double step, const ImpulseOptions& opt, const ClusterShare& share,
+                                      long& groups) {
   const std::size_t n = floes.size();
   const double xi = opt.collision_distance;
   DisjointSets sets(n);
@@ -101,13 +115,13 @@ std::vector<std::uint8_t> share_floes(const Floes& floes, std::span<const FloeSt
   for (const ContactPoint& c : contacts) link(c.a, c.b);
   const std::vector<std::uint8_t> v0 = grouped;  // round 0 may change these
   std::vector<std::uint8_t> v1 = v0;
-  each_candidate(detection, taken, xi, [&](const NearPair& p, const Witness& w, std::uint32_t) {
+  each_candidate(detection, candidates, taken, [&](const NearPair& p, const Witness& w, std::uint32_t) {
     if (v0[p.a] || v0[p.b] || becomes_speculative(floes, start, floes.state, p, w, step, xi, opt.rest_speed)) {
       if (!floes.is_static[p.a]) v1[p.a] = 1;
       if (!floes.is_static[p.b]) v1[p.b] = 1;
     }
   });
-  each_candidate(detection, taken, xi, [&](const NearPair& p, const Witness&, std::uint32_t) {
+  each_candidate(detection, candidates, taken, [&](const NearPair& p, const Witness&, std::uint32_t) {
     if (v1[p.a] || v1[p.b]) link(p.a, p.b);
   });
   // A group belongs to the owner of its lowest floe (the first seen, ascending).
@@ -170,6 +184,7 @@ std::size_t step_collisions(Floes& floes, std::span<const FloeState> start, cons
       contacts.push_back({p.a, p.b, 0.5 * (w.pa + w.pb), w.normal, w.distance, p.shift, true, w.vertex_of_b});
     }
   }
+  std::vector<Candidate> candidates = candidate_witnesses(detection, taken, xi);
   // A share keeps the contacts and witnesses of its step groups only.
   std::vector<std::uint8_t> mine;
   auto kept = [&](std::uint32_t a, std::uint32_t b) {
@@ -178,7 +193,10 @@ std::size_t step_collisions(Floes& floes, std::span<const FloeState> start, cons
     return (da || db) && (!da || mine[a]) && (!db || mine[b]);
   };
   if (share) {
-    mine = share_floes(floes, start, detection, contacts, taken, step, opt, *share, *groups);
+    mine = share_floes(floes, start, detection, contacts, candidates, taken, step, opt, *share, *groups);
+    std::erase_if(candidates, [&](const Candidate& c) {
+      return !kept(detection.pairs[c.pair].a, detection.pairs[c.pair].b);
+    });
     std::size_t to = 0, kept_detected = 0;
     for (std::size_t k = 0; k < contacts.size(); ++k) {
       if (!kept(contacts[k].a, contacts[k].b)) continue;
@@ -209,7 +227,7 @@ std::size_t step_collisions(Floes& floes, std::span<const FloeState> start, cons
   for (int round = 1; round <= 2; ++round) {
     // Pushed points beyond xi that would now close below xi/2 within the step.
     const std::size_t first_new = contacts.size();
-    each_candidate(detection, taken, xi, [&](const NearPair& p, const Witness& w, std::uint32_t k) {
+    each_candidate(detection, candidates, taken, [&](const NearPair& p, const Witness& w, std::uint32_t k) {
       if (!kept(p.a, p.b) || !becomes_speculative(floes, start, before, p, w, step, xi, opt.rest_speed)) return;
       taken[k] = 1;
       contacts.push_back({p.a, p.b, 0.5 * (w.pa + w.pb), w.normal, w.distance, p.shift, true, w.vertex_of_b});
