@@ -357,6 +357,12 @@ int run(const Args& args, const parallel::Session& session) {
     o << "\nparallel.advance_steps: " << share.steps << "\nparallel.advance_fallbacks: " << share.fallbacks
       << "\nparallel.advance_whole: " << share.whole << "\nparallel.advance_clusters:";
     for (const long k : share.clusters) o << " " << k;
+    // The collisions at the step's start by owner, the same way: tried,
+    // redone whole, done whole by the back-off, each rank's step groups.
+    const parallel::AdvanceShareCounts& collide = sim.collide_share();
+    o << "\nparallel.collide_steps: " << collide.steps << "\nparallel.collide_fallbacks: " << collide.fallbacks
+      << "\nparallel.collide_whole: " << collide.whole << "\nparallel.collide_groups:";
+    for (const long k : collide.clusters) o << " " << k;
     o << "\n";
     // Stage seven: with a sea in slabs the strips are its slabs, their first
     // rows (then the row count) now.

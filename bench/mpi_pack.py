@@ -50,7 +50,7 @@ config = moving_pack.write(floesims[0], work, args.floes, args.t_end, seed=1, ou
 phases = ["drift", "collide", "advance", "detect", "record", "choose_dt", "check"]
 strips = ["strip_cuts", "strip_floes", "strip_seconds", "strip_seconds_total", "advance_steps", "advance_fallbacks",
           "advance_whole",
-          "advance_clusters"]
+          "advance_clusters", "collide_steps", "collide_fallbacks", "collide_whole", "collide_groups"]
 rows = []
 load_before = ranks_bench.load()
 for r in range(args.rounds):
@@ -72,8 +72,8 @@ ranks_bench.write_table(
     "waits in collectives included; strip_*: rank 0's parallel.strip_* summary keys (the cuts in y, m; floes "
     "per strip at the end; each rank's by-place CPU seconds over the last balance window and over all windows; "
     "advance_*: the advances by cluster owner, stage seven: tried, redone whole, done whole by the back-off, "
-    "clusters run by each rank), "
-    "blank before stage six",
+    "clusters run by each rank; collide_*: the step-start collisions by owner, the same way, step groups by rank), "
+    "blank before stage six (collide_*: before the step-start collisions by owner)",
     load_before, ranks_bench.load(),
     "ranks,round,wall_s,steps,lcps,bytes_received,collective_s,cpu_s," + ",".join(p + "_s" for p in phases) + "," +
     ",".join(strips) + ",build", rows, group=(lambda row: row[-1]) if len(builds) > 1 else None)

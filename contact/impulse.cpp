@@ -10,29 +10,15 @@
 #include <unordered_map>
 #include <utility>
 
+#include "contact/impulse_detail.hpp"
 #include "contact/lcp/siconos_io.hpp"
 
 namespace floesim::contact {
 
-namespace {
+using detail::approach;
+using detail::Components;
 
-// Disjoint sets over the floes that have contacts (local indices), so a call
-// costs the size of its contact list, not of the pack.
-struct Components {
-  DisjointSets sets;
-  std::unordered_map<std::uint32_t, std::uint32_t> local;  // floe -> local index
-  std::size_t size() const { return sets.size(); }
-  // The local index of floe f, added on first sight.
-  std::uint32_t node(std::uint32_t f) {
-    auto [it, fresh] = local.emplace(f, 0u);
-    if (fresh) it->second = sets.add();
-    return it->second;
-  }
-  // The root of floe f's component; f must have been seen.
-  std::uint32_t root_of(std::uint32_t f) { return sets.find(local.at(f)); }
-  std::uint32_t find(std::uint32_t i) { return sets.find(i); }
-  void join(std::uint32_t a, std::uint32_t b) { sets.join(a, b); }
-};
+namespace {
 
 // One row of G: up to two floe blocks (local floe index, 3 coefficients).
 struct Row {
@@ -54,29 +40,6 @@ Row make_row(const ContactPoint& c, const Vec2& u, const FloeState& sa, const Fl
 }  // namespace
 
 namespace {
-// Velocity of floe f's point p (world, in f's own image).
-Vec2 point_velocity(const FloeState& s, const Vec2& p) { return arm_velocity(s, p - Vec2{s.x, s.y}); }
-// The normal approach speed of a contact's two points (> 0: approaching),
-// with the floes' velocities taken from `s` (the positions are the present
-// ones: velocities from the start of the step are compared at the same points).
-double approach(const Floes& floes, std::span<const FloeState> s, std::uint32_t a, std::uint32_t b,
-                const Vec2& pa, const Vec2& pb_own, const Vec2& normal) {
-  FloeState va = s[a], vb = s[b];
-  va.x = floes.state[a].x; va.y = floes.state[a].y;
-  vb.x = floes.state[b].x; vb.y = floes.state[b].y;
-  return -normal.dot(point_velocity(vb, pb_own) - point_velocity(va, pa));
-}
-// The speed the step's smooth forces gave the two floes' points (the larger
-// of the two): |v_f(p)| of W^- minus that of the step's start, at the present
-// positions.
-double smooth_kick(const Floes& floes, std::span<const FloeState> start, std::span<const FloeState> w_minus,
-                   std::uint32_t a, std::uint32_t b, const Vec2& pa, const Vec2& pb_own) {
-  auto kick = [&](std::uint32_t f, const Vec2& p) {
-    const Vec2 arm = p - Vec2{floes.state[f].x, floes.state[f].y};
-    return (arm_velocity(w_minus[f], arm) - arm_velocity(start[f], arm)).norm();
-  };
-  return std::max(kick(a, pa), kick(b, pb_own));
-}
 // The largest complementarity error of z over the rows of the scaled LCP,
 // in m/s (impulse.hpp, "accepted within velocity_tolerance"). Every row of
 // contact k is in units of velocity times s_k (w' = s_k w, z' = z / s_k for
@@ -96,12 +59,6 @@ double velocity_error(const lcp::Lcp& problem, const Eigen::VectorXd& z, const s
 }
 
 
-// Made by the step (impulse.hpp): the contact approached at the start of the
-// step no faster than rest_speed, or than a third of now, or than the step's
-// smooth forces move either floe's point.
-bool made_by_step(double now, double at_start, double kick, double rest_speed) {
-  return at_start <= std::max({rest_speed, kick, now / 3.0});
-}
 std::uint64_t pair_key(std::uint32_t a, std::uint32_t b) { return (std::uint64_t{a} << 32) | b; }
 Vec2 body_point(const Floes& floes, std::uint32_t a, const Vec2& p) {
   const FloeState& s = floes.state[a];
@@ -526,126 +483,6 @@ void record_impulses(ImpulseRecord& record, const Floes& floes, std::span<const 
                               sustained, sign > 0.0 ? c.a : c.b, ci.normal, ci.point});
     }
   }
-}
-
-std::size_t resolve_step_collisions(Floes& floes, std::span<const FloeState> start, const Detection& detection,
-                                    double step, const ImpulseOptions& options, CollisionStats& stats,
-                                    std::vector<ContactImpulse>* impulses) {
-  const double xi = options.collision_distance;
-  ImpulseOptions opt = options;
-  opt.speculative_step = step;
-  // The solves below may be redone from W^-: only the impulses finally
-  // applied are recorded, at the end.
-  ImpulseRecord* record = std::exchange(opt.record, nullptr);
-  // Jams: contact components (dynamic floes joined by contact points) of at
-  // least opt.jam.floes floes.
-  Components jam;
-  for (const ContactPoint& c : detection.contacts)
-    if (!floes.is_static[c.a] && !floes.is_static[c.b]) jam.join(jam.node(c.a), jam.node(c.b));
-  std::vector<std::uint32_t> jam_size(jam.size(), 0);
-  for (const auto& [f, local] : jam.local) ++jam_size[jam.find(local)];
-  auto in_jam = [&](std::uint32_t f) {
-    if (floes.is_static[f]) return false;
-    const auto it = jam.local.find(f);
-    return it != jam.local.end() && jam_size[jam.find(it->second)] >= opt.jam.floes;
-  };
-  auto jammed = [&](std::uint32_t a, std::uint32_t b) { return in_jam(a) || in_jam(b); };
-  // The contacts solved here (a jam's are left to its time step unless
-  // jam.at_step_start) and where each came from in detection.contacts.
-  std::vector<ContactPoint> contacts;
-  std::vector<std::size_t> from;
-  std::vector<std::uint8_t> resting;
-  for (std::size_t k = 0; k < detection.contacts.size(); ++k) {
-    const ContactPoint& c = detection.contacts[k];
-    if (!opt.jam.at_step_start && jammed(c.a, c.b)) continue;
-    contacts.push_back(c);
-    from.push_back(k);
-    const Vec2 pb = c.point - c.shift;  // in b's own image
-    resting.push_back(jammed(c.a, c.b) || made_by_step(approach(floes, floes.state, c.a, c.b, c.point, pb, c.normal),
-                                                  approach(floes, start, c.a, c.b, c.point, pb, c.normal),
-                                                  smooth_kick(floes, start, floes.state, c.a, c.b, c.point, pb),
-                                                  opt.rest_speed));
-  }
-  const std::size_t detected = contacts.size();
-  // In a jam every point beyond xi is speculative from the start (or left,
-  // with the jam's contacts, to its time step).
-  std::vector<std::uint8_t> taken(detection.witnesses.size(), 0);
-  std::size_t added = 0;
-  for (const NearPair& p : detection.pairs) {
-    if (p.overlap || !jammed(p.a, p.b)) continue;
-    for (std::uint32_t k = p.first_witness; k < p.first_witness + p.witness_count; ++k) {
-      const Witness& w = detection.witnesses[k];
-      if (w.distance < xi) continue;
-      taken[k] = 1;
-      if (!opt.jam.at_step_start) continue;
-      contacts.push_back({p.a, p.b, 0.5 * (w.pa + w.pb), w.normal, w.distance, p.shift, true, w.vertex_of_b});
-      resting.push_back(1);
-      ++added;
-    }
-  }
-  const std::vector<FloeState> before = floes.state;  // W^-
-  std::vector<ContactPoint> again;  // the contacts to solve again: components that gained speculative ones
-  std::vector<std::uint8_t> again_resting;
-  std::vector<std::size_t> again_index;  // their places in contacts
-  std::vector<ContactImpulse> total = resolve_collisions(floes, contacts, opt, stats, resting);
-  for (int round = 1; round <= 2; ++round) {
-    // Pushed points beyond xi that would now close below xi/2 within the step.
-    const std::size_t first_new = contacts.size();
-    for (const NearPair& p : detection.pairs) {
-      if (p.overlap) continue;
-      for (std::uint32_t k = p.first_witness; k < p.first_witness + p.witness_count; ++k) {
-        const Witness& w = detection.witnesses[k];
-        if (taken[k] || w.distance < xi) continue;
-        const Vec2 pb = w.pb - p.shift;
-        const double now = approach(floes, floes.state, p.a, p.b, w.pa, pb, w.normal);
-        if (!(now * step > w.distance - 0.5 * xi)) continue;
-        if (!made_by_step(now, approach(floes, start, p.a, p.b, w.pa, pb, w.normal),
-                          smooth_kick(floes, start, before, p.a, p.b, w.pa, pb), opt.rest_speed))
-          continue;
-        taken[k] = 1;
-        contacts.push_back({p.a, p.b, 0.5 * (w.pa + w.pb), w.normal, w.distance, p.shift, true, w.vertex_of_b});
-        resting.push_back(1);
-        ++added;
-      }
-    }
-    if (contacts.size() == first_new) break;
-    // The components (over all contacts) that gained speculative contacts are
-    // solved again from W^-; the others keep their solution.
-    Components comp;
-    auto dynamic_end = [&](const ContactPoint& c) { return floes.is_static[c.a] ? c.b : c.a; };
-    for (const ContactPoint& c : contacts) {
-      if (floes.is_static[c.a] || floes.is_static[c.b]) comp.node(dynamic_end(c));
-      else comp.join(comp.node(c.a), comp.node(c.b));
-    }
-    std::vector<std::uint8_t> redo(comp.size(), 0);
-    for (std::size_t k = first_new; k < contacts.size(); ++k) redo[comp.root_of(dynamic_end(contacts[k]))] = 1;
-    again.clear();
-    again_resting.clear();
-    again_index.clear();
-    for (std::size_t k = 0; k < contacts.size(); ++k)
-      if (redo[comp.root_of(dynamic_end(contacts[k]))]) {
-        again.push_back(contacts[k]);
-        again_resting.push_back(resting[k]);
-        again_index.push_back(k);
-      }
-    for (const auto& [f, local] : comp.local)
-      if (redo[comp.find(local)]) {
-        floes.state[f].vx = before[f].vx;
-        floes.state[f].vy = before[f].vy;
-        floes.state[f].yaw_rate = before[f].yaw_rate;
-      }
-    const std::vector<ContactImpulse> redone = resolve_collisions(floes, again, opt, stats, again_resting);
-    total.resize(contacts.size());
-    for (std::size_t j = 0; j < again.size(); ++j) total[again_index[j]] = redone[j];
-  }
-  // Sustained or impact by the approach at the start of the step, before the
-  // step's smooth forces: a physical speed, not one the step's length made.
-  if (record) record_impulses(*record, floes, contacts, total, slow_contacts(floes, contacts, opt.rest_speed, start));
-  if (impulses) {
-    impulses->assign(detection.contacts.size(), ContactImpulse{});
-    for (std::size_t j = 0; j < detected; ++j) (*impulses)[from[j]] = total[j];
-  }
-  return added;
 }
 
 }  // namespace floesim::contact

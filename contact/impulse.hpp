@@ -334,4 +334,58 @@ std::size_t resolve_step_collisions(Floes& floes, std::span<const FloeState> sta
                                     double step, const ImpulseOptions& options, CollisionStats& stats,
                                     std::vector<ContactImpulse>* impulses = nullptr);
 
+// A share of the collision work by owner (a distributed run's, docs/parallel.md
+// stage seven): per floe the rank that owns it, and this share's rank. The
+// contact layer knows nothing of ranks: these are numbers. (The advance's
+// clusters use it too, substep.hpp.)
+struct ClusterShare {
+  std::span<const int> owner;  // per floe: its rank
+  int rank = 0;
+};
+
+// One share of resolve_step_collisions: the LCPs of the step groups whose
+// lowest floe `share` gives to `share.rank`.
+//
+// The step groups. resolve_step_collisions solves the components of its
+// contacts (round 0), then up to two rounds find the speculative contacts
+// the answers make (a witness beyond xi whose points would close below xi/2
+// within the step) and solve the components that gained some again from
+// W^-. A speculative contact can join two components, so the components
+// alone do not split the work. Let V0 be the floes of the contacts (round
+// 0 may change them); a witness between two floes outside V0 is tested in
+// round 1 on W^-, which every share knows; V1 adds to V0 the floes of the
+// witnesses with an end in V0 (they may be taken) and of those taken on
+// W^-; round 2 may take only witnesses with an end in V1 (the others are
+// tested on the same velocities as in round 1, and were not taken). The
+// step groups are the connected components of the dynamic floes joined by
+// the contacts, the witnesses taken on W^- and every witness with an end in
+// V1. Every component of every round lies in one group, and a group's
+// solves read and write only its floes (obstacles are not changed). So the
+// share, which runs the same rounds on its groups' contacts and witnesses
+// only, makes the same solves on the same numbers as the whole call: its
+// floes end with the whole call's velocities, its counts are the whole
+// call's over its groups (sums; `largest` a maximum), and the groups of the
+// shares are disjoint.
+//
+// A conflict (the caller then solves the whole step from the states on
+// entry): a solve that would have used the warm store (options.warm: kept
+// across steps by pair, the shares' stores would part; the share is given an
+// empty store that counts uses), a failed LCP (its dump, not written by a
+// share, is numbered by the run's failures), a RunError. options.record
+// must be null: its events are numbered in the whole call's order.
+struct StepCollisionShare {
+  enum class Conflict { none, warm_start, failed_lcp, error };
+  Conflict conflict = Conflict::none;
+  std::vector<std::uint32_t> moved;  // ascending: the floes whose velocities the share changed
+  long groups = 0;                   // step groups of the share
+  std::size_t speculative = 0;       // speculative contacts that took part (resolve_step_collisions' count)
+};
+StepCollisionShare resolve_step_collisions_share(Floes& floes, std::span<const FloeState> start,
+                                                 const Detection& detection, double step,
+                                                 const ImpulseOptions& options, const ClusterShare& share,
+                                                 CollisionStats& stats);
+
+// Adds the counts of `part` (a share's) to `total`: sums, `largest` a maximum.
+void add_collision_counts(CollisionStats& total, const CollisionStats& part);
+
 }  // namespace floesim::contact

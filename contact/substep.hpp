@@ -123,10 +123,7 @@ void advance_with_collisions(Floes& floes, const CollisionShapes& shapes, const 
 // a share that would use it is a conflict too (the stores of the ranks
 // would part); so is a failed LCP (its dump is numbered in the run) and a
 // RunError (the serial advance throws it, or a different one, in its order).
-struct ClusterShare {
-  std::span<const int> owner;  // per floe: its rank
-  int rank = 0;
-};
+// (ClusterShare: impulse.hpp.)
 
 // What a share did. On `conflict` other than none the floes' states are
 // unusable and the caller redoes the advance whole from the step's states.

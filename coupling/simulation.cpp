@@ -12,6 +12,7 @@
 #include "fluid/fft2d.hpp"
 #include "fluid/sea.hpp"
 #include "parallel/advance_share.hpp"
+#include "parallel/collide_share.hpp"
 #include "parallel/detect.hpp"
 
 namespace floesim {
@@ -286,7 +287,15 @@ void Simulation::collide(StepContext& ctx) {
   // (restitution 0), and pushed points that would close below xi/2 within the
   // step are held by speculative contacts (contact/impulse.hpp).
   if (impulse_options_.record) impulse_options_.record->clear();  // this try's impulses (a redone step starts again)
-  contact::resolve_step_collisions(scenario_.floes, ctx.start, detection_, ctx.dt, impulse_options_, stats_);
+  // On several ranks each rank solves the step groups it owns and the ranks
+  // exchange the velocities they changed (stage seven,
+  // parallel/collide_share.hpp); a run that keeps the impulse record solves
+  // whole on every rank, as advance() does.
+  if (comm_.serial() || impulse_options_.record)
+    contact::resolve_step_collisions(scenario_.floes, ctx.start, detection_, ctx.dt, impulse_options_, stats_);
+  else
+    parallel::collide_by_owner(comm_, owners_.owner(), scenario_.floes, ctx.start, detection_, ctx.dt,
+                               impulse_options_, stats_, collide_share_);
   const Vec2 after = momentum();
   step_budget_.collisions = after - ctx.momentum;
   ctx.momentum = after;

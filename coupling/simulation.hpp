@@ -144,6 +144,7 @@ public:
   const parallel::FloeOwners& floe_owners() const { return owners_; }
   const contact::SubstepReport& substep_report() const { return substeps_; }
   const parallel::AdvanceShareCounts& advance_share() const { return advance_share_; }  // stage seven
+  const parallel::AdvanceShareCounts& collide_share() const { return collide_share_; }  // the step-start collisions
   long rejected_steps() const { return rejected_steps_; }
   // Things a user should hear about once, with a count (e.g. steps cut to the floor).
   std::vector<std::string> warnings() const;
@@ -211,6 +212,7 @@ private:
   MomentumBudget budget_, step_budget_;  // run total; this step's (redone steps do not count)
   contact::SubstepReport substeps_;  // collision sub-steps (floors, merges, ...)
   parallel::AdvanceShareCounts advance_share_;  // the advances by cluster owner (stage seven)
+  parallel::AdvanceShareCounts collide_share_;  // the step-start collisions by owner (stage seven)
   long rejected_steps_ = 0;       // steps redone after an overlap
   Profile profile_;
   double t_ = 0.0;

@@ -131,9 +131,7 @@ void advance_by_owner(const Communicator& comm, std::span<const int> owner, Floe
                       const contact::SubstepOptions& options, contact::CollisionStats& stats,
                       contact::SubstepReport& report, AdvanceShareCounts& counts,
                       const AdvanceShareOptions& share_options) {
-  if (counts.wait > 0) {
-    --counts.wait;
-    ++counts.whole;
+  if (counts.whole_now()) {
     contact::advance_with_collisions(floes, shapes, detection, dt, options, stats, report);
     return;
   }
@@ -147,17 +145,14 @@ void advance_by_owner(const Communicator& comm, std::span<const int> owner, Floe
     parts.push_back(unpack_advance_part({all.data() + from, n}));
     from += n;
   }
-  ++counts.steps;
   counts.clusters.resize(parts.size(), 0);
   if (combine_parts(parts, floes, stats, report)) {
     for (std::size_t r = 0; r < parts.size(); ++r) counts.clusters[r] += parts[r].outcome.clusters;
-    counts.next_wait = 1;
+    counts.combined();
     return;
   }
   // A conflict: the whole advance from the step's states, as the serial run.
-  ++counts.fallbacks;
-  counts.wait = counts.next_wait;
-  counts.next_wait = std::min(2 * counts.next_wait, share_options.max_wait);
+  counts.fell_back(share_options);
   floes.state = start;
   contact::advance_with_collisions(floes, shapes, detection, dt, options, stats, report);
 }

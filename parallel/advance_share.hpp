@@ -11,6 +11,7 @@
 // step's states: the serial advance, so the answer is the serial one bit for
 // bit either way.
 
+#include <algorithm>
 #include <cstddef>
 #include <span>
 #include <vector>
@@ -57,7 +58,8 @@ struct AdvanceShareOptions {
 };
 
 // How the advances by cluster owner went (the run's summary), and the
-// back-off's state.
+// back-off's state. The collisions at the step's start by owner
+// (collide_share.hpp) keep their own, with the same back-off.
 struct AdvanceShareCounts {
   long steps = 0;               // advances tried by owner
   long fallbacks = 0;           // of those, redone whole
@@ -65,6 +67,26 @@ struct AdvanceShareCounts {
   std::vector<long> clusters;   // per rank: clusters it ran (steps not redone)
   long wait = 0;                // advances still to do whole
   long next_wait = 1;           // the wait after the next fallback
+
+  // The back-off above. True (and counted in `whole`) when this step is to
+  // be done whole at once; else the step is tried by owner (counted).
+  bool whole_now() {
+    if (wait > 0) {
+      --wait;
+      ++whole;
+      return true;
+    }
+    ++steps;
+    return false;
+  }
+  // The step tried by owner combined: the next fallback waits 1 again.
+  void combined() { next_wait = 1; }
+  // The step tried by owner fell back: wait, then double the next wait.
+  void fell_back(const AdvanceShareOptions& o) {
+    ++fallbacks;
+    wait = next_wait;
+    next_wait = std::min(2 * next_wait, o.max_wait);
+  }
 };
 
 // The step's advance on every rank of `comm` (or whole, while the back-off

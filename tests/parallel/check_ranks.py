@@ -2,7 +2,8 @@
 """Distributed runs against the serial run (docs/parallel.md).
 
 usage: check_ranks.py FLOESIM MPIEXEC WORKDIR [--floes N] [--t-end T] [--ranks 1 2 3] [--rtol R]
-                      [--also CONFIG...] [--also-rtol R] [--no-errors]
+                      [--also CONFIG...] [--also-rtol R] [--fallback CONFIG [--fallback-until T]]
+                      [--no-errors]
        check_ranks.py --no-mpi    (MPI not built: says so and exits 77, ctest's skip code)
 
 The collisions-only periodic pack of scripts/scenarios/moving_pack.py (N
@@ -15,7 +16,9 @@ and ordered gathers promise); so must a run stopped half-way on 2 ranks and
 continued with --restart on 2 ranks. Each --also CONFIG (a run with a sea, say) is
 checked on 2 ranks with --also-rtol (0 by default; a sea with the explicit
 kicks sums the cells shared by ranks grouped by rank, docs/parallel.md stage
-three: issue 21's 1e-6). Then the errors: bad input and a run file that
+three: issue 21's 1e-6). --fallback CONFIG: a run whose step-start collisions
+fall back to the whole solve on 2 and 3 ranks must equal the serial run too,
+with fallbacks counted. Then the errors: bad input and a run file that
 rank 0 cannot create must end every rank with exit 2 and 1, and the message
 said once.
 """
@@ -44,6 +47,9 @@ ap.add_argument("--rtol", type=float, default=0.0)
 ap.add_argument("--errors", action=argparse.BooleanOptionalAction, default=True)
 ap.add_argument("--also", nargs="*", default=[], help="other configurations to check on 2 ranks (e.g. with a sea)")
 ap.add_argument("--also-rtol", type=float, default=0.0, help="relative tolerance of the --also runs")
+ap.add_argument("--fallback", help="a run whose step-start collisions fall back on several ranks (a jam forming "
+                "against a wall, whose LCPs take the warm store): on 2 and 3 ranks, bit for bit")
+ap.add_argument("--fallback-until", type=float, help="the --fallback runs stop at this time")
 args = ap.parse_args()
 
 W = args.workdir
@@ -91,6 +97,14 @@ for n in args.ranks:
         print(f"{n} ranks: {steps} advances by cluster owner, {fallbacks} redone whole, clusters by rank {clusters}")
         if not (steps and fallbacks and int(steps[0]) > int(fallbacks[0]) and sum(map(int, clusters)) > 0):
             failures.append(f"{n} ranks: no advance by cluster owner was kept ({steps}, {fallbacks}, {clusters})")
+    # The collisions at the step's start by owner too: every try kept here
+    # (no warm store at step start in this pack), step groups on every rank.
+    tried, fell, groups = key("parallel.collide_steps"), key("parallel.collide_fallbacks"), key("parallel.collide_groups")
+    if n > 1:
+        print(f"{n} ranks: {tried} step-start collisions by owner, {fell} redone whole, groups by rank {groups}")
+        if not (tried and fell and int(tried[0]) > 0 and int(fell[0]) == 0 and len(groups) == n
+                and all(int(g) > 0 for g in groups)):
+            failures.append(f"{n} ranks: the step-start collisions did not run by owner ({tried}, {fell}, {groups})")
 
 # A restart on 2 ranks: the first half, then --restart from its checkpoint
 # (written by rank 0, read by every rank), equals the serial run.
@@ -113,6 +127,25 @@ for other in args.also:
           f"(rtol {args.also_rtol}, atol 0)")
     if p.returncode != 0 or c.returncode != 0:
         failures.append(f"{other} on 2 ranks: exit {p.returncode}\n{p.stderr}\n{c.stdout}")
+
+# Step-start collisions that fall back to the whole solve on every rank (a
+# share's LCP would use the warm store, kept alike on every rank): still the
+# serial run bit for bit, and some tries kept.
+if args.fallback:
+    until = ["--until", str(args.fallback_until)] if args.fallback_until else []
+    need(run([args.floesim, "run", args.fallback, "-o", "fallback_serial.h5", "-q", *until]), "fallback: serial run")
+    for n in (2, 3):
+        p = mpirun(n, "run", args.fallback, "-o", f"fallback_{n}.h5", "-q", *until)
+        c = run([args.floesim, "compare", f"fallback_{n}.h5", "fallback_serial.h5", "--rtol", "0", "--atol", "0"])
+        key = lambda k: next((l.split(":", 1)[1].split() for l in p.stdout.splitlines() if l.startswith(k + ":")), [])
+        tried, fell = key("parallel.collide_steps"), key("parallel.collide_fallbacks")
+        equal = p.returncode == 0 and c.returncode == 0
+        print(f"fallback run on {n} ranks: {'equal' if equal else 'DIFFERENT'} to the serial run; "
+              f"{tried} step-start collisions by owner, {fell} redone whole")
+        if not equal:
+            failures.append(f"fallback run on {n} ranks: exit {p.returncode}\n{p.stderr}\n{c.stdout}")
+        elif not (tried and fell and int(fell[0]) > 0 and int(tried[0]) > int(fell[0])):
+            failures.append(f"fallback run on {n} ranks: expected fallbacks and kept tries ({tried}, {fell})")
 
 if args.errors:
     # Bad input: every rank reads it, every rank stops, exit 2, said once.

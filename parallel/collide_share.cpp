@@ -1,0 +1,122 @@
+#include "parallel/collide_share.hpp"
+
+#include <array>
+#include <tuple>
+#include <utility>
+
+#include "core/error.hpp"
+#include "parallel/bytes.hpp"
+
+namespace floesim::parallel {
+
+namespace {
+
+using contact::CollisionStats;
+using contact::StepCollisionShare;
+
+constexpr std::size_t kStats = std::tuple_size_v<decltype(contact::collision_counts(std::declval<CollisionStats&>()))>;
+
+// The header's longs: conflict, moved, groups, speculative, the states'
+// count (the moved floes' when the share had no conflict, else none), the
+// stats; then the moved floes and their states.
+constexpr std::size_t kHeader = 5 + kStats;
+
+}  // namespace
+
+std::vector<std::byte> pack(const CollidePart& p) {
+  std::array<long, kHeader> head{};
+  head[0] = static_cast<long>(p.outcome.conflict);
+  head[1] = static_cast<long>(p.outcome.moved.size());
+  head[2] = p.outcome.groups;
+  head[3] = static_cast<long>(p.outcome.speculative);
+  head[4] = static_cast<long>(p.states.size());
+  std::size_t k = 5;
+  for (const auto& [name, f] : contact::collision_counts(p.stats)) head[k++] = *f;
+  std::vector<std::byte> out(sizeof(head) + p.outcome.moved.size() * sizeof(std::uint32_t) +
+                             p.states.size() * sizeof(FloeState));
+  std::byte* at = put(out.data(), head.data(), head.size());
+  at = put(at, p.outcome.moved.data(), p.outcome.moved.size());
+  put(at, p.states.data(), p.states.size());
+  return out;
+}
+
+CollidePart unpack_collide_part(std::span<const std::byte> bytes) {
+  CollidePart p;
+  const std::byte* in = bytes.data();
+  FLOESIM_ASSERT(bytes.size() >= kHeader * sizeof(long));
+  std::array<long, kHeader> head{};
+  for (std::size_t j = 0; j < kHeader; ++j) head[j] = at<long>(in, j);
+  in += sizeof(head);
+  p.outcome.conflict = static_cast<StepCollisionShare::Conflict>(head[0]);
+  const auto moved = static_cast<std::size_t>(head[1]);
+  p.outcome.groups = head[2];
+  p.outcome.speculative = static_cast<std::size_t>(head[3]);
+  const auto states = static_cast<std::size_t>(head[4]);
+  FLOESIM_ASSERT(bytes.size() == sizeof(head) + moved * sizeof(std::uint32_t) + states * sizeof(FloeState));
+  std::size_t k = 5;
+  for (const auto& [name, f] : contact::collision_counts(p.stats)) *f = head[k++];
+  p.outcome.moved = take<std::uint32_t>(in, moved);
+  p.states = take<FloeState>(in, states);
+  return p;
+}
+
+CollidePart run_collide_share(Floes& floes, std::span<const FloeState> start, const contact::Detection& detection,
+                              double step, const contact::ImpulseOptions& options, std::span<const int> owner,
+                              int rank) {
+  CollidePart part;
+  part.outcome = contact::resolve_step_collisions_share(floes, start, detection, step, options, {owner, rank},
+                                                        part.stats);
+  if (part.outcome.conflict == StepCollisionShare::Conflict::none)
+    for (const std::uint32_t i : part.outcome.moved) part.states.push_back(floes.state[i]);
+  return part;
+}
+
+bool combine_collide_parts(std::span<const CollidePart> parts, Floes& floes, CollisionStats& stats,
+                           std::size_t& speculative) {
+  std::vector<std::uint8_t> taken(floes.size(), 0);
+  for (const CollidePart& p : parts) {
+    if (p.outcome.conflict != StepCollisionShare::Conflict::none) return false;
+    for (const std::uint32_t i : p.outcome.moved) {
+      if (taken[i]) return false;
+      taken[i] = 1;
+    }
+  }
+  speculative = 0;
+  for (const CollidePart& p : parts) {
+    for (std::size_t j = 0; j < p.states.size(); ++j) floes.state[p.outcome.moved[j]] = p.states[j];
+    contact::add_collision_counts(stats, p.stats);
+    speculative += p.outcome.speculative;
+  }
+  return true;
+}
+
+std::size_t collide_by_owner(const Communicator& comm, std::span<const int> owner, Floes& floes,
+                             std::span<const FloeState> start, const contact::Detection& detection, double step,
+                             const contact::ImpulseOptions& options, contact::CollisionStats& stats,
+                             AdvanceShareCounts& counts, const AdvanceShareOptions& share_options) {
+  if (counts.whole_now()) return contact::resolve_step_collisions(floes, start, detection, step, options, stats);
+  // W^-: a fallback starts again from it. Only the velocities change here.
+  const std::vector<FloeState> entry = floes.state;
+  const CollidePart mine = run_collide_share(floes, start, detection, step, options, owner, comm.rank());
+  std::vector<std::size_t> sizes;
+  const std::vector<std::byte> all = comm.allgather_bytes(pack(mine), sizes);
+  std::vector<CollidePart> parts;
+  std::size_t from = 0;
+  for (const std::size_t n : sizes) {
+    parts.push_back(unpack_collide_part({all.data() + from, n}));
+    from += n;
+  }
+  counts.clusters.resize(parts.size(), 0);
+  std::size_t speculative = 0;
+  if (combine_collide_parts(parts, floes, stats, speculative)) {
+    for (std::size_t r = 0; r < parts.size(); ++r) counts.clusters[r] += parts[r].outcome.groups;
+    counts.combined();
+    return speculative;
+  }
+  // A conflict: the whole solve from the states on entry, as the serial run.
+  counts.fell_back(share_options);
+  floes.state = entry;
+  return contact::resolve_step_collisions(floes, start, detection, step, options, stats);
+}
+
+}  // namespace floesim::parallel

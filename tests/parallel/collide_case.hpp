@@ -1,0 +1,83 @@
+#pragma once
+// The step-start collisions' test case, shared by test_collide_share.cpp
+// (shares played on one process) and collide_share_ranks.cpp (over the
+// ranks mpirun starts).
+#include <algorithm>
+#include <numeric>
+#include <random>
+#include <vector>
+
+#include "contact/detection.hpp"
+#include "contact/impulse.hpp"
+#include "contact/shapes.hpp"
+#include "core/floe.hpp"
+
+namespace floesim::test {
+
+struct CollideCase {
+  Floes floes;                       // W^-
+  std::vector<FloeState> start;      // the step's start, before its smooth forces
+  contact::Detection detection;
+  contact::ImpulseOptions options;
+  contact::Domain domain;
+  double dt = 10.0;
+};
+
+// `side` x `side` rows of four 10 m squares, 100 m apart in a periodic box,
+// along x or y by turns, floes numbered in a shuffled order. In a row, A
+// (0.2 to 1 m/s) touches B (0.1 m/s) 5 mm ahead of it and D touches C the
+// same way from the other side; B and C are 0.1 to 1.5 m apart, a witness.
+// The collisions throw B and C at each other: a speculative contact joins
+// the two contact components, which are solved again together from W^-, so
+// each row is one step group (and two contact components). The step's start
+// had 60 % of the velocities.
+inline CollideCase rows_of_four(unsigned seed, int side = 8) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> fast(0.2, 1.0), gap(0.1, 1.5);
+  const double spacing = 100.0;
+  std::vector<FloeInput> in;
+  for (int m = 0; m < side * side; ++m) {
+    const bool along_x = m % 2 == 0;
+    const Vec2 at{spacing * (m % side) + 20.0, spacing * (m / side) + 20.0};
+    const double g = gap(rng);
+    const double x[4] = {0.0, 10.005, 20.005 + g, 30.01 + g};
+    const double v[4] = {fast(rng), 0.1, -0.1, -fast(rng)};
+    for (int k = 0; k < 4; ++k) {
+      FloeInput f;
+      const Vec2 o = along_x ? Vec2{at.x() + x[k] - 20.0, at.y()} : Vec2{at.x(), at.y() + x[k] - 20.0};
+      f.vertices = {{o.x(), o.y()}, {o.x() + 10.0, o.y()}, {o.x() + 10.0, o.y() + 10.0}, {o.x(), o.y() + 10.0}};
+      f.velocity = along_x ? Vec2{v[k], 0.0} : Vec2{0.0, v[k]};
+      in.push_back(f);
+    }
+  }
+  std::vector<std::size_t> order(in.size());
+  std::iota(order.begin(), order.end(), 0);
+  std::shuffle(order.begin(), order.end(), rng);
+  CollideCase c;
+  for (const std::size_t i : order) c.floes.add(make_floe_shape(in[i]), in[i]);
+  c.start = c.floes.state;
+  for (FloeState& s : c.start) {
+    s.vx *= 0.6;
+    s.vy *= 0.6;
+  }
+  c.domain = {true, 0.0, spacing * side, 0.0, spacing * side};
+  contact::DetectionOptions d;
+  d.domain = c.domain;
+  d.horizon = c.dt;
+  d.reach.assign(c.floes.size(), 6.0);  // m: pairs within 12 m, each row's own
+  c.detection = contact::detect(c.floes, contact::build_collision_shapes(c.floes), d);
+  c.options.collision_distance = d.collision_distance;
+  c.options.min_gap = 0.1 * d.collision_distance;
+  c.options.relaxation_time = c.dt;
+  return c;
+}
+
+inline bool same_stats(const contact::CollisionStats& a, const contact::CollisionStats& b) {
+  const auto x = contact::collision_counts(a);
+  const auto y = contact::collision_counts(b);
+  for (std::size_t k = 0; k < x.size(); ++k)
+    if (*x[k].second != *y[k].second) return false;
+  return true;
+}
+
+}  // namespace floesim::test

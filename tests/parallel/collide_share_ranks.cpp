@@ -1,0 +1,68 @@
+// The collisions at the step's start by owner (parallel::collide_by_owner,
+// stage seven) over the ranks mpirun starts: the rows of four floes of
+// collide_case.hpp (each row one step group: two contact components that a
+// speculative contact joins), owned by place (FloeOwners, equal strips), solved by
+// each rank's share and one exchange. Every rank's floes and counts must
+// equal the serial solve (resolve_step_collisions on every rank's own copy)
+// bit for bit: first kept (on several ranks: tried once, no fallback, groups
+// solved on every rank), then with every LCP on the warm store (warm_min =
+// 0), which falls back on every rank alike and is the serial solve again.
+// Run by ctest as mpi.collide_share_ranks_N under `mpirun --oversubscribe
+// -np N` (N = 1, 2, 3), and serially without MPI.
+#include <cstdio>
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include "parallel/collide_share.hpp"
+#include "parallel/comm.hpp"
+#include "parallel/place.hpp"
+#include "tests/parallel/collide_case.hpp"
+
+using namespace floesim;
+
+int main() {
+  parallel::Session session;
+  const parallel::Communicator& comm = session.world();
+  const int ranks = comm.size();
+  std::vector<std::string> failures;
+  const test::CollideCase c = test::rows_of_four(3);
+  parallel::FloeOwners owners(comm.rank(), ranks, c.domain);
+  owners.assign(c.floes);
+  for (const bool warm : {false, true}) {
+    const std::string name = warm ? "warm store: " : "";
+    contact::ImpulseOptions o = c.options;
+    contact::WarmStart serial_warm, shared_warm;
+    if (warm) o.warm_min = 0;
+    Floes s = c.floes, f = c.floes;
+    contact::CollisionStats ss, fs;
+    contact::ImpulseOptions so = o, fo = o;
+    so.warm = &serial_warm;
+    fo.warm = &shared_warm;
+    const std::size_t a = contact::resolve_step_collisions(s, c.start, c.detection, c.dt, so, ss);
+    parallel::AdvanceShareCounts counts;
+    const std::size_t b =
+        parallel::collide_by_owner(comm, owners.owner(), f, c.start, c.detection, c.dt, fo, fs, counts);
+    if (std::memcmp(f.state.data(), s.state.data(), f.state.size() * sizeof(FloeState)) != 0)
+      failures.push_back(name + "the floes differ from the serial solve");
+    if (!test::same_stats(fs, ss)) failures.push_back(name + "the collision counts differ from the serial solve");
+    if (a != b) failures.push_back(name + "the speculative contacts' count differs");
+    if (ss.lcps < 64 || a == 0) failures.push_back(name + "too few LCPs or no speculative contact: no test");
+    if (counts.steps != 1 || counts.fallbacks != (warm ? 1 : 0))
+      failures.push_back(name + "expected 1 try and " + std::to_string(warm ? 1 : 0) + " fallback, got " +
+                         std::to_string(counts.steps) + " and " + std::to_string(counts.fallbacks));
+    long busy = 0;  // ranks that solved groups
+    for (const long g : counts.clusters) busy += g > 0 ? 1 : 0;
+    if (!warm && busy != ranks) failures.push_back("not every rank solved step groups");
+    if (comm.writer()) {
+      std::printf("%s%d ranks: %ld LCPs, %zu speculative contacts, fallbacks %ld, groups by rank:", name.c_str(),
+                  ranks, ss.lcps, a, counts.fallbacks);
+      for (const long g : counts.clusters) std::printf(" %ld", g);
+      std::printf("\n");
+    }
+  }
+  for (const std::string& m : failures) std::printf("rank %d: %s\n", comm.rank(), m.c_str());
+  const long long failed = comm.sum(static_cast<long long>(failures.size()));
+  if (comm.writer()) std::printf("%s on %d ranks\n", failed == 0 ? "passed" : "FAILED", ranks);
+  return failed == 0 ? 0 : 1;
+}

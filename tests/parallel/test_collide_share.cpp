@@ -1,0 +1,230 @@
+// Stage seven without ranks: the collisions at the step's start split by
+// owner (contact::resolve_step_collisions_share) over 1, 2, 3 and 7 strips,
+// and with every floe its own rank, each share run on its own copy of the
+// floes as each rank runs it, packed, unpacked and combined as
+// parallel::collide_by_owner combines the gathered parts, are the serial
+// solve (contact::resolve_step_collisions) bit for bit: the floes' states
+// (memcmp), the collision counts and the speculative contacts' count. A
+// speculative contact that joins two ranks' contact components puts both in
+// one step group, on one rank. A share that would use the warm store falls
+// back to the serial solve, with the advance's back-off.
+#include <doctest/doctest.h>
+
+#include <algorithm>
+#include <cstring>
+#include <random>
+#include <numeric>
+#include <string>
+
+#include "core/pack_generator.hpp"
+#include "parallel/collide_share.hpp"
+#include "parallel/place.hpp"
+#include "tests/parallel/collide_case.hpp"
+
+TEST_SUITE_BEGIN("mpi");
+
+using namespace floesim;
+using test::CollideCase;
+using test::same_stats;
+
+namespace {
+
+struct Serial {
+  std::vector<FloeState> state;
+  contact::CollisionStats stats;
+  std::size_t speculative = 0;
+};
+Serial serial_solve(const CollideCase& c) {
+  Floes f = c.floes;
+  Serial s;
+  s.speculative = contact::resolve_step_collisions(f, c.start, c.detection, c.dt, c.options, s.stats);
+  s.state = f.state;
+  return s;
+}
+
+// Plays `ranks` ranks: each runs its share on its own copy, the parts go
+// through pack/unpack, and rank 0's copy combines them. Returns whether they
+// combined; `f`, `stats` and `speculative` hold the combined answer, or,
+// when not, the whole solve redone (the fallback). `groups`: each rank's.
+bool play(const CollideCase& c, std::span<const int> owner, int ranks, Floes& f, contact::CollisionStats& stats,
+          std::size_t& speculative, std::vector<long>& groups) {
+  std::vector<parallel::CollidePart> parts;
+  Floes first;
+  for (int r = 0; r < ranks; ++r) {
+    Floes mine = c.floes;
+    const parallel::CollidePart part =
+        parallel::run_collide_share(mine, c.start, c.detection, c.dt, c.options, owner, r);
+    parts.push_back(parallel::unpack_collide_part(parallel::pack(part)));
+    REQUIRE(parts.back().outcome.moved == part.outcome.moved);  // the bytes carry the part
+    REQUIRE(parts.back().states.size() == part.states.size());
+    groups.push_back(part.outcome.groups);
+    if (r == 0) first = std::move(mine);
+  }
+  f = std::move(first);
+  if (parallel::combine_collide_parts(parts, f, stats, speculative)) return true;
+  f.state = c.floes.state;
+  speculative = contact::resolve_step_collisions(f, c.start, c.detection, c.dt, c.options, stats);
+  return false;
+}
+
+bool same_states(const std::vector<FloeState>& a, const std::vector<FloeState>& b) {
+  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(FloeState)) == 0;
+}
+
+}  // namespace
+
+TEST_CASE("the step-start collisions by owner over 1, 2, 3 and 7 strips, and by floe, are the serial solve") {
+  for (const unsigned seed : {3u, 11u}) {
+    CAPTURE(seed);
+    const CollideCase c = test::rows_of_four(seed);
+    const Serial serial = serial_solve(c);
+    MESSAGE("serial: " << c.detection.contacts.size() << " contact points, " << serial.stats.lcps << " LCPs, "
+                       << serial.speculative << " speculative contacts");
+    REQUIRE(serial.stats.lcps > 64);         // every row's two components, and again joined
+    REQUIRE(serial.speculative >= 64);       // a speculative contact in every row
+    for (const int ranks : {1, 2, 3, 7, 0}) {
+      CAPTURE(ranks);
+      std::vector<int> owner;
+      int n = ranks;
+      if (ranks > 0) {
+        parallel::FloeOwners owners(0, ranks, c.domain);
+        owners.assign(c.floes);
+        owner.assign(owners.owner().begin(), owners.owner().end());
+      } else {  // every floe its own rank: every row spans four ranks
+        owner.resize(c.floes.size());
+        std::iota(owner.begin(), owner.end(), 0);
+        n = static_cast<int>(owner.size());
+      }
+      Floes f;
+      contact::CollisionStats stats;
+      std::size_t speculative = 0;
+      std::vector<long> groups;
+      CHECK(play(c, owner, n, f, stats, speculative, groups));  // no warm store: nothing to conflict
+      CHECK(same_states(f.state, serial.state));
+      CHECK(same_stats(stats, serial.stats));
+      CHECK(speculative == serial.speculative);
+      // One group a row (its two components joined by the witness), each on one rank.
+      CHECK(std::accumulate(groups.begin(), groups.end(), 0L) == 64);
+      if (n > 1) CHECK(std::count_if(groups.begin(), groups.end(), [](long g) { return g > 0; }) >= 2);
+    }
+  }
+}
+
+TEST_CASE("a dense pack is one step group, solved by one rank") {
+  // 400 floes at 90 % cover moving at up to 0.5 m/s, xi the distance of the
+  // nearest tenth of the pairs: witnesses link every contact component to
+  // the next, so the step group is the pack; the shares still combine to
+  // the serial solve (all of it on one rank).
+  PackOptions o;
+  o.floes = 400;
+  o.concentration = 0.9;
+  o.width = o.height = 2000.0;
+  o.seed = 3;
+  GeneratedPack g = generate_pack(o);
+  std::mt19937_64 rng(3);
+  std::uniform_real_distribution<double> u(-0.5, 0.5);
+  CollideCase c;
+  c.floes = std::move(g.floes);
+  for (FloeState& s : c.floes.state) {
+    s.vx = u(rng);
+    s.vy = u(rng);
+  }
+  c.start = c.floes.state;
+  for (FloeState& s : c.start) s.vx *= 0.6;
+  const contact::CollisionShapes shapes = contact::build_collision_shapes(c.floes);
+  c.domain = {true, g.window[0], g.window[1], g.window[2], g.window[3]};
+  contact::DetectionOptions d;
+  d.domain = c.domain;
+  d.horizon = c.dt;
+  d.reach.assign(c.floes.size(), 10.0);
+  std::vector<double> gaps;
+  for (const contact::NearPair& p : contact::detect(c.floes, shapes, d).pairs) gaps.push_back(p.distance);
+  std::sort(gaps.begin(), gaps.end());
+  d.collision_distance = gaps[gaps.size() / 10];
+  c.detection = contact::detect(c.floes, shapes, d);
+  c.options.collision_distance = d.collision_distance;
+  const Serial serial = serial_solve(c);
+  REQUIRE(serial.stats.lcps > 20);
+  REQUIRE(serial.speculative > 0);
+  parallel::FloeOwners owners(0, 3, c.domain);
+  owners.assign(c.floes);
+  Floes f;
+  contact::CollisionStats stats;
+  std::size_t speculative = 0;
+  std::vector<long> groups;
+  CHECK(play(c, owners.owner(), 3, f, stats, speculative, groups));
+  CHECK(std::accumulate(groups.begin(), groups.end(), 0L) == 1);
+  CHECK(same_states(f.state, serial.state));
+  CHECK(same_stats(stats, serial.stats));
+  CHECK(speculative == serial.speculative);
+}
+
+TEST_CASE("a speculative contact between two ranks' contact components puts both on one rank") {
+  // In a row along x, 10 m squares: floe 0 (1 m/s) touches floe 1 (0.1 m/s)
+  // 5 mm ahead of it, floe 3 (-1 m/s) touches floe 2 (-0.1 m/s) from the
+  // other side; floes 1 and 2 are 0.5 m apart, a witness. Components {0, 1}
+  // (rank 0) and {2, 3} (rank 1); the collisions throw 1 and 2 at each other,
+  // a speculative contact that joins them, solved again together from W^-.
+  // A share that solved its component and tested the witness with the other
+  // rank's stale velocities would part from the serial answer; the step
+  // group {0, 1, 2, 3} is rank 0's alone.
+  auto box = [](double x0, double vx) {
+    FloeInput f;
+    f.vertices = {{x0, 0.0}, {x0 + 10.0, 0.0}, {x0 + 10.0, 10.0}, {x0, 10.0}};
+    f.velocity = {vx, 0.0};
+    return f;
+  };
+  CollideCase c;
+  for (const FloeInput& in : {box(0.0, 1.0), box(10.005, 0.1), box(20.505, -0.1), box(30.51, -1.0)})
+    c.floes.add(make_floe_shape(in), in);
+  c.start = c.floes.state;
+  contact::DetectionOptions d;
+  d.horizon = c.dt;
+  d.reach.assign(c.floes.size(), 6.0);
+  c.detection = contact::detect(c.floes, contact::build_collision_shapes(c.floes), d);
+  REQUIRE(c.detection.contacts.size() >= 2);
+  const Serial serial = serial_solve(c);
+  REQUIRE(serial.speculative > 0);
+  const std::vector<int> owner{0, 0, 1, 1};
+  Floes f;
+  contact::CollisionStats stats;
+  std::size_t speculative = 0;
+  std::vector<long> groups;
+  CHECK(play(c, owner, 2, f, stats, speculative, groups));
+  CHECK(groups == std::vector<long>{1, 0});
+  CHECK(same_states(f.state, serial.state));
+  CHECK(same_stats(stats, serial.stats));
+  CHECK(speculative == serial.speculative);
+}
+
+TEST_CASE("step-start collisions that would use the warm store fall back, with the advance's back-off") {
+  // One rank (the serial communicator) owning every floe; every LCP starts
+  // from the warm store (warm_min = 0), which a share must not use: each try
+  // falls back, then waits 1, 2, 4 steps (AdvanceShareOptions), every step
+  // equal to the serial solve with its own warm store.
+  CollideCase c = test::rows_of_four(3);
+  c.options.warm_min = 0;
+  contact::WarmStart serial_warm, shared_warm;
+  const parallel::Communicator comm;
+  const std::vector<int> owner(c.floes.size(), 0);
+  parallel::AdvanceShareCounts counts;
+  parallel::AdvanceShareOptions share;
+  share.max_wait = 4;
+  for (int step = 0; step < 10; ++step) {
+    CAPTURE(step);
+    Floes s = c.floes, f = c.floes;
+    contact::ImpulseOptions so = c.options, fo = c.options;
+    so.warm = &serial_warm;
+    fo.warm = &shared_warm;
+    contact::CollisionStats ss, fs;
+    const std::size_t a = contact::resolve_step_collisions(s, c.start, c.detection, c.dt, so, ss);
+    const std::size_t b = parallel::collide_by_owner(comm, owner, f, c.start, c.detection, c.dt, fo, fs, counts, share);
+    CHECK(same_states(f.state, s.state));
+    CHECK(same_stats(fs, ss));
+    CHECK(a == b);
+  }
+  CHECK(counts.steps == 3);  // tried at steps 0, 2 and 5
+  CHECK(counts.fallbacks == 3);
+  CHECK(counts.whole == 7);
+  CHECK(serial_warm.uses > 0);
+}
