@@ -352,12 +352,16 @@ int run(const Args& args, const parallel::Session& session) {
     for (const double x : owners.charged_seconds()) o << " " << x;
     // The advances by cluster owner (stage seven): tried, redone whole after
     // a conflict, done whole at once after fallbacks (the back-off), and the
-    // clusters each rank ran in the steps not redone.
+    // clusters each rank ran and the pair rooms it computed in the steps not
+    // redone, against the pairs of those steps (a replicated set-up computes
+    // every one).
     const parallel::AdvanceShareCounts& share = sim.advance_share();
     o << "\nparallel.advance_steps: " << share.steps << "\nparallel.advance_fallbacks: " << share.fallbacks
       << "\nparallel.advance_whole: " << share.whole << "\nparallel.advance_clusters:";
     for (const long k : share.clusters) o << " " << k;
-    o << "\n";
+    o << "\nparallel.advance_rooms:";
+    for (const long k : share.rooms) o << " " << k;
+    o << "\nparallel.advance_pairs: " << share.pairs << "\n";
     // Stage seven: with a sea in slabs the strips are its slabs, their first
     // rows (then the row count) now.
     if (owners.has_slabs()) {
