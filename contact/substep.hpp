@@ -143,7 +143,7 @@ void advance_with_collisions(Floes& floes, const CollisionShapes& shapes, const 
 // the share's clusters' members and the obstacles are posed (a member is
 // posed again before each measure; obstacles do not move).
 struct ClusterShare {
-  std::span<const int> owner;  // per floe: its rank
+  std::span<const int> owner;  // per floe: its rank, one of the sharing ranks' (each pair's room on one share)
   int rank = 0;
 };
 
