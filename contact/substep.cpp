@@ -81,6 +81,7 @@ void Stepper::advance(std::span<const PairRoom> tight) {
     if (own_[k]) posed.insert(posed.end(), c.members.begin(), c.members.end());
   }
   posed_ = PosedShapes(floes_, shapes_, posed);
+  moving_ = true;
   // Free floes go to the end of the step now: nobody reads them before, and
   // a floe that joins a cluster is put back on its straight path.
   for (std::size_t i = 0; i < n; ++i)

@@ -130,11 +130,12 @@ private:
   double room(std::uint32_t p) {
     if (!known_[p]) {
       // pair_room reads the floes' states (only): the start's, swapped in
-      // for the call (O(1); pair_room throws nothing).
-      std::swap(floes_.state, start_);
+      // for the call (O(1); pair_room throws nothing). Before anything
+      // moves (set_up, make_clusters) they are the floes' own.
+      if (moving_) std::swap(floes_.state, start_);
       room_[p] = pair_room(floes_, shapes_, det_->pairs[p], witnesses_of(det_->pairs[p], det_->witnesses),
                            opt_.collision_distance, dt_);
-      std::swap(floes_.state, start_);
+      if (moving_) std::swap(floes_.state, start_);
       known_[p] = 1;
       ++rooms_;
     }
@@ -232,6 +233,7 @@ private:
   std::vector<std::uint8_t> known_;    // per pair: room_ computed or gathered
   std::vector<std::uint32_t> tight_;   // ascending: the pairs whose room is below xi (every share's)
   long rooms_ = 0;                     // rooms computed by this call (pair_room)
+  bool moving_ = false;                // floes moved: the start's states are start_ only
   std::vector<std::size_t> pair_offsets_;
   std::vector<std::uint32_t> pair_list_;
   std::vector<int> cluster_of_;        // kFree or a cluster
