@@ -352,11 +352,16 @@ int run(const Args& args, const parallel::Session& session) {
     for (const double x : owners.charged_seconds()) o << " " << x;
     // The advances by cluster owner (stage seven): tried, redone whole after
     // a conflict, done whole at once after fallbacks (the back-off), and the
-    // clusters each rank ran in the steps not redone.
+    // clusters each rank ran and the pair rooms it computed in the steps not
+    // redone, against the pairs of those steps (a replicated set-up computes
+    // every one).
     const parallel::AdvanceShareCounts& share = sim.advance_share();
     o << "\nparallel.advance_steps: " << share.steps << "\nparallel.advance_fallbacks: " << share.fallbacks
       << "\nparallel.advance_whole: " << share.whole << "\nparallel.advance_clusters:";
     for (const long k : share.clusters) o << " " << k;
+    o << "\nparallel.advance_rooms:";
+    for (const long k : share.rooms) o << " " << k;
+    o << "\nparallel.advance_pairs: " << share.pairs;
     // The collisions at the step's start by owner, the same way: tried,
     // redone whole, done whole by the back-off, each rank's step groups.
     const parallel::AdvanceShareCounts& collide = sim.collide_share();

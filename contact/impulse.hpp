@@ -339,7 +339,7 @@ std::size_t resolve_step_collisions(Floes& floes, std::span<const FloeState> sta
 // contact layer knows nothing of ranks: these are numbers. (The advance's
 // clusters use it too, substep.hpp.)
 struct ClusterShare {
-  std::span<const int> owner;  // per floe: its rank
+  std::span<const int> owner;  // per floe: its rank, one of the sharing ranks' (each pair's room on one share)
   int rank = 0;
 };
 

@@ -17,7 +17,7 @@ namespace floesim::contact {
 
 namespace detail {
 
-void Stepper::run() {
+std::vector<PairRoom> Stepper::set_up() {
   const std::size_t n = floes_.size();
   start_ = floes_.state;
   lin_.assign(n, 0.0);
@@ -30,11 +30,31 @@ void Stepper::run() {
   }
   if (outrun) rebuild_pairs();
   build_pair_index();
-  room_.resize(det_->pairs.size());
-  for (std::size_t p = 0; p < det_->pairs.size(); ++p) {
-    const NearPair& q = det_->pairs[p];
-    room_[p] = pair_room(floes_, shapes_, q, witnesses_of(q, det_->witnesses), opt_.collision_distance, dt_);
+  const std::size_t pairs = det_->pairs.size();
+  room_.assign(pairs, kInf);
+  known_.assign(pairs, 0);
+  std::vector<PairRoom> tight;
+  for (std::uint32_t p = 0; p < pairs; ++p) {
+    if (!computes(p)) continue;
+    const double r = room(p);
+    if (r < opt_.collision_distance) tight.push_back({p, r});
   }
+  return tight;
+}
+
+void Stepper::advance(std::span<const PairRoom> tight) {
+  const std::size_t n = floes_.size();
+  tight_.clear();
+  for (const PairRoom& t : tight) {
+    FLOESIM_ASSERT(t.pair < room_.size());
+    if (!known_[t.pair]) {
+      room_[t.pair] = t.room;
+      known_[t.pair] = 1;
+    }
+    tight_.push_back(t.pair);
+  }
+  std::sort(tight_.begin(), tight_.end());
+  tight_.erase(std::unique(tight_.begin(), tight_.end()), tight_.end());
   make_clusters();
   reach_left_.assign(n, kInf);
   budget_.assign(n, kInf);
@@ -46,7 +66,22 @@ void Stepper::run() {
       if (!floes_.is_static[i]) floes_.state[i] = linear(static_cast<std::uint32_t>(i), dt_);
     return;
   }
-  posed_ = PosedShapes(floes_, shapes_);
+  // The clusters this call runs: a share's, those whose lowest floe
+  // (members.front()) it owns. Posed: the obstacles (they never move) and
+  // these clusters' members (posed again before each measure); a measure
+  // reads no other floe (internal pairs: members with members and with
+  // obstacles).
+  own_.assign(clusters_.size(), 1);
+  std::vector<std::uint32_t> posed;
+  for (std::uint32_t i = 0; i < n; ++i)
+    if (floes_.is_static[i]) posed.push_back(i);
+  for (std::size_t k = 0; k < clusters_.size(); ++k) {
+    const Cluster& c = clusters_[k];
+    if (share_) own_[k] = share_->owner[c.members.front()] == share_->rank;
+    if (own_[k]) posed.insert(posed.end(), c.members.begin(), c.members.end());
+  }
+  posed_ = PosedShapes(floes_, shapes_, posed);
+  moving_ = true;
   // Free floes go to the end of the step now: nobody reads them before, and
   // a floe that joins a cluster is put back on its straight path.
   for (std::size_t i = 0; i < n; ++i)
@@ -54,11 +89,8 @@ void Stepper::run() {
   // Time order: a min-heap of (tau, cluster); stale entries are skipped.
   using Entry = std::pair<double, int>;
   std::priority_queue<Entry, std::vector<Entry>, std::greater<Entry>> queue;
-  own_.assign(clusters_.size(), 1);
   for (std::size_t k = 0; k < clusters_.size(); ++k) {
     Cluster& c = clusters_[k];
-    // A share runs the clusters whose lowest floe (members.front()) it owns.
-    if (share_) own_[k] = share_->owner[c.members.front()] == share_->rank;
     if (!own_[k]) continue;
     compute_budgets(static_cast<int>(k));
     collect_internal(static_cast<int>(k));
@@ -117,8 +149,7 @@ void Stepper::make_clusters() {
   auto find = [&](std::uint32_t i) { return sets.find(i); };
   std::vector<std::uint8_t> hot(n, 0);
   const double tight = opt_.collision_distance;
-  for (std::size_t p = 0; p < det_->pairs.size(); ++p) {
-    if (!(room_[p] < tight)) continue;
+  for (const std::uint32_t p : tight_) {
     const NearPair& q = det_->pairs[p];
     const bool da = !floes_.is_static[q.a], db = !floes_.is_static[q.b];
     if (room_[p] < 0.0) {
@@ -156,13 +187,18 @@ void Stepper::make_clusters() {
       const std::uint32_t r = find(i);
       big[i] = !floes_.is_static[i] && hot_root[r] && size[r] >= opt_.impulse.jam.floes;
     }
+    // The pairs of the big clusters' floes (joins and flags are the same
+    // in any order: the components and the hot floes do not depend on it).
     const double pad = opt_.impulse.jam.pad * tight;
-    for (std::size_t p = 0; p < det_->pairs.size(); ++p) {
-      const NearPair& q = det_->pairs[p];
-      if (!(room_[p] < pad) || floes_.is_static[q.a] || floes_.is_static[q.b] || !(big[q.a] || big[q.b])) continue;
-      hot[q.a] = hot[q.a] || big[q.a];
-      hot[q.b] = hot[q.b] || big[q.b];
-      sets.join(q.a, q.b);
+    for (std::uint32_t i = 0; i < n; ++i) {
+      if (!big[i]) continue;
+      for (const std::uint32_t p : pairs_of(i)) {
+        const NearPair& q = det_->pairs[p];
+        if (floes_.is_static[q.a] || floes_.is_static[q.b] || !(room(p) < pad)) continue;
+        hot[q.a] = hot[q.a] || big[q.a];
+        hot[q.b] = hot[q.b] || big[q.b];
+        sets.join(q.a, q.b);
+      }
     }
   }
   std::vector<std::uint8_t> active_root(n, 0);
@@ -211,7 +247,7 @@ void Stepper::compute_budgets(int k) {
     for (std::uint32_t p : pairs_of(i)) {
       const std::uint32_t j = other(p, i);
       if (floes_.is_static[j] || cluster_of_[j] == k) continue;
-      b = std::min(b, 0.5 * room_[p]);
+      b = std::min(b, 0.5 * room(p));
     }
     budget_[i] = b;
   }
@@ -330,7 +366,7 @@ void Stepper::collect_breaks(int k, double t1) {
     if (!(dev > budget_[i])) continue;
     for (std::uint32_t p : pairs_of(i)) {
       const std::uint32_t j = other(p, i);
-      if (floes_.is_static[j] || cluster_of_[j] == k || !(0.5 * room_[p] < dev)) continue;
+      if (floes_.is_static[j] || cluster_of_[j] == k || !(0.5 * room(p) < dev)) continue;
       if (cluster_of_[j] == kFree) joining_.push_back(j);
       else merging_.push_back(cluster_of_[j]);
     }
@@ -391,27 +427,46 @@ void advance_with_collisions(Floes& floes, const CollisionShapes& shapes, const 
   detail::Stepper(floes, shapes, detection, dt, options, stats, report).run();
 }
 
-ShareOutcome advance_share(Floes& floes, const CollisionShapes& shapes, const Detection& detection, double dt,
-                           const SubstepOptions& options, const ClusterShare& share, CollisionStats& stats,
-                           SubstepReport& report) {
-  if (options.impulse.record) throw std::logic_error("advance_share: the impulse record needs the serial order");
+ShareAdvance::ShareAdvance(Floes& floes, const CollisionShapes& shapes, const Detection& detection, double dt,
+                           const SubstepOptions& options, const ClusterShare& share)
+    : options_(options), share_(share) {
+  if (options.impulse.record) throw std::logic_error("ShareAdvance: the impulse record needs the serial order");
   // The warm store is replaced by an empty probe that only says whether a
-  // solve of the share would have used it (ClusterShare above).
-  SubstepOptions o = options;
-  WarmStart probe;
-  if (options.impulse.warm) o.impulse.warm = &probe;
-  const long failures = stats.failures;
-  detail::Stepper stepper(floes, shapes, detection, dt, o, stats, report, &share);
-  ShareOutcome outcome;
+  // solve of the share would have used it (ClusterShare above). A failure's
+  // dump is left to the whole advance that follows it, which numbers it in
+  // the run's count (the share's count starts at zero and would overwrite
+  // the run's first dumps).
+  if (options.impulse.warm) options_.impulse.warm = &probe_;
+  options_.impulse.dump_failed_lcps.clear();
+  stepper_ = std::make_unique<detail::Stepper>(floes, shapes, detection, dt, options_, stats_, report_, &share_);
+}
+
+ShareAdvance::~ShareAdvance() = default;
+
+ShareRooms ShareAdvance::rooms() {
+  ShareRooms out;
   try {
-    stepper.run();
-    outcome = stepper.outcome();
+    out.tight = stepper_->set_up();
+  } catch (const RunError&) {
+    out.conflict = ShareOutcome::Conflict::error;
+  }
+  set_up_ = out.conflict;
+  return out;
+}
+
+ShareOutcome ShareAdvance::advance(std::span<const PairRoom> tight) {
+  ShareOutcome outcome;
+  outcome.conflict = set_up_;
+  if (outcome.conflict != ShareOutcome::Conflict::none) return outcome;
+  try {
+    stepper_->advance(tight);
+    outcome = stepper_->outcome();
   } catch (const RunError&) {
     outcome.conflict = ShareOutcome::Conflict::error;
   }
-  if (outcome.conflict == ShareOutcome::Conflict::none && probe.uses > 0)
+  if (outcome.conflict == ShareOutcome::Conflict::none && probe_.uses > 0)
     outcome.conflict = ShareOutcome::Conflict::warm_start;
-  if (outcome.conflict == ShareOutcome::Conflict::none && stats.failures != failures)
+  if (outcome.conflict == ShareOutcome::Conflict::none && stats_.failures > 0)
     outcome.conflict = ShareOutcome::Conflict::failed_lcp;
   return outcome;
 }

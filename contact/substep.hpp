@@ -51,6 +51,7 @@
 
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <span>
 #include <string>
 #include <utility>
@@ -60,6 +61,10 @@
 #include "contact/impulse.hpp"
 
 namespace floesim::contact {
+
+namespace detail {
+class Stepper;
+}
 
 struct SubstepOptions {
   double collision_distance = 0.01;  // xi, m
@@ -123,7 +128,31 @@ void advance_with_collisions(Floes& floes, const CollisionShapes& shapes, const 
 // a share that would use it is a conflict too (the stores of the ranks
 // would part); so is a failed LCP (its dump is numbered in the run) and a
 // RunError (the serial advance throws it, or a different one, in its order).
-// (ClusterShare: impulse.hpp.)
+//
+// The set-up by share. A pair's room (step 1) is a function of the pair and
+// of its floes' states at the step's start: the same bits on whichever share
+// computes it. The clusters read only which rooms are below xi (hot: below
+// 0; tight: below xi), and, for the pads of jam-sized clusters (jam.hpp),
+// the rooms of the pairs of those clusters' floes. So each share computes
+// the rooms of the pairs whose lower floe it owns, the shares exchange their
+// tight pairs (the caller's exchange between ShareAdvance::rooms and
+// ShareAdvance::advance), and then every share knows every room below xi and
+// finds the same clusters, whole. A room the share reads besides (a pad's
+// pair, the budgets and breaks of its members: compute_budgets,
+// collect_breaks) it computes when first read, from the step's start. Only
+// the share's clusters' members and the obstacles are posed (a member is
+// posed again before each measure; obstacles do not move). (ClusterShare:
+// impulse.hpp; its owners must each be one of the sharing ranks, so that
+// each pair's room is computed by one share.)
+
+// A pair's room over the step (m), as one share gives it to the others: its
+// index in the step's pair list (the detection's, or the list rebuilt from
+// the replicated state for a floe that outruns its reach, alike on every
+// share).
+struct PairRoom {
+  std::uint32_t pair = 0;
+  double room = 0.0;
+};
 
 // What a share did. On `conflict` other than none the floes' states are
 // unusable and the caller redoes the advance whole from the step's states.
@@ -136,15 +165,52 @@ struct ShareOutcome {
   // (tau, cluster) and pair text; the serial floor_pair is the largest key's.
   double floor_tau = -1.0;
   long floor_cluster = -1;
+  long rooms = 0;  // pair rooms the share computed (its own pairs', and those it read besides)
+  long pairs = 0;  // pairs in the step's list (the serial advance computes every one's room)
 };
 
-// Advances the free floes (all of them, linearly) and the clusters of
-// `share` only; `stats` and `report` get this share's counts (report.rebuilt,
+// The first half's answer: the share's tight pairs (room below xi), by
+// ascending pair, or a conflict (a RunError in the set-up).
+struct ShareRooms {
+  ShareOutcome::Conflict conflict = ShareOutcome::Conflict::none;
+  std::vector<PairRoom> tight;
+};
+
+// One share of the advance, in two halves around the caller's exchange of
+// the tight pairs (contact/ knows nothing of ranks: the exchange is the
+// caller's, parallel::advance_by_owner's gather, and each half is a plain
+// call). Between the two halves `floes` must stay at the step's start.
+// advance() moves the free floes (all of them, linearly) and the clusters of
+// `share` only; stats() and report() get this share's counts (report.rebuilt,
 // the pair list's rebuild, is counted on every share: it is not the share's
 // own). The impulse record (options.impulse.record) must be null: its events'
 // order is the serial queue's, not a share's.
-ShareOutcome advance_share(Floes& floes, const CollisionShapes& shapes, const Detection& detection, double dt,
-                           const SubstepOptions& options, const ClusterShare& share, CollisionStats& stats,
-                           SubstepReport& report);
+class ShareAdvance {
+public:
+  ShareAdvance(Floes& floes, const CollisionShapes& shapes, const Detection& detection, double dt,
+               const SubstepOptions& options, const ClusterShare& share);
+  ~ShareAdvance();
+  ShareAdvance(const ShareAdvance&) = delete;
+  ShareAdvance& operator=(const ShareAdvance&) = delete;
+
+  // The set-up of the share's pairs: the straight paths, the pair list (and
+  // its rebuild), and the rooms of the pairs whose lower floe the share owns.
+  ShareRooms rooms();
+  // The rest, given the tight pairs of every share (concatenated, in any
+  // order; this share's included): the clusters, and the share's advance.
+  ShareOutcome advance(std::span<const PairRoom> tight);
+
+  const CollisionStats& stats() const { return stats_; }
+  const SubstepReport& report() const { return report_; }
+
+private:
+  SubstepOptions options_;  // the caller's, with the warm store replaced by probe_
+  WarmStart probe_;         // counts the solves that would have used the warm store
+  CollisionStats stats_;
+  SubstepReport report_;
+  ClusterShare share_;
+  ShareOutcome::Conflict set_up_ = ShareOutcome::Conflict::none;
+  std::unique_ptr<detail::Stepper> stepper_;
+};
 
 }  // namespace floesim::contact

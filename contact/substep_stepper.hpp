@@ -9,10 +9,12 @@
 #include <cstdint>
 #include <limits>
 #include <span>
+#include <utility>
 #include <vector>
 
 #include "contact/detection.hpp"
 #include "contact/impulse.hpp"
+#include "contact/step_limit.hpp"
 #include "contact/substep.hpp"
 
 namespace floesim::contact::detail {
@@ -62,6 +64,8 @@ public:
     o.conflict = conflict_;
     o.floor_tau = floor_tau_;
     o.floor_cluster = floor_cluster_;
+    o.rooms = rooms_;
+    o.pairs = static_cast<long>(det_->pairs.size());
     for (std::size_t k = 0; k < clusters_.size(); ++k) {
       if (!own_[k]) continue;
       ++o.clusters;
@@ -71,9 +75,23 @@ public:
     return o;
   }
 
-  // The advance over dt (substep.hpp, steps 1 to 5), of the share's clusters
-  // only when given one.
-  void run();
+  // The advance over dt (substep.hpp, steps 1 to 5): set_up, then advance
+  // with its own tight pairs (every pair's room computed: the serial advance).
+  void run() {
+    const std::vector<PairRoom> tight = set_up();
+    advance(tight);
+  }
+
+  // Step 1's set-up for the pairs this call computes (a share's: those whose
+  // lower floe it owns; else all): the straight paths, the pair list
+  // (rebuilt if a floe would outrun its reach), its index, and those pairs'
+  // rooms. Returns the tight ones (room below xi), by ascending pair.
+  std::vector<PairRoom> set_up();
+
+  // Steps 1 to 5 from there, given the tight pairs of every share (this
+  // call's included, in any order): the clusters, then the advance of the
+  // share's clusters only when given one.
+  void advance(std::span<const PairRoom> tight);
 
 private:
   std::uint32_t other(std::uint32_t p, std::uint32_t i) const {
@@ -95,6 +113,35 @@ private:
 
   void rebuild_pairs();
 
+  // Whether set_up computes pair p's room: the share's when its lower floe is
+  // the share's (each pair on exactly one share), every pair without a share.
+  bool computes(std::uint32_t p) const {
+    if (!share_) return true;
+    const NearPair& q = det_->pairs[p];
+    return share_->owner[std::min(q.a, q.b)] == share_->rank;
+  }
+
+  // Pair p's room over the step on the straight paths from the step's start
+  // (step_limit.hpp), computed when first read: set_up's pairs, the gathered
+  // tight ones, and, on a share, those it reads besides (substep.hpp,
+  // "The set-up by share"). A pair no share found tight and not read is
+  // +inf in room_, which make_clusters reads as "not below xi": right, as
+  // every pair below xi was gathered.
+  double room(std::uint32_t p) {
+    if (!known_[p]) {
+      // pair_room reads the floes' states (only): the start's, swapped in
+      // for the call (O(1); pair_room throws nothing). Before anything
+      // moves (set_up, make_clusters) they are the floes' own.
+      if (moving_) std::swap(floes_.state, start_);
+      room_[p] = pair_room(floes_, shapes_, det_->pairs[p], witnesses_of(det_->pairs[p], det_->witnesses),
+                           opt_.collision_distance, dt_);
+      if (moving_) std::swap(floes_.state, start_);
+      known_[p] = 1;
+      ++rooms_;
+    }
+    return room_[p];
+  }
+
   // pairs_of(i): indices of the candidate pairs of floe i (compressed rows).
   void build_pair_index();
   std::span<const std::uint32_t> pairs_of(std::uint32_t i) const {
@@ -104,7 +151,8 @@ private:
   // Clusters: connected components of the hot pairs between dynamic floes,
   // grown through tight pairs (room below xi: a floe of the cluster that
   // collides would soon bring the other in anyway, one at a time), numbered
-  // by their lowest floe.
+  // by their lowest floe. Reads the tight pairs (tight_) and the rooms of
+  // the pairs of jam-sized clusters' floes (their pads).
   void make_clusters();
 
   // jam_of_[i]: the jam of floe i (-1: none), jams_: their floes.
@@ -181,7 +229,11 @@ private:
 
   std::vector<FloeState> start_;       // at the start of the step: the straight paths
   std::vector<double> lin_;            // m, linear travel of each floe over the step
-  std::vector<double> room_;           // m, per pair, over the step on straight paths
+  std::vector<double> room_;           // m, per pair, over the step on straight paths (room(): when known_)
+  std::vector<std::uint8_t> known_;    // per pair: room_ computed or gathered
+  std::vector<std::uint32_t> tight_;   // ascending: the pairs whose room is below xi (every share's)
+  long rooms_ = 0;                     // rooms computed by this call (pair_room)
+  bool moving_ = false;                // floes moved: the start's states are start_ only
   std::vector<std::size_t> pair_offsets_;
   std::vector<std::uint32_t> pair_list_;
   std::vector<int> cluster_of_;        // kFree or a cluster

@@ -22,9 +22,9 @@ constexpr std::size_t kReport = std::tuple_size_v<decltype(contact::substep_coun
 
 // The header's longs: conflict, moved, clusters, floor_cluster, the floor
 // pair's length, the states' count (the moved floes' when the share had no
-// conflict, else none), the stats, the report; then floor_tau, the moved
-// floes, their states and the floor pair's text.
-constexpr std::size_t kHeader = 6 + kStats + kReport;
+// conflict, else none), rooms, pairs, the stats, the report; then floor_tau,
+// the moved floes, their states and the floor pair's text.
+constexpr std::size_t kHeader = 8 + kStats + kReport;
 
 }  // namespace
 
@@ -36,7 +36,9 @@ std::vector<std::byte> pack(const AdvancePart& p) {
   head[3] = p.outcome.floor_cluster;
   head[4] = static_cast<long>(p.report.floor_pair.size());
   head[5] = static_cast<long>(p.states.size());
-  std::size_t k = 6;
+  head[6] = p.outcome.rooms;
+  head[7] = p.outcome.pairs;
+  std::size_t k = 8;
   for (const auto& [name, f] : contact::collision_counts(p.stats)) head[k++] = *f;
   for (const auto& [name, f] : contact::substep_counts(p.report)) head[k++] = *f;
   std::vector<std::byte> out(sizeof(head) + sizeof(double) + p.outcome.moved.size() * sizeof(std::uint32_t) +
@@ -63,7 +65,9 @@ AdvancePart unpack_advance_part(std::span<const std::byte> bytes) {
   const auto states = static_cast<std::size_t>(head[5]);
   FLOESIM_ASSERT(bytes.size() == sizeof(head) + sizeof(double) + moved * sizeof(std::uint32_t) +
                                      states * sizeof(FloeState) + text);
-  std::size_t k = 6;
+  p.outcome.rooms = head[6];
+  p.outcome.pairs = head[7];
+  std::size_t k = 8;
   for (const auto& [name, f] : contact::collision_counts(p.stats)) *f = head[k++];
   for (const auto& [name, f] : contact::substep_counts(p.report)) *f = head[k++];
   p.outcome.floor_tau = at<double>(in, 0);
@@ -78,11 +82,45 @@ AdvancePart unpack_advance_part(std::span<const std::byte> bytes) {
   return p;
 }
 
-AdvancePart run_share(Floes& floes, const contact::CollisionShapes& shapes, const contact::Detection& detection,
-                      double dt, const contact::SubstepOptions& options, std::span<const int> owner, int rank) {
+std::vector<std::byte> pack(const contact::ShareRooms& rooms) {
+  const std::array<long, 2> head{static_cast<long>(rooms.conflict), static_cast<long>(rooms.tight.size())};
+  std::vector<std::byte> out(sizeof(head) + rooms.tight.size() * (sizeof(std::uint32_t) + sizeof(double)));
+  std::byte* at = put(out.data(), head.data(), head.size());
+  for (const contact::PairRoom& t : rooms.tight) {
+    at = put(at, &t.pair, 1);
+    at = put(at, &t.room, 1);
+  }
+  return out;
+}
+
+contact::ShareRooms unpack_share_rooms(std::span<const std::byte> bytes) {
+  contact::ShareRooms rooms;
+  const std::byte* in = bytes.data();
+  rooms.conflict = static_cast<ShareOutcome::Conflict>(at<long>(in, 0));
+  const auto count = static_cast<std::size_t>(at<long>(in, 1));
+  constexpr std::size_t kPair = sizeof(std::uint32_t) + sizeof(double);
+  FLOESIM_ASSERT(bytes.size() == 2 * sizeof(long) + count * kPair);
+  in += 2 * sizeof(long);
+  rooms.tight.resize(count);
+  for (std::size_t j = 0; j < count; ++j, in += kPair)
+    rooms.tight[j] = {at<std::uint32_t>(in, 0), at<double>(in + sizeof(std::uint32_t), 0)};
+  return rooms;
+}
+
+bool combine_rooms(std::span<const contact::ShareRooms> parts, std::vector<contact::PairRoom>& tight) {
+  tight.clear();
+  for (const contact::ShareRooms& p : parts) {
+    if (p.conflict != ShareOutcome::Conflict::none) return false;
+    tight.insert(tight.end(), p.tight.begin(), p.tight.end());
+  }
+  return true;
+}
+
+AdvancePart finish_share(contact::ShareAdvance& share, std::span<const contact::PairRoom> tight, const Floes& floes) {
   AdvancePart part;
-  part.outcome =
-      contact::advance_share(floes, shapes, detection, dt, options, {owner, rank}, part.stats, part.report);
+  part.outcome = share.advance(tight);
+  part.stats = share.stats();
+  part.report = share.report();
   if (part.outcome.conflict == ShareOutcome::Conflict::none)
     for (const std::uint32_t i : part.outcome.moved) part.states.push_back(floes.state[i]);
   return part;
@@ -136,18 +174,43 @@ void advance_by_owner(const Communicator& comm, std::span<const int> owner, Floe
     return;
   }
   const std::vector<FloeState> start = floes.state;
-  const AdvancePart mine = run_share(floes, shapes, detection, dt, options, owner, comm.rank());
-  std::vector<std::size_t> sizes;
-  const std::vector<std::byte> all = comm.allgather_bytes(pack(mine), sizes);
-  std::vector<AdvancePart> parts;
-  std::size_t from = 0;
-  for (const std::size_t n : sizes) {
-    parts.push_back(unpack_advance_part({all.data() + from, n}));
-    from += n;
+  bool combined = false;
+  {
+    // The set-up by share, then the exchange of the tight pairs.
+    contact::ShareAdvance share(floes, shapes, detection, dt, options, {owner, comm.rank()});
+    std::vector<std::size_t> sizes;
+    const std::vector<std::byte> all_rooms = comm.allgather_bytes(pack(share.rooms()), sizes);
+    std::vector<contact::ShareRooms> rooms;
+    std::size_t from = 0;
+    for (const std::size_t n : sizes) {
+      rooms.push_back(unpack_share_rooms({all_rooms.data() + from, n}));
+      from += n;
+    }
+    std::vector<contact::PairRoom> tight;
+    // Every rank sees the same gathered conflicts: all skip the second
+    // exchange alike.
+    if (combine_rooms(rooms, tight)) {
+      const AdvancePart mine = finish_share(share, tight, floes);
+      const std::vector<std::byte> all = comm.allgather_bytes(pack(mine), sizes);
+      std::vector<AdvancePart> parts;
+      from = 0;
+      for (const std::size_t n : sizes) {
+        parts.push_back(unpack_advance_part({all.data() + from, n}));
+        from += n;
+      }
+      counts.clusters.resize(parts.size(), 0);
+      counts.rooms.resize(parts.size(), 0);
+      combined = combine_parts(parts, floes, stats, report);
+      if (combined) {
+        for (std::size_t r = 0; r < parts.size(); ++r) {
+          counts.clusters[r] += parts[r].outcome.clusters;
+          counts.rooms[r] += parts[r].outcome.rooms;
+        }
+        counts.pairs += parts.front().outcome.pairs;
+      }
+    }
   }
-  counts.clusters.resize(parts.size(), 0);
-  if (combine_parts(parts, floes, stats, report)) {
-    for (std::size_t r = 0; r < parts.size(); ++r) counts.clusters[r] += parts[r].outcome.clusters;
+  if (combined) {
     counts.combined();
     return;
   }

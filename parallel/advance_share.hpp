@@ -1,10 +1,13 @@
 #pragma once
 // Stage seven (docs/parallel.md): the multirate advance of the floes by
-// cluster owner. Every rank finds the step's clusters from the replicated
-// detection (contact/substep.hpp); each cluster belongs to the owner by place
-// (FloeOwners) of its lowest floe; each rank advances its own clusters and
-// every free floe (linear motion), and the ranks then exchange the states of
-// the floes their clusters moved (index + state) and their collision counts.
+// cluster owner. Each rank computes the rooms of the pairs whose lower floe
+// it owns (FloeOwners, by place) and the ranks exchange the tight ones (room
+// below xi); from those every rank finds the step's clusters, the same on
+// every rank (contact/substep.hpp, "The set-up by share"); each cluster
+// belongs to the owner of its lowest floe; each rank advances its own
+// clusters and every free floe (linear motion), and the ranks then exchange
+// the states of the floes their clusters moved (index + state) and their
+// collision counts.
 // A step where a rank's cluster met another rank's cluster, where two ranks
 // took the same free floe, or where a share could not run alone
 // (ShareOutcome::Conflict) is advanced again whole on every rank from the
@@ -33,10 +36,19 @@ struct AdvancePart {
 std::vector<std::byte> pack(const AdvancePart& part);
 AdvancePart unpack_advance_part(std::span<const std::byte> bytes);
 
-// Runs rank `rank`'s share (contact::advance_share) on `floes` (the step's
-// states on entry) and returns its part; `floes` is left with the share's states.
-AdvancePart run_share(Floes& floes, const contact::CollisionShapes& shapes, const contact::Detection& detection,
-                      double dt, const contact::SubstepOptions& options, std::span<const int> owner, int rank);
+// The first exchange: a share's tight pairs (contact::ShareRooms), 12 bytes a
+// pair (index, room) after a header (conflict, count).
+std::vector<std::byte> pack(const contact::ShareRooms& rooms);
+contact::ShareRooms unpack_share_rooms(std::span<const std::byte> bytes);
+
+// Every rank's tight pairs (rank order) as one list for ShareAdvance::advance;
+// false, leaving `tight` unspecified, when a rank's set-up had a conflict.
+bool combine_rooms(std::span<const contact::ShareRooms> parts, std::vector<contact::PairRoom>& tight);
+
+// The second half of a rank's share (ShareAdvance::advance, given every
+// rank's tight pairs) and its part; `floes` (the share's floes) is left with
+// the share's states.
+AdvancePart finish_share(contact::ShareAdvance& share, std::span<const contact::PairRoom> tight, const Floes& floes);
 
 // Combines every rank's part (rank order) into `floes` (each rank's moved
 // floes get its states; the free floes are already at the end of the step on
@@ -65,6 +77,8 @@ struct AdvanceShareCounts {
   long fallbacks = 0;           // of those, redone whole
   long whole = 0;               // advances done whole at once by the back-off
   std::vector<long> clusters;   // per rank: clusters it ran (steps not redone)
+  std::vector<long> rooms;      // per rank: pair rooms it computed (steps not redone)
+  long pairs = 0;               // pairs in those steps (a replicated set-up computes every one's room)
   long wait = 0;                // advances still to do whole
   long next_wait = 1;           // the wait after the next fallback
 
@@ -90,11 +104,14 @@ struct AdvanceShareCounts {
 };
 
 // The step's advance on every rank of `comm` (or whole, while the back-off
-// above waits): this rank's share, one
-// exchange (allgather_bytes: two collective calls on every rank, every
-// step), then the combination or, on a conflict, the whole advance
-// (contact::advance_with_collisions) from the states on entry. Equal to the
-// serial advance bit for bit, states and counts.
+// above waits): this rank's share's set-up (its pairs' rooms), the exchange
+// of the tight pairs, the share's advance, the exchange of the parts (each
+// exchange one allgather_bytes: two collective calls on every rank), then
+// the combination or, on a conflict, the whole advance
+// (contact::advance_with_collisions) from the states on entry. A conflict in
+// a set-up is known to every rank after the first exchange: every rank then
+// skips the second. Equal to the serial advance bit for bit, states and
+// counts.
 void advance_by_owner(const Communicator& comm, std::span<const int> owner, Floes& floes,
                       const contact::CollisionShapes& shapes, const contact::Detection& detection, double dt,
                       const contact::SubstepOptions& options, contact::CollisionStats& stats,

@@ -97,6 +97,12 @@ for n in args.ranks:
         print(f"{n} ranks: {steps} advances by cluster owner, {fallbacks} redone whole, clusters by rank {clusters}")
         if not (steps and fallbacks and int(steps[0]) > int(fallbacks[0]) and sum(map(int, clusters)) > 0):
             failures.append(f"{n} ranks: no advance by cluster owner was kept ({steps}, {fallbacks}, {clusters})")
+        # Its set-up by owner too: each rank computed the rooms of its own
+        # pairs (and the few it read besides), not every pair's.
+        rooms, pairs = key("parallel.advance_rooms"), key("parallel.advance_pairs")
+        print(f"{n} ranks: pair rooms computed by rank {rooms} of {pairs} pairs in the advances kept")
+        if not (rooms and pairs and len(rooms) == n and all(0 < int(r) < int(pairs[0]) for r in rooms)):
+            failures.append(f"{n} ranks: the advance's set-up was not shared (rooms {rooms}, pairs {pairs})")
     # The collisions at the step's start by owner too: every try kept here
     # (no warm store at step start in this pack), step groups on every rank.
     tried, fell, groups = key("parallel.collide_steps"), key("parallel.collide_fallbacks"), key("parallel.collide_groups")

@@ -8,8 +8,10 @@
 // the step is redone whole, which is the serial advance.
 #include <doctest/doctest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <memory>
 #include <numeric>
 #include <random>
 #include <string>
@@ -101,27 +103,73 @@ Serial serial_advance(const Case& c) {
   return s;
 }
 
-// Plays `ranks` ranks: each runs its share on its own copy, the parts go
-// through pack/unpack (the bytes every rank gathers), and rank 0's copy
-// combines them. Returns whether they combined; `f` and the counts hold the
-// combined answer, or, when not, the whole advance redone (the fallback).
+// Plays `ranks` ranks: each sets its share up on its own copy, the tight
+// pairs and then the parts go through pack/unpack (the bytes every rank
+// gathers), and rank 0's copy combines them. Returns whether they combined;
+// `f` and the counts hold the combined answer, or, when not, the whole
+// advance redone (the fallback). `outcomes` gets each share's outcome.
 bool play(const Case& c, std::span<const int> owner, int ranks, Floes& f, contact::CollisionStats& stats,
-          contact::SubstepReport& report, std::vector<contact::ShareOutcome::Conflict>& conflicts) {
-  std::vector<parallel::AdvancePart> parts;
-  Floes first;
+          contact::SubstepReport& report, std::vector<contact::ShareOutcome>& outcomes) {
+  std::vector<Floes> copies(static_cast<std::size_t>(ranks), c.floes);
+  std::vector<std::unique_ptr<contact::ShareAdvance>> shares;
+  std::vector<contact::ShareRooms> rooms;
   for (int r = 0; r < ranks; ++r) {
-    Floes mine = c.floes;
-    const parallel::AdvancePart part =
-        parallel::run_share(mine, c.shapes, c.detection, c.dt, c.options, owner, r);
-    conflicts.push_back(part.outcome.conflict);
-    parts.push_back(parallel::unpack_advance_part(parallel::pack(part)));
-    if (r == 0) first = std::move(mine);
+    shares.push_back(std::make_unique<contact::ShareAdvance>(copies[static_cast<std::size_t>(r)], c.shapes,
+                                                             c.detection, c.dt, c.options,
+                                                             contact::ClusterShare{owner, r}));
+    rooms.push_back(parallel::unpack_share_rooms(parallel::pack(shares.back()->rooms())));
   }
-  f = std::move(first);
-  if (parallel::combine_parts(parts, f, stats, report)) return true;
-  f.state = c.floes.state;
+  std::vector<contact::PairRoom> tight;
+  bool ok = parallel::combine_rooms(rooms, tight);
+  if (ok) {
+    std::vector<parallel::AdvancePart> parts;
+    for (int r = 0; r < ranks; ++r) {
+      const std::size_t k = static_cast<std::size_t>(r);
+      const parallel::AdvancePart part = parallel::finish_share(*shares[k], tight, copies[k]);
+      outcomes.push_back(part.outcome);
+      parts.push_back(parallel::unpack_advance_part(parallel::pack(part)));
+    }
+    f = std::move(copies.front());
+    ok = parallel::combine_parts(parts, f, stats, report);
+  }
+  if (ok) return true;
+  f = c.floes;
   contact::advance_with_collisions(f, c.shapes, c.detection, c.dt, c.options, stats, report);
   return false;
+}
+
+std::vector<contact::ShareOutcome::Conflict> conflicts_of(const std::vector<contact::ShareOutcome>& outcomes) {
+  std::vector<contact::ShareOutcome::Conflict> out;
+  for (const contact::ShareOutcome& o : outcomes) out.push_back(o.conflict);
+  return out;
+}
+
+// The set-up by share: one share computes every pair's room (the serial
+// set-up); on several, each computes those of its own pairs and the few it
+// reads besides (pads, its members' budgets and breaks), so each fewer than
+// the whole, and together not much more than the whole (unless `pads`:
+// every share computes the rooms of every jam-sized cluster's pairs).
+void check_rooms(const std::vector<contact::ShareOutcome>& outcomes, int ranks, bool pads = false) {
+  long sum = 0, most = 0;
+  for (const contact::ShareOutcome& o : outcomes) {
+    sum += o.rooms;
+    most = std::max(most, o.rooms);
+  }
+  if (outcomes.empty()) return;
+  const long pairs = outcomes.front().pairs;
+  MESSAGE(ranks << " ranks: rooms computed " << sum << " (most by one rank " << most << ") of " << pairs << " pairs");
+  REQUIRE(pairs > 0);
+  if (ranks == 1) {
+    CHECK(sum == pairs);
+    return;
+  }
+  for (const contact::ShareOutcome& o : outcomes) {
+    CHECK(o.pairs == pairs);
+    CHECK(o.rooms < pairs);
+  }
+  if (pads) return;
+  CHECK(static_cast<double>(most) < static_cast<double>(pairs) * (1.0 / ranks + 0.25));
+  CHECK(static_cast<double>(sum) < 1.25 * static_cast<double>(pairs));
 }
 
 }  // namespace
@@ -144,11 +192,12 @@ TEST_CASE("the advance by cluster owner over 1, 2, 3 and 7 strips is the serial 
       Floes f;
       contact::CollisionStats stats;
       contact::SubstepReport report;
-      std::vector<contact::ShareOutcome::Conflict> conflicts;
-      const bool ok = play(c, owners.owner(), ranks, f, stats, report, conflicts);
+      std::vector<contact::ShareOutcome> outcomes;
+      const bool ok = play(c, owners.owner(), ranks, f, stats, report, outcomes);
       MESSAGE(ranks << " ranks: " << std::string(ok ? "combined" : "fell back"));
       if (ranks > 1) combined += ok ? 1 : 0;
       if (ranks == 1) CHECK(ok);  // one rank owns every cluster: nothing to conflict with
+      check_rooms(outcomes, ranks);
       REQUIRE(f.state.size() == serial.state.size());
       CHECK(std::memcmp(f.state.data(), serial.state.data(), f.state.size() * sizeof(FloeState)) == 0);
       CHECK(same_stats(stats, serial.stats));
@@ -158,6 +207,46 @@ TEST_CASE("the advance by cluster owner over 1, 2, 3 and 7 strips is the serial 
   // Splits over several ranks that combined (a fallback is the serial
   // advance itself and proves nothing about the shares): 3 of the 6 here.
   CHECK(combined >= 2);
+}
+
+TEST_CASE("the pads of jam-sized clusters, whose rooms a share computes when it reads them, are the serial ones") {
+  // jam.floes = 2: every cluster is "big" (2 floes or more) and its pad
+  // (the dynamic floes whose room to it is below jam.pad xi = 10 m) joins
+  // it at the step's start (make_clusters). The pads' rooms are mostly not
+  // tight, so no share sent them: each share computes those it reads. The
+  // clusters must be the serial ones on every share, and the answer too.
+  int combined = 0;
+  for (const unsigned seed : {3u, 11u}) {
+    CAPTURE(seed);
+    Case c = dense_pack(2.0, seed, 0.5);
+    c.options.impulse.jam.floes = 2;
+    const Serial serial = serial_advance(c);
+    Case plain = c;
+    plain.options.impulse.jam.pad = 0.0;  // no pads: the pads above must change the answer
+    const Serial unpadded = serial_advance(plain);
+    MESSAGE("serial: " << serial.report.clusters << " clusters, largest " << serial.report.largest_cluster
+                       << " (without pads " << unpadded.report.largest_cluster << "), " << serial.report.time_steps
+                       << " time steps");
+    REQUIRE(serial.report.largest_cluster >= 2);
+    REQUIRE(std::memcmp(serial.state.data(), unpadded.state.data(), serial.state.size() * sizeof(FloeState)) != 0);
+    for (const int ranks : {2, 3}) {
+      CAPTURE(ranks);
+      parallel::FloeOwners owners(0, ranks, c.domain);
+      owners.assign(c.floes);
+      Floes f;
+      contact::CollisionStats stats;
+      contact::SubstepReport report;
+      std::vector<contact::ShareOutcome> outcomes;
+      const bool ok = play(c, owners.owner(), ranks, f, stats, report, outcomes);
+      MESSAGE(ranks << " ranks: " << std::string(ok ? "combined" : "fell back"));
+      combined += ok ? 1 : 0;
+      check_rooms(outcomes, ranks, true);
+      CHECK(std::memcmp(f.state.data(), serial.state.data(), f.state.size() * sizeof(FloeState)) == 0);
+      CHECK(same_stats(stats, serial.stats));
+      CHECK(same_report(report, serial.report));
+    }
+  }
+  CHECK(combined >= 1);
 }
 
 TEST_CASE("clusters of different ranks that merge, or share a free floe, fall back to the serial advance") {
@@ -172,8 +261,9 @@ TEST_CASE("clusters of different ranks that merge, or share a free floe, fall ba
   Floes f;
   contact::CollisionStats stats;
   contact::SubstepReport report;
-  std::vector<contact::ShareOutcome::Conflict> conflicts;
-  const bool ok = play(c, owner, static_cast<int>(owner.size()), f, stats, report, conflicts);
+  std::vector<contact::ShareOutcome> outcomes;
+  const bool ok = play(c, owner, static_cast<int>(owner.size()), f, stats, report, outcomes);
+  const std::vector<contact::ShareOutcome::Conflict> conflicts = conflicts_of(outcomes);
   const long foreign = std::count(conflicts.begin(), conflicts.end(), contact::ShareOutcome::Conflict::foreign_cluster);
   MESSAGE("serial: " << serial.report.merges << " merges, " << serial.report.joined << " joined; shares: " << foreign
                      << " met another rank's cluster");
@@ -219,8 +309,9 @@ TEST_CASE("two ranks' clusters that take the same free floe fall back to the ser
   Floes f;
   contact::CollisionStats stats;
   contact::SubstepReport report;
-  std::vector<contact::ShareOutcome::Conflict> conflicts;
-  const bool ok = play(c, owner, 2, f, stats, report, conflicts);
+  std::vector<contact::ShareOutcome> outcomes;
+  const bool ok = play(c, owner, 2, f, stats, report, outcomes);
+  const std::vector<contact::ShareOutcome::Conflict> conflicts = conflicts_of(outcomes);
   CHECK(conflicts == std::vector<contact::ShareOutcome::Conflict>(2, contact::ShareOutcome::Conflict::none));
   CHECK_FALSE(ok);
   CHECK(std::memcmp(f.state.data(), serial.state.data(), f.state.size() * sizeof(FloeState)) == 0);
