@@ -14,6 +14,7 @@
 #include "parallel/advance_share.hpp"
 #include "parallel/collide_share.hpp"
 #include "parallel/detect.hpp"
+#include "parallel/sea_ranks.hpp"
 
 namespace floesim {
 
@@ -109,20 +110,11 @@ Simulation::Simulation(Scenario scenario, parallel::Communicator comm)
   // On several ranks the spectral sea runs in slabs (docs/parallel.md, stage
   // four) with the explicit kicks; the implicit step and a tank keep it
   // whole on every rank. The incident waves' sea (below) runs in slabs
-  // alike (stage six: each rank holds its modes; its fields are gathered
-  // whole).
+  // alike (each rank holds its modes, and its fields' and snapshots' slab
+  // and halo rows: the row window).
   if (!comm_.serial() && c.sea.model == SeaModel::spectral && c.sea.dims == 2 && !c.sea.tank.enabled &&
       c.coupling.integrator == CouplingIntegrator::explicit_kicks) {
-    const parallel::Communicator ranks = comm_;
-    sea_options.ranks.rank = ranks.rank();
-    sea_options.ranks.ranks = ranks.size();
-    sea_options.ranks.alltoall = [ranks](std::span<const std::byte> send, const std::vector<std::size_t>& send_counts,
-                                        std::span<std::byte> receive, const std::vector<std::size_t>& receive_counts) {
-      ranks.alltoall(send, send_counts, receive, receive_counts);
-    };
-    sea_options.ranks.allgather = [ranks](std::span<std::byte> all, const std::vector<std::size_t>& counts) {
-      ranks.allgather_in_place(all, counts);
-    };
+    sea_options.ranks = parallel::sea_ranks(comm_);
   }
   const fluid::SeaOptions incident_options = sea_options;
   try {

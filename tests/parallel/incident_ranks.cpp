@@ -18,38 +18,16 @@
 #include "coupling/incident.hpp"
 #include "fluid/sea.hpp"
 #include "parallel/comm.hpp"
+#include "parallel/sea_ranks.hpp"
+#include "tests/parallel/sea_case.hpp"
 
 using namespace floesim;
 
 namespace {
 
-fluid::SeaRanks sea_ranks(const parallel::Communicator& comm) {
-  fluid::SeaRanks r;
-  r.rank = comm.rank();
-  r.ranks = comm.size();
-  r.alltoall = [comm](std::span<const std::byte> send, const std::vector<std::size_t>& send_counts,
-                      std::span<std::byte> receive, const std::vector<std::size_t>& receive_counts) {
-    comm.alltoall(send, send_counts, receive, receive_counts);
-  };
-  r.allgather = [comm](std::span<std::byte> all, const std::vector<std::size_t>& counts) {
-    comm.allgather_in_place(all, counts);
-  };
-  return r;
-}
+using parallel::sea_ranks;
 
-SeaParams params(int nx, int ny) {
-  SeaParams p;
-  p.model = SeaModel::spectral;
-  p.dims = 2;
-  p.size = {8.0 * nx, 10.0 * ny};
-  p.cells = {nx, ny};
-  p.depth = 30.0;
-  p.waves.kind = WaveKind::jonswap;
-  p.waves.hs = 1.0;
-  p.waves.tp = 6.0;
-  p.waves.spreading = 4.0;
-  return p;
-}
+SeaParams params(int nx, int ny) { return test::slab_sea_params(nx, ny); }
 
 bool same(std::span<const double> a, std::span<const double> b) {
   return a.size() == b.size() && (a.empty() || std::memcmp(a.data(), b.data(), a.size_bytes()) == 0);
