@@ -136,7 +136,7 @@ struct WarmStart {
   double match_distance = 0.05;  // m
   long clock = 0;
   long max_age = 256;
-  long uses = 0;  // solves that started from the store (advance_share's probe)
+  long uses = 0;  // solves that started from the store (a share's probe: ShareAdvance, resolve_step_collisions_share)
 
   void tick() {
     if (++clock % max_age == 0) std::erase_if(pairs, [&](const auto& p) { return clock - p.second.stored > max_age; });

@@ -58,7 +58,7 @@ public:
       : floes_(floes), shapes_(shapes), det_(&detection), dt_(dt), opt_(options), stats_(stats), report_(report),
         share_(share) {}
 
-  // A share's run (advance_share): what it did.
+  // A share's run (ShareAdvance): what it did.
   ShareOutcome outcome() const {
     ShareOutcome o;
     o.conflict = conflict_;
