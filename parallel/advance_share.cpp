@@ -70,14 +70,9 @@ AdvancePart unpack_advance_part(std::span<const std::byte> bytes) {
   std::size_t k = 8;
   for (const auto& [name, f] : contact::collision_counts(p.stats)) *f = head[k++];
   for (const auto& [name, f] : contact::substep_counts(p.report)) *f = head[k++];
-  p.outcome.floor_tau = at<double>(in, 0);
-  in += sizeof(double);
-  p.outcome.moved.resize(moved);
-  for (std::size_t j = 0; j < moved; ++j) p.outcome.moved[j] = at<std::uint32_t>(in, j);
-  in += moved * sizeof(std::uint32_t);
-  p.states.resize(states);
-  for (std::size_t j = 0; j < states; ++j) p.states[j] = at<FloeState>(in, j);
-  in += states * sizeof(FloeState);
+  p.outcome.floor_tau = take<double>(in, 1).front();
+  p.outcome.moved = take<std::uint32_t>(in, moved);
+  p.states = take<FloeState>(in, states);
   p.report.floor_pair.assign(reinterpret_cast<const char*>(in), text);
   return p;
 }
@@ -141,11 +136,7 @@ bool combine_parts(std::span<const AdvancePart> parts, Floes& floes, CollisionSt
   // list's rebuild, which every share did alike (taken once).
   const AdvancePart* floor = nullptr;
   for (const AdvancePart& p : parts) {
-    const auto to = contact::collision_counts(stats);
-    const auto from = contact::collision_counts(p.stats);
-    for (std::size_t k = 0; k < kStats; ++k)
-      *to[k].second = from[k].second == &p.stats.largest ? std::max(*to[k].second, *from[k].second)
-                                                          : *to[k].second + *from[k].second;
+    contact::add_collision_counts(stats, p.stats);
     const auto rto = contact::substep_counts(report);
     const auto rfrom = contact::substep_counts(p.report);
     for (std::size_t k = 0; k < kReport; ++k) {
@@ -178,26 +169,13 @@ void advance_by_owner(const Communicator& comm, std::span<const int> owner, Floe
   {
     // The set-up by share, then the exchange of the tight pairs.
     contact::ShareAdvance share(floes, shapes, detection, dt, options, {owner, comm.rank()});
-    std::vector<std::size_t> sizes;
-    const std::vector<std::byte> all_rooms = comm.allgather_bytes(pack(share.rooms()), sizes);
-    std::vector<contact::ShareRooms> rooms;
-    std::size_t from = 0;
-    for (const std::size_t n : sizes) {
-      rooms.push_back(unpack_share_rooms({all_rooms.data() + from, n}));
-      from += n;
-    }
+    const std::vector<contact::ShareRooms> rooms = comm.allgather_parts(pack(share.rooms()), unpack_share_rooms);
     std::vector<contact::PairRoom> tight;
     // Every rank sees the same gathered conflicts: all skip the second
     // exchange alike.
     if (combine_rooms(rooms, tight)) {
       const AdvancePart mine = finish_share(share, tight, floes);
-      const std::vector<std::byte> all = comm.allgather_bytes(pack(mine), sizes);
-      std::vector<AdvancePart> parts;
-      from = 0;
-      for (const std::size_t n : sizes) {
-        parts.push_back(unpack_advance_part({all.data() + from, n}));
-        from += n;
-      }
+      const std::vector<AdvancePart> parts = comm.allgather_parts(pack(mine), unpack_advance_part);
       counts.clusters.resize(parts.size(), 0);
       counts.rooms.resize(parts.size(), 0);
       combined = combine_parts(parts, floes, stats, report);

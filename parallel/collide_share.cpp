@@ -98,14 +98,7 @@ std::size_t collide_by_owner(const Communicator& comm, std::span<const int> owne
   // W^-: a fallback starts again from it. Only the velocities change here.
   const std::vector<FloeState> entry = floes.state;
   const CollidePart mine = run_collide_share(floes, start, detection, step, options, owner, comm.rank());
-  std::vector<std::size_t> sizes;
-  const std::vector<std::byte> all = comm.allgather_bytes(pack(mine), sizes);
-  std::vector<CollidePart> parts;
-  std::size_t from = 0;
-  for (const std::size_t n : sizes) {
-    parts.push_back(unpack_collide_part({all.data() + from, n}));
-    from += n;
-  }
+  const std::vector<CollidePart> parts = comm.allgather_parts(pack(mine), unpack_collide_part);
   counts.clusters.resize(parts.size(), 0);
   std::size_t speculative = 0;
   if (combine_collide_parts(parts, floes, stats, speculative)) {

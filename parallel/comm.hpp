@@ -118,6 +118,21 @@ public:
   // Bytes: every rank's `mine` concatenated in rank order; `counts` gets
   // each rank's byte count. Two collective calls (the counts, then the bytes).
   std::vector<std::byte> allgather_bytes(std::span<const std::byte> mine, std::vector<std::size_t>& counts) const;
+  // Every rank's message `mine`, each read back by `read` (a function of
+  // one message's bytes), in rank order: one allgather_bytes.
+  template <class Read>
+  auto allgather_parts(std::span<const std::byte> mine, Read read) const {
+    std::vector<std::size_t> counts;
+    const std::vector<std::byte> all = allgather_bytes(mine, counts);
+    std::vector<decltype(read(std::span<const std::byte>{}))> parts;
+    parts.reserve(counts.size());
+    std::size_t from = 0;
+    for (const std::size_t n : counts) {
+      parts.push_back(read(std::span<const std::byte>(all.data() + from, n)));
+      from += n;
+    }
+    return parts;
+  }
   // The same when every rank's count is known to all (`counts`): one call.
   std::vector<std::byte> allgather_known(std::span<const std::byte> mine, const std::vector<std::size_t>& counts) const;
   // Both into `out`, whose memory is reused (a gather made at every step

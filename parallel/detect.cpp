@@ -65,16 +65,15 @@ contact::Detection detect(const Communicator& comm, FloeOwners& owners, const Fl
   append<contact::NearPair>(message, mine.pairs);
   append<contact::ContactPoint>(message, mine.contacts);
   append<contact::Witness>(message, mine.witnesses);
-  std::vector<std::size_t> counts;
-  const std::vector<std::byte> all = comm.allgather_bytes(message, counts);
-  std::vector<contact::Detection> parts(counts.size());
-  const std::byte* at = all.data();
-  for (contact::Detection& part : parts) {
+  std::vector<contact::Detection> parts = comm.allgather_parts(message, [](std::span<const std::byte> bytes) {
+    const std::byte* at = bytes.data();
+    contact::Detection part;
     const std::vector<std::uint64_t> n = take<std::uint64_t>(at, 3);
     part.pairs = take<contact::NearPair>(at, n[0]);
     part.contacts = take<contact::ContactPoint>(at, n[1]);
     part.witnesses = take<contact::Witness>(at, n[2]);
-  }
+    return part;
+  });
   parts.front().reach = std::move(mine.reach);  // the same on every rank
   return merge(std::move(parts));
 }
