@@ -336,6 +336,17 @@ int run(const Args& args, const parallel::Session& session) {
     const parallel::Communicator::Traffic t = comm.traffic();
     o << "parallel.ranks: " << comm.size() << "\nparallel.collectives: " << t.calls << "\nparallel.bytes_received: " << t.bytes
       << "\nparallel.collective_seconds: " << t.seconds << "\n";
+    // The same by phase (Profile): the calls and bytes of each phase that
+    // made any, then the rest (the run loop's agreements, the set-up, the summary).
+    long long calls = t.calls, bytes = t.bytes;
+    for (std::size_t k = 0; k < kPhaseNames.size(); ++k) {
+      calls -= s.profile.calls[k];
+      bytes -= s.profile.bytes[k];
+      if (s.profile.calls[k] > 0)
+        o << "parallel.phase." << kPhaseNames[k] << ": " << s.profile.calls[k] << " calls, " << s.profile.bytes[k]
+          << " bytes\n";
+    }
+    o << "parallel.phase.other: " << calls << " calls, " << bytes << " bytes\n";
     // The floes' strips (stage six): the cuts in y, the floes in each strip
     // now, the cuts' moves by measured cost and each rank's by-place seconds
     // (CPU) over the window before the last move and over all windows.

@@ -37,7 +37,7 @@ RunSummary run_simulation(Simulation& sim, const RunOptions& options) {
   });
 
   auto record = [&] {
-    PhaseTimer _(sim.profile(), Phase::record);
+    PhaseTimer _(sim.profile(), Phase::record, comm);
     const Energies e = sim.energies();
     const std::span<const double> elevation = sim.sea_elevation();  // on every rank: it applies the sea's deferred kicks
     if (writer) writer->record(sim.time(), sim.floes(), e.values, sim.lcp_counters(), elevation);
@@ -86,7 +86,7 @@ RunSummary run_simulation(Simulation& sim, const RunOptions& options) {
   double next_checkpoint = next_checkpoint_after(sim.time());
   std::size_t checkpoint_steps = static_cast<std::size_t>(-1);  // steps() at the last checkpoint
   auto checkpoint = [&] {
-    PhaseTimer _(sim.profile(), Phase::record);
+    PhaseTimer _(sim.profile(), Phase::record, comm);
     if (!(have_good && good_steps == static_cast<long long>(sim.steps()))) take_good();
     if (writer) writer->write_checkpoint(good);
     checkpoint_steps = sim.steps();

@@ -163,24 +163,24 @@ double Simulation::step(double t_stop) {
     return 0.0;
   }
   StepContext ctx;
-  { PhaseTimer _(profile_, Phase::choose_dt); ctx = choose_dt(t_stop); }
+  { PhaseTimer _(profile_, Phase::choose_dt, comm_); ctx = choose_dt(t_stop); }
   for (bool accepted = false; !accepted;) {
-    { PhaseTimer _(profile_, Phase::forcing); sample_forcing(ctx); }
-    { PhaseTimer _(profile_, Phase::penalty); floes_half_kick(ctx); }
-    { PhaseTimer _(profile_, Phase::drift);   drift(ctx); }
-    { PhaseTimer _(profile_, Phase::collide); collide(ctx); }
-    { PhaseTimer _(profile_, Phase::advance); advance(ctx); }
-    { PhaseTimer _(profile_, Phase::detect);  accepted = detect_and_check(ctx); }
+    { PhaseTimer _(profile_, Phase::forcing, comm_); sample_forcing(ctx); }
+    { PhaseTimer _(profile_, Phase::penalty, comm_); floes_half_kick(ctx); }
+    { PhaseTimer _(profile_, Phase::drift, comm_);   drift(ctx); }
+    { PhaseTimer _(profile_, Phase::collide, comm_); collide(ctx); }
+    { PhaseTimer _(profile_, Phase::advance, comm_); advance(ctx); }
+    { PhaseTimer _(profile_, Phase::detect, comm_);  accepted = detect_and_check(ctx); }
   }
-  { PhaseTimer _(profile_, Phase::sea);       sea_flow(ctx); }
-  { PhaseTimer _(profile_, Phase::penalty);   sea_half_kick(ctx); }
+  { PhaseTimer _(profile_, Phase::sea, comm_);       sea_flow(ctx); }
+  { PhaseTimer _(profile_, Phase::penalty, comm_);   sea_half_kick(ctx); }
   budget_.external += step_budget_.external;
   budget_.collisions += step_budget_.collisions;
   // Land exactly on t_stop when the step was cut to reach it.
   t_ = ctx.dt == t_stop - ctx.t ? t_stop : ctx.t + ctx.dt;
-  { PhaseTimer _(profile_, Phase::record);     note_collisions(); }
-  { PhaseTimer _(profile_, Phase::percussion); percussion(ctx); }
-  { PhaseTimer _(profile_, Phase::check);     check_state(ctx); }
+  { PhaseTimer _(profile_, Phase::record, comm_);     note_collisions(); }
+  { PhaseTimer _(profile_, Phase::percussion, comm_); percussion(ctx); }
+  { PhaseTimer _(profile_, Phase::check, comm_);     check_state(ctx); }
   ++steps_;
   warm_->tick();  // the jam LCPs' warm starts age by one step
   return ctx.dt;

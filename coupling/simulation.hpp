@@ -70,9 +70,14 @@ enum class Phase { choose_dt, forcing, drift, collide, percussion, advance, dete
 inline constexpr std::array<const char*, static_cast<std::size_t>(Phase::count)> kPhaseNames = {
     "choose_dt", "forcing", "drift", "collide", "percussion", "advance", "detect", "sea", "check", "record", "penalty"};
 
-// Wall time spent in each phase (s), for `floesim run --profile`.
+// Wall time spent in each phase (s), for `floesim run --profile`; on
+// several ranks also this rank's collective calls and the bytes it received
+// in them, by phase (the run's summary, docs/parallel.md "Communication per
+// step").
 struct Profile {
-  std::array<double, static_cast<std::size_t>(Phase::count)> seconds{};
+  static constexpr std::size_t kPhases = static_cast<std::size_t>(Phase::count);
+  std::array<double, kPhases> seconds{};
+  std::array<long long, kPhases> calls{}, bytes{};
   double& operator[](Phase p) { return seconds[static_cast<std::size_t>(p)]; }
   double operator[](Phase p) const { return seconds[static_cast<std::size_t>(p)]; }
 };
@@ -219,12 +224,18 @@ private:
   std::size_t steps_ = 0;
 };
 
-// Times a phase into a profile: `PhaseTimer timer(profile, Phase::drift);`.
+// Times a phase into a profile, and counts the communicator's collective
+// calls and received bytes in it: `PhaseTimer timer(profile, Phase::drift, comm);`.
 class PhaseTimer {
 public:
-  PhaseTimer(Profile& p, Phase phase) : p_(p), phase_(phase), start_(std::chrono::steady_clock::now()) {}
+  PhaseTimer(Profile& p, Phase phase, const parallel::Communicator& comm)
+      : p_(p), phase_(phase), comm_(comm), traffic_(comm.traffic()), start_(std::chrono::steady_clock::now()) {}
   ~PhaseTimer() {
-    p_[phase_] += std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+    const auto k = static_cast<std::size_t>(phase_);
+    p_.seconds[k] += std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+    const parallel::Communicator::Traffic now = comm_.traffic();
+    p_.calls[k] += now.calls - traffic_.calls;
+    p_.bytes[k] += now.bytes - traffic_.bytes;
   }
   PhaseTimer(const PhaseTimer&) = delete;
   PhaseTimer& operator=(const PhaseTimer&) = delete;
@@ -232,6 +243,8 @@ public:
 private:
   Profile& p_;
   Phase phase_;
+  const parallel::Communicator& comm_;
+  parallel::Communicator::Traffic traffic_;
   std::chrono::steady_clock::time_point start_;
 };
 

@@ -111,6 +111,16 @@ for n in args.ranks:
         if not (tried and fell and int(tried[0]) > 0 and int(fell[0]) == 0 and len(groups) == n
                 and all(int(g) > 0 for g in groups)):
             failures.append(f"{n} ranks: the step-start collisions did not run by owner ({tried}, {fell}, {groups})")
+    # The communication by phase: the phases' bytes (and the rest) are rank
+    # 0's total, and the drift (the states) and detection (the lists) receive some.
+    if n > 1:
+        phase = {l.split(":")[0][len("parallel.phase."):]: l.split(":", 1)[1].split()
+                 for l in p.stdout.splitlines() if l.startswith("parallel.phase.")}
+        total = key("parallel.bytes_received")
+        print(f"{n} ranks: bytes received by phase {dict((k, int(v[2])) for k, v in phase.items())}")
+        if not (total and sum(int(v[2]) for v in phase.values()) == int(total[0])
+                and all(int(phase.get(k, [0, 0, 0])[2]) > 0 for k in ("drift", "detect"))):
+            failures.append(f"{n} ranks: the bytes by phase do not add up to {total}: {phase}")
 
 # A restart on 2 ranks: the first half, then --restart from its checkpoint
 # (written by rank 0, read by every rank), equals the serial run.
