@@ -56,6 +56,7 @@
 #include "contact/shapes.hpp"
 #include "contact/substep.hpp"
 #include "core/checkpoint.hpp"
+#include "core/exact_sum.hpp"
 #include "core/run_file.hpp"
 #include "coupling/scenario.hpp"
 #include "parallel/comm.hpp"
@@ -83,7 +84,13 @@ struct StepContext {
   double dt = 0.0;     // s
   ForcingSample forcing;
   std::vector<FloeState> start;  // the floes at t, to redo a rejected step
-  Vec2 momentum = Vec2::Zero();   // of the dynamic floes, updated by the phases that change it
+  // The dynamic floes' momentum (x, y; kg m/s) at the try's start (before
+  // the first half kick), after the drift, after the collisions and after
+  // the advance, as exact sums (core/exact_sum.hpp): this rank's part, of
+  // the floes it owns, until detection's reach combines them over the ranks
+  // in its one call (Simulation::set_reach); the step's budget is read then.
+  std::array<ExactSum, 8> momenta;
+  static constexpr std::size_t kAtStart = 0, kAfterDrift = 2, kAfterCollide = 4, kAfterAdvance = 6;
 };
 
 // Energies by part (J), named as the columns of /diagnostics/energy; the last
@@ -137,7 +144,11 @@ public:
     Vec2 collisions = Vec2::Zero();
   };
   const MomentumBudget& momentum_budget() const { return budget_; }
-  Vec2 momentum() const;  // of the dynamic floes now
+  // Of the dynamic floes now: each rank sums the floes it owns exactly and
+  // the ranks combine (collective: every rank calls it). The same bits on
+  // any number of ranks (docs/parallel.md, "Exact sums"); so are
+  // energies() and the budget.
+  Vec2 momentum() const;
   LcpCounters lcp_counters() const;
   const contact::Detection& detection() const { return detection_; }
   // The floes' owners by place for the drift and detection (one rank: all 0).
@@ -170,7 +181,7 @@ private:
   StepContext choose_dt(double t_stop);
   void sample_forcing(StepContext& ctx) const;
   void sea_flow(const StepContext& ctx);
-  void floes_half_kick(const StepContext& ctx);
+  void floes_half_kick(StepContext& ctx);
   void sea_half_kick(const StepContext& ctx);
   void drift(StepContext& ctx);
   void follow_slabs();  // the sea and the coupling take the owners' moved slabs
@@ -178,11 +189,21 @@ private:
   void note_collisions();
   void percussion(const StepContext& ctx);
   void on_floes_changed();  // rebuilds every per-floe structure (after a split)
-  void advance(const StepContext& ctx);
+  void advance(StepContext& ctx);
   bool detect_and_check(StepContext& ctx);  // false: the step overlapped, dt halved
   void wrap_periodic();
-  void set_reach();  // detection reach of each floe for the next step
-  void check_state(const StepContext& ctx) const;
+  // Detection reach of each floe for the next step. Collective: the pack's
+  // rms speed is summed by owner; `along` (exact sums of this rank's part)
+  // are combined over the ranks in the same call.
+  void set_reach(std::span<ExactSum> along = {});
+  void read_try_budget(const StepContext& ctx);  // the try's momenta, combined, into step_budget_
+  void check_state(const StepContext& ctx) const;  // collective: the ranks agree on the first bad floe
+  // The floes whose terms this rank adds to the whole-pack sums: its floes
+  // by place, or (before they are placed, after a split) its share by index.
+  template <class F>
+  void for_owned(F&& f) const;
+  // Adds this rank's part of the dynamic floes' momentum to `into` (x, y).
+  void add_owned_momentum(std::span<ExactSum, 2> into) const;
 
   Scenario scenario_;
   parallel::Communicator comm_;
@@ -192,7 +213,6 @@ private:
   // without wave generation (its velocity is 0).
   std::unique_ptr<IncidentSea> incident_;
   double equal_dt_ = -1.0;            // the last of the equal steps the penalty limit asked for
-  Vec2 ctx_momentum_before_ = Vec2::Zero();  // of the floes at the start of the step's try
   DriftParams drift_params_;
   FootprintQuadrature quadrature_;
   Moorings moorings_;  // [[floes.floe]] mooring_period
