@@ -174,13 +174,11 @@ double Simulation::step(double t_stop) {
   }
   { PhaseTimer _(profile_, Phase::sea);       sea_flow(ctx); }
   { PhaseTimer _(profile_, Phase::penalty);   sea_half_kick(ctx); }
-  budget_.external += step_budget_.external;
-  budget_.collisions += step_budget_.collisions;
   // Land exactly on t_stop when the step was cut to reach it.
   t_ = ctx.dt == t_stop - ctx.t ? t_stop : ctx.t + ctx.dt;
   { PhaseTimer _(profile_, Phase::record);     note_collisions(); }
   { PhaseTimer _(profile_, Phase::percussion); percussion(ctx); }
-  { PhaseTimer _(profile_, Phase::check);     check_state(ctx); }
+  { PhaseTimer _(profile_, Phase::check);     close_step(ctx); }
   ++steps_;
   warm_->tick();  // the jam LCPs' warm starts age by one step
   return ctx.dt;
@@ -424,7 +422,7 @@ void Simulation::read_try_budget(const StepContext& ctx) {
 }
 
 bool Simulation::detect_and_check(StepContext& ctx) {
-  set_reach(ctx.momenta);  // combines the try's momenta over the ranks too (one call)
+  set_reach(std::span(ctx.momenta).first<StepContext::kTry>());  // combines the try's momenta too (one call)
   read_try_budget(ctx);
   if (!comm_.serial()) owners_.assign(scenario_.floes);  // the owners at the advanced places
   contact::Detection next = parallel::detect(comm_, owners_, scenario_.floes, shapes_, detection_options_);
@@ -468,39 +466,55 @@ void Simulation::sea_flow(const StepContext& ctx) {
   floe_sea_->advance_vertical(scenario_.floes, ctx.start, *sea_, ctx.dt);
 }
 
-void Simulation::sea_half_kick(const StepContext& ctx) {
+void Simulation::sea_half_kick(StepContext& ctx) {
   // Loads at t + dt (and the incident waves' velocity under the floes, for
   // the next drag): the second half kick of the sea and of the floes, and,
   // while they hold, the first of the next step (FloeSeaContact's loads cache).
   if (!floe_sea_) return;
   floe_sea_->evaluate_loads(scenario_.floes, *sea_, incident_.get(), 0.5 * ctx.dt);
-  std::array<ExactSum, 4> p;  // x, y before the kick and after it: one call
-  add_owned_momentum(std::span(p).first<2>());
+  add_owned_momentum(std::span(ctx.momenta).subspan<StepContext::kBeforeSeaKick, 2>());
   floe_sea_->kick_floes(scenario_.floes, 0.5 * ctx.dt);
   floe_sea_->kick_sea(*sea_, 0.5 * ctx.dt);
-  add_owned_momentum(std::span(p).last<2>());
-  comm_.sum(p);
-  step_budget_.external += Vec2{p[2].value(), p[3].value()} - Vec2{p[0].value(), p[1].value()};
+  add_owned_momentum(std::span(ctx.momenta).subspan<StepContext::kAfterSeaKick, 2>());
 }
 
-void Simulation::check_state(const StepContext& ctx) const {
-  // Each rank checks the floes it owns; the ranks agree on the first bad
-  // value (the lowest floe, then column: floe * columns + column, the
-  // least over the ranks), so that every rank throws the same message.
+void Simulation::close_step(StepContext& ctx) {
+  // Each rank checks the floes it owns for non-finite values; one call sums
+  // their number over the ranks, with the sea kick's momenta (when the
+  // floes feel the sea). Only when there are bad floes does a second call
+  // agree on the first (the lowest floe, then column: floe * columns +
+  // column, the least over the ranks), so that every rank throws the same
+  // message.
   const Floes& f = scenario_.floes;
   constexpr long long kNone = std::numeric_limits<long long>::max();
   long long first = kNone;
+  std::array<long long, 1> bad{0};
   for_owned([&](std::size_t i) {
     const double* s = reinterpret_cast<const double*>(&f.state[i]);
-    for (int k = 0; k < kStateColumns && first == kNone; ++k)
-      if (!std::isfinite(s[k])) first = static_cast<long long>(i) * kStateColumns + k;
+    for (int k = 0; k < kStateColumns; ++k)
+      if (!std::isfinite(s[k])) {
+        first = std::min(first, static_cast<long long>(i) * kStateColumns + k);
+        ++bad[0];
+        break;
+      }
   });
-  first = comm_.min(first);
-  if (first == kNone) return;
-  std::ostringstream m;
-  m << "floe " << first / kStateColumns << ": " << kStateColumnNames[first % kStateColumns]
-    << " is not finite after the step from t = " << ctx.t << " s with dt = " << ctx.dt << " s";
-  throw RunError(m.str());
+  const std::span<ExactSum> kick =
+      floe_sea_ ? std::span(ctx.momenta).subspan(StepContext::kBeforeSeaKick, 4) : std::span<ExactSum>{};
+  comm_.sum(kick, bad);
+  if (bad[0] > 0) {
+    first = comm_.min(first);
+    std::ostringstream m;
+    m << "floe " << first / kStateColumns << ": " << kStateColumnNames[first % kStateColumns]
+      << " is not finite after the step from t = " << ctx.t << " s with dt = " << ctx.dt << " s";
+    throw RunError(m.str());
+  }
+  if (floe_sea_)
+    step_budget_.external += Vec2{ctx.momenta[StepContext::kAfterSeaKick].value(),
+                                  ctx.momenta[StepContext::kAfterSeaKick + 1].value()} -
+                             Vec2{ctx.momenta[StepContext::kBeforeSeaKick].value(),
+                                  ctx.momenta[StepContext::kBeforeSeaKick + 1].value()};
+  budget_.external += step_budget_.external;
+  budget_.collisions += step_budget_.collisions;
 }
 
 Energies Simulation::energies() const {

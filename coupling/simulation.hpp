@@ -86,11 +86,14 @@ struct StepContext {
   std::vector<FloeState> start;  // the floes at t, to redo a rejected step
   // The dynamic floes' momentum (x, y; kg m/s) at the try's start (before
   // the first half kick), after the drift, after the collisions and after
-  // the advance, as exact sums (core/exact_sum.hpp): this rank's part, of
-  // the floes it owns, until detection's reach combines them over the ranks
-  // in its one call (Simulation::set_reach); the step's budget is read then.
-  std::array<ExactSum, 8> momenta;
-  static constexpr std::size_t kAtStart = 0, kAfterDrift = 2, kAfterCollide = 4, kAfterAdvance = 6;
+  // the advance, then before and after the sea's second half kick, as exact
+  // sums (core/exact_sum.hpp): this rank's part, of the floes it owns, until
+  // a call the step makes anyway combines them over the ranks (the try's
+  // four: detection's reach, Simulation::set_reach; the kick's two: the
+  // state check, Simulation::close_step); the step's budget is read then.
+  std::array<ExactSum, 12> momenta;
+  static constexpr std::size_t kAtStart = 0, kAfterDrift = 2, kAfterCollide = 4, kAfterAdvance = 6,
+                               kTry = 8, kBeforeSeaKick = 8, kAfterSeaKick = 10;
 };
 
 // Energies by part (J), named as the columns of /diagnostics/energy; the last
@@ -182,7 +185,7 @@ private:
   void sample_forcing(StepContext& ctx) const;
   void sea_flow(const StepContext& ctx);
   void floes_half_kick(StepContext& ctx);
-  void sea_half_kick(const StepContext& ctx);
+  void sea_half_kick(StepContext& ctx);
   void drift(StepContext& ctx);
   void follow_slabs();  // the sea and the coupling take the owners' moved slabs
   void collide(StepContext& ctx);
@@ -197,7 +200,9 @@ private:
   // are combined over the ranks in the same call.
   void set_reach(std::span<ExactSum> along = {});
   void read_try_budget(const StepContext& ctx);  // the try's momenta, combined, into step_budget_
-  void check_state(const StepContext& ctx) const;  // collective: the ranks agree on the first bad floe
+  // The state check (the ranks agree on the first non-finite value) and the
+  // step's momentum budget (the sea kick's momenta combined): one call.
+  void close_step(StepContext& ctx);
   // The floes whose terms this rank adds to the whole-pack sums: its floes
   // by place, or (before they are placed, after a split) its share by index.
   template <class F>

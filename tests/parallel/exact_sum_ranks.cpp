@@ -14,6 +14,10 @@
 //    momentum, the energies and the state must be the same bits, each
 //    rank must own a strict, non-empty subset on 2 and 3 ranks, and there
 //    must be collisions and a wind's push (so that the budget is not 0).
+// 3. Four floes blown to infinity by a 1e200 m/s wind, floe 0 in the top
+//    strip (on 2 ranks, the last rank's): every rank must throw the serial
+//    run's message, which names floe 0 (the ranks agree on the lowest bad
+//    floe; rank 0's own first is floe 1).
 #include <algorithm>
 #include <bit>
 #include <cmath>
@@ -28,6 +32,7 @@
 #include <vector>
 
 #include "core/config.hpp"
+#include "core/error.hpp"
 #include "core/exact_sum.hpp"
 #include "core/pack.hpp"
 #include "core/pack_generator.hpp"
@@ -161,6 +166,28 @@ void check_simulation(const parallel::Communicator& comm, std::vector<std::strin
   if (serial.collision_stats().lcps == 0) failures.push_back("no collision: a weak test");
   if (b.external.norm() == 0.0) failures.push_back("no external momentum: a weak test");
 }
+void check_bad_state(const parallel::Communicator& comm, std::vector<std::string>& failures) {
+  const std::string text =
+      "[run]\nt_end = 2.0\ndt_max = 0.5\n[sea]\nmodel = \"none\"\n"
+      "[[floes.floe]]\nvertices = [[0, 900], [20, 900], [20, 920], [0, 920]]\n"
+      "[[floes.floe]]\nvertices = [[0, 0], [20, 0], [20, 20], [0, 20]]\n"
+      "[[floes.floe]]\nvertices = [[100, 0], [120, 0], [120, 20], [100, 20]]\n"
+      "[[floes.floe]]\nvertices = [[100, 900], [120, 900], [120, 920], [100, 920]]\n"
+      "[forcing]\nwind = [1e200, 0.0]\n";
+  auto message = [&](const parallel::Communicator& c) {
+    Simulation sim(build_scenario(parse_config(text, "overflow.toml", ".")), c);
+    try {
+      while (sim.time() < 2.0) sim.step(2.0);
+    } catch (const RunError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  const std::string serial = message(parallel::Communicator{}), mine = message(comm);
+  if (serial.find("floe 0: x is not finite") == std::string::npos)
+    failures.push_back("the serial run's message does not name floe 0: " + serial);
+  if (mine != serial) failures.push_back("the message is \"" + mine + "\", not the serial run's \"" + serial + "\"");
+}
 }  // namespace
 
 int main() {
@@ -170,6 +197,7 @@ int main() {
   try {
     check_sums(comm, failures);
     check_simulation(comm, failures);
+    check_bad_state(comm, failures);
   } catch (const std::exception& e) {
     failures.push_back(std::string("threw: ") + e.what());
   }
