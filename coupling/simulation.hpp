@@ -20,7 +20,8 @@
 //   -> percussion (fracture checks on every collision impulse of the step,
 //      collide's and the sub-steps', coupling/percussion.hpp; a split floe
 //      becomes two, which start the next step)
-//   -> check state
+//   -> check state and close the step's momentum budget (the whole-pack sums
+//      are by owner and exact: docs/parallel.md, "Exact sums")
 //
 // The kicks and flows are the Strang splitting of the floe–sea Hamiltonian
 // (second order, energy conserving for the strong law without drag); drag
