@@ -174,13 +174,11 @@ double Simulation::step(double t_stop) {
   }
   { PhaseTimer _(profile_, Phase::sea, comm_);       sea_flow(ctx); }
   { PhaseTimer _(profile_, Phase::penalty, comm_);   sea_half_kick(ctx); }
-  budget_.external += step_budget_.external;
-  budget_.collisions += step_budget_.collisions;
   // Land exactly on t_stop when the step was cut to reach it.
   t_ = ctx.dt == t_stop - ctx.t ? t_stop : ctx.t + ctx.dt;
   { PhaseTimer _(profile_, Phase::record, comm_);     note_collisions(); }
   { PhaseTimer _(profile_, Phase::percussion, comm_); percussion(ctx); }
-  { PhaseTimer _(profile_, Phase::check, comm_);     check_state(ctx); }
+  { PhaseTimer _(profile_, Phase::check, comm_);      close_step(ctx); }
   ++steps_;
   warm_->tick();  // the jam LCPs' warm starts age by one step
   return ctx.dt;
@@ -226,10 +224,11 @@ void Simulation::sample_forcing(StepContext& ctx) const {
   ctx.forcing = scenario_.forcing.at(ctx.t + 0.5 * ctx.dt);
 }
 
-void Simulation::floes_half_kick(const StepContext& ctx) {
+void Simulation::floes_half_kick(StepContext& ctx) {
   // The sea's loads at t (evaluated at the end of the previous step when
   // its half step was the same) kick the floes' vertical and horizontal rates.
-  ctx_momentum_before_ = momentum();
+  ctx.momenta = {};
+  add_owned_momentum(std::span(ctx.momenta).subspan<StepContext::kAtStart, 2>());
   if (!floe_sea_) return;
   floe_sea_->ready_loads(scenario_.floes, *sea_, incident_.get(), 0.5 * ctx.dt);
   floe_sea_->kick_floes(scenario_.floes, 0.5 * ctx.dt);
@@ -260,8 +259,7 @@ void Simulation::drift(StepContext& ctx) {
     owners_.charge(parallel::thread_seconds() - start);
     comm_.complete_owned(scenario_.floes.state, owners_.owner());
   }
-  ctx.momentum = momentum();
-  step_budget_.external = ctx.momentum - ctx_momentum_before_;
+  add_owned_momentum(std::span(ctx.momenta).subspan<StepContext::kAfterDrift, 2>());
 }
 
 void Simulation::follow_slabs() {
@@ -288,9 +286,7 @@ void Simulation::collide(StepContext& ctx) {
   else
     parallel::collide_by_owner(comm_, owners_.owner(), scenario_.floes, ctx.start, detection_, ctx.dt,
                                impulse_options_, stats_, collide_share_);
-  const Vec2 after = momentum();
-  step_budget_.collisions = after - ctx.momentum;
-  ctx.momentum = after;
+  add_owned_momentum(std::span(ctx.momenta).subspan<StepContext::kAfterCollide, 2>());
 }
 
 void Simulation::note_collisions() {
@@ -322,15 +318,42 @@ std::vector<FractureEventRow> Simulation::take_fracture_events() {
   return percussion_ ? percussion_->take_events() : std::vector<FractureEventRow>{};
 }
 
-Vec2 Simulation::momentum() const {
-  const Floes& f = scenario_.floes;
-  Vec2 p = Vec2::Zero();
-  for (std::size_t i = 0; i < f.size(); ++i)
-    if (!f.is_static[i]) p += f.mass[i] * Vec2{f.state[i].vx, f.state[i].vy};
-  return p;
+template <class F>
+void Simulation::for_owned(F&& f) const {
+  // Any partition of the floes among the ranks gives the same exact sums;
+  // the owners by place are the partition the state held by owner will have
+  // (docs/parallel.md, "Exact sums"). They are a partition of the present
+  // floes once assigned (drift, detection) and until a split adds a floe.
+  const std::size_t n = scenario_.floes.size();
+  if (comm_.serial()) {
+    for (std::size_t i = 0; i < n; ++i) f(i);
+  } else if (owners_.owner().size() == n) {
+    for (const std::uint32_t i : owners_.mine()) f(std::size_t{i});
+  } else {
+    const parallel::Range r = comm_.share(n);
+    for (std::size_t i = r.begin; i < r.end; ++i) f(i);
+  }
 }
 
-void Simulation::advance(const StepContext& ctx) {
+void Simulation::add_owned_momentum(std::span<ExactSum, 2> into) const {
+  // Each floe's m v is one rounded product, the same on any rank; the sum
+  // of the products is exact (rounded once, by value()).
+  const Floes& f = scenario_.floes;
+  for_owned([&](std::size_t i) {
+    if (f.is_static[i]) return;
+    into[0].add(f.mass[i] * f.state[i].vx);
+    into[1].add(f.mass[i] * f.state[i].vy);
+  });
+}
+
+Vec2 Simulation::momentum() const {
+  std::array<ExactSum, 2> p;
+  add_owned_momentum(p);
+  comm_.sum(p);
+  return {p[0].value(), p[1].value()};
+}
+
+void Simulation::advance(StepContext& ctx) {
   // Free floes move in one go; those that may collide within the step are
   // sub-stepped event by event, cluster by cluster (contact/substep.hpp). All
   // the momentum this changes is collisions'.
@@ -339,7 +362,6 @@ void Simulation::advance(const StepContext& ctx) {
   o.floor = kFloorFraction * scenario_.config.run.dt_max;
   o.domain = detection_options_.domain;
   o.impulse = impulse_options_;
-  const Vec2 before = momentum();
   // On several ranks each rank advances the clusters it owns and the ranks
   // exchange what moved (stage seven, parallel/advance_share.hpp); the
   // impulse record's events are in the serial queue's order, so a run that
@@ -349,37 +371,59 @@ void Simulation::advance(const StepContext& ctx) {
   else
     parallel::advance_by_owner(comm_, owners_.owner(), scenario_.floes, shapes_, detection_, ctx.dt, o, stats_,
                                substeps_, advance_share_);
-  step_budget_.collisions += momentum() - before;
+  add_owned_momentum(std::span(ctx.momenta).subspan<StepContext::kAfterAdvance, 2>());
   wrap_periodic();
 }
 
-void Simulation::set_reach() {
+void Simulation::set_reach(std::span<ExactSum> along) {
   // The pair list must hold every pair that can meet within the next step:
   // each floe's reach is what it may travel in dt_max at 1.5 times its
   // present speed (rotation included), plus half the pack's rms speed for
   // what collisions at the start of the step may give it. A floe that would
   // still outrun its reach makes the sub-stepper rebuild the list.
+  // The rms is the same bits on any number of ranks: each rank sums the
+  // squares of the floes it owns exactly, and counts them; one call
+  // combines both (and `along`).
   const Floes& f = scenario_.floes;
   const double dt_max = scenario_.config.run.dt_max;
   std::vector<double> speed(f.size(), 0.0);
-  double sum2 = 0.0;
-  std::size_t dynamic = 0;
   for (std::size_t i = 0; i < f.size(); ++i) {
     if (f.is_static[i]) continue;
     const FloeState& s = f.state[i];
     speed[i] = std::hypot(s.vx, s.vy) + std::abs(s.yaw_rate) * shapes_.radius[i];
-    sum2 += speed[i] * speed[i];
-    ++dynamic;
   }
-  const double rms = dynamic ? std::sqrt(sum2 / static_cast<double>(dynamic)) : 0.0;
+  std::vector<ExactSum> sums(1 + along.size());
+  std::array<long long, 1> dynamic{0};
+  for_owned([&](std::size_t i) {
+    if (f.is_static[i]) return;
+    sums[0].add(speed[i] * speed[i]);
+    ++dynamic[0];
+  });
+  std::copy(along.begin(), along.end(), sums.begin() + 1);
+  comm_.sum(sums, dynamic);
+  std::copy(sums.begin() + 1, sums.end(), along.begin());
+  const double rms = dynamic[0] ? std::sqrt(sums[0].value() / static_cast<double>(dynamic[0])) : 0.0;
   detection_options_.reach.resize(f.size());
   for (std::size_t i = 0; i < f.size(); ++i)
     detection_options_.reach[i] =
         f.is_static[i] ? 0.0 : dt_max * (1.5 * speed[i] + 0.5 * rms) + detection_options_.collision_distance;
 }
 
+void Simulation::read_try_budget(const StepContext& ctx) {
+  // The momenta of the try, combined over the ranks (set_reach): the smooth
+  // forces' part is the drift phase's change (the first half kick's
+  // included), the collisions' part the collide and advance phases'.
+  auto at = [&](std::size_t k) { return Vec2{ctx.momenta[k].value(), ctx.momenta[k + 1].value()}; };
+  const Vec2 start = at(StepContext::kAtStart), drifted = at(StepContext::kAfterDrift),
+             collided = at(StepContext::kAfterCollide), advanced = at(StepContext::kAfterAdvance);
+  step_budget_.external = drifted - start;
+  step_budget_.collisions = collided - drifted;
+  step_budget_.collisions += advanced - collided;
+}
+
 bool Simulation::detect_and_check(StepContext& ctx) {
-  set_reach();
+  set_reach(std::span(ctx.momenta).first<StepContext::kTry>());  // combines the try's momenta too (one call)
+  read_try_budget(ctx);
   if (!comm_.serial()) owners_.assign(scenario_.floes);  // the owners at the advanced places
   contact::Detection next = parallel::detect(comm_, owners_, scenario_.floes, shapes_, detection_options_);
   for (const contact::NearPair& p : next.pairs) {
@@ -422,41 +466,70 @@ void Simulation::sea_flow(const StepContext& ctx) {
   floe_sea_->advance_vertical(scenario_.floes, ctx.start, *sea_, ctx.dt);
 }
 
-void Simulation::sea_half_kick(const StepContext& ctx) {
+void Simulation::sea_half_kick(StepContext& ctx) {
   // Loads at t + dt (and the incident waves' velocity under the floes, for
   // the next drag): the second half kick of the sea and of the floes, and,
   // while they hold, the first of the next step (FloeSeaContact's loads cache).
   if (!floe_sea_) return;
   floe_sea_->evaluate_loads(scenario_.floes, *sea_, incident_.get(), 0.5 * ctx.dt);
-  const Vec2 before = momentum();
+  add_owned_momentum(std::span(ctx.momenta).subspan<StepContext::kBeforeSeaKick, 2>());
   floe_sea_->kick_floes(scenario_.floes, 0.5 * ctx.dt);
   floe_sea_->kick_sea(*sea_, 0.5 * ctx.dt);
-  step_budget_.external += momentum() - before;
+  add_owned_momentum(std::span(ctx.momenta).subspan<StepContext::kAfterSeaKick, 2>());
 }
 
-void Simulation::check_state(const StepContext& ctx) const {
+void Simulation::close_step(StepContext& ctx) {
+  // Each rank checks the floes it owns for non-finite values; one call sums
+  // their number over the ranks, with the sea kick's momenta (when the
+  // floes feel the sea). Only when there are bad floes does a second call
+  // agree on the first (the lowest floe, then column: floe * columns +
+  // column, the least over the ranks), so that every rank throws the same
+  // message.
   const Floes& f = scenario_.floes;
-  for (std::size_t i = 0; i < f.size(); ++i) {
+  constexpr long long kNone = std::numeric_limits<long long>::max();
+  long long first = kNone;
+  std::array<long long, 1> bad{0};
+  for_owned([&](std::size_t i) {
     const double* s = reinterpret_cast<const double*>(&f.state[i]);
     for (int k = 0; k < kStateColumns; ++k)
       if (!std::isfinite(s[k])) {
-        std::ostringstream m;
-        m << "floe " << i << ": " << kStateColumnNames[k] << " is not finite after the step from t = "
-          << ctx.t << " s with dt = " << ctx.dt << " s";
-        throw RunError(m.str());
+        first = std::min(first, static_cast<long long>(i) * kStateColumns + k);
+        ++bad[0];
+        break;
       }
+  });
+  const std::span<ExactSum> kick =
+      floe_sea_ ? std::span(ctx.momenta).subspan(StepContext::kBeforeSeaKick, 4) : std::span<ExactSum>{};
+  comm_.sum(kick, bad);
+  if (bad[0] > 0) {
+    first = comm_.min(first);
+    std::ostringstream m;
+    m << "floe " << first / kStateColumns << ": " << kStateColumnNames[first % kStateColumns]
+      << " is not finite after the step from t = " << ctx.t << " s with dt = " << ctx.dt << " s";
+    throw RunError(m.str());
   }
+  if (floe_sea_)
+    step_budget_.external += Vec2{ctx.momenta[StepContext::kAfterSeaKick].value(),
+                                  ctx.momenta[StepContext::kAfterSeaKick + 1].value()} -
+                             Vec2{ctx.momenta[StepContext::kBeforeSeaKick].value(),
+                                  ctx.momenta[StepContext::kBeforeSeaKick + 1].value()};
+  budget_.external += step_budget_.external;
+  budget_.collisions += step_budget_.collisions;
 }
 
 Energies Simulation::energies() const {
+  // The floes' horizontal kinetic energy: each floe's term, then their
+  // exact sum by owner, combined over the ranks (one call; the same bits on
+  // any number of ranks).
   const Floes& f = scenario_.floes;
-  double horizontal = 0.0;
-  for (std::size_t i = 0; i < f.size(); ++i) {
-    if (f.is_static[i]) continue;
+  std::array<ExactSum, 1> horizontal;
+  for_owned([&](std::size_t i) {
+    if (f.is_static[i]) return;
     const FloeState& s = f.state[i];
-    horizontal += 0.5 * f.mass[i] * (s.vx * s.vx + s.vy * s.vy) + 0.5 * f.inertia_z[i] * s.yaw_rate * s.yaw_rate;
-  }
-  Energies e{{"floes_horizontal_kinetic"}, {horizontal}};
+    horizontal[0].add(0.5 * f.mass[i] * (s.vx * s.vx + s.vy * s.vy) + 0.5 * f.inertia_z[i] * s.yaw_rate * s.yaw_rate);
+  });
+  comm_.sum(horizontal);
+  Energies e{{"floes_horizontal_kinetic"}, {horizontal[0].value()}};
   if (floe_sea_) {
     e.names.insert(e.names.end(), {"floes_vertical_kinetic", "floes_weight", "penalty"});
     e.values.insert(e.values.end(), {floe_sea_->floes_vertical_kinetic(f), floe_sea_->floes_weight_energy(f),

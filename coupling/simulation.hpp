@@ -20,7 +20,8 @@
 //   -> percussion (fracture checks on every collision impulse of the step,
 //      collide's and the sub-steps', coupling/percussion.hpp; a split floe
 //      becomes two, which start the next step)
-//   -> check state
+//   -> check state and close the step's momentum budget (the whole-pack sums
+//      are by owner and exact: docs/parallel.md, "Exact sums")
 //
 // The kicks and flows are the Strang splitting of the floe–sea Hamiltonian
 // (second order, energy conserving for the strong law without drag); drag
@@ -56,6 +57,7 @@
 #include "contact/shapes.hpp"
 #include "contact/substep.hpp"
 #include "core/checkpoint.hpp"
+#include "core/exact_sum.hpp"
 #include "core/run_file.hpp"
 #include "coupling/scenario.hpp"
 #include "parallel/comm.hpp"
@@ -88,7 +90,16 @@ struct StepContext {
   double dt = 0.0;     // s
   ForcingSample forcing;
   std::vector<FloeState> start;  // the floes at t, to redo a rejected step
-  Vec2 momentum = Vec2::Zero();   // of the dynamic floes, updated by the phases that change it
+  // The dynamic floes' momentum (x, y; kg m/s) at the try's start (before
+  // the first half kick), after the drift, after the collisions and after
+  // the advance, then before and after the sea's second half kick, as exact
+  // sums (core/exact_sum.hpp): this rank's part, of the floes it owns, until
+  // a call the step makes anyway combines them over the ranks (the try's
+  // four: detection's reach, Simulation::set_reach; the kick's two: the
+  // state check, Simulation::close_step); the step's budget is read then.
+  std::array<ExactSum, 12> momenta;
+  static constexpr std::size_t kAtStart = 0, kAfterDrift = 2, kAfterCollide = 4, kAfterAdvance = 6,
+                               kTry = 8, kBeforeSeaKick = 8, kAfterSeaKick = 10;
 };
 
 // Energies by part (J), named as the columns of /diagnostics/energy; the last
@@ -142,7 +153,11 @@ public:
     Vec2 collisions = Vec2::Zero();
   };
   const MomentumBudget& momentum_budget() const { return budget_; }
-  Vec2 momentum() const;  // of the dynamic floes now
+  // Of the dynamic floes now: each rank sums the floes it owns exactly and
+  // the ranks combine (collective: every rank calls it). The same bits on
+  // any number of ranks (docs/parallel.md, "Exact sums"); so are
+  // energies() and the budget.
+  Vec2 momentum() const;
   LcpCounters lcp_counters() const;
   const contact::Detection& detection() const { return detection_; }
   // The floes' owners by place for the drift and detection (one rank: all 0).
@@ -175,19 +190,31 @@ private:
   StepContext choose_dt(double t_stop);
   void sample_forcing(StepContext& ctx) const;
   void sea_flow(const StepContext& ctx);
-  void floes_half_kick(const StepContext& ctx);
-  void sea_half_kick(const StepContext& ctx);
+  void floes_half_kick(StepContext& ctx);
+  void sea_half_kick(StepContext& ctx);
   void drift(StepContext& ctx);
   void follow_slabs();  // the sea and the coupling take the owners' moved slabs
   void collide(StepContext& ctx);
   void note_collisions();
   void percussion(const StepContext& ctx);
   void on_floes_changed();  // rebuilds every per-floe structure (after a split)
-  void advance(const StepContext& ctx);
+  void advance(StepContext& ctx);
   bool detect_and_check(StepContext& ctx);  // false: the step overlapped, dt halved
   void wrap_periodic();
-  void set_reach();  // detection reach of each floe for the next step
-  void check_state(const StepContext& ctx) const;
+  // Detection reach of each floe for the next step. Collective: the pack's
+  // rms speed is summed by owner; `along` (exact sums of this rank's part)
+  // are combined over the ranks in the same call.
+  void set_reach(std::span<ExactSum> along = {});
+  void read_try_budget(const StepContext& ctx);  // the try's momenta, combined, into step_budget_
+  // The state check (the ranks agree on the first non-finite value) and the
+  // step's momentum budget (the sea kick's momenta combined): one call.
+  void close_step(StepContext& ctx);
+  // The floes whose terms this rank adds to the whole-pack sums: its floes
+  // by place, or (before they are placed, after a split) its share by index.
+  template <class F>
+  void for_owned(F&& f) const;
+  // Adds this rank's part of the dynamic floes' momentum to `into` (x, y).
+  void add_owned_momentum(std::span<ExactSum, 2> into) const;
 
   Scenario scenario_;
   parallel::Communicator comm_;
@@ -197,7 +224,6 @@ private:
   // without wave generation (its velocity is 0).
   std::unique_ptr<IncidentSea> incident_;
   double equal_dt_ = -1.0;            // the last of the equal steps the penalty limit asked for
-  Vec2 ctx_momentum_before_ = Vec2::Zero();  // of the floes at the start of the step's try
   DriftParams drift_params_;
   FootprintQuadrature quadrature_;
   Moorings moorings_;  // [[floes.floe]] mooring_period

@@ -251,6 +251,46 @@ long long Communicator::sum(long long value) const {
 #endif
 }
 
+long long Communicator::min(long long value) const {
+  if (serial() || !impl_) return value;
+#ifdef FLOESIM_HAVE_MPI
+  Counted counted(impl_->traffic, static_cast<long long>(sizeof(long long)) * size_);
+  long long least = 0;
+  check(MPI_Allreduce(&value, &least, 1, MPI_LONG_LONG, MPI_MIN, impl_->comm), "MPI_Allreduce");
+  return least;
+#else
+  return value;
+#endif
+}
+
+void Communicator::sum(std::span<ExactSum> sums, std::span<long long> counts) const {
+  if (serial() || !impl_) return;
+#ifdef FLOESIM_HAVE_MPI
+  // Normalised limbs are below 2^32 (the top one and the counters hold
+  // small integers): an int64 sum over fewer than 2^30 ranks cannot
+  // overflow, and integer addition gives the same words in any order.
+  constexpr std::size_t w = ExactSum::kWords;
+  std::vector<std::int64_t> words(sums.size() * w + counts.size());
+  for (std::size_t j = 0; j < sums.size(); ++j) {
+    const std::span<const std::int64_t> limbs = sums[j].limbs();
+    std::copy(limbs.begin(), limbs.end(), words.begin() + static_cast<std::ptrdiff_t>(j * w));
+  }
+  std::copy(counts.begin(), counts.end(), words.begin() + static_cast<std::ptrdiff_t>(sums.size() * w));
+  if (words.size() > static_cast<std::size_t>(INT_MAX)) throw RunError("MPI: too many exact sums in one call");
+  {
+    Counted counted(impl_->traffic, static_cast<long long>(words.size() * sizeof(std::int64_t)) * size_);
+    check(MPI_Allreduce(MPI_IN_PLACE, words.data(), static_cast<int>(words.size()), MPI_INT64_T, MPI_SUM, impl_->comm),
+          "MPI_Allreduce");
+  }
+  for (std::size_t j = 0; j < sums.size(); ++j)
+    sums[j] = ExactSum::from_limbs(std::span<const std::int64_t>(words.data() + j * w, w));
+  std::copy(words.begin() + static_cast<std::ptrdiff_t>(sums.size() * w), words.end(), counts.begin());
+#else
+  (void)sums;
+  (void)counts;
+#endif
+}
+
 std::vector<std::byte> Communicator::broadcast(std::span<const std::byte> bytes, int root) const {
   if (serial() || !impl_) return {bytes.begin(), bytes.end()};
 #ifdef FLOESIM_HAVE_MPI

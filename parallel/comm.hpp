@@ -10,7 +10,8 @@
 // where a count is an argument. The results do not depend on
 // the number of ranks: gathers concatenate the ranks' parts in rank order, so
 // a list split in contiguous shares (share()) comes back in its serial order,
-// and reductions here are only of integers (exact in any order).
+// and reductions here are only of integers (exact in any order): a sum of
+// doubles goes through ExactSum's integer limbs (core/exact_sum.hpp).
 //
 // Errors: a failure on one rank must stop every rank with the same message
 // and exit code. together() runs a piece of work on every rank and then
@@ -29,6 +30,8 @@
 #include <string>
 #include <type_traits>
 #include <vector>
+
+#include "core/exact_sum.hpp"
 
 namespace floesim::parallel {
 
@@ -162,6 +165,15 @@ public:
 
   // The sum of one integer over the ranks (in rank order; exact).
   long long sum(long long value) const;
+  // The least of one integer over the ranks.
+  long long min(long long value) const;
+  // Exact sums over the ranks: on exit each of `sums` holds the sum of every
+  // rank's terms (its own and the others' accumulators merged), and each of
+  // `counts` the sum of every rank's; the same on every rank, and the same
+  // bits whatever the number of ranks and whichever rank added which term.
+  // One collective call: an integer sum of the accumulators' limbs
+  // (ExactSum::limbs(), 70 int64s each) and the counts.
+  void sum(std::span<ExactSum> sums, std::span<long long> counts = {}) const;
   // True on every rank when it is true on any.
   bool any(bool value) const { return sum(value ? 1 : 0) > 0; }
   // The same bytes on every rank as on `root`.
