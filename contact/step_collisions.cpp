@@ -84,8 +84,8 @@ std::vector<Candidate> candidate_witnesses(const Detection& detection, const std
   }
   return out;
 }
-// visit(pair, witness, index) for the candidates not taken since (the
-// pair's index in c.pair of the candidate `visit` may read: `last`).
+// visit(pair, witness, index) for the candidates not taken since; `last`
+// (if not null) holds the pair's index in the detection while visit runs.
 template <class Visit>
 void each_candidate(const Detection& detection, const std::vector<Candidate>& candidates,
                     const std::vector<std::uint8_t>& taken, Visit&& visit, std::uint32_t* last = nullptr) {
