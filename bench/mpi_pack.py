@@ -17,9 +17,14 @@ in the lower half of the periodic box only (open water above): the case for
 the load balance by measured cost (stage six of docs/parallel.md); the rows
 give rank 0's strip cuts, the floes in each strip at the end and each rank's
 by-place seconds over the last balance window (parallel.strip_* keys).
+--percussion adds percussion fracture (splits on, strength 0.2 MPa) and
+[run] record_collisions: a run that keeps the impulse record (stage seven:
+its collisions by owner, the record merged in the serial order);
+--record-collisions adds record_collisions alone (the record without the
+fracture check, which runs whole on every rank).
 
 usage: bench/mpi_pack.py [--build build [build2 ...]] [--floes 10000] [--t-end 1000] [--ranks 0 1 2]
-                         [--rounds 3] [--half] [--csv FILE | -] [--note TEXT]
+                         [--rounds 3] [--half] [--percussion | --record-collisions] [--csv FILE | -] [--note TEXT]
 """
 import argparse
 import os
@@ -39,6 +44,8 @@ ap.add_argument("--ranks", type=int, nargs="+", default=[0, 1, 2])
 ap.add_argument("--rounds", type=int, default=3)
 ap.add_argument("--csv", default="-")
 ap.add_argument("--half", action="store_true", help="floes in the lower half of the box only")
+ap.add_argument("--percussion", action="store_true", help="percussion fracture and record_collisions on")
+ap.add_argument("--record-collisions", action="store_true", help="record_collisions on (no fracture)")
 ap.add_argument("--note", default="")
 args = ap.parse_args()
 
@@ -47,7 +54,14 @@ floesims = [os.path.join(b, "bin", "floesim") for b in builds]
 work = tempfile.mkdtemp(prefix="floesim_mpi_bench_")
 config = moving_pack.write(floesims[0], work, args.floes, args.t_end, seed=1, output_interval=args.t_end,
                            half=args.half)
-phases = ["drift", "collide", "advance", "detect", "record", "choose_dt", "check"]
+if args.percussion or args.record_collisions:
+    with open(config) as f:
+        text = f.read()
+    with open(config, "w") as f:  # as tests/parallel/check_record_ranks.py
+        f.write(text.replace("[run]\n", "[run]\nrecord_collisions = true\n", 1) +
+                ('\n[fracture]\nenabled = true\ncriterion = "stress"\nstrength = 0.2e6\nsplit = true\n'
+                 'mesh_size = 20.0\nmin_fragment_area = 400.0\n' if args.percussion else ""))
+phases = ["drift", "collide", "advance", "detect", "record", "choose_dt", "check"] + (["percussion"] if args.percussion else [])
 strips = ["strip_cuts", "strip_floes", "strip_seconds", "strip_seconds_total", "advance_steps", "advance_fallbacks",
           "advance_whole",
           "advance_clusters", "collide_steps", "collide_fallbacks", "collide_whole", "collide_groups"]
@@ -65,6 +79,8 @@ for r in range(args.rounds):
 ranks_bench.write_table(
     args.csv, f"bench/mpi_pack.py {' '.join(sys.argv[1:])}", args.note,
     f"{args.floes} floes, 50 % cover{' in the lower half of the box' if args.half else ''}, periodic, "
+    f"{'percussion fracture and record_collisions on, ' if args.percussion else ''}"
+    f"{'record_collisions on, ' if args.record_collisions else ''}"
     f"to {args.t_end} s; ranks 0 = serial binary without mpirun; "
     "one thread per rank; wall_s = the run loop (summary wall_time); bytes_received and collective_s: "
     "rank 0's collectives over the run (the transfers and the waits for the other ranks); cpu_s: CPU time "

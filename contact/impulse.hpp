@@ -92,6 +92,7 @@
 // (static floe) does not join components since it transmits no impulse.
 
 #include <array>
+#include <compare>
 #include <cstdint>
 #include <span>
 #include <string>
@@ -187,6 +188,47 @@ struct ImpulseRecord {
     events = 0;
   }
 };
+
+// A share's part of the impulse record (a distributed run's, docs/parallel.md
+// stage seven): the loads a share of the collision work recorded, and where
+// they go in the record the whole (serial) call would have made, so that
+// merging the parts of every share gives that record exactly: the same loads
+// in the same order, the same event numbers and event count.
+//  * The collisions at the step's start (resolve_step_collisions) are one
+//    event; its loads follow the contacts of the call's list, in which a
+//    share's contacts keep their relative order (its step groups' contacts,
+//    each list in the order the whole call builds it). A contact's place
+//    there is `ContactPlace`: the segment of the list (0: detected contacts, by
+//    their index in the detection; 1: a jam's speculative points; 2, 3: the
+//    speculative contacts of rounds 1 and 2; those by pair, then witness).
+//  * The advance (advance_with_collisions) numbers one event per solve, in
+//    the order of its queue's pops, keyed (tau, cluster) (substep.hpp); all
+//    the solves of one pop are one cluster's, so one share's. A share's
+//    event's place is `EventPlace`: its pop's key. Events whose loads a jam's
+//    time step dropped (it solves again) still count, as in the serial record.
+struct ContactPlace {
+  std::uint32_t segment = 0, first = 0, second = 0;
+  auto operator<=>(const ContactPlace&) const = default;
+};
+struct EventPlace {
+  double tau = 0.0;  // s into the step
+  std::int64_t cluster = 0;
+  auto operator<=>(const EventPlace&) const = default;
+};
+struct RecordPart {
+  ImpulseRecord record;              // the share's loads, its events numbered from 0
+  std::vector<ContactPlace> places;  // step's start: per load, its contact's place
+  std::vector<EventPlace> events;    // advance: per event of `record`, its place
+};
+// Appends the step-start collisions' record of the shares' `parts` to `into`
+// as the whole call would have: one event (numbered into.events) whose loads
+// are ordered by their contacts' places (a contact's two loads, a then b,
+// stay together: one share made both).
+void merge_step_record(ImpulseRecord& into, std::span<const RecordPart* const> parts);
+// Appends the advance's record of the shares' `parts` to `into`: the events
+// of every part ordered by place (each place is one share's: ties keep the
+// share's own order), numbered on from into.events, with their loads.
+void merge_advance_record(ImpulseRecord& into, std::span<const RecordPart* const> parts);
 
 // Appends to `record` the nonzero impulses of `contacts` (one per contact, at
 // the floes' present poses) as one event: -J on a, J on b (b's point shifted
@@ -371,14 +413,16 @@ struct ClusterShare {
 // entry): a solve that would have used the warm store (options.warm: kept
 // across steps by pair, the shares' stores would part; the share is given an
 // empty store that counts uses), a failed LCP (its dump, not written by a
-// share, is numbered by the run's failures), a RunError. options.record
-// must be null: its events are numbered in the whole call's order.
+// share, is numbered by the run's failures), a RunError. options.record (if
+// any) receives the share's loads as one event, and `places` their places
+// in the whole call's record (RecordPart, merge_step_record).
 struct StepCollisionShare {
   enum class Conflict { none, warm_start, failed_lcp, error };
   Conflict conflict = Conflict::none;
   std::vector<std::uint32_t> moved;  // ascending: the floes whose velocities the share changed
   long groups = 0;                   // step groups of the share
   std::size_t speculative = 0;       // speculative contacts that took part (resolve_step_collisions' count)
+  std::vector<ContactPlace> places;  // per load the share recorded (options.record): its contact's place
 };
 StepCollisionShare resolve_step_collisions_share(Floes& floes, std::span<const FloeState> start,
                                                  const Detection& detection, double step,

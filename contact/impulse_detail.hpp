@@ -5,8 +5,10 @@
 #include <cstdint>
 #include <span>
 #include <unordered_map>
+#include <vector>
 
 #include "contact/detection.hpp"
+#include "contact/impulse.hpp"
 #include "contact/jam.hpp"
 
 namespace floesim::contact::detail {
@@ -28,6 +30,13 @@ struct Components {
   std::uint32_t find(std::uint32_t i) { return sets.find(i); }
   void join(std::uint32_t a, std::uint32_t b) { sets.join(a, b); }
 };
+
+// record_impulses (impulse.hpp), and for each load it appends the index of
+// its contact in `contacts` into `contact_of` (a share's record: the loads'
+// places follow their contacts').
+void record_impulses(ImpulseRecord& record, const Floes& floes, std::span<const ContactPoint> contacts,
+                     std::span<const ContactImpulse> impulses, std::span<const std::uint8_t> sustained,
+                     std::vector<std::uint32_t>* contact_of);
 
 // Velocity of floe f's point p (world, in f's own image).
 inline Vec2 point_velocity(const FloeState& s, const Vec2& p) { return arm_velocity(s, p - Vec2{s.x, s.y}); }

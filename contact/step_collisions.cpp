@@ -4,7 +4,6 @@
 #include <cstdint>
 #include <limits>
 #include <span>
-#include <stdexcept>
 #include <utility>
 #include <vector>
 
@@ -85,12 +84,16 @@ std::vector<Candidate> candidate_witnesses(const Detection& detection, const std
   }
   return out;
 }
-// visit(pair, witness, index) for the candidates not taken since.
+// visit(pair, witness, index) for the candidates not taken since; `last`
+// (if not null) holds the pair's index in the detection while visit runs.
 template <class Visit>
 void each_candidate(const Detection& detection, const std::vector<Candidate>& candidates,
-                    const std::vector<std::uint8_t>& taken, Visit&& visit) {
+                    const std::vector<std::uint8_t>& taken, Visit&& visit, std::uint32_t* last = nullptr) {
   for (const Candidate& c : candidates)
-    if (!taken[c.witness]) visit(detection.pairs[c.pair], detection.witnesses[c.witness], c.witness);
+    if (!taken[c.witness]) {
+      if (last) *last = c.pair;
+      visit(detection.pairs[c.pair], detection.witnesses[c.witness], c.witness);
+    }
 }
 
 // Per floe, 1 if it is in a step group (resolve_step_collisions_share,
@@ -144,11 +147,12 @@ std::vector<std::uint8_t> share_floes(const Floes& floes, std::span<const FloeSt
 // resolve_step_collisions (impulse.hpp), of the whole step or, with `share`,
 // of the share's step groups: the same rounds on the share's contacts and
 // witnesses. With a share, `moved` receives the floes whose velocities it
-// changed (ascending) and `groups` the share's group count.
+// changed (ascending), `groups` the share's group count and `places` the
+// places of the loads it recorded (options.record) in the whole call's list.
 std::size_t step_collisions(Floes& floes, std::span<const FloeState> start, const Detection& detection, double step,
                             const ImpulseOptions& options, CollisionStats& stats,
                             std::vector<ContactImpulse>* impulses, const ClusterShare* share,
-                            std::vector<std::uint32_t>* moved, long* groups) {
+                            std::vector<std::uint32_t>* moved, long* groups, std::vector<ContactPlace>* places) {
   const double xi = options.collision_distance;
   ImpulseOptions opt = options;
   opt.speculative_step = step;
@@ -164,17 +168,23 @@ std::size_t step_collisions(Floes& floes, std::span<const FloeState> start, cons
   // jam.at_step_start) and where each came from in detection.contacts.
   std::vector<ContactPoint> contacts;
   std::vector<std::size_t> from;
+  // With a share's record: each contact's place in the whole call's list
+  // (ContactPlace, impulse.hpp), which the share's list keeps in order.
+  const bool placed = places && record;
+  std::vector<ContactPlace> place;
   for (std::size_t k = 0; k < detection.contacts.size(); ++k) {
     const ContactPoint& c = detection.contacts[k];
     if (!opt.jam.at_step_start && jammed(c.a, c.b)) continue;
     contacts.push_back(c);
     from.push_back(k);
+    if (placed) place.push_back({0, static_cast<std::uint32_t>(k), 0});
   }
   std::size_t detected = contacts.size();
   // In a jam every point beyond xi is speculative from the start (or left,
   // with the jam's contacts, to its time step).
   std::vector<std::uint8_t> taken(detection.witnesses.size(), 0);
-  for (const NearPair& p : detection.pairs) {
+  for (std::uint32_t i = 0; i < detection.pairs.size(); ++i) {
+    const NearPair& p = detection.pairs[i];
     if (p.overlap || !jammed(p.a, p.b)) continue;
     for (std::uint32_t k = p.first_witness; k < p.first_witness + p.witness_count; ++k) {
       const Witness& w = detection.witnesses[k];
@@ -182,6 +192,7 @@ std::size_t step_collisions(Floes& floes, std::span<const FloeState> start, cons
       taken[k] = 1;
       if (!opt.jam.at_step_start) continue;
       contacts.push_back({p.a, p.b, 0.5 * (w.pa + w.pb), w.normal, w.distance, p.shift, true, w.vertex_of_b});
+      if (placed) place.push_back({1, i, k});
     }
   }
   std::vector<Candidate> candidates = candidate_witnesses(detection, taken, xi);
@@ -201,9 +212,11 @@ std::size_t step_collisions(Floes& floes, std::span<const FloeState> start, cons
     for (std::size_t k = 0; k < contacts.size(); ++k) {
       if (!kept(contacts[k].a, contacts[k].b)) continue;
       if (k < detected) from[kept_detected++] = from[k];
+      if (placed) place[to] = place[k];
       contacts[to++] = contacts[k];
     }
     contacts.resize(to);
+    if (placed) place.resize(to);
     from.resize(kept_detected);
     detected = kept_detected;
   }
@@ -227,13 +240,15 @@ std::size_t step_collisions(Floes& floes, std::span<const FloeState> start, cons
   for (int round = 1; round <= 2; ++round) {
     // Pushed points beyond xi that would now close below xi/2 within the step.
     const std::size_t first_new = contacts.size();
+    std::uint32_t pair = 0;
     each_candidate(detection, candidates, taken, [&](const NearPair& p, const Witness& w, std::uint32_t k) {
       if (!kept(p.a, p.b) || !becomes_speculative(floes, start, before, p, w, step, xi, opt.rest_speed)) return;
       taken[k] = 1;
       contacts.push_back({p.a, p.b, 0.5 * (w.pa + w.pb), w.normal, w.distance, p.shift, true, w.vertex_of_b});
+      if (placed) place.push_back({static_cast<std::uint32_t>(1 + round), pair, k});
       resting.push_back(1);
       ++added;
-    });
+    }, &pair);
     if (contacts.size() == first_new) break;
     // The components (over all contacts) that gained speculative contacts are
     // solved again from W^-; the others keep their solution.
@@ -266,7 +281,13 @@ std::size_t step_collisions(Floes& floes, std::span<const FloeState> start, cons
   }
   // Sustained or impact by the approach at the start of the step, before the
   // step's smooth forces: a physical speed, not one the step's length made.
-  if (record) record_impulses(*record, floes, contacts, total, slow_contacts(floes, contacts, opt.rest_speed, start));
+  if (record) {
+    std::vector<std::uint32_t> contact_of;
+    detail::record_impulses(*record, floes, contacts, total, slow_contacts(floes, contacts, opt.rest_speed, start),
+                            placed ? &contact_of : nullptr);
+    if (placed)
+      for (const std::uint32_t j : contact_of) places->push_back(place[j]);
+  }
   if (impulses) {
     impulses->assign(detection.contacts.size(), ContactImpulse{});
     for (std::size_t j = 0; j < detected; ++j) (*impulses)[from[j]] = total[j];
@@ -289,14 +310,13 @@ std::size_t step_collisions(Floes& floes, std::span<const FloeState> start, cons
 std::size_t resolve_step_collisions(Floes& floes, std::span<const FloeState> start, const Detection& detection,
                                     double step, const ImpulseOptions& options, CollisionStats& stats,
                                     std::vector<ContactImpulse>* impulses) {
-  return step_collisions(floes, start, detection, step, options, stats, impulses, nullptr, nullptr, nullptr);
+  return step_collisions(floes, start, detection, step, options, stats, impulses, nullptr, nullptr, nullptr, nullptr);
 }
 
 StepCollisionShare resolve_step_collisions_share(Floes& floes, std::span<const FloeState> start,
                                                  const Detection& detection, double step,
                                                  const ImpulseOptions& options, const ClusterShare& share,
                                                  CollisionStats& stats) {
-  if (options.record) throw std::logic_error("resolve_step_collisions_share: the impulse record needs the whole order");
   // The warm store is replaced by an empty probe that only says whether a
   // solve would have used it; a failure's dump is left to the whole solve.
   ImpulseOptions o = options;
@@ -306,8 +326,8 @@ StepCollisionShare resolve_step_collisions_share(Floes& floes, std::span<const F
   const long failures = stats.failures;
   StepCollisionShare outcome;
   try {
-    outcome.speculative =
-        step_collisions(floes, start, detection, step, o, stats, nullptr, &share, &outcome.moved, &outcome.groups);
+    outcome.speculative = step_collisions(floes, start, detection, step, o, stats, nullptr, &share, &outcome.moved,
+                                          &outcome.groups, &outcome.places);
   } catch (const RunError&) {
     outcome.conflict = StepCollisionShare::Conflict::error;
   }

@@ -7,7 +7,6 @@
 #include <numeric>
 #include <queue>
 #include <sstream>
-#include <stdexcept>
 
 #include "contact/step_limit.hpp"
 #include "contact/substep_stepper.hpp"
@@ -103,7 +102,11 @@ void Stepper::advance(std::span<const PairRoom> tight) {
     queue.pop();
     Cluster& c = clusters_[static_cast<std::size_t>(k)];
     if (!c.alive || tau != c.tau || !(c.tau < dt_)) continue;
+    // A share's solves of this pop get its key (RecordPart, impulse.hpp).
+    ImpulseRecord* const record = opt_.impulse.record;
+    const std::uint32_t events = record ? record->events : 0;
     advance_cluster(k);
+    if (share_ && record) events_.insert(events_.end(), record->events - events, EventPlace{tau, k});
     if (conflict_ != ShareOutcome::Conflict::none) return;
     if (c.alive && c.tau < dt_) queue.push({c.tau, k});
   }
@@ -430,7 +433,6 @@ void advance_with_collisions(Floes& floes, const CollisionShapes& shapes, const 
 ShareAdvance::ShareAdvance(Floes& floes, const CollisionShapes& shapes, const Detection& detection, double dt,
                            const SubstepOptions& options, const ClusterShare& share)
     : options_(options), share_(share) {
-  if (options.impulse.record) throw std::logic_error("ShareAdvance: the impulse record needs the serial order");
   // The warm store is replaced by an empty probe that only says whether a
   // solve of the share would have used it (ClusterShare above). A failure's
   // dump is left to the whole advance that follows it, which numbers it in

@@ -124,6 +124,9 @@ void advance_with_collisions(Floes& floes, const CollisionShapes& shapes, const 
 // clusters in between change nothing the share reads. Collision counters
 // are sums (largest: a maximum); the last floor pair of the serial advance
 // is the one with the largest (tau, cluster) key, which each share reports.
+// So are the impulse record's events: the serial advance numbers its solves
+// in pop order, and a share's solves of one pop get that pop's key, which
+// no other share's pop has (merge_advance_record, impulse.hpp).
 // The warm store (ImpulseOptions::warm) is shared across steps by pair, so
 // a share that would use it is a conflict too (the stores of the ranks
 // would part); so is a failed LCP (its dump is numbered in the run) and a
@@ -167,6 +170,9 @@ struct ShareOutcome {
   long floor_cluster = -1;
   long rooms = 0;  // pair rooms the share computed (its own pairs', and those it read besides)
   long pairs = 0;  // pairs in the step's list (the serial advance computes every one's room)
+  // Per event the share recorded (options.impulse.record), the key (tau,
+  // cluster) of the queue's pop it was solved in (RecordPart, impulse.hpp).
+  std::vector<EventPlace> events;
 };
 
 // The first half's answer: the share's tight pairs (room below xi), by
@@ -183,8 +189,9 @@ struct ShareRooms {
 // advance() moves the free floes (all of them, linearly) and the clusters of
 // `share` only; stats() and report() get this share's counts (report.rebuilt,
 // the pair list's rebuild, is counted on every share: it is not the share's
-// own). The impulse record (options.impulse.record) must be null: its events'
-// order is the serial queue's, not a share's.
+// own). The impulse record (options.impulse.record, if any) receives the
+// share's events, and ShareOutcome::events their places in the serial
+// queue's order (merge_advance_record, impulse.hpp).
 class ShareAdvance {
 public:
   ShareAdvance(Floes& floes, const CollisionShapes& shapes, const Detection& detection, double dt,

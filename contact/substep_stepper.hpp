@@ -66,6 +66,7 @@ public:
     o.floor_cluster = floor_cluster_;
     o.rooms = rooms_;
     o.pairs = static_cast<long>(det_->pairs.size());
+    o.events = events_;
     for (std::size_t k = 0; k < clusters_.size(); ++k) {
       if (!own_[k]) continue;
       ++o.clusters;
@@ -224,6 +225,7 @@ private:
   const ClusterShare* share_;          // null: every cluster (the serial advance)
   std::vector<std::uint8_t> own_;      // per cluster: run by this call
   ShareOutcome::Conflict conflict_ = ShareOutcome::Conflict::none;
+  std::vector<EventPlace> events_;     // a share's: per event it recorded, its pop's key
   double floor_tau_ = -1.0;            // the last floor step's key (tau, cluster)
   long floor_cluster_ = -1;
 

@@ -278,10 +278,10 @@ void Simulation::collide(StepContext& ctx) {
   // step are held by speculative contacts (contact/impulse.hpp).
   if (impulse_options_.record) impulse_options_.record->clear();  // this try's impulses (a redone step starts again)
   // On several ranks each rank solves the step groups it owns and the ranks
-  // exchange the velocities they changed (stage seven,
-  // parallel/collide_share.hpp); a run that keeps the impulse record solves
-  // whole on every rank, as advance() does.
-  if (comm_.serial() || impulse_options_.record)
+  // exchange the velocities they changed and the impulses they recorded,
+  // which every rank merges into the serial record (stage seven,
+  // parallel/collide_share.hpp).
+  if (comm_.serial())
     contact::resolve_step_collisions(scenario_.floes, ctx.start, detection_, ctx.dt, impulse_options_, stats_);
   else
     parallel::collide_by_owner(comm_, owners_.owner(), scenario_.floes, ctx.start, detection_, ctx.dt,
@@ -363,10 +363,10 @@ void Simulation::advance(StepContext& ctx) {
   o.domain = detection_options_.domain;
   o.impulse = impulse_options_;
   // On several ranks each rank advances the clusters it owns and the ranks
-  // exchange what moved (stage seven, parallel/advance_share.hpp); the
-  // impulse record's events are in the serial queue's order, so a run that
-  // records them (percussion, collision events) advances whole on every rank.
-  if (comm_.serial() || impulse_options_.record)
+  // exchange what moved and the impulses they recorded, which every rank
+  // merges into the serial record, events in the serial queue's order
+  // (stage seven, parallel/advance_share.hpp).
+  if (comm_.serial())
     contact::advance_with_collisions(scenario_.floes, shapes_, detection_, ctx.dt, o, stats_, substeps_);
   else
     parallel::advance_by_owner(comm_, owners_.owner(), scenario_.floes, shapes_, detection_, ctx.dt, o, stats_,

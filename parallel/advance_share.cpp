@@ -22,11 +22,52 @@ constexpr std::size_t kReport = std::tuple_size_v<decltype(contact::substep_coun
 
 // The header's longs: conflict, moved, clusters, floor_cluster, the floor
 // pair's length, the states' count (the moved floes' when the share had no
-// conflict, else none), rooms, pairs, the stats, the report; then floor_tau,
-// the moved floes, their states and the floor pair's text.
-constexpr std::size_t kHeader = 8 + kStats + kReport;
+// conflict, else none), rooms, pairs, the event places' count, the stats,
+// the report; then floor_tau, the moved floes, their states, the floor
+// pair's text, the event places (tau, cluster) and the record.
+constexpr std::size_t kHeader = 9 + kStats + kReport;
+
+// A load in a message: floe, event, other, sustained (4 uint32), then
+// point, impulse, world (2 doubles each) and normal.
+constexpr std::size_t kLoadInts = 4, kLoadDoubles = 7;
+constexpr std::size_t kLoadBytes = kLoadInts * sizeof(std::uint32_t) + kLoadDoubles * sizeof(double);
 
 }  // namespace
+
+void append_record(std::vector<std::byte>& out, const contact::ImpulseRecord& record) {
+  const std::array<std::uint32_t, 2> head{static_cast<std::uint32_t>(record.loads.size()), record.events};
+  append(out, std::span<const std::uint32_t>(head));
+  const std::size_t from = out.size();
+  out.resize(from + record.loads.size() * kLoadBytes);
+  std::byte* at = out.data() + from;
+  for (const contact::ImpulseRecord::Load& l : record.loads) {
+    const std::array<std::uint32_t, kLoadInts> ints{l.floe, l.event, l.other, l.sustained ? 1u : 0u};
+    const std::array<double, kLoadDoubles> doubles{l.point.x(), l.point.y(), l.impulse.x(), l.impulse.y(),
+                                                   l.world.x(), l.world.y(), l.normal};
+    at = put(at, ints.data(), ints.size());
+    at = put(at, doubles.data(), doubles.size());
+  }
+}
+
+contact::ImpulseRecord take_record(const std::byte*& in) {
+  contact::ImpulseRecord record;
+  const std::vector<std::uint32_t> head = take<std::uint32_t>(in, 2);
+  record.events = head[1];
+  record.loads.resize(head[0]);
+  for (contact::ImpulseRecord::Load& l : record.loads) {
+    const std::vector<std::uint32_t> ints = take<std::uint32_t>(in, kLoadInts);
+    const std::vector<double> d = take<double>(in, kLoadDoubles);
+    l.floe = ints[0];
+    l.event = ints[1];
+    l.other = ints[2];
+    l.sustained = ints[3] != 0;
+    l.point = {d[0], d[1]};
+    l.impulse = {d[2], d[3]};
+    l.world = {d[4], d[5]};
+    l.normal = d[6];
+  }
+  return record;
+}
 
 std::vector<std::byte> pack(const AdvancePart& p) {
   std::array<long, kHeader> head{};
@@ -38,7 +79,8 @@ std::vector<std::byte> pack(const AdvancePart& p) {
   head[5] = static_cast<long>(p.states.size());
   head[6] = p.outcome.rooms;
   head[7] = p.outcome.pairs;
-  std::size_t k = 8;
+  head[8] = static_cast<long>(p.outcome.events.size());
+  std::size_t k = 9;
   for (const auto& [name, f] : contact::collision_counts(p.stats)) head[k++] = *f;
   for (const auto& [name, f] : contact::substep_counts(p.report)) head[k++] = *f;
   std::vector<std::byte> out(sizeof(head) + sizeof(double) + p.outcome.moved.size() * sizeof(std::uint32_t) +
@@ -48,6 +90,11 @@ std::vector<std::byte> pack(const AdvancePart& p) {
   at = put(at, p.outcome.moved.data(), p.outcome.moved.size());
   at = put(at, p.states.data(), p.states.size());
   put(at, p.report.floor_pair.data(), p.report.floor_pair.size());
+  for (const contact::EventPlace& e : p.outcome.events) {
+    append(out, std::span<const double>(&e.tau, 1));
+    append(out, std::span<const std::int64_t>(&e.cluster, 1));
+  }
+  append_record(out, p.record);
   return out;
 }
 
@@ -63,17 +110,24 @@ AdvancePart unpack_advance_part(std::span<const std::byte> bytes) {
   p.outcome.floor_cluster = head[3];
   const auto text = static_cast<std::size_t>(head[4]);
   const auto states = static_cast<std::size_t>(head[5]);
-  FLOESIM_ASSERT(bytes.size() == sizeof(head) + sizeof(double) + moved * sizeof(std::uint32_t) +
-                                     states * sizeof(FloeState) + text);
   p.outcome.rooms = head[6];
   p.outcome.pairs = head[7];
-  std::size_t k = 8;
+  const auto events = static_cast<std::size_t>(head[8]);
+  std::size_t k = 9;
   for (const auto& [name, f] : contact::collision_counts(p.stats)) *f = head[k++];
   for (const auto& [name, f] : contact::substep_counts(p.report)) *f = head[k++];
   p.outcome.floor_tau = take<double>(in, 1).front();
   p.outcome.moved = take<std::uint32_t>(in, moved);
   p.states = take<FloeState>(in, states);
   p.report.floor_pair.assign(reinterpret_cast<const char*>(in), text);
+  in += text;
+  p.outcome.events.resize(events);
+  for (contact::EventPlace& e : p.outcome.events) {
+    e.tau = take<double>(in, 1).front();
+    e.cluster = take<std::int64_t>(in, 1).front();
+  }
+  p.record = take_record(in);
+  FLOESIM_ASSERT(in == bytes.data() + bytes.size());
   return p;
 }
 
@@ -111,17 +165,23 @@ bool combine_rooms(std::span<const contact::ShareRooms> parts, std::vector<conta
   return true;
 }
 
-AdvancePart finish_share(contact::ShareAdvance& share, std::span<const contact::PairRoom> tight, const Floes& floes) {
+AdvancePart finish_share(contact::ShareAdvance& share, std::span<const contact::PairRoom> tight, const Floes& floes,
+                         contact::ImpulseRecord* record) {
   AdvancePart part;
   part.outcome = share.advance(tight);
   part.stats = share.stats();
   part.report = share.report();
-  if (part.outcome.conflict == ShareOutcome::Conflict::none)
+  if (part.outcome.conflict == ShareOutcome::Conflict::none) {
     for (const std::uint32_t i : part.outcome.moved) part.states.push_back(floes.state[i]);
+    if (record) part.record = std::move(*record);
+  } else {
+    part.outcome.events.clear();
+  }
   return part;
 }
 
-bool combine_parts(std::span<const AdvancePart> parts, Floes& floes, CollisionStats& stats, SubstepReport& report) {
+bool combine_parts(std::span<const AdvancePart> parts, Floes& floes, CollisionStats& stats, SubstepReport& report,
+                   contact::ImpulseRecord* record) {
   std::vector<std::uint8_t> taken(floes.size(), 0);
   for (const AdvancePart& p : parts) {
     if (p.outcome.conflict != ShareOutcome::Conflict::none) return false;
@@ -152,6 +212,16 @@ bool combine_parts(std::span<const AdvancePart> parts, Floes& floes, CollisionSt
   }
   if (!parts.empty()) report.rebuilt += parts.front().report.rebuilt;
   if (floor) report.floor_pair = floor->report.floor_pair;
+  if (record) {
+    std::vector<contact::RecordPart> records(parts.size());
+    std::vector<const contact::RecordPart*> each;
+    for (std::size_t r = 0; r < parts.size(); ++r) {
+      records[r].record = parts[r].record;
+      records[r].events = parts[r].outcome.events;
+      each.push_back(&records[r]);
+    }
+    contact::merge_advance_record(*record, each);
+  }
   return true;
 }
 
@@ -167,18 +237,24 @@ void advance_by_owner(const Communicator& comm, std::span<const int> owner, Floe
   const std::vector<FloeState> start = floes.state;
   bool combined = false;
   {
+    // A run that keeps the impulse record: the share records into its own
+    // (sent in its part), and every rank merges the parts in the serial order.
+    contact::ImpulseRecord* const record = options.impulse.record;
+    contact::ImpulseRecord own;
+    contact::SubstepOptions own_options = options;
+    if (record) own_options.impulse.record = &own;
     // The set-up by share, then the exchange of the tight pairs.
-    contact::ShareAdvance share(floes, shapes, detection, dt, options, {owner, comm.rank()});
+    contact::ShareAdvance share(floes, shapes, detection, dt, own_options, {owner, comm.rank()});
     const std::vector<contact::ShareRooms> rooms = comm.allgather_parts(pack(share.rooms()), unpack_share_rooms);
     std::vector<contact::PairRoom> tight;
     // Every rank sees the same gathered conflicts: all skip the second
     // exchange alike.
     if (combine_rooms(rooms, tight)) {
-      const AdvancePart mine = finish_share(share, tight, floes);
+      const AdvancePart mine = finish_share(share, tight, floes, record ? &own : nullptr);
       const std::vector<AdvancePart> parts = comm.allgather_parts(pack(mine), unpack_advance_part);
       counts.clusters.resize(parts.size(), 0);
       counts.rooms.resize(parts.size(), 0);
-      combined = combine_parts(parts, floes, stats, report);
+      combined = combine_parts(parts, floes, stats, report, record);
       if (combined) {
         for (std::size_t r = 0; r < parts.size(); ++r) {
           counts.clusters[r] += parts[r].outcome.clusters;

@@ -25,13 +25,21 @@
 namespace floesim::parallel {
 
 // One rank's part of a step's advance: what its share did, the states of the
-// floes it moved (outcome.moved's order) and its counts.
+// floes it moved (outcome.moved's order), its counts and, in a run that keeps
+// the impulse record, its record (events: outcome.events; none on a conflict).
 struct AdvancePart {
   contact::ShareOutcome outcome;
   std::vector<FloeState> states;
   contact::CollisionStats stats;
   contact::SubstepReport report;
+  contact::ImpulseRecord record;
 };
+
+// A share's impulse record in a message (the loads, field by field, then the
+// event count), appended to `out`; read back by take_record, which moves `in`
+// past it.
+void append_record(std::vector<std::byte>& out, const contact::ImpulseRecord& record);
+contact::ImpulseRecord take_record(const std::byte*& in);
 
 std::vector<std::byte> pack(const AdvancePart& part);
 AdvancePart unpack_advance_part(std::span<const std::byte> bytes);
@@ -47,15 +55,19 @@ bool combine_rooms(std::span<const contact::ShareRooms> parts, std::vector<conta
 
 // The second half of a rank's share (ShareAdvance::advance, given every
 // rank's tight pairs) and its part; `floes` (the share's floes) is left with
-// the share's states.
-AdvancePart finish_share(contact::ShareAdvance& share, std::span<const contact::PairRoom> tight, const Floes& floes);
+// the share's states. `record`: the share's impulse record (the one its
+// options point at; null: none), moved into the part.
+AdvancePart finish_share(contact::ShareAdvance& share, std::span<const contact::PairRoom> tight, const Floes& floes,
+                         contact::ImpulseRecord* record = nullptr);
 
 // Combines every rank's part (rank order) into `floes` (each rank's moved
 // floes get its states; the free floes are already at the end of the step on
-// every rank), `stats` and `report`, and returns true; or returns false,
-// changing nothing, when a part has a conflict or two parts moved one floe.
+// every rank), `stats`, `report` and `record` (if not null: the parts'
+// records merged in the serial order, contact::merge_advance_record), and
+// returns true; or returns false, changing nothing, when a part has a
+// conflict or two parts moved one floe.
 bool combine_parts(std::span<const AdvancePart> parts, Floes& floes, contact::CollisionStats& stats,
-                   contact::SubstepReport& report);
+                   contact::SubstepReport& report, contact::ImpulseRecord* record = nullptr);
 
 // A step redone whole costs the share's work and the whole advance; packs
 // where ranks' clusters keep meeting (a jam across strips, a jam whose LCP
@@ -110,8 +122,11 @@ struct AdvanceShareCounts {
 // the combination or, on a conflict, the whole advance
 // (contact::advance_with_collisions) from the states on entry. A conflict in
 // a set-up is known to every rank after the first exchange: every rank then
-// skips the second. Equal to the serial advance bit for bit, states and
-// counts.
+// skips the second. With options.impulse.record, each share records into
+// a record of its own, sent in its part, and every rank merges the parts
+// into options.impulse.record in the serial order (contact::RecordPart); on
+// a fallback the whole advance records into it. Equal to the serial advance
+// bit for bit, states, counts and record.
 void advance_by_owner(const Communicator& comm, std::span<const int> owner, Floes& floes,
                       const contact::CollisionShapes& shapes, const contact::Detection& detection, double dt,
                       const contact::SubstepOptions& options, contact::CollisionStats& stats,

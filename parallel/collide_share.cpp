@@ -18,8 +18,9 @@ constexpr std::size_t kStats = std::tuple_size_v<decltype(contact::collision_cou
 
 // The header's longs: conflict, moved, groups, speculative, the states'
 // count (the moved floes' when the share had no conflict, else none), the
-// stats; then the moved floes and their states.
-constexpr std::size_t kHeader = 5 + kStats;
+// load places' count, the stats; then the moved floes, their states, the
+// places (3 uint32 each) and the record (append_record).
+constexpr std::size_t kHeader = 6 + kStats;
 
 }  // namespace
 
@@ -30,13 +31,19 @@ std::vector<std::byte> pack(const CollidePart& p) {
   head[2] = p.outcome.groups;
   head[3] = static_cast<long>(p.outcome.speculative);
   head[4] = static_cast<long>(p.states.size());
-  std::size_t k = 5;
+  head[5] = static_cast<long>(p.outcome.places.size());
+  std::size_t k = 6;
   for (const auto& [name, f] : contact::collision_counts(p.stats)) head[k++] = *f;
   std::vector<std::byte> out(sizeof(head) + p.outcome.moved.size() * sizeof(std::uint32_t) +
                              p.states.size() * sizeof(FloeState));
   std::byte* at = put(out.data(), head.data(), head.size());
   at = put(at, p.outcome.moved.data(), p.outcome.moved.size());
   put(at, p.states.data(), p.states.size());
+  for (const contact::ContactPlace& c : p.outcome.places) {
+    const std::array<std::uint32_t, 3> place{c.segment, c.first, c.second};
+    append(out, std::span<const std::uint32_t>(place));
+  }
+  append_record(out, p.record);
   return out;
 }
 
@@ -52,11 +59,18 @@ CollidePart unpack_collide_part(std::span<const std::byte> bytes) {
   p.outcome.groups = head[2];
   p.outcome.speculative = static_cast<std::size_t>(head[3]);
   const auto states = static_cast<std::size_t>(head[4]);
-  FLOESIM_ASSERT(bytes.size() == sizeof(head) + moved * sizeof(std::uint32_t) + states * sizeof(FloeState));
-  std::size_t k = 5;
+  const auto places = static_cast<std::size_t>(head[5]);
+  std::size_t k = 6;
   for (const auto& [name, f] : contact::collision_counts(p.stats)) *f = head[k++];
   p.outcome.moved = take<std::uint32_t>(in, moved);
   p.states = take<FloeState>(in, states);
+  p.outcome.places.resize(places);
+  for (contact::ContactPlace& c : p.outcome.places) {
+    const std::vector<std::uint32_t> place = take<std::uint32_t>(in, 3);
+    c = {place[0], place[1], place[2]};
+  }
+  p.record = take_record(in);
+  FLOESIM_ASSERT(in == bytes.data() + bytes.size());
   return p;
 }
 
@@ -64,15 +78,20 @@ CollidePart run_collide_share(Floes& floes, std::span<const FloeState> start, co
                               double step, const contact::ImpulseOptions& options, std::span<const int> owner,
                               int rank) {
   CollidePart part;
-  part.outcome = contact::resolve_step_collisions_share(floes, start, detection, step, options, {owner, rank},
-                                                        part.stats);
-  if (part.outcome.conflict == StepCollisionShare::Conflict::none)
+  contact::ImpulseOptions o = options;
+  if (options.record) o.record = &part.record;
+  part.outcome = contact::resolve_step_collisions_share(floes, start, detection, step, o, {owner, rank}, part.stats);
+  if (part.outcome.conflict == StepCollisionShare::Conflict::none) {
     for (const std::uint32_t i : part.outcome.moved) part.states.push_back(floes.state[i]);
+  } else {
+    part.record.clear();
+    part.outcome.places.clear();
+  }
   return part;
 }
 
 bool combine_collide_parts(std::span<const CollidePart> parts, Floes& floes, CollisionStats& stats,
-                           std::size_t& speculative) {
+                           std::size_t& speculative, contact::ImpulseRecord* record) {
   std::vector<std::uint8_t> taken(floes.size(), 0);
   for (const CollidePart& p : parts) {
     if (p.outcome.conflict != StepCollisionShare::Conflict::none) return false;
@@ -86,6 +105,16 @@ bool combine_collide_parts(std::span<const CollidePart> parts, Floes& floes, Col
     for (std::size_t j = 0; j < p.states.size(); ++j) floes.state[p.outcome.moved[j]] = p.states[j];
     contact::add_collision_counts(stats, p.stats);
     speculative += p.outcome.speculative;
+  }
+  if (record) {
+    std::vector<contact::RecordPart> records(parts.size());
+    std::vector<const contact::RecordPart*> each;
+    for (std::size_t r = 0; r < parts.size(); ++r) {
+      records[r].record = parts[r].record;
+      records[r].places = parts[r].outcome.places;
+      each.push_back(&records[r]);
+    }
+    contact::merge_step_record(*record, each);
   }
   return true;
 }
@@ -101,7 +130,7 @@ std::size_t collide_by_owner(const Communicator& comm, std::span<const int> owne
   const std::vector<CollidePart> parts = comm.allgather_parts(pack(mine), unpack_collide_part);
   counts.clusters.resize(parts.size(), 0);
   std::size_t speculative = 0;
-  if (combine_collide_parts(parts, floes, stats, speculative)) {
+  if (combine_collide_parts(parts, floes, stats, speculative, options.record)) {
     for (std::size_t r = 0; r < parts.size(); ++r) counts.clusters[r] += parts[r].outcome.groups;
     counts.combined();
     return speculative;

@@ -22,11 +22,14 @@
 namespace floesim::parallel {
 
 // One rank's part of a step's collisions: what its share did, the states of
-// the floes it changed (outcome.moved's order; none on a conflict) and its counts.
+// the floes it changed (outcome.moved's order; none on a conflict), its
+// counts and, in a run that keeps the impulse record, its record (its loads'
+// places: outcome.places; none on a conflict).
 struct CollidePart {
   contact::StepCollisionShare outcome;
   std::vector<FloeState> states;
   contact::CollisionStats stats;
+  contact::ImpulseRecord record;
 };
 
 std::vector<std::byte> pack(const CollidePart& part);
@@ -34,28 +37,32 @@ CollidePart unpack_collide_part(std::span<const std::byte> bytes);
 
 // Runs rank `rank`'s share (contact::resolve_step_collisions_share) on
 // `floes` (the states on entry, W^-) and returns its part; `floes` is left
-// with the share's states.
+// with the share's states. With options.record, the share records into the
+// part's own record (options.record itself is left alone).
 CollidePart run_collide_share(Floes& floes, std::span<const FloeState> start, const contact::Detection& detection,
                               double step, const contact::ImpulseOptions& options, std::span<const int> owner,
                               int rank);
 
 // Combines every rank's part (rank order) into `floes` (each part's moved
-// floes take its states) and `stats` (contact::add_collision_counts), sets
-// `speculative` to the parts' sum and returns true; or returns false,
-// changing nothing, when a part has a conflict or two parts moved one floe
-// (the groups are disjoint: this would be a bug, refused all the same).
+// floes take its states), `stats` (contact::add_collision_counts) and
+// `record` (if not null: the parts' records merged as the whole call's one
+// event, contact::merge_step_record), sets `speculative` to the parts' sum
+// and returns true; or returns false, changing nothing, when a part has a
+// conflict or two parts moved one floe (the groups are disjoint: this would
+// be a bug, refused all the same).
 bool combine_collide_parts(std::span<const CollidePart> parts, Floes& floes, contact::CollisionStats& stats,
-                           std::size_t& speculative);
+                           std::size_t& speculative, contact::ImpulseRecord* record = nullptr);
 
 // The collisions at the step's start on every rank of `comm`, as
-// contact::resolve_step_collisions (whose arguments these are; no impulse
-// record, no impulses out): this rank's share, one exchange
-// (allgather_bytes: two collective calls on every rank), then the
-// combination or, on a conflict, the whole solve from the states on entry.
+// contact::resolve_step_collisions (whose arguments these are; no impulses
+// out): this rank's share, one exchange (allgather_bytes: two collective
+// calls on every rank; the share's impulse record, with options.record, in
+// the same message), then the combination or, on a conflict, the whole
+// solve from the states on entry (which records into options.record).
 // `counts` and the back-off are those of the advance's (AdvanceShareCounts,
 // AdvanceShareOptions), kept apart; `counts.clusters` counts each rank's step
 // groups in the steps not redone. Returns the speculative contacts' count.
-// Equal to the serial solve bit for bit, states and counts.
+// Equal to the serial solve bit for bit, states, counts and record.
 std::size_t collide_by_owner(const Communicator& comm, std::span<const int> owner, Floes& floes,
                              std::span<const FloeState> start, const contact::Detection& detection, double step,
                              const contact::ImpulseOptions& options, contact::CollisionStats& stats,

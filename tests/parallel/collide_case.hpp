@@ -3,6 +3,7 @@
 // (shares played on one process) and collide_share_ranks.cpp (over the
 // ranks mpirun starts).
 #include <algorithm>
+#include <cstring>
 #include <numeric>
 #include <random>
 #include <vector>
@@ -77,6 +78,21 @@ inline bool same_stats(const contact::CollisionStats& a, const contact::Collisio
   const auto y = contact::collision_counts(b);
   for (std::size_t k = 0; k < x.size(); ++k)
     if (*x[k].second != *y[k].second) return false;
+  return true;
+}
+
+// The same record: the same loads in the same order, field for field (the
+// doubles bit for bit), the same event numbers and count.
+inline bool same_record(const contact::ImpulseRecord& a, const contact::ImpulseRecord& b) {
+  if (a.events != b.events || a.loads.size() != b.loads.size()) return false;
+  auto bits = [](const Vec2& u, const Vec2& v) { return std::memcmp(u.data(), v.data(), 2 * sizeof(double)) == 0; };
+  for (std::size_t k = 0; k < a.loads.size(); ++k) {
+    const contact::ImpulseRecord::Load &x = a.loads[k], &y = b.loads[k];
+    if (x.floe != y.floe || x.event != y.event || x.other != y.other || x.sustained != y.sustained ||
+        std::memcmp(&x.normal, &y.normal, sizeof(double)) != 0 || !bits(x.point, y.point) ||
+        !bits(x.impulse, y.impulse) || !bits(x.world, y.world))
+      return false;
+  }
   return true;
 }
 

@@ -5,7 +5,8 @@
 // bit for bit: the floes' states (memcmp), the collision counts and the
 // sub-step report. Where the shares interact (a cluster of one merges with a
 // cluster of another, or two take one free floe) the combination refuses and
-// the step is redone whole, which is the serial advance.
+// the step is redone whole, which is the serial advance. In a run that keeps
+// the impulse record, the shares' records merged are the serial record.
 #include <doctest/doctest.h>
 
 #include <algorithm>
@@ -22,6 +23,7 @@
 #include "core/pack_generator.hpp"
 #include "parallel/advance_share.hpp"
 #include "parallel/place.hpp"
+#include "tests/parallel/collide_case.hpp"
 
 TEST_SUITE_BEGIN("mpi");
 
@@ -354,4 +356,118 @@ TEST_CASE("a share that would use the warm store falls back, and the next advanc
   CHECK(counts.fallbacks == 3);
   CHECK(counts.whole == 7);
   CHECK(serial_warm.uses > 0);
+}
+
+namespace {
+
+// The shares' records of `ranks` ranks (each share's advance on its own copy
+// with a record of its own), packed, unpacked and merged by combine_parts
+// into `merged`. Returns whether they combined; `events` gets each share's
+// event count.
+bool play_record(const Case& c, std::span<const int> owner, int ranks, contact::ImpulseRecord& merged,
+                 std::vector<std::uint32_t>& events) {
+  std::vector<Floes> copies(static_cast<std::size_t>(ranks), c.floes);
+  std::vector<contact::ImpulseRecord> own(static_cast<std::size_t>(ranks));
+  std::vector<std::unique_ptr<contact::ShareAdvance>> shares;
+  std::vector<contact::ShareRooms> rooms;
+  for (int r = 0; r < ranks; ++r) {
+    contact::SubstepOptions o = c.options;
+    o.impulse.record = &own[static_cast<std::size_t>(r)];
+    shares.push_back(std::make_unique<contact::ShareAdvance>(copies[static_cast<std::size_t>(r)], c.shapes,
+                                                             c.detection, c.dt, o, contact::ClusterShare{owner, r}));
+    rooms.push_back(parallel::unpack_share_rooms(parallel::pack(shares.back()->rooms())));
+  }
+  std::vector<contact::PairRoom> tight;
+  if (!parallel::combine_rooms(rooms, tight)) return false;
+  std::vector<parallel::AdvancePart> parts;
+  for (int r = 0; r < ranks; ++r) {
+    const std::size_t k = static_cast<std::size_t>(r);
+    const parallel::AdvancePart part = parallel::finish_share(*shares[k], tight, copies[k], &own[k]);
+    if (part.outcome.conflict == contact::ShareOutcome::Conflict::none)
+      REQUIRE(part.outcome.events.size() == part.record.events);
+    events.push_back(part.record.events);
+    parts.push_back(parallel::unpack_advance_part(parallel::pack(part)));
+  }
+  contact::CollisionStats stats;
+  contact::SubstepReport report;
+  return parallel::combine_parts(parts, copies.front(), stats, report, &merged);
+}
+
+}  // namespace
+
+TEST_CASE("the advance's impulse records by cluster owner merge into the serial record") {
+  // The packs above (events of many clusters at many sub-step times), and
+  // with jams of two floes (time steps, whose solves again drop their loads
+  // but keep counting events), over 2, 3 and 7 strips: where the shares
+  // combine, every rank's events merged are the serial record's, in the
+  // serial queue's order, numbered after the record's earlier ones.
+  int combined = 0;
+  for (const unsigned seed : {3u, 11u})
+    for (const std::size_t jam : {std::size_t{0}, std::size_t{2}}) {
+      CAPTURE(seed);
+      CAPTURE(jam);
+      Case c = dense_pack(2.0, seed, 0.5);
+      if (jam > 0) c.options.impulse.jam.floes = jam;
+      contact::ImpulseRecord serial;
+      serial.events = 1;  // the step-start collisions' event
+      {
+        Floes f = c.floes;
+        contact::SubstepOptions o = c.options;
+        o.impulse.record = &serial;
+        contact::CollisionStats stats;
+        contact::SubstepReport report;
+        contact::advance_with_collisions(f, c.shapes, c.detection, c.dt, o, stats, report);
+        MESSAGE("serial: " << serial.events - 1 << " events, " << serial.loads.size() << " loads, "
+                           << report.time_steps << " time steps");
+      }
+      REQUIRE(serial.events > 20);
+      REQUIRE(!serial.loads.empty());
+      for (const int ranks : {1, 2, 3, 7}) {
+        CAPTURE(ranks);
+        parallel::FloeOwners owners(0, ranks, c.domain);
+        owners.assign(c.floes);
+        contact::ImpulseRecord merged;
+        merged.events = 1;
+        std::vector<std::uint32_t> events;
+        const bool ok = play_record(c, owners.owner(), ranks, merged, events);
+        MESSAGE(ranks << " ranks: " << std::string(ok ? "combined" : "fell back"));
+        if (ranks == 1) CHECK(ok);
+        if (!ok) continue;
+        CHECK(test::same_record(merged, serial));
+        if (ranks > 1) {
+          ++combined;
+          CHECK(std::count_if(events.begin(), events.end(), [](std::uint32_t e) { return e > 0; }) >= 2);
+        }
+      }
+    }
+  CHECK(combined >= 3);
+}
+
+TEST_CASE("merge_advance_record orders the events by (tau, cluster), renumbered, their loads with them") {
+  // Rank 0: events at (0, 4) [loads 10, 11], (2.5, 4) [none: its loads
+  // dropped], (2.5, 4) again [12]; rank 1: (0, 1) [20], (1.0, 1) [21, 22].
+  // Serial order: (0, 1), (0, 4), (1.0, 1), (2.5, 4), (2.5, 4) -> events
+  // 5..9, loads 20 | 10 11 | 21 22 | - | 12.
+  auto load = [](std::uint32_t floe, std::uint32_t event) {
+    contact::ImpulseRecord::Load l;
+    l.floe = floe;
+    l.event = event;
+    return l;
+  };
+  contact::RecordPart a, b;
+  a.record.loads = {load(10, 0), load(11, 0), load(12, 2)};
+  a.record.events = 3;
+  a.events = {{0.0, 4}, {2.5, 4}, {2.5, 4}};
+  b.record.loads = {load(20, 0), load(21, 1), load(22, 1)};
+  b.record.events = 2;
+  b.events = {{0.0, 1}, {1.0, 1}};
+  contact::ImpulseRecord into;
+  into.events = 5;
+  const std::vector<const contact::RecordPart*> parts{&a, &b};
+  contact::merge_advance_record(into, parts);
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> got;
+  for (const auto& l : into.loads) got.emplace_back(l.floe, l.event);
+  CHECK(got == std::vector<std::pair<std::uint32_t, std::uint32_t>>{{20, 5}, {10, 6}, {11, 6}, {21, 7}, {22, 7},
+                                                                     {12, 9}});
+  CHECK(into.events == 10);
 }

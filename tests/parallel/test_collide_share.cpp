@@ -7,7 +7,8 @@
 // (memcmp), the collision counts and the speculative contacts' count. A
 // speculative contact that joins two ranks' contact components puts both in
 // one step group, on one rank. A share that would use the warm store falls
-// back to the serial solve, with the advance's back-off.
+// back to the serial solve, with the advance's back-off. In a run that keeps
+// the impulse record, the shares' records merged are the serial record.
 #include <doctest/doctest.h>
 
 #include <algorithm>
@@ -25,6 +26,7 @@ TEST_SUITE_BEGIN("mpi");
 
 using namespace floesim;
 using test::CollideCase;
+using test::same_record;
 using test::same_stats;
 
 namespace {
@@ -227,4 +229,119 @@ TEST_CASE("step-start collisions that would use the warm store fall back, with t
   CHECK(counts.fallbacks == 3);
   CHECK(counts.whole == 7);
   CHECK(serial_warm.uses > 0);
+}
+
+namespace {
+
+// The serial record of a step's collisions after `before` events (a record
+// the step's earlier solves began), and the shares' records of `ranks`
+// ranks, packed, unpacked and merged into a record that began alike.
+// Returns whether the shares combined (else `merged` is untouched but for
+// the start).
+bool play_record(const CollideCase& c, std::span<const int> owner, int ranks, contact::ImpulseRecord& merged,
+                 std::vector<std::size_t>& loads) {
+  std::vector<parallel::CollidePart> parts;
+  contact::ImpulseRecord unused;  // a share records into its part's own; this one stays empty
+  contact::ImpulseOptions o = c.options;
+  o.record = &unused;
+  Floes first;
+  for (int r = 0; r < ranks; ++r) {
+    Floes mine = c.floes;
+    const parallel::CollidePart part = parallel::run_collide_share(mine, c.start, c.detection, c.dt, o, owner, r);
+    REQUIRE(part.outcome.places.size() == part.record.loads.size());
+    loads.push_back(part.record.loads.size());
+    parts.push_back(parallel::unpack_collide_part(parallel::pack(part)));
+    if (r == 0) first = std::move(mine);
+  }
+  CHECK(unused.loads.empty());
+  CHECK(unused.events == 0);
+  contact::CollisionStats stats;
+  std::size_t speculative = 0;
+  return parallel::combine_collide_parts(parts, first, stats, speculative, &merged);
+}
+
+contact::ImpulseRecord begun() {
+  contact::ImpulseRecord r;
+  r.events = 3;
+  return r;
+}
+
+}  // namespace
+
+TEST_CASE("the step-start collisions' impulse records by owner merge into the serial record") {
+  // The rows of four (jams off) over 2, 3 and 7 strips and by floe, and the
+  // same rows as jams of two floes solved at the step's start (jam.floes 2,
+  // at_step_start: a jam's speculative points, segment 1 of the places):
+  // every rank's loads, merged, are the serial record's, in its order, as
+  // one event numbered after the record's earlier ones.
+  for (const bool jams : {false, true}) {
+    CAPTURE(jams);
+    CollideCase c = test::rows_of_four(7);
+    if (jams) {
+      c.options.jam.floes = 2;
+      c.options.jam.at_step_start = true;
+    }
+    contact::ImpulseRecord serial = begun();
+    {
+      Floes f = c.floes;
+      contact::ImpulseOptions o = c.options;
+      o.record = &serial;
+      contact::CollisionStats stats;
+      contact::resolve_step_collisions(f, c.start, c.detection, c.dt, o, stats);
+    }
+    MESSAGE("serial record: " << serial.loads.size() << " loads, " << serial.events << " events");
+    REQUIRE(serial.events == 4);
+    REQUIRE(serial.loads.size() > 100);
+    for (const int ranks : {1, 2, 3, 7, 0}) {
+      CAPTURE(ranks);
+      std::vector<int> owner;
+      int n = ranks;
+      if (ranks > 0) {
+        parallel::FloeOwners owners(0, ranks, c.domain);
+        owners.assign(c.floes);
+        owner.assign(owners.owner().begin(), owners.owner().end());
+      } else {
+        owner.resize(c.floes.size());
+        std::iota(owner.begin(), owner.end(), 0);
+        n = static_cast<int>(owner.size());
+      }
+      contact::ImpulseRecord merged = begun();
+      std::vector<std::size_t> loads;
+      REQUIRE(play_record(c, owner, n, merged, loads));
+      CHECK(same_record(merged, serial));
+      // The loads came from several ranks (the merge had work to do).
+      if (n > 1) CHECK(std::count_if(loads.begin(), loads.end(), [](std::size_t l) { return l > 0; }) >= 2);
+    }
+  }
+}
+
+TEST_CASE("merge_step_record orders the loads by their contacts' places, not by rank") {
+  // Two simulated shares whose loads interleave in the serial list: rank 0
+  // has places (0, 1), (2, 0, 5), rank 1 (0, 0) with two loads (a's and b's)
+  // and (1, 4, 2). The merge: (0, 0) twice, (0, 1), (1, 4, 2), (2, 0, 5),
+  // all event 7, and the count 8.
+  auto load = [](std::uint32_t floe) {
+    contact::ImpulseRecord::Load l;
+    l.floe = floe;
+    l.event = 0;
+    return l;
+  };
+  contact::RecordPart a, b;
+  a.record.loads = {load(10), load(11)};
+  a.record.events = 1;
+  a.places = {{0, 1, 0}, {2, 0, 5}};
+  b.record.loads = {load(20), load(21), load(22)};
+  b.record.events = 1;
+  b.places = {{0, 0, 0}, {0, 0, 0}, {1, 4, 2}};
+  contact::ImpulseRecord into;
+  into.events = 7;
+  const std::vector<const contact::RecordPart*> parts{&a, &b};
+  contact::merge_step_record(into, parts);
+  std::vector<std::uint32_t> floes;
+  for (const auto& l : into.loads) {
+    floes.push_back(l.floe);
+    CHECK(l.event == 7);
+  }
+  CHECK(floes == std::vector<std::uint32_t>{20, 21, 10, 22, 11});
+  CHECK(into.events == 8);
 }

@@ -1,0 +1,132 @@
+#!/usr/bin/env python3
+"""Runs that keep the impulse record (percussion fracture, [run]
+record_collisions) on several ranks against the serial run (docs/parallel.md,
+stage seven: the record made by owner and merged in the serial order).
+
+usage: check_record_ranks.py FLOESIM MPIEXEC WORKDIR [--floes N] [--t-end T] [--ranks 2 3]
+       check_record_ranks.py --no-mpi    (MPI not built: exits 77, ctest's skip code)
+
+1. The collisions-only periodic pack of scripts/scenarios/moving_pack.py (400
+   floes to 500 s by default) with percussion fracture (splits on) and
+   record_collisions: on 2 and 3 ranks the run file, its /events/collisions
+   (the record's events and loads) and /events/fracture (percussion reads the
+   record on every rank) equal the serial run's bit for bit; some floes
+   split; and the step-start collisions and the advance ran by owner (not
+   redone whole) in most steps: parallel.collide_steps and advance_steps
+   count the tries, *_fallbacks those redone whole, *_whole those skipped by
+   the back-off.
+2. examples/pack_fracture.toml (a jam against a coast, breaking; its jam
+   LCPs take the warm store, so some steps fall back): bit for bit on 2
+   ranks, with both kinds of step (kept and redone) present.
+"""
+import argparse
+import os
+import shutil
+import sys
+
+from ranks_harness import Ranks, need, summary
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+sys.path.insert(0, os.path.join(ROOT, "scripts", "scenarios"))
+import moving_pack  # noqa: E402
+
+if "--no-mpi" in sys.argv:
+    print("floesim was built without MPI (FLOESIM_MPI=OFF): the record on several ranks is not checked")
+    sys.exit(77)
+
+ap = argparse.ArgumentParser()
+ap.add_argument("floesim")
+ap.add_argument("mpiexec")
+ap.add_argument("workdir")
+ap.add_argument("--floes", type=int, default=400)
+ap.add_argument("--t-end", type=float, default=500.0)
+ap.add_argument("--ranks", type=int, nargs="+", default=[2, 3])
+args = ap.parse_args()
+
+W = args.workdir
+harness = Ranks(args.floesim, args.mpiexec, W)
+run, mpirun = harness.run, harness.mpirun
+failures = []
+
+FRACTURE = """
+[fracture]
+enabled = true
+criterion = "stress"
+strength = 0.2e6
+split = true
+mesh_size = 20.0
+min_fragment_area = 400.0
+"""
+
+try:
+    base = moving_pack.write(args.floesim, W, args.floes, args.t_end, seed=5, output_interval=args.t_end / 4,
+                             wind=(10.0, 3.0))
+except RuntimeError as e:
+    sys.exit(f"FAILED: {e}")
+config = os.path.join(W, "record.toml")
+with open(base) as f:
+    text = f.read()
+if "[run]\n" not in text:
+    sys.exit("FAILED: the moving pack's configuration has no [run] table")
+with open(config, "w") as f:
+    f.write(text.replace("[run]\n", "[run]\nrecord_collisions = true\n", 1) + FRACTURE)
+
+s = summary(need(run([args.floesim, "run", config, "-o", "serial.h5", "-q"]), "serial run"))
+splits, lcps = int(s.get("fracture.splits", "0")), int(s.get("collisions.lcps", "0"))
+print(f"serial: {args.floes} floes to {args.t_end} s, {lcps} collision LCPs, {splits} splits, {s.get('floes')} floes")
+if splits == 0 or lcps == 0:
+    failures.append(f"the serial run had {lcps} LCPs and {splits} splits: the check would not test the record")
+
+
+def kept_mostly(p, n, what):
+    """The summary's tries by owner of `what` (collide, advance): most kept."""
+    k = summary(p)
+    steps = int(k.get(f"parallel.{what}_steps", "0"))
+    fell = int(k.get(f"parallel.{what}_fallbacks", "0"))
+    whole = int(k.get(f"parallel.{what}_whole", "0"))
+    print(f"{n} ranks: {what}: {steps} steps tried by owner, {fell} redone whole, {whole} whole by the back-off")
+    return steps, fell, whole
+
+
+for n in args.ranks:
+    out = f"ranks{n}.h5"
+    p = mpirun(n, "run", config, "-o", out, "-q")
+    if p.returncode != 0:
+        failures.append(f"{n} ranks: exit {p.returncode}\n{p.stdout}\n{p.stderr}")
+        continue
+    c = harness.compare(out, "serial.h5", 0)
+    print(f"{n} ranks: {'equal' if c.returncode == 0 else 'DIFFERENT'} to the serial run (bit for bit)")
+    if c.returncode != 0:
+        failures.append(f"{n} ranks differ from the serial run:\n{c.stdout}")
+    for what in ("collide", "advance"):
+        steps, fell, whole = kept_mostly(p, n, what)
+        total = steps + whole
+        if not (total > 0 and steps - fell > total / 2):
+            failures.append(f"{n} ranks: the {what} by owner was kept in {steps - fell} of {total} steps")
+
+# The jam against a coast: its LCPs take the warm store, so some steps fall
+# back to the whole solve, recorded into the run's record directly.
+example = os.path.join(ROOT, "examples", "pack_fracture.toml")
+for name in ("pack_fracture.toml", "pack_against_wall.h5"):
+    shutil.copy(os.path.join(ROOT, "examples", name), W)
+until = ["--until", "900"]
+s = summary(need(run([args.floesim, "run", "pack_fracture.toml", "-o", "jam_serial.h5", "-q", *until]),
+                 "pack_fracture serial"))
+p = mpirun(2, "run", "pack_fracture.toml", "-o", "jam_2.h5", "-q", *until)
+c = harness.compare("jam_2.h5", "jam_serial.h5", 0)
+equal = p.returncode == 0 and c.returncode == 0
+print(f"pack_fracture to 900 s ({s.get('fracture.splits')} splits): 2 ranks {'equal' if equal else 'DIFFERENT'} "
+      "to the serial run")
+if not equal:
+    failures.append(f"pack_fracture on 2 ranks: exit {p.returncode}\n{p.stderr}\n{c.stdout}")
+else:
+    steps, fell, whole = kept_mostly(p, 2, "advance")
+    if not (steps > fell > 0):
+        failures.append(f"pack_fracture on 2 ranks: expected advances kept and redone ({steps} tried, {fell} redone)")
+if s.get("fracture.splits", "0") == "0":
+    failures.append("pack_fracture: no split by 900 s")
+
+if failures:
+    print("FAILED:\n" + "\n".join(failures))
+    sys.exit(1)
+print("ok")
