@@ -239,13 +239,22 @@ void Communicator::alltoall_bytes(std::span<const std::byte> send, const std::ve
   alltoall(send, send_counts, receive, receive_counts);
 }
 
+#ifdef FLOESIM_HAVE_MPI
+namespace {
+// One integer reduced over the ranks by `op` (MPI_SUM, MPI_MIN), one call.
+long long reduce_one(MPI_Comm comm, Communicator::Traffic& traffic, int ranks, long long value, MPI_Op op) {
+  Counted counted(traffic, static_cast<long long>(sizeof(long long)) * ranks);
+  long long out = 0;
+  check(MPI_Allreduce(&value, &out, 1, MPI_LONG_LONG, op, comm), "MPI_Allreduce");
+  return out;
+}
+}  // namespace
+#endif
+
 long long Communicator::sum(long long value) const {
   if (serial() || !impl_) return value;
 #ifdef FLOESIM_HAVE_MPI
-  Counted counted(impl_->traffic, static_cast<long long>(sizeof(long long)) * size_);
-  long long total = 0;
-  check(MPI_Allreduce(&value, &total, 1, MPI_LONG_LONG, MPI_SUM, impl_->comm), "MPI_Allreduce");
-  return total;
+  return reduce_one(impl_->comm, impl_->traffic, size_, value, MPI_SUM);
 #else
   return value;
 #endif
@@ -254,10 +263,7 @@ long long Communicator::sum(long long value) const {
 long long Communicator::min(long long value) const {
   if (serial() || !impl_) return value;
 #ifdef FLOESIM_HAVE_MPI
-  Counted counted(impl_->traffic, static_cast<long long>(sizeof(long long)) * size_);
-  long long least = 0;
-  check(MPI_Allreduce(&value, &least, 1, MPI_LONG_LONG, MPI_MIN, impl_->comm), "MPI_Allreduce");
-  return least;
+  return reduce_one(impl_->comm, impl_->traffic, size_, value, MPI_MIN);
 #else
   return value;
 #endif
