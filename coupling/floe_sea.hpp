@@ -226,9 +226,11 @@ public:
   // a step, after the last evaluation's pressure was kicked): the cells'
   // routes go to the new slabs' ranks, and the pressure this rank summed for
   // its old slab's cells is cleared (the next evaluation writes its new
-  // slab's). The floes' owners stay on the slabs of set_communicator (the
-  // first ones); their pieces' reach in rows grows by the move
-  // (MovingFootprints::reach_rows).
+  // slab's). The floes' owners follow the slabs from the footprints' next
+  // rebuild (MovingFootprints::set_sea_slabs; until then their pieces'
+  // reach in rows grows by the move): the sums being the serial ones
+  // whatever the owners (stage eight), the answer does not depend on the
+  // timings that moved the slabs.
   void set_slabs(std::vector<int> first_row);
   struct ImplicitStats {
     long steps = 0, newton = 0, cg = 0, g_products = 0;  // totals over the run
@@ -261,6 +263,11 @@ public:
   // (coupling/moving_footprint.hpp; [coupling] footprint_reach).
   long footprint_placements() const { return footprints_.placements(); }
   long footprint_rebuilds() const { return footprints_.rebuilds(); }
+  // By owner with the sea in slabs: the slabs (first rows) the floes' owners
+  // were set by at the footprints' last rebuild (empty otherwise).
+  std::span<const int> owner_slabs() const {
+    return routed() ? footprints_.owner_slabs() : std::span<const int>{};
+  }
   std::span<const FloeSeaLoad> loads() const { return loads_; }
   std::span<const double> pressure() const { return pressure_; }
   double strong_share() const { return s_; }

@@ -62,7 +62,7 @@ void FloeSeaContact::set_slabs(std::vector<int> first_row) {
   slab_rows_ = std::move(first_row);
   if (!routed()) return;
   routes_ = parallel::CellRoutes(slab_rows_, static_cast<std::size_t>(grid_.nx));
-  footprints_.set_sea_slabs(slab_rows_, false);
+  footprints_.set_sea_slabs(slab_rows_, true);
   owner_.interior_reach = -1;  // the interior cells are those of the new routes
 }
 

@@ -111,6 +111,8 @@ public:
   // largest move of a cut is added: the pieces then lie within that many
   // rows of their owner's slab of the sea.
   bool by_place() const { return by_place_; }
+  // The slabs the owners were set by at the last rebuild (empty: by index).
+  std::span<const int> owner_slabs() const { return owner_rows_; }
   int reach_rows() const { return reach_rows_from(sea_rows_); }
   // The same from other slabs (first_row as set_slabs takes it): the rows a
   // floe's pieces may lie from those slabs' slab of its owner.
