@@ -305,16 +305,18 @@ private:
   // By owner (floe_sea_owners.cpp): zeroes pressure_ and cells_ where the
   // last evaluation by owner wrote them.
   void clear_cells_by_owner();
-  // By owner (floe_sea_owners.cpp): this rank's pieces' coverage summed into
-  // its cells, then every rank's parts in rank order into cells_[c].coverage
-  // of this rank's cells (cells_ is zero in the others).
+  // By owner (floe_sea_owners.cpp): this rank's pieces' coverage into
+  // cells_[c].coverage of this rank's cells (cells_ is zero in the others):
+  // routed, every rank's pieces of a shared cell summed in the serial order
+  // by the cell's slab's rank; not routed, every rank's parts in rank order.
   void sum_coverage_by_owner();
   // By owner, after the law (eval_: penetrations u, weights psi, forces):
   // this rank's pieces' a u^2 and pressure in its cells and its part of the
-  // penalty energy ks psi a u^2 / 2, in one pass; then every rank's parts in
-  // rank order into pressure_ (every cell; routed, the cells of this rank's
-  // slab) and cells_[c].sum (this rank's cells); returns the energy, the
-  // ranks' parts summed in rank order.
+  // penalty energy ks psi a u^2 / 2, in one pass; then, summed over the
+  // ranks as the coverage is, into pressure_ (every cell; routed, the cells
+  // of this rank's slab) and cells_[c].sum (this rank's cells); returns the
+  // energy, the ranks' parts summed in rank order (routed, until
+  // settle_energy sums the terms in the serial order).
   double sum_cells_by_owner(double ks);
   // By owner: order_ <- this rank's floes in the serial order, and
   // owner_.position every floe's place in that order (one gather of the

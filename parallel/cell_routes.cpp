@@ -75,7 +75,6 @@ void CellRoutes::open(const Communicator& comm, std::span<const std::uint32_t> c
     for (std::size_t j = begin; j < end; ++j)
       out = put(out, &parts[first[route_[j]] * w], (first[route_[j] + 1] - first[route_[j]]) * w);
   }
-  open_bytes_ = send_.size();
   std::vector<std::size_t> receive_bytes;
   comm.alltoall_bytes(send_, bytes, receive_, receive_bytes);
   // The owner's cells, in the order they first arrive, and every piece
@@ -194,7 +193,6 @@ double CellRoutes::add(const Communicator& comm, std::span<const double> parts, 
     for (std::size_t j = begin; j < begin + sent_[r]; ++j)
       out = put(out, &parts[first_[route_[j]] * w], (first_[route_[j] + 1] - first_[route_[j]]) * w);
   }
-  add_bytes_ = send_.size();
   receive_.resize(receive_total);
   comm.alltoall(send_, bytes, receive_, receive_bytes);
   width_ = width;

@@ -83,11 +83,6 @@ public:
   // their owners in the order open() sums them; returns the sum of `extra`
   // over the ranks, in rank order from zero (the same on every rank).
   double add(const Communicator& comm, std::span<const double> parts, int width, double extra);
-  // Bytes this rank sent in the last open() and add() (the pieces' cells,
-  // counts, keys and values; measured in docs/parallel.md).
-  std::size_t open_bytes() const { return open_bytes_; }
-  std::size_t add_bytes() const { return add_bytes_; }
-
   // The cells this rank owns that some rank sent parts for in the last open(),
   // in the order they first arrived (rank order), and their totals.
   std::span<const std::uint32_t> owned() const { return owned_; }
@@ -112,7 +107,6 @@ private:
   std::vector<double> values_;        // per received piece, `width_` values
   std::vector<double> totals_;
   int width_ = 0;
-  std::size_t open_bytes_ = 0, add_bytes_ = 0;
   // Sums owned cell j's values w from zero in key order, into totals_.
   void sum_pieces();
   std::vector<std::byte> send_, receive_;  // kept from one round to the next
