@@ -380,6 +380,13 @@ int run(const Args& args, const parallel::Session& session) {
       << "\nparallel.collide_whole: " << collide.whole << "\nparallel.collide_groups:";
     for (const long k : collide.clusters) o << " " << k;
     o << "\n";
+    // Stage eight: the slabs the coupling's floe owners followed at the
+    // footprints' last rebuild.
+    if (const FloeSeaContact* fs = sim.floe_sea(); fs && !fs->owner_slabs().empty()) {
+      o << "parallel.coupling_slab_rows:";
+      for (const int r : fs->owner_slabs()) o << " " << r;
+      o << "\n";
+    }
     // Stage seven: with a sea in slabs the strips are its slabs, their first
     // rows (then the row count) now.
     if (owners.has_slabs()) {

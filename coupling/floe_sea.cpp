@@ -98,6 +98,7 @@ FloeSeaContact::FloeSeaContact(const CouplingParams& params, const SeaParams& se
   kernel_ = params.footprint == FootprintChoice::cell || !periodic ? FootprintKernel::cell : FootprintKernel::tent;
   footprints_ = MovingFootprints(grid, kernel_, {params.footprint_reach});
   slab_rows_ = sea.slab_rows();
+  first_slab_rows_ = slab_rows_;
   cell_area_ = grid.dx() * (grid.dims == 2 ? grid.dy() : grid.ly);
   // The sea under the floes, as fast as it can answer: one cell, or the
   // grid's shortest wave, at a few places (a walled basin answers faster near
@@ -150,7 +151,7 @@ void FloeSeaContact::floes_changed(const Floes& floes) {
 }
 
 FloeSeaState FloeSeaContact::saved_state() const {
-  FloeSeaState s{true, bottom0_, loads_h_, penalty_energy_, {}, {}};
+  FloeSeaState s{true, bottom0_, loads_h_, penalty_energy(), {}, {}};
   for (const FloePose& p : footprints_.reference()) s.footprint_reference.push_back({p.x, p.y, p.yaw});
   // The implicit step's mean horizontal loads cannot be evaluated again from the state.
   if (step_mean_loads_ && loads_h_ >= 0.0)
@@ -176,6 +177,7 @@ void FloeSeaContact::restore(const FloeSeaState& state, const Floes& floes, flui
       step_horizontal_[i] = loads_[i].horizontal;
     }
   penalty_energy_ = state.penalty_energy;
+  energy_pending_ = false;
 }
 
 double FloeSeaContact::weak_coefficient(const Floes& floes, std::size_t i) const {
@@ -214,23 +216,21 @@ void FloeSeaContact::clear_footprint_cells() {
 void FloeSeaContact::place_footprints(const Floes& floes) {
   clear_footprint_cells();
   footprints_.place(floes, dynamic_, poses_, threads_);
+  // By owner, this rank's floes only, in the serial order (the others'
+  // pieces are not here).
+  if (by_owner()) {
+    order_by_owner(floes.size());
+    return sum_coverage_by_owner();
+  }
   const Footprints& fp = footprints_.pieces();
   // Floes in the order of their first cell, so that floes next to each
   // other on the grid come one after the other (the grid's arrays are
   // read and written where each floe lies: this keeps them in cache).
-  // By owner, this rank's floes only (the others' pieces are not here).
   order_.clear();
-  auto take = [&](std::size_t i) {
+  for (std::size_t i = 0; i < floes.size(); ++i)
     if (dynamic_[i] && fp.offsets[i] < fp.offsets[i + 1]) order_.push_back(static_cast<std::uint32_t>(i));
-  };
-  if (by_owner()) {
-    for (std::uint32_t i : footprints_.mine()) take(i);
-  } else {
-    for (std::size_t i = 0; i < floes.size(); ++i) take(i);
-  }
   std::sort(order_.begin(), order_.end(),
             [&](std::uint32_t x, std::uint32_t y) { return fp.cell[fp.offsets[x]] < fp.cell[fp.offsets[y]]; });
-  if (by_owner()) return sum_coverage_by_owner();
   const double inv_cell_area = 1.0 / cell_area_;
   for (std::uint32_t i : order_)
     for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k) cells_[fp.cell[k]].coverage += fp.area[k] * inv_cell_area;
@@ -238,6 +238,7 @@ void FloeSeaContact::place_footprints(const Floes& floes) {
 
 void FloeSeaContact::evaluate(const Floes& floes, fluid::Sea& sea, double h) {
   pressure_kicked_ = false;
+  energy_pending_ = false;
   loads_h_ = h;
   pose_at_states(floes);
   place_footprints(floes);
@@ -388,10 +389,11 @@ void FloeSeaContact::update_water(const Floes& floes, const fluid::Sea& sea, Inc
   water_.assign(floes.size(), Vec2::Zero());
   if (!incident) return;
   // Routed with the floes owned by place, this rank's floes' pieces lie
-  // within reach_rows() of its first slab (the coupling's owners keep the
-  // first slabs), which is the incident sea's slab (it keeps its first,
-  // equal, shares): the snapshots are windows of that slab and halo.
-  const int halo = routed() && footprints_.by_place() ? footprints_.reach_rows() : -1;
+  // within reach_rows_from(first_slab_rows_) of the first slabs (the
+  // owners follow the sea's slabs, which may have moved from them), which
+  // are the incident sea's slabs (it keeps its first, equal, shares): the
+  // snapshots are windows of that slab and halo.
+  const int halo = routed() && footprints_.by_place() ? footprints_.reach_rows_from(first_slab_rows_) : -1;
   incident->advance_to(sea.time(), halo);
   const double w = incident->weight(sea.time());
   const fluid::RowWindow u0 = incident->u0(), v0 = incident->v0(), u1 = incident->u1(), v1 = incident->v1();

@@ -194,20 +194,24 @@ public:
   // and computes their horizontal loads and water velocities; the other
   // ranks receive them.
   // With the explicit kicks each rank also runs the law on its own floes'
-  // pieces and sums them into the cells; the cells' coverage, sums and
-  // pressure are then summed over the ranks in rank order (by_owner()): the
-  // same to the bit as a serial run in cells where one rank's floes lie, to
+  // pieces and sums them into the cells (by_owner()), in the serial run's
+  // order of the floes (order_by_owner). When the sea is in slabs
+  // (fluid::Sea::slab_rows; stages five and eight) the floes are owned by
+  // place (the rank whose slab holds the row of a floe's centroid at the
+  // footprints' last rebuild: MovingFootprints::set_slabs), and each cell
+  // the pieces of several ranks' floes may share is summed by the rank whose
+  // slab holds its row from the pieces themselves, in the serial order
+  // (parallel::CellRoutes with the floes' serial positions as keys), which
+  // sends the coverage and the sums back to the ranks with pieces there; a
+  // cell deeper in a slab than any floe of another rank reaches is summed by
+  // its owner alone, with no exchange. Every cell's sums are then the serial
+  // run's to the bit, whichever rank owns which floe. pressure() then holds
+  // this rank's slab's rows only, which is what its sea's kick reads. A sea
+  // not in slabs (stage three) sums each rank's part of a cell and then the
+  // parts in rank order: the serial sums where one rank's floes lie, to
   // round-off where several ranks' floes share a cell. The implicit step
   // stays replicated on every floe's pieces (gathered), to the bit. Every
   // rank calls every method in the same order (they may exchange data).
-  // When the sea is in slabs (fluid::Sea::slab_rows; stage five), the floes
-  // are owned by place (the rank whose slab holds the row of a floe's
-  // centroid at the footprints' last rebuild: MovingFootprints::set_slabs),
-  // and each cell's parts go to the rank whose slab holds its row, which sums
-  // them and sends the coverage and the sums back to the ranks with pieces
-  // there; a cell deeper in a slab than any floe of another rank reaches is
-  // summed by its owner alone, with no exchange. pressure() then holds this
-  // rank's slab's rows only, which is what its sea's kick reads.
   void set_communicator(const parallel::Communicator& comm) {
     comm_ = comm;
     footprints_.set_communicator(comm);
@@ -222,11 +226,11 @@ public:
   // a step, after the last evaluation's pressure was kicked): the cells'
   // routes go to the new slabs' ranks, and the pressure this rank summed for
   // its old slab's cells is cleared (the next evaluation writes its new
-  // slab's). The floes' owners stay on the slabs of set_communicator (the
-  // first ones): which rank sums which pieces fixes the round-off of a cell
-  // shared by several ranks' floes, so the answer does not depend on the
-  // timings that moved the slabs (docs/parallel.md, stage seven); their
-  // pieces' reach in rows grows by the move (MovingFootprints::reach_rows).
+  // slab's). The floes' owners follow the slabs from the footprints' next
+  // rebuild (MovingFootprints::set_sea_slabs; until then their pieces'
+  // reach in rows grows by the move): the sums being the serial ones
+  // whatever the owners (stage eight), the answer does not depend on the
+  // timings that moved the slabs.
   void set_slabs(std::vector<int> first_row);
   struct ImplicitStats {
     long steps = 0, newton = 0, cg = 0, g_products = 0;  // totals over the run
@@ -241,7 +245,13 @@ public:
 
   // Energies (J) at the last evaluate(): the penalty spring's, and the floes'
   // vertical kinetic and weight (M g zeta) energies at the present state.
-  double penalty_energy() const { return penalty_energy_; }
+  // By owner with the sea in slabs the first call after an evaluation is
+  // collective (every rank's terms gathered and summed in the serial order:
+  // settle_energy).
+  double penalty_energy() const {
+    if (energy_pending_) settle_energy();
+    return penalty_energy_;
+  }
   double floes_vertical_kinetic(const Floes& floes) const;
   double floes_weight_energy(const Floes& floes) const;
 
@@ -253,6 +263,11 @@ public:
   // (coupling/moving_footprint.hpp; [coupling] footprint_reach).
   long footprint_placements() const { return footprints_.placements(); }
   long footprint_rebuilds() const { return footprints_.rebuilds(); }
+  // By owner with the sea in slabs: the slabs (first rows) the floes' owners
+  // were set by at the footprints' last rebuild (empty otherwise).
+  std::span<const int> owner_slabs() const {
+    return routed() ? footprints_.owner_slabs() : std::span<const int>{};
+  }
   std::span<const FloeSeaLoad> loads() const { return loads_; }
   std::span<const double> pressure() const { return pressure_; }
   double strong_share() const { return s_; }
@@ -290,17 +305,26 @@ private:
   // By owner (floe_sea_owners.cpp): zeroes pressure_ and cells_ where the
   // last evaluation by owner wrote them.
   void clear_cells_by_owner();
-  // By owner (floe_sea_owners.cpp): this rank's pieces' coverage summed into
-  // its cells, then every rank's parts in rank order into cells_[c].coverage
-  // of this rank's cells (cells_ is zero in the others).
+  // By owner (floe_sea_owners.cpp): this rank's pieces' coverage into
+  // cells_[c].coverage of this rank's cells (cells_ is zero in the others):
+  // routed, every rank's pieces of a shared cell summed in the serial order
+  // by the cell's slab's rank; not routed, every rank's parts in rank order.
   void sum_coverage_by_owner();
   // By owner, after the law (eval_: penetrations u, weights psi, forces):
   // this rank's pieces' a u^2 and pressure in its cells and its part of the
-  // penalty energy ks psi a u^2 / 2, in one pass; then every rank's parts in
-  // rank order into pressure_ (every cell; routed, the cells of this rank's
-  // slab) and cells_[c].sum (this rank's cells); returns the energy, the
-  // ranks' parts summed in rank order.
+  // penalty energy ks psi a u^2 / 2, in one pass; then, summed over the
+  // ranks as the coverage is, into pressure_ (every cell; routed, the cells
+  // of this rank's slab) and cells_[c].sum (this rank's cells); returns the
+  // energy, the ranks' parts summed in rank order (routed, until
+  // settle_energy sums the terms in the serial order).
   double sum_cells_by_owner(double ks);
+  // By owner: order_ <- this rank's floes in the serial order, and
+  // owner_.position every floe's place in that order (one gather of the
+  // floes' first cells).
+  void order_by_owner(std::size_t floes);
+  // By owner, routed: the penalty energy from every rank's terms
+  // (owner_.energy_*), summed in the serial order (one gather).
+  void settle_energy() const;
   // poses_ <- the floes' present poses.
   void pose_at_states(const Floes& floes);
   // The contact at the present state for a kick of length h (see evaluate_loads).
@@ -371,12 +395,27 @@ private:
     std::vector<std::uint8_t> interior;
     int interior_reach = -1;
     std::vector<double> parts;
+    // The serial order (order_by_owner): per floe its first cell (kNoCell:
+    // not in the order) and its place in the order, and the order.
+    std::vector<std::uint32_t> first_cell, position, serial;
+    // Routed: the pieces of the cells of `cells` grouped by cell (cell j's
+    // are [first[j], first[j + 1])), each with its floe's position (keys)
+    // and its coverage (values); per area piece of this rank's floes, its
+    // place there (piece_at).
+    std::vector<std::uint32_t> first, keys, piece_at;
+    std::vector<double> values;
+    // Routed: this rank's terms of the penalty energy, per floe with terms
+    // (its position and count), in order_.
+    std::vector<std::uint32_t> energy_keys, energy_counts;
+    std::vector<double> energy_terms;
   } owner_;
+  static constexpr std::uint32_t kNoCell = 0xffffffffu;
   // The sea's slabs (fluid::Sea::slab_rows; empty: whole on every rank), and
   // by owner on them, the routes of the cells' sums to the slabs' ranks;
   // the next evaluation clears pressure_ in routes_.owned() (this rank's
   // slab's cells of the last one) and cells_ in owner_.cells.
   std::vector<int> slab_rows_;
+  std::vector<int> first_slab_rows_;  // the slabs at set-up (the incident sea's, which do not move)
   parallel::CellRoutes routes_;
   std::vector<std::uint32_t> order_;  // dynamic floes with pieces, by their first cell
   bool pressure_kicked_ = false;  // the sea's last kick was with pressure_ as it is
@@ -409,7 +448,8 @@ private:
     std::vector<double> force;        // of each area piece on the sea (N)
     std::vector<double> wetted;       // per floe: sum psi_c a_c [delta_c]^+
   } eval_;
-  double penalty_energy_ = 0.0;
+  mutable double penalty_energy_ = 0.0;
+  mutable bool energy_pending_ = false;  // penalty_energy_ is this rank's part, to be settled
   std::vector<std::string> notes_;
 };
 

@@ -2,30 +2,44 @@
 // velocities to every rank (docs/parallel.md, stage two), and the contact
 // evaluated by owner (stage three; FloeSeaContact::by_owner): the sums into
 // the cells that the law needs before it (the coverage Phi_c) and that it
-// gives after it (the cells' sum of a_k u_k^2 and the pressure), each rank
-// summing its own floes' pieces, then the ranks' parts summed in rank order.
+// gives after it (the cells' sum of a_k u_k^2 and the pressure).
 //
-// Each rank sends, for the cells its pieces lie in, its part of each sum: the
-// cells and their coverage (12 bytes a cell) before the law, the sums and
-// pressures (16 bytes a cell, the cells already known) after it. Every rank
-// receives every rank's parts and adds them in rank order from zero, so the
-// sums do not depend on timing: the pressure in every cell (the sea,
-// replicated, needs all of it), the coverage and the sums only in the cells
-// of its own pieces (the law and the horizontal loads read no other: an edge
-// piece's cell is its area piece's); cells_ elsewhere stays zero. A cell
-// where one rank's floes lie gets 0 + that rank's part: the serial sum over
-// the same pieces in the same order (order_ is the serial order restricted to
-// the rank's floes), to the bit. A cell shared by several ranks' floes gets
-// the parts' sum, which groups the pieces by rank: equal to the serial sum up
-// to round-off (a few ulps of the cell's value).
+// The serial loop adds a cell's pieces floe by floe in order_ (every dynamic
+// floe with pieces, sorted by its first cell), each floe's pieces in their
+// order; a floe's pieces are not interleaved with another's. A floating-point
+// sum depends on the order of its terms, so each rank works in that order:
+// the floes' first cells are gathered (4 bytes a floe) and every rank sorts
+// them as the serial run does (the same input, the same comparisons: the
+// same permutation, ties included), keeps its own floes in that order
+// (order_) and knows every floe's place in it (owner_.position).
 //
-// When the sea is in slabs (stage five, routed()), a rank's sea reads only
-// the pressure of its slab's rows, so each rank sends a cell's parts only to
-// the rank whose slab holds the cell's row (parallel::CellRoutes, an
-// all-to-all), which sums them in rank order from zero, as above, keeps the
-// pressure and sends the coverage and the sums back to the ranks that sent
-// the cell: the same totals to the bit, each summed once instead of on every
-// rank, and received only by the ranks that have pieces in the cell.
+// Sea in slabs (stages five and eight, routed()). A cell deeper in a rank's
+// slab than any other rank's floe reaches (CellRoutes::interior_rows) holds
+// that rank's pieces only: it sums them into cells_ and pressure_ directly,
+// as the serial loop does. Every other cell goes to the rank whose slab holds
+// its row (parallel::CellRoutes, an all-to-all) as its pieces, each with its
+// floe's serial position as key: before the law the cell, its pieces'
+// count, keys and coverage (8 bytes a cell, 12 a piece); after it the pieces'
+// a u^2 and pressure (16 bytes a piece). The cell's owner adds every rank's
+// pieces from zero in key order, which is the serial loop's order of
+// additions into that cell: the sum is the serial one to the bit, whichever
+// rank owns which floe. It keeps the pressure (its sea's kick reads its
+// slab's rows) and sends the coverage and the sums back to the ranks that
+// sent the cell. The penalty energy, a running sum over all pieces in the
+// serial order, is kept as this rank's terms and summed in that order on
+// demand (settle_energy: at records and checkpoints).
+//
+// Sea not in slabs (stage three): each rank sends, for the cells its pieces
+// lie in, its part of each sum: the cells and their coverage (12 bytes a
+// cell) before the law, the sums and pressures (16 bytes a cell) after it.
+// Every rank receives every rank's parts and adds them in rank order from
+// zero: the pressure in every cell (the sea, replicated, needs all of it),
+// the coverage and the sums only in the cells of its own pieces (the law and
+// the horizontal loads read no other: an edge piece's cell is its area
+// piece's). A cell where one rank's floes lie gets 0 + that rank's part, the
+// serial sum; a cell shared by several ranks' floes gets the parts' sum,
+// which groups the pieces by rank: equal to the serial sum up to round-off.
+#include <algorithm>
 #include <cstring>
 
 #include "coupling/floe_sea.hpp"
@@ -48,8 +62,69 @@ void FloeSeaContact::set_slabs(std::vector<int> first_row) {
   slab_rows_ = std::move(first_row);
   if (!routed()) return;
   routes_ = parallel::CellRoutes(slab_rows_, static_cast<std::size_t>(grid_.nx));
-  footprints_.set_sea_slabs(slab_rows_);
+  footprints_.set_sea_slabs(slab_rows_, true);
   owner_.interior_reach = -1;  // the interior cells are those of the new routes
+}
+
+void FloeSeaContact::order_by_owner(std::size_t floes) {
+  const Footprints& fp = footprints_.pieces();
+  OwnerCells& o = owner_;
+  o.first_cell.assign(floes, kNoCell);
+  for (std::uint32_t i : footprints_.mine())
+    if (i < fp.floes() && dynamic_[i] && fp.offsets[i] < fp.offsets[i + 1]) o.first_cell[i] = fp.cell[fp.offsets[i]];
+  comm_.complete_owned(o.first_cell, footprints_.owners());
+  // place_footprints' serial sort, on the same floes in the same order.
+  o.serial.clear();
+  for (std::size_t i = 0; i < floes; ++i)
+    if (o.first_cell[i] != kNoCell) o.serial.push_back(static_cast<std::uint32_t>(i));
+  std::sort(o.serial.begin(), o.serial.end(),
+            [&](std::uint32_t x, std::uint32_t y) { return o.first_cell[x] < o.first_cell[y]; });
+  o.position.assign(floes, kNoCell);
+  order_.clear();
+  for (std::size_t j = 0; j < o.serial.size(); ++j) {
+    const std::uint32_t i = o.serial[j];
+    o.position[i] = static_cast<std::uint32_t>(j);
+    if (footprints_.owns(i)) order_.push_back(i);
+  }
+}
+
+void FloeSeaContact::settle_energy() const {
+  // Every rank's terms, then summed from zero floe by floe in the serial
+  // order (each floe's terms in their order), as evaluate() sums them.
+  const OwnerCells& o = owner_;
+  std::vector<std::byte> message(sizeof(std::uint64_t) + o.energy_keys.size() * 2 * sizeof(std::uint32_t) +
+                                 o.energy_terms.size() * sizeof(double));
+  const std::uint64_t n = o.energy_keys.size();
+  put(put(put(put(message.data(), &n, 1), o.energy_keys.data(), o.energy_keys.size()), o.energy_counts.data(),
+          o.energy_counts.size()),
+      o.energy_terms.data(), o.energy_terms.size());
+  std::vector<std::size_t> bytes;
+  std::vector<std::byte> all;
+  comm_.allgather_bytes(message, bytes, all);
+  struct Floe {
+    std::uint32_t key, count;
+    const std::byte* terms;
+  };
+  std::vector<Floe> floes;
+  const std::byte* in = all.data();
+  for (std::size_t b : bytes) {
+    const std::size_t m = static_cast<std::size_t>(at<std::uint64_t>(in, 0));
+    const std::byte* keys = in + sizeof(std::uint64_t);
+    const std::byte* counts = keys + m * sizeof(std::uint32_t);
+    const std::byte* terms = counts + m * sizeof(std::uint32_t);
+    for (std::size_t j = 0; j < m; ++j) {
+      const std::uint32_t count = at<std::uint32_t>(counts, j);
+      floes.push_back({at<std::uint32_t>(keys, j), count, terms});
+      terms += count * sizeof(double);
+    }
+    in += b;
+  }
+  std::sort(floes.begin(), floes.end(), [](const Floe& x, const Floe& y) { return x.key < y.key; });
+  double energy = 0.0;
+  for (const Floe& f : floes)
+    for (std::size_t k = 0; k < f.count; ++k) energy += at<double>(f.terms, k);
+  penalty_energy_ = energy;
+  energy_pending_ = false;
 }
 
 void FloeSeaContact::clear_cells_by_owner() {
@@ -112,7 +187,26 @@ void FloeSeaContact::sum_coverage_by_owner() {
       o.coverage[o.piece_slot[k]] += fp.area[k] * inv_cell_area;
     }
   if (routed()) {
-    routes_.open(comm_, o.cells, o.coverage, 1);
+    // The routed cells' pieces grouped by cell, in the serial order within
+    // each (order_ is), with their floes' positions.
+    o.first.assign(o.cells.size() + 1, 0);
+    for (std::uint32_t i : order_)
+      for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k)
+        if (o.piece_slot[k] != kInteriorCell) ++o.first[o.piece_slot[k] + 1];
+    for (std::size_t j = 0; j < o.cells.size(); ++j) o.first[j + 1] += o.first[j];
+    o.keys.resize(o.first.back());
+    o.values.resize(o.first.back());
+    o.piece_at.resize(fp.cell.size());
+    std::vector<std::uint32_t> next(o.first.begin(), o.first.end() - 1);
+    for (std::uint32_t i : order_)
+      for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k) {
+        if (o.piece_slot[k] == kInteriorCell) continue;
+        const std::uint32_t p = next[o.piece_slot[k]]++;
+        o.piece_at[k] = p;
+        o.keys[p] = o.position[i];
+        o.values[p] = fp.area[k] * inv_cell_area;
+      }
+    routes_.open(comm_, o.cells, o.first, o.keys, o.values, 1);
     routes_.reply(comm_, 0, o.coverage);  // the cells' totals, in place of this rank's parts
     for (std::size_t j = 0; j < o.cells.size(); ++j) cells_[o.cells[j]].coverage = o.coverage[j];
     return;
@@ -148,36 +242,55 @@ double FloeSeaContact::sum_cells_by_owner(double ks) {
   const std::vector<double>& psi = eval_.psi;
   const std::vector<double>& force = eval_.force;
   OwnerCells& o = owner_;
-  o.sum.assign(o.cells.size(), 0.0);
-  o.pressure.assign(o.cells.size(), 0.0);
   const double inv_cell_area = 1.0 / cell_area_;
   double energy = 0.0;
+  if (routed()) {
+    // The routed pieces' a u^2 and pressure (zero where u <= 0, which the
+    // serial loop skips: adding +0 changes no sum that starts from +0), the
+    // interior cells' sums made here, and this rank's energy terms.
+    o.parts.assign(2 * o.first.back(), 0.0);
+    o.energy_keys.clear();
+    o.energy_counts.clear();
+    o.energy_terms.clear();
+    for (std::uint32_t i : order_) {
+      const std::size_t terms = o.energy_terms.size();
+      for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k) {
+        if (u[k] <= 0.0) continue;
+        const double term = 0.5 * ks * psi[k] * fp.area[k] * u[k] * u[k];
+        energy += term;
+        o.energy_terms.push_back(term);
+        if (o.piece_slot[k] == kInteriorCell) {
+          cells_[fp.cell[k]].sum += fp.area[k] * u[k] * u[k];
+          pressure_[fp.cell[k]] += force[k] * inv_cell_area;
+          continue;
+        }
+        o.parts[2 * o.piece_at[k]] = fp.area[k] * u[k] * u[k];
+        o.parts[2 * o.piece_at[k] + 1] = force[k] * inv_cell_area;
+      }
+      if (o.energy_terms.size() > terms) {
+        o.energy_keys.push_back(o.position[i]);
+        o.energy_counts.push_back(static_cast<std::uint32_t>(o.energy_terms.size() - terms));
+      }
+    }
+    const double total = routes_.add(comm_, o.parts, 2, energy);
+    const std::span<const std::uint32_t> slab = routes_.owned();
+    for (std::size_t j = 0; j < slab.size(); ++j) pressure_[slab[j]] = routes_.total(j, 1);  // zero before: 0 + the total
+    o.sum.resize(o.cells.size());
+    routes_.reply(comm_, 0, o.sum);
+    for (std::size_t j = 0; j < o.cells.size(); ++j) cells_[o.cells[j]].sum = o.sum[j];
+    energy_pending_ = true;  // the ranks' parts summed in rank order until settled
+    return total;
+  }
+  o.sum.assign(o.cells.size(), 0.0);
+  o.pressure.assign(o.cells.size(), 0.0);
   for (std::uint32_t i : order_)
     for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k) {
       if (u[k] <= 0.0) continue;
       const std::uint32_t j = o.piece_slot[k];
       energy += 0.5 * ks * psi[k] * fp.area[k] * u[k] * u[k];
-      if (j == kInteriorCell) {
-        cells_[fp.cell[k]].sum += fp.area[k] * u[k] * u[k];
-        pressure_[fp.cell[k]] += force[k] * inv_cell_area;
-        continue;
-      }
       o.sum[j] += fp.area[k] * u[k] * u[k];
       o.pressure[j] += force[k] * inv_cell_area;
     }
-  if (routed()) {
-    o.parts.resize(2 * o.cells.size());
-    for (std::size_t j = 0; j < o.cells.size(); ++j) {
-      o.parts[2 * j] = o.sum[j];
-      o.parts[2 * j + 1] = o.pressure[j];
-    }
-    const double total = routes_.add(comm_, o.parts, 2, energy);
-    const std::span<const std::uint32_t> slab = routes_.owned();
-    for (std::size_t j = 0; j < slab.size(); ++j) pressure_[slab[j]] = routes_.total(j, 1);  // zero before: 0 + the total
-    routes_.reply(comm_, 0, o.sum);
-    for (std::size_t j = 0; j < o.cells.size(); ++j) cells_[o.cells[j]].sum = o.sum[j];
-    return total;
-  }
   // Message: the energy, then the sums and pressures of the cells sent
   // before (every rank knows how many).
   o.message.resize(sizeof(double) * (1 + 2 * o.cells.size()));

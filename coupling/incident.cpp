@@ -42,15 +42,16 @@ void IncidentSea::take(Snapshot& u, Snapshot& v) {
   for (auto [field, s] : {std::pair{fluid::Field::velocity_x, &u}, std::pair{fluid::Field::velocity_y, &v}}) {
     const fluid::RowWindow w = sea_->field(field);
     s->rows = {w.first_row(), w.rows()};
+    s->halo = sea_->in_slabs() ? halo_ : -1;
     s->values.assign(w.values().begin(), w.values().end());
     sea_->release_field(field);
   }
   sea_->set_field_halo(-1);
 }
 
-void IncidentSea::cut(Snapshot& s, const fluid::Sea::WindowRows& rows) const {
+void IncidentSea::cut(Snapshot& s, const fluid::Sea::WindowRows& rows, int halo) const {
   const fluid::SurfaceGrid& g = sea_->grid();
-  if (!(s.rows.first == 0 && s.rows.rows == g.ny) || rows.rows == g.ny) return;  // only whole ones are cut
+  if (s.halo >= 0 || rows.rows == g.ny) return;  // only whole ones are cut
   const auto nx = static_cast<std::size_t>(g.nx);
   std::vector<double> kept(static_cast<std::size_t>(rows.rows) * nx);
   for (int j = 0; j < rows.rows; ++j) {
@@ -60,13 +61,21 @@ void IncidentSea::cut(Snapshot& s, const fluid::Sea::WindowRows& rows) const {
   }
   s.values = std::move(kept);
   s.rows = rows;
+  s.halo = halo;
 }
 
 void IncidentSea::advance_to(double t, int halo) {
   halo_ = halo;
   if (sea_->in_slabs() && halo >= 0) {
     const fluid::Sea::WindowRows rows = sea_->field_rows(halo);
-    for (Snapshot* s : {&u0_, &v0_, &u1_, &v1_}) cut(*s, rows);
+    for (Snapshot* s : {&u0_, &v0_, &u1_, &v1_}) {
+      cut(*s, rows, halo);
+      // s.halo is the same on every rank: all widen, or none.
+      if (s->halo >= 0 && s->halo < halo) {
+        sea_->widen_window(s->values, s->rows, halo);
+        s->halo = halo;
+      }
+    }
   }
   if (!(tau_ > 0.0)) {
     if (t > t1_) sea_->flow(t - t1_);

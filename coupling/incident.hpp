@@ -38,8 +38,11 @@ public:
   // set_field_halo: the snapshots taken from now on are windows of this
   // rank's slab of the incident sea and `halo` rows either side, and whole
   // ones (taken at construction or restored) are cut to that window (a
-  // copy of its rows); halo < 0, whole snapshots. Collective in slabs:
-  // every rank calls it with the same t and halo.
+  // copy of its rows), and windows taken for a smaller halo are widened to
+  // it from the other ranks' rows (fluid::Sea::widen_window: the halo grows
+  // when the coupling's floes follow the run's sea's slabs away from this
+  // sea's); halo < 0, whole snapshots. Collective in slabs: every rank
+  // calls it with the same t and halo.
   void advance_to(double t, int halo = -1);
   // The weight w of the t1 snapshot at time t.
   double weight(double t) const;
@@ -62,13 +65,14 @@ private:
   struct Snapshot {
     fluid::Sea::WindowRows rows;
     std::vector<double> values;
+    int halo = -1;  // the halo its window was taken or widened for; -1: whole
     fluid::RowWindow window(const fluid::Sea& sea) const {
       return fluid::RowWindow(rows.first, rows.rows, sea.grid().nx, sea.grid().ny, values);
     }
   };
   void take(Snapshot& u, Snapshot& v);
   // A whole snapshot cut to `rows` (a copy of those rows).
-  void cut(Snapshot& s, const fluid::Sea::WindowRows& rows) const;
+  void cut(Snapshot& s, const fluid::Sea::WindowRows& rows, int halo) const;
 
   std::unique_ptr<fluid::Sea> sea_;
   double tau_ = 0.0;

@@ -53,17 +53,18 @@ bool MovingFootprints::place(const Floes& floes, std::span<const std::uint8_t> i
 void MovingFootprints::set_slabs(std::vector<int> first_row) {
   row_owner_ = parallel::row_owners(first_row);
   owner_rows_ = first_row;
+  next_owner_rows_.clear();
   sea_rows_ = std::move(first_row);
   FLOESIM_ASSERT(row_owner_.empty() || static_cast<int>(row_owner_.size()) == grid_.ny);
 }
 
-int MovingFootprints::reach_rows() const {
-  // The sea's slabs moved away from the owners' (stage seven): a floe's
+int MovingFootprints::reach_rows_from(std::span<const int> first_row) const {
+  // The owners' slabs moved away from first_row (stage seven): a floe's
   // pieces lie within piece_rows_ of its owner's slab, which is at most the
-  // largest move of a cut away from the owner's slab in the sea now.
+  // largest move of a cut away from the owner's slab in first_row.
   int moved = 0;
-  if (sea_rows_.size() == owner_rows_.size())
-    for (std::size_t r = 0; r < sea_rows_.size(); ++r) moved = std::max(moved, std::abs(sea_rows_[r] - owner_rows_[r]));
+  if (first_row.size() == owner_rows_.size())
+    for (std::size_t r = 0; r < first_row.size(); ++r) moved = std::max(moved, std::abs(first_row[r] - owner_rows_[r]));
   return piece_rows_ + moved;
 }
 
@@ -71,6 +72,12 @@ void MovingFootprints::set_owners(std::span<const FloePose> poses) {
   const std::size_t n = poses.size();
   owner_.assign(n, 0);
   by_place_ = !comm_.serial() && !row_owner_.empty();
+  if (by_place_ && !next_owner_rows_.empty()) {
+    // The sea's slabs moved since the last rebuild: the owners follow them.
+    row_owner_ = parallel::row_owners(next_owner_rows_);
+    owner_rows_ = std::move(next_owner_rows_);
+    next_owner_rows_.clear();
+  }
   if (by_place_) {
     // The row of the centroid, the grid's seam crossed (periodic).
     const double dy = grid_.dy();

@@ -87,12 +87,15 @@ public:
   // fluid::Sea::slab_rows gives it (rank r's slab holds rows [first_row[r],
   // first_row[r + 1]) of the grid); empty: by index.
   void set_slabs(std::vector<int> first_row);
-  // The sea's slabs moved (issue 21 stage seven) while the owners stay on
-  // set_slabs' slabs: reach_rows() grows by the largest move of a cut, so
-  // that the pieces of a rank's floes still lie within reach_rows() of its
-  // slab of the sea.
-  void set_sea_slabs(std::vector<int> first_row) {
+  // The sea's slabs moved (issue 21 stage seven). With `owners_follow` the
+  // owners follow them from the next rebuild on (the pieces stay with their
+  // builder until then); else they stay on the slabs of set_slabs. Until
+  // the owners' slabs are the sea's, reach_rows() grows by the largest move
+  // of a cut, so that the pieces of a rank's floes still lie within
+  // reach_rows() of its slab of the sea.
+  void set_sea_slabs(std::vector<int> first_row, bool owners_follow) {
     FLOESIM_ASSERT(first_row.size() == owner_rows_.size());
+    if (owners_follow) next_owner_rows_ = first_row;
     sea_rows_ = std::move(first_row);
   }
   // This rank's floes, in floe order, and each floe's owner (the same on
@@ -108,7 +111,12 @@ public:
   // largest move of a cut is added: the pieces then lie within that many
   // rows of their owner's slab of the sea.
   bool by_place() const { return by_place_; }
-  int reach_rows() const;
+  // The slabs the owners were set by at the last rebuild (empty: by index).
+  std::span<const int> owner_slabs() const { return owner_rows_; }
+  int reach_rows() const { return reach_rows_from(sea_rows_); }
+  // The same from other slabs (first_row as set_slabs takes it): the rows a
+  // floe's pieces may lie from those slabs' slab of its owner.
+  int reach_rows_from(std::span<const int> first_row) const;
 
   // The next placement rebuilds (the floes changed).
   void forget() { reference_.clear(); }
@@ -151,7 +159,10 @@ private:
   std::vector<std::uint32_t> mine_;
   bool by_place_ = false;
   int piece_rows_ = 0;  // the rows a floe's pieces may lie from its centroid's row (last rebuild)
-  std::vector<int> owner_rows_, sea_rows_;  // the slabs that give the owners (set_slabs), the sea's now (set_sea_slabs)
+  // The slabs that gave the owners at the last rebuild, the sea's now
+  // (set_sea_slabs), and those the next rebuild's owners follow (empty:
+  // owner_rows_).
+  std::vector<int> owner_rows_, sea_rows_, next_owner_rows_;
 };
 
 }  // namespace floesim

@@ -228,6 +228,14 @@ public:
   // `whole`; the other ranks get `whole` empty. Collective in slabs (every
   // rank calls it); not in slabs, w's values (w whole).
   virtual void gather_to_writer_rows(const RowWindow& w, std::vector<double>& whole);
+  // In slabs: `values` hold the window `rows` of a field (which holds this
+  // rank's slab); on exit they hold the window of `halo` rows
+  // (field_rows(halo)), the rows beyond the slab from their slabs' ranks
+  // (one all-to-all: the fields' halo exchange). For a window kept from an
+  // earlier step whose halo has to grow (the incident waves' snapshots when
+  // the coupling's floes move with the slabs). Collective in slabs: every
+  // rank calls it with the same halo >= 0. Not in slabs: nothing (whole).
+  virtual void widen_window(std::vector<double>& /*values*/, WindowRows& /*rows*/, int /*halo*/) {}
   // The whole fields' point values (a sea not in slabs, or halo < 0).
   SurfaceSample sample(double x, double y = 0.0);
   // Collective in slabs (the modes' terms are summed in the whole bank's

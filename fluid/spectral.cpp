@@ -171,6 +171,23 @@ void SpectralSea::gather_to_writer_rows(const RowWindow& w, std::vector<double>&
   m.gather_rows(own, m.ranks.rank == 0 ? whole.data() : nullptr);
 }
 
+void SpectralSea::widen_window(std::vector<double>& values, WindowRows& rows, int halo) {
+  Impl& m = *impl_;
+  if (!m.slab) return;
+  FLOESIM_ASSERT(halo >= 0);
+  // This rank's slab rows into the new window, then its halo from the
+  // slabs' ranks, as a field computed for that halo gets it.
+  const WindowRows w = m.window(halo);
+  std::vector<double> out(static_cast<std::size_t>(w.rows) * static_cast<std::size_t>(m.nx), 0.0);
+  const std::size_t row = static_cast<std::size_t>(m.nx);
+  for (int y = m.rows.begin; y < m.rows.end; ++y)
+    std::copy_n(values.begin() + static_cast<std::ptrdiff_t>(m.at_row(rows, y)), row,
+                out.begin() + static_cast<std::ptrdiff_t>(m.at_row(w, y)));
+  m.exchange_halo(out, halo, w);
+  values = std::move(out);
+  rows = w;
+}
+
 double SpectralSea::take_row_seconds() { return impl_->slab ? impl_->slab->take_row_seconds() : 0.0; }
 
 const TankZones* SpectralSea::tank() const { return impl_->tank ? &*impl_->tank : nullptr; }

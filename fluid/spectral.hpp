@@ -68,6 +68,7 @@ public:
   WindowRows field_rows(int halo) const override;
   bool in_slabs() const override;
   void gather_to_writer_rows(const RowWindow& w, std::vector<double>& whole) override;
+  void widen_window(std::vector<double>& values, WindowRows& rows, int halo) override;
 
   // What this sea allocates: `modes`, the modes its bank holds (every mode
   // of the half spectrum, or in slabs this rank's columns of each row);

@@ -7,7 +7,7 @@
 // hold exactly the cells of its slab that some rank sent. Each rank has
 // random distinct cells all over the grid (many shared by several ranks),
 // parts of random sign and size; slabs of uneven height, one empty on 3
-// ranks. Run by ctest as mpi.cell_routes_ranks_N under `mpirun
+// ranks. Then pieces with order keys (pieces_in_key_order). Run by ctest as mpi.cell_routes_ranks_N under `mpirun
 // --oversubscribe -np N` (N = 1, 2, 3), and serially without MPI.
 #include <algorithm>
 #include <cmath>
@@ -84,6 +84,75 @@ bool routes_equal_merge(const parallel::Communicator& comm, int nx, int ny, cons
   return equal;
 }
 
+// Pieces with order keys (stage eight): each rank has random distinct
+// cells, each with 1 to 3 pieces whose keys are drawn from a small range (so
+// that pieces of several ranks interleave in a cell and some keys repeat);
+// the owners' totals must equal, to the bit, the sum from zero of every
+// rank's pieces of the cell sorted by key (equal keys in rank order, then in
+// the sender's order), for open()'s values and for add()'s.
+bool pieces_in_key_order(const parallel::Communicator& comm, int nx, int ny, const std::vector<int>& cut, unsigned seed) {
+  const std::size_t n = static_cast<std::size_t>(nx) * static_cast<std::size_t>(ny);
+  std::mt19937_64 rng(seed * 7 + static_cast<unsigned>(comm.rank()));
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  std::vector<std::uint32_t> cells, first{0}, keys;
+  for (std::uint32_t c = 0; c < n; ++c)
+    if (u(rng) < 0.0) cells.push_back(c);
+  std::shuffle(cells.begin(), cells.end(), rng);
+  for (std::size_t j = 0; j < cells.size(); ++j) {
+    const int count = 1 + static_cast<int>(rng() % 3);
+    std::vector<std::uint32_t> k;
+    for (int q = 0; q < count; ++q) k.push_back(static_cast<std::uint32_t>(rng() % 8));
+    std::sort(k.begin(), k.end());  // a sender's pieces of a cell come in key order
+    keys.insert(keys.end(), k.begin(), k.end());
+    first.push_back(static_cast<std::uint32_t>(keys.size()));
+  }
+  std::vector<double> one(keys.size()), two(2 * keys.size());
+  for (double& x : one) x = u(rng) * std::exp(10.0 * u(rng));
+  for (double& x : two) x = u(rng) * std::exp(10.0 * u(rng));
+  // The reference: every rank's pieces (cell, key, rank, index), sorted, summed from zero.
+  std::vector<std::uint32_t> piece_cell(keys.size());
+  for (std::size_t j = 0; j < cells.size(); ++j)
+    for (std::uint32_t p = first[j]; p < first[j + 1]; ++p) piece_cell[p] = cells[j];
+  std::vector<std::size_t> counts;
+  const std::vector<std::uint32_t> all_cell = comm.allgather<std::uint32_t>(piece_cell);
+  const std::vector<std::uint32_t> all_key = comm.allgather<std::uint32_t>(keys);
+  const std::vector<double> all_one = comm.allgather<double>(one), all_two = comm.allgather<double>(two);
+  std::vector<std::size_t> order(all_cell.size());
+  for (std::size_t k = 0; k < order.size(); ++k) order[k] = k;  // index order is rank order, then the sender's
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+    return all_cell[a] != all_cell[b] ? all_cell[a] < all_cell[b] : all_key[a] < all_key[b];
+  });
+  std::vector<double> ref1(n, 0.0), ref2(2 * n, 0.0);
+  for (std::size_t k : order) {
+    ref1[all_cell[k]] += all_one[k];
+    ref2[2 * all_cell[k]] += all_two[2 * k];
+    ref2[2 * all_cell[k] + 1] += all_two[2 * k + 1];
+  }
+  parallel::CellRoutes routes(cut, static_cast<std::size_t>(nx));
+  bool equal = true;
+  routes.open(comm, cells, first, keys, one, 1);
+  for (std::size_t j = 0; j < routes.owned().size(); ++j) equal = equal && same_bits(routes.total(j, 0), ref1[routes.owned()[j]]);
+  std::vector<double> back(cells.size());
+  routes.reply(comm, 0, back);
+  for (std::size_t k = 0; k < cells.size(); ++k) equal = equal && same_bits(back[k], ref1[cells[k]]);
+  routes.add(comm, two, 2, 0.0);
+  for (std::size_t j = 0; j < routes.owned().size(); ++j)
+    for (int w = 0; w < 2; ++w) equal = equal && same_bits(routes.total(j, w), ref2[2 * routes.owned()[j] + w]);
+  routes.reply(comm, 1, back);
+  for (std::size_t k = 0; k < cells.size(); ++k) equal = equal && same_bits(back[k], ref2[2 * cells[k] + 1]);
+  // A test that could fail: summed in rank order instead, some cell differs.
+  std::size_t differs = 0;
+  {
+    std::vector<double> by_rank(n, 0.0);
+    for (std::size_t k = 0; k < all_cell.size(); ++k) by_rank[all_cell[k]] += all_one[k];
+    for (std::size_t c = 0; c < n; ++c) differs += same_bits(by_rank[c], ref1[c]) ? 0 : 1;
+  }
+  std::printf("rank %d of %d, %d x %d, %zu cells, %zu pieces, %zu owned (%zu cells of the grid differ summed in rank order): %s\n",
+              comm.rank(), comm.size(), nx, ny, cells.size(), keys.size(), routes.owned().size(), differs,
+              equal ? "the pieces summed in key order, bit for bit" : "DIFFERENT");
+  return equal && (comm.size() == 1 || differs > 0);
+}
+
 }  // namespace
 
 int main() {
@@ -103,6 +172,7 @@ int main() {
     }
     if (ranks >= 3) cut[2] = cut[1];
     if (!routes_equal_merge(comm, nx, ny, cut, static_cast<unsigned>(nx))) ++failed;
+    if (!pieces_in_key_order(comm, nx, ny, cut, static_cast<unsigned>(ny))) ++failed;
   }
   failed = comm.sum(failed);
   if (comm.writer()) std::printf("%s on %d ranks\n", failed == 0 ? "passed" : "FAILED", ranks);

@@ -13,13 +13,18 @@ cuts move from the equal shares toward the floes (parallel.slab_rows, every
 10 steps by the gathered CPU times). Checked:
   - the slabs moved (parallel.strip_moves > 0 and parallel.slab_rows not the
     equal shares) on 2 and 3 ranks;
-  - the run files equal the serial one within issue 21's relative 1e-6 (as
-    mpi.sea_ranks_equal_serial: a cell with pieces of floes of several ranks
-    sums them grouped by rank);
+  - the run files equal the serial one bit for bit (as
+    mpi.sea_ranks_equal_serial: the cells' sums are made in the serial order
+    whatever the owners, stage eight);
   - two runs on 2 ranks are equal bit for bit: the slabs' moves follow the
     timings, but the answer does not depend on them (the sea's row blocks
-    are transformed by the same plans wherever they lie, and the coupling's
-    floe owners, which fix the round-off grouping, stay on the first slabs).
+    are transformed by the same plans wherever they lie, and the cells' sums
+    do not depend on which rank owns which floe);
+  - the coupling's floe owners follow the slabs (stage eight): with the
+    footprints rebuilt at every evaluation (footprint_reach = 0, the run
+    "rebuilt"), the slabs they were set by at the last rebuild
+    (parallel.coupling_slab_rows) are the sea's at the end and not the first,
+    equal ones, and that run too equals the serial one bit for bit.
 """
 import os
 import sys
@@ -56,8 +61,25 @@ for n, out in ((2, "ranks2.h5"), (3, "ranks3.h5"), (2, "ranks2_again.h5")):
     print(f"{n} ranks ({out}): slabs {rows}, {moves} moves, floes by strip {s.get('parallel.strip_floes')}")
     if moves == 0 or rows == EQUAL[n]:
         failures.append(f"{n} ranks: the slabs did not move ({rows}, {moves} moves): the check would not test the moves")
-    p = compare(out, "serial.h5", "1e-6")
-    print(f"{n} ranks ({out}): {'equal' if p.returncode == 0 else 'DIFFERENT'} to the serial run (within 1e-6)")
+    p = compare(out, "serial.h5", "0")
+    print(f"{n} ranks ({out}): {'equal' if p.returncode == 0 else 'DIFFERENT'} to the serial run (bit for bit)")
+    if p.returncode != 0:
+        failures.append(f"{out} against the serial run:\n{p.stdout}")
+# The owners follow the slabs: footprints rebuilt at every evaluation.
+rebuilt = os.path.join(W, "half_rebuilt.toml")
+with open(rebuilt, "w") as f:
+    f.write(ocean_toml("half_pack.h5", 3.0, 0.5, contact="box = [0.0, 200.0, 0.0, 200.0]\n"))
+need(run([floesim, "run", rebuilt, "-o", "rebuilt_serial.h5", "-q"]), "the serial run (rebuilt)")
+for n in (2, 3):
+    out = f"rebuilt{n}.h5"
+    s = summary(need(mpirun(n, "run", rebuilt, "-o", out), f"the rebuilt run on {n} ranks"))
+    rows = [int(x) for x in s.get("parallel.slab_rows", "").split()]
+    owners = [int(x) for x in s.get("parallel.coupling_slab_rows", "").split()]
+    print(f"{n} ranks ({out}): slabs {rows}, the coupling's owners by {owners}")
+    if rows == EQUAL[n] or owners != rows:
+        failures.append(f"{n} ranks rebuilt: the coupling's owners did not follow the slabs ({owners} against {rows})")
+    p = compare(out, "rebuilt_serial.h5", "0")
+    print(f"{n} ranks ({out}): {'equal' if p.returncode == 0 else 'DIFFERENT'} to the serial run (bit for bit)")
     if p.returncode != 0:
         failures.append(f"{out} against the serial run:\n{p.stdout}")
 p = compare("ranks2.h5", "ranks2_again.h5", "0")
