@@ -91,6 +91,9 @@ namespace fracture { class FloeFracture; }
 // Rows are in the order of the solves, then of the floe numbers.
 std::vector<CollisionEventRow> collision_rows(const Floes& floes, const contact::ImpulseRecord& record, double t);
 
+// On several ranks the counts are the serial run's (every rank adds every
+// rank's, Percussion::conclude); models and the seconds are this rank's own
+// (the models it built, the time it spent).
 struct PercussionStats {
   long checks = 0;        // floes analysed (again when a step is redone)
   long screened = 0;      // floes loaded but below the screen
