@@ -123,16 +123,26 @@ struct PercussionStats {
 // summed over the shares, they are the serial run's.
 struct PercussionCounts {
   long checks = 0, screened = 0, bounded = 0, sustained = 0, cut_short = 0, loop_steps = 0;
+  PercussionCounts& operator+=(const PercussionCounts& o) {
+    checks += o.checks;
+    screened += o.screened;
+    bounded += o.bounded;
+    sustained += o.sustained;
+    cut_short += o.cut_short;
+    loop_steps += o.loop_steps;
+    return *this;
+  }
 };
 
 // One share of the analyses: per floe the rank that analyses it, and this
-// share's rank (numbers, as contact::ClusterShare). An empty `owner` gives
-// every floe to this share (the serial run); a floe past the end of `owner`
-// (added by a split since the owners were made) is rank 0's.
+// share's rank (numbers, as contact::ClusterShare). A floe past the end of
+// `owner` (added by a split since the owners were made; every floe when it
+// is empty) is rank 0's: so every floe has one rank, and the default share,
+// rank 0 with no owners, is the serial run's.
 struct PercussionShare {
   std::span<const int> owner;
   int rank = 0;
-  bool mine(std::size_t i) const { return owner.empty() || (i < owner.size() ? owner[i] : 0) == rank; }
+  bool mine(std::size_t i) const { return (i < owner.size() ? owner[i] : 0) == rank; }
 };
 
 // A loaded floe's initiation (one case of its step initiated): the event

@@ -324,12 +324,7 @@ void Simulation::percussion(const StepContext& ctx) {
     const PercussionAnalyses& p = parts[r];
     percussion_ranks_.checks[r] += p.counts.checks;
     percussion_ranks_.seconds[r] += p.seconds;
-    counts.checks += p.counts.checks;
-    counts.screened += p.counts.screened;
-    counts.bounded += p.counts.bounded;
-    counts.sustained += p.counts.sustained;
-    counts.cut_short += p.counts.cut_short;
-    counts.loop_steps += p.counts.loop_steps;
+    counts += p.counts;
     initiations.insert(initiations.end(), p.initiations.begin(), p.initiations.end());
   }
   if (percussion_->conclude(scenario_.floes, counts, std::move(initiations))) on_floes_changed();

@@ -147,12 +147,7 @@ TEST_CASE("percussion by owner: the analyses shared by 1, 2 and 3 ranks and conc
       for (int r = 0; r < ranks; ++r) {
         const PercussionAnalyses& p = parts[static_cast<std::size_t>(r)];
         checks[static_cast<std::size_t>(r)] += p.counts.checks;
-        counts.checks += p.counts.checks;
-        counts.screened += p.counts.screened;
-        counts.bounded += p.counts.bounded;
-        counts.sustained += p.counts.sustained;
-        counts.cut_short += p.counts.cut_short;
-        counts.loop_steps += p.counts.loop_steps;
+        counts += p.counts;
         // In rank order, not floe order: conclude sorts them.
         all.insert(all.end(), p.initiations.begin(), p.initiations.end());
       }
