@@ -379,6 +379,15 @@ int run(const Args& args, const parallel::Session& session) {
     o << "\nparallel.collide_steps: " << collide.steps << "\nparallel.collide_fallbacks: " << collide.fallbacks
       << "\nparallel.collide_whole: " << collide.whole << "\nparallel.collide_groups:";
     for (const long k : collide.clusters) o << " " << k;
+    // The fracture analyses by owner: the steps that exchanged them, each
+    // rank's checks (they sum to fracture.checks) and its wall time in them.
+    if (sim.percussion_stats()) {
+      const PercussionRanks& fr = sim.percussion_ranks();
+      o << "\nparallel.fracture_steps: " << fr.steps << "\nparallel.fracture_checks:";
+      for (const long k : fr.checks) o << " " << k;
+      o << "\nparallel.fracture_seconds:";
+      for (const double x : fr.seconds) o << " " << x;
+    }
     o << "\n";
     // Stage eight: the slabs the coupling's floe owners followed at the
     // footprints' last rebuild.

@@ -19,7 +19,8 @@ give rank 0's strip cuts, the floes in each strip at the end and each rank's
 by-place seconds over the last balance window (parallel.strip_* keys).
 --percussion adds percussion fracture (splits on, strength 0.2 MPa) and
 [run] record_collisions: a run that keeps the impulse record (stage seven:
-its collisions by owner, the record merged in the serial order);
+its collisions by owner, the record merged in the serial order; the
+fracture checks by owner, with each rank's checks and seconds in them);
 --record-collisions adds record_collisions alone (the record without the
 fracture check, which runs whole on every rank).
 
@@ -64,7 +65,8 @@ if args.percussion or args.record_collisions:
 phases = ["drift", "collide", "advance", "detect", "record", "choose_dt", "check"] + (["percussion"] if args.percussion else [])
 strips = ["strip_cuts", "strip_floes", "strip_seconds", "strip_seconds_total", "advance_steps", "advance_fallbacks",
           "advance_whole",
-          "advance_clusters", "collide_steps", "collide_fallbacks", "collide_whole", "collide_groups"]
+          "advance_clusters", "collide_steps", "collide_fallbacks", "collide_whole", "collide_groups"] + \
+    (["fracture_steps", "fracture_checks", "fracture_seconds"] if args.percussion else [])
 rows = []
 load_before = ranks_bench.load()
 for r in range(args.rounds):
@@ -88,7 +90,9 @@ ranks_bench.write_table(
     "waits in collectives included; strip_*: rank 0's parallel.strip_* summary keys (the cuts in y, m; floes "
     "per strip at the end; each rank's by-place CPU seconds over the last balance window and over all windows; "
     "advance_*: the advances by cluster owner, stage seven: tried, redone whole, done whole by the back-off, "
-    "clusters run by each rank; collide_*: the step-start collisions by owner, the same way, step groups by rank), "
+    "clusters run by each rank; collide_*: the step-start collisions by owner, the same way, step groups by rank; "
+    "fracture_*: the fracture checks by owner: steps that exchanged them, each rank's analyses and its wall "
+    "seconds in them), "
     "blank before stage six (collide_*: before the step-start collisions by owner)",
     load_before, ranks_bench.load(),
     "ranks,round,wall_s,steps,lcps,bytes_received,collective_s,cpu_s," + ",".join(p + "_s" for p in phases) + "," +

@@ -1,5 +1,6 @@
 #include "coupling/percussion.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <map>
@@ -9,6 +10,7 @@
 #include "contact/fracture/floe_fracture.hpp"
 #include "contact/fracture/split.hpp"
 #include "contact/shapes.hpp"
+#include "parallel/bytes.hpp"
 
 namespace floesim {
 
@@ -102,19 +104,34 @@ struct FloeLoads {
 };
 
 bool Percussion::check(Floes& floes, const contact::ImpulseRecord& record, double t, double dt) {
+  PercussionAnalyses all = analyse(floes, record, t, dt, PercussionShare{});
+  return all.loaded && conclude(floes, all.counts, std::move(all.initiations));
+}
+
+PercussionAnalyses Percussion::analyse(const Floes& floes, const contact::ImpulseRecord& record, double t, double dt,
+                                       const PercussionShare& share) {
   const auto phase_begin = std::chrono::steady_clock::now();
-  struct PhaseClock {  // adds the phase's wall time on every return
+  PercussionAnalyses out;
+  struct PhaseClock {  // adds the analyses' wall time on every return
     std::chrono::steady_clock::time_point begin;
     double& total;
-    ~PhaseClock() { total += std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count(); }
-  } phase_clock{phase_begin, stats_.phase_seconds};
+    double& mine;
+    ~PhaseClock() {
+      mine = std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
+      total += mine;
+    }
+  } phase_clock{phase_begin, stats_.phase_seconds, out.seconds};
   if (t != fresh_time_) {
     fresh_.clear();
     fresh_time_ = t;
   }
+  // Every share reads the whole record (whether any floe is loaded is the
+  // same on all) and keeps its own floes' loads.
   std::map<std::size_t, FloeLoads> loaded;  // by floe index
   for (const contact::ImpulseRecord::Load& l : record.loads) {
     if (l.floe >= floes.size() || floes.is_static[l.floe] || fresh_.count(floes.id[l.floe])) continue;
+    out.loaded = true;
+    if (!share.mine(l.floe)) continue;
     FloeLoads& fl = loaded[l.floe];
     const double size = l.impulse.norm();
     if (l.sustained) {
@@ -127,12 +144,11 @@ bool Percussion::check(Floes& floes, const contact::ImpulseRecord& record, doubl
       e.largest = std::max(e.largest, size);
     }
   }
-  if (loaded.empty()) return false;
 
   const double needed = params_.criterion == FractureCriterion::stress
                             ? params_.strength
                             : std::sqrt(params_.young * params_.toughness / (M_PI * params_.mesh_size));
-  bool changed = false;
+  PercussionCounts& counts = out.counts;
   for (auto& [i, fl] : loaded) {
     const double h = floes.thickness[i];
     const double radius = params_.load_radius > 0.0 ? params_.load_radius : h;
@@ -164,7 +180,7 @@ bool Percussion::check(Floes& floes, const contact::ImpulseRecord& record, doubl
     }
     if (cases.empty() && !fl.forces.empty() && sustained_scale >= screen_ * needed) cases.push_back(nullptr);
     if (cases.empty()) {
-      ++stats_.screened;
+      ++counts.screened;
       continue;
     }
     for (const FloeLoads::Event* e : cases) {
@@ -183,23 +199,30 @@ bool Percussion::check(Floes& floes, const contact::ImpulseRecord& record, doubl
         if (below) {
           stats_.seconds += std::chrono::duration<double>(bound_end - begin).count();
           stats_.factor_seconds += model.responder().factor_seconds() - factor_before;
-          ++stats_.bounded;
+          ++counts.bounded;
           continue;
         }
       }
       const fracture::FloeFracture::Result result = model.decide(loads);
       stats_.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
       stats_.factor_seconds += model.responder().factor_seconds() - factor_before;
-      ++stats_.checks;
-      if (!e) ++stats_.sustained;
-      if (result.response.cut_short) ++stats_.cut_short;
-      stats_.loop_steps += result.response.steps;
+      ++counts.checks;
+      if (!e) ++counts.sustained;
+      if (result.response.cut_short) ++counts.cut_short;
+      counts.loop_steps += result.response.steps;
       const fracture::Initiation& init = result.initiation;
       if (!init.initiates) continue;
-      ++stats_.initiations;
+      // The event in world coordinates at the step's end: floe i's state is
+      // the same when conclude() reaches it (earlier splits leave it).
       const FloeState& s = floes.state[i];
       const Vec2 g{s.x, s.y};
-      FractureEventRow ev;
+      FloeInitiation fi;
+      fi.floe = i;
+      fi.through = init.through ? 1 : 0;
+      fi.point_x = init.point.x();
+      fi.point_y = init.point.y();
+      fi.direction = init.direction;
+      FractureEventRow& ev = fi.event;
       ev.time = t;
       ev.floe = floes.id[i];
       const Vec2 at = g + rotate(init.point, s.yaw), from = g + rotate(init.crack_from, s.yaw),
@@ -217,16 +240,58 @@ bool Percussion::check(Floes& floes, const contact::ImpulseRecord& record, doubl
       ev.energy_released = init.energy_released;
       ev.energy_needed = init.energy_needed;
       ev.delay = init.time;  // 0 for a static analysis (sustained contact alone), > 0 for an impact
-      if (params_.split && init.through) {
-        const auto cut = std::chrono::steady_clock::now();
-        if (split(floes, i, init.point, init.direction, ev)) changed = true;
-        stats_.split_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - cut).count();
-      }
-      events_.push_back(ev);
+      out.initiations.push_back(fi);
       break;  // one initiation per floe and step: the floe has cracked
     }
   }
+  return out;
+}
+
+bool Percussion::conclude(Floes& floes, const PercussionCounts& counts, std::vector<FloeInitiation> initiations) {
+  const auto begin = std::chrono::steady_clock::now();
+  stats_.checks += counts.checks;
+  stats_.screened += counts.screened;
+  stats_.bounded += counts.bounded;
+  stats_.sustained += counts.sustained;
+  stats_.cut_short += counts.cut_short;
+  stats_.loop_steps += counts.loop_steps;
+  // The serial order: by floe index (each floe at most once).
+  std::sort(initiations.begin(), initiations.end(),
+            [](const FloeInitiation& a, const FloeInitiation& b) { return a.floe < b.floe; });
+  bool changed = false;
+  for (FloeInitiation& fi : initiations) {
+    ++stats_.initiations;
+    if (params_.split && fi.through) {
+      const auto cut = std::chrono::steady_clock::now();
+      if (split(floes, fi.floe, Vec2{fi.point_x, fi.point_y}, fi.direction, fi.event)) changed = true;
+      stats_.split_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - cut).count();
+    }
+    events_.push_back(fi.event);
+  }
+  stats_.phase_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
   return changed;
+}
+
+std::vector<std::byte> pack(const PercussionAnalyses& analyses) {
+  std::vector<std::byte> out(sizeof(PercussionCounts) + sizeof(double) + sizeof(std::uint64_t) +
+                             analyses.initiations.size() * sizeof(FloeInitiation));
+  const std::uint64_t n = analyses.initiations.size();
+  std::byte* at = parallel::put(out.data(), &analyses.counts, 1);
+  at = parallel::put(at, &analyses.seconds, 1);
+  at = parallel::put(at, &n, 1);
+  parallel::put(at, analyses.initiations.data(), analyses.initiations.size());
+  return out;
+}
+
+PercussionAnalyses unpack_percussion(std::span<const std::byte> bytes) {
+  PercussionAnalyses a;
+  a.loaded = true;
+  const std::byte* in = bytes.data();
+  a.counts = parallel::take<PercussionCounts>(in, 1)[0];
+  a.seconds = parallel::take<double>(in, 1)[0];
+  const auto n = parallel::take<std::uint64_t>(in, 1)[0];
+  a.initiations = parallel::take<FloeInitiation>(in, n);
+  return a;
 }
 
 double Percussion::min_fragment_area() const {

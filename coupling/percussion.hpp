@@ -54,9 +54,24 @@
 // Models are built on a floe's first case past the screen (meshing and factorisations)
 // and kept for its later ones; a floe that splits drops its model, and its
 // pieces are not checked again in the step that made them.
+//
+// Two parts. Each loaded floe's analyses are independent of the others':
+// they read the floe's outline, material and loads only, and a split
+// replaces the split floe and appends a piece, leaving every other floe's
+// index and data as they were. So check() is (1) analyse(): the loaded
+// floes of a share, each to its verdict (the counts, and the initiation if
+// one of its cases initiated), and (2) conclude(): in floe order, the
+// initiations become events and splits. On several ranks each rank analyses
+// the floes it owns, the ranks exchange the verdicts (the Simulation's
+// percussion phase, docs/parallel.md "The fracture checks by owner"), and
+// every rank concludes on all of them: the serial events and splits. The
+// serial run is the share that owns every floe.
 
+#include <cstddef>
 #include <cstdint>
 #include <memory>
+#include <span>
+#include <type_traits>
 #include <unordered_map>
 #include <unordered_set>
 #include <vector>
@@ -76,6 +91,9 @@ namespace fracture { class FloeFracture; }
 // Rows are in the order of the solves, then of the floe numbers.
 std::vector<CollisionEventRow> collision_rows(const Floes& floes, const contact::ImpulseRecord& record, double t);
 
+// On several ranks the counts are the serial run's (every rank adds every
+// rank's, Percussion::conclude); models and the seconds are this rank's own
+// (the models it built, the time it spent).
 struct PercussionStats {
   long checks = 0;        // floes analysed (again when a step is redone)
   long screened = 0;      // floes loaded but below the screen
@@ -101,6 +119,67 @@ struct PercussionStats {
   long lattice_meshes = 0;      // of models, meshed by the lattice mesher (the rest by CGAL)
 };
 
+// The counts of PercussionStats an analysis makes (its floes' verdicts):
+// summed over the shares, they are the serial run's.
+struct PercussionCounts {
+  long checks = 0, screened = 0, bounded = 0, sustained = 0, cut_short = 0, loop_steps = 0;
+  PercussionCounts& operator+=(const PercussionCounts& o) {
+    checks += o.checks;
+    screened += o.screened;
+    bounded += o.bounded;
+    sustained += o.sustained;
+    cut_short += o.cut_short;
+    loop_steps += o.loop_steps;
+    return *this;
+  }
+};
+
+// One share of the analyses: per floe the rank that analyses it, and this
+// share's rank (numbers, as contact::ClusterShare). A floe past the end of
+// `owner` (added by a split since the owners were made; every floe when it
+// is empty) is rank 0's: so every floe has one rank, and the default share,
+// rank 0 with no owners, is the serial run's.
+struct PercussionShare {
+  std::span<const int> owner;
+  int rank = 0;
+  bool mine(std::size_t i) const { return (i < owner.size() ? owner[i] : 0) == rank; }
+};
+
+// A loaded floe's initiation (one case of its step initiated): the event
+// row (without the pieces) and what a split needs. Plain numbers, trivially
+// copyable, so that ranks exchange them as bytes.
+struct FloeInitiation {
+  std::uint64_t floe = 0;     // index in the floes the step ended with (before the step's splits)
+  std::uint64_t through = 0;  // 1: the crack reaches the outline at both ends (Initiation::through)
+  double point_x = 0.0, point_y = 0.0;  // m, the floe's mesh (body) frame: where the crack starts
+  double direction = 0.0;               // rad, mesh frame: the crack's line
+  FractureEventRow event;               // piece_a, piece_b: -1 (set by the split)
+};
+static_assert(std::is_trivially_copyable_v<FloeInitiation> && std::is_trivially_copyable_v<PercussionCounts>);
+
+// One share's analyses of a step.
+struct PercussionAnalyses {
+  bool loaded = false;      // some floe was loaded: the same on every share (the record and floes are)
+  PercussionCounts counts;  // of this share's floes
+  double seconds = 0.0;     // wall time of this share's analyses (screens, bounds, models, time loops)
+  std::vector<FloeInitiation> initiations;  // in floe order
+};
+
+// The analyses by owner on several ranks, per rank (Simulation's percussion
+// phase; the summary's parallel.fracture_*): the steps that exchanged
+// analyses, and each rank's checks (summing to PercussionStats::checks) and
+// wall time in them (the share's PercussionAnalyses::seconds, summed).
+struct PercussionRanks {
+  long steps = 0;
+  std::vector<long> checks;
+  std::vector<double> seconds;
+};
+
+// One share's analyses as bytes for parallel::Communicator::allgather_parts,
+// and back (`loaded` is not sent: a share that sends has loaded floes).
+std::vector<std::byte> pack(const PercussionAnalyses& analyses);
+PercussionAnalyses unpack_percussion(std::span<const std::byte> bytes);
+
 class Percussion {
 public:
   // `gap`: how far apart the pieces of a split are put (m).
@@ -113,7 +192,17 @@ public:
   // ends at time t (positions are those of t; the loads are in the floes'
   // body frames). Split floes are replaced in `floes`. Returns true if the
   // set of floes changed.
+  // It is conclude(analyse(..., every floe)).
   bool check(Floes& floes, const contact::ImpulseRecord& record, double t, double dt);
+
+  // The first part of check: the analyses of the loaded floes `share` owns.
+  // The models of the floes analysed are built and kept on this share.
+  PercussionAnalyses analyse(const Floes& floes, const contact::ImpulseRecord& record, double t, double dt,
+                             const PercussionShare& share);
+  // The second part: adds `counts` (every share's, summed) to the stats and
+  // turns `initiations` (every share's, any order) into events and splits in
+  // floe order. Returns true if the set of floes changed.
+  bool conclude(Floes& floes, const PercussionCounts& counts, std::vector<FloeInitiation> initiations);
 
   // The initiations since the last call.
   std::vector<FractureEventRow> take_events();

@@ -299,7 +299,35 @@ void Simulation::note_collisions() {
 void Simulation::percussion(const StepContext& ctx) {
   // The step is done (the floes at t_ = ctx.t + dt): its collisions' loads
   // are judged; pieces of a split start the next step.
-  if (percussion_ && percussion_->check(scenario_.floes, *impulse_record_, t_, ctx.dt)) on_floes_changed();
+  if (!percussion_) return;
+  if (comm_.serial()) {
+    if (percussion_->check(scenario_.floes, *impulse_record_, t_, ctx.dt)) on_floes_changed();
+    return;
+  }
+  // On several ranks every rank holds the serial record (stage seven) and
+  // analyses the loaded floes it owns (docs/parallel.md, "The fracture
+  // checks by owner"); one exchange of their counts and initiations, made by
+  // all ranks alike when any floe was loaded (the same on all: the record
+  // and the floes are), and every rank concludes on all of them in floe
+  // order: the serial events and splits.
+  const PercussionAnalyses mine = percussion_->analyse(scenario_.floes, *impulse_record_, t_, ctx.dt,
+                                                       PercussionShare{owners_.owner(), comm_.rank()});
+  if (!mine.loaded) return;
+  const std::vector<PercussionAnalyses> parts = comm_.allgather_parts(pack(mine), unpack_percussion);
+  const auto ranks = static_cast<std::size_t>(comm_.size());
+  percussion_ranks_.checks.resize(ranks, 0);
+  percussion_ranks_.seconds.resize(ranks, 0.0);
+  ++percussion_ranks_.steps;
+  PercussionCounts counts;
+  std::vector<FloeInitiation> initiations;
+  for (std::size_t r = 0; r < parts.size(); ++r) {
+    const PercussionAnalyses& p = parts[r];
+    percussion_ranks_.checks[r] += p.counts.checks;
+    percussion_ranks_.seconds[r] += p.seconds;
+    counts += p.counts;
+    initiations.insert(initiations.end(), p.initiations.begin(), p.initiations.end());
+  }
+  if (percussion_->conclude(scenario_.floes, counts, std::move(initiations))) on_floes_changed();
 }
 
 void Simulation::on_floes_changed() {

@@ -174,6 +174,8 @@ public:
   // The collisions since the last call ([run] record_collisions; rows of /events/collisions).
   std::vector<CollisionEventRow> take_collision_events() { return std::exchange(collision_events_, {}); }
   const PercussionStats* percussion_stats() const { return percussion_ ? &percussion_->stats() : nullptr; }
+  // The fracture analyses by owner on several ranks, per rank (empty when serial).
+  const PercussionRanks& percussion_ranks() const { return percussion_ranks_; }
 
   // The sea surface, if the run has one ([sea] model != "none").
   bool has_sea() const { return sea_ != nullptr; }
@@ -235,6 +237,7 @@ private:
   contact::Detection detection_;  // at the present positions
   contact::CollisionStats stats_;
   std::unique_ptr<Percussion> percussion_;  // [fracture] enabled
+  PercussionRanks percussion_ranks_;         // its analyses by owner (several ranks)
   // The step's contact impulses for percussion and /events/collisions
   // (impulse_options_.record; null without fracture and record_collisions).
   std::unique_ptr<contact::ImpulseRecord> impulse_record_;

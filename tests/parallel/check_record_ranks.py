@@ -14,7 +14,9 @@ usage: check_record_ranks.py FLOESIM MPIEXEC WORKDIR [--floes N] [--t-end T] [--
    split; and the step-start collisions and the advance ran by owner (not
    redone whole) in most steps: parallel.collide_steps and advance_steps
    count the tries, *_fallbacks those redone whole, *_whole those skipped by
-   the back-off.
+   the back-off. The fracture checks ran by owner: parallel.fracture_checks
+   lists each rank's analyses, every one > 0, summing to the serial
+   fracture.checks, and the summary's fracture.* counts equal the serial ones.
 2. examples/pack_fracture.toml (a jam against a coast, breaking; its jam
    LCPs take the warm store, so some steps fall back): bit for bit on 2
    ranks, with both kinds of step (kept and redone) present.
@@ -98,6 +100,17 @@ for n in args.ranks:
     print(f"{n} ranks: {'equal' if c.returncode == 0 else 'DIFFERENT'} to the serial run (bit for bit)")
     if c.returncode != 0:
         failures.append(f"{n} ranks differ from the serial run:\n{c.stdout}")
+    k = summary(p)
+    by_rank = [int(x) for x in k.get("parallel.fracture_checks", "").split()]
+    print(f"{n} ranks: fracture checks by rank {by_rank} (serial {s.get('fracture.checks')}), "
+          f"seconds by rank {k.get('parallel.fracture_seconds')}")
+    if len(by_rank) != n or min(by_rank) <= 0 or sum(by_rank) != int(s.get("fracture.checks", "-1")):
+        failures.append(f"{n} ranks: the fracture checks by rank {by_rank} are not {n} shares > 0 summing to the "
+                        f"serial {s.get('fracture.checks')}")
+    for key in ("checks", "screened", "bounded", "sustained", "cut_short", "loop_steps", "initiations", "splits",
+                "failed_splits"):
+        if k.get(f"fracture.{key}") != s.get(f"fracture.{key}"):
+            failures.append(f"{n} ranks: fracture.{key} {k.get(f'fracture.{key}')}, serial {s.get(f'fracture.{key}')}")
     for what in ("collide", "advance"):
         steps, fell, whole = kept_mostly(p, n, what)
         total = steps + whole
