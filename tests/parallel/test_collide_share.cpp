@@ -69,6 +69,22 @@ bool play(const CollideCase& c, std::span<const int> owner, int ranks, Floes& f,
   return false;
 }
 
+// The owners of the case's floes over `ranks` equal strips, or with 0
+// every floe its own rank (every row then spans four ranks); `n` gets the
+// number of ranks.
+std::vector<int> owners_of(const CollideCase& c, int ranks, int& n) {
+  n = ranks;
+  if (ranks > 0) {
+    parallel::FloeOwners owners(0, ranks, c.domain);
+    owners.assign(c.floes);
+    return {owners.owner().begin(), owners.owner().end()};
+  }
+  std::vector<int> owner(c.floes.size());
+  std::iota(owner.begin(), owner.end(), 0);
+  n = static_cast<int>(owner.size());
+  return owner;
+}
+
 bool same_states(const std::vector<FloeState>& a, const std::vector<FloeState>& b) {
   return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(FloeState)) == 0;
 }
@@ -86,17 +102,8 @@ TEST_CASE("the step-start collisions by owner over 1, 2, 3 and 7 strips, and by 
     REQUIRE(serial.speculative >= 64);       // a speculative contact in every row
     for (const int ranks : {1, 2, 3, 7, 0}) {
       CAPTURE(ranks);
-      std::vector<int> owner;
       int n = ranks;
-      if (ranks > 0) {
-        parallel::FloeOwners owners(0, ranks, c.domain);
-        owners.assign(c.floes);
-        owner.assign(owners.owner().begin(), owners.owner().end());
-      } else {  // every floe its own rank: every row spans four ranks
-        owner.resize(c.floes.size());
-        std::iota(owner.begin(), owner.end(), 0);
-        n = static_cast<int>(owner.size());
-      }
+      const std::vector<int> owner = owners_of(c, ranks, n);
       Floes f;
       contact::CollisionStats stats;
       std::size_t speculative = 0;
@@ -294,17 +301,8 @@ TEST_CASE("the step-start collisions' impulse records by owner merge into the se
     REQUIRE(serial.loads.size() > 100);
     for (const int ranks : {1, 2, 3, 7, 0}) {
       CAPTURE(ranks);
-      std::vector<int> owner;
       int n = ranks;
-      if (ranks > 0) {
-        parallel::FloeOwners owners(0, ranks, c.domain);
-        owners.assign(c.floes);
-        owner.assign(owners.owner().begin(), owners.owner().end());
-      } else {
-        owner.resize(c.floes.size());
-        std::iota(owner.begin(), owner.end(), 0);
-        n = static_cast<int>(owner.size());
-      }
+      const std::vector<int> owner = owners_of(c, ranks, n);
       contact::ImpulseRecord merged = begun();
       std::vector<std::size_t> loads;
       REQUIRE(play_record(c, owner, n, merged, loads));
