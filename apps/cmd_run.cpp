@@ -401,6 +401,10 @@ int run(const Args& args, const parallel::Session& session) {
     if (owners.has_slabs()) {
       o << "parallel.slab_rows:";
       for (const int row : owners.slabs().first_row) o << " " << row;
+      // Each rank's CPU seconds in the coupling's per-floe work charged to
+      // the slabs' moves (part of strip_seconds_total), over every window.
+      o << "\nparallel.coupling_seconds:";
+      for (const double x : owners.coupling_seconds()) o << " " << x;
       o << "\n";
     }
   }

@@ -11,6 +11,7 @@
 #include "coupling/parallel.hpp"
 #include "coupling/penalty_law.hpp"
 #include "fluid/sea.hpp"
+#include "parallel/place.hpp"
 
 namespace floesim {
 
@@ -268,6 +269,7 @@ void FloeSeaContact::evaluate(const Floes& floes, fluid::Sea& sea, double h) {
   force.assign(fp.cell.size(), 0.0);
   wetted.assign(floes.size(), 0.0);
   for (FloeSeaLoad& load : loads_) load = {};
+  const double law_start = owned_clock();
   // Vertical: the law on each area piece, floe by floe (on threads); then
   // the pieces' sums into the cells, in order (the same sums whatever the
   // thread count).
@@ -305,6 +307,7 @@ void FloeSeaContact::evaluate(const Floes& floes, fluid::Sea& sea, double h) {
     wetted[i] = wet;
     load.vertical = {fz - floes.mass[i] * weight, moment.x(), moment.y()};
   }
+  charge_owned(law_start);
   double energy = 0.0;
   if (by_owner()) {
     energy = sum_cells_by_owner(ks);
@@ -337,6 +340,7 @@ void FloeSeaContact::horizontal_loads(std::span<const double> u) {
   // Each rank its own floes (their edge pieces are only there); the caller
   // shares the loads (share_owned).
   const std::ptrdiff_t floes_in_order = static_cast<std::ptrdiff_t>(order_.size());
+  const double start = owned_clock();
 #pragma omp parallel for num_threads(threads_) schedule(dynamic, 16) if (floes_in_order > kFloesPerThread)
   for (std::ptrdiff_t j = 0; j < floes_in_order; ++j) {
     const std::uint32_t i = order_[static_cast<std::size_t>(j)];
@@ -367,6 +371,7 @@ void FloeSeaContact::horizontal_loads(std::span<const double> u) {
     fh -= ks * wetted[i] * a;
     loads_[i].horizontal = {fh.x(), fh.y(), torque};
   }
+  charge_owned(start);
 }
 
 void FloeSeaContact::evaluate_loads(const Floes& floes, fluid::Sea& sea, IncidentSea* incident, double h) {
@@ -401,6 +406,7 @@ void FloeSeaContact::update_water(const Floes& floes, const fluid::Sea& sea, Inc
   // Each rank its own floes; the caller shares them (share_owned).
   const std::span<const std::uint32_t> mine = footprints_.mine();
   const std::ptrdiff_t count = static_cast<std::ptrdiff_t>(mine.size());
+  const double start = owned_clock();
 #pragma omp parallel for num_threads(threads_) schedule(static) if (count > kFloesPerThread)
   for (std::ptrdiff_t j = 0; j < count; ++j) {
     const std::size_t i = mine[static_cast<std::size_t>(j)];
@@ -415,6 +421,17 @@ void FloeSeaContact::update_water(const Floes& floes, const fluid::Sea& sea, Inc
     }
     if (area > 0.0) water_[i] = ((1.0 - w) * sum0 + w * sum1) / area;
   }
+  charge_owned(start);
+}
+
+// Timed by owner only: with the implicit step every rank runs the law on
+// every floe, work that is the same on every rank whatever the owners.
+double FloeSeaContact::owned_clock() const { return by_owner() ? parallel::thread_seconds() : 0.0; }
+
+void FloeSeaContact::charge_owned(double start) {
+  // The calling thread's time only: with OpenMP threads the others' share of
+  // the loop is not counted (as for the drift's charge, parallel/place.hpp).
+  if (by_owner()) owned_seconds_ += parallel::thread_seconds() - start;
 }
 
 void FloeSeaContact::kick_sea(fluid::Sea& sea, double h) {

@@ -119,6 +119,7 @@
 #include <algorithm>
 #include <span>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "core/checkpoint.hpp"
@@ -268,6 +269,16 @@ public:
   std::span<const int> owner_slabs() const {
     return routed() ? footprints_.owner_slabs() : std::span<const int>{};
   }
+  // On several ranks: the calling thread's CPU time (s, parallel::
+  // thread_seconds) in this rank's per-floe work since the last take: its
+  // floes' footprints built and moved, the law on their area pieces, their
+  // edge pieces' horizontal loads and their incident water velocity. Not
+  // the cells' sums and exchanges (per cell, or waits that may spin). The
+  // load balance charges it to the floes' owners by place
+  // (parallel::FloeOwners::charge_coupling; docs/parallel.md, "The
+  // coupling's cost"). With the implicit step (the law replicated) only the
+  // footprints are.
+  double take_owned_seconds() { return std::exchange(owned_seconds_, 0.0) + footprints_.take_owned_seconds(); }
   std::span<const FloeSeaLoad> loads() const { return loads_; }
   std::span<const double> pressure() const { return pressure_; }
   double strong_share() const { return s_; }
@@ -449,6 +460,11 @@ private:
     std::vector<double> wetted;       // per floe: sum psi_c a_c [delta_c]^+
   } eval_;
   mutable double penalty_energy_ = 0.0;
+  double owned_seconds_ = 0.0;  // take_owned_seconds()
+  // Adds the calling thread's CPU time since `start` (from owned_clock()) to
+  // owned_seconds_, when the law runs by owner (by_owner()).
+  double owned_clock() const;
+  void charge_owned(double start);
   mutable bool energy_pending_ = false;  // penalty_energy_ is this rank's part, to be settled
   std::vector<std::string> notes_;
 };

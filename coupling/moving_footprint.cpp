@@ -8,6 +8,7 @@
 #include "core/error.hpp"
 #include "coupling/parallel.hpp"
 #include "parallel/cell_routes.hpp"
+#include "parallel/place.hpp"
 
 namespace floesim {
 
@@ -100,9 +101,11 @@ void MovingFootprints::rebuild_at(const Floes& floes, std::span<const std::uint8
   if (comm_.serial()) {
     build_footprints(floes, include, grid_, pieces_, kernel_, threads, reference);
   } else {
+    const double start = parallel::thread_seconds();
     std::vector<std::uint8_t> mask(include.size(), 0);
     for (std::uint32_t i : mine_) mask[i] = include[i];
     build_footprints(floes, mask, grid_, pieces_, kernel_, threads, reference);
+    owned_seconds_ += parallel::thread_seconds() - start;
     if (gather_) gather_built();
   }
   reference_.assign(reference.begin(), reference.end());
@@ -121,6 +124,7 @@ void MovingFootprints::rebuild_at(const Floes& floes, std::span<const std::uint8
 
 void MovingFootprints::move(std::span<const FloePose> poses, int threads) {
   Footprints& fp = pieces_;
+  const double start = comm_.serial() ? 0.0 : parallel::thread_seconds();
   parallel::for_each_index(mine_.size(), threads, [&](std::size_t j) {
     const std::size_t i = mine_[j];
     if (fp.offsets[i] == fp.offsets[i + 1]) return;
@@ -148,6 +152,7 @@ void MovingFootprints::move(std::span<const FloePose> poses, int threads) {
       }
     }
   }, static_cast<std::size_t>(parallel::kFloesPerThread));
+  if (!comm_.serial()) owned_seconds_ += parallel::thread_seconds() - start;
   if (!comm_.serial() && gather_) gather_moved();
 }
 

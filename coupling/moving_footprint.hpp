@@ -50,6 +50,7 @@
 
 #include <cstdint>
 #include <span>
+#include <utility>
 #include <vector>
 
 #include "core/error.hpp"
@@ -121,6 +122,13 @@ public:
   // The next placement rebuilds (the floes changed).
   void forget() { reference_.clear(); }
 
+  // The calling thread's CPU time (s, parallel::thread_seconds) spent
+  // building and moving this rank's floes' pieces since the last take, the
+  // gathers excluded (a wait in a collective call may spin): the per-floe
+  // work the load balance charges to the owners (parallel::FloeOwners::
+  // charge_coupling). Timed on several ranks only.
+  double take_owned_seconds() { return std::exchange(owned_seconds_, 0.0); }
+
   const Footprints& pieces() const { return pieces_; }
   // Each area piece's a_c at the reference pose (m^2).
   std::span<const double> reference_area() const { return area0_; }
@@ -152,6 +160,7 @@ private:
   std::vector<double> area0_;   // per area piece, a_c(P0)
   std::vector<Vec2> moment0_;   // per area piece, m_c(P0)
   long placements_ = 0, rebuilds_ = 0;
+  double owned_seconds_ = 0.0;  // take_owned_seconds()
   parallel::Communicator comm_;
   bool gather_ = true;
   std::vector<int> row_owner_;  // by place: per grid row, the rank whose slab holds it; empty: by index

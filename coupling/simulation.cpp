@@ -252,6 +252,10 @@ void Simulation::drift(StepContext& ctx) {
     // Each rank drifts the floes in its strip (each floe's drift is its own),
     // charged to the load balance, then every rank takes the others' floes.
     if (owners_.has_slabs()) owners_.charge_rows(sea_->take_row_seconds());  // the sea's row work, by place too
+    // The coupling's per-floe work since the last step, done by the floes'
+    // owners by place (they follow the slabs): by-place cost on the floes'
+    // rows, like the drift's (FloeOwners::charge_coupling).
+    if (owners_.has_slabs() && floe_sea_) owners_.charge_coupling(floe_sea_->take_owned_seconds());
     // Floes migrate; every few steps the strips move (with slabs, the sea's and the coupling's too).
     if (owners_.update(comm_, scenario_.floes, steps_) && owners_.has_slabs()) follow_slabs();
     const double start = parallel::thread_seconds();

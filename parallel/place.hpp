@@ -29,7 +29,8 @@
 // Stage seven: with a spectral sea in slabs the strips are the sea's slabs
 // (set_slabs): the cuts are whole blocks of the transform's rows, a floe's
 // owner is the slab of its centroid's row, and the moves are by the cost of
-// the drift, detection and the sea's row passes, per row (set_slabs' comment).
+// the drift, detection, the floe–sea coupling's per-floe work and the sea's
+// row passes, per row (set_slabs' comment).
 
 #include <cstdint>
 #include <span>
@@ -37,6 +38,7 @@
 
 #include "contact/detection.hpp"
 #include "contact/shapes.hpp"
+#include "core/error.hpp"
 #include "core/floes.hpp"
 #include "parallel/comm.hpp"
 
@@ -104,7 +106,8 @@ public:
   // move the slabs' cuts by whole blocks (update()). The cost model: a row
   // costs the sea's row work, the same for every row (the transforms' row
   // passes: the ranks' charged row seconds summed, over the rows), plus the
-  // by-place cost of the floes whose centroid lies in it, each floe costing
+  // by-place cost (drift, detection, the coupling's per-floe work) of the
+  // floes whose centroid lies in it, each floe costing
   // its owner's charged seconds over its owner's floe count (a density
   // piecewise constant over the old slabs, floored as without slabs). The
   // columns, and so the sea's modes, do not move.
@@ -129,6 +132,19 @@ public:
   void charge(double seconds) { charged_ += seconds; }
   // With slabs: charges this rank's CPU time in the sea's row work.
   void charge_rows(double seconds) { row_charged_ += seconds; }
+  // With slabs: charges this rank's CPU time in the floe–sea coupling's
+  // per-floe work (FloeSeaContact::take_owned_seconds) as by-place work, as
+  // charge() does: the coupling's owners follow the slabs (stage eight, the
+  // same rule, grid_row, as assign()), so its work on a floe is done by the
+  // floe's owner here, and it lands on the floe's row as the drift's does. It
+  // is not row cost: that is spread evenly over every row (the transforms'
+  // passes cost the same in each), while the coupling's follows the floes'
+  // pieces. Kept apart too for the summary (coupling_seconds()).
+  void charge_coupling(double seconds) {
+    FLOESIM_ASSERT(has_slabs());
+    charged_ += seconds;
+    coupling_charged_ += seconds;
+  }
 
   std::span<const int> owner() const { return owner_; }  // per floe, after assign()
   const std::vector<std::uint32_t>& mine() const { return mine_; }  // this rank's floes, ascending
@@ -142,6 +158,9 @@ public:
   int moves() const { return moves_; }
   const std::vector<double>& window_seconds() const { return window_seconds_; }
   const std::vector<double>& charged_seconds() const { return total_seconds_; }
+  // With slabs: each rank's coupling seconds (charge_coupling) over every
+  // window so far, which charged_seconds() include.
+  const std::vector<double>& coupling_seconds() const { return coupling_seconds_; }
 
 private:
   int rank_ = 0, ranks_ = 1;
@@ -151,11 +170,12 @@ private:
   bool cut_ = false;  // cuts_ set (else equal counts at the next assign)
   std::vector<int> owner_;
   std::vector<std::uint32_t> mine_;
-  double charged_ = 0.0, row_charged_ = 0.0;
+  double charged_ = 0.0, row_charged_ = 0.0, coupling_charged_ = 0.0;
   RowSlabs slabs_;                 // empty: free cuts in y
   std::vector<int> row_owner_;     // with slabs: per grid row, its slab's rank
   // A window's charged seconds, gathered (one collective call): per rank
-  // its by-place seconds, and the ranks' row seconds summed.
+  // its by-place seconds (the coupling's included), and the ranks' row
+  // seconds summed.
   struct WindowCharges {
     std::vector<double> floe;
     double rows = 0.0;
@@ -167,7 +187,7 @@ private:
   std::size_t next_move_ = 0;
   bool started_ = false;
   int moves_ = 0;
-  std::vector<double> window_seconds_, total_seconds_;
+  std::vector<double> window_seconds_, total_seconds_, coupling_seconds_;
 };
 
 // The halo rule: the part of the detection that `rank` makes. It keeps the

@@ -25,6 +25,11 @@ cuts move from the equal shares toward the floes (parallel.slab_rows, every
     "rebuilt"), the slabs they were set by at the last rebuild
     (parallel.coupling_slab_rows) are the sea's at the end and not the first,
     equal ones, and that run too equals the serial one bit for bit.
+  - the coupling's per-floe work is charged to the slabs' moves (the owners
+    doing it follow the slabs): parallel.coupling_seconds > 0 on every rank
+    of every run on 2 and 3 ranks. At the start every floe lies in the
+    first slab of 2 ranks (rows 0 to 63) and in the first two of 3, so the
+    last rank has coupling work only once the slabs moved into the floes.
 """
 import os
 import sys
@@ -52,13 +57,21 @@ def compare(a, b, rtol):
     return harness.compare(a, b, rtol)
 
 
+def check_coupling(n, out, coupling):
+    if len(coupling) != n or not all(x > 0.0 for x in coupling):
+        failures.append(f"{n} ranks ({out}): the coupling's seconds were not charged on every rank ({coupling})")
+
+
 need(run([floesim, "run", config, "-o", "serial.h5", "-q"]), "the serial run")
 EQUAL = {2: [0, 64, 128], 3: [0, 48, 88, 128]}  # SlabFft2d::equal_rows: 16 blocks of 8 rows
 for n, out in ((2, "ranks2.h5"), (3, "ranks3.h5"), (2, "ranks2_again.h5")):
     s = summary(need(mpirun(n, "run", config, "-o", out), f"the run on {n} ranks"))
     rows = [int(x) for x in s.get("parallel.slab_rows", "").split()]
     moves = int(s.get("parallel.strip_moves", "0"))
-    print(f"{n} ranks ({out}): slabs {rows}, {moves} moves, floes by strip {s.get('parallel.strip_floes')}")
+    coupling = [float(x) for x in s.get("parallel.coupling_seconds", "").split()]
+    print(f"{n} ranks ({out}): slabs {rows}, {moves} moves, floes by strip {s.get('parallel.strip_floes')}, "
+          f"coupling seconds charged {coupling}")
+    check_coupling(n, out, coupling)
     if moves == 0 or rows == EQUAL[n]:
         failures.append(f"{n} ranks: the slabs did not move ({rows}, {moves} moves): the check would not test the moves")
     p = compare(out, "serial.h5", "0")
@@ -75,7 +88,9 @@ for n in (2, 3):
     s = summary(need(mpirun(n, "run", rebuilt, "-o", out), f"the rebuilt run on {n} ranks"))
     rows = [int(x) for x in s.get("parallel.slab_rows", "").split()]
     owners = [int(x) for x in s.get("parallel.coupling_slab_rows", "").split()]
-    print(f"{n} ranks ({out}): slabs {rows}, the coupling's owners by {owners}")
+    coupling = [float(x) for x in s.get("parallel.coupling_seconds", "").split()]
+    print(f"{n} ranks ({out}): slabs {rows}, the coupling's owners by {owners}, coupling seconds charged {coupling}")
+    check_coupling(n, out, coupling)
     if rows == EQUAL[n] or owners != rows:
         failures.append(f"{n} ranks rebuilt: the coupling's owners did not follow the slabs ({owners} against {rows})")
     p = compare(out, "rebuilt_serial.h5", "0")

@@ -10,6 +10,19 @@
 // once. Run by ctest as
 // mpi.place_ranks_N under `mpirun --oversubscribe -np N` (N = 1, 2, 3), and
 // serially without MPI.
+//
+// Then the slabs moved by the coupling's cost (issue 21, load balance;
+// coupling_moves below): 32 static floes in rows 0 to 31 of 64 (blocks of 8),
+// each rank charging 1 ms a step for each floe it owns as coupling seconds
+// (FloeOwners::charge_coupling), on slabs starting at {0, 32, 64} (2 ranks)
+// or {0, 24, 48, 64} (3 ranks). The floe cost is then the same for every
+// floe, the target cuts split the floes' rows evenly ({0, 16, 64};
+// {0, 8, 24, 64}), and each move goes half way in whole blocks (half a
+// block rounds away from the cut), so by hand: 2 ranks {0, 24, 64} at the
+// first move, {0, 16, 64} at the second and after; 3 ranks {0, 16, 32, 64},
+// then {0, 8, 24, 64}. The same seconds charged as row seconds
+// (charge_rows) are spread evenly over the rows and leave the first cut
+// where it is: the reason the coupling's seconds are charged per floe.
 #include <algorithm>
 #include <bit>
 #include <cmath>
@@ -23,6 +36,57 @@
 #include "parallel/place.hpp"
 
 using namespace floesim;
+
+namespace {
+
+// The slabs moved by coupling seconds charged per floe (the file's comment).
+void coupling_moves(const parallel::Communicator& comm, std::vector<std::string>& failures) {
+  const int ranks = comm.size();
+  if (ranks > 3) return;
+  Floes floes;
+  for (int k = 0; k < 32; ++k) {
+    FloeState s{};
+    s.y = 0.5 + k;  // row k (dy = 1 m)
+    floes.state.push_back(s);
+    floes.thickness.push_back(1.0);
+  }
+  const contact::Domain box{true, 0.0, 64.0, 0.0, 64.0};
+  const std::vector<std::vector<int>> start{{0, 64}, {0, 32, 64}, {0, 24, 48, 64}};
+  const std::vector<std::vector<std::vector<int>>> expected{
+      {{0, 64}, {0, 64}, {0, 64}}, {{0, 24, 64}, {0, 16, 64}, {0, 16, 64}}, {{0, 16, 32, 64}, {0, 8, 24, 64}, {0, 8, 24, 64}}};
+  const auto r = static_cast<std::size_t>(ranks - 1);
+  parallel::FloeOwners by_floe(comm.rank(), ranks, box), by_row(comm.rank(), ranks, box);
+  by_floe.set_slabs({start[r], 1.0, 8});
+  by_row.set_slabs({start[r], 1.0, 8});
+  double charged = 0.0;  // this rank's coupling seconds in the closed windows
+  double window = 0.0;
+  for (std::size_t step = 0; step <= 30; ++step) {
+    by_floe.update(comm, floes, step);
+    by_row.update(comm, floes, step);
+    if (step % 10 == 0 && step > 0) {
+      charged += window;
+      window = 0.0;
+      if (by_floe.slabs().first_row != expected[r][step / 10 - 1])
+        failures.push_back("coupling seconds: the slabs after move " + std::to_string(step / 10) + " are not as computed by hand");
+      if (by_row.slabs().first_row[1] != start[r][1]) failures.push_back("row seconds moved the first cut");
+    }
+    const double seconds = 1e-3 * static_cast<double>(by_floe.mine().size());
+    by_floe.charge_coupling(seconds);
+    by_row.charge_rows(1e-3 * static_cast<double>(by_row.mine().size()));
+    window += seconds;
+  }
+  const std::vector<double> all = comm.allgather<double>(std::span<const double>(&charged, 1));
+  if (by_floe.coupling_seconds() != all) failures.push_back("coupling_seconds() is not each rank's charged seconds");
+  if (comm.writer()) {
+    std::printf("coupling seconds: %d moves, slabs", by_floe.moves());
+    for (const int row : by_floe.slabs().first_row) std::printf(" %d", row);
+    std::printf("; the same as row seconds: slabs");
+    for (const int row : by_row.slabs().first_row) std::printf(" %d", row);
+    std::printf("\n");
+  }
+}
+
+}  // namespace
 
 int main() {
   parallel::Session session;
@@ -99,6 +163,7 @@ int main() {
     for (const double c : owners.cuts()) std::printf(" %.3f", c);
     std::printf("\n");
   }
+  coupling_moves(comm, failures);
   for (const std::string& f : failures) std::printf("rank %d: %s\n", comm.rank(), f.c_str());
   const long long failed = comm.sum(static_cast<long long>(failures.size()));
   if (comm.writer()) std::printf("%s on %d ranks\n", failed == 0 ? "passed" : "FAILED", ranks);
