@@ -445,9 +445,9 @@ void Simulation::read_try_budget(const StepContext& ctx) {
   // The momenta of the try, combined over the ranks (set_reach): the smooth
   // forces' part is the drift phase's change (the first half kick's
   // included), the collisions' part the collide and advance phases'.
-  auto at = [&](std::size_t k) { return Vec2{ctx.momenta[k].value(), ctx.momenta[k + 1].value()}; };
-  const Vec2 start = at(StepContext::kAtStart), drifted = at(StepContext::kAfterDrift),
-             collided = at(StepContext::kAfterCollide), advanced = at(StepContext::kAfterAdvance);
+  const Vec2 start = ctx.momentum_at(StepContext::kAtStart), drifted = ctx.momentum_at(StepContext::kAfterDrift),
+             collided = ctx.momentum_at(StepContext::kAfterCollide),
+             advanced = ctx.momentum_at(StepContext::kAfterAdvance);
   step_budget_.external = drifted - start;
   step_budget_.collisions = collided - drifted;
   step_budget_.collisions += advanced - collided;
@@ -541,10 +541,8 @@ void Simulation::close_step(StepContext& ctx) {
     throw RunError(m.str());
   }
   if (floe_sea_)
-    step_budget_.external += Vec2{ctx.momenta[StepContext::kAfterSeaKick].value(),
-                                  ctx.momenta[StepContext::kAfterSeaKick + 1].value()} -
-                             Vec2{ctx.momenta[StepContext::kBeforeSeaKick].value(),
-                                  ctx.momenta[StepContext::kBeforeSeaKick + 1].value()};
+    step_budget_.external +=
+        ctx.momentum_at(StepContext::kAfterSeaKick) - ctx.momentum_at(StepContext::kBeforeSeaKick);
   budget_.external += step_budget_.external;
   budget_.collisions += step_budget_.collisions;
 }

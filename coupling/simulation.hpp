@@ -100,6 +100,8 @@ struct StepContext {
   std::array<ExactSum, 12> momenta;
   static constexpr std::size_t kAtStart = 0, kAfterDrift = 2, kAfterCollide = 4, kAfterAdvance = 6,
                                kTry = 8, kBeforeSeaKick = 8, kAfterSeaKick = 10;
+  // The momentum at slot k (one of the above), once combined.
+  Vec2 momentum_at(std::size_t k) const { return {momenta[k].value(), momenta[k + 1].value()}; }
 };
 
 // Energies by part (J), named as the columns of /diagnostics/energy; the last
