@@ -494,43 +494,43 @@ void detail::record_impulses(ImpulseRecord& record, const Floes& floes, std::spa
   }
 }
 
-void merge_step_record(ImpulseRecord& into, std::span<const RecordPart* const> parts) {
+void merge_step_record(ImpulseRecord& into, std::span<const RecordPart> parts) {
   // The whole call records once: one event, even with no load.
   const std::uint32_t event = into.events++;
   // (place, part, load): a place is one contact, hence one share's; its
   // loads (a's, then b's) keep their order by the load index.
   std::vector<std::tuple<ContactPlace, std::size_t, std::size_t>> order;
   for (std::size_t p = 0; p < parts.size(); ++p) {
-    FLOESIM_ASSERT(parts[p]->places.size() == parts[p]->record.loads.size());
-    for (std::size_t l = 0; l < parts[p]->record.loads.size(); ++l) order.emplace_back(parts[p]->places[l], p, l);
+    FLOESIM_ASSERT(parts[p].places.size() == parts[p].record->loads.size());
+    for (std::size_t l = 0; l < parts[p].record->loads.size(); ++l) order.emplace_back(parts[p].places[l], p, l);
   }
   std::sort(order.begin(), order.end());
   into.loads.reserve(into.loads.size() + order.size());
   for (const auto& [place, p, l] : order) {
-    into.loads.push_back(parts[p]->record.loads[l]);
+    into.loads.push_back(parts[p].record->loads[l]);
     into.loads.back().event = event;
   }
 }
 
-void merge_advance_record(ImpulseRecord& into, std::span<const RecordPart* const> parts) {
+void merge_advance_record(ImpulseRecord& into, std::span<const RecordPart> parts) {
   // (place, part, event): the serial queue pops by place; the solves of one
   // pop are one share's, in its own order (its event numbers).
   std::vector<std::tuple<EventPlace, std::size_t, std::uint32_t>> order;
   std::vector<std::vector<std::size_t>> first(parts.size());  // per part, per event: its first load (then the next's)
   for (std::size_t p = 0; p < parts.size(); ++p) {
-    const RecordPart& part = *parts[p];
-    FLOESIM_ASSERT(part.events.size() == part.record.events);
-    for (std::uint32_t e = 0; e < part.record.events; ++e) order.emplace_back(part.events[e], p, e);
+    const ImpulseRecord& record = *parts[p].record;
+    FLOESIM_ASSERT(parts[p].events.size() == record.events);
+    for (std::uint32_t e = 0; e < record.events; ++e) order.emplace_back(parts[p].events[e], p, e);
     // Loads are appended event by event: each event's loads are a run.
-    first[p].assign(part.record.events + 1, part.record.loads.size());
-    for (std::size_t l = part.record.loads.size(); l-- > 0;) first[p][part.record.loads[l].event] = l;
-    for (std::size_t e = part.record.events; e-- > 0;) first[p][e] = std::min(first[p][e], first[p][e + 1]);
+    first[p].assign(record.events + 1, record.loads.size());
+    for (std::size_t l = record.loads.size(); l-- > 0;) first[p][record.loads[l].event] = l;
+    for (std::size_t e = record.events; e-- > 0;) first[p][e] = std::min(first[p][e], first[p][e + 1]);
   }
   std::sort(order.begin(), order.end());
   for (const auto& [place, p, e] : order) {
     const std::uint32_t event = into.events++;
     for (std::size_t l = first[p][e]; l < first[p][e + 1]; ++l) {
-      into.loads.push_back(parts[p]->record.loads[l]);
+      into.loads.push_back(parts[p].record->loads[l]);
       into.loads.back().event = event;
     }
   }

@@ -215,20 +215,21 @@ struct EventPlace {
   std::int64_t cluster = 0;
   auto operator<=>(const EventPlace&) const = default;
 };
+// A share's record as the merges read it (views of the share's part: nothing copied).
 struct RecordPart {
-  ImpulseRecord record;              // the share's loads, its events numbered from 0
-  std::vector<ContactPlace> places;  // step's start: per load, its contact's place
-  std::vector<EventPlace> events;    // advance: per event of `record`, its place
+  const ImpulseRecord* record = nullptr;  // the share's loads, its events numbered from 0
+  std::span<const ContactPlace> places;   // step's start: per load, its contact's place
+  std::span<const EventPlace> events;     // advance: per event of `record`, its place
 };
 // Appends the step-start collisions' record of the shares' `parts` to `into`
 // as the whole call would have: one event (numbered into.events) whose loads
 // are ordered by their contacts' places (a contact's two loads, a then b,
 // stay together: one share made both).
-void merge_step_record(ImpulseRecord& into, std::span<const RecordPart* const> parts);
+void merge_step_record(ImpulseRecord& into, std::span<const RecordPart> parts);
 // Appends the advance's record of the shares' `parts` to `into`: the events
 // of every part ordered by place (each place is one share's: ties keep the
 // share's own order), numbered on from into.events, with their loads.
-void merge_advance_record(ImpulseRecord& into, std::span<const RecordPart* const> parts);
+void merge_advance_record(ImpulseRecord& into, std::span<const RecordPart> parts);
 
 // Appends to `record` the nonzero impulses of `contacts` (one per contact, at
 // the floes' present poses) as one event: -J on a, J on b (b's point shifted

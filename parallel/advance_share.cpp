@@ -213,14 +213,9 @@ bool combine_parts(std::span<const AdvancePart> parts, Floes& floes, CollisionSt
   if (!parts.empty()) report.rebuilt += parts.front().report.rebuilt;
   if (floor) report.floor_pair = floor->report.floor_pair;
   if (record) {
-    std::vector<contact::RecordPart> records(parts.size());
-    std::vector<const contact::RecordPart*> each;
-    for (std::size_t r = 0; r < parts.size(); ++r) {
-      records[r].record = parts[r].record;
-      records[r].events = parts[r].outcome.events;
-      each.push_back(&records[r]);
-    }
-    contact::merge_advance_record(*record, each);
+    std::vector<contact::RecordPart> records;
+    for (const AdvancePart& p : parts) records.push_back({&p.record, {}, p.outcome.events});
+    contact::merge_advance_record(*record, records);
   }
   return true;
 }

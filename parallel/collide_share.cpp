@@ -107,14 +107,9 @@ bool combine_collide_parts(std::span<const CollidePart> parts, Floes& floes, Col
     speculative += p.outcome.speculative;
   }
   if (record) {
-    std::vector<contact::RecordPart> records(parts.size());
-    std::vector<const contact::RecordPart*> each;
-    for (std::size_t r = 0; r < parts.size(); ++r) {
-      records[r].record = parts[r].record;
-      records[r].places = parts[r].outcome.places;
-      each.push_back(&records[r]);
-    }
-    contact::merge_step_record(*record, each);
+    std::vector<contact::RecordPart> records;
+    for (const CollidePart& p : parts) records.push_back({&p.record, p.outcome.places, {}});
+    contact::merge_step_record(*record, records);
   }
   return true;
 }

@@ -324,16 +324,16 @@ TEST_CASE("merge_step_record orders the loads by their contacts' places, not by 
     l.event = 0;
     return l;
   };
-  contact::RecordPart a, b;
-  a.record.loads = {load(10), load(11)};
-  a.record.events = 1;
-  a.places = {{0, 1, 0}, {2, 0, 5}};
-  b.record.loads = {load(20), load(21), load(22)};
-  b.record.events = 1;
-  b.places = {{0, 0, 0}, {0, 0, 0}, {1, 4, 2}};
+  contact::ImpulseRecord a, b;
+  a.loads = {load(10), load(11)};
+  a.events = 1;
+  const std::vector<contact::ContactPlace> a_places{{0, 1, 0}, {2, 0, 5}};
+  b.loads = {load(20), load(21), load(22)};
+  b.events = 1;
+  const std::vector<contact::ContactPlace> b_places{{0, 0, 0}, {0, 0, 0}, {1, 4, 2}};
   contact::ImpulseRecord into;
   into.events = 7;
-  const std::vector<const contact::RecordPart*> parts{&a, &b};
+  const std::vector<contact::RecordPart> parts{{&a, a_places, {}}, {&b, b_places, {}}};
   contact::merge_step_record(into, parts);
   std::vector<std::uint32_t> floes;
   for (const auto& l : into.loads) {
