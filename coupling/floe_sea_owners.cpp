@@ -168,6 +168,7 @@ void FloeSeaContact::sum_coverage_by_owner() {
   for (std::uint32_t c : o.cells) o.slot[c] = 0;
   o.cells.clear();
   o.coverage.clear();
+  o.first.assign(1, 0);  // routed: then each cell's piece count, made offsets below
   o.piece_slot.resize(fp.cell.size());
   const double inv_cell_area = 1.0 / cell_area_;
   for (std::uint32_t i : order_)
@@ -181,18 +182,18 @@ void FloeSeaContact::sum_coverage_by_owner() {
       if (o.slot[c] == 0) {
         o.cells.push_back(c);
         o.coverage.push_back(0.0);
+        o.first.push_back(0);
         o.slot[c] = static_cast<std::uint32_t>(o.cells.size());
       }
       o.piece_slot[k] = o.slot[c] - 1;
-      o.coverage[o.piece_slot[k]] += fp.area[k] * inv_cell_area;
+      // Routed, the cell's owner sums the pieces (its total replaces this
+      // rank's part below): only counted here.
+      if (routed_cells) ++o.first[o.slot[c]];
+      else o.coverage[o.piece_slot[k]] += fp.area[k] * inv_cell_area;
     }
   if (routed()) {
     // The routed cells' pieces grouped by cell, in the serial order within
     // each (order_ is), with their floes' positions.
-    o.first.assign(o.cells.size() + 1, 0);
-    for (std::uint32_t i : order_)
-      for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k)
-        if (o.piece_slot[k] != kInteriorCell) ++o.first[o.piece_slot[k] + 1];
     for (std::size_t j = 0; j < o.cells.size(); ++j) o.first[j + 1] += o.first[j];
     o.keys.resize(o.first.back());
     o.values.resize(o.first.back());
