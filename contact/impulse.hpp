@@ -425,10 +425,53 @@ struct StepCollisionShare {
   std::size_t speculative = 0;       // speculative contacts that took part (resolve_step_collisions' count)
   std::vector<ContactPlace> places;  // per load the share recorded (options.record): its contact's place
 };
+//
+// `groups` (optional): the step groups, found from every pair's edge
+// (group_edges, step_groups below) by the caller; `detection` may then be a
+// part of the step's detection, in pair order, that holds every pair with
+// contact points or witnesses whose dynamic floes are all in the share's
+// groups (a distributed run's rank: the pairs it detected and those the
+// detecting ranks sent it; docs/parallel.md, "The detection's lists by
+// owner"). Without the record: `places` number a whole detection's lists.
+// Without `groups`, they are found from `detection`, the whole one.
+struct StepGroups;
 StepCollisionShare resolve_step_collisions_share(Floes& floes, std::span<const FloeState> start,
                                                  const Detection& detection, double step,
                                                  const ImpulseOptions& options, const ClusterShare& share,
-                                                 CollisionStats& stats);
+                                                 CollisionStats& stats, const StepGroups* groups = nullptr);
+
+// What one pair says of the step groups (resolve_step_collisions_share):
+// whether it has contact points (`contacts`), whether it has a witness at or
+// beyond xi and does not overlap (`witnesses`: a candidate for the rounds'
+// speculative contacts, or a jam's speculative point), and whether one of
+// those would become speculative on the present velocities, W^-
+// (`speculative`). A function of the pair and the states alone, so the rank
+// that detected the pair can say it; every rank then finds the same groups
+// from every rank's edges (step_groups), whatever the order of the list.
+struct GroupEdge {
+  static constexpr std::uint32_t contacts = 1, witnesses = 2, speculative = 4;
+  std::uint32_t a = 0, b = 0;  // floes, a < b
+  std::uint32_t flags = 0;
+};
+// The edges of `detection`'s pairs that have a flag (in its order). `floes`
+// holds W^-, `start` the step's start, as for resolve_step_collisions.
+std::vector<GroupEdge> group_edges(const Floes& floes, std::span<const FloeState> start, const Detection& detection,
+                                   double step, const ImpulseOptions& options);
+
+// The step groups of a step: per floe, whether it is in a jam (a component
+// of at least options.jam.floes dynamic floes joined by contact points) and
+// the lowest floe of its step group (kNone: in none).
+struct StepGroups {
+  static constexpr std::uint32_t kNone = 0xffffffffu;
+  std::vector<std::uint8_t> jam;
+  std::vector<std::uint32_t> lowest;
+  // Whether the floe's group is share.rank's: its lowest floe is owned there.
+  bool mine(std::uint32_t f, const ClusterShare& share) const {
+    return lowest[f] != kNone && share.owner[lowest[f]] == share.rank;
+  }
+};
+// The step groups from every pair's edges (any order, each pair once).
+StepGroups step_groups(const Floes& floes, std::span<const GroupEdge> edges, const ImpulseOptions& options);
 
 // Adds the counts of `part` (a share's) to `total`: sums, `largest` a maximum.
 void add_collision_counts(CollisionStats& total, const CollisionStats& part);

@@ -96,54 +96,6 @@ void each_candidate(const Detection& detection, const std::vector<Candidate>& ca
     }
 }
 
-// Per floe, 1 if it is in a step group (resolve_step_collisions_share,
-// impulse.hpp) whose lowest floe `share` gives to share.rank; `groups`
-// counts those groups. `contacts`: the step's contacts before any solve,
-// with the floes at W^-; `candidates`: the witnesses the rounds may take.
-std::vector<std::uint8_t> share_floes(const Floes& floes, std::span<const FloeState> start, const Detection& detection,
-                                      const std::vector<ContactPoint>& contacts,
-                                      const std::vector<Candidate>& candidates, const std::vector<std::uint8_t>& taken,
-                                      double step, const ImpulseOptions& opt, const ClusterShare& share,
-                                      long& groups) {
-  const std::size_t n = floes.size();
-  const double xi = opt.collision_distance;
-  DisjointSets sets(n);
-  std::vector<std::uint8_t> grouped(n, 0);
-  auto link = [&](std::uint32_t a, std::uint32_t b) {  // obstacles join nothing
-    const bool da = !floes.is_static[a], db = !floes.is_static[b];
-    if (da) grouped[a] = 1;
-    if (db) grouped[b] = 1;
-    if (da && db) sets.join(a, b);
-  };
-  for (const ContactPoint& c : contacts) link(c.a, c.b);
-  const std::vector<std::uint8_t> v0 = grouped;  // round 0 may change these
-  std::vector<std::uint8_t> v1 = v0;
-  each_candidate(detection, candidates, taken, [&](const NearPair& p, const Witness& w, std::uint32_t) {
-    if (v0[p.a] || v0[p.b] || becomes_speculative(floes, start, floes.state, p, w, step, xi, opt.rest_speed)) {
-      if (!floes.is_static[p.a]) v1[p.a] = 1;
-      if (!floes.is_static[p.b]) v1[p.b] = 1;
-    }
-  });
-  each_candidate(detection, candidates, taken, [&](const NearPair& p, const Witness&, std::uint32_t) {
-    if (v1[p.a] || v1[p.b]) link(p.a, p.b);
-  });
-  // A group belongs to the owner of its lowest floe (the first seen, ascending).
-  constexpr std::uint32_t none = std::numeric_limits<std::uint32_t>::max();
-  std::vector<std::uint32_t> lowest(n, none);
-  std::vector<std::uint8_t> mine(n, 0);
-  groups = 0;
-  for (std::uint32_t f = 0; f < n; ++f) {
-    if (!grouped[f]) continue;
-    std::uint32_t& low = lowest[sets.find(f)];
-    if (low == none) {
-      low = f;
-      if (share.owner[f] == share.rank) ++groups;
-    }
-    mine[f] = share.owner[low] == share.rank;
-  }
-  return mine;
-}
-
 // resolve_step_collisions (impulse.hpp), of the whole step or, with `share`,
 // of the share's step groups: the same rounds on the share's contacts and
 // witnesses. With a share, `moved` receives the floes whose velocities it
@@ -152,7 +104,8 @@ std::vector<std::uint8_t> share_floes(const Floes& floes, std::span<const FloeSt
 std::size_t step_collisions(Floes& floes, std::span<const FloeState> start, const Detection& detection, double step,
                             const ImpulseOptions& options, CollisionStats& stats,
                             std::vector<ContactImpulse>* impulses, const ClusterShare* share,
-                            std::vector<std::uint32_t>* moved, long* groups, std::vector<ContactPlace>* places) {
+                            const StepGroups* step_groups, std::vector<std::uint32_t>* moved, long* groups,
+                            std::vector<ContactPlace>* places) {
   const double xi = options.collision_distance;
   ImpulseOptions opt = options;
   opt.speculative_step = step;
@@ -162,7 +115,10 @@ std::size_t step_collisions(Floes& floes, std::span<const FloeState> start, cons
   // Jams: contact components (dynamic floes joined by contact points) of at
   // least opt.jam.floes floes. Per floe, as every pair asks (an array, not
   // a hash of the contacts' floes: O(floes) a step, the lookups O(1)).
-  const std::vector<std::uint8_t> in_jam = jam_floes(floes, detection.contacts, opt.jam.floes);
+  // (A share is given them with its groups: its detection may be a part.)
+  std::vector<std::uint8_t> whole_jam;
+  if (!share) whole_jam = jam_floes(floes, detection.contacts, opt.jam.floes);
+  const std::vector<std::uint8_t>& in_jam = share ? step_groups->jam : whole_jam;
   auto jammed = [&](std::uint32_t a, std::uint32_t b) { return in_jam[a] || in_jam[b]; };
   // The contacts solved here (a jam's are left to its time step unless
   // jam.at_step_start) and where each came from in detection.contacts.
@@ -197,14 +153,15 @@ std::size_t step_collisions(Floes& floes, std::span<const FloeState> start, cons
   }
   std::vector<Candidate> candidates = candidate_witnesses(detection, taken, xi);
   // A share keeps the contacts and witnesses of its step groups only.
-  std::vector<std::uint8_t> mine;
   auto kept = [&](std::uint32_t a, std::uint32_t b) {
     if (!share) return true;
     const bool da = !floes.is_static[a], db = !floes.is_static[b];
-    return (da || db) && (!da || mine[a]) && (!db || mine[b]);
+    return (da || db) && (!da || step_groups->mine(a, *share)) && (!db || step_groups->mine(b, *share));
   };
   if (share) {
-    mine = share_floes(floes, start, detection, contacts, candidates, taken, step, opt, *share, *groups);
+    *groups = 0;
+    for (std::uint32_t f = 0; f < floes.size(); ++f)
+      if (step_groups->lowest[f] == f && share->owner[f] == share->rank) ++*groups;
     std::erase_if(candidates, [&](const Candidate& c) {
       return !kept(detection.pairs[c.pair].a, detection.pairs[c.pair].b);
     });
@@ -310,13 +267,14 @@ std::size_t step_collisions(Floes& floes, std::span<const FloeState> start, cons
 std::size_t resolve_step_collisions(Floes& floes, std::span<const FloeState> start, const Detection& detection,
                                     double step, const ImpulseOptions& options, CollisionStats& stats,
                                     std::vector<ContactImpulse>* impulses) {
-  return step_collisions(floes, start, detection, step, options, stats, impulses, nullptr, nullptr, nullptr, nullptr);
+  return step_collisions(floes, start, detection, step, options, stats, impulses, nullptr, nullptr, nullptr, nullptr,
+                         nullptr);
 }
 
 StepCollisionShare resolve_step_collisions_share(Floes& floes, std::span<const FloeState> start,
                                                  const Detection& detection, double step,
                                                  const ImpulseOptions& options, const ClusterShare& share,
-                                                 CollisionStats& stats) {
+                                                 CollisionStats& stats, const StepGroups* groups) {
   // The warm store is replaced by an empty probe that only says whether a
   // solve would have used it; a failure's dump is left to the whole solve.
   ImpulseOptions o = options;
@@ -326,8 +284,11 @@ StepCollisionShare resolve_step_collisions_share(Floes& floes, std::span<const F
   const long failures = stats.failures;
   StepCollisionShare outcome;
   try {
-    outcome.speculative = step_collisions(floes, start, detection, step, o, stats, nullptr, &share, &outcome.moved,
-                                          &outcome.groups, &outcome.places);
+    // The groups from the whole detection's edges, before any solve (W^-).
+    StepGroups found;
+    if (!groups) found = step_groups(floes, group_edges(floes, start, detection, step, o), o);
+    outcome.speculative = step_collisions(floes, start, detection, step, o, stats, nullptr, &share,
+                                          groups ? groups : &found, &outcome.moved, &outcome.groups, &outcome.places);
   } catch (const RunError&) {
     outcome.conflict = StepCollisionShare::Conflict::error;
   }
@@ -336,6 +297,76 @@ StepCollisionShare resolve_step_collisions_share(Floes& floes, std::span<const F
   if (outcome.conflict == StepCollisionShare::Conflict::none && stats.failures != failures)
     outcome.conflict = StepCollisionShare::Conflict::failed_lcp;
   return outcome;
+}
+
+std::vector<GroupEdge> group_edges(const Floes& floes, std::span<const FloeState> start, const Detection& detection,
+                                   double step, const ImpulseOptions& options) {
+  const double xi = options.collision_distance;
+  std::vector<GroupEdge> out;
+  for (const NearPair& p : detection.pairs) {
+    GroupEdge e{p.a, p.b, p.contact_count > 0 ? GroupEdge::contacts : 0u};
+    if (!p.overlap)
+      for (std::uint32_t k = p.first_witness; k < p.first_witness + p.witness_count; ++k) {
+        const Witness& w = detection.witnesses[k];
+        if (w.distance < xi) continue;
+        e.flags |= GroupEdge::witnesses;
+        if (becomes_speculative(floes, start, floes.state, p, w, step, xi, options.rest_speed)) {
+          e.flags |= GroupEdge::speculative;
+          break;
+        }
+      }
+    if (e.flags) out.push_back(e);
+  }
+  return out;
+}
+
+StepGroups step_groups(const Floes& floes, std::span<const GroupEdge> edges, const ImpulseOptions& options) {
+  // The rule of impulse.hpp (resolve_step_collisions_share) on the edges:
+  // the step's contacts are a pair's contact points unless a jam leaves them
+  // to its time step, and a jam's speculative points when it does not; the
+  // rounds' candidates are the witnesses beyond xi of the pairs outside jams.
+  const std::size_t n = floes.size();
+  StepGroups g;
+  {
+    std::vector<ContactPoint> contacts;  // one per pair with contact points: the components are the same
+    for (const GroupEdge& e : edges)
+      if (e.flags & GroupEdge::contacts) contacts.push_back({e.a, e.b});
+    g.jam = jam_floes(floes, contacts, options.jam.floes);
+  }
+  auto jammed = [&](const GroupEdge& e) { return g.jam[e.a] || g.jam[e.b]; };
+  DisjointSets sets(n);
+  std::vector<std::uint8_t> grouped(n, 0);
+  auto link = [&](std::uint32_t a, std::uint32_t b) {  // obstacles join nothing
+    const bool da = !floes.is_static[a], db = !floes.is_static[b];
+    if (da) grouped[a] = 1;
+    if (db) grouped[b] = 1;
+    if (da && db) sets.join(a, b);
+  };
+  const bool at_start = options.jam.at_step_start;
+  for (const GroupEdge& e : edges)
+    if (((e.flags & GroupEdge::contacts) && (at_start || !jammed(e))) ||
+        (at_start && jammed(e) && (e.flags & GroupEdge::witnesses)))
+      link(e.a, e.b);
+  const std::vector<std::uint8_t> v0 = grouped;  // round 0 may change these
+  std::vector<std::uint8_t> v1 = v0;
+  auto candidate = [&](const GroupEdge& e) { return (e.flags & GroupEdge::witnesses) && !jammed(e); };
+  for (const GroupEdge& e : edges)
+    if (candidate(e) && (v0[e.a] || v0[e.b] || (e.flags & GroupEdge::speculative))) {
+      if (!floes.is_static[e.a]) v1[e.a] = 1;
+      if (!floes.is_static[e.b]) v1[e.b] = 1;
+    }
+  for (const GroupEdge& e : edges)
+    if (candidate(e) && (v1[e.a] || v1[e.b])) link(e.a, e.b);
+  // A group's lowest floe: the first seen, ascending.
+  std::vector<std::uint32_t> lowest_of_root(n, StepGroups::kNone);
+  g.lowest.assign(n, StepGroups::kNone);
+  for (std::uint32_t f = 0; f < n; ++f) {
+    if (!grouped[f]) continue;
+    std::uint32_t& low = lowest_of_root[sets.find(f)];
+    if (low == StepGroups::kNone) low = f;
+    g.lowest[f] = low;
+  }
+  return g;
 }
 
 void add_collision_counts(CollisionStats& total, const CollisionStats& part) {

@@ -285,8 +285,14 @@ void Simulation::collide(StepContext& ctx) {
   // exchange the velocities they changed and the impulses they recorded,
   // which every rank merges into the serial record (stage seven,
   // parallel/collide_share.hpp).
+  // Without the impulse record, from this rank's part of the detection and
+  // the pairs of its groups the others send it ("The detection's lists by
+  // owner").
   if (comm_.serial())
     contact::resolve_step_collisions(scenario_.floes, ctx.start, detection_, ctx.dt, impulse_options_, stats_);
+  else if (detection_part_ && !impulse_options_.record)
+    parallel::collide_on_part(comm_, owners_.owner(), scenario_.floes, ctx.start, *detection_part_, ctx.dt,
+                              impulse_options_, stats_, collide_share_);
   else
     parallel::collide_by_owner(comm_, owners_.owner(), scenario_.floes, ctx.start, detection_, ctx.dt,
                                impulse_options_, stats_, collide_share_);
@@ -339,6 +345,7 @@ void Simulation::on_floes_changed() {
   shapes_ = contact::build_collision_shapes(scenario_.floes);
   set_reach();  // one reach per floe: detect reads reach[i] for every floe, new pieces included
   detection_ = contact::detect(scenario_.floes, shapes_, detection_options_);
+  detection_part_.reset();
   if (floe_sea_) {
     // A split piece keeps its parent's reference bottom (same thickness);
     // the loads are evaluated afresh for the new footprints.
@@ -457,7 +464,8 @@ bool Simulation::detect_and_check(StepContext& ctx) {
   set_reach(std::span(ctx.momenta).first<StepContext::kTry>());  // combines the try's momenta too (one call)
   read_try_budget(ctx);
   if (!comm_.serial()) owners_.assign(scenario_.floes);  // the owners at the advanced places
-  contact::Detection next = parallel::detect(comm_, owners_, scenario_.floes, shapes_, detection_options_);
+  contact::Detection part;
+  contact::Detection next = parallel::detect(comm_, owners_, scenario_.floes, shapes_, detection_options_, &part);
   for (const contact::NearPair& p : next.pairs) {
     if (!p.overlap) continue;
     // Redo the step with half the time.
@@ -476,6 +484,7 @@ bool Simulation::detect_and_check(StepContext& ctx) {
     return false;
   }
   detection_ = std::move(next);
+  if (!comm_.serial()) detection_part_ = std::move(part);
   return true;
 }
 

@@ -42,6 +42,7 @@
 #include <array>
 #include <chrono>
 #include <memory>
+#include <optional>
 #include <span>
 #include <string>
 #include <utility>
@@ -237,6 +238,10 @@ private:
   contact::ImpulseOptions impulse_options_;
   std::unique_ptr<contact::WarmStart> warm_ = std::make_unique<contact::WarmStart>();  // jam LCPs' last bases
   contact::Detection detection_;  // at the present positions
+  // On several ranks, this rank's part of detection_ (the pairs it
+  // detected, parallel::detect); empty at the start and after a split,
+  // whose detection is made whole on every rank.
+  std::optional<contact::Detection> detection_part_;
   contact::CollisionStats stats_;
   std::unique_ptr<Percussion> percussion_;  // [fracture] enabled
   PercussionRanks percussion_ranks_;         // its analyses by owner (several ranks)

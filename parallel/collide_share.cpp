@@ -6,6 +6,7 @@
 
 #include "core/error.hpp"
 #include "parallel/bytes.hpp"
+#include "parallel/detect.hpp"
 
 namespace floesim::parallel {
 
@@ -76,11 +77,12 @@ CollidePart unpack_collide_part(std::span<const std::byte> bytes) {
 
 CollidePart run_collide_share(Floes& floes, std::span<const FloeState> start, const contact::Detection& detection,
                               double step, const contact::ImpulseOptions& options, std::span<const int> owner,
-                              int rank) {
+                              int rank, const contact::StepGroups* groups) {
   CollidePart part;
   contact::ImpulseOptions o = options;
   if (options.record) o.record = &part.record;
-  part.outcome = contact::resolve_step_collisions_share(floes, start, detection, step, o, {owner, rank}, part.stats);
+  part.outcome =
+      contact::resolve_step_collisions_share(floes, start, detection, step, o, {owner, rank}, part.stats, groups);
   if (part.outcome.conflict == StepCollisionShare::Conflict::none) {
     for (const std::uint32_t i : part.outcome.moved) part.states.push_back(floes.state[i]);
   } else {
@@ -134,6 +136,86 @@ std::size_t collide_by_owner(const Communicator& comm, std::span<const int> owne
   counts.fell_back(share_options);
   floes.state = entry;
   return contact::resolve_step_collisions(floes, start, detection, step, options, stats);
+}
+
+std::vector<contact::Detection> pairs_for_groups(const Floes& floes, const contact::Detection& part,
+                                                 const contact::StepGroups& groups, std::span<const int> owner,
+                                                 int ranks, int rank, double collision_distance) {
+  // The rank whose share reads pair p (resolve_step_collisions_share keeps
+  // the contacts and witnesses whose dynamic floes are all in its groups),
+  // or -1: none does, or p has nothing a share reads (no contact point and
+  // no witness at or beyond xi of a pair that does not overlap).
+  auto reader = [&](const contact::NearPair& p) {
+    bool read = p.contact_count > 0;
+    if (!p.overlap)
+      for (std::uint32_t k = p.first_witness; k < p.first_witness + p.witness_count && !read; ++k)
+        read = !(part.witnesses[k].distance < collision_distance);
+    if (!read) return -1;
+    const bool da = !floes.is_static[p.a], db = !floes.is_static[p.b];
+    if (!da && !db) return -1;
+    const std::uint32_t low = da ? groups.lowest[p.a] : groups.lowest[p.b];
+    if (low == contact::StepGroups::kNone || (da && db && groups.lowest[p.b] != low)) return -1;
+    return owner[low];
+  };
+  std::vector<contact::Detection> out(static_cast<std::size_t>(ranks));
+  std::vector<int> to(part.pairs.size());
+  for (std::size_t j = 0; j < part.pairs.size(); ++j) to[j] = reader(part.pairs[j]);
+  for (int s = 0; s < ranks; ++s) {
+    if (s == rank) continue;
+    std::size_t j = 0;
+    out[static_cast<std::size_t>(s)] = select_pairs(part, [&](const contact::NearPair&) { return to[j++] == s; });
+  }
+  return out;
+}
+
+std::size_t collide_on_part(const Communicator& comm, std::span<const int> owner, Floes& floes,
+                            std::span<const FloeState> start, const contact::Detection& part, double step,
+                            const contact::ImpulseOptions& options, contact::CollisionStats& stats,
+                            AdvanceShareCounts& counts, const AdvanceShareOptions& share_options) {
+  // The record's places number the whole call's lists: such a run keeps the whole detection.
+  if (options.record || comm.serial())
+    return collide_by_owner(comm, owner, floes, start, gather(comm, part), step, options, stats, counts,
+                            share_options);
+  if (counts.whole_now())
+    return contact::resolve_step_collisions(floes, start, gather(comm, part), step, options, stats);
+  // Every rank's edges (12 bytes a pair with a flag), the same groups on every rank.
+  const std::vector<contact::GroupEdge> mine = contact::group_edges(floes, start, part, step, options);
+  const std::vector<contact::GroupEdge> edges = comm.allgather<contact::GroupEdge>(mine);
+  const contact::StepGroups groups = contact::step_groups(floes, edges, options);
+  // The pairs of the groups owned elsewhere, to their owners.
+  const std::vector<contact::Detection> out =
+      pairs_for_groups(floes, part, groups, owner, comm.size(), comm.rank(), options.collision_distance);
+  std::vector<std::byte> send;
+  std::vector<std::size_t> send_counts;
+  for (const contact::Detection& d : out) {
+    const std::vector<std::byte> bytes = d.pairs.empty() ? std::vector<std::byte>{} : pack(d);
+    send.insert(send.end(), bytes.begin(), bytes.end());
+    send_counts.push_back(bytes.size());
+  }
+  std::vector<std::byte> received;
+  std::vector<std::size_t> received_counts;
+  comm.alltoall_bytes(send, send_counts, received, received_counts);
+  std::vector<contact::Detection> parts{part};
+  std::size_t from = 0;
+  for (const std::size_t n : received_counts) {
+    if (n) parts.push_back(unpack_detection(std::span<const std::byte>(received.data() + from, n)));
+    from += n;
+  }
+  const contact::Detection local = merge(std::move(parts));
+  // The share on its pairs, then collide_by_owner's exchange.
+  const std::vector<FloeState> entry = floes.state;
+  const CollidePart share = run_collide_share(floes, start, local, step, options, owner, comm.rank(), &groups);
+  const std::vector<CollidePart> shares = comm.allgather_parts(pack(share), unpack_collide_part);
+  counts.clusters.resize(shares.size(), 0);
+  std::size_t speculative = 0;
+  if (combine_collide_parts(shares, floes, stats, speculative)) {
+    for (std::size_t r = 0; r < shares.size(); ++r) counts.clusters[r] += shares[r].outcome.groups;
+    counts.combined();
+    return speculative;
+  }
+  counts.fell_back(share_options);
+  floes.state = entry;
+  return contact::resolve_step_collisions(floes, start, gather(comm, part), step, options, stats);
 }
 
 }  // namespace floesim::parallel

@@ -39,9 +39,11 @@ CollidePart unpack_collide_part(std::span<const std::byte> bytes);
 // `floes` (the states on entry, W^-) and returns its part; `floes` is left
 // with the share's states. With options.record, the share records into the
 // part's own record (options.record itself is left alone).
+// With `groups` (contact::resolve_step_collisions_share), `detection` may be
+// the rank's part of the step's (collide_on_part).
 CollidePart run_collide_share(Floes& floes, std::span<const FloeState> start, const contact::Detection& detection,
                               double step, const contact::ImpulseOptions& options, std::span<const int> owner,
-                              int rank);
+                              int rank, const contact::StepGroups* groups = nullptr);
 
 // Combines every rank's part (rank order) into `floes` (each part's moved
 // floes take its states), `stats` (contact::add_collision_counts) and
@@ -67,5 +69,31 @@ std::size_t collide_by_owner(const Communicator& comm, std::span<const int> owne
                              std::span<const FloeState> start, const contact::Detection& detection, double step,
                              const contact::ImpulseOptions& options, contact::CollisionStats& stats,
                              AdvanceShareCounts& counts, const AdvanceShareOptions& share_options = {});
+
+// The detection's lists by owner (docs/parallel.md, "The detection's lists
+// by owner"). `part`: the pairs a rank detected (parallel::detect_part, in
+// pair order). Per rank s, the pairs of `part` that s's step groups read and
+// s did not detect: a pair with contact points or a witness at or beyond xi
+// (contact::group_edges' flags) whose dynamic floes are in one group whose
+// lowest floe s owns. Entry `rank` (this rank's) is empty.
+std::vector<contact::Detection> pairs_for_groups(const Floes& floes, const contact::Detection& part,
+                                                 const contact::StepGroups& groups, std::span<const int> owner,
+                                                 int ranks, int rank, double collision_distance);
+
+// The collisions at the step's start on every rank of `comm` from this
+// rank's part of the detection (`part`, as parallel::detect gives it)
+// instead of the whole: its edges (contact::group_edges) gathered to every
+// rank (one allgather_bytes), the same step groups on every rank
+// (contact::step_groups), the pairs of groups owned elsewhere sent to their
+// owners (one alltoall_bytes: two collective calls), this rank's share on
+// its pairs and those received, then collide_by_owner's exchange and
+// combination. A fallback, a step the back-off does whole, and a run that
+// keeps the impulse record (its places number the whole lists) gather the
+// whole detection first (parallel::gather). Equal to the serial solve bit
+// for bit, states, counts and record.
+std::size_t collide_on_part(const Communicator& comm, std::span<const int> owner, Floes& floes,
+                            std::span<const FloeState> start, const contact::Detection& part, double step,
+                            const contact::ImpulseOptions& options, contact::CollisionStats& stats,
+                            AdvanceShareCounts& counts, const AdvanceShareOptions& share_options = {});
 
 }  // namespace floesim::parallel

@@ -51,31 +51,47 @@ contact::Detection detect_part(const FloeOwners& owners, int rank, const Floes& 
   return contact::detect(floes, shapes, options);
 }
 
+std::vector<std::byte> pack(const contact::Detection& d) {
+  const std::uint64_t sizes[3] = {d.pairs.size(), d.contacts.size(), d.witnesses.size()};
+  std::vector<std::byte> message;
+  append<std::uint64_t>(message, sizes);
+  append<contact::NearPair>(message, d.pairs);
+  append<contact::ContactPoint>(message, d.contacts);
+  append<contact::Witness>(message, d.witnesses);
+  return message;
+}
+
+contact::Detection unpack_detection(std::span<const std::byte> bytes) {
+  const std::byte* at = bytes.data();
+  contact::Detection part;
+  const std::vector<std::uint64_t> n = take<std::uint64_t>(at, 3);
+  part.pairs = take<contact::NearPair>(at, n[0]);
+  part.contacts = take<contact::ContactPoint>(at, n[1]);
+  part.witnesses = take<contact::Witness>(at, n[2]);
+  return part;
+}
+
+contact::Detection gather(const Communicator& comm, const contact::Detection& part) {
+  if (comm.serial()) return part;
+  std::vector<contact::Detection> parts = comm.allgather_parts(pack(part), unpack_detection);
+  parts.front().reach = part.reach;  // the same on every rank
+  return merge(std::move(parts));
+}
+
 contact::Detection detect(const Communicator& comm, FloeOwners& owners, const Floes& floes,
-                          const contact::CollisionShapes& shapes, contact::DetectionOptions options) {
-  if (comm.serial()) return contact::detect(floes, shapes, options);
+                          const contact::CollisionShapes& shapes, contact::DetectionOptions options,
+                          contact::Detection* part) {
+  if (comm.serial()) {
+    contact::Detection whole = contact::detect(floes, shapes, options);
+    if (part) *part = whole;
+    return whole;
+  }
   const double start = thread_seconds();
   contact::Detection mine = detect_part(owners, comm.rank(), floes, shapes, std::move(options));
   owners.charge(thread_seconds() - start);
-  // A rank's part as one message: three counts, then the pairs, contact
-  // points and witnesses.
-  const std::uint64_t sizes[3] = {mine.pairs.size(), mine.contacts.size(), mine.witnesses.size()};
-  std::vector<std::byte> message;
-  append<std::uint64_t>(message, sizes);
-  append<contact::NearPair>(message, mine.pairs);
-  append<contact::ContactPoint>(message, mine.contacts);
-  append<contact::Witness>(message, mine.witnesses);
-  std::vector<contact::Detection> parts = comm.allgather_parts(message, [](std::span<const std::byte> bytes) {
-    const std::byte* at = bytes.data();
-    contact::Detection part;
-    const std::vector<std::uint64_t> n = take<std::uint64_t>(at, 3);
-    part.pairs = take<contact::NearPair>(at, n[0]);
-    part.contacts = take<contact::ContactPoint>(at, n[1]);
-    part.witnesses = take<contact::Witness>(at, n[2]);
-    return part;
-  });
-  parts.front().reach = std::move(mine.reach);  // the same on every rank
-  return merge(std::move(parts));
+  contact::Detection whole = gather(comm, mine);
+  if (part) *part = std::move(mine);
+  return whole;
 }
 
 }  // namespace floesim::parallel

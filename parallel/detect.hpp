@@ -23,7 +23,38 @@ namespace floesim::parallel {
 // rank's own work (its subset, pose, broad and narrow phases; not the
 // gather) to `owners`, for the load balance.
 contact::Detection detect(const Communicator& comm, FloeOwners& owners, const Floes& floes,
-                          const contact::CollisionShapes& shapes, contact::DetectionOptions options);
+                          const contact::CollisionShapes& shapes, contact::DetectionOptions options,
+                          contact::Detection* part = nullptr);
+// (`part`, if not null, receives this rank's part: detect_part's. Serially, the whole detection.)
+
+// The whole detection from every rank's part (each rank's detect_part, in
+// pair order): the parts gathered to every rank (one allgather_bytes) and
+// merged. Collective.
+contact::Detection gather(const Communicator& comm, const contact::Detection& part);
+
+// A detection's lists as one message (three counts, then the pairs, contact
+// points and witnesses; the reach is not sent), and back.
+std::vector<std::byte> pack(const contact::Detection& d);
+contact::Detection unpack_detection(std::span<const std::byte> bytes);
+
+// The pairs of `d` (in its order) for which keep(pair) is true, with their
+// contact points and witnesses (first_contact and first_witness moved to
+// where they now start).
+template <class Keep>
+contact::Detection select_pairs(const contact::Detection& d, Keep&& keep) {
+  contact::Detection out;
+  for (contact::NearPair p : d.pairs) {
+    if (!keep(p)) continue;
+    const auto c0 = d.contacts.begin() + p.first_contact;
+    const auto w0 = d.witnesses.begin() + p.first_witness;
+    p.first_contact = static_cast<std::uint32_t>(out.contacts.size());
+    p.first_witness = static_cast<std::uint32_t>(out.witnesses.size());
+    out.contacts.insert(out.contacts.end(), c0, c0 + p.contact_count);
+    out.witnesses.insert(out.witnesses.end(), w0, w0 + p.witness_count);
+    out.pairs.push_back(p);
+  }
+  return out;
+}
 
 // Rank `rank`'s part of the detection by place (no communication): the
 // serial detection's pairs whose floe a `rank` owns, with their contact

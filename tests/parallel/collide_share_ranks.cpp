@@ -7,6 +7,10 @@
 // bit for bit: first kept (on several ranks: tried once, no fallback, groups
 // solved on every rank), then with every LCP on the warm store (warm_min =
 // 0), which falls back on every rank alike and is the serial solve again.
+// Both from the whole detection (collide_by_owner) and from each rank's
+// part of it, the pairs whose floe a it owns (parallel::collide_on_part:
+// the edges gathered, the groups' pairs sent to their owners, the whole
+// detection gathered only for the fallback).
 // Run by ctest as mpi.collide_share_ranks_N under `mpirun --oversubscribe
 // -np N` (N = 1, 2, 3), and serially without MPI.
 #include <cstdio>
@@ -16,6 +20,7 @@
 
 #include "parallel/collide_share.hpp"
 #include "parallel/comm.hpp"
+#include "parallel/detect.hpp"
 #include "parallel/place.hpp"
 #include "tests/parallel/collide_case.hpp"
 
@@ -29,8 +34,11 @@ int main() {
   const test::CollideCase c = test::rows_of_four(3);
   parallel::FloeOwners owners(comm.rank(), ranks, c.domain);
   owners.assign(c.floes);
+  const contact::Detection part = parallel::select_pairs(
+      c.detection, [&](const contact::NearPair& p) { return owners.owner()[p.a] == comm.rank(); });
+  for (const bool on_part : {false, true})
   for (const bool warm : {false, true}) {
-    const std::string name = warm ? "warm store: " : "";
+    const std::string name = std::string(on_part ? "on the rank's part: " : "") + (warm ? "warm store: " : "");
     contact::ImpulseOptions o = c.options;
     contact::WarmStart serial_warm, shared_warm;
     if (warm) o.warm_min = 0;
@@ -42,7 +50,8 @@ int main() {
     const std::size_t a = contact::resolve_step_collisions(s, c.start, c.detection, c.dt, so, ss);
     parallel::AdvanceShareCounts counts;
     const std::size_t b =
-        parallel::collide_by_owner(comm, owners.owner(), f, c.start, c.detection, c.dt, fo, fs, counts);
+        on_part ? parallel::collide_on_part(comm, owners.owner(), f, c.start, part, c.dt, fo, fs, counts)
+                : parallel::collide_by_owner(comm, owners.owner(), f, c.start, c.detection, c.dt, fo, fs, counts);
     if (std::memcmp(f.state.data(), s.state.data(), f.state.size() * sizeof(FloeState)) != 0)
       failures.push_back(name + "the floes differ from the serial solve");
     if (!test::same_stats(fs, ss)) failures.push_back(name + "the collision counts differ from the serial solve");

@@ -1,0 +1,173 @@
+// The detection's lists by owner without ranks (docs/parallel.md, "The
+// detection's lists by owner"): each simulated rank holds only the pairs it
+// detected (those whose floe a it owned at the detection), says its pairs'
+// edges (contact::group_edges), finds the step groups from every rank's
+// edges (contact::step_groups), sends the pairs of the groups other ranks own
+// to them (parallel::pairs_for_groups) and runs its share on its pairs and
+// those received. Over 1, 2, 3 and 7 strips, with the groups' owners not the
+// detection's, the shares combined are the serial solve bit for bit (states
+// by memcmp, counts, speculative contacts), the pairs sent are a small part
+// of the lists, and a share that needs the warm store falls back.
+#include <doctest/doctest.h>
+
+#include <algorithm>
+#include <cstring>
+#include <numeric>
+#include <vector>
+
+#include "parallel/collide_share.hpp"
+#include "parallel/detect.hpp"
+#include "parallel/place.hpp"
+#include "tests/parallel/collide_case.hpp"
+
+TEST_SUITE_BEGIN("mpi");
+
+using namespace floesim;
+using test::CollideCase;
+using test::same_stats;
+
+namespace {
+
+bool same_states(const std::vector<FloeState>& a, const std::vector<FloeState>& b) {
+  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(FloeState)) == 0;
+}
+
+std::vector<int> strips(const CollideCase& c, int ranks) {
+  parallel::FloeOwners owners(0, ranks, c.domain);
+  owners.assign(c.floes);
+  return {owners.owner().begin(), owners.owner().end()};
+}
+
+struct Played {
+  Floes floes;
+  contact::CollisionStats stats;
+  std::size_t speculative = 0;
+  std::vector<long> groups;
+  std::size_t sent = 0, whole = 0;  // pairs sent between ranks; pairs in the detection
+  bool combined = false;
+};
+
+// `ranks` ranks: rank r detected the pairs whose floe a detected[a] == r;
+// the step groups belong to the owners `owner` (of the step, after the
+// drift). Each rank's share runs on its own copy of W^-.
+Played play(const CollideCase& c, const std::vector<int>& detected, const std::vector<int>& owner, int ranks) {
+  Played out;
+  out.whole = c.detection.pairs.size();
+  std::vector<contact::Detection> part(static_cast<std::size_t>(ranks));
+  std::vector<contact::GroupEdge> edges;
+  for (int r = 0; r < ranks; ++r) {
+    part[static_cast<std::size_t>(r)] =
+        parallel::select_pairs(c.detection, [&](const contact::NearPair& p) { return detected[p.a] == r; });
+    const std::vector<contact::GroupEdge> e =
+        contact::group_edges(c.floes, c.start, part[static_cast<std::size_t>(r)], c.dt, c.options);
+    edges.insert(edges.end(), e.begin(), e.end());
+  }
+  const contact::StepGroups groups = contact::step_groups(c.floes, edges, c.options);
+  // The groups do not depend on the edges' order.
+  std::reverse(edges.begin(), edges.end());
+  const contact::StepGroups reversed = contact::step_groups(c.floes, edges, c.options);
+  CHECK(reversed.lowest == groups.lowest);
+  CHECK(reversed.jam == groups.jam);
+  // What each rank receives: the pairs of its groups that others detected.
+  std::vector<std::vector<contact::Detection>> to(static_cast<std::size_t>(ranks));
+  for (int r = 0; r < ranks; ++r)
+    to[static_cast<std::size_t>(r)] = parallel::pairs_for_groups(c.floes, part[static_cast<std::size_t>(r)], groups,
+                                                                owner, ranks, r, c.options.collision_distance);
+  std::vector<parallel::CollidePart> parts;
+  for (int s = 0; s < ranks; ++s) {
+    std::vector<contact::Detection> held{part[static_cast<std::size_t>(s)]};
+    for (int r = 0; r < ranks; ++r) {
+      const contact::Detection& d = to[static_cast<std::size_t>(r)][static_cast<std::size_t>(s)];
+      if (r == s) CHECK(d.pairs.empty());
+      if (d.pairs.empty()) continue;
+      out.sent += d.pairs.size();
+      held.push_back(parallel::unpack_detection(parallel::pack(d)));
+    }
+    const contact::Detection local = parallel::merge(std::move(held));
+    Floes mine = c.floes;
+    const parallel::CollidePart p =
+        parallel::run_collide_share(mine, c.start, local, c.dt, c.options, owner, s, &groups);
+    out.groups.push_back(p.outcome.groups);
+    parts.push_back(parallel::unpack_collide_part(parallel::pack(p)));
+    if (s == 0) out.floes = std::move(mine);
+  }
+  out.combined = parallel::combine_collide_parts(parts, out.floes, out.stats, out.speculative);
+  return out;
+}
+
+}  // namespace
+
+TEST_CASE("the step-start collisions from each rank's detected pairs and its groups' pairs are the serial solve") {
+  for (const unsigned seed : {3u, 11u}) {
+    CAPTURE(seed);
+    const CollideCase c = test::rows_of_four(seed);
+    Floes serial = c.floes;
+    contact::CollisionStats serial_stats;
+    const std::size_t serial_speculative =
+        contact::resolve_step_collisions(serial, c.start, c.detection, c.dt, c.options, serial_stats);
+    REQUIRE(serial_speculative >= 64);  // every row's components joined by a speculative contact
+    for (const int ranks : {1, 2, 3, 7}) {
+      CAPTURE(ranks);
+      const std::vector<int> detected = strips(c, ranks);
+      // The groups' owners: the detection's strips, and the strips shifted
+      // by one rank (the floes migrated: every group's pairs travel).
+      for (const int shift : {0, 1}) {
+        CAPTURE(shift);
+        std::vector<int> owner = detected;
+        for (int& o : owner) o = (o + shift) % ranks;
+        const Played p = play(c, detected, owner, ranks);
+        CHECK(p.combined);
+        CHECK(same_states(p.floes.state, serial.state));
+        CHECK(same_stats(p.stats, serial_stats));
+        CHECK(p.speculative == serial_speculative);
+        CHECK(std::accumulate(p.groups.begin(), p.groups.end(), 0L) == 64);  // one group a row
+        MESSAGE(ranks << " ranks, shift " << shift << ": " << p.sent << " of " << p.whole << " pairs sent");
+        if (ranks == 1) CHECK(p.sent == 0);
+        // Unshifted, only the rows across a cut send pairs; shifted, every
+        // group's pairs go to the next rank, still never a pair no group reads.
+        if (ranks > 1 && shift == 0) CHECK(p.sent < p.whole / 4);
+        if (ranks > 1 && shift == 1) CHECK(p.sent > 0);
+        CHECK(p.sent <= p.whole);
+      }
+    }
+  }
+}
+
+TEST_CASE("the step groups from the edges are those of the whole detection, jams included") {
+  // resolve_step_collisions_share without groups finds them from the whole
+  // detection's edges; with jams of two floes (solved at the step's start or
+  // left to their time step) a jam's pairs are contacts or nothing.
+  for (const bool at_start : {false, true}) {
+    CAPTURE(at_start);
+    CollideCase c = test::rows_of_four(5);
+    c.options.jam.floes = 2;
+    c.options.jam.at_step_start = at_start;
+    Floes serial = c.floes;
+    contact::CollisionStats serial_stats;
+    const std::size_t serial_speculative =
+        contact::resolve_step_collisions(serial, c.start, c.detection, c.dt, c.options, serial_stats);
+    for (const int ranks : {2, 3, 7}) {
+      CAPTURE(ranks);
+      const std::vector<int> detected = strips(c, ranks);
+      const Played p = play(c, detected, detected, ranks);
+      CHECK(p.combined);
+      CHECK(same_states(p.floes.state, serial.state));
+      CHECK(same_stats(p.stats, serial_stats));
+      CHECK(p.speculative == serial_speculative);
+    }
+  }
+}
+
+TEST_CASE("a share on its pairs that would use the warm store is a conflict: the whole solve") {
+  // warm_min = 0: every LCP would start from the warm store; each share
+  // reports the conflict, so the parts do not combine (collide_on_part then
+  // gathers the whole detection and solves it whole).
+  CollideCase c = test::rows_of_four(3);
+  c.options.warm_min = 0;
+  contact::WarmStart warm;
+  c.options.warm = &warm;
+  const std::vector<int> detected = strips(c, 3);
+  const Played p = play(c, detected, detected, 3);
+  CHECK_FALSE(p.combined);
+  CHECK(warm.uses == 0);  // the shares probed an empty store of their own
+}
