@@ -464,21 +464,22 @@ bool Simulation::detect_and_check(StepContext& ctx) {
   set_reach(std::span(ctx.momenta).first<StepContext::kTry>());  // combines the try's momenta too (one call)
   read_try_budget(ctx);
   if (!comm_.serial()) owners_.assign(scenario_.floes);  // the owners at the advanced places
-  contact::Detection part;
-  contact::Detection next = parallel::detect(comm_, owners_, scenario_.floes, shapes_, detection_options_, &part);
-  for (const contact::NearPair& p : next.pairs) {
-    if (!p.overlap) continue;
+  contact::Detection part;  // this rank's (serially: `next` itself)
+  contact::Detection next = parallel::detect(comm_, owners_, scenario_.floes, shapes_, detection_options_,
+                                             comm_.serial() ? nullptr : &part);
+  // The first overlapping pair and its distance at t, found from the ranks'
+  // parts (a reduction): the serial scan's on every rank.
+  const parallel::Overlap overlap = parallel::first_overlap(comm_, comm_.serial() ? next : part,
+                                                            detection_part_ ? *detection_part_ : detection_);
+  if (overlap.any) {
     // Redo the step with half the time.
     ++rejected_steps_;
     scenario_.floes.state = ctx.start;
     ctx.dt *= 0.5;
     if (ctx.dt < kFloorFraction * scenario_.config.run.dt_max * std::pow(0.5, kMaxHalvings / 2)) {
-      double before = -1.0;
-      for (const contact::NearPair& q : detection_.pairs)
-        if (q.a == p.a && q.b == p.b) before = q.distance;
       std::ostringstream m;
-      m << "floes " << p.a << " and " << p.b << " overlap however short the step from t = " << ctx.t
-        << " s (their distance at t was " << before << " m)";
+      m << "floes " << overlap.a << " and " << overlap.b << " overlap however short the step from t = " << ctx.t
+        << " s (their distance at t was " << overlap.before << " m)";
       throw RunError(m.str());
     }
     return false;

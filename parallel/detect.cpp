@@ -53,11 +53,13 @@ contact::Detection detect_part(const FloeOwners& owners, int rank, const Floes& 
 
 std::vector<std::byte> pack(const contact::Detection& d) {
   const std::uint64_t sizes[3] = {d.pairs.size(), d.contacts.size(), d.witnesses.size()};
-  std::vector<std::byte> message;
-  append<std::uint64_t>(message, sizes);
-  append<contact::NearPair>(message, d.pairs);
-  append<contact::ContactPoint>(message, d.contacts);
-  append<contact::Witness>(message, d.witnesses);
+  std::vector<std::byte> message(sizeof(sizes) + d.pairs.size() * sizeof(contact::NearPair) +
+                                 d.contacts.size() * sizeof(contact::ContactPoint) +
+                                 d.witnesses.size() * sizeof(contact::Witness));
+  std::byte* at = put(message.data(), sizes, 3);
+  at = put(at, d.pairs.data(), d.pairs.size());
+  at = put(at, d.contacts.data(), d.contacts.size());
+  put(at, d.witnesses.data(), d.witnesses.size());
   return message;
 }
 
@@ -76,6 +78,43 @@ contact::Detection gather(const Communicator& comm, const contact::Detection& pa
   std::vector<contact::Detection> parts = comm.allgather_parts(pack(part), unpack_detection);
   parts.front().reach = part.reach;  // the same on every rank
   return merge(std::move(parts));
+}
+
+long long overlap_key(const contact::Detection& part) {
+  for (const contact::NearPair& p : part.pairs)
+    if (p.overlap) return static_cast<long long>(p.a) << 32 | p.b;
+  return kNoOverlap;
+}
+
+bool distance_before(const contact::Detection& previous, std::uint32_t a, std::uint32_t b, double& distance) {
+  bool found = false;
+  for (const contact::NearPair& q : previous.pairs)
+    if (q.a == a && q.b == b) {
+      distance = q.distance;
+      found = true;
+    }
+  return found;
+}
+
+Overlap first_overlap(const Communicator& comm, const contact::Detection& part, const contact::Detection& previous) {
+  const long long key = comm.min(overlap_key(part));
+  Overlap o;
+  if (key == kNoOverlap) return o;
+  o.any = true;
+  o.a = static_cast<std::uint32_t>(key >> 32);
+  o.b = static_cast<std::uint32_t>(key & 0xffffffffLL);
+  struct Found {
+    double distance = -1.0;
+    long long found = 0;
+  };
+  Found mine;
+  mine.found = distance_before(previous, o.a, o.b, mine.distance) ? 1 : 0;
+  for (const Found& f : comm.allgather<Found>(std::span<const Found>(&mine, 1)))
+    if (f.found) {
+      o.before = f.distance;
+      break;
+    }
+  return o;
 }
 
 contact::Detection detect(const Communicator& comm, FloeOwners& owners, const Floes& floes,

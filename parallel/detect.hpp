@@ -32,6 +32,30 @@ contact::Detection detect(const Communicator& comm, FloeOwners& owners, const Fl
 // merged. Collective.
 contact::Detection gather(const Communicator& comm, const contact::Detection& part);
 
+// The overlap check by parts (Simulation::detect_and_check): the first
+// overlapping pair of a detection in pair order, and the distance at t of the
+// last pair of those two floes in the previous detection (-1 m if none), as
+// the serial scan of the whole lists finds them.
+struct Overlap {
+  bool any = false;
+  std::uint32_t a = 0, b = 0;
+  double before = -1.0;  // m
+};
+// A part's first overlapping pair as a key ordered as the pairs (a, b; the
+// shift does not matter: only a and b are said), kNoOverlap if none.
+inline constexpr long long kNoOverlap = 0x7fffffffffffffffLL;
+long long overlap_key(const contact::Detection& part);
+// The distance of the last pair (a, b) of `previous`, if it holds one.
+bool distance_before(const contact::Detection& previous, std::uint32_t a, std::uint32_t b, double& distance);
+// Collective: `part` this rank's part of the new detection, `previous` its
+// part of the previous one (or the whole, the same on every rank). Every
+// pair (a, b) of a detection is in the part of the owner of a at that
+// detection, so the least key over the ranks is the serial first pair, and
+// the rank that holds the previous pairs (a, b) holds all of them: the same
+// answer on every rank. One reduction; one gather (16 bytes a rank) more
+// only when a pair overlaps.
+Overlap first_overlap(const Communicator& comm, const contact::Detection& part, const contact::Detection& previous);
+
 // A detection's lists as one message (three counts, then the pairs, contact
 // points and witnesses; the reach is not sent), and back.
 std::vector<std::byte> pack(const contact::Detection& d);

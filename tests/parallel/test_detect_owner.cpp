@@ -171,3 +171,60 @@ TEST_CASE("a share on its pairs that would use the warm store is a conflict: the
   CHECK_FALSE(p.combined);
   CHECK(warm.uses == 0);  // the shares probed an empty store of their own
 }
+
+TEST_CASE("the first overlapping pair and its distance at t from the ranks' parts are the serial scan's") {
+  // The rows of four moved on straight paths over the step: A runs into B
+  // and D into C, so many pairs overlap. Each simulated rank detects its
+  // part (detect_part, strips at the new places); the least key over the
+  // parts and the distance said by the rank that held the pair in the
+  // previous detection (strips at the old places) are the serial scan's:
+  // the first overlapping pair in pair order, and the distance at t of the
+  // last pair of its two floes.
+  const CollideCase c = test::rows_of_four(3);
+  Floes moved = c.floes;
+  for (FloeState& s : moved.state) {
+    s.x += s.vx * c.dt;
+    s.y += s.vy * c.dt;
+  }
+  const contact::CollisionShapes shapes = contact::build_collision_shapes(moved);
+  contact::DetectionOptions d;
+  d.domain = c.domain;
+  d.horizon = c.dt;
+  d.reach.assign(moved.size(), 6.0);
+  const contact::Detection whole = contact::detect(moved, shapes, d);
+  const auto first = std::find_if(whole.pairs.begin(), whole.pairs.end(), [](const auto& p) { return p.overlap; });
+  REQUIRE(first != whole.pairs.end());
+  REQUIRE(std::count_if(whole.pairs.begin(), whole.pairs.end(), [](const auto& p) { return p.overlap; }) > 10);
+  double before = -1.0;
+  for (const contact::NearPair& q : c.detection.pairs)
+    if (q.a == first->a && q.b == first->b) before = q.distance;
+  REQUIRE(before >= 0.0);
+  for (const int ranks : {1, 2, 3, 7}) {
+    CAPTURE(ranks);
+    parallel::FloeOwners now(0, ranks, c.domain), then(0, ranks, c.domain);
+    now.assign(moved);
+    then.assign(c.floes);
+    long long key = parallel::kNoOverlap;
+    for (int r = 0; r < ranks; ++r)
+      key = std::min(key, parallel::overlap_key(parallel::detect_part(now, r, moved, shapes, d)));
+    CHECK(key == (static_cast<long long>(first->a) << 32 | first->b));
+    const auto a = static_cast<std::uint32_t>(key >> 32), b = static_cast<std::uint32_t>(key & 0xffffffffLL);
+    int holders = 0;
+    for (int r = 0; r < ranks; ++r) {
+      const contact::Detection previous =
+          parallel::select_pairs(c.detection, [&](const contact::NearPair& p) { return then.owner()[p.a] == r; });
+      double distance = -1.0;
+      if (!parallel::distance_before(previous, a, b, distance)) continue;
+      ++holders;
+      CHECK(std::memcmp(&distance, &before, sizeof(double)) == 0);
+    }
+    CHECK(holders == 1);
+  }
+  // The serial communicator: the whole detection is the one part.
+  const parallel::Overlap o = parallel::first_overlap(parallel::Communicator(), whole, c.detection);
+  CHECK(o.any);
+  CHECK(o.a == first->a);
+  CHECK(o.b == first->b);
+  CHECK(o.before == before);
+  CHECK_FALSE(parallel::first_overlap(parallel::Communicator(), c.detection, c.detection).any);
+}
