@@ -432,7 +432,8 @@ struct StepCollisionShare {
 // contact points or witnesses whose dynamic floes are all in the share's
 // groups (a distributed run's rank: the pairs it detected and those the
 // detecting ranks sent it; docs/parallel.md, "The detection's lists by
-// owner"). Without the record: `places` number a whole detection's lists.
+// owner"); `places` number the lists of `detection`, so a share on a part
+// is run without options.record (the merge needs the whole lists' places).
 // Without `groups`, they are found from `detection`, the whole one.
 struct StepGroups;
 StepCollisionShare resolve_step_collisions_share(Floes& floes, std::span<const FloeState> start,
