@@ -29,8 +29,9 @@
 // Stage seven: with a spectral sea in slabs the strips are the sea's slabs
 // (set_slabs): the cuts are whole blocks of the transform's rows, a floe's
 // owner is the slab of its centroid's row, and the moves are by the cost of
-// the drift, detection, the floe–sea coupling's per-floe work and the sea's
-// row passes, per row (set_slabs' comment).
+// the drift, detection, the floe–sea coupling's per-floe work, the fracture
+// analyses (charge_fracture, with or without slabs) and the sea's row
+// passes, per row (set_slabs' comment).
 
 #include <cstdint>
 #include <span>
@@ -106,9 +107,9 @@ public:
   // move the slabs' cuts by whole blocks (update()). The cost model: a row
   // costs the sea's row work, the same for every row (the transforms' row
   // passes: the ranks' charged row seconds summed, over the rows), plus the
-  // by-place cost (drift, detection, the coupling's per-floe work) of the
-  // floes whose centroid lies in it, each floe costing
-  // its owner's charged seconds over its owner's floe count (a density
+  // by-place cost (drift, detection, the coupling's per-floe work, the
+  // fracture analyses) of the floes whose centroid lies in it, each floe
+  // costing its owner's charged seconds over its owner's floe count (a density
   // piecewise constant over the old slabs, floored as without slabs). The
   // columns, and so the sea's modes, do not move.
   void set_slabs(RowSlabs slabs);
