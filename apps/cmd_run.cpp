@@ -309,12 +309,13 @@ int run(const Args& args, const parallel::Session& session) {
       o << "substeps." << kSubstepColumnNames[k] << ": " << counters.substeps[static_cast<std::size_t>(k)] << "\n";
   }
   if (const PercussionStats* f = sim.percussion_stats())
-    o << "fracture.checks: " << f->checks << "\nfracture.screened: " << f->screened
-      << "\nfracture.bounded: " << f->bounded << "\nfracture.cut_short: " << f->cut_short
-      << "\nfracture.loop_steps: " << f->loop_steps
-      << "\nfracture.sustained: " << f->sustained << "\nfracture.initiations: " << f->initiations
+    o << "fracture.checks: " << f->counts.checks << "\nfracture.screened: " << f->counts.screened
+      << "\nfracture.bounded: " << f->counts.bounded << "\nfracture.cut_short: " << f->counts.cut_short
+      << "\nfracture.loop_steps: " << f->counts.loop_steps
+      << "\nfracture.sustained: " << f->counts.sustained << "\nfracture.initiations: " << f->initiations
       << "\nfracture.splits: " << f->splits << "\nfracture.failed_splits: " << f->failed_splits
       << "\nfracture.refused_small: " << f->refused_small << "\nfracture.refused_overlap: " << f->refused_overlap
+      << "\nfracture.splits_redone: " << f->splits_redone
       << "\nfracture.seconds: " << f->seconds << "\nfracture.models: " << f->models
       << "\nfracture.model_seconds: " << f->model_seconds
       << "\nfracture.split_seconds: " << f->split_seconds << "\nfracture.phase_seconds: " << f->phase_seconds
@@ -387,6 +388,10 @@ int run(const Args& args, const parallel::Session& session) {
       for (const long k : fr.checks) o << " " << k;
       o << "\nparallel.fracture_seconds:";
       for (const double x : fr.seconds) o << " " << x;
+      // The CPU seconds of those analyses charged to the strips' moves (part
+      // of strip_seconds_total), over every window.
+      o << "\nparallel.fracture_charged:";
+      for (const double x : owners.fracture_seconds()) o << " " << x;
     }
     o << "\n";
     // Stage eight: the slabs the coupling's floe owners followed at the

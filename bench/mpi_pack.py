@@ -66,7 +66,7 @@ phases = ["drift", "collide", "advance", "detect", "record", "choose_dt", "check
 strips = ["strip_cuts", "strip_floes", "strip_seconds", "strip_seconds_total", "advance_steps", "advance_fallbacks",
           "advance_whole",
           "advance_clusters", "collide_steps", "collide_fallbacks", "collide_whole", "collide_groups"] + \
-    (["fracture_steps", "fracture_checks", "fracture_seconds"] if args.percussion else [])
+    (["fracture_steps", "fracture_checks", "fracture_seconds", "fracture_charged"] if args.percussion else [])
 rows = []
 load_before = ranks_bench.load()
 for r in range(args.rounds):
@@ -92,7 +92,7 @@ ranks_bench.write_table(
     "advance_*: the advances by cluster owner, stage seven: tried, redone whole, done whole by the back-off, "
     "clusters run by each rank; collide_*: the step-start collisions by owner, the same way, step groups by rank; "
     "fracture_*: the fracture checks by owner: steps that exchanged them, each rank's analyses and its wall "
-    "seconds in them), "
+    "seconds in them, and its CPU seconds in them charged to the strips, blank before perc10), "
     "blank before stage six (collide_*: before the step-start collisions by owner)",
     load_before, ranks_bench.load(),
     "ranks,round,wall_s,steps,lcps,bytes_received,collective_s,cpu_s," + ",".join(p + "_s" for p in phases) + "," +

@@ -105,7 +105,7 @@ struct FloeLoads {
 
 bool Percussion::check(Floes& floes, const contact::ImpulseRecord& record, double t, double dt) {
   PercussionAnalyses all = analyse(floes, record, t, dt, PercussionShare{});
-  return all.loaded && conclude(floes, all.counts, std::move(all.initiations));
+  return all.loaded && conclude(floes, std::move(all));
 }
 
 PercussionAnalyses Percussion::analyse(const Floes& floes, const contact::ImpulseRecord& record, double t, double dt,
@@ -244,26 +244,68 @@ PercussionAnalyses Percussion::analyse(const Floes& floes, const contact::Impuls
       break;  // one initiation per floe and step: the floe has cracked
     }
   }
+  // The splits of this share's floes, decided against the floes the step
+  // ended with (conclude decides again one that an earlier split of the
+  // step came within reach of).
+  if (params_.split) {
+    const auto cut = std::chrono::steady_clock::now();
+    for (FloeInitiation& fi : out.initiations)
+      if (fi.through) fi.split = decide_split(floes, fi.floe, fi);
+    stats_.split_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - cut).count();
+  }
   return out;
 }
 
-bool Percussion::conclude(Floes& floes, const PercussionCounts& counts, std::vector<FloeInitiation> initiations) {
+bool Percussion::conclude(Floes& floes, PercussionAnalyses all) {
   const auto begin = std::chrono::steady_clock::now();
-  stats_.checks += counts.checks;
-  stats_.screened += counts.screened;
-  stats_.bounded += counts.bounded;
-  stats_.sustained += counts.sustained;
-  stats_.cut_short += counts.cut_short;
-  stats_.loop_steps += counts.loop_steps;
+  stats_.counts += all.counts;
+  std::vector<FloeInitiation>& initiations = all.initiations;
   // The serial order: by floe index (each floe at most once).
   std::sort(initiations.begin(), initiations.end(),
             [](const FloeInitiation& a, const FloeInitiation& b) { return a.floe < b.floe; });
+  // The splits made so far in this step: their parent's centroid and radius
+  // (the neighbours' reach, as decide_split measures it) and the two pieces.
+  struct Made {
+    double x, y, radius;
+    std::size_t a, b;
+  };
+  std::vector<Made> made;
+  // Whether a split made so far was within reach of floe i, before or after
+  // it: then floe i's neighbours are not those its split was decided
+  // against. Otherwise they are the same floes, with the same data, in the
+  // same order (a split changes only its parent and appends a piece), and
+  // so is the decision (decide_split reads no other floe).
+  auto changed_near = [&](std::size_t i) {
+    const double ri = radius_of(floes, i);
+    auto reaches = [&](double x, double y, double r) {
+      return std::hypot(x - floes.state[i].x, y - floes.state[i].y) <= ri + r + gap_;  // as decide_split
+    };
+    auto piece_reaches = [&](std::size_t j) {
+      return reaches(floes.state[j].x, floes.state[j].y, radius_of(floes, j));
+    };
+    return std::any_of(made.begin(), made.end(), [&](const Made& m) {
+      return reaches(m.x, m.y, m.radius) || piece_reaches(m.a) || piece_reaches(m.b);
+    });
+  };
   bool changed = false;
   for (FloeInitiation& fi : initiations) {
     ++stats_.initiations;
     if (params_.split && fi.through) {
       const auto cut = std::chrono::steady_clock::now();
-      if (split(floes, fi.floe, Vec2{fi.point_x, fi.point_y}, fi.direction, fi.event)) changed = true;
+      const std::size_t i = fi.floe;
+      SplitDecision decision = fi.split;
+      // Decisions made without the neighbours (a piece too small, no two
+      // polygons) stand whatever the other splits.
+      const bool neighbours =
+          decision.verdict == SplitVerdict::split || decision.verdict == SplitVerdict::refused_overlap;
+      const bool again = neighbours && changed_near(i);
+      if (again) ++stats_.splits_redone;
+      if (again || decision.verdict == SplitVerdict::undecided) decision = decide_split(floes, i, fi);
+      const Made before{floes.state[i].x, floes.state[i].y, radius_of(floes, i), i, floes.size()};
+      if (apply_split(floes, i, fi, decision, fi.event)) {
+        changed = true;
+        made.push_back(before);
+      }
       stats_.split_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - cut).count();
     }
     events_.push_back(fi.event);
@@ -294,48 +336,81 @@ PercussionAnalyses unpack_percussion(std::span<const std::byte> bytes) {
   return a;
 }
 
+PercussionAnalyses combine(std::span<const PercussionAnalyses> parts, PercussionRanks& ranks) {
+  PercussionAnalyses all;
+  ranks.checks.resize(parts.size(), 0);
+  ranks.seconds.resize(parts.size(), 0.0);
+  ++ranks.steps;
+  for (std::size_t r = 0; r < parts.size(); ++r) {
+    const PercussionAnalyses& p = parts[r];
+    all.loaded = all.loaded || p.loaded;
+    ranks.checks[r] += p.counts.checks;
+    ranks.seconds[r] += p.seconds;
+    all.counts += p.counts;
+    all.seconds += p.seconds;
+    all.initiations.insert(all.initiations.end(), p.initiations.begin(), p.initiations.end());
+  }
+  return all;
+}
+
 double Percussion::min_fragment_area() const {
   return params_.min_fragment_area > 0.0 ? params_.min_fragment_area : params_.mesh_size * params_.mesh_size;
 }
 
-bool Percussion::split(Floes& floes, std::size_t i, const Vec2& point, double direction, FractureEventRow& event) {
-  const fracture::Chord chord =
-      fracture::chord_through(floes.vertices(i), point, Vec2{std::cos(direction), std::sin(direction)});
+SplitDecision Percussion::decide_split(const Floes& floes, std::size_t i, const FloeInitiation& fi) const {
+  const fracture::Chord chord = fracture::chord_through(
+      floes.vertices(i), Vec2{fi.point_x, fi.point_y}, Vec2{std::cos(fi.direction), std::sin(fi.direction)});
   // No piece below the minimum fragment area (a sliver): the floe is not split.
   const double min_area = min_fragment_area();
-  // The floes that could touch a piece: within reach of the parent.
-  std::vector<std::size_t> near{i};
-  const double ri = radius_of(floes, i);
-  for (std::size_t j = 0; j < floes.size(); ++j) {
-    if (j == i) continue;
-    const double d = std::hypot(floes.state[j].x - floes.state[i].x, floes.state[j].y - floes.state[i].y);
-    if (d <= ri + radius_of(floes, j) + gap_) near.push_back(j);
-  }
+  // The floes that could touch a piece: within reach of the parent (found
+  // once two pieces are planned).
+  std::vector<std::size_t> near;
   // Open the crack by gap, or less if that would push a piece into a neighbour.
-  bool planned = false;  // two pieces of at least min_area at the full gap
   for (double gap = gap_; gap >= 1e-3 * gap_; gap *= 0.25) {
     const auto plan = fracture::plan_split(floes, i, chord, gap, min_area);
     if (!plan) break;
-    planned = true;
-    const auto states = fracture::piece_states(*plan, floes.state[i], floes.inertia_z[i]);
+    if (near.empty()) {
+      near.push_back(i);
+      const double ri = radius_of(floes, i);
+      for (std::size_t j = 0; j < floes.size(); ++j) {
+        if (j == i) continue;
+        const double d = std::hypot(floes.state[j].x - floes.state[i].x, floes.state[j].y - floes.state[i].y);
+        if (d <= ri + radius_of(floes, j) + gap_) near.push_back(j);
+      }
+    }
     Floes trial = floes.select(near);
-    fracture::apply_split(trial, 0, *plan, states);
-    if (any_overlap(trial)) continue;
-    const std::uint32_t parent = floes.id[i];
-    const std::size_t second = fracture::apply_split(floes, i, *plan, states);
-    models_.erase(parent);
-    fresh_.insert(floes.id[i]);
-    fresh_.insert(floes.id[second]);
-    event.piece_a = floes.id[i];
-    event.piece_b = floes.id[second];
-    ++stats_.splits;
-    return true;
+    fracture::apply_split(trial, 0, *plan, fracture::piece_states(*plan, floes.state[i], floes.inertia_z[i]));
+    if (!any_overlap(trial)) return {SplitVerdict::split, gap};
   }
-  ++stats_.failed_splits;
   // Two valid pieces refused by the neighbours at every gap, or for the area of one.
-  if (planned) ++stats_.refused_overlap;
-  else if (fracture::plan_split(floes, i, chord, gap_, 0.0)) ++stats_.refused_small;
-  return false;
+  if (!near.empty()) return {SplitVerdict::refused_overlap, 0.0};
+  if (fracture::plan_split(floes, i, chord, gap_, 0.0)) return {SplitVerdict::refused_small, 0.0};
+  return {SplitVerdict::refused_chord, 0.0};
+}
+
+bool Percussion::apply_split(Floes& floes, std::size_t i, const FloeInitiation& fi, SplitDecision decision,
+                             FractureEventRow& event) {
+  if (decision.verdict != SplitVerdict::split) {
+    ++stats_.failed_splits;
+    if (decision.verdict == SplitVerdict::refused_overlap) ++stats_.refused_overlap;
+    if (decision.verdict == SplitVerdict::refused_small) ++stats_.refused_small;
+    return false;
+  }
+  // The plan at the decided opening, made again here from floe i alone (the
+  // same bits as when it was decided: floe i is as it was).
+  const fracture::Chord chord = fracture::chord_through(
+      floes.vertices(i), Vec2{fi.point_x, fi.point_y}, Vec2{std::cos(fi.direction), std::sin(fi.direction)});
+  const fracture::SplitPlan plan = fracture::plan_split(floes, i, chord, decision.gap, min_fragment_area()).value();
+  const auto states = fracture::piece_states(plan, floes.state[i], floes.inertia_z[i]);
+  const std::uint32_t parent = floes.id[i];
+  const std::size_t second = fracture::apply_split(floes, i, plan, states);
+  models_.erase(parent);
+  fresh_.insert(floes.id[i]);
+  fresh_.insert(floes.id[second]);
+  event.piece_a = floes.id[i];
+  event.piece_b = floes.id[second];
+  ++stats_.splits;
+  return true;
 }
 
 std::vector<FractureEventRow> Percussion::take_events() { return std::exchange(events_, {}); }

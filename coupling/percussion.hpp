@@ -46,10 +46,10 @@
 //
 // Stress bound. Past the screen, a stress-criterion case whose exact upper
 // bound (fracture::Responder::stress_bound) is below the strength is not
-// analysed (PercussionStats::bounded): it could not initiate. A case that is
+// analysed (PercussionCounts::bounded): it could not initiate. A case that is
 // analysed stops its time loop as soon as the same bound, taken on the
 // energy the response holds, shows that no later step can reach the
-// strength (FloeFracture::decide; PercussionStats::cut_short).
+// strength (FloeFracture::decide; PercussionCounts::cut_short).
 //
 // Models are built on a floe's first case past the screen (meshing and factorisations)
 // and kept for its later ones; a floe that splits drops its model, and its
@@ -60,8 +60,13 @@
 // replaces the split floe and appends a piece, leaving every other floe's
 // index and data as they were. So check() is (1) analyse(): the loaded
 // floes of a share, each to its verdict (the counts, and the initiation if
-// one of its cases initiated), and (2) conclude(): in floe order, the
-// initiations become events and splits. On several ranks each rank analyses
+// one of its cases initiated, with its split decided against the floes the
+// step ended with), and (2) conclude(): in floe order, the initiations
+// become events and splits. A split's decision reads its floe and the floes
+// within reach of it (the pieces must not overlap them), so conclude keeps
+// it unless an earlier split of the step was within reach (before or after
+// it), and decides that one again against the floes as they then are: the
+// serial loop's decision either way. On several ranks each rank analyses
 // the floes it owns, the ranks exchange the verdicts (the Simulation's
 // percussion phase, docs/parallel.md "The fracture checks by owner"), and
 // every rank concludes on all of them: the serial events and splits. The
@@ -91,38 +96,15 @@ namespace fracture { class FloeFracture; }
 // Rows are in the order of the solves, then of the floe numbers.
 std::vector<CollisionEventRow> collision_rows(const Floes& floes, const contact::ImpulseRecord& record, double t);
 
-// On several ranks the counts are the serial run's (every rank adds every
-// rank's, Percussion::conclude); models and the seconds are this rank's own
-// (the models it built, the time it spent).
-struct PercussionStats {
-  long checks = 0;        // floes analysed (again when a step is redone)
-  long screened = 0;      // floes loaded but below the screen
-  long bounded = 0;       // load cases past the screen whose stress bound is below the strength (not analysed)
-  long sustained = 0;     // of checks, of sustained forces alone (static)
-  long cut_short = 0;     // of checks, time loops stopped once they could no longer initiate (Response::cut_short)
-  long loop_steps = 0;    // time steps run by the checks' responses
-  long initiations = 0;   // events (a crack whose line leaves the floe at once, from a corner, is not split)
-  long splits = 0;
-  long failed_splits = 0;  // cracked through but not split (sliver, or the pieces would overlap)
-  long refused_small = 0;    // of failed_splits, a piece below min_fragment_area
-  long refused_overlap = 0;  // of failed_splits, a piece would overlap a neighbour however narrow the opening
-                             // (the rest: the chord does not cut two valid polygons)
-  double seconds = 0.0;    // wall time in analyses and bounds, models included
-  long models = 0;         // floe models built (mesh, elastic model), on a floe's first case past the screen
-  double model_seconds = 0.0;  // of seconds, wall time building them
-  double split_seconds = 0.0;  // wall time in splits (cut, overlap checks), without the rebuild after them
-  // Where the time of the phase goes (docs/fracture.md, "In packs"):
-  double phase_seconds = 0.0;   // the whole phase (check), screen and splits included
-  double mesh_seconds = 0.0;    // of model_seconds, meshing the floes
-  double bound_seconds = 0.0;   // of seconds, the stress bounds (factorisations they start included)
-  double factor_seconds = 0.0;  // of seconds, assembling K and factorising (in bounds or analyses)
-  long lattice_meshes = 0;      // of models, meshed by the lattice mesher (the rest by CGAL)
-};
-
-// The counts of PercussionStats an analysis makes (its floes' verdicts):
-// summed over the shares, they are the serial run's.
+// The counts an analysis makes (its floes' verdicts): summed over the
+// shares, they are the serial run's.
 struct PercussionCounts {
-  long checks = 0, screened = 0, bounded = 0, sustained = 0, cut_short = 0, loop_steps = 0;
+  long checks = 0;      // floes analysed (again when a step is redone)
+  long screened = 0;    // floes loaded but below the screen
+  long bounded = 0;     // load cases past the screen whose stress bound is below the strength (not analysed)
+  long sustained = 0;   // of checks, of sustained forces alone (static)
+  long cut_short = 0;   // of checks, time loops stopped once they could no longer initiate (Response::cut_short)
+  long loop_steps = 0;  // time steps run by the checks' responses
   PercussionCounts& operator+=(const PercussionCounts& o) {
     checks += o.checks;
     screened += o.screened;
@@ -132,6 +114,32 @@ struct PercussionCounts {
     loop_steps += o.loop_steps;
     return *this;
   }
+};
+
+// On several ranks the counts are the serial run's (every rank adds every
+// rank's, Percussion::conclude); models and the seconds are this rank's own
+// (the models it built, the time it spent).
+struct PercussionStats {
+  PercussionCounts counts;  // the analyses' verdicts
+  long initiations = 0;   // events (a crack whose line leaves the floe at once, from a corner, is not split)
+  long splits = 0;
+  long failed_splits = 0;  // cracked through but not split (sliver, or the pieces would overlap)
+  long refused_small = 0;    // of failed_splits, a piece below min_fragment_area
+  long refused_overlap = 0;  // of failed_splits, a piece would overlap a neighbour however narrow the opening
+                             // (the rest: the chord does not cut two valid polygons)
+  double seconds = 0.0;    // wall time in analyses and bounds, models included
+  long models = 0;         // floe models built (mesh, elastic model), on a floe's first case past the screen
+  double model_seconds = 0.0;  // of seconds, wall time building them
+  long splits_redone = 0;    // of the splits decided by the analysing share and needing the neighbours (split or
+                             // refused_overlap), those decided again when concluding: an earlier split of the
+                             // step was within reach of the floe (its neighbours had changed)
+  double split_seconds = 0.0;  // wall time in splits (cut, overlap checks), without the rebuild after them
+  // Where the time of the phase goes (docs/fracture.md, "In packs"):
+  double phase_seconds = 0.0;   // the whole phase (check), screen and splits included
+  double mesh_seconds = 0.0;    // of model_seconds, meshing the floes
+  double bound_seconds = 0.0;   // of seconds, the stress bounds (factorisations they start included)
+  double factor_seconds = 0.0;  // of seconds, assembling K and factorising (in bounds or analyses)
+  long lattice_meshes = 0;      // of models, meshed by the lattice mesher (the rest by CGAL)
 };
 
 // One share of the analyses: per floe the rank that analyses it, and this
@@ -145,15 +153,36 @@ struct PercussionShare {
   bool mine(std::size_t i) const { return (i < owner.size() ? owner[i] : 0) == rank; }
 };
 
+// What becomes of a floe cracked through ([fracture] split = true): split
+// with an opening, or refused, and why (PercussionStats).
+enum class SplitVerdict : std::uint64_t {
+  undecided = 0,    // not decided yet (conclude decides it), or not asked (no through crack, split = false)
+  split = 1,        // two pieces, opened by SplitDecision::gap
+  refused_small,    // a piece below min_fragment_area at the full opening
+  refused_overlap,  // two valid pieces, but at every opening a piece would overlap a neighbour
+  refused_chord,    // the chord does not cut two valid polygons
+};
+
+// A split worked out against given floes (Percussion::decide_split): the
+// verdict and, for a split, the opening (m). A split is the same when its
+// floe and its neighbours (the floes within reach of it) are.
+struct SplitDecision {
+  SplitVerdict verdict = SplitVerdict::undecided;
+  double gap = 0.0;
+};
+
 // A loaded floe's initiation (one case of its step initiated): the event
-// row (without the pieces) and what a split needs. Plain numbers, trivially
-// copyable, so that ranks exchange them as bytes.
+// row (without the pieces) and what a split needs, with the split's
+// decision as its analysing share worked it out against the floes the step
+// ended with. Plain numbers, trivially copyable, so that ranks exchange them
+// as bytes.
 struct FloeInitiation {
   std::uint64_t floe = 0;     // index in the floes the step ended with (before the step's splits)
   std::uint64_t through = 0;  // 1: the crack reaches the outline at both ends (Initiation::through)
   double point_x = 0.0, point_y = 0.0;  // m, the floe's mesh (body) frame: where the crack starts
   double direction = 0.0;               // rad, mesh frame: the crack's line
   FractureEventRow event;               // piece_a, piece_b: -1 (set by the split)
+  SplitDecision split;                  // undecided unless split = true and through
 };
 static_assert(std::is_trivially_copyable_v<FloeInitiation> && std::is_trivially_copyable_v<PercussionCounts>);
 
@@ -161,14 +190,14 @@ static_assert(std::is_trivially_copyable_v<FloeInitiation> && std::is_trivially_
 struct PercussionAnalyses {
   bool loaded = false;      // some floe was loaded: the same on every share (the record and floes are)
   PercussionCounts counts;  // of this share's floes
-  double seconds = 0.0;     // wall time of this share's analyses (screens, bounds, models, time loops)
+  double seconds = 0.0;     // wall time of this share's analyses (screens, bounds, models, time loops, splits decided)
   std::vector<FloeInitiation> initiations;  // in floe order
 };
 
 // The analyses by owner on several ranks, per rank (Simulation's percussion
 // phase; the summary's parallel.fracture_*): the steps that exchanged
-// analyses, and each rank's checks (summing to PercussionStats::checks) and
-// wall time in them (the share's PercussionAnalyses::seconds, summed).
+// analyses, and each rank's checks (summing to PercussionStats::counts.checks)
+// and wall time in them (the share's PercussionAnalyses::seconds, summed).
 struct PercussionRanks {
   long steps = 0;
   std::vector<long> checks;
@@ -179,6 +208,13 @@ struct PercussionRanks {
 // and back (`loaded` is not sent: a share that sends has loaded floes).
 std::vector<std::byte> pack(const PercussionAnalyses& analyses);
 PercussionAnalyses unpack_percussion(std::span<const std::byte> bytes);
+
+// The ranks' analyses of a step (`parts`, one per rank in rank order) as
+// one, which Percussion::conclude takes: the counts summed, the seconds
+// summed, every rank's initiations (rank by rank: conclude puts them in floe
+// order). Each rank's checks and seconds are added to `ranks`, and the step
+// counted.
+PercussionAnalyses combine(std::span<const PercussionAnalyses> parts, PercussionRanks& ranks);
 
 class Percussion {
 public:
@@ -199,10 +235,13 @@ public:
   // The models of the floes analysed are built and kept on this share.
   PercussionAnalyses analyse(const Floes& floes, const contact::ImpulseRecord& record, double t, double dt,
                              const PercussionShare& share);
-  // The second part: adds `counts` (every share's, summed) to the stats and
-  // turns `initiations` (every share's, any order) into events and splits in
-  // floe order. Returns true if the set of floes changed.
-  bool conclude(Floes& floes, const PercussionCounts& counts, std::vector<FloeInitiation> initiations);
+  // The second part: adds the counts of `all` (every share's analyses,
+  // combined) to the stats and turns its initiations (any order) into events
+  // and splits in floe order, each split as decided by its share unless an
+  // earlier split of the step was within reach, or undecided (then decided
+  // here, against the floes as they then are). Returns true if the set of
+  // floes changed.
+  bool conclude(Floes& floes, PercussionAnalyses all);
 
   // The initiations since the last call.
   std::vector<FractureEventRow> take_events();
@@ -216,7 +255,16 @@ public:
 
 private:
   fracture::FloeFracture& model_of(const Floes& floes, std::size_t i);
-  bool split(Floes& floes, std::size_t i, const Vec2& point, double direction, FractureEventRow& event);
+  // Floe i's split along the crack of `fi` (mesh frame), worked out against
+  // `floes`: the pieces at the widest opening (from gap, quartered down to
+  // 1e-3 gap) at which neither overlaps a floe within reach of floe i, or
+  // why there is none.
+  SplitDecision decide_split(const Floes& floes, std::size_t i, const FloeInitiation& fi) const;
+  // Makes `decision` (a split: floe i becomes the first piece, the second is
+  // appended; the event gets their numbers) and counts it. Returns whether
+  // the floes changed.
+  bool apply_split(Floes& floes, std::size_t i, const FloeInitiation& fi, SplitDecision decision,
+                   FractureEventRow& event);
 
   FractureParams params_;
   double gap_, screen_;

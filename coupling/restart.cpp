@@ -85,15 +85,16 @@ Checkpoint Simulation::save() {
   k.add("budget.collisions_y", budget_.collisions.y());
   if (percussion_) {
     const PercussionStats& p = percussion_->stats();
-    for (auto [name, v] : {std::pair{"checks", p.checks}, {"screened", p.screened}, {"initiations", p.initiations},
-                           {"splits", p.splits}, {"failed_splits", p.failed_splits},
-                           {"sustained", p.sustained}})
+    for (auto [name, v] : {std::pair{"checks", p.counts.checks}, {"screened", p.counts.screened},
+                           {"initiations", p.initiations}, {"splits", p.splits}, {"failed_splits", p.failed_splits},
+                           {"sustained", p.counts.sustained}})
       k.add(std::string("fracture.") + name, static_cast<double>(v));
-    k.add("fracture.bounded", static_cast<double>(p.bounded));
-    k.add("fracture.cut_short", static_cast<double>(p.cut_short));
+    k.add("fracture.bounded", static_cast<double>(p.counts.bounded));
+    k.add("fracture.cut_short", static_cast<double>(p.counts.cut_short));
     k.add("fracture.refused_small", static_cast<double>(p.refused_small));
     k.add("fracture.refused_overlap", static_cast<double>(p.refused_overlap));
-    k.add("fracture.loop_steps", static_cast<double>(p.loop_steps));
+    k.add("fracture.splits_redone", static_cast<double>(p.splits_redone));
+    k.add("fracture.loop_steps", static_cast<double>(p.counts.loop_steps));
     k.add("fracture.models", static_cast<double>(p.models));
     k.add("fracture.model_seconds", p.model_seconds);
     k.add("fracture.seconds", p.seconds);
@@ -148,9 +149,9 @@ void Simulation::restore(const Checkpoint& c) {
   budget_.collisions = Vec2{counter("budget.collisions_x"), counter("budget.collisions_y")};
   if (percussion_) {
     PercussionStats p;
-    for (auto [name, v] : {std::pair{"checks", &p.checks}, {"screened", &p.screened},
+    for (auto [name, v] : {std::pair{"checks", &p.counts.checks}, {"screened", &p.counts.screened},
                            {"initiations", &p.initiations}, {"splits", &p.splits},
-                           {"failed_splits", &p.failed_splits}, {"sustained", &p.sustained}})
+                           {"failed_splits", &p.failed_splits}, {"sustained", &p.counts.sustained}})
       *v = count(std::string("fracture.") + name);
     // Counters that checkpoints written before them lack keep their zeros.
     auto has = [&](const char* name) {
@@ -158,11 +159,11 @@ void Simulation::restore(const Checkpoint& c) {
     };
     // Absent before the stress bound.
     if (has("fracture.bounded"))
-      p.bounded = count("fracture.bounded");
+      p.counts.bounded = count("fracture.bounded");
     // Absent before the energy bound in the time loop.
     if (has("fracture.cut_short")) {
-      p.cut_short = count("fracture.cut_short");
-      p.loop_steps = count("fracture.loop_steps");
+      p.counts.cut_short = count("fracture.cut_short");
+      p.counts.loop_steps = count("fracture.loop_steps");
       p.models = count("fracture.models");
       p.model_seconds = counter("fracture.model_seconds");
     }
@@ -171,6 +172,8 @@ void Simulation::restore(const Checkpoint& c) {
       p.refused_small = count("fracture.refused_small");
       p.refused_overlap = count("fracture.refused_overlap");
     }
+    // Absent before the splits were decided by the analysing share.
+    if (has("fracture.splits_redone")) p.splits_redone = count("fracture.splits_redone");
     // Absent before the phase's time was split up.
     if (has("fracture.phase_seconds")) {
       p.phase_seconds = counter("fracture.phase_seconds");

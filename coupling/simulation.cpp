@@ -316,28 +316,18 @@ void Simulation::percussion(const StepContext& ctx) {
   }
   // On several ranks every rank holds the serial record (stage seven) and
   // analyses the loaded floes it owns (docs/parallel.md, "The fracture
-  // checks by owner"); one exchange of their counts and initiations, made by
-  // all ranks alike when any floe was loaded (the same on all: the record
-  // and the floes are), and every rank concludes on all of them in floe
-  // order: the serial events and splits.
+  // checks by owner"), by-place work charged to the load balance like the
+  // drift's; one exchange of the ranks' analyses, made by all ranks alike
+  // when any floe was loaded (the same on all: the record and the floes
+  // are), and every rank concludes on all of them in floe order: the serial
+  // events and splits.
+  const double start = parallel::thread_seconds();
   const PercussionAnalyses mine = percussion_->analyse(scenario_.floes, *impulse_record_, t_, ctx.dt,
                                                        PercussionShare{owners_.owner(), comm_.rank()});
+  owners_.charge_fracture(parallel::thread_seconds() - start);
   if (!mine.loaded) return;
-  const std::vector<PercussionAnalyses> parts = comm_.allgather_parts(pack(mine), unpack_percussion);
-  const auto ranks = static_cast<std::size_t>(comm_.size());
-  percussion_ranks_.checks.resize(ranks, 0);
-  percussion_ranks_.seconds.resize(ranks, 0.0);
-  ++percussion_ranks_.steps;
-  PercussionCounts counts;
-  std::vector<FloeInitiation> initiations;
-  for (std::size_t r = 0; r < parts.size(); ++r) {
-    const PercussionAnalyses& p = parts[r];
-    percussion_ranks_.checks[r] += p.counts.checks;
-    percussion_ranks_.seconds[r] += p.seconds;
-    counts += p.counts;
-    initiations.insert(initiations.end(), p.initiations.begin(), p.initiations.end());
-  }
-  if (percussion_->conclude(scenario_.floes, counts, std::move(initiations))) on_floes_changed();
+  PercussionAnalyses all = combine(comm_.allgather_parts(pack(mine), unpack_percussion), percussion_ranks_);
+  if (percussion_->conclude(scenario_.floes, std::move(all))) on_floes_changed();
 }
 
 void Simulation::on_floes_changed() {

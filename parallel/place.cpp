@@ -119,20 +119,23 @@ void FloeOwners::assign(const Floes& floes) {
 }
 
 FloeOwners::WindowCharges FloeOwners::close_window(const Communicator& comm) {
-  // One call: each rank's by-place seconds (and with slabs its row seconds
-  // and, for the summary, the coupling's part of the by-place seconds) of the window.
+  // One call: each rank's by-place seconds, its row seconds (with slabs)
+  // and, for the summary, the coupling's and the fracture analyses' parts
+  // of the by-place seconds.
   WindowCharges w;
-  const int per_rank = has_slabs() ? 3 : 1;
-  const double mine[3] = {charged_, row_charged_, coupling_charged_};
-  const std::vector<double> all = comm.allgather<double>(std::span<const double>(mine, static_cast<std::size_t>(per_rank)));
-  charged_ = row_charged_ = coupling_charged_ = 0.0;
+  constexpr std::size_t kPerRank = 4;
+  const double mine[kPerRank] = {charged_, row_charged_, coupling_charged_, fracture_charged_};
+  const std::vector<double> all = comm.allgather<double>(std::span<const double>(mine, kPerRank));
+  charged_ = row_charged_ = coupling_charged_ = fracture_charged_ = 0.0;
   coupling_seconds_.resize(static_cast<std::size_t>(ranks_), 0.0);
+  fracture_seconds_.resize(static_cast<std::size_t>(ranks_), 0.0);
   window_seconds_.assign(static_cast<std::size_t>(ranks_), 0.0);
   w.floe.assign(static_cast<std::size_t>(ranks_), 0.0);
   for (std::size_t r = 0; r < static_cast<std::size_t>(ranks_); ++r) {
-    const auto at = static_cast<std::size_t>(per_rank) * r;
-    const double row = per_rank == 3 ? all[at + 1] : 0.0;
-    if (per_rank == 3) coupling_seconds_[r] += all[at + 2];
+    const std::size_t at = kPerRank * r;
+    const double row = all[at + 1];
+    coupling_seconds_[r] += all[at + 2];
+    fracture_seconds_[r] += all[at + 3];
     w.floe[r] = all[at];
     w.rows += row;
     window_seconds_[r] = w.floe[r] + row;

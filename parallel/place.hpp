@@ -29,8 +29,9 @@
 // Stage seven: with a spectral sea in slabs the strips are the sea's slabs
 // (set_slabs): the cuts are whole blocks of the transform's rows, a floe's
 // owner is the slab of its centroid's row, and the moves are by the cost of
-// the drift, detection, the floe–sea coupling's per-floe work and the sea's
-// row passes, per row (set_slabs' comment).
+// the drift, detection, the floe–sea coupling's per-floe work, the fracture
+// analyses (charge_fracture, with or without slabs) and the sea's row
+// passes, per row (set_slabs' comment).
 
 #include <cstdint>
 #include <span>
@@ -46,7 +47,7 @@ namespace floesim::parallel {
 
 struct StripOptions {
   // Steps between two moves of the cuts by measured cost (each move is one
-  // collective call of 8 bytes a rank). Ten steps average out the scheduler's
+  // collective call of 32 bytes a rank). Ten steps average out the scheduler's
   // noise in a window of a 10 000-floe pack (about 0.1 s of by-place work).
   int rebalance_steps = 10;
   // A floor on a floe's estimated cost, as a fraction of the mean cost per
@@ -106,9 +107,9 @@ public:
   // move the slabs' cuts by whole blocks (update()). The cost model: a row
   // costs the sea's row work, the same for every row (the transforms' row
   // passes: the ranks' charged row seconds summed, over the rows), plus the
-  // by-place cost (drift, detection, the coupling's per-floe work) of the
-  // floes whose centroid lies in it, each floe costing
-  // its owner's charged seconds over its owner's floe count (a density
+  // by-place cost (drift, detection, the coupling's per-floe work, the
+  // fracture analyses) of the floes whose centroid lies in it, each floe
+  // costing its owner's charged seconds over its owner's floe count (a density
   // piecewise constant over the old slabs, floored as without slabs). The
   // columns, and so the sea's modes, do not move.
   void set_slabs(RowSlabs slabs);
@@ -145,6 +146,15 @@ public:
     charged_ += seconds;
     coupling_charged_ += seconds;
   }
+  // Charges this rank's CPU time in the fracture analyses of the loaded
+  // floes it owns (Percussion::analyse with the owners of owner()) as
+  // by-place work, as charge() does: a floe's analyses are done by its owner
+  // here, so their cost lands on the floe's place (on its row, with slabs).
+  // Kept apart for the summary (fracture_seconds()).
+  void charge_fracture(double seconds) {
+    charged_ += seconds;
+    fracture_charged_ += seconds;
+  }
 
   std::span<const int> owner() const { return owner_; }  // per floe, after assign()
   const std::vector<std::uint32_t>& mine() const { return mine_; }  // this rank's floes, ascending
@@ -161,6 +171,9 @@ public:
   // With slabs: each rank's coupling seconds (charge_coupling) over every
   // window so far, which charged_seconds() include.
   const std::vector<double>& coupling_seconds() const { return coupling_seconds_; }
+  // Each rank's fracture seconds (charge_fracture) over every window so
+  // far, which charged_seconds() include.
+  const std::vector<double>& fracture_seconds() const { return fracture_seconds_; }
 
 private:
   int rank_ = 0, ranks_ = 1;
@@ -170,12 +183,12 @@ private:
   bool cut_ = false;  // cuts_ set (else equal counts at the next assign)
   std::vector<int> owner_;
   std::vector<std::uint32_t> mine_;
-  double charged_ = 0.0, row_charged_ = 0.0, coupling_charged_ = 0.0;
+  double charged_ = 0.0, row_charged_ = 0.0, coupling_charged_ = 0.0, fracture_charged_ = 0.0;
   RowSlabs slabs_;                 // empty: free cuts in y
   std::vector<int> row_owner_;     // with slabs: per grid row, its slab's rank
   // A window's charged seconds, gathered (one collective call): per rank
-  // its by-place seconds (the coupling's included), and the ranks' row
-  // seconds summed.
+  // its by-place seconds (the coupling's and the fracture analyses'
+  // included), and the ranks' row seconds summed.
   struct WindowCharges {
     std::vector<double> floe;
     double rows = 0.0;
@@ -187,7 +200,7 @@ private:
   std::size_t next_move_ = 0;
   bool started_ = false;
   int moves_ = 0;
-  std::vector<double> window_seconds_, total_seconds_, coupling_seconds_;
+  std::vector<double> window_seconds_, total_seconds_, coupling_seconds_, fracture_seconds_;
 };
 
 // The halo rule: the part of the detection that `rank` makes. It keeps the

@@ -154,9 +154,10 @@ std::vector<FractureEventRow> run_beam(double strength) {
   // At rest against the supports: no impact, every check was of sustained forces.
   // A floe that can carry the load is judged by the stress bound alone (for
   // static forces it is the analysed stress itself: Responder::stress_bound).
-  CHECK(sim.percussion_stats()->checks == sim.percussion_stats()->sustained);
-  CHECK(sim.percussion_stats()->checks + sim.percussion_stats()->bounded >= 1);
-  CHECK((strength > beam_stress() ? sim.percussion_stats()->checks : sim.percussion_stats()->bounded) == 0);
+  const PercussionCounts& counts = sim.percussion_stats()->counts;
+  CHECK(counts.checks == counts.sustained);
+  CHECK(counts.checks + counts.bounded >= 1);
+  CHECK((strength > beam_stress() ? counts.checks : counts.bounded) == 0);
   return events;
 }
 

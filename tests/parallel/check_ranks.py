@@ -26,43 +26,25 @@ import argparse
 import os
 import sys
 
-from ranks_harness import Ranks, need
+from ranks_harness import moving_pack_check, need
 
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))),
-                                "scripts", "scenarios"))
-import moving_pack  # noqa: E402  (the pack shared with bench/mpi_pack.py)
 
-if "--no-mpi" in sys.argv:
-    print("floesim was built without MPI (FLOESIM_MPI=OFF): the distributed runs are not checked")
-    sys.exit(77)
+def options(ap):
+    ap.add_argument("--rtol", type=float, default=0.0)
+    ap.add_argument("--errors", action=argparse.BooleanOptionalAction, default=True)
+    ap.add_argument("--also", nargs="*", default=[], help="other configurations to check on 2 ranks (e.g. with a sea)")
+    ap.add_argument("--also-rtol", type=float, default=0.0, help="relative tolerance of the --also runs")
+    ap.add_argument("--fallback", help="a run whose step-start collisions fall back on several ranks (a jam forming "
+                    "against a wall, whose LCPs take the warm store): on 2 and 3 ranks, bit for bit")
+    ap.add_argument("--fallback-until", type=float, help="the --fallback runs stop at this time")
 
-ap = argparse.ArgumentParser()
-ap.add_argument("floesim")
-ap.add_argument("mpiexec")
-ap.add_argument("workdir")
-ap.add_argument("--floes", type=int, default=1500)
-ap.add_argument("--t-end", type=float, default=1000.0)
-ap.add_argument("--ranks", type=int, nargs="+", default=[1, 2, 3])
-ap.add_argument("--rtol", type=float, default=0.0)
-ap.add_argument("--errors", action=argparse.BooleanOptionalAction, default=True)
-ap.add_argument("--also", nargs="*", default=[], help="other configurations to check on 2 ranks (e.g. with a sea)")
-ap.add_argument("--also-rtol", type=float, default=0.0, help="relative tolerance of the --also runs")
-ap.add_argument("--fallback", help="a run whose step-start collisions fall back on several ranks (a jam forming "
-                "against a wall, whose LCPs take the warm store): on 2 and 3 ranks, bit for bit")
-ap.add_argument("--fallback-until", type=float, help="the --fallback runs stop at this time")
-args = ap.parse_args()
 
+args, harness, config = moving_pack_check(
+    "floesim was built without MPI (FLOESIM_MPI=OFF): the distributed runs are not checked", 1500, 1000.0, [1, 2, 3],
+    options)
 W = args.workdir
 failures = []
-harness = Ranks(args.floesim, args.mpiexec, W)
 run, mpirun = harness.run, harness.mpirun
-
-
-try:
-    config = moving_pack.write(args.floesim, W, args.floes, args.t_end, seed=5, output_interval=args.t_end / 4,
-                               wind=(10.0, 3.0))
-except RuntimeError as e:
-    sys.exit(f"FAILED: {e}")
 
 serial = need(run([args.floesim, "run", config, "-o", "serial.h5", "-q"]), "serial run")
 lcps = next(int(l.split()[1]) for l in serial.stdout.splitlines() if l.startswith("collisions.lcps:"))

@@ -16,37 +16,25 @@ usage: check_record_ranks.py FLOESIM MPIEXEC WORKDIR [--floes N] [--t-end T] [--
    count the tries, *_fallbacks those redone whole, *_whole those skipped by
    the back-off. The fracture checks ran by owner: parallel.fracture_checks
    lists each rank's analyses, every one > 0, summing to the serial
-   fracture.checks, and the summary's fracture.* counts equal the serial ones.
+   fracture.checks, parallel.fracture_charged their CPU seconds charged to
+   the strips (every one > 0), and the summary's fracture.* counts equal the
+   serial ones (the splits decided by their floe's owner and again when
+   concluding, fracture.splits_redone, included).
 2. examples/pack_fracture.toml (a jam against a coast, breaking; its jam
    LCPs take the warm store, so some steps fall back): bit for bit on 2
    ranks, with both kinds of step (kept and redone) present.
 """
-import argparse
 import os
 import shutil
 import sys
 
-from ranks_harness import Ranks, need, summary
+from ranks_harness import moving_pack_check, need, summary
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-sys.path.insert(0, os.path.join(ROOT, "scripts", "scenarios"))
-import moving_pack  # noqa: E402
 
-if "--no-mpi" in sys.argv:
-    print("floesim was built without MPI (FLOESIM_MPI=OFF): the record on several ranks is not checked")
-    sys.exit(77)
-
-ap = argparse.ArgumentParser()
-ap.add_argument("floesim")
-ap.add_argument("mpiexec")
-ap.add_argument("workdir")
-ap.add_argument("--floes", type=int, default=400)
-ap.add_argument("--t-end", type=float, default=500.0)
-ap.add_argument("--ranks", type=int, nargs="+", default=[2, 3])
-args = ap.parse_args()
-
+args, harness, base = moving_pack_check(
+    "floesim was built without MPI (FLOESIM_MPI=OFF): the record on several ranks is not checked", 400, 500.0, [2, 3])
 W = args.workdir
-harness = Ranks(args.floesim, args.mpiexec, W)
 run, mpirun = harness.run, harness.mpirun
 failures = []
 
@@ -60,11 +48,6 @@ mesh_size = 20.0
 min_fragment_area = 400.0
 """
 
-try:
-    base = moving_pack.write(args.floesim, W, args.floes, args.t_end, seed=5, output_interval=args.t_end / 4,
-                             wind=(10.0, 3.0))
-except RuntimeError as e:
-    sys.exit(f"FAILED: {e}")
 config = os.path.join(W, "record.toml")
 with open(base) as f:
     text = f.read()
@@ -107,8 +90,15 @@ for n in args.ranks:
     if len(by_rank) != n or min(by_rank) <= 0 or sum(by_rank) != int(s.get("fracture.checks", "-1")):
         failures.append(f"{n} ranks: the fracture checks by rank {by_rank} are not {n} shares > 0 summing to the "
                         f"serial {s.get('fracture.checks')}")
+    # The analyses' CPU seconds charged to the strips' moves, by rank: every
+    # rank analysed floes in the closed windows.
+    charged = [float(x) for x in k.get("parallel.fracture_charged", "").split()]
+    print(f"{n} ranks: fracture seconds charged to the strips by rank {charged}; splits decided by their owner "
+          f"and again in conclude: {k.get('fracture.splits_redone')} (serial {s.get('fracture.splits_redone')})")
+    if len(charged) != n or min(charged) <= 0.0:
+        failures.append(f"{n} ranks: the fracture seconds charged by rank {charged} are not {n} values > 0")
     for key in ("checks", "screened", "bounded", "sustained", "cut_short", "loop_steps", "initiations", "splits",
-                "failed_splits"):
+                "failed_splits", "refused_small", "refused_overlap", "splits_redone"):
         if k.get(f"fracture.{key}") != s.get(f"fracture.{key}"):
             failures.append(f"{n} ranks: fracture.{key} {k.get(f'fracture.{key}')}, serial {s.get(f'fracture.{key}')}")
     for what in ("collide", "advance"):

@@ -23,6 +23,22 @@
 // then {0, 8, 24, 64}. The same seconds charged as row seconds
 // (charge_rows) are spread evenly over the rows and leave the first cut
 // where it is: the reason the coupling's seconds are charged per floe.
+//
+// Then the strips moved by the fracture analyses' cost (fracture_moves
+// below): 32 static floes at y = 0.5, 1.5, ..., 31.5 m in free strips (no
+// sea), those below y = 8 m loaded: each rank charges 1 ms a step for each
+// loaded floe it owns as fracture seconds (FloeOwners::charge_fracture), as
+// Simulation's percussion phase charges the analyses of its loaded floes.
+// The strips start with equal counts (cut 16 on 2 ranks, 11 and 21 on 3).
+// By hand on 2 ranks: rank 0 charges 80 ms over its 16 floes (5 ms each),
+// rank 1 nothing (its floes at the floor, 1 % of the mean: 0.025 ms); the
+// costs' half (40.2 ms) is nearest after the 8 loaded floes, so the target
+// cut is 8 (midway between 7.5 and 8.5) and the cut moves half way, to 12;
+// then (80 ms over 12 floes) target 6, cut 9; then (80 ms over 9) target 5,
+// cut 7. On 3 ranks: targets 4 and 7, cuts 7.5 and 14; then (rank 0 70 ms
+// over 7 floes, rank 1 10 ms over 7, the floe at y = 7.5 being rank 1's)
+// targets 3 and 5, cuts 5.25 and 9.5; then targets 3 and 5, cuts 4.125 and
+// 7.25.
 #include <algorithm>
 #include <bit>
 #include <cmath>
@@ -82,6 +98,50 @@ void coupling_moves(const parallel::Communicator& comm, std::vector<std::string>
     for (const int row : by_floe.slabs().first_row) std::printf(" %d", row);
     std::printf("; the same as row seconds: slabs");
     for (const int row : by_row.slabs().first_row) std::printf(" %d", row);
+    std::printf("\n");
+  }
+}
+
+// The strips moved by fracture seconds charged per loaded floe (the file's comment).
+void fracture_moves(const parallel::Communicator& comm, std::vector<std::string>& failures) {
+  const int ranks = comm.size();
+  if (ranks > 3) return;
+  Floes floes;
+  for (int k = 0; k < 32; ++k) {
+    FloeState s{};
+    s.y = 0.5 + k;
+    floes.state.push_back(s);
+    floes.thickness.push_back(1.0);
+  }
+  const contact::Domain box{true, 0.0, 64.0, 0.0, 64.0};
+  const std::vector<std::vector<std::vector<double>>> expected{
+      {{}, {}, {}}, {{12.0}, {9.0}, {7.0}}, {{7.5, 14.0}, {5.25, 9.5}, {4.125, 7.25}}};
+  const auto r = static_cast<std::size_t>(ranks - 1);
+  parallel::FloeOwners owners(comm.rank(), ranks, box);
+  double charged = 0.0;  // this rank's fracture seconds in the closed windows
+  double window = 0.0;
+  for (std::size_t step = 0; step <= 30; ++step) {
+    owners.update(comm, floes, step);
+    if (step % 10 == 0 && step > 0) {
+      charged += window;
+      window = 0.0;
+      if (owners.cuts() != expected[r][step / 10 - 1])
+        failures.push_back("fracture seconds: the cuts after move " + std::to_string(step / 10) +
+                           " are not as computed by hand");
+    }
+    double seconds = 0.0;
+    for (const std::uint32_t i : owners.mine())
+      if (floes.state[i].y < 8.0) seconds += 1e-3;
+    owners.charge_fracture(seconds);
+    window += seconds;
+  }
+  const std::vector<double> all = comm.allgather<double>(std::span<const double>(&charged, 1));
+  if (owners.fracture_seconds() != all) failures.push_back("fracture_seconds() is not each rank's charged seconds");
+  if (ranks > 1 && !(all.back() == 0.0 && all.front() > 0.0))
+    failures.push_back("fracture seconds: expected rank 0 to charge and the last rank not");
+  if (comm.writer()) {
+    std::printf("fracture seconds: %d moves, cuts", owners.moves());
+    for (const double c : owners.cuts()) std::printf(" %g", c);
     std::printf("\n");
   }
 }
@@ -164,6 +224,7 @@ int main() {
     std::printf("\n");
   }
   coupling_moves(comm, failures);
+  fracture_moves(comm, failures);
   for (const std::string& f : failures) std::printf("rank %d: %s\n", comm.rank(), f.c_str());
   const long long failed = comm.sum(static_cast<long long>(failures.size()));
   if (comm.writer()) std::printf("%s on %d ranks\n", failed == 0 ? "passed" : "FAILED", ranks);

@@ -1,9 +1,11 @@
-"""What the distributed-run checks share (check_ranks.py, check_sea_ranks.py,
-check_slab_moves.py, check_rank_killed.py): commands run in the work folder
-with MPI allowed as root (CI containers) and one thread per rank, `mpirun
---oversubscribe`, `floesim compare`, the run summary as a dict, the small
-ocean the sea checks run on, and a stop with the command's output when a
-step that must work fails."""
+"""What the distributed-run checks share (check_ranks.py, check_record_ranks.py,
+check_sea_ranks.py, check_slab_moves.py, check_rank_killed.py): commands run
+in the work folder with MPI allowed as root (CI containers) and one thread
+per rank, `mpirun --oversubscribe`, `floesim compare`, the run summary as a
+dict, the small ocean the sea checks run on, the moving pack's checks'
+set-up, and a stop with the command's output when a step that must work
+fails."""
+import argparse
 import os
 import subprocess
 import sys
@@ -76,3 +78,37 @@ def need(p, what):
     if p.returncode != 0:
         sys.exit(f"FAILED: {what}: exit {p.returncode}\n{p.stdout}\n{p.stderr}")
     return p
+
+
+def moving_pack_check(no_mpi, floes, t_end, ranks, options=None):
+    """The set-up of the checks on the moving pack (check_ranks.py,
+    check_record_ranks.py). With --no-mpi (MPI not built): says `no_mpi` and
+    exits 77 (ctest's skip code). Else the arguments FLOESIM MPIEXEC WORKDIR
+    [--floes N] [--t-end T] [--ranks R...] (the defaults given here), and
+    those `options(parser)` adds; then the collisions-only periodic pack of
+    scripts/scenarios/moving_pack.py (seed 5, wind (10, 3) m/s, records every
+    quarter of the run) written to WORKDIR. Returns the arguments, a Ranks
+    for WORKDIR and the configuration's path."""
+    if "--no-mpi" in sys.argv:
+        print(no_mpi)
+        sys.exit(77)
+    ap = argparse.ArgumentParser()
+    ap.add_argument("floesim")
+    ap.add_argument("mpiexec")
+    ap.add_argument("workdir")
+    ap.add_argument("--floes", type=int, default=floes)
+    ap.add_argument("--t-end", type=float, default=t_end)
+    ap.add_argument("--ranks", type=int, nargs="+", default=ranks)
+    if options:
+        options(ap)
+    args = ap.parse_args()
+    harness = Ranks(args.floesim, args.mpiexec, args.workdir)
+    sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))),
+                                    "scripts", "scenarios"))
+    import moving_pack  # (the pack shared with bench/mpi_pack.py; it needs h5py, which --no-mpi does not)
+    try:
+        config = moving_pack.write(args.floesim, args.workdir, args.floes, args.t_end, seed=5,
+                                   output_interval=args.t_end / 4, wind=(10.0, 3.0))
+    except RuntimeError as e:
+        sys.exit(f"FAILED: {e}")
+    return args, harness, config

@@ -110,15 +110,21 @@ Serial serial_advance(const Case& c) {
 // gathers), and rank 0's copy combines them. Returns whether they combined;
 // `f` and the counts hold the combined answer, or, when not, the whole
 // advance redone (the fallback). `outcomes` gets each share's outcome.
+// With `merged`, each share records its solves into a record of its own,
+// whose events are merged into `merged` (or the fallback records into it);
+// `events` gets each share's event count.
 bool play(const Case& c, std::span<const int> owner, int ranks, Floes& f, contact::CollisionStats& stats,
-          contact::SubstepReport& report, std::vector<contact::ShareOutcome>& outcomes) {
+          contact::SubstepReport& report, std::vector<contact::ShareOutcome>& outcomes,
+          contact::ImpulseRecord* merged = nullptr, std::vector<std::uint32_t>* events = nullptr) {
   std::vector<Floes> copies(static_cast<std::size_t>(ranks), c.floes);
+  std::vector<contact::ImpulseRecord> own(static_cast<std::size_t>(ranks));
   std::vector<std::unique_ptr<contact::ShareAdvance>> shares;
   std::vector<contact::ShareRooms> rooms;
   for (int r = 0; r < ranks; ++r) {
+    contact::SubstepOptions o = c.options;
+    if (merged) o.impulse.record = &own[static_cast<std::size_t>(r)];
     shares.push_back(std::make_unique<contact::ShareAdvance>(copies[static_cast<std::size_t>(r)], c.shapes,
-                                                             c.detection, c.dt, c.options,
-                                                             contact::ClusterShare{owner, r}));
+                                                             c.detection, c.dt, o, contact::ClusterShare{owner, r}));
     rooms.push_back(parallel::unpack_share_rooms(parallel::pack(shares.back()->rooms())));
   }
   std::vector<contact::PairRoom> tight;
@@ -127,16 +133,24 @@ bool play(const Case& c, std::span<const int> owner, int ranks, Floes& f, contac
     std::vector<parallel::AdvancePart> parts;
     for (int r = 0; r < ranks; ++r) {
       const std::size_t k = static_cast<std::size_t>(r);
-      const parallel::AdvancePart part = parallel::finish_share(*shares[k], tight, copies[k]);
+      const parallel::AdvancePart part =
+          parallel::finish_share(*shares[k], tight, copies[k], merged ? &own[k] : nullptr);
       outcomes.push_back(part.outcome);
+      if (merged) {
+        if (part.outcome.conflict == contact::ShareOutcome::Conflict::none)
+          REQUIRE(part.outcome.events.size() == part.record.events);
+        events->push_back(part.record.events);
+      }
       parts.push_back(parallel::unpack_advance_part(parallel::pack(part)));
     }
     f = std::move(copies.front());
-    ok = parallel::combine_parts(parts, f, stats, report);
+    ok = parallel::combine_parts(parts, f, stats, report, merged);
   }
   if (ok) return true;
   f = c.floes;
-  contact::advance_with_collisions(f, c.shapes, c.detection, c.dt, c.options, stats, report);
+  contact::SubstepOptions whole = c.options;
+  if (merged) whole.impulse.record = merged;
+  contact::advance_with_collisions(f, c.shapes, c.detection, c.dt, whole, stats, report);
   return false;
 }
 
@@ -358,43 +372,6 @@ TEST_CASE("a share that would use the warm store falls back, and the next advanc
   CHECK(serial_warm.uses > 0);
 }
 
-namespace {
-
-// The shares' records of `ranks` ranks (each share's advance on its own copy
-// with a record of its own), packed, unpacked and merged by combine_parts
-// into `merged`. Returns whether they combined; `events` gets each share's
-// event count.
-bool play_record(const Case& c, std::span<const int> owner, int ranks, contact::ImpulseRecord& merged,
-                 std::vector<std::uint32_t>& events) {
-  std::vector<Floes> copies(static_cast<std::size_t>(ranks), c.floes);
-  std::vector<contact::ImpulseRecord> own(static_cast<std::size_t>(ranks));
-  std::vector<std::unique_ptr<contact::ShareAdvance>> shares;
-  std::vector<contact::ShareRooms> rooms;
-  for (int r = 0; r < ranks; ++r) {
-    contact::SubstepOptions o = c.options;
-    o.impulse.record = &own[static_cast<std::size_t>(r)];
-    shares.push_back(std::make_unique<contact::ShareAdvance>(copies[static_cast<std::size_t>(r)], c.shapes,
-                                                             c.detection, c.dt, o, contact::ClusterShare{owner, r}));
-    rooms.push_back(parallel::unpack_share_rooms(parallel::pack(shares.back()->rooms())));
-  }
-  std::vector<contact::PairRoom> tight;
-  if (!parallel::combine_rooms(rooms, tight)) return false;
-  std::vector<parallel::AdvancePart> parts;
-  for (int r = 0; r < ranks; ++r) {
-    const std::size_t k = static_cast<std::size_t>(r);
-    const parallel::AdvancePart part = parallel::finish_share(*shares[k], tight, copies[k], &own[k]);
-    if (part.outcome.conflict == contact::ShareOutcome::Conflict::none)
-      REQUIRE(part.outcome.events.size() == part.record.events);
-    events.push_back(part.record.events);
-    parts.push_back(parallel::unpack_advance_part(parallel::pack(part)));
-  }
-  contact::CollisionStats stats;
-  contact::SubstepReport report;
-  return parallel::combine_parts(parts, copies.front(), stats, report, &merged);
-}
-
-}  // namespace
-
 TEST_CASE("the advance's impulse records by cluster owner merge into the serial record") {
   // The packs above (events of many clusters at many sub-step times), and
   // with jams of two floes (time steps, whose solves again drop their loads
@@ -429,7 +406,11 @@ TEST_CASE("the advance's impulse records by cluster owner merge into the serial 
         contact::ImpulseRecord merged;
         merged.events = 1;
         std::vector<std::uint32_t> events;
-        const bool ok = play_record(c, owners.owner(), ranks, merged, events);
+        Floes f;
+        contact::CollisionStats stats;
+        contact::SubstepReport report;
+        std::vector<contact::ShareOutcome> outcomes;
+        const bool ok = play(c, owners.owner(), ranks, f, stats, report, outcomes, &merged, &events);
         MESSAGE(ranks << " ranks: " << std::string(ok ? "combined" : "fell back"));
         if (ranks == 1) CHECK(ok);
         if (!ok) continue;

@@ -48,24 +48,39 @@ Serial serial_solve(const CollideCase& c) {
 // through pack/unpack, and rank 0's copy combines them. Returns whether they
 // combined; `f`, `stats` and `speculative` hold the combined answer, or,
 // when not, the whole solve redone (the fallback). `groups`: each rank's.
+// With `merged`, the shares record their impulses (each into its part's own
+// record, not the options' one, which stays empty), their parts' records
+// are merged into `merged` (a record the step's earlier solves began), or
+// the fallback records into it; `loads` gets each rank's count of loads.
 bool play(const CollideCase& c, std::span<const int> owner, int ranks, Floes& f, contact::CollisionStats& stats,
-          std::size_t& speculative, std::vector<long>& groups) {
+          std::size_t& speculative, std::vector<long>& groups, contact::ImpulseRecord* merged = nullptr,
+          std::vector<std::size_t>* loads = nullptr) {
   std::vector<parallel::CollidePart> parts;
+  contact::ImpulseRecord unused;
+  contact::ImpulseOptions o = c.options;
+  if (merged) o.record = &unused;
   Floes first;
   for (int r = 0; r < ranks; ++r) {
     Floes mine = c.floes;
-    const parallel::CollidePart part =
-        parallel::run_collide_share(mine, c.start, c.detection, c.dt, c.options, owner, r);
+    const parallel::CollidePart part = parallel::run_collide_share(mine, c.start, c.detection, c.dt, o, owner, r);
     parts.push_back(parallel::unpack_collide_part(parallel::pack(part)));
     REQUIRE(parts.back().outcome.moved == part.outcome.moved);  // the bytes carry the part
     REQUIRE(parts.back().states.size() == part.states.size());
     groups.push_back(part.outcome.groups);
+    if (merged) {
+      REQUIRE(part.outcome.places.size() == part.record.loads.size());
+      loads->push_back(part.record.loads.size());
+    }
     if (r == 0) first = std::move(mine);
   }
+  CHECK(unused.loads.empty());
+  CHECK(unused.events == 0);
   f = std::move(first);
-  if (parallel::combine_collide_parts(parts, f, stats, speculative)) return true;
+  if (parallel::combine_collide_parts(parts, f, stats, speculative, merged)) return true;
   f.state = c.floes.state;
-  speculative = contact::resolve_step_collisions(f, c.start, c.detection, c.dt, c.options, stats);
+  contact::ImpulseOptions whole = c.options;
+  if (merged) whole.record = merged;
+  speculative = contact::resolve_step_collisions(f, c.start, c.detection, c.dt, whole, stats);
   return false;
 }
 
@@ -240,33 +255,6 @@ TEST_CASE("step-start collisions that would use the warm store fall back, with t
 
 namespace {
 
-// The serial record of a step's collisions after `before` events (a record
-// the step's earlier solves began), and the shares' records of `ranks`
-// ranks, packed, unpacked and merged into a record that began alike.
-// Returns whether the shares combined (else `merged` is untouched but for
-// the start).
-bool play_record(const CollideCase& c, std::span<const int> owner, int ranks, contact::ImpulseRecord& merged,
-                 std::vector<std::size_t>& loads) {
-  std::vector<parallel::CollidePart> parts;
-  contact::ImpulseRecord unused;  // a share records into its part's own; this one stays empty
-  contact::ImpulseOptions o = c.options;
-  o.record = &unused;
-  Floes first;
-  for (int r = 0; r < ranks; ++r) {
-    Floes mine = c.floes;
-    const parallel::CollidePart part = parallel::run_collide_share(mine, c.start, c.detection, c.dt, o, owner, r);
-    REQUIRE(part.outcome.places.size() == part.record.loads.size());
-    loads.push_back(part.record.loads.size());
-    parts.push_back(parallel::unpack_collide_part(parallel::pack(part)));
-    if (r == 0) first = std::move(mine);
-  }
-  CHECK(unused.loads.empty());
-  CHECK(unused.events == 0);
-  contact::CollisionStats stats;
-  std::size_t speculative = 0;
-  return parallel::combine_collide_parts(parts, first, stats, speculative, &merged);
-}
-
 contact::ImpulseRecord begun() {
   contact::ImpulseRecord r;
   r.events = 3;
@@ -305,7 +293,11 @@ TEST_CASE("the step-start collisions' impulse records by owner merge into the se
       const std::vector<int> owner = owners_of(c, ranks, n);
       contact::ImpulseRecord merged = begun();
       std::vector<std::size_t> loads;
-      REQUIRE(play_record(c, owner, n, merged, loads));
+      Floes f;
+      contact::CollisionStats stats;
+      std::size_t speculative = 0;
+      std::vector<long> groups;
+      REQUIRE(play(c, owner, n, f, stats, speculative, groups, &merged, &loads));
       CHECK(same_record(merged, serial));
       // The loads came from several ranks (the merge had work to do).
       if (n > 1) CHECK(std::count_if(loads.begin(), loads.end(), [](std::size_t l) { return l > 0; }) >= 2);
