@@ -204,8 +204,10 @@ public:
   // slab holds its row from the pieces themselves, in the serial order
   // (parallel::CellRoutes with the floes' serial positions as keys), which
   // sends the coverage and the sums back to the ranks with pieces there; a
-  // cell deeper in a slab than any floe of another rank reaches is summed by
-  // its owner alone, with no exchange. Every cell's sums are then the serial
+  // cell deeper in a slab than any floe of another rank reaches, or under
+  // no other rank's floe's box of cells (parallel::CellBox, gathered with
+  // the serial order), is summed by the rank whose floes lie there alone,
+  // which sends only the pressure's total to the cell's slab's rank. Every cell's sums are then the serial
   // run's to the bit, whichever rank owns which floe. pressure() then holds
   // this rank's slab's rows only, which is what its sea's kick reads. A sea
   // not in slabs (stage three) sums each rank's part of a cell and then the
