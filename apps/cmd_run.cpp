@@ -399,7 +399,11 @@ int run(const Args& args, const parallel::Session& session) {
     if (const FloeSeaContact* fs = sim.floe_sea(); fs && !fs->owner_slabs().empty()) {
       o << "parallel.coupling_slab_rows:";
       for (const int r : fs->owner_slabs()) o << " " << r;
-      o << "\n";
+      // Rank 0's cells outside its slab's interior, summed over the
+      // evaluations: sent as pieces (their pieces), summed alone here.
+      const FloeSeaContact::RoutedCells& cells = fs->routed_cells();
+      o << "\nparallel.coupling_cells: " << cells.shared << " shared (" << cells.pieces << " pieces), "
+        << cells.alone_here << " alone owned, " << cells.alone_sent << " alone sent\n";
     }
     // Stage seven: with a sea in slabs the strips are its slabs, their first
     // rows (then the row count) now.

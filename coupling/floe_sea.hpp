@@ -204,8 +204,10 @@ public:
   // slab holds its row from the pieces themselves, in the serial order
   // (parallel::CellRoutes with the floes' serial positions as keys), which
   // sends the coverage and the sums back to the ranks with pieces there; a
-  // cell deeper in a slab than any floe of another rank reaches is summed by
-  // its owner alone, with no exchange. Every cell's sums are then the serial
+  // cell deeper in a slab than any floe of another rank reaches, or under
+  // no other rank's floe's box of cells (parallel::CellBox, gathered with
+  // the serial order), is summed by the rank whose floes lie there alone,
+  // which sends only the pressure's total to the cell's slab's rank. Every cell's sums are then the serial
   // run's to the bit, whichever rank owns which floe. pressure() then holds
   // this rank's slab's rows only, which is what its sea's kick reads. A sea
   // not in slabs (stage three) sums each rank's part of a cell and then the
@@ -279,6 +281,15 @@ public:
   // coupling's cost"). With the implicit step (the law replicated) only the
   // footprints are.
   double take_owned_seconds() { return std::exchange(owned_seconds_, 0.0) + footprints_.take_owned_seconds(); }
+  // By owner with the sea in slabs, this rank's cells outside its slab's
+  // interior since the start, per evaluation summed: those sent as pieces
+  // (shared with another rank's floes, or possibly: their boxes meet), and
+  // those summed here alone, owned here or by another rank (then sent as
+  // the pressure's total).
+  struct RoutedCells {
+    long shared = 0, pieces = 0, alone_here = 0, alone_sent = 0;
+  };
+  const RoutedCells& routed_cells() const { return owner_.routed_counts; }
   std::span<const FloeSeaLoad> loads() const { return loads_; }
   std::span<const double> pressure() const { return pressure_; }
   double strong_share() const { return s_; }
@@ -313,6 +324,13 @@ private:
   bool by_owner() const { return !comm_.serial() && !implicit_; }
   // The cells' sums by owner go to the slabs' ranks (the sea in slabs).
   bool routed() const { return !routes_.empty(); }
+  // Routed, whether the floes' boxes (parallel::CellBox) tell each rank
+  // which of its cells no other rank's floe may share: on grids of at most
+  // CellBox::kMaxSide rows and columns; else every cell outside the slabs'
+  // interiors goes as pieces.
+  bool boxed() const {
+    return routed() && grid_.nx <= parallel::CellBox::kMaxSide && grid_.ny <= parallel::CellBox::kMaxSide;
+  }
   // By owner (floe_sea_owners.cpp): zeroes pressure_ and cells_ where the
   // last evaluation by owner wrote them.
   void clear_cells_by_owner();
@@ -398,17 +416,26 @@ private:
     std::vector<std::uint32_t> touched;  // every rank's cells, in rank order (where pressure_ may be nonzero)
     std::vector<std::size_t> counts;     // cells per rank in `touched`
     std::vector<std::byte> message, received;  // the exchanges' buffers, kept from one evaluation to the next
-    // Routed: per grid cell, whether it lies deep in its slab (every row
-    // within `interior_reach` rows is the slab's), where only the slab's
-    // rank has pieces, summed into cells_ and pressure_ directly (piece_slot
-    // kInteriorCell; `cells` holds the others); and the parts sent, per
-    // cell of `cells`.
-    std::vector<std::uint8_t> interior;
+    // Routed: per grid cell, what kind (CellKind): deep in its slab (every
+    // row within `interior_reach` rows is the slab's), where only the slab's
+    // rank has pieces; else, during sum_coverage_by_owner, whether another
+    // rank's floe's box covers it (shared: its pieces are routed), and
+    // whether it is in `alone`. A cell with this rank's pieces that is not
+    // shared is summed into cells_ and pressure_ directly (piece_slot
+    // kInteriorCell; `cells` holds the others); `alone` lists those of them
+    // another rank owns, whose pressure goes to the owner as a total
+    // (alone_totals); and the parts sent, per cell of `cells`.
+    enum CellKind : std::uint8_t { kRoutedRow = 0, kInteriorRow = 1, kShared = 2, kAloneListed = 3 };
+    std::vector<std::uint8_t> kind, interior_row;
     int interior_reach = -1;
     std::vector<double> parts;
-    // The serial order (order_by_owner): per floe its first cell (kNoCell:
-    // not in the order) and its place in the order, and the order.
-    std::vector<std::uint32_t> first_cell, position, serial;
+    std::vector<std::uint32_t> alone, painted;  // painted: the cells whose kind is not their row's
+    std::vector<double> alone_totals;
+    // The serial order (order_by_owner): per floe the box of its pieces'
+    // cells (parallel::CellBox, first_cell kNoCell: not in the order) and
+    // its place in the order, and the order.
+    std::vector<parallel::CellBox> box;
+    std::vector<std::uint32_t> position, serial;
     // Routed: the pieces of the cells of `cells` grouped by cell (cell j's
     // are [first[j], first[j + 1])), each with its floe's position (keys)
     // and its coverage (values); per area piece of this rank's floes, its
@@ -419,8 +446,9 @@ private:
     // (its position and count), in order_.
     std::vector<std::uint32_t> energy_keys, energy_counts;
     std::vector<double> energy_terms;
+    RoutedCells routed_counts;  // since the start, this rank's
   } owner_;
-  static constexpr std::uint32_t kNoCell = 0xffffffffu;
+  static constexpr std::uint32_t kNoCell = parallel::CellBox::kNone;
   // The sea's slabs (fluid::Sea::slab_rows; empty: whole on every rank), and
   // by owner on them, the routes of the cells' sums to the slabs' ranks;
   // the next evaluation clears pressure_ in routes_.owned() (this rank's

@@ -8,16 +8,25 @@
 // floe with pieces, sorted by its first cell), each floe's pieces in their
 // order; a floe's pieces are not interleaved with another's. A floating-point
 // sum depends on the order of its terms, so each rank works in that order:
-// the floes' first cells are gathered (4 bytes a floe) and every rank sorts
+// the floes' first cells are gathered (in a parallel::CellBox, 12 bytes a
+// floe, with the box below on a sea in slabs) and every rank sorts
 // them as the serial run does (the same input, the same comparisons: the
 // same permutation, ties included), keeps its own floes in that order
 // (order_) and knows every floe's place in it (owner_.position).
 //
-// Sea in slabs (stages five and eight, routed()). A cell deeper in a rank's
-// slab than any other rank's floe reaches (CellRoutes::interior_rows) holds
-// that rank's pieces only: it sums them into cells_ and pressure_ directly,
-// as the serial loop does. Every other cell goes to the rank whose slab holds
-// its row (parallel::CellRoutes, an all-to-all) as its pieces, each with its
+// Sea in slabs (stages five and eight, routed()). A cell where only this
+// rank's floes have pieces is summed here, into cells_ and pressure_
+// directly, from zero in order_ (the serial order restricted to this rank's
+// floes, which are all of the cell's): the serial loop's sums. Such are the
+// cells deeper in a rank's slab than any other rank's floe reaches
+// (CellRoutes::interior_rows) and, on the rows between, the cells under no
+// other rank's floe's box (parallel::CellBox: the rows and columns of a
+// floe's pieces, gathered with the floes' first cells); if another rank
+// owns such a cell (its slab holds the row), the pressure's total goes to
+// it (CellRoutes' alone cells: 4 bytes a cell before the law, 8 after).
+// Every other cell (under a box of another rank's floe: shared, or nearly)
+// goes to the rank whose slab holds its row (parallel::CellRoutes, an
+// all-to-all) as its pieces, each with its
 // floe's serial position as key: before the law the cell, its pieces'
 // count, keys and coverage (8 bytes a cell, 12 a piece); after it the pieces'
 // a u^2 and pressure (16 bytes a piece). The cell's owner adds every rank's
@@ -41,6 +50,7 @@
 // which groups the pieces by rank: equal to the serial sum up to round-off.
 #include <algorithm>
 #include <cstring>
+#include <utility>
 
 #include "coupling/floe_sea.hpp"
 
@@ -57,8 +67,10 @@ void FloeSeaContact::set_slabs(std::vector<int> first_row) {
   if (first_row == slab_rows_) return;
   // The old routes' cells: this rank's sums there are no longer read by
   // its sea, and clear_cells_by_owner() will clear the new routes' cells.
-  if (routed() && pressure_.size() == grid_.size())
+  if (routed() && pressure_.size() == grid_.size()) {
     for (std::uint32_t c : routes_.owned()) pressure_[c] = 0.0;
+    for (std::uint32_t c : routes_.alone_owned()) pressure_[c] = 0.0;
+  }
   slab_rows_ = std::move(first_row);
   if (!routed()) return;
   routes_ = parallel::CellRoutes(slab_rows_, static_cast<std::size_t>(grid_.nx));
@@ -69,16 +81,26 @@ void FloeSeaContact::set_slabs(std::vector<int> first_row) {
 void FloeSeaContact::order_by_owner(std::size_t floes) {
   const Footprints& fp = footprints_.pieces();
   OwnerCells& o = owner_;
-  o.first_cell.assign(floes, kNoCell);
+  // Each floe's first cell, and with the boxes (boxed()) the box of its
+  // cells, which tells the other ranks where its pieces may share a cell.
+  const bool boxes = boxed();
+  o.box.assign(floes, {});
   for (std::uint32_t i : footprints_.mine())
-    if (i < fp.floes() && dynamic_[i] && fp.offsets[i] < fp.offsets[i + 1]) o.first_cell[i] = fp.cell[fp.offsets[i]];
-  comm_.complete_owned(o.first_cell, footprints_.owners());
+    if (i < fp.floes() && dynamic_[i] && fp.offsets[i] < fp.offsets[i + 1]) {
+      if (boxes) {
+        const std::span<const std::uint32_t> cells(fp.cell.data() + fp.offsets[i], fp.offsets[i + 1] - fp.offsets[i]);
+        o.box[i] = parallel::CellBox::of(cells, grid_.nx, grid_.ny);
+      } else {
+        o.box[i].first_cell = fp.cell[fp.offsets[i]];
+      }
+    }
+  comm_.complete_owned(o.box, footprints_.owners());
   // place_footprints' serial sort, on the same floes in the same order.
   o.serial.clear();
   for (std::size_t i = 0; i < floes; ++i)
-    if (o.first_cell[i] != kNoCell) o.serial.push_back(static_cast<std::uint32_t>(i));
+    if (o.box[i].first_cell != kNoCell) o.serial.push_back(static_cast<std::uint32_t>(i));
   std::sort(o.serial.begin(), o.serial.end(),
-            [&](std::uint32_t x, std::uint32_t y) { return o.first_cell[x] < o.first_cell[y]; });
+            [&](std::uint32_t x, std::uint32_t y) { return o.box[x].first_cell < o.box[y].first_cell; });
   o.position.assign(floes, kNoCell);
   order_.clear();
   for (std::size_t j = 0; j < o.serial.size(); ++j) {
@@ -133,6 +155,7 @@ void FloeSeaContact::clear_cells_by_owner() {
   // this rank's cells; and, routed, the cells deep in its slab, where its
   // last pieces lie.
   for (std::uint32_t c : routed() ? routes_.owned() : std::span<const std::uint32_t>(owner_.touched)) pressure_[c] = 0.0;
+  for (std::uint32_t c : routes_.alone_owned()) pressure_[c] = 0.0;
   for (std::uint32_t c : owner_.cells) cells_[c] = {};
   if (!routed()) return;
   const Footprints& fp = footprints_.pieces();
@@ -147,20 +170,39 @@ void FloeSeaContact::clear_cells_by_owner() {
 void FloeSeaContact::sum_coverage_by_owner() {
   const Footprints& fp = footprints_.pieces();
   OwnerCells& o = owner_;
-  // Routed, the cells deep in this rank's slab (floes owned by place) get
-  // no other rank's parts: their sums are made in cells_ and pressure_
-  // directly, as the serial loop makes them (the totals are this rank's
-  // parts: 0 + its part, what the merge would give), and every other cell
-  // goes to its owner. Not routed, no cell is interior.
-  const bool routed_cells = routed();
+  // Routed, a cell where this rank's floes' pieces lie alone gets no other
+  // rank's: its sums are made in cells_ and pressure_ directly, as the
+  // serial loop makes them (its pieces are all of the cell's, in order_,
+  // the serial order). Such are the cells deep in this rank's slab (no
+  // other rank's floe reaches them) and, with the floes' boxes (boxed()),
+  // every cell no other rank's floe's box covers; the pressure of those
+  // another rank owns goes to it as a total (`alone`). Every other cell
+  // goes to its owner as pieces. Not routed, no cell is summed alone.
+  const bool routed_cells = routed(), boxes = boxed();
+  const std::size_t nx = static_cast<std::size_t>(grid_.nx);
   if (routed_cells) {
     const int reach = footprints_.by_place() ? footprints_.reach_rows() : grid_.ny;
     if (reach != o.interior_reach) {
-      const std::vector<std::uint8_t> rows = routes_.interior_rows(reach);
-      o.interior.resize(grid_.size());
-      for (std::size_t c = 0; c < grid_.size(); ++c) o.interior[c] = rows[c / static_cast<std::size_t>(grid_.nx)];
+      o.interior_row = routes_.interior_rows(reach);
+      o.kind.resize(grid_.size());
+      for (std::size_t c = 0; c < grid_.size(); ++c)
+        o.kind[c] = o.interior_row[c / nx] ? OwnerCells::kInteriorRow : OwnerCells::kRoutedRow;
       o.interior_reach = reach;
     }
+    // The cells other ranks' floes may have pieces in, outside the slabs'
+    // interiors (where no other rank's floe reaches).
+    o.painted.clear();
+    if (boxes)
+      for (std::uint32_t i : o.serial) {
+        if (footprints_.owns(i)) continue;
+        o.box[i].for_each(
+            grid_.nx, grid_.ny, [&](int y) { return o.interior_row[static_cast<std::size_t>(y)] == 0; },
+            [&](std::uint32_t c) {
+              if (o.kind[c] != OwnerCells::kRoutedRow) return;
+              o.kind[c] = OwnerCells::kShared;
+              o.painted.push_back(c);
+            });
+      }
   }
   // This rank's other cells, in the order its floes' pieces meet them, and
   // its part of each cell's coverage, summed as the serial loop sums it.
@@ -168,16 +210,28 @@ void FloeSeaContact::sum_coverage_by_owner() {
   for (std::uint32_t c : o.cells) o.slot[c] = 0;
   o.cells.clear();
   o.coverage.clear();
+  o.alone.clear();
   o.first.assign(1, 0);  // routed: then each cell's piece count, made offsets below
   o.piece_slot.resize(fp.cell.size());
   const double inv_cell_area = 1.0 / cell_area_;
+  const int rank = comm_.rank();
+  std::size_t alone_here = 0;
   for (std::uint32_t i : order_)
     for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k) {
       const std::uint32_t c = fp.cell[k];
-      if (routed_cells && o.interior[c]) {
-        o.piece_slot[k] = kInteriorCell;
-        cells_[c].coverage += fp.area[k] * inv_cell_area;
-        continue;
+      if (routed_cells) {
+        const std::uint8_t kind = o.kind[c];
+        if (kind == OwnerCells::kInteriorRow || (boxes && kind != OwnerCells::kShared)) {
+          o.piece_slot[k] = kInteriorCell;
+          cells_[c].coverage += fp.area[k] * inv_cell_area;
+          if (kind == OwnerCells::kRoutedRow) {  // first met: listed, and its total sent if another rank owns it
+            o.kind[c] = OwnerCells::kAloneListed;
+            o.painted.push_back(c);
+            if (routes_.owner(c) != rank) o.alone.push_back(c);
+            else ++alone_here;
+          }
+          continue;
+        }
       }
       if (o.slot[c] == 0) {
         o.cells.push_back(c);
@@ -191,6 +245,8 @@ void FloeSeaContact::sum_coverage_by_owner() {
       if (routed_cells) ++o.first[o.slot[c]];
       else o.coverage[o.piece_slot[k]] += fp.area[k] * inv_cell_area;
     }
+  // The kinds back to the rows' (the boxes move with the floes).
+  for (std::uint32_t c : o.painted) o.kind[c] = OwnerCells::kRoutedRow;
   if (routed()) {
     // The routed cells' pieces grouped by cell, in the serial order within
     // each (order_ is), with their floes' positions.
@@ -207,7 +263,11 @@ void FloeSeaContact::sum_coverage_by_owner() {
         o.keys[p] = o.position[i];
         o.values[p] = fp.area[k] * inv_cell_area;
       }
-    routes_.open(comm_, o.cells, o.first, o.keys, o.values, 1);
+    routes_.open(comm_, o.cells, o.first, o.keys, o.values, 1, o.alone);
+    o.routed_counts.shared += static_cast<long>(o.cells.size());
+    o.routed_counts.pieces += static_cast<long>(o.first.back());
+    o.routed_counts.alone_here += static_cast<long>(alone_here);
+    o.routed_counts.alone_sent += static_cast<long>(o.alone.size());
     routes_.reply(comm_, 0, o.coverage);  // the cells' totals, in place of this rank's parts
     for (std::size_t j = 0; j < o.cells.size(); ++j) cells_[o.cells[j]].coverage = o.coverage[j];
     return;
@@ -273,9 +333,15 @@ double FloeSeaContact::sum_cells_by_owner(double ks) {
         o.energy_counts.push_back(static_cast<std::uint32_t>(o.energy_terms.size() - terms));
       }
     }
-    const double total = routes_.add(comm_, o.parts, 2, energy);
+    // The pressure of the cells summed here alone that another rank owns:
+    // their totals to it (this rank's sea does not read them).
+    o.alone_totals.resize(o.alone.size());
+    for (std::size_t j = 0; j < o.alone.size(); ++j) o.alone_totals[j] = std::exchange(pressure_[o.alone[j]], 0.0);
+    const double total = routes_.add(comm_, o.parts, 2, energy, o.alone_totals);
     const std::span<const std::uint32_t> slab = routes_.owned();
     for (std::size_t j = 0; j < slab.size(); ++j) pressure_[slab[j]] = routes_.total(j, 1);  // zero before: 0 + the total
+    const std::span<const std::uint32_t> alone = routes_.alone_owned();
+    for (std::size_t j = 0; j < alone.size(); ++j) pressure_[alone[j]] = routes_.alone_total(j);  // the sender's sum from zero
     o.sum.resize(o.cells.size());
     routes_.reply(comm_, 0, o.sum);
     for (std::size_t j = 0; j < o.cells.size(); ++j) cells_[o.cells[j]].sum = o.sum[j];

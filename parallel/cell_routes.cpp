@@ -15,6 +15,43 @@ std::vector<int> row_owners(std::span<const int> first_row) {
   return owner;
 }
 
+CellBox CellBox::of(std::span<const std::uint32_t> cells, int columns, int rows) {
+  FLOESIM_ASSERT(columns <= kMaxSide && rows <= kMaxSide);
+  CellBox box;
+  if (cells.empty()) return box;
+  box.first_cell = cells[0];
+  const std::uint32_t nx = static_cast<std::uint32_t>(columns);
+  const int row0 = static_cast<int>(cells[0] / nx), column0 = static_cast<int>(cells[0] % nx);
+  // Each offset from the first cell taken the short way round, in
+  // [-floor(n/2), ceil(n/2)): any choice holds the cell, this one keeps the
+  // box small. d = x - x0 lies in (-n, n).
+  auto offset = [](int d, int n) {
+    if (d >= 0) return d >= (n + 1) / 2 ? d - n : d;
+    return d + n < (n + 1) / 2 ? d + n : d;
+  };
+  int row_lo = 0, row_hi = 0, column_lo = 0, column_hi = 0;
+  // The row found by a division only when it changes (a floe's cells come
+  // sorted, row by row).
+  std::uint32_t base = static_cast<std::uint32_t>(row0) * nx;
+  for (const std::uint32_t c : cells) {
+    if (c < base || c - base >= nx) {
+      const int row = static_cast<int>(c / nx);
+      base = static_cast<std::uint32_t>(row) * nx;
+      const int dy = offset(row - row0, rows);
+      row_lo = std::min(row_lo, dy);
+      row_hi = std::max(row_hi, dy);
+    }
+    const int dx = offset(static_cast<int>(c - base) - column0, columns);
+    column_lo = std::min(column_lo, dx);
+    column_hi = std::max(column_hi, dx);
+  }
+  box.row_lo = static_cast<std::int16_t>(row_lo);
+  box.row_hi = static_cast<std::int16_t>(row_hi);
+  box.column_lo = static_cast<std::int16_t>(column_lo);
+  box.column_hi = static_cast<std::int16_t>(column_hi);
+  return box;
+}
+
 CellRoutes::CellRoutes(std::vector<int> first_row, std::size_t columns)
     : first_row_(std::move(first_row)), columns_(columns) {
   FLOESIM_ASSERT(first_row_.size() >= 2 && columns_ > 0);
@@ -35,101 +72,122 @@ std::vector<std::uint8_t> CellRoutes::interior_rows(int reach) const {
 }
 
 void CellRoutes::open(const Communicator& comm, std::span<const std::uint32_t> cells, std::span<const std::uint32_t> first,
-                      std::span<const std::uint32_t> keys, std::span<const double> parts, int width) {
+                      std::span<const std::uint32_t> keys, std::span<const double> parts, int width,
+                      std::span<const std::uint32_t> alone) {
   const std::size_t ranks = static_cast<std::size_t>(comm.size()), w = static_cast<std::size_t>(width);
   FLOESIM_ASSERT(ranks + 1 == first_row_.size() && first.size() == cells.size() + 1 && keys.size() == first.back() &&
                  parts.size() == keys.size() * w);
-  // This rank's cells grouped by owner, in their order within each group.
+  // This rank's cells and alone cells grouped by owner, in their order
+  // within each group.
   sent_.assign(ranks, 0);
   sent_pieces_.assign(ranks, 0);
+  sent_alone_.assign(ranks, 0);
   for (std::size_t k = 0; k < cells.size(); ++k) {
     const std::size_t r = static_cast<std::size_t>(owner(cells[k]));
     ++sent_[r];
     sent_pieces_[r] += first[k + 1] - first[k];
   }
-  std::vector<std::size_t> next(ranks, 0);
-  for (std::size_t r = 1; r < ranks; ++r) next[r] = next[r - 1] + sent_[r - 1];
-  route_.resize(cells.size());
-  for (std::size_t k = 0; k < cells.size(); ++k) route_[next[static_cast<std::size_t>(owner(cells[k]))]++] = static_cast<std::uint32_t>(k);
+  for (const std::uint32_t c : alone) ++sent_alone_[static_cast<std::size_t>(owner(c))];
+  auto group = [&](std::span<const std::uint32_t> list, const std::vector<std::size_t>& count, std::vector<std::uint32_t>& route) {
+    std::vector<std::size_t> next(ranks, 0);
+    for (std::size_t r = 1; r < ranks; ++r) next[r] = next[r - 1] + count[r - 1];
+    route.resize(list.size());
+    for (std::size_t k = 0; k < list.size(); ++k) route[next[static_cast<std::size_t>(owner(list[k]))]++] = static_cast<std::uint32_t>(k);
+  };
+  group(cells, sent_, route_);
+  group(alone, sent_alone_, alone_route_);
   first_.assign(first.begin(), first.end());
-  // To each owner: the count of its cells, the cells, their pieces' counts,
-  // then the pieces' keys and values.
-  std::vector<std::size_t> bytes(ranks);
+  // To each owner: the counts of its cells and alone cells, the cells, their
+  // pieces' counts, the alone cells, then the pieces' keys and values.
+  bytes_.resize(ranks);
   std::size_t total_bytes = 0;
   for (std::size_t r = 0; r < ranks; ++r) {
-    bytes[r] = sizeof(std::uint64_t) + sent_[r] * 2 * sizeof(std::uint32_t) + sent_pieces_[r] * (sizeof(std::uint32_t) + w * sizeof(double));
-    total_bytes += bytes[r];
+    bytes_[r] = 2 * sizeof(std::uint64_t) + (sent_[r] * 2 + sent_alone_[r]) * sizeof(std::uint32_t) +
+                sent_pieces_[r] * (sizeof(std::uint32_t) + w * sizeof(double));
+    total_bytes += bytes_[r];
   }
   send_.resize(total_bytes);
   std::byte* out = send_.data();
-  for (std::size_t r = 0, begin = 0; r < ranks; begin += sent_[r], ++r) {
+  for (std::size_t r = 0, begin = 0, alone_begin = 0; r < ranks; begin += sent_[r], alone_begin += sent_alone_[r], ++r) {
     const std::size_t end = begin + sent_[r];
-    const std::uint64_t n = sent_[r];
-    out = put(out, &n, 1);
+    const std::uint64_t n[2] = {sent_[r], sent_alone_[r]};
+    out = put(out, n, 2);
     for (std::size_t j = begin; j < end; ++j) out = put(out, &cells[route_[j]], 1);
     for (std::size_t j = begin; j < end; ++j) {
       const std::uint32_t count = first[route_[j] + 1] - first[route_[j]];
       out = put(out, &count, 1);
     }
+    for (std::size_t j = alone_begin; j < alone_begin + sent_alone_[r]; ++j) out = put(out, &alone[alone_route_[j]], 1);
     for (std::size_t j = begin; j < end; ++j) out = put(out, &keys[first[route_[j]]], first[route_[j] + 1] - first[route_[j]]);
     for (std::size_t j = begin; j < end; ++j)
       out = put(out, &parts[first[route_[j]] * w], (first[route_[j] + 1] - first[route_[j]]) * w);
   }
-  std::vector<std::size_t> receive_bytes;
-  comm.alltoall_bytes(send_, bytes, receive_, receive_bytes);
-  // The owner's cells, in the order they first arrive, and every piece
-  // received with its cell's slot and key.
+  comm.alltoall_bytes(send_, bytes_, receive_, receive_bytes_);
+  // The owner's cells, in the order they first arrive, each received cell's
+  // slot and count, the alone cells, and every piece's key and values in the
+  // order received.
   for (std::uint32_t c : owned_) slot_[c] = 0;
   owned_.clear();
+  alone_owned_.clear();
   from_.clear();
+  count_.clear();
+  keys_.clear();
   values_.clear();
   width_ = width;
   received_.assign(ranks, 0);
   received_pieces_.assign(ranks, 0);
-  struct Piece {
-    std::uint32_t slot, key, index;  // index: in the order received
-  };
-  std::vector<Piece> pieces;
+  received_alone_.assign(ranks, 0);
   const std::byte* in = receive_.data();
   for (std::size_t r = 0; r < ranks; ++r) {
     const std::size_t n = static_cast<std::size_t>(at<std::uint64_t>(in, 0));
-    const std::byte* cell = in + sizeof(std::uint64_t);
+    const std::size_t n_alone = static_cast<std::size_t>(at<std::uint64_t>(in, 1));
+    const std::byte* cell = in + 2 * sizeof(std::uint64_t);
     const std::byte* count = cell + n * sizeof(std::uint32_t);
-    const std::byte* key = count + n * sizeof(std::uint32_t);
+    const std::byte* alone_cell = count + n * sizeof(std::uint32_t);
+    const std::byte* key = alone_cell + n_alone * sizeof(std::uint32_t);
     std::size_t m = 0;
-    for (std::size_t j = 0; j < n; ++j) m += at<std::uint32_t>(count, j);
-    const std::byte* value = key + m * sizeof(std::uint32_t);
-    received_[r] = n;
-    received_pieces_[r] = m;
-    for (std::size_t j = 0, p = 0; j < n; ++j) {
-      const std::uint32_t c = at<std::uint32_t>(cell, j);
+    for (std::size_t j = 0; j < n; ++j) {
+      const std::uint32_t c = at<std::uint32_t>(cell, j), q = at<std::uint32_t>(count, j);
       FLOESIM_ASSERT(owner(c) == comm.rank());
       if (slot_[c] == 0) {
         owned_.push_back(c);
         slot_[c] = static_cast<std::uint32_t>(owned_.size());
       }
-      const std::uint32_t s = slot_[c] - 1;
-      from_.push_back(s);
-      for (std::uint32_t q = at<std::uint32_t>(count, j); q > 0; --q, ++p)
-        pieces.push_back({s, at<std::uint32_t>(key, p), static_cast<std::uint32_t>(pieces.size())});
+      from_.push_back(slot_[c] - 1);
+      count_.push_back(q);
+      m += q;
     }
-    const std::size_t before = values_.size();
-    values_.resize(before + m * w);
-    if (m > 0) std::memcpy(values_.data() + before, value, m * w * sizeof(double));
-    in += receive_bytes[r];
+    for (std::size_t j = 0; j < n_alone; ++j) alone_owned_.push_back(at<std::uint32_t>(alone_cell, j));
+    received_[r] = n;
+    received_pieces_[r] = m;
+    received_alone_[r] = n_alone;
+    const std::size_t before = keys_.size();
+    keys_.resize(before + m);
+    values_.resize((before + m) * w);
+    if (m > 0) {
+      std::memcpy(keys_.data() + before, key, m * sizeof(std::uint32_t));
+      std::memcpy(values_.data() + before * w, key + m * sizeof(std::uint32_t), m * w * sizeof(double));
+    }
+    in += receive_bytes_[r];
   }
-  // Each cell's pieces by key; equal keys in the order received (rank
-  // order, then the sender's order).
-  std::sort(pieces.begin(), pieces.end(), [](const Piece& x, const Piece& y) {
-    return x.slot != y.slot ? x.slot < y.slot : x.key != y.key ? x.key < y.key : x.index < y.index;
-  });
-  order_.resize(pieces.size());
+  // Each cell's pieces: a bucket by cell in the order received (rank order,
+  // then the sender's order), then the senders' runs, each in key order,
+  // merged by key (stable: equal keys keep that order). Most cells hold one
+  // run, already in order.
   order_first_.assign(owned_.size() + 1, 0);
-  for (std::size_t k = 0; k < pieces.size(); ++k) {
-    order_[k] = pieces[k].index;
-    ++order_first_[pieces[k].slot + 1];
-  }
+  for (std::size_t j = 0; j < from_.size(); ++j) order_first_[from_[j] + 1] += count_[j];
   for (std::size_t j = 0; j < owned_.size(); ++j) order_first_[j + 1] += order_first_[j];
+  order_.resize(keys_.size());
+  {
+    std::vector<std::uint32_t> next(order_first_.begin(), order_first_.end() - 1);
+    for (std::size_t j = 0, p = 0; j < from_.size(); ++j)
+      for (std::uint32_t q = 0; q < count_[j]; ++q, ++p) order_[next[from_[j]]++] = static_cast<std::uint32_t>(p);
+  }
+  const auto by_key = [this](std::uint32_t x, std::uint32_t y) { return keys_[x] < keys_[y]; };
+  for (std::size_t j = 0; j < owned_.size(); ++j) {
+    const auto begin = order_.begin() + order_first_[j], end = order_.begin() + order_first_[j + 1];
+    if (!std::is_sorted(begin, end, by_key)) std::stable_sort(begin, end, by_key);
+  }
   sum_pieces();
 }
 
@@ -158,53 +216,60 @@ void CellRoutes::reply(const Communicator& comm, int w, std::span<double> out) {
   FLOESIM_ASSERT(out.size() == route_.size());
   // To each rank, the totals of the cells it sent, in the order it sent them.
   send_.resize(from_.size() * sizeof(double));
-  std::vector<std::size_t> bytes(ranks), receive_bytes(ranks);
+  bytes_.resize(ranks);
+  receive_bytes_.resize(ranks);
   std::byte* message = send_.data();
   for (std::size_t k = 0; k < from_.size(); ++k) {
     const double t = total(from_[k], w);
     message = put(message, &t, 1);
   }
   for (std::size_t r = 0; r < ranks; ++r) {
-    bytes[r] = received_[r] * sizeof(double);
-    receive_bytes[r] = sent_[r] * sizeof(double);
+    bytes_[r] = received_[r] * sizeof(double);
+    receive_bytes_[r] = sent_[r] * sizeof(double);
   }
   receive_.resize(route_.size() * sizeof(double));
-  comm.alltoall(send_, bytes, receive_, receive_bytes);
+  comm.alltoall(send_, bytes_, receive_, receive_bytes_);
   for (std::size_t k = 0; k < route_.size(); ++k) out[route_[k]] = at<double>(receive_.data(), k);
 }
 
-double CellRoutes::add(const Communicator& comm, std::span<const double> parts, int width, double extra) {
+double CellRoutes::add(const Communicator& comm, std::span<const double> parts, int width, double extra,
+                       std::span<const double> alone_totals) {
   const std::size_t ranks = received_.size(), w = static_cast<std::size_t>(width);
-  FLOESIM_ASSERT(parts.size() == first_.back() * w);
-  // To each owner: `extra`, then the values of its cells' pieces in the
-  // order of open().
+  FLOESIM_ASSERT(parts.size() == first_.back() * w && alone_totals.size() == alone_route_.size());
+  // To each owner: `extra`, the values of its cells' pieces in the order of
+  // open(), then the totals of its alone cells.
   std::size_t send_total = 0, receive_total = 0;
-  std::vector<std::size_t> bytes(ranks), receive_bytes(ranks);
+  bytes_.resize(ranks);
+  receive_bytes_.resize(ranks);
   for (std::size_t r = 0; r < ranks; ++r) {
-    bytes[r] = (1 + sent_pieces_[r] * w) * sizeof(double);
-    receive_bytes[r] = (1 + received_pieces_[r] * w) * sizeof(double);
-    send_total += bytes[r];
-    receive_total += receive_bytes[r];
+    bytes_[r] = (1 + sent_pieces_[r] * w + sent_alone_[r]) * sizeof(double);
+    receive_bytes_[r] = (1 + received_pieces_[r] * w + received_alone_[r]) * sizeof(double);
+    send_total += bytes_[r];
+    receive_total += receive_bytes_[r];
   }
   send_.resize(send_total);
   std::byte* out = send_.data();
-  for (std::size_t r = 0, begin = 0; r < ranks; begin += sent_[r], ++r) {
+  for (std::size_t r = 0, begin = 0, alone_begin = 0; r < ranks; begin += sent_[r], alone_begin += sent_alone_[r], ++r) {
     out = put(out, &extra, 1);
     for (std::size_t j = begin; j < begin + sent_[r]; ++j)
       out = put(out, &parts[first_[route_[j]] * w], (first_[route_[j] + 1] - first_[route_[j]]) * w);
+    for (std::size_t j = alone_begin; j < alone_begin + sent_alone_[r]; ++j) out = put(out, &alone_totals[alone_route_[j]], 1);
   }
   receive_.resize(receive_total);
-  comm.alltoall(send_, bytes, receive_, receive_bytes);
+  comm.alltoall(send_, bytes_, receive_, receive_bytes_);
   width_ = width;
-  values_.resize((receive_total / sizeof(double) - ranks));
+  values_.resize(keys_.size() * w);
+  alone_totals_.resize(alone_owned_.size());
   double sum = 0.0;
   const std::byte* in = receive_.data();
-  for (std::size_t r = 0, at_value = 0; r < ranks; ++r) {
+  for (std::size_t r = 0, at_value = 0, at_alone = 0; r < ranks; ++r) {
     sum += at<double>(in, 0);
-    const std::size_t m = received_pieces_[r] * w;
+    const std::size_t m = received_pieces_[r] * w, a = received_alone_[r];
     if (m > 0) std::memcpy(values_.data() + at_value, in + sizeof(double), m * sizeof(double));
+    if (a > 0) std::memcpy(alone_totals_.data() + at_alone, in + (1 + m) * sizeof(double), a * sizeof(double));
     at_value += m;
-    in += receive_bytes[r];
+    at_alone += a;
+    in += receive_bytes_[r];
   }
   sum_pieces();
   return sum;

@@ -15,15 +15,24 @@
 // part added in rank order. The totals go back only to the ranks that sent
 // pieces of the cell.
 //
+// A cell whose pieces all lie on one rank (the caller knows it: no other
+// rank has pieces there) needs no pieces sent: that rank sums them itself,
+// from zero in key order, which is the owner's sum of the same pieces to the
+// bit, and sends the owner the total of the value it needs (`alone` cells:
+// their cells with open(), one total each with add()).
+//
 // One round of sums (one contact evaluation), every call collective:
-//   open(cells, pieces)  this rank's cells with their pieces' keys and a
-//                        first set of values, each cell to its owner: two
-//                        calls (the counts, then the lists)
+//   open(cells, pieces, alone)  this rank's cells with their pieces' keys
+//                        and a first set of values, each cell to its
+//                        owner, and the cells it sums alone: two calls (the
+//                        counts, then the lists)
 //   reply(w, out)        the owners' totals of value w back to the senders,
 //                        in the order of their cells: one call
-//   add(values, extra)   new values for the same pieces, and one number from
-//                        every rank summed over all ranks: one call
-// Between the calls, owned() and total() give the owner's cells and totals.
+//   add(values, extra, alone totals)  new values for the same pieces, one
+//                        number from every rank summed over all ranks, and
+//                        the alone cells' totals: one call
+// Between the calls, owned() and total() give the owner's cells and totals,
+// after add() alone_owned() and alone_total() the alone cells'.
 
 #include <algorithm>
 #include <cmath>
@@ -52,6 +61,39 @@ inline int grid_row(double y, double dy, int rows) {
   return std::min(static_cast<int>(wrapped), rows - 1);
 }
 
+// Where a list of cells lies on a periodic grid, coarsely: a box of rows
+// and columns, each range taken from the first cell's row and column
+// (offsets lo to hi, the grid's seam crossed: modulo the row or column
+// count), that holds every cell of the list. 12 bytes, sent as they are:
+// every rank learns where every floe's pieces lie (FloeSeaContact), and
+// a cell outside every other rank's floes' boxes holds this rank's pieces
+// alone. Grids of at most kMaxSide rows and columns (offsets in 16 bits).
+struct CellBox {
+  static constexpr std::uint32_t kNone = 0xffffffffu;
+  static constexpr int kMaxSide = 32768;
+  std::uint32_t first_cell = kNone;  // the list's first cell; kNone: an empty list
+  std::int16_t row_lo = 0, row_hi = -1, column_lo = 0, column_hi = -1;
+  // The box of `cells` (any order, the first one first) on a grid of
+  // `columns` x `rows` cells (each at most kMaxSide).
+  static CellBox of(std::span<const std::uint32_t> cells, int columns, int rows);
+  // Calls visit(cell) for every cell of the box in rows where
+  // keep_row(row) is true, each cell once.
+  template <class KeepRow, class Visit>
+  void for_each(int columns, int rows, KeepRow keep_row, Visit visit) const {
+    if (first_cell == kNone) return;
+    const int row0 = static_cast<int>(first_cell / static_cast<std::uint32_t>(columns));
+    const int column0 = static_cast<int>(first_cell % static_cast<std::uint32_t>(columns));
+    const int row_count = std::min(row_hi - row_lo + 1, rows), column_count = std::min(column_hi - column_lo + 1, columns);
+    for (int dy = 0; dy < row_count; ++dy) {
+      const int y = ((row0 + row_lo + dy) % rows + rows) % rows;
+      if (!keep_row(y)) continue;
+      const std::size_t base = static_cast<std::size_t>(y) * static_cast<std::size_t>(columns);
+      for (int dx = 0; dx < column_count; ++dx)
+        visit(static_cast<std::uint32_t>(base + static_cast<std::size_t>(((column0 + column_lo + dx) % columns + columns) % columns)));
+    }
+  }
+};
+
 class CellRoutes {
 public:
   CellRoutes() = default;
@@ -70,9 +112,14 @@ public:
   // Sends each of `cells` (distinct) with its pieces to its owner: cell
   // cells[j] has the pieces p in [first[j], first[j + 1]), each with the
   // order key keys[p] and `width` values parts[p * width + w]; the owner sums
-  // every rank's pieces of a cell from zero in key order (total()).
+  // every rank's pieces of a cell from zero in key order (total()). A
+  // sender's pieces of a cell come in key order (the owner merges the
+  // senders' runs). `alone`: cells (distinct, none of them in `cells` of
+  // any rank) where this rank alone has pieces, summed by itself; their
+  // owners receive them now and their totals with the next add().
   void open(const Communicator& comm, std::span<const std::uint32_t> cells, std::span<const std::uint32_t> first,
-            std::span<const std::uint32_t> keys, std::span<const double> parts, int width);
+            std::span<const std::uint32_t> keys, std::span<const double> parts, int width,
+            std::span<const std::uint32_t> alone = {});
   // One piece a cell, all keys equal: the parts summed in rank order
   // (parts[k * width + w] for cells[k]).
   void open(const Communicator& comm, std::span<const std::uint32_t> cells, std::span<const double> parts, int width);
@@ -80,36 +127,46 @@ public:
   // out[k] for this rank's cells[k] of the last open().
   void reply(const Communicator& comm, int w, std::span<double> out);
   // New values (`width` a piece) for the last open()'s pieces, summed by
-  // their owners in the order open() sums them; returns the sum of `extra`
-  // over the ranks, in rank order from zero (the same on every rank).
-  double add(const Communicator& comm, std::span<const double> parts, int width, double extra);
-  // The cells this rank owns that some rank sent parts for in the last open(),
-  // in the order they first arrived (rank order), and their totals.
+  // their owners in the order open() sums them, and one total for each of
+  // its `alone` cells (alone_totals[k] for alone[k]) to their owners;
+  // returns the sum of `extra` over the ranks, in rank order from zero (the
+  // same on every rank).
+  double add(const Communicator& comm, std::span<const double> parts, int width, double extra,
+             std::span<const double> alone_totals = {});
+  // The cells this rank owns that some rank sent pieces of in the last
+  // open(), in the order they first arrived (rank order), and their totals.
   std::span<const std::uint32_t> owned() const { return owned_; }
   double total(std::size_t j, int w) const { return totals_[j * static_cast<std::size_t>(width_) + static_cast<std::size_t>(w)]; }
+  // The cells this rank owns that some rank summed alone in the last open()
+  // (in rank order, then the sender's), and after add() their totals.
+  std::span<const std::uint32_t> alone_owned() const { return alone_owned_; }
+  double alone_total(std::size_t j) const { return alone_totals_[j]; }
 
 private:
   std::vector<int> first_row_, row_owner_;
   std::size_t columns_ = 1;
   // This rank's cells grouped by owner (route_[k]: the index in open()'s
-  // cells of the k-th sent), their pieces' offsets (first_), and the counts
-  // each way: cells (sent_, received_) and pieces (sent_pieces_,
-  // received_pieces_).
-  std::vector<std::uint32_t> route_, first_;
-  std::vector<std::size_t> sent_, received_, sent_pieces_, received_pieces_;
+  // cells of the k-th sent; alone_route_ the same for its alone cells),
+  // their pieces' offsets (first_), and the counts each way: cells (sent_,
+  // received_), pieces (sent_pieces_, received_pieces_) and alone cells
+  // (sent_alone_, received_alone_).
+  std::vector<std::uint32_t> route_, alone_route_, first_;
+  std::vector<std::size_t> sent_, received_, sent_pieces_, received_pieces_, sent_alone_, received_alone_;
   std::vector<std::uint32_t> from_;   // per received cell, in rank order: its index in owned_
-  std::vector<std::uint32_t> owned_;
+  std::vector<std::uint32_t> count_;  // per received cell: its pieces' count
+  std::vector<std::uint32_t> owned_, alone_owned_;
   std::vector<std::uint32_t> slot_;   // per grid cell: 1 + its index in owned_, 0: none
   // The received pieces (in rank order, then the senders' order) in the
   // order they are summed: owned cell j's are order_[order_first_[j]] up to
-  // order_[order_first_[j + 1]], by key.
-  std::vector<std::uint32_t> order_, order_first_;
+  // order_[order_first_[j + 1]], by key; keys_ per received piece.
+  std::vector<std::uint32_t> order_, order_first_, keys_;
   std::vector<double> values_;        // per received piece, `width_` values
-  std::vector<double> totals_;
+  std::vector<double> totals_, alone_totals_;
   int width_ = 0;
   // Sums owned cell j's values w from zero in key order, into totals_.
   void sum_pieces();
   std::vector<std::byte> send_, receive_;  // kept from one round to the next
+  std::vector<std::size_t> bytes_, receive_bytes_;
 };
 
 }  // namespace floesim::parallel

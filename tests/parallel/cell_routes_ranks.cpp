@@ -14,6 +14,7 @@
 #include <cstdio>
 #include <cstring>
 #include <random>
+#include <utility>
 #include <vector>
 
 #include "parallel/cell_routes.hpp"
@@ -89,7 +90,10 @@ bool routes_equal_merge(const parallel::Communicator& comm, int nx, int ny, cons
 // that pieces of several ranks interleave in a cell and some keys repeat);
 // the owners' totals must equal, to the bit, the sum from zero of every
 // rank's pieces of the cell sorted by key (equal keys in rank order, then in
-// the sender's order), for open()'s values and for add()'s.
+// the sender's order), for open()'s values and for add()'s. Each rank also
+// sums some other cells alone (none of any rank's pieces lie there): their
+// owners must receive exactly the cells of their slab and the senders'
+// totals, bit for bit.
 bool pieces_in_key_order(const parallel::Communicator& comm, int nx, int ny, const std::vector<int>& cut, unsigned seed) {
   const std::size_t n = static_cast<std::size_t>(nx) * static_cast<std::size_t>(ny);
   std::mt19937_64 rng(seed * 7 + static_cast<unsigned>(comm.rank()));
@@ -128,16 +132,36 @@ bool pieces_in_key_order(const parallel::Communicator& comm, int nx, int ny, con
     ref2[2 * all_cell[k]] += all_two[2 * k];
     ref2[2 * all_cell[k] + 1] += all_two[2 * k + 1];
   }
+  // Cells this rank sums alone: none of any rank's cells above, each on
+  // one rank (c % ranks), in a random order, with random totals.
+  std::vector<std::uint8_t> any(n, 0);
+  for (std::uint32_t c : all_cell) any[c] = 1;
+  std::vector<std::uint32_t> alone;
+  for (std::uint32_t c = 0; c < n; ++c)
+    if (!any[c] && c % static_cast<std::uint32_t>(comm.size()) == static_cast<std::uint32_t>(comm.rank()) && u(rng) < 0.0)
+      alone.push_back(c);
+  std::shuffle(alone.begin(), alone.end(), rng);
+  std::vector<double> alone_totals(alone.size());
+  for (double& x : alone_totals) x = u(rng) * std::exp(10.0 * u(rng));
+  const std::vector<std::uint32_t> all_alone = comm.allgather<std::uint32_t>(alone);
+  const std::vector<double> all_alone_totals = comm.allgather<double>(alone_totals);
+  std::vector<std::pair<std::uint32_t, double>> expected_alone;  // this rank's slab's, in rank order then the sender's
+  const std::vector<int> row_owner = parallel::row_owners(cut);
+  for (std::size_t k = 0; k < all_alone.size(); ++k)
+    if (row_owner[all_alone[k] / static_cast<std::uint32_t>(nx)] == comm.rank()) expected_alone.push_back({all_alone[k], all_alone_totals[k]});
   parallel::CellRoutes routes(cut, static_cast<std::size_t>(nx));
   bool equal = true;
-  routes.open(comm, cells, first, keys, one, 1);
+  routes.open(comm, cells, first, keys, one, 1, alone);
   for (std::size_t j = 0; j < routes.owned().size(); ++j) equal = equal && same_bits(routes.total(j, 0), ref1[routes.owned()[j]]);
+  equal = equal && routes.alone_owned().size() == expected_alone.size();
   std::vector<double> back(cells.size());
   routes.reply(comm, 0, back);
   for (std::size_t k = 0; k < cells.size(); ++k) equal = equal && same_bits(back[k], ref1[cells[k]]);
-  routes.add(comm, two, 2, 0.0);
+  routes.add(comm, two, 2, 0.0, alone_totals);
   for (std::size_t j = 0; j < routes.owned().size(); ++j)
     for (int w = 0; w < 2; ++w) equal = equal && same_bits(routes.total(j, w), ref2[2 * routes.owned()[j] + w]);
+  for (std::size_t j = 0; j < expected_alone.size() && j < routes.alone_owned().size(); ++j)
+    equal = equal && routes.alone_owned()[j] == expected_alone[j].first && same_bits(routes.alone_total(j), expected_alone[j].second);
   routes.reply(comm, 1, back);
   for (std::size_t k = 0; k < cells.size(); ++k) equal = equal && same_bits(back[k], ref2[2 * cells[k] + 1]);
   // A test that could fail: summed in rank order instead, some cell differs.
@@ -147,8 +171,9 @@ bool pieces_in_key_order(const parallel::Communicator& comm, int nx, int ny, con
     for (std::size_t k = 0; k < all_cell.size(); ++k) by_rank[all_cell[k]] += all_one[k];
     for (std::size_t c = 0; c < n; ++c) differs += same_bits(by_rank[c], ref1[c]) ? 0 : 1;
   }
-  std::printf("rank %d of %d, %d x %d, %zu cells, %zu pieces, %zu owned (%zu cells of the grid differ summed in rank order): %s\n",
-              comm.rank(), comm.size(), nx, ny, cells.size(), keys.size(), routes.owned().size(), differs,
+  std::printf("rank %d of %d, %d x %d, %zu cells, %zu pieces, %zu owned, %zu alone sent, %zu alone owned (%zu cells of the grid differ summed in rank order): %s\n",
+              comm.rank(), comm.size(), nx, ny, cells.size(), keys.size(), routes.owned().size(), alone.size(),
+              routes.alone_owned().size(), differs,
               equal ? "the pieces summed in key order, bit for bit" : "DIFFERENT");
   return equal && (comm.size() == 1 || differs > 0);
 }

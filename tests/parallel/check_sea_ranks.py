@@ -23,7 +23,9 @@ Every run file must equal the serial one bit for bit (`floesim compare
 and the explicit kicks on 2 and 3 ranks (stage eight: a cell where pieces of
 floes of several ranks lie is summed by its slab's rank from the pieces, in
 the serial order, and the penalty energy from every rank's terms, in the
-serial order). A fourth variant, "dense" (300 floes of 4 to 10 m at 70 %
+serial order). Rank 0's cells outside its slab's interior must include both
+kinds: cells sent as pieces (under another rank's floe's box) and cells it
+summed alone and sent to their slab's rank as totals. A fourth variant, "dense" (300 floes of 4 to 10 m at 70 %
 cover), has cells holding three or more floes of two ranks at the slab
 boundaries, where summing the ranks' parts (stage five) differed from the
 serial run in the floes' states and the sea (by ~1e-15 relative), not only
@@ -42,6 +44,7 @@ checkpoint on 3 ranks and serially, both within 1e-6 of the serial run.
 """
 import argparse
 import os
+import re
 import sys
 
 from ranks_harness import Ranks, need, ocean_toml, summary
@@ -114,6 +117,18 @@ for name, text in VARIANTS.items():
         print(f"{name}: {n} ranks {verdict} to the serial run ({how(exact)})")
         if c.returncode != 0:
             failures.append(f"{name} on {n} ranks: exit {p.returncode}\n{p.stderr}\n{c.stdout}")
+        # The cells outside the slabs' interiors: sent as pieces where
+        # another rank's floe's box covers them, else summed alone (those of
+        # another rank's slab sent as totals). Both kinds must occur on rank 0
+        # of the explicit runs, or the check would not test them.
+        cells = summary(p).get("parallel.coupling_cells") if p.returncode == 0 and n > 1 else None
+        if cells is not None:
+            m = re.match(r"(\d+) shared \((\d+) pieces\), (\d+) alone owned, (\d+) alone sent", cells)
+            print(f"{name}: {n} ranks, rank 0's cells: {cells}")
+            if not m or int(m.group(1)) == 0 or int(m.group(4)) == 0:
+                failures.append(f"{name} on {n} ranks: no cell sent as pieces or none as a total ({cells})")
+        elif name != "implicit" and n > 1 and p.returncode == 0:
+            failures.append(f"{name} on {n} ranks: no parallel.coupling_cells in the summary")
 
 # Floes that split on a sea: the floe count changes during the run, and with
 # it every rank's share. tests/regression/floes_on_sea.toml with the first
