@@ -16,7 +16,7 @@ namespace floesim::contact {
 
 namespace detail {
 
-std::vector<PairRoom> Stepper::set_up() {
+ShareRooms Stepper::set_up() {
   const std::size_t n = floes_.size();
   start_ = floes_.state;
   lin_.assign(n, 0.0);
@@ -32,26 +32,36 @@ std::vector<PairRoom> Stepper::set_up() {
   const std::size_t pairs = det_->pairs.size();
   room_.assign(pairs, kInf);
   known_.assign(pairs, 0);
-  std::vector<PairRoom> tight;
+  ShareRooms out;
   for (std::uint32_t p = 0; p < pairs; ++p) {
     if (!computes(p)) continue;
+    const NearPair& q = det_->pairs[p];
     const double r = room(p);
-    if (r < opt_.collision_distance) tight.push_back({p, r});
+    if (r < opt_.collision_distance) out.tight.push_back({q.a, q.b, q.shift, r});
+    if (q.contact_count > 0 && !floes_.is_static[q.a] && !floes_.is_static[q.b]) out.touching.push_back({q.a, q.b});
   }
-  return tight;
+  return out;
 }
 
-void Stepper::advance(std::span<const PairRoom> tight) {
+void Stepper::advance(std::span<const PairRoom> tight, std::span<const ContactEdge> touching) {
   const std::size_t n = floes_.size();
   tight_.clear();
   for (const PairRoom& t : tight) {
-    FLOESIM_ASSERT(t.pair < room_.size());
-    if (!known_[t.pair]) {
-      room_[t.pair] = t.room;
-      known_[t.pair] = 1;
+    // The pair list is in pair order (detection.hpp, pair_before).
+    const auto before = [](const NearPair& q, const PairRoom& k) {
+      return pair_before(PairRoom{q.a, q.b, q.shift, 0.0}, k);
+    };
+    const auto at = std::lower_bound(det_->pairs.begin(), det_->pairs.end(), t, before);
+    FLOESIM_ASSERT(at != det_->pairs.end() && at->a == t.a && at->b == t.b && at->shift.x() == t.shift.x() &&
+                   at->shift.y() == t.shift.y());
+    const auto p = static_cast<std::uint32_t>(at - det_->pairs.begin());
+    if (!known_[p]) {
+      room_[p] = t.room;
+      known_[p] = 1;
     }
-    tight_.push_back(t.pair);
+    tight_.push_back(p);
   }
+  touching_.assign(touching.begin(), touching.end());
   std::sort(tight_.begin(), tight_.end());
   tight_.erase(std::unique(tight_.begin(), tight_.end()), tight_.end());
   make_clusters();
@@ -225,8 +235,7 @@ void Stepper::find_jams() {
   const std::size_t n = floes_.size();
   DisjointSets sets(n);
   auto find = [&](std::uint32_t i) { return sets.find(i); };
-  for (const ContactPoint& c : det_->contacts)
-    if (!floes_.is_static[c.a] && !floes_.is_static[c.b]) sets.join(c.a, c.b);
+  for (const ContactEdge& e : touching_) sets.join(e.a, e.b);
   std::vector<std::uint32_t> size(n, 0);
   for (std::uint32_t i = 0; i < n; ++i)
     if (!floes_.is_static[i]) ++size[find(i)];
@@ -448,7 +457,7 @@ ShareAdvance::~ShareAdvance() = default;
 ShareRooms ShareAdvance::rooms() {
   ShareRooms out;
   try {
-    out.tight = stepper_->set_up();
+    out = stepper_->set_up();
   } catch (const RunError&) {
     out.conflict = ShareOutcome::Conflict::error;
   }
@@ -456,12 +465,12 @@ ShareRooms ShareAdvance::rooms() {
   return out;
 }
 
-ShareOutcome ShareAdvance::advance(std::span<const PairRoom> tight) {
+ShareOutcome ShareAdvance::advance(const ShareRooms& all) {
   ShareOutcome outcome;
   outcome.conflict = set_up_;
   if (outcome.conflict != ShareOutcome::Conflict::none) return outcome;
   try {
-    stepper_->advance(tight);
+    stepper_->advance(all.tight, all.touching);
     outcome = stepper_->outcome();
   } catch (const RunError&) {
     outcome.conflict = ShareOutcome::Conflict::error;

@@ -148,13 +148,21 @@ void advance_with_collisions(Floes& floes, const CollisionShapes& shapes, const 
 // impulse.hpp; its owners must each be one of the sharing ranks, so that
 // each pair's room is computed by one share.)
 
-// A pair's room over the step (m), as one share gives it to the others: its
-// index in the step's pair list (the detection's, or the list rebuilt from
-// the replicated state for a floe that outruns its reach, alike on every
-// share).
+// A pair's room over the step (m), as one share gives it to the others,
+// keyed by the pair itself (floes a < b and b's periodic shift), not by its
+// place in one rank's list: a key every share can look up in whatever list
+// of pairs it holds.
 struct PairRoom {
-  std::uint32_t pair = 0;
+  std::uint32_t a = 0, b = 0;
+  Vec2 shift = Vec2::Zero();
   double room = 0.0;
+};
+
+// A pair with contact points between two dynamic floes: the jams
+// (find_jams; jam.hpp) are the components of these edges, so the shares
+// find the same jams from every share's edges, without every contact point.
+struct ContactEdge {
+  std::uint32_t a = 0, b = 0;
 };
 
 // What a share did. On `conflict` other than none the floes' states are
@@ -175,11 +183,14 @@ struct ShareOutcome {
   std::vector<EventPlace> events;
 };
 
-// The first half's answer: the share's tight pairs (room below xi), by
-// ascending pair, or a conflict (a RunError in the set-up).
+// The first half's answer: the share's tight pairs (room below xi) and
+// contact edges, each in pair order, or a conflict (a RunError in the
+// set-up). Concatenated over the shares (in any order), the second half's
+// input.
 struct ShareRooms {
   ShareOutcome::Conflict conflict = ShareOutcome::Conflict::none;
   std::vector<PairRoom> tight;
+  std::vector<ContactEdge> touching;
 };
 
 // One share of the advance, in two halves around the caller's exchange of
@@ -203,9 +214,10 @@ public:
   // The set-up of the share's pairs: the straight paths, the pair list (and
   // its rebuild), and the rooms of the pairs whose lower floe the share owns.
   ShareRooms rooms();
-  // The rest, given the tight pairs of every share (concatenated, in any
-  // order; this share's included): the clusters, and the share's advance.
-  ShareOutcome advance(std::span<const PairRoom> tight);
+  // The rest, given the tight pairs and contact edges of every share
+  // (concatenated, in any order; this share's included): the clusters, and
+  // the share's advance.
+  ShareOutcome advance(const ShareRooms& all);
 
   const CollisionStats& stats() const { return stats_; }
   const SubstepReport& report() const { return report_; }

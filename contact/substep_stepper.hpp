@@ -79,20 +79,22 @@ public:
   // The advance over dt (substep.hpp, steps 1 to 5): set_up, then advance
   // with its own tight pairs (every pair's room computed: the serial advance).
   void run() {
-    const std::vector<PairRoom> tight = set_up();
-    advance(tight);
+    const ShareRooms own = set_up();
+    advance(own.tight, own.touching);
   }
 
   // Step 1's set-up for the pairs this call computes (a share's: those whose
   // lower floe it owns; else all): the straight paths, the pair list
   // (rebuilt if a floe would outrun its reach), its index, and those pairs'
-  // rooms. Returns the tight ones (room below xi), by ascending pair.
-  std::vector<PairRoom> set_up();
+  // rooms. Returns the tight ones (room below xi) and the contact edges of
+  // those pairs, in pair order.
+  ShareRooms set_up();
 
-  // Steps 1 to 5 from there, given the tight pairs of every share (this
-  // call's included, in any order): the clusters, then the advance of the
-  // share's clusters only when given one.
-  void advance(std::span<const PairRoom> tight);
+  // Steps 1 to 5 from there, given the tight pairs and contact edges of
+  // every share (this call's included, in any order): the clusters, then
+  // the advance of the share's clusters only when given one. A tight pair is
+  // looked up in the pair list by its key (a, b, shift).
+  void advance(std::span<const PairRoom> tight, std::span<const ContactEdge> touching);
 
 private:
   std::uint32_t other(std::uint32_t p, std::uint32_t i) const {
@@ -156,7 +158,8 @@ private:
   // the pairs of jam-sized clusters' floes (their pads).
   void make_clusters();
 
-  // jam_of_[i]: the jam of floe i (-1: none), jams_: their floes.
+  // jam_of_[i]: the jam of floe i (-1: none), jams_: their floes; from the
+  // contact edges of every share (touching_).
   void find_jams();
 
   // Budget of each member: half the room of each pair with a floe outside
@@ -234,6 +237,7 @@ private:
   std::vector<double> room_;           // m, per pair, over the step on straight paths (room(): when known_)
   std::vector<std::uint8_t> known_;    // per pair: room_ computed or gathered
   std::vector<std::uint32_t> tight_;   // ascending: the pairs whose room is below xi (every share's)
+  std::vector<ContactEdge> touching_;  // every share's pairs with contact points between dynamic floes
   long rooms_ = 0;                     // rooms computed by this call (pair_room)
   bool moving_ = false;                // floes moved: the start's states are start_ only
   std::vector<std::size_t> pair_offsets_;

@@ -44,20 +44,22 @@ contact::ImpulseRecord take_record(const std::byte*& in);
 std::vector<std::byte> pack(const AdvancePart& part);
 AdvancePart unpack_advance_part(std::span<const std::byte> bytes);
 
-// The first exchange: a share's tight pairs (contact::ShareRooms), 12 bytes a
-// pair (index, room) after a header (conflict, count).
+// The first exchange: a share's tight pairs and contact edges
+// (contact::ShareRooms), 32 bytes a tight pair (a, b, shift, room) and 8 an
+// edge (a, b) after a header (conflict, the two counts).
 std::vector<std::byte> pack(const contact::ShareRooms& rooms);
 contact::ShareRooms unpack_share_rooms(std::span<const std::byte> bytes);
 
-// Every rank's tight pairs (rank order) as one list for ShareAdvance::advance;
-// false, leaving `tight` unspecified, when a rank's set-up had a conflict.
-bool combine_rooms(std::span<const contact::ShareRooms> parts, std::vector<contact::PairRoom>& tight);
+// Every rank's tight pairs and contact edges (rank order) as one list each
+// for ShareAdvance::advance; false, leaving `all` unspecified, when a rank's
+// set-up had a conflict.
+bool combine_rooms(std::span<const contact::ShareRooms> parts, contact::ShareRooms& all);
 
 // The second half of a rank's share (ShareAdvance::advance, given every
 // rank's tight pairs) and its part; `floes` (the share's floes) is left with
 // the share's states. `record`: the share's impulse record (the one its
 // options point at; null: none), moved into the part.
-AdvancePart finish_share(contact::ShareAdvance& share, std::span<const contact::PairRoom> tight, const Floes& floes,
+AdvancePart finish_share(contact::ShareAdvance& share, const contact::ShareRooms& all, const Floes& floes,
                          contact::ImpulseRecord* record = nullptr);
 
 // Combines every rank's part (rank order) into `floes` (each rank's moved

@@ -121,7 +121,7 @@ bool play(const Case& c, std::span<const int> owner, int ranks, Floes& f, contac
                                                              contact::ClusterShare{owner, r}));
     rooms.push_back(parallel::unpack_share_rooms(parallel::pack(shares.back()->rooms())));
   }
-  std::vector<contact::PairRoom> tight;
+  contact::ShareRooms tight;
   bool ok = parallel::combine_rooms(rooms, tight);
   if (ok) {
     std::vector<parallel::AdvancePart> parts;
@@ -377,7 +377,7 @@ bool play_record(const Case& c, std::span<const int> owner, int ranks, contact::
                                                              c.detection, c.dt, o, contact::ClusterShare{owner, r}));
     rooms.push_back(parallel::unpack_share_rooms(parallel::pack(shares.back()->rooms())));
   }
-  std::vector<contact::PairRoom> tight;
+  contact::ShareRooms tight;
   if (!parallel::combine_rooms(rooms, tight)) return false;
   std::vector<parallel::AdvancePart> parts;
   for (int r = 0; r < ranks; ++r) {
