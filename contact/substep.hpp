@@ -168,7 +168,9 @@ struct ContactEdge {
 // What a share did. On `conflict` other than none the floes' states are
 // unusable and the caller redoes the advance whole from the step's states.
 struct ShareOutcome {
-  enum class Conflict { none, foreign_cluster, warm_start, failed_lcp, error };
+  // missing_pairs: a share on a part of the detection would read a pair it
+  // does not hold (a free floe joining its cluster, a jam-sized cluster's pads).
+  enum class Conflict { none, foreign_cluster, warm_start, failed_lcp, error, missing_pairs };
   Conflict conflict = Conflict::none;
   std::vector<std::uint32_t> moved;  // ascending: the floes of the share's clusters (joined free floes included)
   long clusters = 0;                 // clusters of the share at the start of the step
@@ -205,8 +207,12 @@ struct ShareRooms {
 // queue's order (merge_advance_record, impulse.hpp).
 class ShareAdvance {
 public:
+  // on_part: `detection` is only this share's part of the detection (each
+  // pair in exactly one share's part; the part's reach the whole reach):
+  // the share computes the rooms of all its pairs, and between advance()'s
+  // two halves below (clusters(), advance()) the caller routes the pairs.
   ShareAdvance(Floes& floes, const CollisionShapes& shapes, const Detection& detection, double dt,
-               const SubstepOptions& options, const ClusterShare& share);
+               const SubstepOptions& options, const ClusterShare& share, bool on_part = false);
   ~ShareAdvance();
   ShareAdvance(const ShareAdvance&) = delete;
   ShareAdvance& operator=(const ShareAdvance&) = delete;
@@ -218,6 +224,23 @@ public:
   // (concatenated, in any order; this share's included): the clusters, and
   // the share's advance.
   ShareOutcome advance(const ShareRooms& all);
+
+  // On a part, advance(all) in two halves around the caller's routing of the
+  // pairs. clusters(): the clusters (the same on every share) and, unless
+  // that is a conflict (a jam-sized cluster, whose pads' pairs no share
+  // holds whole: the same on every share), the pairs of the part to send:
+  // (share, index in the part), each pair to every other share that runs a
+  // cluster with one of its floes. hold(): the part and the pairs received,
+  // merged in pair order. advance(): the share's advance on them; a free
+  // floe that would join one of its clusters (its pairs are not all held) is
+  // a conflict (missing_pairs).
+  struct Routes {
+    ShareOutcome::Conflict conflict = ShareOutcome::Conflict::none;
+    std::vector<std::pair<int, std::uint32_t>> to;
+  };
+  Routes clusters(const ShareRooms& all);
+  void hold(Detection held);
+  ShareOutcome advance();
 
   const CollisionStats& stats() const { return stats_; }
   const SubstepReport& report() const { return report_; }

@@ -8,6 +8,7 @@
 
 #include "core/error.hpp"
 #include "parallel/bytes.hpp"
+#include "parallel/detect.hpp"
 
 namespace floesim::parallel {
 
@@ -189,8 +190,13 @@ bool combine_rooms(std::span<const contact::ShareRooms> parts, contact::ShareRoo
 
 AdvancePart finish_share(contact::ShareAdvance& share, const contact::ShareRooms& all, const Floes& floes,
                          contact::ImpulseRecord* record) {
+  return share_part(share, share.advance(all), floes, record);
+}
+
+AdvancePart share_part(const contact::ShareAdvance& share, contact::ShareOutcome outcome, const Floes& floes,
+                       contact::ImpulseRecord* record) {
   AdvancePart part;
-  part.outcome = share.advance(all);
+  part.outcome = std::move(outcome);
   part.stats = share.stats();
   part.report = share.report();
   if (part.outcome.conflict == ShareOutcome::Conflict::none) {
@@ -289,6 +295,90 @@ void advance_by_owner(const Communicator& comm, std::span<const int> owner, Floe
   counts.fell_back(share_options);
   floes.state = start;
   contact::advance_with_collisions(floes, shapes, detection, dt, options, stats, report);
+}
+
+std::vector<contact::Detection> routed_pairs(const contact::Detection& part,
+                                             std::span<const std::pair<int, std::uint32_t>> routes, int ranks) {
+  std::vector<contact::Detection> out(static_cast<std::size_t>(ranks));
+  std::vector<std::uint8_t> to(part.pairs.size());
+  for (int s = 0; s < ranks; ++s) {
+    std::fill(to.begin(), to.end(), 0);
+    bool any = false;
+    for (const auto& [r, p] : routes)
+      if (r == s) {
+        to[p] = 1;
+        any = true;
+      }
+    if (!any) continue;
+    std::size_t j = 0;
+    out[static_cast<std::size_t>(s)] = select_pairs(part, [&](const contact::NearPair&) { return to[j++] != 0; });
+  }
+  return out;
+}
+
+void advance_on_part(const Communicator& comm, std::span<const int> owner, Floes& floes,
+                     const contact::CollisionShapes& shapes, const contact::Detection& part,
+                     const std::function<const contact::Detection&()>& whole, double dt,
+                     const contact::SubstepOptions& options, contact::CollisionStats& stats,
+                     contact::SubstepReport& report, AdvanceShareCounts& counts,
+                     const AdvanceShareOptions& share_options) {
+  // The record's places number the whole call's lists: such a run keeps the whole detection.
+  if (options.impulse.record || comm.serial())
+    return advance_by_owner(comm, owner, floes, shapes, whole(), dt, options, stats, report, counts, share_options);
+  if (counts.whole_now()) {
+    contact::advance_with_collisions(floes, shapes, whole(), dt, options, stats, report);
+    return;
+  }
+  const std::vector<FloeState> start = floes.state;
+  bool combined = false;
+  {
+    contact::ShareAdvance share(floes, shapes, part, dt, options, {owner, comm.rank()}, true);
+    const std::vector<contact::ShareRooms> rooms = comm.allgather_parts(pack(share.rooms()), unpack_share_rooms);
+    contact::ShareRooms all;
+    // The gathered conflicts and the clusters are the same on every rank:
+    // all skip the next exchanges alike.
+    if (combine_rooms(rooms, all)) {
+      const contact::ShareAdvance::Routes routes = share.clusters(all);
+      if (routes.conflict == contact::ShareOutcome::Conflict::none) {
+        std::vector<std::byte> send;
+        std::vector<std::size_t> send_counts;
+        for (const contact::Detection& d : routed_pairs(part, routes.to, comm.size())) {
+          const std::vector<std::byte> bytes = d.pairs.empty() ? std::vector<std::byte>{} : pack(d);
+          send.insert(send.end(), bytes.begin(), bytes.end());
+          send_counts.push_back(bytes.size());
+        }
+        std::vector<std::byte> received;
+        std::vector<std::size_t> received_counts;
+        comm.alltoall_bytes(send, send_counts, received, received_counts);
+        std::vector<contact::Detection> held{part};
+        std::size_t from = 0;
+        for (const std::size_t n : received_counts) {
+          if (n) held.push_back(unpack_detection(std::span<const std::byte>(received.data() + from, n)));
+          from += n;
+        }
+        share.hold(merge(std::move(held)));
+        const AdvancePart mine = share_part(share, share.advance(), floes);
+        const std::vector<AdvancePart> parts = comm.allgather_parts(pack(mine), unpack_advance_part);
+        counts.clusters.resize(parts.size(), 0);
+        counts.rooms.resize(parts.size(), 0);
+        combined = combine_parts(parts, floes, stats, report, nullptr);
+        if (combined) {
+          for (std::size_t r = 0; r < parts.size(); ++r) {
+            counts.clusters[r] += parts[r].outcome.clusters;
+            counts.rooms[r] += parts[r].outcome.rooms;
+            counts.pairs += parts[r].outcome.pairs;
+          }
+        }
+      }
+    }
+  }
+  if (combined) {
+    counts.combined();
+    return;
+  }
+  counts.fell_back(share_options);
+  floes.state = start;
+  contact::advance_with_collisions(floes, shapes, whole(), dt, options, stats, report);
 }
 
 }  // namespace floesim::parallel

@@ -17,6 +17,7 @@
 #include <algorithm>
 #include <cstddef>
 #include <span>
+#include <functional>
 #include <vector>
 
 #include "contact/substep.hpp"
@@ -61,6 +62,14 @@ bool combine_rooms(std::span<const contact::ShareRooms> parts, contact::ShareRoo
 // options point at; null: none), moved into the part.
 AdvancePart finish_share(contact::ShareAdvance& share, const contact::ShareRooms& all, const Floes& floes,
                          contact::ImpulseRecord* record = nullptr);
+// The same from the share's outcome (a share on a part: ShareAdvance::advance()).
+AdvancePart share_part(const contact::ShareAdvance& share, contact::ShareOutcome outcome, const Floes& floes,
+                       contact::ImpulseRecord* record = nullptr);
+
+// On a part: the pairs of `part` that `routes` (ShareAdvance::clusters) sends
+// to each of `ranks` ranks (none to itself).
+std::vector<contact::Detection> routed_pairs(const contact::Detection& part,
+                                             std::span<const std::pair<int, std::uint32_t>> routes, int ranks);
 
 // Combines every rank's part (rank order) into `floes` (each rank's moved
 // floes get its states; the free floes are already at the end of the step on
@@ -134,5 +143,23 @@ void advance_by_owner(const Communicator& comm, std::span<const int> owner, Floe
                       const contact::SubstepOptions& options, contact::CollisionStats& stats,
                       contact::SubstepReport& report, AdvanceShareCounts& counts,
                       const AdvanceShareOptions& share_options = {});
+
+// The same from this rank's part of the detection (parallel::detect's part,
+// docs/parallel.md "The detection's lists by owner"): the share's set-up on
+// its part (every pair of the part its own), the exchange of the tight pairs
+// and contact edges, the clusters, the pairs touching each cluster's members
+// sent to its owner (one alltoall_bytes: two collective calls), the share's
+// advance on its part and the pairs received, the exchange of the parts.
+// `whole` gives the whole detection (collective: every rank calls it at the
+// same point, or none does) for a record run, the back-off's whole steps
+// and the fallback, which is taken also when a share would read a pair it
+// does not hold (Conflict::missing_pairs). Equal to the serial advance bit
+// for bit.
+void advance_on_part(const Communicator& comm, std::span<const int> owner, Floes& floes,
+                     const contact::CollisionShapes& shapes, const contact::Detection& part,
+                     const std::function<const contact::Detection&()>& whole, double dt,
+                     const contact::SubstepOptions& options, contact::CollisionStats& stats,
+                     contact::SubstepReport& report, AdvanceShareCounts& counts,
+                     const AdvanceShareOptions& share_options = {});
 
 }  // namespace floesim::parallel
