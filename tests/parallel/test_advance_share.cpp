@@ -539,7 +539,8 @@ TEST_CASE("the advance from each rank's part of the detection over 1, 2, 3 and 7
   // combined or not, the answer is the serial one.
   int combined = 0;
   long routed = 0;
-  for (const auto [seed, speed] : {std::pair{3u, 2.0}, std::pair{11u, 2.0}, std::pair{5u, 1.5}, std::pair{7u, 1.2}, std::pair{9u, 1.8}}) {
+  const std::pair<unsigned, double> packs[] = {{3u, 2.0}, {11u, 2.0}, {5u, 1.5}, {7u, 1.2}, {9u, 1.8}};
+  for (const auto& [seed, speed] : packs) {
     CAPTURE(seed);
     const Case c = dense_pack(speed, seed, 0.5);
     const Serial serial = serial_advance(c);
