@@ -16,7 +16,7 @@ namespace floesim::contact {
 
 namespace detail {
 
-std::vector<PairRoom> Stepper::set_up() {
+ShareRooms Stepper::set_up() {
   const std::size_t n = floes_.size();
   start_ = floes_.state;
   lin_.assign(n, 0.0);
@@ -30,31 +30,78 @@ std::vector<PairRoom> Stepper::set_up() {
   if (outrun) rebuild_pairs();
   build_pair_index();
   const std::size_t pairs = det_->pairs.size();
+  pairs_ = static_cast<long>(pairs);
   room_.assign(pairs, kInf);
   known_.assign(pairs, 0);
-  std::vector<PairRoom> tight;
+  ShareRooms out;
   for (std::uint32_t p = 0; p < pairs; ++p) {
     if (!computes(p)) continue;
+    const NearPair& q = det_->pairs[p];
     const double r = room(p);
-    if (r < opt_.collision_distance) tight.push_back({p, r});
+    if (r < opt_.collision_distance) out.tight.push_back({q.a, q.b, q.shift, r});
+    if (q.contact_count > 0 && !floes_.is_static[q.a] && !floes_.is_static[q.b]) out.touching.push_back({q.a, q.b});
   }
-  return tight;
+  return out;
 }
 
-void Stepper::advance(std::span<const PairRoom> tight) {
-  const std::size_t n = floes_.size();
-  tight_.clear();
-  for (const PairRoom& t : tight) {
-    FLOESIM_ASSERT(t.pair < room_.size());
-    if (!known_[t.pair]) {
-      room_[t.pair] = t.room;
-      known_[t.pair] = 1;
+void Stepper::clusters(std::span<const PairRoom> tight, std::span<const ContactEdge> touching) {
+  tight_.assign(tight.begin(), tight.end());
+  // The rooms of the tight pairs this call holds (pair order: find_pair); on
+  // a part, a tight pair of another share's part is not held.
+  for (const PairRoom& t : tight_) {
+    const std::size_t p = find_pair(t);
+    FLOESIM_ASSERT(p < det_->pairs.size() || holds_part());
+    if (p < det_->pairs.size() && !known_[p]) {
+      room_[p] = t.room;
+      known_[p] = 1;
     }
-    tight_.push_back(t.pair);
   }
-  std::sort(tight_.begin(), tight_.end());
-  tight_.erase(std::unique(tight_.begin(), tight_.end()), tight_.end());
+  touching_.assign(touching.begin(), touching.end());
   make_clusters();
+}
+
+std::vector<std::pair<int, std::uint32_t>> Stepper::routes() const {
+  std::vector<std::pair<int, std::uint32_t>> out;
+  if (!holds_part()) return out;
+  auto runner = [&](std::uint32_t i) {
+    const int k = cluster_of_[i];
+    return k == kFree ? -1 : share_->owner[clusters_[static_cast<std::size_t>(k)].members.front()];
+  };
+  for (std::uint32_t p = 0; p < det_->pairs.size(); ++p) {
+    const NearPair& q = det_->pairs[p];
+    const int ra = runner(q.a), rb = runner(q.b);
+    if (ra >= 0 && ra != share_->rank) out.push_back({ra, p});
+    if (rb >= 0 && rb != share_->rank && rb != ra) out.push_back({rb, p});
+  }
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+void Stepper::hold(Detection held) {
+  if (!holds_part()) return;  // the pair list was rebuilt whole
+  std::vector<double> room(held.pairs.size(), kInf);
+  std::vector<std::uint8_t> known(held.pairs.size(), 0);
+  for (std::size_t p = 0; p < held.pairs.size(); ++p) {
+    const std::size_t was = find_pair(held.pairs[p]);
+    if (was < det_->pairs.size() && known_[was]) {
+      room[p] = room_[was];
+      known[p] = 1;
+    }
+  }
+  held_ = std::move(held);
+  det_ = &held_;
+  room_ = std::move(room);
+  known_ = std::move(known);
+  build_pair_index();
+  for (const PairRoom& t : tight_)
+    if (const std::size_t p = find_pair(t); p < det_->pairs.size() && !known_[p]) {
+      room_[p] = t.room;
+      known_[p] = 1;
+    }
+}
+
+void Stepper::run_share() {
+  const std::size_t n = floes_.size();
   reach_left_.assign(n, kInf);
   budget_.assign(n, kInf);
   outran_.assign(n, 0);
@@ -152,10 +199,9 @@ void Stepper::make_clusters() {
   auto find = [&](std::uint32_t i) { return sets.find(i); };
   std::vector<std::uint8_t> hot(n, 0);
   const double tight = opt_.collision_distance;
-  for (const std::uint32_t p : tight_) {
-    const NearPair& q = det_->pairs[p];
+  for (const PairRoom& q : tight_) {
     const bool da = !floes_.is_static[q.a], db = !floes_.is_static[q.b];
-    if (room_[p] < 0.0) {
+    if (q.room < 0.0) {
       if (da) hot[q.a] = 1;
       if (db) hot[q.b] = 1;
     }
@@ -189,6 +235,12 @@ void Stepper::make_clusters() {
     for (std::uint32_t i = 0; i < n; ++i) {
       const std::uint32_t r = find(i);
       big[i] = !floes_.is_static[i] && hot_root[r] && size[r] >= opt_.impulse.jam.floes;
+    }
+    // On a part the pads' pairs are not all held: every share finds the
+    // same big clusters, and all redo the advance whole.
+    if (holds_part() && std::find(big.begin(), big.end(), 1) != big.end()) {
+      conflict_ = ShareOutcome::Conflict::missing_pairs;
+      return;
     }
     // The pairs of the big clusters' floes (joins and flags are the same
     // in any order: the components and the hot floes do not depend on it).
@@ -225,8 +277,7 @@ void Stepper::find_jams() {
   const std::size_t n = floes_.size();
   DisjointSets sets(n);
   auto find = [&](std::uint32_t i) { return sets.find(i); };
-  for (const ContactPoint& c : det_->contacts)
-    if (!floes_.is_static[c.a] && !floes_.is_static[c.b]) sets.join(c.a, c.b);
+  for (const ContactEdge& e : touching_) sets.join(e.a, e.b);
   std::vector<std::uint32_t> size(n, 0);
   for (std::uint32_t i = 0; i < n; ++i)
     if (!floes_.is_static[i]) ++size[find(i)];
@@ -387,6 +438,12 @@ void Stepper::bring_in(int k) {
       else if (cluster_of_[f] != k) merging_.push_back(cluster_of_[f]);
     }
   }
+  // On a part, a free floe's pairs are not all held (only its members'
+  // are routed): the share stops.
+  if (holds_part() && !joining_.empty()) {
+    conflict_ = ShareOutcome::Conflict::missing_pairs;
+    return;
+  }
   // A share stops at a cluster it does not run: the serial advance merges
   // the two at a time the share cannot know.
   for (int l : merging_)
@@ -431,7 +488,7 @@ void advance_with_collisions(Floes& floes, const CollisionShapes& shapes, const 
 }
 
 ShareAdvance::ShareAdvance(Floes& floes, const CollisionShapes& shapes, const Detection& detection, double dt,
-                           const SubstepOptions& options, const ClusterShare& share)
+                           const SubstepOptions& options, const ClusterShare& share, bool on_part)
     : options_(options), share_(share) {
   // The warm store is replaced by an empty probe that only says whether a
   // solve of the share would have used it (ClusterShare above). A failure's
@@ -440,7 +497,7 @@ ShareAdvance::ShareAdvance(Floes& floes, const CollisionShapes& shapes, const De
   // the run's first dumps).
   if (options.impulse.warm) options_.impulse.warm = &probe_;
   options_.impulse.dump_failed_lcps.clear();
-  stepper_ = std::make_unique<detail::Stepper>(floes, shapes, detection, dt, options_, stats_, report_, &share_);
+  stepper_ = std::make_unique<detail::Stepper>(floes, shapes, detection, dt, options_, stats_, report_, &share_, on_part);
 }
 
 ShareAdvance::~ShareAdvance() = default;
@@ -448,7 +505,7 @@ ShareAdvance::~ShareAdvance() = default;
 ShareRooms ShareAdvance::rooms() {
   ShareRooms out;
   try {
-    out.tight = stepper_->set_up();
+    out = stepper_->set_up();
   } catch (const RunError&) {
     out.conflict = ShareOutcome::Conflict::error;
   }
@@ -456,12 +513,43 @@ ShareRooms ShareAdvance::rooms() {
   return out;
 }
 
-ShareOutcome ShareAdvance::advance(std::span<const PairRoom> tight) {
+ShareOutcome ShareAdvance::advance(const ShareRooms& all) {
+  if (set_up_ == ShareOutcome::Conflict::none) {
+    try {
+      stepper_->clusters(all.tight, all.touching);
+      set_up_ = stepper_->conflict();
+    } catch (const RunError&) {
+      set_up_ = ShareOutcome::Conflict::error;
+    }
+  }
+  return advance();
+}
+
+ShareAdvance::Routes ShareAdvance::clusters(const ShareRooms& all) {
+  Routes out;
+  if (set_up_ == ShareOutcome::Conflict::none) {
+    try {
+      stepper_->clusters(all.tight, all.touching);
+      set_up_ = stepper_->conflict();
+      if (set_up_ == ShareOutcome::Conflict::none) out.to = stepper_->routes();
+    } catch (const RunError&) {
+      set_up_ = ShareOutcome::Conflict::error;
+    }
+  }
+  out.conflict = set_up_;
+  return out;
+}
+
+void ShareAdvance::hold(Detection held) {
+  if (set_up_ == ShareOutcome::Conflict::none) stepper_->hold(std::move(held));
+}
+
+ShareOutcome ShareAdvance::advance() {
   ShareOutcome outcome;
   outcome.conflict = set_up_;
   if (outcome.conflict != ShareOutcome::Conflict::none) return outcome;
   try {
-    stepper_->advance(tight);
+    stepper_->run_share();
     outcome = stepper_->outcome();
   } catch (const RunError&) {
     outcome.conflict = ShareOutcome::Conflict::error;

@@ -148,19 +148,29 @@ void advance_with_collisions(Floes& floes, const CollisionShapes& shapes, const 
 // impulse.hpp; its owners must each be one of the sharing ranks, so that
 // each pair's room is computed by one share.)
 
-// A pair's room over the step (m), as one share gives it to the others: its
-// index in the step's pair list (the detection's, or the list rebuilt from
-// the replicated state for a floe that outruns its reach, alike on every
-// share).
+// A pair's room over the step (m), as one share gives it to the others,
+// keyed by the pair itself (floes a < b and b's periodic shift), not by its
+// place in one rank's list: a key every share can look up in whatever list
+// of pairs it holds.
 struct PairRoom {
-  std::uint32_t pair = 0;
+  std::uint32_t a = 0, b = 0;
+  Vec2 shift = Vec2::Zero();
   double room = 0.0;
+};
+
+// A pair with contact points between two dynamic floes: the jams
+// (find_jams; jam.hpp) are the components of these edges, so the shares
+// find the same jams from every share's edges, without every contact point.
+struct ContactEdge {
+  std::uint32_t a = 0, b = 0;
 };
 
 // What a share did. On `conflict` other than none the floes' states are
 // unusable and the caller redoes the advance whole from the step's states.
 struct ShareOutcome {
-  enum class Conflict { none, foreign_cluster, warm_start, failed_lcp, error };
+  // missing_pairs: a share on a part of the detection would read a pair it
+  // does not hold (a free floe joining its cluster, a jam-sized cluster's pads).
+  enum class Conflict { none, foreign_cluster, warm_start, failed_lcp, error, missing_pairs };
   Conflict conflict = Conflict::none;
   std::vector<std::uint32_t> moved;  // ascending: the floes of the share's clusters (joined free floes included)
   long clusters = 0;                 // clusters of the share at the start of the step
@@ -175,11 +185,14 @@ struct ShareOutcome {
   std::vector<EventPlace> events;
 };
 
-// The first half's answer: the share's tight pairs (room below xi), by
-// ascending pair, or a conflict (a RunError in the set-up).
+// The first half's answer: the share's tight pairs (room below xi) and
+// contact edges, each in pair order, or a conflict (a RunError in the
+// set-up). Concatenated over the shares (in any order), the second half's
+// input.
 struct ShareRooms {
   ShareOutcome::Conflict conflict = ShareOutcome::Conflict::none;
   std::vector<PairRoom> tight;
+  std::vector<ContactEdge> touching;
 };
 
 // One share of the advance, in two halves around the caller's exchange of
@@ -194,8 +207,12 @@ struct ShareRooms {
 // queue's order (merge_advance_record, impulse.hpp).
 class ShareAdvance {
 public:
+  // on_part: `detection` is only this share's part of the detection (each
+  // pair in exactly one share's part; the part's reach the whole reach):
+  // the share computes the rooms of all its pairs, and between advance()'s
+  // two halves below (clusters(), advance()) the caller routes the pairs.
   ShareAdvance(Floes& floes, const CollisionShapes& shapes, const Detection& detection, double dt,
-               const SubstepOptions& options, const ClusterShare& share);
+               const SubstepOptions& options, const ClusterShare& share, bool on_part = false);
   ~ShareAdvance();
   ShareAdvance(const ShareAdvance&) = delete;
   ShareAdvance& operator=(const ShareAdvance&) = delete;
@@ -203,9 +220,27 @@ public:
   // The set-up of the share's pairs: the straight paths, the pair list (and
   // its rebuild), and the rooms of the pairs whose lower floe the share owns.
   ShareRooms rooms();
-  // The rest, given the tight pairs of every share (concatenated, in any
-  // order; this share's included): the clusters, and the share's advance.
-  ShareOutcome advance(std::span<const PairRoom> tight);
+  // The rest, given the tight pairs and contact edges of every share
+  // (concatenated, in any order; this share's included): the clusters, and
+  // the share's advance.
+  ShareOutcome advance(const ShareRooms& all);
+
+  // On a part, advance(all) in two halves around the caller's routing of the
+  // pairs. clusters(): the clusters (the same on every share) and, unless
+  // that is a conflict (a jam-sized cluster, whose pads' pairs no share
+  // holds whole: the same on every share), the pairs of the part to send:
+  // (share, index in the part), each pair to every other share that runs a
+  // cluster with one of its floes. hold(): the part and the pairs received,
+  // merged in pair order. advance(): the share's advance on them; a free
+  // floe that would join one of its clusters (its pairs are not all held) is
+  // a conflict (missing_pairs).
+  struct Routes {
+    ShareOutcome::Conflict conflict = ShareOutcome::Conflict::none;
+    std::vector<std::pair<int, std::uint32_t>> to;
+  };
+  Routes clusters(const ShareRooms& all);
+  void hold(Detection held);
+  ShareOutcome advance();
 
   const CollisionStats& stats() const { return stats_; }
   const SubstepReport& report() const { return report_; }

@@ -54,10 +54,11 @@ class Stepper {
 public:
   Stepper(Floes& floes, const CollisionShapes& shapes, const Detection& detection, double dt,
           const SubstepOptions& options, CollisionStats& stats, SubstepReport& report,
-          const ClusterShare* share = nullptr)
+          const ClusterShare* share = nullptr, bool part = false)
       : floes_(floes), shapes_(shapes), det_(&detection), dt_(dt), opt_(options), stats_(stats), report_(report),
-        share_(share) {}
+        share_(share), part_(part) {}
 
+  ShareOutcome::Conflict conflict() const { return conflict_; }
   // A share's run (ShareAdvance): what it did.
   ShareOutcome outcome() const {
     ShareOutcome o;
@@ -65,7 +66,7 @@ public:
     o.floor_tau = floor_tau_;
     o.floor_cluster = floor_cluster_;
     o.rooms = rooms_;
-    o.pairs = static_cast<long>(det_->pairs.size());
+    o.pairs = pairs_;
     o.events = events_;
     for (std::size_t k = 0; k < clusters_.size(); ++k) {
       if (!own_[k]) continue;
@@ -79,20 +80,38 @@ public:
   // The advance over dt (substep.hpp, steps 1 to 5): set_up, then advance
   // with its own tight pairs (every pair's room computed: the serial advance).
   void run() {
-    const std::vector<PairRoom> tight = set_up();
-    advance(tight);
+    const ShareRooms own = set_up();
+    advance(own.tight, own.touching);
   }
 
   // Step 1's set-up for the pairs this call computes (a share's: those whose
   // lower floe it owns; else all): the straight paths, the pair list
   // (rebuilt if a floe would outrun its reach), its index, and those pairs'
-  // rooms. Returns the tight ones (room below xi), by ascending pair.
-  std::vector<PairRoom> set_up();
+  // rooms. Returns the tight ones (room below xi) and the contact edges of
+  // those pairs, in pair order.
+  ShareRooms set_up();
 
-  // Steps 1 to 5 from there, given the tight pairs of every share (this
-  // call's included, in any order): the clusters, then the advance of the
-  // share's clusters only when given one.
-  void advance(std::span<const PairRoom> tight);
+  // Steps 1 to 5 from there, given the tight pairs and contact edges of
+  // every share (this call's included, in any order): the clusters, then
+  // the advance of the share's clusters only when given one. A tight pair is
+  // looked up in the pair list by its key (a, b, shift).
+  void advance(std::span<const PairRoom> tight, std::span<const ContactEdge> touching) {
+    clusters(tight, touching);
+    if (conflict_ == ShareOutcome::Conflict::none) run_share();
+  }
+  // The two halves of advance() for a share on a part of the detection
+  // (ShareAdvance, on_part), around the caller's routing of the pairs.
+  // clusters(): the same clusters on every share; on a part, a jam-sized
+  // cluster (its pads read pairs no share holds whole) is a conflict.
+  void clusters(std::span<const PairRoom> tight, std::span<const ContactEdge> touching);
+  // On a part: for each held pair touching a member of a cluster another
+  // share runs, (that share, the pair's index), sorted.
+  std::vector<std::pair<int, std::uint32_t>> routes() const;
+  // On a part: the pairs the share holds from now on (its part and the
+  // pairs routed to it, in pair order: every pair of its clusters' members),
+  // the rooms known so far carried over by key.
+  void hold(Detection held);
+  void run_share();
 
 private:
   std::uint32_t other(std::uint32_t p, std::uint32_t i) const {
@@ -113,11 +132,26 @@ private:
   }
 
   void rebuild_pairs();
+  // A share given only its part of the detection (each pair in one part),
+  // and the pair list not rebuilt whole.
+  bool holds_part() const { return part_ && det_ != &rebuilt_; }
+  // The index of the pair keyed as `k` in det_, or det_->pairs.size().
+  template <class Key>
+  std::size_t find_pair(const Key& k) const {
+    const auto before = [](const NearPair& q, const Key& key) {
+      return pair_before(PairRoom{q.a, q.b, q.shift, 0.0}, PairRoom{key.a, key.b, key.shift, 0.0});
+    };
+    const auto at = std::lower_bound(det_->pairs.begin(), det_->pairs.end(), k, before);
+    if (at == det_->pairs.end() || at->a != k.a || at->b != k.b || at->shift.x() != k.shift.x() ||
+        at->shift.y() != k.shift.y())
+      return det_->pairs.size();
+    return static_cast<std::size_t>(at - det_->pairs.begin());
+  }
 
   // Whether set_up computes pair p's room: the share's when its lower floe is
   // the share's (each pair on exactly one share), every pair without a share.
   bool computes(std::uint32_t p) const {
-    if (!share_) return true;
+    if (!share_ || holds_part()) return true;
     const NearPair& q = det_->pairs[p];
     return share_->owner[std::min(q.a, q.b)] == share_->rank;
   }
@@ -156,7 +190,8 @@ private:
   // the pairs of jam-sized clusters' floes (their pads).
   void make_clusters();
 
-  // jam_of_[i]: the jam of floe i (-1: none), jams_: their floes.
+  // jam_of_[i]: the jam of floe i (-1: none), jams_: their floes; from the
+  // contact edges of every share (touching_).
   void find_jams();
 
   // Budget of each member: half the room of each pair with a floe outside
@@ -223,6 +258,8 @@ private:
   CollisionStats& stats_;
   SubstepReport& report_;
   const ClusterShare* share_;          // null: every cluster (the serial advance)
+  bool part_ = false;                  // det_ is the share's part of the detection (until rebuilt)
+  Detection held_;                     // on a part: its pairs and those routed to the share
   std::vector<std::uint8_t> own_;      // per cluster: run by this call
   ShareOutcome::Conflict conflict_ = ShareOutcome::Conflict::none;
   std::vector<EventPlace> events_;     // a share's: per event it recorded, its pop's key
@@ -233,8 +270,10 @@ private:
   std::vector<double> lin_;            // m, linear travel of each floe over the step
   std::vector<double> room_;           // m, per pair, over the step on straight paths (room(): when known_)
   std::vector<std::uint8_t> known_;    // per pair: room_ computed or gathered
-  std::vector<std::uint32_t> tight_;   // ascending: the pairs whose room is below xi (every share's)
+  std::vector<PairRoom> tight_;        // the pairs whose room is below xi (every share's)
+  std::vector<ContactEdge> touching_;  // every share's pairs with contact points between dynamic floes
   long rooms_ = 0;                     // rooms computed by this call (pair_room)
+  long pairs_ = 0;                     // pairs in the list set_up saw (on a part: the part's)
   bool moving_ = false;                // floes moved: the start's states are start_ only
   std::vector<std::size_t> pair_offsets_;
   std::vector<std::uint32_t> pair_list_;

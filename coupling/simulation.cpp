@@ -397,9 +397,13 @@ void Simulation::advance(StepContext& ctx) {
   // (stage seven, parallel/advance_share.hpp).
   if (comm_.serial())
     contact::advance_with_collisions(scenario_.floes, shapes_, detection_, ctx.dt, o, stats_, substeps_);
+  else if (detection_part_ && advance_share_options_.on_part)
+    parallel::advance_on_part(comm_, owners_.owner(), scenario_.floes, shapes_, *detection_part_,
+                              [this]() -> const contact::Detection& { return detection_; }, ctx.dt, o, stats_,
+                              substeps_, advance_share_, advance_share_options_);
   else
     parallel::advance_by_owner(comm_, owners_.owner(), scenario_.floes, shapes_, detection_, ctx.dt, o, stats_,
-                               substeps_, advance_share_);
+                               substeps_, advance_share_, advance_share_options_);
   add_owned_momentum(std::span(ctx.momenta).subspan<StepContext::kAfterAdvance, 2>());
   wrap_periodic();
 }

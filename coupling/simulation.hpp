@@ -253,6 +253,7 @@ private:
   MomentumBudget budget_, step_budget_;  // run total; this step's (redone steps do not count)
   contact::SubstepReport substeps_;  // collision sub-steps (floors, merges, ...)
   parallel::AdvanceShareCounts advance_share_;  // the advances by cluster owner (stage seven)
+  parallel::AdvanceShareOptions advance_share_options_;  // their back-off, and whether from the rank's part
   parallel::AdvanceShareCounts collide_share_;  // the step-start collisions by owner (stage seven)
   long rejected_steps_ = 0;       // steps redone after an overlap
   Profile profile_;

@@ -8,6 +8,7 @@
 
 #include "core/error.hpp"
 #include "parallel/bytes.hpp"
+#include "parallel/detect.hpp"
 
 namespace floesim::parallel {
 
@@ -31,6 +32,11 @@ constexpr std::size_t kHeader = 9 + kStats + kReport;
 // point, impulse, world (2 doubles each) and normal.
 constexpr std::size_t kLoadInts = 4, kLoadDoubles = 7;
 constexpr std::size_t kLoadBytes = kLoadInts * sizeof(std::uint32_t) + kLoadDoubles * sizeof(double);
+
+// A tight pair in a message: a, b (uint32), then shift x, y and the room
+// (doubles); a contact edge: a, b.
+constexpr std::size_t kTight = 2 * sizeof(std::uint32_t) + 3 * sizeof(double);
+constexpr std::size_t kEdge = 2 * sizeof(std::uint32_t);
 
 }  // namespace
 
@@ -132,12 +138,19 @@ AdvancePart unpack_advance_part(std::span<const std::byte> bytes) {
 }
 
 std::vector<std::byte> pack(const contact::ShareRooms& rooms) {
-  const std::array<long, 2> head{static_cast<long>(rooms.conflict), static_cast<long>(rooms.tight.size())};
-  std::vector<std::byte> out(sizeof(head) + rooms.tight.size() * (sizeof(std::uint32_t) + sizeof(double)));
+  const std::array<long, 3> head{static_cast<long>(rooms.conflict), static_cast<long>(rooms.tight.size()),
+                                 static_cast<long>(rooms.touching.size())};
+  std::vector<std::byte> out(sizeof(head) + rooms.tight.size() * kTight + rooms.touching.size() * kEdge);
   std::byte* at = put(out.data(), head.data(), head.size());
   for (const contact::PairRoom& t : rooms.tight) {
-    at = put(at, &t.pair, 1);
-    at = put(at, &t.room, 1);
+    const std::array<std::uint32_t, 2> ab{t.a, t.b};
+    const std::array<double, 3> d{t.shift.x(), t.shift.y(), t.room};
+    at = put(at, ab.data(), ab.size());
+    at = put(at, d.data(), d.size());
+  }
+  for (const contact::ContactEdge& e : rooms.touching) {
+    const std::array<std::uint32_t, 2> ab{e.a, e.b};
+    at = put(at, ab.data(), ab.size());
   }
   return out;
 }
@@ -147,28 +160,43 @@ contact::ShareRooms unpack_share_rooms(std::span<const std::byte> bytes) {
   const std::byte* in = bytes.data();
   rooms.conflict = static_cast<ShareOutcome::Conflict>(at<long>(in, 0));
   const auto count = static_cast<std::size_t>(at<long>(in, 1));
-  constexpr std::size_t kPair = sizeof(std::uint32_t) + sizeof(double);
-  FLOESIM_ASSERT(bytes.size() == 2 * sizeof(long) + count * kPair);
-  in += 2 * sizeof(long);
+  const auto edges = static_cast<std::size_t>(at<long>(in, 2));
+  FLOESIM_ASSERT(bytes.size() == 3 * sizeof(long) + count * kTight + edges * kEdge);
+  in += 3 * sizeof(long);
   rooms.tight.resize(count);
-  for (std::size_t j = 0; j < count; ++j, in += kPair)
-    rooms.tight[j] = {at<std::uint32_t>(in, 0), at<double>(in + sizeof(std::uint32_t), 0)};
+  for (contact::PairRoom& t : rooms.tight) {
+    const std::vector<std::uint32_t> ab = take<std::uint32_t>(in, 2);
+    const std::vector<double> d = take<double>(in, 3);
+    t = {ab[0], ab[1], {d[0], d[1]}, d[2]};
+  }
+  rooms.touching.resize(edges);
+  for (contact::ContactEdge& e : rooms.touching) {
+    const std::vector<std::uint32_t> ab = take<std::uint32_t>(in, 2);
+    e = {ab[0], ab[1]};
+  }
   return rooms;
 }
 
-bool combine_rooms(std::span<const contact::ShareRooms> parts, std::vector<contact::PairRoom>& tight) {
-  tight.clear();
+bool combine_rooms(std::span<const contact::ShareRooms> parts, contact::ShareRooms& all) {
+  all.tight.clear();
+  all.touching.clear();
   for (const contact::ShareRooms& p : parts) {
     if (p.conflict != ShareOutcome::Conflict::none) return false;
-    tight.insert(tight.end(), p.tight.begin(), p.tight.end());
+    all.tight.insert(all.tight.end(), p.tight.begin(), p.tight.end());
+    all.touching.insert(all.touching.end(), p.touching.begin(), p.touching.end());
   }
   return true;
 }
 
-AdvancePart finish_share(contact::ShareAdvance& share, std::span<const contact::PairRoom> tight, const Floes& floes,
+AdvancePart finish_share(contact::ShareAdvance& share, const contact::ShareRooms& all, const Floes& floes,
                          contact::ImpulseRecord* record) {
+  return share_part(share, share.advance(all), floes, record);
+}
+
+AdvancePart share_part(const contact::ShareAdvance& share, contact::ShareOutcome outcome, const Floes& floes,
+                       contact::ImpulseRecord* record) {
   AdvancePart part;
-  part.outcome = share.advance(tight);
+  part.outcome = std::move(outcome);
   part.stats = share.stats();
   part.report = share.report();
   if (part.outcome.conflict == ShareOutcome::Conflict::none) {
@@ -241,11 +269,11 @@ void advance_by_owner(const Communicator& comm, std::span<const int> owner, Floe
     // The set-up by share, then the exchange of the tight pairs.
     contact::ShareAdvance share(floes, shapes, detection, dt, own_options, {owner, comm.rank()});
     const std::vector<contact::ShareRooms> rooms = comm.allgather_parts(pack(share.rooms()), unpack_share_rooms);
-    std::vector<contact::PairRoom> tight;
+    contact::ShareRooms all;
     // Every rank sees the same gathered conflicts: all skip the second
     // exchange alike.
-    if (combine_rooms(rooms, tight)) {
-      const AdvancePart mine = finish_share(share, tight, floes, record ? &own : nullptr);
+    if (combine_rooms(rooms, all)) {
+      const AdvancePart mine = finish_share(share, all, floes, record ? &own : nullptr);
       const std::vector<AdvancePart> parts = comm.allgather_parts(pack(mine), unpack_advance_part);
       counts.clusters.resize(parts.size(), 0);
       counts.rooms.resize(parts.size(), 0);
@@ -267,6 +295,90 @@ void advance_by_owner(const Communicator& comm, std::span<const int> owner, Floe
   counts.fell_back(share_options);
   floes.state = start;
   contact::advance_with_collisions(floes, shapes, detection, dt, options, stats, report);
+}
+
+std::vector<contact::Detection> routed_pairs(const contact::Detection& part,
+                                             std::span<const std::pair<int, std::uint32_t>> routes, int ranks) {
+  std::vector<contact::Detection> out(static_cast<std::size_t>(ranks));
+  std::vector<std::uint8_t> to(part.pairs.size());
+  for (int s = 0; s < ranks; ++s) {
+    std::fill(to.begin(), to.end(), 0);
+    bool any = false;
+    for (const auto& [r, p] : routes)
+      if (r == s) {
+        to[p] = 1;
+        any = true;
+      }
+    if (!any) continue;
+    std::size_t j = 0;
+    out[static_cast<std::size_t>(s)] = select_pairs(part, [&](const contact::NearPair&) { return to[j++] != 0; });
+  }
+  return out;
+}
+
+void advance_on_part(const Communicator& comm, std::span<const int> owner, Floes& floes,
+                     const contact::CollisionShapes& shapes, const contact::Detection& part,
+                     const std::function<const contact::Detection&()>& whole, double dt,
+                     const contact::SubstepOptions& options, contact::CollisionStats& stats,
+                     contact::SubstepReport& report, AdvanceShareCounts& counts,
+                     const AdvanceShareOptions& share_options) {
+  // The record's places number the whole call's lists: such a run keeps the whole detection.
+  if (options.impulse.record || comm.serial())
+    return advance_by_owner(comm, owner, floes, shapes, whole(), dt, options, stats, report, counts, share_options);
+  if (counts.whole_now()) {
+    contact::advance_with_collisions(floes, shapes, whole(), dt, options, stats, report);
+    return;
+  }
+  const std::vector<FloeState> start = floes.state;
+  bool combined = false;
+  {
+    contact::ShareAdvance share(floes, shapes, part, dt, options, {owner, comm.rank()}, true);
+    const std::vector<contact::ShareRooms> rooms = comm.allgather_parts(pack(share.rooms()), unpack_share_rooms);
+    contact::ShareRooms all;
+    // The gathered conflicts and the clusters are the same on every rank:
+    // all skip the next exchanges alike.
+    if (combine_rooms(rooms, all)) {
+      const contact::ShareAdvance::Routes routes = share.clusters(all);
+      if (routes.conflict == contact::ShareOutcome::Conflict::none) {
+        std::vector<std::byte> send;
+        std::vector<std::size_t> send_counts;
+        for (const contact::Detection& d : routed_pairs(part, routes.to, comm.size())) {
+          const std::vector<std::byte> bytes = d.pairs.empty() ? std::vector<std::byte>{} : pack(d);
+          send.insert(send.end(), bytes.begin(), bytes.end());
+          send_counts.push_back(bytes.size());
+        }
+        std::vector<std::byte> received;
+        std::vector<std::size_t> received_counts;
+        comm.alltoall_bytes(send, send_counts, received, received_counts);
+        std::vector<contact::Detection> held{part};
+        std::size_t from = 0;
+        for (const std::size_t n : received_counts) {
+          if (n) held.push_back(unpack_detection(std::span<const std::byte>(received.data() + from, n)));
+          from += n;
+        }
+        share.hold(merge(std::move(held)));
+        const AdvancePart mine = share_part(share, share.advance(), floes);
+        const std::vector<AdvancePart> parts = comm.allgather_parts(pack(mine), unpack_advance_part);
+        counts.clusters.resize(parts.size(), 0);
+        counts.rooms.resize(parts.size(), 0);
+        combined = combine_parts(parts, floes, stats, report, nullptr);
+        if (combined) {
+          for (std::size_t r = 0; r < parts.size(); ++r) {
+            counts.clusters[r] += parts[r].outcome.clusters;
+            counts.rooms[r] += parts[r].outcome.rooms;
+            counts.pairs += parts[r].outcome.pairs;
+          }
+        }
+      }
+    }
+  }
+  if (combined) {
+    counts.combined();
+    return;
+  }
+  counts.fell_back(share_options);
+  floes.state = start;
+  contact::advance_with_collisions(floes, shapes, whole(), dt, options, stats, report);
 }
 
 }  // namespace floesim::parallel

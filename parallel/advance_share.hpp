@@ -17,6 +17,7 @@
 #include <algorithm>
 #include <cstddef>
 #include <span>
+#include <functional>
 #include <vector>
 
 #include "contact/substep.hpp"
@@ -44,21 +45,31 @@ contact::ImpulseRecord take_record(const std::byte*& in);
 std::vector<std::byte> pack(const AdvancePart& part);
 AdvancePart unpack_advance_part(std::span<const std::byte> bytes);
 
-// The first exchange: a share's tight pairs (contact::ShareRooms), 12 bytes a
-// pair (index, room) after a header (conflict, count).
+// The first exchange: a share's tight pairs and contact edges
+// (contact::ShareRooms), 32 bytes a tight pair (a, b, shift, room) and 8 an
+// edge (a, b) after a header (conflict, the two counts).
 std::vector<std::byte> pack(const contact::ShareRooms& rooms);
 contact::ShareRooms unpack_share_rooms(std::span<const std::byte> bytes);
 
-// Every rank's tight pairs (rank order) as one list for ShareAdvance::advance;
-// false, leaving `tight` unspecified, when a rank's set-up had a conflict.
-bool combine_rooms(std::span<const contact::ShareRooms> parts, std::vector<contact::PairRoom>& tight);
+// Every rank's tight pairs and contact edges (rank order) as one list each
+// for ShareAdvance::advance; false, leaving `all` unspecified, when a rank's
+// set-up had a conflict.
+bool combine_rooms(std::span<const contact::ShareRooms> parts, contact::ShareRooms& all);
 
 // The second half of a rank's share (ShareAdvance::advance, given every
 // rank's tight pairs) and its part; `floes` (the share's floes) is left with
 // the share's states. `record`: the share's impulse record (the one its
 // options point at; null: none), moved into the part.
-AdvancePart finish_share(contact::ShareAdvance& share, std::span<const contact::PairRoom> tight, const Floes& floes,
+AdvancePart finish_share(contact::ShareAdvance& share, const contact::ShareRooms& all, const Floes& floes,
                          contact::ImpulseRecord* record = nullptr);
+// The same from the share's outcome (a share on a part: ShareAdvance::advance()).
+AdvancePart share_part(const contact::ShareAdvance& share, contact::ShareOutcome outcome, const Floes& floes,
+                       contact::ImpulseRecord* record = nullptr);
+
+// On a part: the pairs of `part` that `routes` (ShareAdvance::clusters) sends
+// to each of `ranks` ranks (none to itself).
+std::vector<contact::Detection> routed_pairs(const contact::Detection& part,
+                                             std::span<const std::pair<int, std::uint32_t>> routes, int ranks);
 
 // Combines every rank's part (rank order) into `floes` (each rank's moved
 // floes get its states; the free floes are already at the end of the step on
@@ -79,6 +90,12 @@ bool combine_parts(std::span<const AdvancePart> parts, Floes& floes, contact::Co
 // Either way the answer is the serial one.
 struct AdvanceShareOptions {
   long max_wait = 64;
+  // Simulation: advance from the rank's part of the detection
+  // (advance_on_part) rather than from the whole (advance_by_owner). Off:
+  // on a part a free floe joining a cluster is a conflict, and on the
+  // 10 000-floe pack on 2 ranks that redid 8 of 28 advances and the
+  // back-off did 72 of 100 whole (docs/parallel.md).
+  bool on_part = false;
 };
 
 // How the advances by cluster owner went (the run's summary), and the
@@ -132,5 +149,23 @@ void advance_by_owner(const Communicator& comm, std::span<const int> owner, Floe
                       const contact::SubstepOptions& options, contact::CollisionStats& stats,
                       contact::SubstepReport& report, AdvanceShareCounts& counts,
                       const AdvanceShareOptions& share_options = {});
+
+// The same from this rank's part of the detection (parallel::detect's part,
+// docs/parallel.md "The detection's lists by owner"): the share's set-up on
+// its part (every pair of the part its own), the exchange of the tight pairs
+// and contact edges, the clusters, the pairs touching each cluster's members
+// sent to its owner (one alltoall_bytes: two collective calls), the share's
+// advance on its part and the pairs received, the exchange of the parts.
+// `whole` gives the whole detection (collective: every rank calls it at the
+// same point, or none does) for a record run, the back-off's whole steps
+// and the fallback, which is taken also when a share would read a pair it
+// does not hold (Conflict::missing_pairs). Equal to the serial advance bit
+// for bit.
+void advance_on_part(const Communicator& comm, std::span<const int> owner, Floes& floes,
+                     const contact::CollisionShapes& shapes, const contact::Detection& part,
+                     const std::function<const contact::Detection&()>& whole, double dt,
+                     const contact::SubstepOptions& options, contact::CollisionStats& stats,
+                     contact::SubstepReport& report, AdvanceShareCounts& counts,
+                     const AdvanceShareOptions& share_options = {});
 
 }  // namespace floesim::parallel

@@ -137,7 +137,7 @@ TEST_CASE("impulse: a rank's share of the advance dumps no failed LCP, the whole
     contact::ShareAdvance share(f, shapes, det, 0.997, o, contact::ClusterShare{owner, 0});
     const contact::ShareRooms rooms = share.rooms();
     REQUIRE(rooms.conflict == contact::ShareOutcome::Conflict::none);
-    const contact::ShareOutcome out = share.advance(rooms.tight);
+    const contact::ShareOutcome out = share.advance(rooms);
     CHECK(out.conflict == contact::ShareOutcome::Conflict::failed_lcp);
     CHECK(share.stats().failures >= 1);
   }
