@@ -60,18 +60,76 @@ void Stepper::clusters(std::span<const PairRoom> tight, std::span<const ContactE
   make_clusters();
 }
 
-std::vector<std::pair<int, std::uint32_t>> Stepper::routes() const {
-  std::vector<std::pair<int, std::uint32_t>> out;
+// Which free floes a cluster may take in during the step. A free floe j
+// joins cluster k at time t only through a member i and a pair p = (i, j)
+// with room(p)/2 < dev_i(t) (collect_breaks), dev_i the member's deviation
+// from its straight path; the deviation has no bound known at the start
+// (the collisions set it), so every free dynamic floe with a pair to a
+// member is a candidate: exact at depth one. A floe j that joined is a
+// member from then on, and brings in a free l through a pair (j, l) with
+// room(j, l)/2 < dev_j. As long as j stays within its reach, dev_j <=
+// reach_j - lin_j (beyond it the detection no longer holds every pair j may
+// meet: reach_exceeded, the caller's check), so l is a candidate at depth two
+// when room(j, l) < 2 (reach_j - lin_j). The rank holding a pair (i, j) says
+// j, and l from the pairs (j, l) of its own part (away from the cuts a rank
+// holds all of them). A floe joining beyond that (deeper, through a pair
+// (j, l) of another part, a jam of free floes brought in whole) is not held:
+// missing_pairs, and the advance is redone whole, the serial path.
+std::vector<JoinCandidate> Stepper::candidates() const {
+  std::vector<JoinCandidate> out;
   if (!holds_part()) return out;
-  auto runner = [&](std::uint32_t i) {
-    const int k = cluster_of_[i];
-    return k == kFree ? -1 : share_->owner[clusters_[static_cast<std::size_t>(k)].members.front()];
-  };
+  auto free_dynamic = [&](std::uint32_t j) { return !floes_.is_static[j] && cluster_of_[j] == kFree; };
+  std::vector<std::uint32_t> near;
   for (std::uint32_t p = 0; p < det_->pairs.size(); ++p) {
     const NearPair& q = det_->pairs[p];
-    const int ra = runner(q.a), rb = runner(q.b);
-    if (ra >= 0 && ra != share_->rank) out.push_back({ra, p});
-    if (rb >= 0 && rb != share_->rank && rb != ra) out.push_back({rb, p});
+    for (const auto& [i, j] : {std::pair{q.a, q.b}, std::pair{q.b, q.a}}) {
+      const int r = runner(i);
+      if (r < 0 || !free_dynamic(j)) continue;
+      out.push_back({j, r});
+      const double left = det_->reach[j] - lin_[j];
+      for (const std::uint32_t pl : pairs_of(j)) {
+        const std::uint32_t l = other(pl, j);
+        if (free_dynamic(l) && room_[pl] < 2.0 * left) out.push_back({l, r});
+      }
+    }
+  }
+  const auto key = [](const JoinCandidate& c) { return std::pair(c.floe, c.rank); };
+  std::sort(out.begin(), out.end(), [&](const JoinCandidate& x, const JoinCandidate& y) { return key(x) < key(y); });
+  out.erase(std::unique(out.begin(), out.end(), [&](const JoinCandidate& x, const JoinCandidate& y) { return key(x) == key(y); }),
+            out.end());
+  return out;
+}
+
+std::vector<std::pair<int, std::uint32_t>> Stepper::routes(std::span<const JoinCandidate> candidates) {
+  std::vector<std::pair<int, std::uint32_t>> out;
+  if (!holds_part()) return out;
+  // Per floe, the shares that must hold every pair of it: its cluster's
+  // runner and the shares it is a candidate of (compressed rows).
+  const std::size_t n = floes_.size();
+  std::vector<std::size_t> at(n + 1, 0);
+  for (const JoinCandidate& c : candidates) ++at[c.floe + 1];
+  std::partial_sum(at.begin(), at.end(), at.begin());
+  std::vector<int> to(at[n]);
+  std::vector<std::size_t> fill(at.begin(), at.end() - 1);
+  for (const JoinCandidate& c : candidates) to[fill[c.floe]++] = c.rank;
+  held_floe_.assign(n, 0);
+  for (std::uint32_t i = 0; i < n; ++i) {
+    held_floe_[i] = runner(i) == share_->rank;
+    for (std::size_t m = at[i]; m < at[i + 1]; ++m) held_floe_[i] = held_floe_[i] || to[m] == share_->rank;
+  }
+  std::vector<int> ranks;
+  for (std::uint32_t p = 0; p < det_->pairs.size(); ++p) {
+    const NearPair& q = det_->pairs[p];
+    ranks.clear();
+    for (const std::uint32_t i : {q.a, q.b}) {
+      ranks.push_back(runner(i));
+      ranks.insert(ranks.end(), to.begin() + static_cast<std::ptrdiff_t>(at[i]),
+                   to.begin() + static_cast<std::ptrdiff_t>(at[i + 1]));
+    }
+    std::sort(ranks.begin(), ranks.end());
+    ranks.erase(std::unique(ranks.begin(), ranks.end()), ranks.end());
+    for (const int r : ranks)
+      if (r >= 0 && r != share_->rank) out.push_back({r, p});
   }
   std::sort(out.begin(), out.end());
   return out;
@@ -239,7 +297,7 @@ void Stepper::make_clusters() {
     // On a part the pads' pairs are not all held: every share finds the
     // same big clusters, and all redo the advance whole.
     if (holds_part() && std::find(big.begin(), big.end(), 1) != big.end()) {
-      conflict_ = ShareOutcome::Conflict::missing_pairs;
+      conflict_ = ShareOutcome::Conflict::missing_pads;
       return;
     }
     // The pairs of the big clusters' floes (joins and flags are the same
@@ -438,12 +496,14 @@ void Stepper::bring_in(int k) {
       else if (cluster_of_[f] != k) merging_.push_back(cluster_of_[f]);
     }
   }
-  // On a part, a free floe's pairs are not all held (only its members'
-  // are routed): the share stops.
-  if (holds_part() && !joining_.empty()) {
-    conflict_ = ShareOutcome::Conflict::missing_pairs;
-    return;
-  }
+  // On a part, a free floe that is not one of the share's candidates
+  // (Stepper::candidates) has pairs the share may not hold: it stops.
+  if (holds_part())
+    for (const std::uint32_t j : joining_)
+      if (!held_floe_[j]) {
+        conflict_ = ShareOutcome::Conflict::missing_pairs;
+        return;
+      }
   // A share stops at a cluster it does not run: the serial advance merges
   // the two at a time the share cannot know.
   for (int l : merging_)
@@ -531,13 +591,18 @@ ShareAdvance::Routes ShareAdvance::clusters(const ShareRooms& all) {
     try {
       stepper_->clusters(all.tight, all.touching);
       set_up_ = stepper_->conflict();
-      if (set_up_ == ShareOutcome::Conflict::none) out.to = stepper_->routes();
+      if (set_up_ == ShareOutcome::Conflict::none) out.candidates = stepper_->candidates();
     } catch (const RunError&) {
       set_up_ = ShareOutcome::Conflict::error;
     }
   }
   out.conflict = set_up_;
   return out;
+}
+
+std::vector<std::pair<int, std::uint32_t>> ShareAdvance::routes(std::span<const JoinCandidate> candidates) {
+  if (set_up_ != ShareOutcome::Conflict::none) return {};
+  return stepper_->routes(candidates);
 }
 
 void ShareAdvance::hold(Detection held) {

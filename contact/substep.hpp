@@ -165,12 +165,22 @@ struct ContactEdge {
   std::uint32_t a = 0, b = 0;
 };
 
+// On a part of the detection: a free floe that a cluster run by share `rank`
+// may take in during the step, so every share sends it the floe's pairs too
+// (ShareAdvance::clusters and routes; docs/parallel.md, "The advance from the
+// rank's part").
+struct JoinCandidate {
+  std::uint32_t floe = 0;
+  std::int32_t rank = 0;
+};
+
 // What a share did. On `conflict` other than none the floes' states are
 // unusable and the caller redoes the advance whole from the step's states.
 struct ShareOutcome {
-  // missing_pairs: a share on a part of the detection would read a pair it
-  // does not hold (a free floe joining its cluster, a jam-sized cluster's pads).
-  enum class Conflict { none, foreign_cluster, warm_start, failed_lcp, error, missing_pairs };
+  // On a part of the detection, a share would read pairs it does not hold:
+  // missing_pairs, a free floe joining its cluster that is not one of its
+  // candidates (JoinCandidate); missing_pads, a jam-sized cluster's pads.
+  enum class Conflict { none, foreign_cluster, warm_start, failed_lcp, error, missing_pairs, missing_pads };
   Conflict conflict = Conflict::none;
   std::vector<std::uint32_t> moved;  // ascending: the floes of the share's clusters (joined free floes included)
   long clusters = 0;                 // clusters of the share at the start of the step
@@ -225,20 +235,24 @@ public:
   // the share's advance.
   ShareOutcome advance(const ShareRooms& all);
 
-  // On a part, advance(all) in two halves around the caller's routing of the
-  // pairs. clusters(): the clusters (the same on every share) and, unless
-  // that is a conflict (a jam-sized cluster, whose pads' pairs no share
-  // holds whole: the same on every share), the pairs of the part to send:
-  // (share, index in the part), each pair to every other share that runs a
-  // cluster with one of its floes. hold(): the part and the pairs received,
+  // On a part, advance(all) in three pieces around the caller's two
+  // exchanges. clusters(): the clusters (the same on every share) and,
+  // unless that is a conflict (a jam-sized cluster, whose pads' pairs no
+  // share holds whole: missing_pads, the same on every share), the free
+  // floes the part says a cluster may take in (`candidates`: the rule in
+  // substep.cpp, Stepper::candidates). routes(every share's candidates):
+  // the pairs of the part to send, (share, index in the part), each pair to
+  // every other share that runs a cluster with one of its floes or has one
+  // of its floes as a candidate. hold(): the part and the pairs received,
   // merged in pair order. advance(): the share's advance on them; a free
-  // floe that would join one of its clusters (its pairs are not all held) is
-  // a conflict (missing_pairs).
+  // floe that would join one of its clusters and is not its candidate (its
+  // pairs are not all held) is a conflict (missing_pairs).
   struct Routes {
     ShareOutcome::Conflict conflict = ShareOutcome::Conflict::none;
-    std::vector<std::pair<int, std::uint32_t>> to;
+    std::vector<JoinCandidate> candidates;
   };
   Routes clusters(const ShareRooms& all);
+  std::vector<std::pair<int, std::uint32_t>> routes(std::span<const JoinCandidate> candidates);
   void hold(Detection held);
   ShareOutcome advance();
 

@@ -104,9 +104,14 @@ public:
   // clusters(): the same clusters on every share; on a part, a jam-sized
   // cluster (its pads read pairs no share holds whole) is a conflict.
   void clusters(std::span<const PairRoom> tight, std::span<const ContactEdge> touching);
-  // On a part: for each held pair touching a member of a cluster another
-  // share runs, (that share, the pair's index), sorted.
-  std::vector<std::pair<int, std::uint32_t>> routes() const;
+  // On a part: the free floes the part's pairs say a cluster may take in,
+  // with the share that runs it (sorted, unique; substep.cpp).
+  std::vector<JoinCandidate> candidates() const;
+  // On a part, given every share's candidates: for each held pair touching
+  // a member of a cluster another share runs or a candidate of another
+  // share, (that share, the pair's index), sorted; and which floes this
+  // share will hold every pair of (held_floe_: its members and candidates).
+  std::vector<std::pair<int, std::uint32_t>> routes(std::span<const JoinCandidate> candidates);
   // On a part: the pairs the share holds from now on (its part and the
   // pairs routed to it, in pair order: every pair of its clusters' members),
   // the rooms known so far carried over by key.
@@ -114,6 +119,12 @@ public:
   void run_share();
 
 private:
+  // The share that runs floe i's cluster, or -1 for a free floe.
+  int runner(std::uint32_t i) const {
+    const int k = cluster_of_[i];
+    return k == kFree ? -1 : share_->owner[clusters_[static_cast<std::size_t>(k)].members.front()];
+  }
+
   std::uint32_t other(std::uint32_t p, std::uint32_t i) const {
     const NearPair& q = det_->pairs[p];
     return q.a == i ? q.b : q.a;
@@ -260,6 +271,7 @@ private:
   const ClusterShare* share_;          // null: every cluster (the serial advance)
   bool part_ = false;                  // det_ is the share's part of the detection (until rebuilt)
   Detection held_;                     // on a part: its pairs and those routed to the share
+  std::vector<std::uint8_t> held_floe_;  // on a part: per floe, every pair of it held (members, candidates)
   std::vector<std::uint8_t> own_;      // per cluster: run by this call
   ShareOutcome::Conflict conflict_ = ShareOutcome::Conflict::none;
   std::vector<EventPlace> events_;     // a share's: per event it recorded, its pop's key

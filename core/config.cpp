@@ -59,6 +59,7 @@ void read_run(Section s, RunParams& r) {
                                    [](double v) { return std::isfinite(v) && v >= 0.0; },
                                    "an interval >= 0 (s; 0: a checkpoint only at the end)");
   r.record_collisions = s.boolean("record_collisions", r.record_collisions);
+  r.advance_on_part = s.boolean("advance_on_part", r.advance_on_part);
   s.finish();
 }
 

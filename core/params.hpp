@@ -27,6 +27,12 @@ struct RunParams {
   // Record every collision solve's impulses, per pair of floes, in the run
   // file (/events/collisions; docs/formats.md).
   bool record_collisions = false;
+  // On several ranks (docs/parallel.md, "The advance from the rank's part"):
+  // each rank advances its clusters from its own part of the detection and
+  // the pairs routed to it, rather than from the whole detection gathered to
+  // every rank. Like threads, an execution setting: the results are the same
+  // bits either way, and it is not written to run files.
+  bool advance_on_part = false;
 };
 
 enum class SeaModel { none, spectral, bem };

@@ -96,6 +96,7 @@ Simulation::Simulation(Scenario scenario, parallel::Communicator comm)
   impulse_options_.collision_distance = c.contact.collision_distance;
   impulse_options_.warm = warm_.get();
   impulse_options_.dump_failed_lcps = c.contact.dump_failed_lcps;
+  advance_share_options_.on_part = c.run.advance_on_part;
   wrap_periodic();
   set_reach();
   detection_ = contact::detect(scenario_.floes, shapes_, detection_options_);

@@ -339,24 +339,15 @@ void advance_on_part(const Communicator& comm, std::span<const int> owner, Floes
     // all skip the next exchanges alike.
     if (combine_rooms(rooms, all)) {
       const contact::ShareAdvance::Routes routes = share.clusters(all);
+      if (routes.conflict == contact::ShareOutcome::Conflict::missing_pads) ++counts.pads;
       if (routes.conflict == contact::ShareOutcome::Conflict::none) {
-        std::vector<std::byte> send;
-        std::vector<std::size_t> send_counts;
-        for (const contact::Detection& d : routed_pairs(part, routes.to, comm.size())) {
-          const std::vector<std::byte> bytes = d.pairs.empty() ? std::vector<std::byte>{} : pack(d);
-          send.insert(send.end(), bytes.begin(), bytes.end());
-          send_counts.push_back(bytes.size());
-        }
-        std::vector<std::byte> received;
-        std::vector<std::size_t> received_counts;
-        comm.alltoall_bytes(send, send_counts, received, received_counts);
-        std::vector<contact::Detection> held{part};
-        std::size_t from = 0;
-        for (const std::size_t n : received_counts) {
-          if (n) held.push_back(unpack_detection(std::span<const std::byte>(received.data() + from, n)));
-          from += n;
-        }
-        share.hold(merge(std::move(held)));
+        // Every rank's join candidates (8 bytes each), then the pairs
+        // touching a cluster's members or candidates to its runner.
+        const std::vector<contact::JoinCandidate> candidates =
+            comm.allgather<contact::JoinCandidate>(routes.candidates);
+        counts.candidates += static_cast<long>(candidates.size());
+        const std::vector<std::pair<int, std::uint32_t>> to = share.routes(candidates);
+        share.hold(exchange_pairs(comm, part, routed_pairs(part, to, comm.size())));
         const AdvancePart mine = share_part(share, share.advance(), floes);
         const std::vector<AdvancePart> parts = comm.allgather_parts(pack(mine), unpack_advance_part);
         counts.clusters.resize(parts.size(), 0);
@@ -368,6 +359,10 @@ void advance_on_part(const Communicator& comm, std::span<const int> owner, Floes
             counts.rooms[r] += parts[r].outcome.rooms;
             counts.pairs += parts[r].outcome.pairs;
           }
+        } else if (std::any_of(parts.begin(), parts.end(), [](const AdvancePart& p) {
+                     return p.outcome.conflict == contact::ShareOutcome::Conflict::missing_pairs;
+                   })) {
+          ++counts.missing;
         }
       }
     }

@@ -108,6 +108,13 @@ struct AdvanceShareCounts {
   std::vector<long> clusters;   // per rank: clusters it ran (steps not redone)
   std::vector<long> rooms;      // per rank: pair rooms it computed (steps not redone)
   long pairs = 0;               // pairs in those steps (a replicated set-up computes every one's room)
+  // From the rank's part (advance_on_part): the tries redone because a free
+  // floe joined a cluster without being its candidate (missing_pairs), or
+  // because a cluster was jam-sized (missing_pads), and the join candidates
+  // gathered over the tries (contact::JoinCandidate).
+  long missing = 0;
+  long pads = 0;
+  long candidates = 0;
   long wait = 0;                // advances still to do whole
   long next_wait = 1;           // the wait after the next fallback
 

@@ -185,23 +185,7 @@ std::size_t collide_on_part(const Communicator& comm, std::span<const int> owner
   // The pairs of the groups owned elsewhere, to their owners.
   const std::vector<contact::Detection> out =
       pairs_for_groups(floes, part, groups, owner, comm.size(), comm.rank(), options.collision_distance);
-  std::vector<std::byte> send;
-  std::vector<std::size_t> send_counts;
-  for (const contact::Detection& d : out) {
-    const std::vector<std::byte> bytes = d.pairs.empty() ? std::vector<std::byte>{} : pack(d);
-    send.insert(send.end(), bytes.begin(), bytes.end());
-    send_counts.push_back(bytes.size());
-  }
-  std::vector<std::byte> received;
-  std::vector<std::size_t> received_counts;
-  comm.alltoall_bytes(send, send_counts, received, received_counts);
-  std::vector<contact::Detection> parts{part};
-  std::size_t from = 0;
-  for (const std::size_t n : received_counts) {
-    if (n) parts.push_back(unpack_detection(std::span<const std::byte>(received.data() + from, n)));
-    from += n;
-  }
-  const contact::Detection local = merge(std::move(parts));
+  const contact::Detection local = exchange_pairs(comm, part, out);
   // The share on its pairs, then collide_by_owner's exchange.
   const std::vector<FloeState> entry = floes.state;
   const CollidePart share = run_collide_share(floes, start, local, step, options, owner, comm.rank(), &groups);

@@ -32,17 +32,41 @@ contact::Detection merge(std::vector<contact::Detection> parts) {
       if (next[k] < parts[k].pairs.size() &&
           (from == parts.size() || contact::pair_before(parts[k].pairs[next[k]], parts[from].pairs[next[from]])))
         from = k;
-    const contact::Detection& part = parts[from];
-    contact::NearPair p = part.pairs[next[from]++];
-    const auto c0 = part.contacts.begin() + p.first_contact;
-    const auto w0 = part.witnesses.begin() + p.first_witness;
-    p.first_contact = static_cast<std::uint32_t>(out.contacts.size());
-    p.first_witness = static_cast<std::uint32_t>(out.witnesses.size());
-    out.contacts.insert(out.contacts.end(), c0, c0 + p.contact_count);
-    out.witnesses.insert(out.witnesses.end(), w0, w0 + p.witness_count);
-    out.pairs.push_back(p);
+    append_pair(out, parts[from], parts[from].pairs[next[from]++]);
   }
   return out;
+}
+
+void append_pair(contact::Detection& to, const contact::Detection& from, const contact::NearPair& p) {
+  const auto c0 = from.contacts.begin() + p.first_contact;
+  const auto w0 = from.witnesses.begin() + p.first_witness;
+  contact::NearPair q = p;
+  q.first_contact = static_cast<std::uint32_t>(to.contacts.size());
+  q.first_witness = static_cast<std::uint32_t>(to.witnesses.size());
+  to.contacts.insert(to.contacts.end(), c0, c0 + p.contact_count);
+  to.witnesses.insert(to.witnesses.end(), w0, w0 + p.witness_count);
+  to.pairs.push_back(q);
+}
+
+contact::Detection exchange_pairs(const Communicator& comm, const contact::Detection& part,
+                                  const std::vector<contact::Detection>& outgoing) {
+  std::vector<std::byte> send;
+  std::vector<std::size_t> send_counts;
+  for (const contact::Detection& d : outgoing) {
+    const std::vector<std::byte> bytes = d.pairs.empty() ? std::vector<std::byte>{} : pack(d);
+    send.insert(send.end(), bytes.begin(), bytes.end());
+    send_counts.push_back(bytes.size());
+  }
+  std::vector<std::byte> received;
+  std::vector<std::size_t> received_counts;
+  comm.alltoall_bytes(send, send_counts, received, received_counts);
+  std::vector<contact::Detection> parts{part};
+  std::size_t from = 0;
+  for (const std::size_t n : received_counts) {
+    if (n) parts.push_back(unpack_detection(std::span<const std::byte>(received.data() + from, n)));
+    from += n;
+  }
+  return merge(std::move(parts));
 }
 
 contact::Detection detect_part(const FloeOwners& owners, int rank, const Floes& floes,

@@ -61,24 +61,26 @@ Overlap first_overlap(const Communicator& comm, const contact::Detection& part, 
 std::vector<std::byte> pack(const contact::Detection& d);
 contact::Detection unpack_detection(std::span<const std::byte> bytes);
 
+// Pair p of `from` appended to `to` with its contact points and witnesses
+// (first_contact and first_witness moved to where they now start in `to`).
+void append_pair(contact::Detection& to, const contact::Detection& from, const contact::NearPair& p);
+
 // The pairs of `d` (in its order) for which keep(pair) is true, with their
-// contact points and witnesses (first_contact and first_witness moved to
-// where they now start).
+// contact points and witnesses.
 template <class Keep>
 contact::Detection select_pairs(const contact::Detection& d, Keep&& keep) {
   contact::Detection out;
-  for (contact::NearPair p : d.pairs) {
-    if (!keep(p)) continue;
-    const auto c0 = d.contacts.begin() + p.first_contact;
-    const auto w0 = d.witnesses.begin() + p.first_witness;
-    p.first_contact = static_cast<std::uint32_t>(out.contacts.size());
-    p.first_witness = static_cast<std::uint32_t>(out.witnesses.size());
-    out.contacts.insert(out.contacts.end(), c0, c0 + p.contact_count);
-    out.witnesses.insert(out.witnesses.end(), w0, w0 + p.witness_count);
-    out.pairs.push_back(p);
-  }
+  for (const contact::NearPair& p : d.pairs)
+    if (keep(p)) append_pair(out, d, p);
   return out;
 }
+
+// The routed pairs' exchange: `outgoing[s]` (pairs of this rank's part, in
+// pair order) sent to rank s (none to itself; an empty one sends nothing),
+// and `part` merged with what every rank sent here, in pair order
+// (merge). Collective: one alltoall_bytes, two calls.
+contact::Detection exchange_pairs(const Communicator& comm, const contact::Detection& part,
+                                  const std::vector<contact::Detection>& outgoing);
 
 // Rank `rank`'s part of the detection by place (no communication): the
 // serial detection's pairs whose floe a `rank` owns, with their contact

@@ -460,11 +460,14 @@ namespace {
 
 // Plays parallel::advance_on_part over `ranks` ranks: each rank's part of the
 // detection by `strips` (detect_part), its share on that part with the
-// clusters given to `owner`, the tight pairs and edges and then the routed
-// pairs and the parts through pack/unpack. Returns whether they combined
-// (else `f` holds the whole advance); `sent` counts the routed pairs.
+// clusters given to `owner`, the tight pairs and edges, the join candidates
+// (none with `candidates` false: only the members' pairs routed), then the
+// routed pairs and the parts through pack/unpack. Returns whether they
+// combined (else `f` holds the whole advance); `sent` counts the routed
+// pairs, `missing` the shares that stopped at a floe they did not hold.
 bool play_parts(const Case& c, const parallel::FloeOwners& strips, std::span<const int> owner, int ranks, Floes& f,
-                contact::CollisionStats& stats, contact::SubstepReport& report, long& sent) {
+                contact::CollisionStats& stats, contact::SubstepReport& report, long& sent, long& missing,
+                bool candidates = true) {
   const auto n = static_cast<std::size_t>(ranks);
   std::vector<Floes> copies(n, c.floes);
   std::vector<contact::Detection> parts;
@@ -480,13 +483,16 @@ bool play_parts(const Case& c, const parallel::FloeOwners& strips, std::span<con
   }
   contact::ShareRooms all;
   bool ok = parallel::combine_rooms(rooms, all);
-  std::vector<std::vector<contact::Detection>> out;
+  std::vector<contact::JoinCandidate> joins;  // every rank's, in rank order (the allgather)
   for (std::size_t k = 0; ok && k < n; ++k) {
     const contact::ShareAdvance::Routes routes = shares[k]->clusters(all);
     if (k > 0) CHECK((routes.conflict == contact::ShareOutcome::Conflict::none) == ok);  // alike on every rank
     ok = routes.conflict == contact::ShareOutcome::Conflict::none;
-    out.push_back(parallel::routed_pairs(parts[k], routes.to, ranks));
+    if (candidates) joins.insert(joins.end(), routes.candidates.begin(), routes.candidates.end());
   }
+  std::vector<std::vector<contact::Detection>> out;
+  for (std::size_t k = 0; ok && k < n; ++k)
+    out.push_back(parallel::routed_pairs(parts[k], shares[k]->routes(joins), ranks));
   if (ok) {
     std::vector<parallel::AdvancePart> advanced;
     for (std::size_t k = 0; k < n; ++k) {
@@ -498,6 +504,7 @@ bool play_parts(const Case& c, const parallel::FloeOwners& strips, std::span<con
         }
       shares[k]->hold(parallel::merge(std::move(held)));
       const parallel::AdvancePart part = parallel::share_part(*shares[k], shares[k]->advance(), copies[k]);
+      if (part.outcome.conflict == contact::ShareOutcome::Conflict::missing_pairs) ++missing;
       advanced.push_back(parallel::unpack_advance_part(parallel::pack(part)));
     }
     f = std::move(copies.front());
@@ -515,11 +522,14 @@ bool play_parts(const Case& c, const parallel::FloeOwners& strips, std::span<con
 
 TEST_CASE("the advance from each rank's part of the detection over 1, 2, 3 and 7 strips is the serial advance") {
   // The clusters' owners the strips, and the strips shifted by one rank
-  // (every cluster's pairs then travel); a free floe joining a cluster is
-  // a conflict on a part (missing_pairs): the whole advance. Whether
-  // combined or not, the answer is the serial one.
-  int combined = 0;
-  long routed = 0;
+  // (every cluster's pairs then travel). The free floes a cluster may take
+  // in are routed to its runner with its members (join candidates); a floe
+  // joining that is not one is a conflict (missing_pairs): the whole
+  // advance. Whether combined or not, the answer is the serial one; without
+  // the candidates (only the members' pairs routed, as before them) the
+  // splits with a join fall back.
+  int combined = 0, combined_bare = 0, splits = 0;
+  long routed = 0, missing = 0, missing_bare = 0;
   const std::pair<unsigned, double> packs[] = {{3u, 2.0}, {11u, 2.0}, {5u, 1.5}, {7u, 1.2}, {9u, 1.8}};
   for (const auto& [seed, speed] : packs) {
     CAPTURE(seed);
@@ -528,34 +538,48 @@ TEST_CASE("the advance from each rank's part of the detection over 1, 2, 3 and 7
     MESSAGE("serial: " << serial.report.clusters << " clusters, " << serial.report.joined << " joined");
     for (const int ranks : {1, 2, 3, 7}) {
       for (const int shift : {0, 1}) {
-        CAPTURE(ranks);
-        CAPTURE(shift);
-        parallel::FloeOwners strips(0, ranks, c.domain);
-        strips.assign(c.floes);
-        std::vector<int> owner(strips.owner().begin(), strips.owner().end());
-        for (int& o : owner) o = (o + shift) % ranks;
-        Floes f;
-        contact::CollisionStats stats;
-        contact::SubstepReport report;
-        long sent = 0;
-        const bool ok = play_parts(c, strips, owner, ranks, f, stats, report, sent);
-        MESSAGE(ranks << " ranks, shift " << shift << ": " << std::string(ok ? "combined" : "fell back") << ", " << sent
-                      << " pairs routed");
-        if (ranks > 1) {
-          combined += ok ? 1 : 0;
-          routed += sent;
+        for (const bool candidates : {true, false}) {
+          CAPTURE(ranks);
+          CAPTURE(shift);
+          CAPTURE(candidates);
+          parallel::FloeOwners strips(0, ranks, c.domain);
+          strips.assign(c.floes);
+          std::vector<int> owner(strips.owner().begin(), strips.owner().end());
+          for (int& o : owner) o = (o + shift) % ranks;
+          Floes f;
+          contact::CollisionStats stats;
+          contact::SubstepReport report;
+          long sent = 0, stopped = 0;
+          const bool ok = play_parts(c, strips, owner, ranks, f, stats, report, sent, stopped, candidates);
+          MESSAGE(ranks << " ranks, shift " << shift << std::string(candidates ? "" : ", no candidates") << ": "
+                        << std::string(ok ? "combined" : "fell back") << ", " << sent << " pairs routed, " << stopped
+                        << " shares stopped at a floe not held");
+          if (ranks > 1 && candidates) {
+            ++splits;
+            combined += ok ? 1 : 0;
+            routed += sent;
+            missing += stopped;
+          }
+          if (ranks > 1 && !candidates) {
+            combined_bare += ok ? 1 : 0;
+            missing_bare += stopped;
+          }
+          // Without a free floe joining and a jam-sized cluster nothing is
+          // missing: the shares combine.
+          if (serial.report.joined == 0 && serial.report.time_steps == 0) CHECK(ok);
+          REQUIRE(f.state.size() == serial.state.size());
+          CHECK(std::memcmp(f.state.data(), serial.state.data(), f.state.size() * sizeof(FloeState)) == 0);
+          CHECK(same_stats(stats, serial.stats));
+          CHECK(same_report(report, serial.report));
         }
-        // Without a free floe joining and a jam-sized cluster nothing is
-        // missing: the shares combine.
-        if (serial.report.joined == 0 && serial.report.time_steps == 0) CHECK(ok);
-        REQUIRE(f.state.size() == serial.state.size());
-        CHECK(std::memcmp(f.state.data(), serial.state.data(), f.state.size() * sizeof(FloeState)) == 0);
-        CHECK(same_stats(stats, serial.stats));
-        CHECK(same_report(report, serial.report));
       }
     }
   }
-  MESSAGE(combined << " splits over several ranks combined, " << routed << " pairs routed");
-  CHECK(combined >= 2);
+  MESSAGE(combined << " of " << splits << " splits over several ranks combined (" << combined_bare
+                   << " without candidates), " << routed << " pairs routed, " << missing << " shares stopped at a floe not held ("
+                   << missing_bare << " without candidates)");
   CHECK(routed > 0);
+  CHECK(missing_bare > 0);  // the packs do have floes joining across parts
+  CHECK(combined > combined_bare);
+  CHECK(missing < missing_bare);
 }
