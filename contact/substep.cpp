@@ -38,7 +38,8 @@ ShareRooms Stepper::set_up() {
     if (!computes(p)) continue;
     const NearPair& q = det_->pairs[p];
     const double r = room(p);
-    if (r < opt_.collision_distance) out.tight.push_back({q.a, q.b, q.shift, r});
+    // On a part the near pairs too (Stepper::candidates, depth three and on).
+    if (r < (holds_part() ? kNearRooms : 1.0) * opt_.collision_distance) out.tight.push_back({q.a, q.b, q.shift, r});
     if (q.contact_count > 0 && !floes_.is_static[q.a] && !floes_.is_static[q.b]) out.touching.push_back({q.a, q.b});
   }
   return out;
@@ -72,8 +73,12 @@ void Stepper::clusters(std::span<const PairRoom> tight, std::span<const ContactE
 // meet: reach_exceeded, the caller's check), so l is a candidate at depth two
 // when room(j, l) < 2 (reach_j - lin_j). The rank holding a pair (i, j) says
 // j, and l from the pairs (j, l) of its own part (away from the cuts a rank
-// holds all of them). A floe joining beyond that (deeper, through a pair
-// (j, l) of another part, a jam of free floes brought in whole) is not held:
+// holds all of them). Deeper, and across parts, the shares' near pairs
+// (room below kNearRooms xi, gathered with the tight ones) carry the same
+// rule on every share: l is a candidate of s when a near pair (j, l) has j a
+// candidate of s and room(j, l) < 2 (reach_j - lin_j), to the closure
+// (routes). A floe joining beyond that (through a pair of another part
+// that is not near, a jam of free floes brought in whole) is not held:
 // missing_pairs, and the advance is redone whole, the serial path.
 std::vector<JoinCandidate> Stepper::candidates() const {
   std::vector<JoinCandidate> out;
@@ -106,12 +111,56 @@ std::vector<std::pair<int, std::uint32_t>> Stepper::routes(std::span<const JoinC
   // Per floe, the shares that must hold every pair of it: its cluster's
   // runner and the shares it is a candidate of (compressed rows).
   const std::size_t n = floes_.size();
+  // The closure over the near pairs (every share's, the same on every
+  // share), from the candidates gathered: a set, so the same whatever the
+  // order.
+  std::vector<JoinCandidate> all(candidates.begin(), candidates.end());
+  {
+    std::vector<std::size_t> near_at(n + 1, 0);
+    for (const PairRoom& q : tight_) {
+      ++near_at[q.a + 1];
+      ++near_at[q.b + 1];
+    }
+    std::partial_sum(near_at.begin(), near_at.end(), near_at.begin());
+    std::vector<std::uint32_t> near(near_at[n]);
+    std::vector<std::size_t> fill(near_at.begin(), near_at.end() - 1);
+    for (std::uint32_t t = 0; t < tight_.size(); ++t) {
+      near[fill[tight_[t].a]++] = t;
+      near[fill[tight_[t].b]++] = t;
+    }
+    const auto key = [](const JoinCandidate& c) { return std::pair(c.floe, c.rank); };
+    const auto before = [&](const JoinCandidate& x, const JoinCandidate& y) { return key(x) < key(y); };
+    std::sort(all.begin(), all.end(), before);
+    all.erase(std::unique(all.begin(), all.end(), [&](const JoinCandidate& x, const JoinCandidate& y) { return key(x) == key(y); }),
+              all.end());
+    std::vector<JoinCandidate> grow = all;
+    while (!grow.empty()) {
+      std::vector<JoinCandidate> next;
+      for (const JoinCandidate& c : grow) {
+        const double left = det_->reach[c.floe] - lin_[c.floe];
+        for (std::size_t m = near_at[c.floe]; m < near_at[c.floe + 1]; ++m) {
+          const PairRoom& q = tight_[near[m]];
+          const std::uint32_t l = q.a == c.floe ? q.b : q.a;
+          if (floes_.is_static[l] || cluster_of_[l] != kFree || !(q.room < 2.0 * left)) continue;
+          const JoinCandidate d{l, c.rank};
+          if (!std::binary_search(all.begin(), all.end(), d, before)) next.push_back(d);
+        }
+      }
+      std::sort(next.begin(), next.end(), before);
+      next.erase(std::unique(next.begin(), next.end(), [&](const JoinCandidate& x, const JoinCandidate& y) { return key(x) == key(y); }),
+                 next.end());
+      const std::size_t old = all.size();
+      all.insert(all.end(), next.begin(), next.end());
+      std::inplace_merge(all.begin(), all.begin() + static_cast<std::ptrdiff_t>(old), all.end(), before);
+      grow = std::move(next);
+    }
+  }
   std::vector<std::size_t> at(n + 1, 0);
-  for (const JoinCandidate& c : candidates) ++at[c.floe + 1];
+  for (const JoinCandidate& c : all) ++at[c.floe + 1];
   std::partial_sum(at.begin(), at.end(), at.begin());
   std::vector<int> to(at[n]);
   std::vector<std::size_t> fill(at.begin(), at.end() - 1);
-  for (const JoinCandidate& c : candidates) to[fill[c.floe]++] = c.rank;
+  for (const JoinCandidate& c : all) to[fill[c.floe]++] = c.rank;
   held_floe_.assign(n, 0);
   for (std::uint32_t i = 0; i < n; ++i) {
     held_floe_[i] = runner(i) == share_->rank;
@@ -258,6 +307,7 @@ void Stepper::make_clusters() {
   std::vector<std::uint8_t> hot(n, 0);
   const double tight = opt_.collision_distance;
   for (const PairRoom& q : tight_) {
+    if (!(q.room < tight)) continue;  // a near pair (on a part), not a tight one
     const bool da = !floes_.is_static[q.a], db = !floes_.is_static[q.b];
     if (q.room < 0.0) {
       if (da) hot[q.a] = 1;

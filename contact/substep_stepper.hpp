@@ -23,6 +23,11 @@ inline constexpr double kInf = std::numeric_limits<double>::infinity();
 inline constexpr int kFree = -1;
 // A sub-step is halved after an overlap down to this fraction of the floor.
 inline constexpr double kHalvingFloor = 0x1.0p-20;
+// On a part of the detection, the pairs whose room is below this many xi
+// ("near") are gathered with the tight ones: the join candidates' closure
+// (Stepper::candidates, routes). The pairs that brought floes in beyond
+// depth two on the 1500- and 10 000-floe packs had rooms of a few mm.
+inline constexpr double kNearRooms = 10.0;
 
 // Pairs measured with their contact points and witnesses.
 struct Measured {
@@ -282,7 +287,7 @@ private:
   std::vector<double> lin_;            // m, linear travel of each floe over the step
   std::vector<double> room_;           // m, per pair, over the step on straight paths (room(): when known_)
   std::vector<std::uint8_t> known_;    // per pair: room_ computed or gathered
-  std::vector<PairRoom> tight_;        // the pairs whose room is below xi (every share's)
+  std::vector<PairRoom> tight_;        // the pairs whose room is below xi (every share's; on a part, the near ones too)
   std::vector<ContactEdge> touching_;  // every share's pairs with contact points between dynamic floes
   long rooms_ = 0;                     // rooms computed by this call (pair_room)
   long pairs_ = 0;                     // pairs in the list set_up saw (on a part: the part's)

@@ -1,0 +1,60 @@
+#!/usr/bin/env python3
+"""The advance from each rank's part of the detection ([run] advance_on_part,
+docs/parallel.md "The advance from the rank's part") against the serial run.
+
+usage: check_advance_part.py FLOESIM MPIEXEC WORKDIR [--floes N] [--t-end T] [--ranks 2 3]
+       check_advance_part.py --no-mpi    (MPI not built: says so and exits 77, ctest's skip code)
+
+The moving pack of check_ranks.py run serially, then on each of --ranks with
+advance_on_part = true and = false: every run file must equal the serial one
+bit for bit (`floesim compare`, rtol 0, atol 0). With it on the advances ran
+from the parts (join candidates gathered) and combined in at least as many
+steps as from the whole detection; with it off no candidate was gathered.
+"""
+from ranks_harness import moving_pack_check, need, summary
+
+args, harness, config = moving_pack_check(
+    "floesim was built without MPI (FLOESIM_MPI=OFF): the advance from the parts is not checked", 1500, 1000.0, [2, 3])
+run, mpirun = harness.run, harness.mpirun
+failures = []
+
+with open(config) as f:
+    text = f.read()
+configs = {}
+for on in (True, False):
+    name = config.replace(".toml", "_on.toml" if on else "_off.toml")
+    with open(name, "w") as f:
+        f.write(text.replace("[run]\n", f"[run]\nadvance_on_part = {'true' if on else 'false'}\n", 1))
+    configs[on] = name
+
+need(run([args.floesim, "run", configs[True], "-o", "serial.h5", "-q"]), "serial run")
+for n in args.ranks:
+    combined = {}
+    for on in (True, False):
+        out = f"ranks{n}_{'on' if on else 'off'}.h5"
+        p = mpirun(n, "run", configs[on], "-o", out, "-q")
+        if p.returncode != 0:
+            failures.append(f"{n} ranks, advance_on_part {on}: exit {p.returncode}\n{p.stdout}\n{p.stderr}")
+            continue
+        c = harness.compare(out, "serial.h5", 0)
+        s = summary(p)
+        steps, fallbacks = int(s["parallel.advance_steps"]), int(s["parallel.advance_fallbacks"])
+        candidates, missing = int(s["parallel.advance_candidates"]), int(s["parallel.advance_missing"])
+        combined[on] = steps - fallbacks
+        print(f"{n} ranks, advance_on_part {on}: {'equal' if c.returncode == 0 else 'DIFFERENT'} to the serial run; "
+              f"{steps} advances tried, {fallbacks} redone ({missing} for a floe not held), "
+              f"{s['parallel.advance_whole']} whole, {candidates} join candidates; {s['parallel.phase.advance']}")
+        if c.returncode != 0:
+            failures.append(f"{n} ranks, advance_on_part {on}: differs from the serial run\n{c.stdout}")
+        if on and not candidates > 0:
+            failures.append(f"{n} ranks: advance_on_part on gathered no join candidate (not from the parts?)")
+        if not on and candidates != 0:
+            failures.append(f"{n} ranks: advance_on_part off gathered {candidates} join candidates")
+    if len(combined) == 2 and combined[True] < combined[False]:
+        failures.append(f"{n} ranks: from the parts {combined[True]} advances combined, "
+                        f"fewer than {combined[False]} from the whole detection")
+
+if failures:
+    print("FAILED:\n" + "\n".join(failures))
+    raise SystemExit(1)
+print("ok")
