@@ -375,7 +375,8 @@ int run(const Args& args, const parallel::Session& session) {
     for (const long k : share.rooms) o << " " << k;
     o << "\nparallel.advance_pairs: " << share.pairs;
     // From the rank's part ([run] advance_on_part): the tries redone for a
-    // join or pads the share did not hold, and the join candidates gathered.
+    // join the share did not hold, the tries with a jam-sized cluster's pads
+    // gathered, and the join candidates gathered.
     o << "\nparallel.advance_missing: " << share.missing << "\nparallel.advance_pads: " << share.pads
       << "\nparallel.advance_candidates: " << share.candidates;
     // The collisions at the step's start by owner, the same way: tried,

@@ -302,76 +302,97 @@ void Stepper::build_pair_index() {
 
 void Stepper::make_clusters() {
   const std::size_t n = floes_.size();
-  DisjointSets sets(n);
-  auto find = [&](std::uint32_t i) { return sets.find(i); };
-  std::vector<std::uint8_t> hot(n, 0);
+  sets_ = DisjointSets(n);
+  hot_.assign(n, 0);
   const double tight = opt_.collision_distance;
   for (const PairRoom& q : tight_) {
     if (!(q.room < tight)) continue;  // a near pair (on a part), not a tight one
     const bool da = !floes_.is_static[q.a], db = !floes_.is_static[q.b];
     if (q.room < 0.0) {
-      if (da) hot[q.a] = 1;
-      if (db) hot[q.b] = 1;
+      if (da) hot_[q.a] = 1;
+      if (db) hot_[q.b] = 1;
     }
-    if (da && db) sets.join(q.a, q.b);
+    if (da && db) sets_.join(q.a, q.b);
   }
   // A jam (a contact component of jam.floes floes or more, impulse.hpp)
   // joins a cluster whole: its floes would come in one by one anyway, each
   // time with an LCP of the part that came in so far.
   find_jams();
   for (std::uint32_t i = 0; i < n; ++i)
-    if (jam_of_[i] >= 0) sets.join(i, jams_[static_cast<std::size_t>(jam_of_[i])].front());
+    if (jam_of_[i] >= 0) sets_.join(i, jams_[static_cast<std::size_t>(jam_of_[i])].front());
   // A jam whose LCP was not solved at the start of the step (jam.hpp,
   // at_step_start) is time-stepped whatever its rooms: its time step is
   // where its contacts are resolved.
   if (!opt_.impulse.jam.at_step_start)
     for (std::uint32_t i = 0; i < n; ++i)
-      if (jam_of_[i] >= 0) hot[i] = 1;
+      if (jam_of_[i] >= 0) hot_[i] = 1;
   // A cluster of jam.floes floes or more takes time steps, whose LCP turns
   // and speeds up its floes: their deviations from the straight paths
   // outgrow small budgets. The dynamic floes close to such a cluster (room
   // below jam.pad xi) join it now rather than during its time step, where
   // each join reruns its LCP.
-  {
-    std::vector<std::uint32_t> size(n, 0), hot_root(n, 0);
-    for (std::uint32_t i = 0; i < n; ++i)
-      if (!floes_.is_static[i]) {
-        ++size[find(i)];
-        if (hot[i]) hot_root[find(i)] = 1;
-      }
-    std::vector<std::uint8_t> big(n, 0);
-    for (std::uint32_t i = 0; i < n; ++i) {
-      const std::uint32_t r = find(i);
-      big[i] = !floes_.is_static[i] && hot_root[r] && size[r] >= opt_.impulse.jam.floes;
+  std::vector<std::uint32_t> size(n, 0), hot_root(n, 0);
+  for (std::uint32_t i = 0; i < n; ++i)
+    if (!floes_.is_static[i]) {
+      ++size[sets_.find(i)];
+      if (hot_[i]) hot_root[sets_.find(i)] = 1;
     }
-    // On a part the pads' pairs are not all held: every share finds the
-    // same big clusters, and all redo the advance whole.
-    if (holds_part() && std::find(big.begin(), big.end(), 1) != big.end()) {
-      conflict_ = ShareOutcome::Conflict::missing_pads;
-      return;
-    }
-    // The pairs of the big clusters' floes (joins and flags are the same
-    // in any order: the components and the hot floes do not depend on it).
-    const double pad = opt_.impulse.jam.pad * tight;
-    for (std::uint32_t i = 0; i < n; ++i) {
-      if (!big[i]) continue;
-      for (const std::uint32_t p : pairs_of(i)) {
-        const NearPair& q = det_->pairs[p];
-        if (floes_.is_static[q.a] || floes_.is_static[q.b] || !(room(p) < pad)) continue;
-        hot[q.a] = hot[q.a] || big[q.a];
-        hot[q.b] = hot[q.b] || big[q.b];
-        sets.join(q.a, q.b);
-      }
+  big_.assign(n, 0);
+  for (std::uint32_t i = 0; i < n; ++i) {
+    const std::uint32_t r = sets_.find(i);
+    big_[i] = !floes_.is_static[i] && hot_root[r] && size[r] >= opt_.impulse.jam.floes;
+  }
+  // On a part the pads' pairs are spread over the shares (each pair in one
+  // part): every share finds the same big clusters, so all wait alike for
+  // the caller's exchange of the pad edges (pad_edges, apply_pads).
+  if (std::find(big_.begin(), big_.end(), 1) == big_.end()) return form_clusters();
+  if (holds_part()) {
+    pads_pending_ = true;
+    return;
+  }
+  apply_pads(pad_edges());
+}
+
+std::vector<ContactEdge> Stepper::pad_edges() {
+  // The pairs of the big clusters' floes between dynamic floes with a room
+  // below jam.pad xi; on a part, those of the part (each rank the rooms of
+  // its own pairs: the same bits on any).
+  std::vector<ContactEdge> out;
+  const double pad = opt_.impulse.jam.pad * opt_.collision_distance;
+  for (std::uint32_t i = 0; i < floes_.size(); ++i) {
+    if (!big_[i]) continue;
+    for (const std::uint32_t p : pairs_of(i)) {
+      const NearPair& q = det_->pairs[p];
+      if (floes_.is_static[q.a] || floes_.is_static[q.b] || !(room(p) < pad)) continue;
+      out.push_back({q.a, q.b});
     }
   }
+  return out;
+}
+
+void Stepper::apply_pads(std::span<const ContactEdge> pads) {
+  // Joins and flags are the same in any order (the components and the hot
+  // floes do not depend on it), and an edge given twice changes nothing:
+  // every share's edges, concatenated, give the serial clusters.
+  for (const ContactEdge& e : pads) {
+    hot_[e.a] = hot_[e.a] || big_[e.a];
+    hot_[e.b] = hot_[e.b] || big_[e.b];
+    sets_.join(e.a, e.b);
+  }
+  pads_pending_ = false;
+  form_clusters();
+}
+
+void Stepper::form_clusters() {
+  const std::size_t n = floes_.size();
   std::vector<std::uint8_t> active_root(n, 0);
   for (std::uint32_t i = 0; i < n; ++i)
-    if (hot[i]) active_root[find(i)] = 1;
+    if (hot_[i]) active_root[sets_.find(i)] = 1;
   cluster_of_.assign(n, kFree);
   std::vector<int> of_root(n, kFree);
   for (std::uint32_t i = 0; i < n; ++i) {
-    if (floes_.is_static[i] || !active_root[find(i)]) continue;
-    const std::uint32_t r = find(i);
+    if (floes_.is_static[i] || !active_root[sets_.find(i)]) continue;
+    const std::uint32_t r = sets_.find(i);
     if (of_root[r] == kFree) {
       of_root[r] = static_cast<int>(clusters_.size());
       clusters_.emplace_back();
@@ -641,10 +662,26 @@ ShareAdvance::Routes ShareAdvance::clusters(const ShareRooms& all) {
     try {
       stepper_->clusters(all.tight, all.touching);
       set_up_ = stepper_->conflict();
-      if (set_up_ == ShareOutcome::Conflict::none) out.candidates = stepper_->candidates();
+      out.pads = stepper_->pads_pending();
+      if (set_up_ == ShareOutcome::Conflict::none && !out.pads) out.candidates = stepper_->candidates();
     } catch (const RunError&) {
       set_up_ = ShareOutcome::Conflict::error;
     }
+  }
+  out.conflict = set_up_;
+  return out;
+}
+
+std::vector<ContactEdge> ShareAdvance::pad_edges() {
+  if (set_up_ != ShareOutcome::Conflict::none) return {};
+  return stepper_->pad_edges();
+}
+
+ShareAdvance::Routes ShareAdvance::pads(std::span<const ContactEdge> edges) {
+  Routes out;
+  if (set_up_ == ShareOutcome::Conflict::none) {
+    stepper_->apply_pads(edges);
+    out.candidates = stepper_->candidates();
   }
   out.conflict = set_up_;
   return out;

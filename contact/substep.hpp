@@ -177,10 +177,10 @@ struct JoinCandidate {
 // What a share did. On `conflict` other than none the floes' states are
 // unusable and the caller redoes the advance whole from the step's states.
 struct ShareOutcome {
-  // On a part of the detection, a share would read pairs it does not hold:
-  // missing_pairs, a free floe joining its cluster that is not one of its
-  // candidates (JoinCandidate); missing_pads, a jam-sized cluster's pads.
-  enum class Conflict { none, foreign_cluster, warm_start, failed_lcp, error, missing_pairs, missing_pads };
+  // missing_pairs: on a part of the detection, a free floe would join a
+  // cluster of the share without being its candidate (JoinCandidate): the
+  // share may not hold its pairs.
+  enum class Conflict { none, foreign_cluster, warm_start, failed_lcp, error, missing_pairs };
   Conflict conflict = Conflict::none;
   std::vector<std::uint32_t> moved;  // ascending: the floes of the share's clusters (joined free floes included)
   long clusters = 0;                 // clusters of the share at the start of the step
@@ -235,11 +235,9 @@ public:
   // the share's advance.
   ShareOutcome advance(const ShareRooms& all);
 
-  // On a part, advance(all) in three pieces around the caller's two
-  // exchanges. clusters(): the clusters (the same on every share) and,
-  // unless that is a conflict (a jam-sized cluster, whose pads' pairs no
-  // share holds whole: missing_pads, the same on every share), the free
-  // floes the part says a cluster may take in (`candidates`: the rule in
+  // On a part, advance(all) in pieces around the caller's exchanges.
+  // clusters(): the clusters (the same on every share) and the free floes
+  // the part says a cluster may take in (`candidates`: the rule in
   // substep.cpp, Stepper::candidates). routes(every share's candidates):
   // the pairs of the part to send, (share, index in the part), each pair to
   // every other share that runs a cluster with one of its floes or has one
@@ -247,11 +245,18 @@ public:
   // merged in pair order. advance(): the share's advance on them; a free
   // floe that would join one of its clusters and is not its candidate (its
   // pairs are not all held) is a conflict (missing_pairs).
+  // When a cluster is jam-sized (`pads`, the same on every share) its pads'
+  // pairs are spread over the parts: the caller gathers every share's
+  // pad_edges() (8 bytes each) and pads(every share's) gives the
+  // candidates.
   struct Routes {
     ShareOutcome::Conflict conflict = ShareOutcome::Conflict::none;
+    bool pads = false;
     std::vector<JoinCandidate> candidates;
   };
   Routes clusters(const ShareRooms& all);
+  std::vector<ContactEdge> pad_edges();
+  Routes pads(std::span<const ContactEdge> edges);
   std::vector<std::pair<int, std::uint32_t>> routes(std::span<const JoinCandidate> candidates);
   void hold(Detection held);
   ShareOutcome advance();

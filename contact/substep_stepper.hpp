@@ -203,8 +203,20 @@ private:
   // grown through tight pairs (room below xi: a floe of the cluster that
   // collides would soon bring the other in anyway, one at a time), numbered
   // by their lowest floe. Reads the tight pairs (tight_) and the rooms of
-  // the pairs of jam-sized clusters' floes (their pads).
+  // the pairs of jam-sized clusters' floes (their pads: pad_edges, then
+  // apply_pads and form_clusters; on a part the caller gathers every
+  // share's pad edges in between, pads_pending()).
   void make_clusters();
+  void form_clusters();
+
+public:
+  bool pads_pending() const { return pads_pending_; }
+  // The pad edges of the pairs this call holds (every pair without a part).
+  std::vector<ContactEdge> pad_edges();
+  // Every share's pad edges (any order) joined, then the clusters formed.
+  void apply_pads(std::span<const ContactEdge> pads);
+
+private:
 
   // jam_of_[i]: the jam of floe i (-1: none), jams_: their floes; from the
   // contact edges of every share (touching_).
@@ -305,6 +317,9 @@ private:
   std::vector<std::uint32_t> joining_;
   std::vector<int> merging_;
   std::array<Measured, 2> wide_;                 // time_step: the pairs measured within wider ranges (two rounds)
+  DisjointSets sets_;                            // make_clusters: the floes' components so far
+  std::vector<std::uint8_t> hot_, big_;          // make_clusters: per floe, hot; in a jam-sized cluster
+  bool pads_pending_ = false;                    // on a part: the clusters wait for every share's pad edges
   std::vector<int> jam_of_;                      // per floe: its jam, or -1
   std::vector<std::vector<std::uint32_t>> jams_; // the floes of each jam
 };

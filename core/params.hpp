@@ -31,8 +31,10 @@ struct RunParams {
   // each rank advances its clusters from its own part of the detection and
   // the pairs routed to it, rather than from the whole detection gathered to
   // every rank. Like threads, an execution setting: the results are the same
-  // bits either way, and it is not written to run files.
-  bool advance_on_part = false;
+  // bits either way, and it is not written to run files. Off: from the
+  // whole detection (advance_by_owner), the path of the runs that keep the
+  // impulse record.
+  bool advance_on_part = true;
 };
 
 enum class SeaModel { none, spectral, bem };

@@ -338,8 +338,12 @@ void advance_on_part(const Communicator& comm, std::span<const int> owner, Floes
     // The gathered conflicts and the clusters are the same on every rank:
     // all skip the next exchanges alike.
     if (combine_rooms(rooms, all)) {
-      const contact::ShareAdvance::Routes routes = share.clusters(all);
-      if (routes.conflict == contact::ShareOutcome::Conflict::missing_pads) ++counts.pads;
+      contact::ShareAdvance::Routes routes = share.clusters(all);
+      // A jam-sized cluster (the same on every rank): every rank's pad edges first.
+      if (routes.conflict == contact::ShareOutcome::Conflict::none && routes.pads) {
+        ++counts.pads;
+        routes = share.pads(comm.allgather<contact::ContactEdge>(share.pad_edges()));
+      }
       if (routes.conflict == contact::ShareOutcome::Conflict::none) {
         // Every rank's join candidates (8 bytes each), then the pairs
         // touching a cluster's members or candidates to its runner.

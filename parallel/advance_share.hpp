@@ -91,11 +91,11 @@ bool combine_parts(std::span<const AdvancePart> parts, Floes& floes, contact::Co
 struct AdvanceShareOptions {
   long max_wait = 64;
   // Simulation: advance from the rank's part of the detection
-  // (advance_on_part) rather than from the whole (advance_by_owner). Off:
-  // on a part a free floe joining a cluster is a conflict, and on the
-  // 10 000-floe pack on 2 ranks that redid 8 of 28 advances and the
-  // back-off did 72 of 100 whole (docs/parallel.md).
-  bool on_part = false;
+  // (advance_on_part) rather than from the whole (advance_by_owner);
+  // [run] advance_on_part. On by default: with the join candidates routed it
+  // combines as often as from the whole (docs/parallel.md, "The advance from
+  // the rank's part").
+  bool on_part = true;
 };
 
 // How the advances by cluster owner went (the run's summary), and the
@@ -109,9 +109,9 @@ struct AdvanceShareCounts {
   std::vector<long> rooms;      // per rank: pair rooms it computed (steps not redone)
   long pairs = 0;               // pairs in those steps (a replicated set-up computes every one's room)
   // From the rank's part (advance_on_part): the tries redone because a free
-  // floe joined a cluster without being its candidate (missing_pairs), or
-  // because a cluster was jam-sized (missing_pads), and the join candidates
-  // gathered over the tries (contact::JoinCandidate).
+  // floe joined a cluster without being its candidate (missing_pairs), the
+  // tries with a jam-sized cluster (its pad edges gathered), and the join
+  // candidates gathered over the tries (contact::JoinCandidate).
   long missing = 0;
   long pads = 0;
   long candidates = 0;

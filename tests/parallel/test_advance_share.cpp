@@ -462,12 +462,13 @@ namespace {
 // detection by `strips` (detect_part), its share on that part with the
 // clusters given to `owner`, the tight pairs and edges, the join candidates
 // (none with `candidates` false: only the members' pairs routed), then the
-// routed pairs and the parts through pack/unpack. Returns whether they
+// routed pairs and the parts through pack/unpack (and the pad edges first
+// when a cluster is jam-sized: `pads` counts those). Returns whether they
 // combined (else `f` holds the whole advance); `sent` counts the routed
 // pairs, `missing` the shares that stopped at a floe they did not hold.
 bool play_parts(const Case& c, const parallel::FloeOwners& strips, std::span<const int> owner, int ranks, Floes& f,
                 contact::CollisionStats& stats, contact::SubstepReport& report, long& sent, long& missing,
-                bool candidates = true) {
+                long& pads, bool candidates = true) {
   const auto n = static_cast<std::size_t>(ranks);
   std::vector<Floes> copies(n, c.floes);
   std::vector<contact::Detection> parts;
@@ -483,13 +484,26 @@ bool play_parts(const Case& c, const parallel::FloeOwners& strips, std::span<con
   }
   contact::ShareRooms all;
   bool ok = parallel::combine_rooms(rooms, all);
-  std::vector<contact::JoinCandidate> joins;  // every rank's, in rank order (the allgather)
+  std::vector<contact::ShareAdvance::Routes> routes;
   for (std::size_t k = 0; ok && k < n; ++k) {
-    const contact::ShareAdvance::Routes routes = shares[k]->clusters(all);
-    if (k > 0) CHECK((routes.conflict == contact::ShareOutcome::Conflict::none) == ok);  // alike on every rank
-    ok = routes.conflict == contact::ShareOutcome::Conflict::none;
-    if (candidates) joins.insert(joins.end(), routes.candidates.begin(), routes.candidates.end());
+    routes.push_back(shares[k]->clusters(all));
+    if (k > 0) CHECK((routes[k].conflict == contact::ShareOutcome::Conflict::none) == ok);  // alike on every rank
+    if (k > 0) CHECK(routes[k].pads == routes[0].pads);
+    ok = routes[k].conflict == contact::ShareOutcome::Conflict::none;
   }
+  if (ok && routes[0].pads) {
+    // A jam-sized cluster: every rank's pad edges (the allgather), then the clusters.
+    ++pads;
+    std::vector<contact::ContactEdge> edges;
+    for (std::size_t k = 0; k < n; ++k) {
+      const std::vector<contact::ContactEdge> mine = shares[k]->pad_edges();
+      edges.insert(edges.end(), mine.begin(), mine.end());
+    }
+    for (std::size_t k = 0; k < n; ++k) routes[k] = shares[k]->pads(edges);
+  }
+  std::vector<contact::JoinCandidate> joins;  // every rank's, in rank order (the allgather)
+  for (std::size_t k = 0; ok && candidates && k < n; ++k)
+    joins.insert(joins.end(), routes[k].candidates.begin(), routes[k].candidates.end());
   std::vector<std::vector<contact::Detection>> out;
   for (std::size_t k = 0; ok && k < n; ++k)
     out.push_back(parallel::routed_pairs(parts[k], shares[k]->routes(joins), ranks));
@@ -549,8 +563,8 @@ TEST_CASE("the advance from each rank's part of the detection over 1, 2, 3 and 7
           Floes f;
           contact::CollisionStats stats;
           contact::SubstepReport report;
-          long sent = 0, stopped = 0;
-          const bool ok = play_parts(c, strips, owner, ranks, f, stats, report, sent, stopped, candidates);
+          long sent = 0, stopped = 0, pads = 0;
+          const bool ok = play_parts(c, strips, owner, ranks, f, stats, report, sent, stopped, pads, candidates);
           MESSAGE(ranks << " ranks, shift " << shift << std::string(candidates ? "" : ", no candidates") << ": "
                         << std::string(ok ? "combined" : "fell back") << ", " << sent << " pairs routed, " << stopped
                         << " shares stopped at a floe not held");
@@ -582,4 +596,42 @@ TEST_CASE("the advance from each rank's part of the detection over 1, 2, 3 and 7
   CHECK(missing_bare > 0);  // the packs do have floes joining across parts
   CHECK(combined > combined_bare);
   CHECK(missing < missing_bare);
+}
+
+TEST_CASE("the advance from each rank's part with jam-sized clusters gathers their pads and is the serial advance") {
+  // jam.floes = 2: every cluster is "big" and its pad (room below jam.pad
+  // xi = 10 m) joins it at the step's start; on a part those pairs are
+  // spread over the ranks, which exchange their pad edges. Clusters owned
+  // by the strips and shifted by one rank; the answer is the serial one.
+  int combined = 0, padded = 0;
+  for (const unsigned seed : {3u, 11u}) {
+    CAPTURE(seed);
+    Case c = dense_pack(2.0, seed, 0.5);
+    c.options.impulse.jam.floes = 2;
+    const Serial serial = serial_advance(c);
+    REQUIRE(serial.report.largest_cluster >= 2);
+    for (const int ranks : {2, 3, 7})
+      for (const int shift : {0, 1}) {
+        CAPTURE(ranks);
+        CAPTURE(shift);
+        parallel::FloeOwners strips(0, ranks, c.domain);
+        strips.assign(c.floes);
+        std::vector<int> owner(strips.owner().begin(), strips.owner().end());
+        for (int& o : owner) o = (o + shift) % ranks;
+        Floes f;
+        contact::CollisionStats stats;
+        contact::SubstepReport report;
+        long sent = 0, stopped = 0, pads = 0;
+        const bool ok = play_parts(c, strips, owner, ranks, f, stats, report, sent, stopped, pads);
+        MESSAGE(ranks << " ranks, shift " << shift << ": " << std::string(ok ? "combined" : "fell back") << ", " << pads
+                      << " pad exchanges, " << sent << " pairs routed");
+        combined += ok ? 1 : 0;
+        padded += static_cast<int>(pads);
+        CHECK(std::memcmp(f.state.data(), serial.state.data(), f.state.size() * sizeof(FloeState)) == 0);
+        CHECK(same_stats(stats, serial.stats));
+        CHECK(same_report(report, serial.report));
+      }
+  }
+  CHECK(padded == 12);  // every split had a jam-sized cluster
+  CHECK(combined >= 1);
 }
