@@ -135,6 +135,7 @@ void Simulation::restore(const Checkpoint& c) {
   shapes_ = contact::build_collision_shapes(scenario_.floes);
   set_reach();
   detection_ = contact::detect(scenario_.floes, shapes_, detection_options_);
+  detection_whole_ = true;
   if (sea_) restore_modal(*sea_, c.sea, "the sea");
   if (incident_) incident_->restore(c.incident);
   if (floe_sea_) floe_sea_->restore(c.floe_sea, scenario_.floes, *sea_, incident_.get());

@@ -336,6 +336,7 @@ void Simulation::on_floes_changed() {
   shapes_ = contact::build_collision_shapes(scenario_.floes);
   set_reach();  // one reach per floe: detect reads reach[i] for every floe, new pieces included
   detection_ = contact::detect(scenario_.floes, shapes_, detection_options_);
+  detection_whole_ = true;
   detection_part_.reset();
   if (floe_sea_) {
     // A split piece keeps its parent's reference bottom (same thickness);
@@ -400,7 +401,7 @@ void Simulation::advance(StepContext& ctx) {
     contact::advance_with_collisions(scenario_.floes, shapes_, detection_, ctx.dt, o, stats_, substeps_);
   else if (detection_part_ && advance_share_options_.on_part)
     parallel::advance_on_part(comm_, owners_.owner(), scenario_.floes, shapes_, *detection_part_,
-                              [this]() -> const contact::Detection& { return detection_; }, ctx.dt, o, stats_,
+                              [this]() -> const contact::Detection& { return whole_detection(); }, ctx.dt, o, stats_,
                               substeps_, advance_share_, advance_share_options_);
   else
     parallel::advance_by_owner(comm_, owners_.owner(), scenario_.floes, shapes_, detection_, ctx.dt, o, stats_,
@@ -460,8 +461,12 @@ bool Simulation::detect_and_check(StepContext& ctx) {
   read_try_budget(ctx);
   if (!comm_.serial()) owners_.assign(scenario_.floes);  // the owners at the advanced places
   contact::Detection part;  // this rank's (serially: `next` itself)
+  // The whole lists are gathered only for the readers of the whole (the
+  // impulse record's runs, the advance from the whole detection); else
+  // whole_detection() gathers them when a step needs them.
+  const bool whole = !advance_share_options_.on_part || impulse_options_.record;
   contact::Detection next = parallel::detect(comm_, owners_, scenario_.floes, shapes_, detection_options_,
-                                             comm_.serial() ? nullptr : &part);
+                                             comm_.serial() ? nullptr : &part, whole);
   // The first overlapping pair and its distance at t, found from the ranks'
   // parts (a reduction): the serial scan's on every rank.
   const parallel::Overlap overlap = parallel::first_overlap(comm_, comm_.serial() ? next : part,
@@ -480,8 +485,18 @@ bool Simulation::detect_and_check(StepContext& ctx) {
     return false;
   }
   detection_ = std::move(next);
+  detection_whole_ = comm_.serial() || whole;
   if (!comm_.serial()) detection_part_ = std::move(part);
   return true;
+}
+
+const contact::Detection& Simulation::whole_detection() {
+  // Collective: every rank reaches it at the same point of the same step.
+  if (!detection_whole_) {
+    detection_ = parallel::gather(comm_, *detection_part_);
+    detection_whole_ = true;
+  }
+  return detection_;
 }
 
 void Simulation::wrap_periodic() {

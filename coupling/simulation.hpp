@@ -162,6 +162,9 @@ public:
   // energies() and the budget.
   Vec2 momentum() const;
   LcpCounters lcp_counters() const;
+  // The contact detection at the present positions. On several ranks with
+  // [run] advance_on_part and no impulse record, it may be empty after a
+  // step: each rank then holds only its part, gathered when needed.
   const contact::Detection& detection() const { return detection_; }
   // The floes' owners by place for the drift and detection (one rank: all 0).
   const parallel::FloeOwners& floe_owners() const { return owners_; }
@@ -242,6 +245,12 @@ private:
   // detected, parallel::detect); empty at the start and after a split,
   // whose detection is made whole on every rank.
   std::optional<contact::Detection> detection_part_;
+  // Whether detection_ holds the whole detection. On several ranks with the
+  // advance from the parts and no impulse record, detect_and_check gathers
+  // it only when a step needs it (whole_detection(): a fallback, a step the
+  // back-off does whole), every rank alike.
+  bool detection_whole_ = true;
+  const contact::Detection& whole_detection();
   contact::CollisionStats stats_;
   std::unique_ptr<Percussion> percussion_;  // [fracture] enabled
   PercussionRanks percussion_ranks_;         // its analyses by owner (several ranks)

@@ -143,7 +143,7 @@ Overlap first_overlap(const Communicator& comm, const contact::Detection& part, 
 
 contact::Detection detect(const Communicator& comm, FloeOwners& owners, const Floes& floes,
                           const contact::CollisionShapes& shapes, contact::DetectionOptions options,
-                          contact::Detection* part) {
+                          contact::Detection* part, bool whole_too) {
   if (comm.serial()) {
     contact::Detection whole = contact::detect(floes, shapes, options);
     if (part) *part = whole;
@@ -152,7 +152,7 @@ contact::Detection detect(const Communicator& comm, FloeOwners& owners, const Fl
   const double start = thread_seconds();
   contact::Detection mine = detect_part(owners, comm.rank(), floes, shapes, std::move(options));
   owners.charge(thread_seconds() - start);
-  contact::Detection whole = gather(comm, mine);
+  contact::Detection whole = whole_too || !part ? gather(comm, mine) : contact::Detection{};
   if (part) *part = std::move(mine);
   return whole;
 }

@@ -24,8 +24,10 @@ namespace floesim::parallel {
 // gather) to `owners`, for the load balance.
 contact::Detection detect(const Communicator& comm, FloeOwners& owners, const Floes& floes,
                           const contact::CollisionShapes& shapes, contact::DetectionOptions options,
-                          contact::Detection* part = nullptr);
-// (`part`, if not null, receives this rank's part: detect_part's. Serially, the whole detection.)
+                          contact::Detection* part = nullptr, bool whole = true);
+// (`part`, if not null, receives this rank's part: detect_part's. Serially, the whole detection.
+// With `whole` false on several ranks (and `part` given) the parts are not
+// gathered and the result is empty: the caller gathers later if it must.)
 
 // The whole detection from every rank's part (each rank's detect_part, in
 // pair order): the parts gathered to every rank (one allgather_bytes) and

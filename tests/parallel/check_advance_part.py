@@ -9,7 +9,9 @@ The moving pack of check_ranks.py run serially, then on each of --ranks with
 advance_on_part = true and = false: every run file must equal the serial one
 bit for bit (`floesim compare`, rtol 0, atol 0). With it on the advances ran
 from the parts (join candidates gathered) and combined in at least as many
-steps as from the whole detection; with it off no candidate was gathered.
+steps as from the whole detection, and the detect phase received less than a
+tenth of the bytes (the whole lists gathered only when a step needs them);
+with it off no candidate was gathered.
 """
 from ranks_harness import moving_pack_check, need, summary
 
@@ -29,7 +31,7 @@ for on in (True, False):
 
 need(run([args.floesim, "run", configs[True], "-o", "serial.h5", "-q"]), "serial run")
 for n in args.ranks:
-    combined = {}
+    combined, detect = {}, {}
     for on in (True, False):
         out = f"ranks{n}_{'on' if on else 'off'}.h5"
         p = mpirun(n, "run", configs[on], "-o", out, "-q")
@@ -41,15 +43,23 @@ for n in args.ranks:
         steps, fallbacks = int(s["parallel.advance_steps"]), int(s["parallel.advance_fallbacks"])
         candidates, missing = int(s["parallel.advance_candidates"]), int(s["parallel.advance_missing"])
         combined[on] = steps - fallbacks
+        detect[on] = int(s["parallel.phase.detect"].split()[2])
         print(f"{n} ranks, advance_on_part {on}: {'equal' if c.returncode == 0 else 'DIFFERENT'} to the serial run; "
               f"{steps} advances tried, {fallbacks} redone ({missing} for a floe not held), "
-              f"{s['parallel.advance_whole']} whole, {candidates} join candidates; {s['parallel.phase.advance']}")
+              f"{s['parallel.advance_whole']} whole, {candidates} join candidates; advance {s['parallel.phase.advance']}; "
+              f"detect {s['parallel.phase.detect']}")
         if c.returncode != 0:
             failures.append(f"{n} ranks, advance_on_part {on}: differs from the serial run\n{c.stdout}")
         if on and not candidates > 0:
             failures.append(f"{n} ranks: advance_on_part on gathered no join candidate (not from the parts?)")
         if not on and candidates != 0:
             failures.append(f"{n} ranks: advance_on_part off gathered {candidates} join candidates")
+    # The whole detection is gathered only when a step needs it (none did
+    # here): the detect phase receives far less than the lists (the overlap
+    # check's reductions and the start's).
+    if len(detect) == 2 and not detect[True] * 10 < detect[False]:
+        failures.append(f"{n} ranks: the detect phase received {detect[True]} bytes from the parts, "
+                        f"not a tenth of {detect[False]} with the whole lists gathered")
     if len(combined) == 2 and combined[True] < combined[False]:
         failures.append(f"{n} ranks: from the parts {combined[True]} advances combined, "
                         f"fewer than {combined[False]} from the whole detection")
