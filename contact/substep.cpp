@@ -664,6 +664,7 @@ ShareAdvance::Routes ShareAdvance::clusters(const ShareRooms& all) {
       set_up_ = stepper_->conflict();
       out.pads = stepper_->pads_pending();
       if (set_up_ == ShareOutcome::Conflict::none && !out.pads) out.candidates = stepper_->candidates();
+      out.any_cluster = stepper_->any_cluster();
     } catch (const RunError&) {
       set_up_ = ShareOutcome::Conflict::error;
     }
@@ -682,6 +683,7 @@ ShareAdvance::Routes ShareAdvance::pads(std::span<const ContactEdge> edges) {
   if (set_up_ == ShareOutcome::Conflict::none) {
     stepper_->apply_pads(edges);
     out.candidates = stepper_->candidates();
+    out.any_cluster = stepper_->any_cluster();
   }
   out.conflict = set_up_;
   return out;

@@ -252,6 +252,7 @@ public:
   struct Routes {
     ShareOutcome::Conflict conflict = ShareOutcome::Conflict::none;
     bool pads = false;
+    bool any_cluster = false;  // the step has a cluster (the same on every share)
     std::vector<JoinCandidate> candidates;
   };
   Routes clusters(const ShareRooms& all);

@@ -211,6 +211,7 @@ private:
 
 public:
   bool pads_pending() const { return pads_pending_; }
+  bool any_cluster() const { return !clusters_.empty(); }
   // The pad edges of the pairs this call holds (every pair without a part).
   std::vector<ContactEdge> pad_edges();
   // Every share's pad edges (any order) joined, then the clusters formed.

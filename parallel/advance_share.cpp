@@ -346,12 +346,15 @@ void advance_on_part(const Communicator& comm, std::span<const int> owner, Floes
       }
       if (routes.conflict == contact::ShareOutcome::Conflict::none) {
         // Every rank's join candidates (8 bytes each), then the pairs
-        // touching a cluster's members or candidates to its runner.
-        const std::vector<contact::JoinCandidate> candidates =
-            comm.allgather<contact::JoinCandidate>(routes.candidates);
-        counts.candidates += static_cast<long>(candidates.size());
-        const std::vector<std::pair<int, std::uint32_t>> to = share.routes(candidates);
-        share.hold(exchange_pairs(comm, part, routed_pairs(part, to, comm.size())));
+        // touching a cluster's members or candidates to its runner; with no
+        // cluster anywhere (the same on every rank) nothing to route.
+        if (routes.any_cluster) {
+          const std::vector<contact::JoinCandidate> candidates =
+              comm.allgather<contact::JoinCandidate>(routes.candidates);
+          counts.candidates += static_cast<long>(candidates.size());
+          const std::vector<std::pair<int, std::uint32_t>> to = share.routes(candidates);
+          share.hold(exchange_pairs(comm, part, routed_pairs(part, to, comm.size())));
+        }
         const AdvancePart mine = share_part(share, share.advance(), floes);
         const std::vector<AdvancePart> parts = comm.allgather_parts(pack(mine), unpack_advance_part);
         counts.clusters.resize(parts.size(), 0);
