@@ -158,16 +158,19 @@ void advance_by_owner(const Communicator& comm, std::span<const int> owner, Floe
                       const AdvanceShareOptions& share_options = {});
 
 // The same from this rank's part of the detection (parallel::detect's part,
-// docs/parallel.md "The detection's lists by owner"): the share's set-up on
-// its part (every pair of the part its own), the exchange of the tight pairs
-// and contact edges, the clusters, the pairs touching each cluster's members
-// sent to its owner (one alltoall_bytes: two collective calls), the share's
-// advance on its part and the pairs received, the exchange of the parts.
-// `whole` gives the whole detection (collective: every rank calls it at the
-// same point, or none does) for a record run, the back-off's whole steps
-// and the fallback, which is taken also when a share would read a pair it
-// does not hold (Conflict::missing_pairs). Equal to the serial advance bit
-// for bit.
+// docs/parallel.md "The advance from the rank's part"): the share's set-up
+// on its part (every pair of the part its own), the exchange of the tight
+// and near pairs and contact edges, the clusters (with every rank's pad
+// edges gathered first when a cluster is jam-sized), then, when the step has
+// a cluster, the gather of every rank's join candidates and the pairs
+// touching each cluster's members or candidates sent to its runner (one
+// alltoall_bytes: two collective calls), the share's advance on its part
+// and the pairs received, the exchange of the parts. `whole` gives the whole
+// detection (collective: every rank calls it at the same point, or none
+// does) for a record run, the back-off's whole steps and the fallback, which
+// is taken also when a floe joins a share's cluster without being its
+// candidate (Conflict::missing_pairs). Equal to the serial advance bit for
+// bit.
 void advance_on_part(const Communicator& comm, std::span<const int> owner, Floes& floes,
                      const contact::CollisionShapes& shapes, const contact::Detection& part,
                      const std::function<const contact::Detection&()>& whole, double dt,
