@@ -430,6 +430,14 @@ private:
     int interior_reach = -1;
     std::vector<double> parts;
     std::vector<std::uint32_t> alone, painted;  // painted: the cells whose kind is not their row's
+    // With the boxes (boxed()), during sum_coverage_by_owner: per grid cell
+    // 1 + its index among the shared cells (0: not shared), and per shared
+    // cell the ranks whose floes' boxes cover it (`rank_words` 64-bit words
+    // of bits); per cell of `cells`, the ranks that sum it (receivers_first
+    // into receivers: those ranks, the cell's slab's rank and this one).
+    std::vector<std::uint32_t> shared_at, receivers_first;
+    std::vector<std::uint64_t> shared_ranks;
+    std::vector<int> receivers;
     std::vector<double> alone_totals;
     // The serial order (order_by_owner): per floe the box of its pieces'
     // cells (parallel::CellBox, first_cell kNoCell: not in the order) and
