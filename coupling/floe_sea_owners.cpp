@@ -25,16 +25,20 @@
 // owns such a cell (its slab holds the row), the pressure's total goes to
 // it (CellRoutes' alone cells: 4 bytes a cell before the law, 8 after).
 // Every other cell (under a box of another rank's floe: shared, or nearly)
-// goes to the rank whose slab holds its row (parallel::CellRoutes, an
-// all-to-all) as its pieces, each with its
-// floe's serial position as key: before the law the cell, its pieces'
-// count, keys and coverage (8 bytes a cell, 12 a piece); after it the pieces'
-// a u^2 and pressure (16 bytes a piece). The cell's owner adds every rank's
-// pieces from zero in key order, which is the serial loop's order of
-// additions into that cell: the sum is the serial one to the bit, whichever
-// rank owns which floe. It keeps the pressure (its sea's kick reads its
-// slab's rows) and sends the coverage and the sums back to the ranks that
-// sent the cell. The penalty energy, a running sum over all pieces in the
+// travels as its pieces, each with its floe's serial position as key:
+// before the law the cell, its pieces' count, keys and coverage (8 bytes a
+// cell, 12 a piece); after it the pieces' a u^2 and pressure (16 bytes a
+// piece). With the boxes (boxed()) they go to every rank that needs the
+// cell's totals (CellRoutes::open_shared, one all-to-all): the ranks whose
+// floes' boxes cover it (all that may have pieces there), the rank whose
+// slab holds its row (the pressure, for its sea's kick) and this one; each
+// adds every rank's pieces from zero in key order, which is the serial
+// loop's order of additions into that cell: the same sum on each, the
+// serial one to the bit, whichever rank owns which floe; nothing goes back.
+// Without the boxes (grids wider than CellBox::kMaxSide) they go to the
+// slab's rank alone, which sums them so and sends the coverage and the
+// sums back to the ranks that sent the cell (CellRoutes::open, reply).
+// The penalty energy, a running sum over all pieces in the
 // serial order, is kept as this rank's terms and summed in that order on
 // demand (settle_energy: at records and checkpoints).
 //
