@@ -1,5 +1,6 @@
 #include "parallel/collide_share.hpp"
 
+#include <algorithm>
 #include <array>
 #include <tuple>
 #include <utility>
@@ -182,6 +183,14 @@ std::size_t collide_on_part(const Communicator& comm, std::span<const int> owner
   const std::vector<contact::GroupEdge> mine = contact::group_edges(floes, start, part, step, options);
   const std::vector<contact::GroupEdge> edges = comm.allgather<contact::GroupEdge>(mine);
   const contact::StepGroups groups = contact::step_groups(floes, edges, options);
+  // No step group on any rank (the same groups on all): the serial call
+  // solves nothing and changes nothing, and every rank skips the exchanges.
+  if (std::none_of(groups.lowest.begin(), groups.lowest.end(),
+                   [](std::uint32_t g) { return g != contact::StepGroups::kNone; })) {
+    counts.clusters.resize(static_cast<std::size_t>(comm.size()), 0);
+    counts.combined();
+    return 0;
+  }
   // The pairs of the groups owned elsewhere, to their owners.
   const std::vector<contact::Detection> out =
       pairs_for_groups(floes, part, groups, owner, comm.size(), comm.rank(), options.collision_distance);

@@ -173,8 +173,10 @@ void Communicator::allgather_known(std::span<const std::byte> mine, const std::v
 #ifdef FLOESIM_HAVE_MPI
   std::vector<int> sizes, offsets;
   const std::size_t total = displacements(counts, sizes, offsets, "a gather");
-  Counted counted(impl_->traffic, static_cast<long long>(total));
   out.resize(total);  // a buffer kept by the caller: filled only where it grows
+  // Every rank knows every count: when all are zero all ranks skip the call alike.
+  if (total == 0) return;
+  Counted counted(impl_->traffic, static_cast<long long>(total));
   check(MPI_Allgatherv(mine.data(), static_cast<int>(mine.size()), MPI_BYTE, out.data(), sizes.data(),
                        offsets.data(), MPI_BYTE, impl_->comm),
         "MPI_Allgatherv");
@@ -187,6 +189,7 @@ void Communicator::allgather_in_place(std::span<std::byte> all, const std::vecto
   std::vector<int> sizes, offsets;
   const std::size_t total = displacements(counts, sizes, offsets, "a gather");
   FLOESIM_ASSERT(total <= all.size());
+  if (total == 0) return;  // all ranks alike, as allgather_known
   Counted counted(impl_->traffic, static_cast<long long>(total - counts[static_cast<std::size_t>(rank_)]));
   check(MPI_Allgatherv(MPI_IN_PLACE, 0, MPI_BYTE, all.data(), sizes.data(), offsets.data(), MPI_BYTE, impl_->comm),
         "MPI_Allgatherv");

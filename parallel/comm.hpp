@@ -136,7 +136,9 @@ public:
     }
     return parts;
   }
-  // The same when every rank's count is known to all (`counts`): one call.
+  // The same when every rank's count is known to all (`counts`): one call,
+  // none when every count is zero (every rank skips it alike; so a gather
+  // of nothing from anyone costs allgather_bytes the counts' call only).
   std::vector<std::byte> allgather_known(std::span<const std::byte> mine, const std::vector<std::size_t>& counts) const;
   // Both into `out`, whose memory is reused (a gather made at every step
   // then allocates, and the system zeroes fresh pages, only when it grows).
@@ -147,7 +149,7 @@ public:
 
   // Bytes, in place: `all` holds the ranks' parts in rank order, counts[r]
   // bytes for rank r (known to all); this rank's part is in place on entry,
-  // every rank's on exit. One collective call.
+  // every rank's on exit. One collective call (none when every count is zero).
   void allgather_in_place(std::span<std::byte> all, const std::vector<std::size_t>& counts) const;
 
   // Bytes from every rank to every rank (a transpose): `send` holds this

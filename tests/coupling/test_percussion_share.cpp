@@ -167,6 +167,19 @@ long check_ranks(int ranks, const Floes& start, const std::vector<contact::Impul
   return narrower;
 }
 
+// The serial reference: two steps of check() at t = 10 and 20 s, each on
+// its own random record of collisions (record_for, seed 7), kept for the
+// shared runs with the events the steps gave.
+void check_serially(Floes& serial, Percussion& whole, double dt, std::vector<contact::ImpulseRecord>& records,
+                    std::vector<FractureEventRow>& events) {
+  std::mt19937_64 rng(7);
+  for (int step = 0; step < 2; ++step) {
+    records.push_back(record_for(serial, rng));
+    whole.check(serial, records.back(), 10.0 * (step + 1), dt);
+    for (const FractureEventRow& e : whole.take_events()) events.push_back(e);
+  }
+}
+
 }  // namespace
 
 TEST_CASE("percussion by owner: the analyses shared by 1, 2 and 3 ranks and concluded on each are the serial check") {
@@ -176,12 +189,7 @@ TEST_CASE("percussion by owner: the analyses shared by 1, 2 and 3 ranks and conc
   Percussion whole(params(), gap);
   std::vector<contact::ImpulseRecord> records;
   std::vector<FractureEventRow> serial_events;
-  std::mt19937_64 rng(7);
-  for (int step = 0; step < 2; ++step) {
-    records.push_back(record_for(serial, rng));
-    whole.check(serial, records.back(), 10.0 * (step + 1), dt);
-    for (const FractureEventRow& e : whole.take_events()) serial_events.push_back(e);
-  }
+  check_serially(serial, whole, dt, records, serial_events);
   const PercussionStats& s = whole.stats();
   MESSAGE("serial: " << s.counts.checks << " checks, " << s.counts.screened << " screened, " << s.counts.bounded
                      << " bounded, " << s.counts.sustained << " sustained, " << s.initiations << " initiations, "
@@ -219,12 +227,7 @@ TEST_CASE("percussion by owner: splits within reach of each other, decided by th
   Percussion whole(params(), gap);
   std::vector<contact::ImpulseRecord> records;
   std::vector<FractureEventRow> serial_events;
-  std::mt19937_64 rng(7);
-  for (int step = 0; step < 2; ++step) {
-    records.push_back(record_for(serial, rng));
-    whole.check(serial, records.back(), 10.0 * (step + 1), dt);
-    for (const FractureEventRow& e : whole.take_events()) serial_events.push_back(e);
-  }
+  check_serially(serial, whole, dt, records, serial_events);
   const PercussionStats& s = whole.stats();
   // The serial loop as it was: every split decided in floe order against
   // the floes as they are when it is reached (conclude decides the

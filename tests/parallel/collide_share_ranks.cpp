@@ -10,7 +10,8 @@
 // Both from the whole detection (collide_by_owner) and from each rank's
 // part of it, the pairs whose floe a it owns (parallel::collide_on_part:
 // the edges gathered, the groups' pairs sent to their owners, the whole
-// detection gathered only for the fallback).
+// detection gathered only for the fallback). Last, a step with no step
+// group: the serial answer with at most two collective calls.
 // Run by ctest as mpi.collide_share_ranks_N under `mpirun --oversubscribe
 // -np N` (N = 1, 2, 3), and serially without MPI.
 #include <cstdio>
@@ -69,6 +70,34 @@ int main() {
       for (const long g : counts.clusters) std::printf(" %ld", g);
       std::printf("\n");
     }
+  }
+  {
+    // At rest and without the contacts' pairs (the witnesses only): no step
+    // group on any rank. Nothing changes, as the serial solve, and the ranks
+    // skip the exchanges: the edges' counts are the only call (a second, the
+    // edges, when a rank has one), where a step with groups makes six.
+    Floes s = c.floes, f = c.floes;
+    std::vector<FloeState> start = c.start;
+    for (std::vector<FloeState>* v : {&s.state, &f.state, &start})
+      for (FloeState& x : *v) x.vx = x.vy = x.yaw_rate = 0.0;
+    auto untouched = [](const contact::NearPair& p) { return p.contact_count == 0; };
+    const contact::Detection whole = parallel::select_pairs(c.detection, untouched);
+    const contact::Detection rest = parallel::select_pairs(part, untouched);
+    contact::CollisionStats ss, fs;
+    contact::ImpulseOptions so = c.options, fo = c.options;
+    const std::size_t a = contact::resolve_step_collisions(s, start, whole, c.dt, so, ss);
+    parallel::AdvanceShareCounts counts;
+    const long long calls = comm.traffic().calls;
+    const std::size_t b = parallel::collide_on_part(comm, owners.owner(), f, start, rest, c.dt, fo, fs, counts);
+    const long long made = comm.traffic().calls - calls;
+    if (std::memcmp(f.state.data(), s.state.data(), f.state.size() * sizeof(FloeState)) != 0 || a != b ||
+        !test::same_stats(fs, ss))
+      failures.push_back("no step group: the floes or counts differ from the serial solve");
+    if (whole.pairs.empty() || ss.lcps != 0) failures.push_back("no step group: no witnesses, or an LCP: no test");
+    if (ranks > 1 && made > 2)
+      failures.push_back("no step group: " + std::to_string(made) + " collective calls, at most 2 expected");
+    if (comm.writer())
+      std::printf("no step group, %d ranks: %zu pairs, %lld collective calls\n", ranks, whole.pairs.size(), made);
   }
   for (const std::string& m : failures) std::printf("rank %d: %s\n", comm.rank(), m.c_str());
   const long long failed = comm.sum(static_cast<long long>(failures.size()));
