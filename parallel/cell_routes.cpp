@@ -82,8 +82,8 @@ void CellRoutes::open(const Communicator& comm, std::span<const std::uint32_t> c
     owner_list_[k] = owner(cells[k]);
   }
   owner_first_[cells.size()] = static_cast<std::uint32_t>(cells.size());
-  send_pieces(comm, cells, first, keys, parts, width, owner_first_, owner_list_, alone);
   to_owners_ = true;
+  send_pieces(comm, cells, first, keys, parts, width, owner_first_, owner_list_, alone);
 }
 
 void CellRoutes::open_shared(const Communicator& comm, std::span<const std::uint32_t> cells,
@@ -91,8 +91,8 @@ void CellRoutes::open_shared(const Communicator& comm, std::span<const std::uint
                              std::span<const double> parts, int width, std::span<const std::uint32_t> receivers_first,
                              std::span<const int> receivers, std::span<const std::uint32_t> alone) {
   FLOESIM_ASSERT(receivers_first.size() == cells.size() + 1 && receivers.size() == receivers_first.back());
-  send_pieces(comm, cells, first, keys, parts, width, receivers_first, receivers, alone);
   to_owners_ = false;
+  send_pieces(comm, cells, first, keys, parts, width, receivers_first, receivers, alone);
 }
 
 void CellRoutes::send_pieces(const Communicator& comm, std::span<const std::uint32_t> cells,
@@ -127,8 +127,9 @@ void CellRoutes::send_pieces(const Communicator& comm, std::span<const std::uint
   for (std::size_t k = 0; k < alone.size(); ++k)
     alone_route_[next[static_cast<std::size_t>(owner(alone[k]))]++] = static_cast<std::uint32_t>(k);
   first_.assign(first.begin(), first.end());
-  // To each owner: the counts of its cells and alone cells, the cells, their
-  // pieces' counts, the alone cells, then the pieces' keys and values.
+  // To each rank: the counts of the cells it receives and of its alone
+  // cells, the cells, their pieces' counts, the alone cells, then the
+  // pieces' keys and values.
   bytes_.resize(ranks);
   std::size_t total_bytes = 0;
   for (std::size_t r = 0; r < ranks; ++r) {
@@ -178,6 +179,7 @@ void CellRoutes::send_pieces(const Communicator& comm, std::span<const std::uint
     std::size_t m = 0;
     for (std::size_t j = 0; j < n; ++j) {
       const std::uint32_t c = at<std::uint32_t>(cell, j), q = at<std::uint32_t>(count, j);
+      FLOESIM_ASSERT(!to_owners_ || owner(c) == comm.rank());
       if (slot_[c] == 0) {
         owned_.push_back(c);
         slot_[c] = static_cast<std::uint32_t>(owned_.size());
