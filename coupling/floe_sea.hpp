@@ -200,10 +200,12 @@ public:
   // (fluid::Sea::slab_rows; stages five and eight) the floes are owned by
   // place (the rank whose slab holds the row of a floe's centroid at the
   // footprints' last rebuild: MovingFootprints::set_slabs), and each cell
-  // the pieces of several ranks' floes may share is summed by the rank whose
-  // slab holds its row from the pieces themselves, in the serial order
-  // (parallel::CellRoutes with the floes' serial positions as keys), which
-  // sends the coverage and the sums back to the ranks with pieces there; a
+  // the pieces of several ranks' floes may share is summed from the pieces
+  // themselves, in the serial order (parallel::CellRoutes with the floes'
+  // serial positions as keys), by every rank that needs it: the ranks whose
+  // floes' boxes cover it and the rank whose slab holds its row (without
+  // the boxes, by the slab's rank, which sends the coverage and the sums
+  // back to the ranks with pieces there); a
   // cell deeper in a slab than any floe of another rank reaches, or under
   // no other rank's floe's box of cells (parallel::CellBox, gathered with
   // the serial order), is summed by the rank whose floes lie there alone,
@@ -337,7 +339,8 @@ private:
   // By owner (floe_sea_owners.cpp): this rank's pieces' coverage into
   // cells_[c].coverage of this rank's cells (cells_ is zero in the others):
   // routed, every rank's pieces of a shared cell summed in the serial order
-  // by the cell's slab's rank; not routed, every rank's parts in rank order.
+  // by each rank that needs it (without the boxes, by the cell's slab's rank);
+  // not routed, every rank's parts in rank order.
   void sum_coverage_by_owner();
   // By owner, after the law (eval_: penetrations u, weights psi, forces):
   // this rank's pieces' a u^2 and pressure in its cells and its part of the
@@ -430,6 +433,14 @@ private:
     int interior_reach = -1;
     std::vector<double> parts;
     std::vector<std::uint32_t> alone, painted;  // painted: the cells whose kind is not their row's
+    // With the boxes (boxed()), during sum_coverage_by_owner: per grid cell
+    // 1 + its index among the shared cells (0: not shared), and per shared
+    // cell the ranks whose floes' boxes cover it (`rank_words` 64-bit words
+    // of bits); per cell of `cells`, the ranks that sum it (receivers_first
+    // into receivers: those ranks, the cell's slab's rank and this one).
+    std::vector<std::uint32_t> shared_at, receivers_first;
+    std::vector<std::uint64_t> shared_ranks;
+    std::vector<int> receivers;
     std::vector<double> alone_totals;
     // The serial order (order_by_owner): per floe the box of its pieces'
     // cells (parallel::CellBox, first_cell kNoCell: not in the order) and
@@ -451,8 +462,10 @@ private:
   static constexpr std::uint32_t kNoCell = parallel::CellBox::kNone;
   // The sea's slabs (fluid::Sea::slab_rows; empty: whole on every rank), and
   // by owner on them, the routes of the cells' sums to the slabs' ranks;
-  // the next evaluation clears pressure_ in routes_.owned() (this rank's
-  // slab's cells of the last one) and cells_ in owner_.cells.
+  // the next evaluation clears pressure_ in routes_.owned() (the cells the
+  // last one received pieces of: its slab's, where it wrote the pressure,
+  // and with the boxes other slabs' shared cells, where pressure_ is zero)
+  // and cells_ in owner_.cells.
   std::vector<int> slab_rows_;
   std::vector<int> first_slab_rows_;  // the slabs at set-up (the incident sea's, which do not move)
   parallel::CellRoutes routes_;

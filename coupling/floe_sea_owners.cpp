@@ -25,16 +25,20 @@
 // owns such a cell (its slab holds the row), the pressure's total goes to
 // it (CellRoutes' alone cells: 4 bytes a cell before the law, 8 after).
 // Every other cell (under a box of another rank's floe: shared, or nearly)
-// goes to the rank whose slab holds its row (parallel::CellRoutes, an
-// all-to-all) as its pieces, each with its
-// floe's serial position as key: before the law the cell, its pieces'
-// count, keys and coverage (8 bytes a cell, 12 a piece); after it the pieces'
-// a u^2 and pressure (16 bytes a piece). The cell's owner adds every rank's
-// pieces from zero in key order, which is the serial loop's order of
-// additions into that cell: the sum is the serial one to the bit, whichever
-// rank owns which floe. It keeps the pressure (its sea's kick reads its
-// slab's rows) and sends the coverage and the sums back to the ranks that
-// sent the cell. The penalty energy, a running sum over all pieces in the
+// travels as its pieces, each with its floe's serial position as key:
+// before the law the cell, its pieces' count, keys and coverage (8 bytes a
+// cell, 12 a piece); after it the pieces' a u^2 and pressure (16 bytes a
+// piece). With the boxes (boxed()) they go to every rank that needs the
+// cell's totals (CellRoutes::open_shared, one all-to-all): the ranks whose
+// floes' boxes cover it (all that may have pieces there), the rank whose
+// slab holds its row (the pressure, for its sea's kick) and this one; each
+// adds every rank's pieces from zero in key order, which is the serial
+// loop's order of additions into that cell: the same sum on each, the
+// serial one to the bit, whichever rank owns which floe; nothing goes back.
+// Without the boxes (grids wider than CellBox::kMaxSide) they go to the
+// slab's rank alone, which sums them so and sends the coverage and the
+// sums back to the ranks that sent the cell (CellRoutes::open, reply).
+// The penalty energy, a running sum over all pieces in the
 // serial order, is kept as this rank's terms and summed in that order on
 // demand (settle_energy: at records and checkpoints).
 //
@@ -180,6 +184,7 @@ void FloeSeaContact::sum_coverage_by_owner() {
   // goes to its owner as pieces. Not routed, no cell is summed alone.
   const bool routed_cells = routed(), boxes = boxed();
   const std::size_t nx = static_cast<std::size_t>(grid_.nx);
+  const std::size_t rank_words = (static_cast<std::size_t>(comm_.size()) + 63) / 64;
   if (routed_cells) {
     const int reach = footprints_.by_place() ? footprints_.reach_rows() : grid_.ny;
     if (reach != o.interior_reach) {
@@ -191,18 +196,31 @@ void FloeSeaContact::sum_coverage_by_owner() {
     }
     // The cells other ranks' floes may have pieces in, outside the slabs'
     // interiors (where no other rank's floe reaches).
+    // With each such cell, the ranks of those floes: each sums the cell
+    // too.
     o.painted.clear();
-    if (boxes)
+    o.shared_ranks.clear();
+    if (boxes) {
+      o.shared_at.resize(grid_.size(), 0);
+      const std::span<const int> owners = footprints_.owners();
+      std::uint32_t shared = 0;
       for (std::uint32_t i : o.serial) {
         if (footprints_.owns(i)) continue;
+        const std::size_t word = static_cast<std::size_t>(owners[i]) / 64;
+        const std::uint64_t bit = std::uint64_t{1} << (static_cast<unsigned>(owners[i]) % 64);
         o.box[i].for_each(
             grid_.nx, grid_.ny, [&](int y) { return o.interior_row[static_cast<std::size_t>(y)] == 0; },
             [&](std::uint32_t c) {
-              if (o.kind[c] != OwnerCells::kRoutedRow) return;
-              o.kind[c] = OwnerCells::kShared;
-              o.painted.push_back(c);
+              if (o.kind[c] == OwnerCells::kRoutedRow) {
+                o.kind[c] = OwnerCells::kShared;
+                o.painted.push_back(c);
+                o.shared_at[c] = ++shared;
+                o.shared_ranks.resize(shared * rank_words, 0);
+              }
+              o.shared_ranks[(o.shared_at[c] - 1) * rank_words + word] |= bit;
             });
       }
+    }
   }
   // This rank's other cells, in the order its floes' pieces meet them, and
   // its part of each cell's coverage, summed as the serial loop sums it.
@@ -263,13 +281,32 @@ void FloeSeaContact::sum_coverage_by_owner() {
         o.keys[p] = o.position[i];
         o.values[p] = fp.area[k] * inv_cell_area;
       }
-    routes_.open(comm_, o.cells, o.first, o.keys, o.values, 1, o.alone);
     o.routed_counts.shared += static_cast<long>(o.cells.size());
     o.routed_counts.pieces += static_cast<long>(o.first.back());
     o.routed_counts.alone_here += static_cast<long>(alone_here);
     o.routed_counts.alone_sent += static_cast<long>(o.alone.size());
-    routes_.reply(comm_, 0, o.coverage);  // the cells' totals, in place of this rank's parts
-    for (std::size_t j = 0; j < o.cells.size(); ++j) cells_[o.cells[j]].coverage = o.coverage[j];
+    if (!boxes) {
+      // Each cell to its slab's rank, which sends the total back.
+      routes_.open(comm_, o.cells, o.first, o.keys, o.values, 1, o.alone);
+      routes_.reply(comm_, 0, o.coverage);  // the cells' totals, in place of this rank's parts
+      for (std::size_t j = 0; j < o.cells.size(); ++j) cells_[o.cells[j]].coverage = o.coverage[j];
+      return;
+    }
+    // Each shared cell to every rank that needs its total: the ranks whose
+    // floes' boxes cover it (all that may have pieces there), its slab's
+    // rank and this one; each sums every rank's pieces in the serial order.
+    o.receivers_first.assign(1, 0);
+    o.receivers.clear();
+    for (const std::uint32_t c : o.cells) {
+      const std::uint64_t* ranks = o.shared_ranks.data() + (o.shared_at[c] - 1) * rank_words;
+      const int slab = routes_.owner(c);
+      for (int r = 0; r < comm_.size(); ++r)
+        if (r == rank || r == slab || ((ranks[r / 64] >> (r % 64)) & 1u) != 0) o.receivers.push_back(r);
+      o.receivers_first.push_back(static_cast<std::uint32_t>(o.receivers.size()));
+    }
+    for (const std::uint32_t c : o.painted) o.shared_at[c] = 0;
+    routes_.open_shared(comm_, o.cells, o.first, o.keys, o.values, 1, o.receivers_first, o.receivers, o.alone);
+    for (const std::uint32_t c : o.cells) cells_[c].coverage = routes_.total(routes_.index(c), 0);
     return;
   }
   // Message: the cells, then their coverage.
@@ -304,6 +341,7 @@ double FloeSeaContact::sum_cells_by_owner(double ks) {
   const std::vector<double>& force = eval_.force;
   OwnerCells& o = owner_;
   const double inv_cell_area = 1.0 / cell_area_;
+  const int rank = comm_.rank();
   double energy = 0.0;
   if (routed()) {
     // The routed pieces' a u^2 and pressure (zero where u <= 0, which the
@@ -338,13 +376,22 @@ double FloeSeaContact::sum_cells_by_owner(double ks) {
     o.alone_totals.resize(o.alone.size());
     for (std::size_t j = 0; j < o.alone.size(); ++j) o.alone_totals[j] = std::exchange(pressure_[o.alone[j]], 0.0);
     const double total = routes_.add(comm_, o.parts, 2, energy, o.alone_totals);
-    const std::span<const std::uint32_t> slab = routes_.owned();
-    for (std::size_t j = 0; j < slab.size(); ++j) pressure_[slab[j]] = routes_.total(j, 1);  // zero before: 0 + the total
+    // The pressure of this rank's slab's cells (zero before: 0 + the total;
+    // with the boxes some received cells are other slabs', summed here for
+    // their sums), then the sums of this rank's cells: with the boxes
+    // summed here, else sent back by the cells' slabs' ranks.
+    const std::span<const std::uint32_t> held = routes_.owned();
+    for (std::size_t j = 0; j < held.size(); ++j)
+      if (routes_.owner(held[j]) == rank) pressure_[held[j]] = routes_.total(j, 1);
     const std::span<const std::uint32_t> alone = routes_.alone_owned();
     for (std::size_t j = 0; j < alone.size(); ++j) pressure_[alone[j]] = routes_.alone_total(j);  // the sender's sum from zero
-    o.sum.resize(o.cells.size());
-    routes_.reply(comm_, 0, o.sum);
-    for (std::size_t j = 0; j < o.cells.size(); ++j) cells_[o.cells[j]].sum = o.sum[j];
+    if (boxed()) {
+      for (const std::uint32_t c : o.cells) cells_[c].sum = routes_.total(routes_.index(c), 0);
+    } else {
+      o.sum.resize(o.cells.size());
+      routes_.reply(comm_, 0, o.sum);
+      for (std::size_t j = 0; j < o.cells.size(); ++j) cells_[o.cells[j]].sum = o.sum[j];
+    }
     energy_pending_ = true;  // the ranks' parts summed in rank order until settled
     return total;
   }

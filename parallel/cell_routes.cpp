@@ -74,31 +74,62 @@ std::vector<std::uint8_t> CellRoutes::interior_rows(int reach) const {
 void CellRoutes::open(const Communicator& comm, std::span<const std::uint32_t> cells, std::span<const std::uint32_t> first,
                       std::span<const std::uint32_t> keys, std::span<const double> parts, int width,
                       std::span<const std::uint32_t> alone) {
+  // Each cell to its owner alone.
+  owner_first_.resize(cells.size() + 1);
+  owner_list_.resize(cells.size());
+  for (std::size_t k = 0; k < cells.size(); ++k) {
+    owner_first_[k] = static_cast<std::uint32_t>(k);
+    owner_list_[k] = owner(cells[k]);
+  }
+  owner_first_[cells.size()] = static_cast<std::uint32_t>(cells.size());
+  to_owners_ = true;
+  send_pieces(comm, cells, first, keys, parts, width, owner_first_, owner_list_, alone);
+}
+
+void CellRoutes::open_shared(const Communicator& comm, std::span<const std::uint32_t> cells,
+                             std::span<const std::uint32_t> first, std::span<const std::uint32_t> keys,
+                             std::span<const double> parts, int width, std::span<const std::uint32_t> receivers_first,
+                             std::span<const int> receivers, std::span<const std::uint32_t> alone) {
+  FLOESIM_ASSERT(receivers_first.size() == cells.size() + 1 && receivers.size() == receivers_first.back());
+  to_owners_ = false;
+  send_pieces(comm, cells, first, keys, parts, width, receivers_first, receivers, alone);
+}
+
+void CellRoutes::send_pieces(const Communicator& comm, std::span<const std::uint32_t> cells,
+                             std::span<const std::uint32_t> first, std::span<const std::uint32_t> keys,
+                             std::span<const double> parts, int width, std::span<const std::uint32_t> receivers_first,
+                             std::span<const int> receivers, std::span<const std::uint32_t> alone) {
   const std::size_t ranks = static_cast<std::size_t>(comm.size()), w = static_cast<std::size_t>(width);
   FLOESIM_ASSERT(ranks + 1 == first_row_.size() && first.size() == cells.size() + 1 && keys.size() == first.back() &&
                  parts.size() == keys.size() * w);
-  // This rank's cells and alone cells grouped by owner, in their order
-  // within each group.
+  // This rank's cells grouped by receiver (a cell in the group of each of
+  // its receivers) and its alone cells by owner, in their order within each
+  // group.
   sent_.assign(ranks, 0);
   sent_pieces_.assign(ranks, 0);
   sent_alone_.assign(ranks, 0);
-  for (std::size_t k = 0; k < cells.size(); ++k) {
-    const std::size_t r = static_cast<std::size_t>(owner(cells[k]));
-    ++sent_[r];
-    sent_pieces_[r] += first[k + 1] - first[k];
-  }
+  for (std::size_t k = 0; k < cells.size(); ++k)
+    for (std::uint32_t q = receivers_first[k]; q < receivers_first[k + 1]; ++q) {
+      const std::size_t r = static_cast<std::size_t>(receivers[q]);
+      ++sent_[r];
+      sent_pieces_[r] += first[k + 1] - first[k];
+    }
   for (const std::uint32_t c : alone) ++sent_alone_[static_cast<std::size_t>(owner(c))];
-  auto group = [&](std::span<const std::uint32_t> list, const std::vector<std::size_t>& count, std::vector<std::uint32_t>& route) {
-    std::vector<std::size_t> next(ranks, 0);
-    for (std::size_t r = 1; r < ranks; ++r) next[r] = next[r - 1] + count[r - 1];
-    route.resize(list.size());
-    for (std::size_t k = 0; k < list.size(); ++k) route[next[static_cast<std::size_t>(owner(list[k]))]++] = static_cast<std::uint32_t>(k);
-  };
-  group(cells, sent_, route_);
-  group(alone, sent_alone_, alone_route_);
+  std::vector<std::size_t> next(ranks, 0);
+  for (std::size_t r = 1; r < ranks; ++r) next[r] = next[r - 1] + sent_[r - 1];
+  route_.resize(receivers.size());
+  for (std::size_t k = 0; k < cells.size(); ++k)
+    for (std::uint32_t q = receivers_first[k]; q < receivers_first[k + 1]; ++q)
+      route_[next[static_cast<std::size_t>(receivers[q])]++] = static_cast<std::uint32_t>(k);
+  next.assign(ranks, 0);
+  for (std::size_t r = 1; r < ranks; ++r) next[r] = next[r - 1] + sent_alone_[r - 1];
+  alone_route_.resize(alone.size());
+  for (std::size_t k = 0; k < alone.size(); ++k)
+    alone_route_[next[static_cast<std::size_t>(owner(alone[k]))]++] = static_cast<std::uint32_t>(k);
   first_.assign(first.begin(), first.end());
-  // To each owner: the counts of its cells and alone cells, the cells, their
-  // pieces' counts, the alone cells, then the pieces' keys and values.
+  // To each rank: the counts of the cells it receives and of its alone
+  // cells, the cells, their pieces' counts, the alone cells, then the
+  // pieces' keys and values.
   bytes_.resize(ranks);
   std::size_t total_bytes = 0;
   for (std::size_t r = 0; r < ranks; ++r) {
@@ -148,7 +179,7 @@ void CellRoutes::open(const Communicator& comm, std::span<const std::uint32_t> c
     std::size_t m = 0;
     for (std::size_t j = 0; j < n; ++j) {
       const std::uint32_t c = at<std::uint32_t>(cell, j), q = at<std::uint32_t>(count, j);
-      FLOESIM_ASSERT(owner(c) == comm.rank());
+      FLOESIM_ASSERT(!to_owners_ || owner(c) == comm.rank());
       if (slot_[c] == 0) {
         owned_.push_back(c);
         slot_[c] = static_cast<std::uint32_t>(owned_.size());
@@ -179,9 +210,9 @@ void CellRoutes::open(const Communicator& comm, std::span<const std::uint32_t> c
   for (std::size_t j = 0; j < owned_.size(); ++j) order_first_[j + 1] += order_first_[j];
   order_.resize(keys_.size());
   {
-    std::vector<std::uint32_t> next(order_first_.begin(), order_first_.end() - 1);
+    std::vector<std::uint32_t> at_cell(order_first_.begin(), order_first_.end() - 1);
     for (std::size_t j = 0, p = 0; j < from_.size(); ++j)
-      for (std::uint32_t q = 0; q < count_[j]; ++q, ++p) order_[next[from_[j]]++] = static_cast<std::uint32_t>(p);
+      for (std::uint32_t q = 0; q < count_[j]; ++q, ++p) order_[at_cell[from_[j]]++] = static_cast<std::uint32_t>(p);
   }
   const auto by_key = [this](std::uint32_t x, std::uint32_t y) { return keys_[x] < keys_[y]; };
   for (std::size_t j = 0; j < owned_.size(); ++j) {
@@ -213,7 +244,7 @@ void CellRoutes::sum_pieces() {
 
 void CellRoutes::reply(const Communicator& comm, int w, std::span<double> out) {
   const std::size_t ranks = received_.size();
-  FLOESIM_ASSERT(out.size() == route_.size());
+  FLOESIM_ASSERT(to_owners_ && out.size() == route_.size());
   // To each rank, the totals of the cells it sent, in the order it sent them.
   send_.resize(from_.size() * sizeof(double));
   bytes_.resize(ranks);

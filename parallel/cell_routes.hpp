@@ -21,18 +21,29 @@
 // bit, and sends the owner the total of the value it needs (`alone` cells:
 // their cells with open(), one total each with add()).
 //
+// A cell's total can also be made by every rank that needs it, from the
+// pieces themselves (open_shared): each sender names the cell's receivers
+// (the ranks with pieces there, itself included, and the cell's owner), each
+// of which receives every sender's pieces of the cell and sums them from
+// zero in key order, as the owner would: the same terms in the same order,
+// the same bits on every receiver. No totals go back (no reply()): one round
+// trip less, for the bytes of the pieces sent to more than one rank.
+//
 // One round of sums (one contact evaluation), every call collective:
 //   open(cells, pieces, alone)  this rank's cells with their pieces' keys
 //                        and a first set of values, each cell to its
 //                        owner, and the cells it sums alone: two calls (the
 //                        counts, then the lists)
-//   reply(w, out)        the owners' totals of value w back to the senders,
-//                        in the order of their cells: one call
+//   or open_shared(cells, pieces, receivers, alone)  each cell to its
+//                        receivers: the same two calls
+//   reply(w, out)        after open(), the owners' totals of value w back
+//                        to the senders, in the order of their cells: one call
 //   add(values, extra, alone totals)  new values for the same pieces, one
 //                        number from every rank summed over all ranks, and
 //                        the alone cells' totals: one call
-// Between the calls, owned() and total() give the owner's cells and totals,
-// after add() alone_owned() and alone_total() the alone cells'.
+// Between the calls, owned() and total() give the cells received and their
+// totals (index() finds a cell there), after add() alone_owned() and
+// alone_total() the alone cells'.
 
 #include <algorithm>
 #include <cmath>
@@ -120,11 +131,22 @@ public:
   void open(const Communicator& comm, std::span<const std::uint32_t> cells, std::span<const std::uint32_t> first,
             std::span<const std::uint32_t> keys, std::span<const double> parts, int width,
             std::span<const std::uint32_t> alone = {});
+  // As open(), but cell cells[j] goes to the ranks receivers[q] for q in
+  // [receivers_first[j], receivers_first[j + 1]) (distinct; this rank among
+  // them if it needs the total) instead of its owner, and each of them sums
+  // every sender's pieces of it in key order (total(index(cell), w)). Every
+  // rank with pieces of a cell must name, for that cell, every rank that
+  // needs its total: then each of them gets every piece. No reply(); add()
+  // sends the new values along the same routes.
+  void open_shared(const Communicator& comm, std::span<const std::uint32_t> cells, std::span<const std::uint32_t> first,
+                   std::span<const std::uint32_t> keys, std::span<const double> parts, int width,
+                   std::span<const std::uint32_t> receivers_first, std::span<const int> receivers,
+                   std::span<const std::uint32_t> alone = {});
   // One piece a cell, all keys equal: the parts summed in rank order
   // (parts[k * width + w] for cells[k]).
   void open(const Communicator& comm, std::span<const std::uint32_t> cells, std::span<const double> parts, int width);
   // The owners' totals of value w back to the ranks that sent the cells:
-  // out[k] for this rank's cells[k] of the last open().
+  // out[k] for this rank's cells[k] of the last open() (not open_shared()).
   void reply(const Communicator& comm, int w, std::span<double> out);
   // New values (`width` a piece) for the last open()'s pieces, summed by
   // their owners in the order open() sums them, and one total for each of
@@ -133,10 +155,14 @@ public:
   // same on every rank).
   double add(const Communicator& comm, std::span<const double> parts, int width, double extra,
              std::span<const double> alone_totals = {});
-  // The cells this rank owns that some rank sent pieces of in the last
-  // open(), in the order they first arrived (rank order), and their totals.
+  // The cells some rank sent this rank pieces of in the last open() (those
+  // it owns) or open_shared() (those it was named a receiver of), in the
+  // order they first arrived (rank order), and their totals.
   std::span<const std::uint32_t> owned() const { return owned_; }
   double total(std::size_t j, int w) const { return totals_[j * static_cast<std::size_t>(width_) + static_cast<std::size_t>(w)]; }
+  // The place of `cell` in owned(); kNotHeld if no rank sent it here.
+  static constexpr std::size_t kNotHeld = static_cast<std::size_t>(-1);
+  std::size_t index(std::uint32_t cell) const { return slot_[cell] == 0 ? kNotHeld : slot_[cell] - 1; }
   // The cells this rank owns that some rank summed alone in the last open()
   // (in rank order, then the sender's), and after add() their totals.
   std::span<const std::uint32_t> alone_owned() const { return alone_owned_; }
@@ -145,8 +171,9 @@ public:
 private:
   std::vector<int> first_row_, row_owner_;
   std::size_t columns_ = 1;
-  // This rank's cells grouped by owner (route_[k]: the index in open()'s
-  // cells of the k-th sent; alone_route_ the same for its alone cells),
+  // This rank's cells grouped by receiver (route_[k]: the index in open()'s
+  // cells of the k-th sent; alone_route_ the same for its alone cells, by
+  // owner),
   // their pieces' offsets (first_), and the counts each way: cells (sent_,
   // received_), pieces (sent_pieces_, received_pieces_) and alone cells
   // (sent_alone_, received_alone_).
@@ -165,6 +192,14 @@ private:
   int width_ = 0;
   // Sums owned cell j's values w from zero in key order, into totals_.
   void sum_pieces();
+  // open() and open_shared(): cells[k] to receivers[receivers_first[k]...].
+  void send_pieces(const Communicator& comm, std::span<const std::uint32_t> cells, std::span<const std::uint32_t> first,
+                   std::span<const std::uint32_t> keys, std::span<const double> parts, int width,
+                   std::span<const std::uint32_t> receivers_first, std::span<const int> receivers,
+                   std::span<const std::uint32_t> alone);
+  bool to_owners_ = true;  // the last open was open(): reply() may follow
+  std::vector<std::uint32_t> owner_first_;  // open()'s receivers: each cell's owner
+  std::vector<int> owner_list_;
   std::vector<std::byte> send_, receive_;  // kept from one round to the next
   std::vector<std::size_t> bytes_, receive_bytes_;
 };

@@ -7,8 +7,10 @@
 // hold exactly the cells of its slab that some rank sent. Each rank has
 // random distinct cells all over the grid (many shared by several ranks),
 // parts of random sign and size; slabs of uneven height, one empty on 3
-// ranks. Then pieces with order keys (pieces_in_key_order). Run by ctest as mpi.cell_routes_ranks_N under `mpirun
-// --oversubscribe -np N` (N = 1, 2, 3), and serially without MPI.
+// ranks. Then pieces with order keys (pieces_in_key_order), and the same
+// summed by every rank named a receiver (pieces_summed_by_receivers). Run
+// by ctest as mpi.cell_routes_ranks_N under `mpirun --oversubscribe -np N`
+// (N = 1, 2, 3), and serially without MPI.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -178,6 +180,122 @@ bool pieces_in_key_order(const parallel::Communicator& comm, int nx, int ny, con
   return equal && (comm.size() == 1 || differs > 0);
 }
 
+// Pieces summed by every rank that needs the total (open_shared, issue 21
+// ocean12): each rank has random cells with 1 to 3 pieces, keys from a small
+// range as above; a cell goes to the ranks with pieces there, its owner, and
+// for some cells one more rank (as a floe's box covers a cell its pieces
+// miss). Each rank must hold exactly the cells it was named a receiver of
+// by some rank, and every total there, for open_shared()'s values and
+// add()'s, must equal the sum from zero of every rank's pieces of the cell
+// in key order (equal keys in rank order, then the sender's) to the bit:
+// on the owner and on every other receiver alike. The alone cells' totals
+// reach their owners as with open().
+bool pieces_summed_by_receivers(const parallel::Communicator& comm, int nx, int ny, const std::vector<int>& cut,
+                                unsigned seed) {
+  const std::size_t n = static_cast<std::size_t>(nx) * static_cast<std::size_t>(ny);
+  const int ranks = comm.size(), rank = comm.rank();
+  std::mt19937_64 rng(seed * 13 + static_cast<unsigned>(rank));
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  std::vector<std::uint32_t> cells, first{0}, keys;
+  for (std::uint32_t c = 0; c < n; ++c)
+    if (u(rng) < -0.4) cells.push_back(c);
+  std::shuffle(cells.begin(), cells.end(), rng);
+  for (std::size_t j = 0; j < cells.size(); ++j) {
+    const int count = 1 + static_cast<int>(rng() % 3);
+    std::vector<std::uint32_t> k;
+    for (int q = 0; q < count; ++q) k.push_back(static_cast<std::uint32_t>(rng() % 8));
+    std::sort(k.begin(), k.end());
+    keys.insert(keys.end(), k.begin(), k.end());
+    first.push_back(static_cast<std::uint32_t>(keys.size()));
+  }
+  std::vector<double> one(keys.size()), two(2 * keys.size());
+  for (double& x : one) x = u(rng) * std::exp(10.0 * u(rng));
+  for (double& x : two) x = u(rng) * std::exp(10.0 * u(rng));
+  // Which ranks have pieces in each cell (every rank's cells gathered), and
+  // the reference sums in key order.
+  std::vector<std::uint32_t> piece_cell(keys.size());
+  for (std::size_t j = 0; j < cells.size(); ++j)
+    for (std::uint32_t p = first[j]; p < first[j + 1]; ++p) piece_cell[p] = cells[j];
+  const std::vector<std::uint32_t> all_cell = comm.allgather<std::uint32_t>(piece_cell);
+  const std::vector<std::uint32_t> all_key = comm.allgather<std::uint32_t>(keys);
+  const std::vector<double> all_one = comm.allgather<double>(one), all_two = comm.allgather<double>(two);
+  const std::vector<std::uint32_t> all_cells = comm.allgather<std::uint32_t>(cells);
+  const std::vector<std::uint64_t> cell_counts = comm.allgather<std::uint64_t>(std::vector<std::uint64_t>{cells.size()});
+  std::vector<std::uint64_t> has(n, 0);  // bit r: rank r has pieces in the cell
+  for (std::size_t r = 0, k = 0; r < cell_counts.size(); ++r)
+    for (std::uint64_t j = 0; j < cell_counts[r]; ++j, ++k) has[all_cells[k]] |= std::uint64_t{1} << r;
+  std::vector<std::size_t> order(all_cell.size());
+  for (std::size_t k = 0; k < order.size(); ++k) order[k] = k;
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+    return all_cell[a] != all_cell[b] ? all_cell[a] < all_cell[b] : all_key[a] < all_key[b];
+  });
+  std::vector<double> ref1(n, 0.0), ref2(2 * n, 0.0);
+  for (std::size_t k : order) {
+    ref1[all_cell[k]] += all_one[k];
+    ref2[2 * all_cell[k]] += all_two[2 * k];
+    ref2[2 * all_cell[k] + 1] += all_two[2 * k + 1];
+  }
+  // The receivers: the ranks with pieces, the owner, and for a third of the
+  // cells one more rank, drawn from the cell (the same on every rank).
+  const std::vector<int> row_owner = parallel::row_owners(cut);
+  auto receivers_of = [&](std::uint32_t c) {
+    std::uint64_t to = has[c] | std::uint64_t{1} << row_owner[c / static_cast<std::uint32_t>(nx)];
+    if (c % 3 == 0) to |= std::uint64_t{1} << ((c / 3) % static_cast<std::uint32_t>(ranks));
+    return to;
+  };
+  std::vector<std::uint32_t> receivers_first{0};
+  std::vector<int> receivers;
+  for (std::uint32_t c : cells) {
+    const std::uint64_t to = receivers_of(c);
+    for (int r = 0; r < ranks; ++r)
+      if ((to >> r) & 1u) receivers.push_back(r);
+    receivers_first.push_back(static_cast<std::uint32_t>(receivers.size()));
+  }
+  // Alone cells: no rank's pieces there, one rank's each, as above.
+  std::vector<std::uint32_t> alone;
+  for (std::uint32_t c = 0; c < n; ++c)
+    if (has[c] == 0 && c % static_cast<std::uint32_t>(ranks) == static_cast<std::uint32_t>(rank) && u(rng) < 0.0)
+      alone.push_back(c);
+  std::vector<double> alone_totals(alone.size());
+  for (double& x : alone_totals) x = u(rng) * std::exp(10.0 * u(rng));
+  const std::vector<std::uint32_t> all_alone = comm.allgather<std::uint32_t>(alone);
+  const std::vector<double> all_alone_totals = comm.allgather<double>(alone_totals);
+  std::vector<std::pair<std::uint32_t, double>> expected_alone;
+  for (std::size_t k = 0; k < all_alone.size(); ++k)
+    if (row_owner[all_alone[k] / static_cast<std::uint32_t>(nx)] == rank) expected_alone.push_back({all_alone[k], all_alone_totals[k]});
+  // The cells this rank must hold: those some rank with pieces names it for.
+  std::vector<std::uint32_t> expected;
+  for (std::uint32_t c = 0; c < n; ++c)
+    if (has[c] != 0 && ((receivers_of(c) >> rank) & 1u)) expected.push_back(c);
+
+  parallel::CellRoutes routes(cut, static_cast<std::size_t>(nx));
+  bool equal = true;
+  routes.open_shared(comm, cells, first, keys, one, 1, receivers_first, receivers, alone);
+  std::vector<std::uint32_t> held(routes.owned().begin(), routes.owned().end());
+  std::sort(held.begin(), held.end());
+  equal = equal && held == expected;
+  std::size_t others = 0;  // held cells another rank owns
+  for (std::uint32_t c : expected) {
+    const std::size_t j = routes.index(c);
+    equal = equal && j != parallel::CellRoutes::kNotHeld && same_bits(routes.total(j, 0), ref1[c]);
+    others += row_owner[c / static_cast<std::uint32_t>(nx)] != rank ? 1 : 0;
+  }
+  const double extra = static_cast<double>(rank) + 0.25;
+  double extras = 0.0;
+  for (int r = 0; r < ranks; ++r) extras += static_cast<double>(r) + 0.25;
+  equal = equal && same_bits(routes.add(comm, two, 2, extra, alone_totals), extras);
+  for (std::uint32_t c : expected)
+    for (int w = 0; w < 2; ++w) equal = equal && same_bits(routes.total(routes.index(c), w), ref2[2 * c + static_cast<std::uint32_t>(w)]);
+  equal = equal && routes.alone_owned().size() == expected_alone.size();
+  for (std::size_t j = 0; j < expected_alone.size() && j < routes.alone_owned().size(); ++j)
+    equal = equal && routes.alone_owned()[j] == expected_alone[j].first && same_bits(routes.alone_total(j), expected_alone[j].second);
+  std::printf("rank %d of %d, %d x %d, %zu cells, %zu held (%zu of other slabs), %zu alone owned: %s\n", rank, ranks, nx,
+              ny, cells.size(), held.size(), others, routes.alone_owned().size(),
+              equal ? "every receiver's totals the pieces summed in key order, bit for bit" : "DIFFERENT");
+  // The check could fail: on several ranks, cells of other slabs are held.
+  return equal && (ranks == 1 || others > 0);
+}
+
 }  // namespace
 
 int main() {
@@ -198,6 +316,7 @@ int main() {
     if (ranks >= 3) cut[2] = cut[1];
     if (!routes_equal_merge(comm, nx, ny, cut, static_cast<unsigned>(nx))) ++failed;
     if (!pieces_in_key_order(comm, nx, ny, cut, static_cast<unsigned>(ny))) ++failed;
+    if (!pieces_summed_by_receivers(comm, nx, ny, cut, static_cast<unsigned>(nx + ny))) ++failed;
   }
   failed = comm.sum(failed);
   if (comm.writer()) std::printf("%s on %d ranks\n", failed == 0 ? "passed" : "FAILED", ranks);
