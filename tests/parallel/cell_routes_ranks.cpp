@@ -28,6 +28,36 @@ namespace {
 
 bool same_bits(double a, double b) { return std::memcmp(&a, &b, sizeof(double)) == 0; }
 
+// A rank's random pieces: the cells of n where a uniform draw in (-1, 1) is
+// below `below`, shuffled; 1 to 3 pieces a cell with keys in 0..7 (a
+// sender's pieces of a cell come in key order, first[j] the first of cell
+// j's); one value a piece (`one`) and two (`two`), spread over ten decades.
+struct RandomPieces {
+  std::vector<std::uint32_t> cells, first, keys;
+  std::vector<double> one, two;
+};
+RandomPieces random_pieces(std::size_t n, double below, std::mt19937_64& rng) {
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  RandomPieces r;
+  r.first.push_back(0);
+  for (std::uint32_t c = 0; c < n; ++c)
+    if (u(rng) < below) r.cells.push_back(c);
+  std::shuffle(r.cells.begin(), r.cells.end(), rng);
+  for (std::size_t j = 0; j < r.cells.size(); ++j) {
+    const int count = 1 + static_cast<int>(rng() % 3);
+    std::vector<std::uint32_t> k;
+    for (int q = 0; q < count; ++q) k.push_back(static_cast<std::uint32_t>(rng() % 8));
+    std::sort(k.begin(), k.end());
+    r.keys.insert(r.keys.end(), k.begin(), k.end());
+    r.first.push_back(static_cast<std::uint32_t>(r.keys.size()));
+  }
+  r.one.resize(r.keys.size());
+  r.two.resize(2 * r.keys.size());
+  for (double& x : r.one) x = u(rng) * std::exp(10.0 * u(rng));
+  for (double& x : r.two) x = u(rng) * std::exp(10.0 * u(rng));
+  return r;
+}
+
 // One round on an nx x ny grid whose rows are cut at `cut` (ranks + 1 values).
 bool routes_equal_merge(const parallel::Communicator& comm, int nx, int ny, const std::vector<int>& cut, unsigned seed) {
   const std::size_t n = static_cast<std::size_t>(nx) * static_cast<std::size_t>(ny);
@@ -100,21 +130,7 @@ bool pieces_in_key_order(const parallel::Communicator& comm, int nx, int ny, con
   const std::size_t n = static_cast<std::size_t>(nx) * static_cast<std::size_t>(ny);
   std::mt19937_64 rng(seed * 7 + static_cast<unsigned>(comm.rank()));
   std::uniform_real_distribution<double> u(-1.0, 1.0);
-  std::vector<std::uint32_t> cells, first{0}, keys;
-  for (std::uint32_t c = 0; c < n; ++c)
-    if (u(rng) < 0.0) cells.push_back(c);
-  std::shuffle(cells.begin(), cells.end(), rng);
-  for (std::size_t j = 0; j < cells.size(); ++j) {
-    const int count = 1 + static_cast<int>(rng() % 3);
-    std::vector<std::uint32_t> k;
-    for (int q = 0; q < count; ++q) k.push_back(static_cast<std::uint32_t>(rng() % 8));
-    std::sort(k.begin(), k.end());  // a sender's pieces of a cell come in key order
-    keys.insert(keys.end(), k.begin(), k.end());
-    first.push_back(static_cast<std::uint32_t>(keys.size()));
-  }
-  std::vector<double> one(keys.size()), two(2 * keys.size());
-  for (double& x : one) x = u(rng) * std::exp(10.0 * u(rng));
-  for (double& x : two) x = u(rng) * std::exp(10.0 * u(rng));
+  auto [cells, first, keys, one, two] = random_pieces(n, 0.0, rng);
   // The reference: every rank's pieces (cell, key, rank, index), sorted, summed from zero.
   std::vector<std::uint32_t> piece_cell(keys.size());
   for (std::size_t j = 0; j < cells.size(); ++j)
@@ -196,21 +212,7 @@ bool pieces_summed_by_receivers(const parallel::Communicator& comm, int nx, int 
   const int ranks = comm.size(), rank = comm.rank();
   std::mt19937_64 rng(seed * 13 + static_cast<unsigned>(rank));
   std::uniform_real_distribution<double> u(-1.0, 1.0);
-  std::vector<std::uint32_t> cells, first{0}, keys;
-  for (std::uint32_t c = 0; c < n; ++c)
-    if (u(rng) < -0.4) cells.push_back(c);
-  std::shuffle(cells.begin(), cells.end(), rng);
-  for (std::size_t j = 0; j < cells.size(); ++j) {
-    const int count = 1 + static_cast<int>(rng() % 3);
-    std::vector<std::uint32_t> k;
-    for (int q = 0; q < count; ++q) k.push_back(static_cast<std::uint32_t>(rng() % 8));
-    std::sort(k.begin(), k.end());
-    keys.insert(keys.end(), k.begin(), k.end());
-    first.push_back(static_cast<std::uint32_t>(keys.size()));
-  }
-  std::vector<double> one(keys.size()), two(2 * keys.size());
-  for (double& x : one) x = u(rng) * std::exp(10.0 * u(rng));
-  for (double& x : two) x = u(rng) * std::exp(10.0 * u(rng));
+  auto [cells, first, keys, one, two] = random_pieces(n, -0.4, rng);
   // Which ranks have pieces in each cell (every rank's cells gathered), and
   // the reference sums in key order.
   std::vector<std::uint32_t> piece_cell(keys.size());

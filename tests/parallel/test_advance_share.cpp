@@ -532,6 +532,32 @@ bool play_parts(const Case& c, const parallel::FloeOwners& strips, std::span<con
   return false;
 }
 
+// play_parts over `ranks` strips of the case with the clusters' owners
+// shifted by `shift` ranks (0: the strips'; 1: every cluster's pairs travel).
+struct PartsPlay {
+  bool ok = false;
+  Floes f;
+  contact::CollisionStats stats;
+  contact::SubstepReport report;
+  long sent = 0, stopped = 0, pads = 0;
+};
+PartsPlay play_shifted(const Case& c, int ranks, int shift, bool candidates = true) {
+  parallel::FloeOwners strips(0, ranks, c.domain);
+  strips.assign(c.floes);
+  std::vector<int> owner(strips.owner().begin(), strips.owner().end());
+  for (int& o : owner) o = (o + shift) % ranks;
+  PartsPlay p;
+  p.ok = play_parts(c, strips, owner, ranks, p.f, p.stats, p.report, p.sent, p.stopped, p.pads, candidates);
+  return p;
+}
+// The played advance is the serial one: states to the bit, counts, report.
+void check_serial(const PartsPlay& p, const Serial& serial) {
+  REQUIRE(p.f.state.size() == serial.state.size());
+  CHECK(std::memcmp(p.f.state.data(), serial.state.data(), p.f.state.size() * sizeof(FloeState)) == 0);
+  CHECK(same_stats(p.stats, serial.stats));
+  CHECK(same_report(p.report, serial.report));
+}
+
 }  // namespace
 
 TEST_CASE("the advance from each rank's part of the detection over 1, 2, 3 and 7 strips is the serial advance") {
@@ -556,15 +582,9 @@ TEST_CASE("the advance from each rank's part of the detection over 1, 2, 3 and 7
           CAPTURE(ranks);
           CAPTURE(shift);
           CAPTURE(candidates);
-          parallel::FloeOwners strips(0, ranks, c.domain);
-          strips.assign(c.floes);
-          std::vector<int> owner(strips.owner().begin(), strips.owner().end());
-          for (int& o : owner) o = (o + shift) % ranks;
-          Floes f;
-          contact::CollisionStats stats;
-          contact::SubstepReport report;
-          long sent = 0, stopped = 0, pads = 0;
-          const bool ok = play_parts(c, strips, owner, ranks, f, stats, report, sent, stopped, pads, candidates);
+          const PartsPlay p = play_shifted(c, ranks, shift, candidates);
+          const bool ok = p.ok;
+          const long sent = p.sent, stopped = p.stopped;
           MESSAGE(ranks << " ranks, shift " << shift << std::string(candidates ? "" : ", no candidates") << ": "
                         << std::string(ok ? "combined" : "fell back") << ", " << sent << " pairs routed, " << stopped
                         << " shares stopped at a floe not held");
@@ -581,10 +601,7 @@ TEST_CASE("the advance from each rank's part of the detection over 1, 2, 3 and 7
           // Without a free floe joining and a jam-sized cluster nothing is
           // missing: the shares combine.
           if (serial.report.joined == 0 && serial.report.time_steps == 0) CHECK(ok);
-          REQUIRE(f.state.size() == serial.state.size());
-          CHECK(std::memcmp(f.state.data(), serial.state.data(), f.state.size() * sizeof(FloeState)) == 0);
-          CHECK(same_stats(stats, serial.stats));
-          CHECK(same_report(report, serial.report));
+          check_serial(p, serial);
         }
       }
     }
@@ -614,22 +631,12 @@ TEST_CASE("the advance from each rank's part with jam-sized clusters gathers the
       for (const int shift : {0, 1}) {
         CAPTURE(ranks);
         CAPTURE(shift);
-        parallel::FloeOwners strips(0, ranks, c.domain);
-        strips.assign(c.floes);
-        std::vector<int> owner(strips.owner().begin(), strips.owner().end());
-        for (int& o : owner) o = (o + shift) % ranks;
-        Floes f;
-        contact::CollisionStats stats;
-        contact::SubstepReport report;
-        long sent = 0, stopped = 0, pads = 0;
-        const bool ok = play_parts(c, strips, owner, ranks, f, stats, report, sent, stopped, pads);
-        MESSAGE(ranks << " ranks, shift " << shift << ": " << std::string(ok ? "combined" : "fell back") << ", " << pads
-                      << " pad exchanges, " << sent << " pairs routed");
-        combined += ok ? 1 : 0;
-        padded += static_cast<int>(pads);
-        CHECK(std::memcmp(f.state.data(), serial.state.data(), f.state.size() * sizeof(FloeState)) == 0);
-        CHECK(same_stats(stats, serial.stats));
-        CHECK(same_report(report, serial.report));
+        const PartsPlay p = play_shifted(c, ranks, shift);
+        MESSAGE(ranks << " ranks, shift " << shift << ": " << std::string(p.ok ? "combined" : "fell back") << ", "
+                      << p.pads << " pad exchanges, " << p.sent << " pairs routed");
+        combined += p.ok ? 1 : 0;
+        padded += static_cast<int>(p.pads);
+        check_serial(p, serial);
       }
   }
   CHECK(padded == 12);  // every split had a jam-sized cluster
