@@ -61,6 +61,14 @@ void Stepper::clusters(std::span<const PairRoom> tight, std::span<const ContactE
   make_clusters();
 }
 
+namespace {
+// The candidates as a set: sorted by (floe, rank), each once.
+void sort_unique(std::vector<JoinCandidate>& c) {
+  std::sort(c.begin(), c.end());
+  c.erase(std::unique(c.begin(), c.end()), c.end());
+}
+}  // namespace
+
 // Which free floes a cluster may take in during the step. A free floe j
 // joins cluster k at time t only through a member i and a pair p = (i, j)
 // with room(p)/2 < dev_i(t) (collect_breaks), dev_i the member's deviation
@@ -84,7 +92,6 @@ std::vector<JoinCandidate> Stepper::candidates() const {
   std::vector<JoinCandidate> out;
   if (!holds_part()) return out;
   auto free_dynamic = [&](std::uint32_t j) { return !floes_.is_static[j] && cluster_of_[j] == kFree; };
-  std::vector<std::uint32_t> near;
   for (std::uint32_t p = 0; p < det_->pairs.size(); ++p) {
     const NearPair& q = det_->pairs[p];
     for (const auto& [i, j] : {std::pair{q.a, q.b}, std::pair{q.b, q.a}}) {
@@ -98,10 +105,7 @@ std::vector<JoinCandidate> Stepper::candidates() const {
       }
     }
   }
-  const auto key = [](const JoinCandidate& c) { return std::pair(c.floe, c.rank); };
-  std::sort(out.begin(), out.end(), [&](const JoinCandidate& x, const JoinCandidate& y) { return key(x) < key(y); });
-  out.erase(std::unique(out.begin(), out.end(), [&](const JoinCandidate& x, const JoinCandidate& y) { return key(x) == key(y); }),
-            out.end());
+  sort_unique(out);
   return out;
 }
 
@@ -128,11 +132,7 @@ std::vector<std::pair<int, std::uint32_t>> Stepper::routes(std::span<const JoinC
       near[fill[tight_[t].a]++] = t;
       near[fill[tight_[t].b]++] = t;
     }
-    const auto key = [](const JoinCandidate& c) { return std::pair(c.floe, c.rank); };
-    const auto before = [&](const JoinCandidate& x, const JoinCandidate& y) { return key(x) < key(y); };
-    std::sort(all.begin(), all.end(), before);
-    all.erase(std::unique(all.begin(), all.end(), [&](const JoinCandidate& x, const JoinCandidate& y) { return key(x) == key(y); }),
-              all.end());
+    sort_unique(all);
     std::vector<JoinCandidate> grow = all;
     while (!grow.empty()) {
       std::vector<JoinCandidate> next;
@@ -143,15 +143,13 @@ std::vector<std::pair<int, std::uint32_t>> Stepper::routes(std::span<const JoinC
           const std::uint32_t l = q.a == c.floe ? q.b : q.a;
           if (floes_.is_static[l] || cluster_of_[l] != kFree || !(q.room < 2.0 * left)) continue;
           const JoinCandidate d{l, c.rank};
-          if (!std::binary_search(all.begin(), all.end(), d, before)) next.push_back(d);
+          if (!std::binary_search(all.begin(), all.end(), d)) next.push_back(d);
         }
       }
-      std::sort(next.begin(), next.end(), before);
-      next.erase(std::unique(next.begin(), next.end(), [&](const JoinCandidate& x, const JoinCandidate& y) { return key(x) == key(y); }),
-                 next.end());
+      sort_unique(next);
       const std::size_t old = all.size();
       all.insert(all.end(), next.begin(), next.end());
-      std::inplace_merge(all.begin(), all.begin() + static_cast<std::ptrdiff_t>(old), all.end(), before);
+      std::inplace_merge(all.begin(), all.begin() + static_cast<std::ptrdiff_t>(old), all.end());
       grow = std::move(next);
     }
   }

@@ -172,6 +172,13 @@ struct ContactEdge {
 struct JoinCandidate {
   std::uint32_t floe = 0;
   std::int32_t rank = 0;
+  // Ordered by (floe, rank): the candidates are kept as sorted sets.
+  friend bool operator<(const JoinCandidate& x, const JoinCandidate& y) {
+    return x.floe != y.floe ? x.floe < y.floe : x.rank < y.rank;
+  }
+  friend bool operator==(const JoinCandidate& x, const JoinCandidate& y) {
+    return x.floe == y.floe && x.rank == y.rank;
+  }
 };
 
 // What a share did. On `conflict` other than none the floes' states are

@@ -53,6 +53,7 @@
 // serial sum; a cell shared by several ranks' floes gets the parts' sum,
 // which groups the pieces by rank: equal to the serial sum up to round-off.
 #include <algorithm>
+#include <bit>
 #include <cstring>
 #include <utility>
 
@@ -297,11 +298,18 @@ void FloeSeaContact::sum_coverage_by_owner() {
     // rank and this one; each sums every rank's pieces in the serial order.
     o.receivers_first.assign(1, 0);
     o.receivers.clear();
+    // (Ascending, each once: the covering ranks' bits, with this rank and
+    // the slab's; a cell's cost is its covering ranks', not every rank's.)
     for (const std::uint32_t c : o.cells) {
       const std::uint64_t* ranks = o.shared_ranks.data() + (o.shared_at[c] - 1) * rank_words;
-      const int slab = routes_.owner(c);
-      for (int r = 0; r < comm_.size(); ++r)
-        if (r == rank || r == slab || ((ranks[r / 64] >> (r % 64)) & 1u) != 0) o.receivers.push_back(r);
+      const auto first = static_cast<std::ptrdiff_t>(o.receivers.size());
+      o.receivers.push_back(rank);
+      o.receivers.push_back(routes_.owner(c));
+      for (std::size_t w = 0; w < rank_words; ++w)
+        for (std::uint64_t bits = ranks[w]; bits != 0; bits &= bits - 1)
+          o.receivers.push_back(static_cast<int>(64 * w) + std::countr_zero(bits));
+      std::sort(o.receivers.begin() + first, o.receivers.end());
+      o.receivers.erase(std::unique(o.receivers.begin() + first, o.receivers.end()), o.receivers.end());
       o.receivers_first.push_back(static_cast<std::uint32_t>(o.receivers.size()));
     }
     for (const std::uint32_t c : o.painted) o.shared_at[c] = 0;
