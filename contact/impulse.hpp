@@ -198,18 +198,37 @@ struct ImpulseRecord {
 //    event; its loads follow the contacts of the call's list, in which a
 //    share's contacts keep their relative order (its step groups' contacts,
 //    each list in the order the whole call builds it). A contact's place
-//    there is `ContactPlace`: the segment of the list (0: detected contacts, by
-//    their index in the detection; 1: a jam's speculative points; 2, 3: the
-//    speculative contacts of rounds 1 and 2; those by pair, then witness).
+//    there is `ContactPlace`: the segment of the list (0: detected contacts;
+//    1: a jam's speculative points; 2, 3: the speculative contacts of rounds
+//    1 and 2), then its pair, keyed by the pair itself, and its index among
+//    that pair's contact points (segment 0) or witnesses (1 to 3).
 //  * The advance (advance_with_collisions) numbers one event per solve, in
 //    the order of its queue's pops, keyed (tau, cluster) (substep.hpp); all
 //    the solves of one pop are one cluster's, so one share's. A share's
 //    event's place is `EventPlace`: its pop's key. Events whose loads a jam's
 //    time step dropped (it solves again) still count, as in the serial record.
+// Why a key by pair orders as the whole call's list. Each segment lists
+// its contacts in the order of the detection's lists: segment 0 by contact
+// point, the others by pair, then witness. The whole detection holds its
+// pairs in pair order (pair_before: a, b, then b's shift, each pair once)
+// and each pair's contact points and witnesses as one run of its lists,
+// the runs in the pairs' order (detect measures the pairs in that order;
+// parallel::merge keeps it). So a contact point's index in the whole list
+// orders as (its pair, its index within the pair's run), and likewise a
+// witness's: the key below, which any part of the detection that holds the
+// pair gives alike (a share on a rank's part records with it, and no rank
+// needs the whole lists to place its loads).
 struct ContactPlace {
-  std::uint32_t segment = 0, first = 0, second = 0;
+  std::uint32_t segment = 0;
+  std::uint32_t a = 0, b = 0;         // the pair's floes (a < b)
+  double shift_x = 0.0, shift_y = 0.0;  // m, b's periodic shift (pair_before's order)
+  std::uint32_t index = 0;            // within the pair: its contact point's (segment 0) or witness's
   auto operator<=>(const ContactPlace&) const = default;
 };
+// The place of a pair's index-th contact point or witness in `segment`.
+inline ContactPlace contact_place(std::uint32_t segment, const NearPair& p, std::uint32_t index) {
+  return {segment, p.a, p.b, p.shift.x(), p.shift.y(), index};
+}
 struct EventPlace {
   double tau = 0.0;  // s into the step
   std::int64_t cluster = 0;
@@ -432,9 +451,9 @@ struct StepCollisionShare {
 // contact points or witnesses whose dynamic floes are all in the share's
 // groups (a distributed run's rank: the pairs it detected and those the
 // detecting ranks sent it; docs/parallel.md, "The detection's lists by
-// owner"); `places` number the lists of `detection`, so a share on a part
-// is run without options.record (the merge needs the whole lists' places).
-// Without `groups`, they are found from `detection`, the whole one.
+// owner"); `places` key the loads by pair (ContactPlace), so a share on a
+// part records as one on the whole detection. Without `groups`, they are
+// found from `detection`, the whole one.
 struct StepGroups;
 StepCollisionShare resolve_step_collisions_share(Floes& floes, std::span<const FloeState> start,
                                                  const Detection& detection, double step,

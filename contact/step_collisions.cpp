@@ -84,16 +84,12 @@ std::vector<Candidate> candidate_witnesses(const Detection& detection, const std
   }
   return out;
 }
-// visit(pair, witness, index) for the candidates not taken since; `last`
-// (if not null) holds the pair's index in the detection while visit runs.
+// visit(pair, witness, index) for the candidates not taken since.
 template <class Visit>
 void each_candidate(const Detection& detection, const std::vector<Candidate>& candidates,
-                    const std::vector<std::uint8_t>& taken, Visit&& visit, std::uint32_t* last = nullptr) {
+                    const std::vector<std::uint8_t>& taken, Visit&& visit) {
   for (const Candidate& c : candidates)
-    if (!taken[c.witness]) {
-      if (last) *last = c.pair;
-      visit(detection.pairs[c.pair], detection.witnesses[c.witness], c.witness);
-    }
+    if (!taken[c.witness]) visit(detection.pairs[c.pair], detection.witnesses[c.witness], c.witness);
 }
 
 // resolve_step_collisions (impulse.hpp), of the whole step or, with `share`,
@@ -124,16 +120,28 @@ std::size_t step_collisions(Floes& floes, std::span<const FloeState> start, cons
   // jam.at_step_start) and where each came from in detection.contacts.
   std::vector<ContactPoint> contacts;
   std::vector<std::size_t> from;
-  // With a share's record: each contact's place in the whole call's list
-  // (ContactPlace, impulse.hpp), which the share's list keeps in order.
+  // With a share's record: each contact's place in the whole call's list,
+  // keyed by pair (ContactPlace, impulse.hpp), which the share's list keeps
+  // in order.
   const bool placed = places && record;
   std::vector<ContactPlace> place;
+  std::vector<std::uint32_t> pair_of;  // with places: per contact point, its pair
+  if (placed) {
+    pair_of.resize(detection.contacts.size());
+    for (std::uint32_t i = 0; i < detection.pairs.size(); ++i) {
+      const NearPair& p = detection.pairs[i];
+      std::fill_n(pair_of.begin() + p.first_contact, p.contact_count, i);
+    }
+  }
   for (std::size_t k = 0; k < detection.contacts.size(); ++k) {
     const ContactPoint& c = detection.contacts[k];
     if (!opt.jam.at_step_start && jammed(c.a, c.b)) continue;
     contacts.push_back(c);
     from.push_back(k);
-    if (placed) place.push_back({0, static_cast<std::uint32_t>(k), 0});
+    if (placed) {
+      const NearPair& p = detection.pairs[pair_of[k]];
+      place.push_back(contact_place(0, p, static_cast<std::uint32_t>(k) - p.first_contact));
+    }
   }
   std::size_t detected = contacts.size();
   // In a jam every point beyond xi is speculative from the start (or left,
@@ -148,7 +156,7 @@ std::size_t step_collisions(Floes& floes, std::span<const FloeState> start, cons
       taken[k] = 1;
       if (!opt.jam.at_step_start) continue;
       contacts.push_back({p.a, p.b, 0.5 * (w.pa + w.pb), w.normal, w.distance, p.shift, true, w.vertex_of_b});
-      if (placed) place.push_back({1, i, k});
+      if (placed) place.push_back(contact_place(1, p, k - p.first_witness));
     }
   }
   std::vector<Candidate> candidates = candidate_witnesses(detection, taken, xi);
@@ -197,15 +205,14 @@ std::size_t step_collisions(Floes& floes, std::span<const FloeState> start, cons
   for (int round = 1; round <= 2; ++round) {
     // Pushed points beyond xi that would now close below xi/2 within the step.
     const std::size_t first_new = contacts.size();
-    std::uint32_t pair = 0;
     each_candidate(detection, candidates, taken, [&](const NearPair& p, const Witness& w, std::uint32_t k) {
       if (!kept(p.a, p.b) || !becomes_speculative(floes, start, before, p, w, step, xi, opt.rest_speed)) return;
       taken[k] = 1;
       contacts.push_back({p.a, p.b, 0.5 * (w.pa + w.pb), w.normal, w.distance, p.shift, true, w.vertex_of_b});
-      if (placed) place.push_back({static_cast<std::uint32_t>(1 + round), pair, k});
+      if (placed) place.push_back(contact_place(static_cast<std::uint32_t>(1 + round), p, k - p.first_witness));
       resting.push_back(1);
       ++added;
-    }, &pair);
+    });
     if (contacts.size() == first_new) break;
     // The components (over all contacts) that gained speculative contacts are
     // solved again from W^-; the others keep their solution.

@@ -286,12 +286,12 @@ void Simulation::collide(StepContext& ctx) {
   // exchange the velocities they changed and the impulses they recorded,
   // which every rank merges into the serial record (stage seven,
   // parallel/collide_share.hpp).
-  // Without the impulse record, from this rank's part of the detection and
-  // the pairs of its groups the others send it ("The detection's lists by
-  // owner").
+  // From this rank's part of the detection and the pairs of its groups the
+  // others send it ("The detection's lists by owner"; the record's places
+  // are keyed by pair, so record runs too).
   if (comm_.serial())
     contact::resolve_step_collisions(scenario_.floes, ctx.start, detection_, ctx.dt, impulse_options_, stats_);
-  else if (detection_part_ && !impulse_options_.record)
+  else if (detection_part_)
     parallel::collide_on_part(comm_, owners_.owner(), scenario_.floes, ctx.start, *detection_part_, ctx.dt,
                               impulse_options_, stats_, collide_share_);
   else
@@ -461,10 +461,10 @@ bool Simulation::detect_and_check(StepContext& ctx) {
   read_try_budget(ctx);
   if (!comm_.serial()) owners_.assign(scenario_.floes);  // the owners at the advanced places
   contact::Detection part;  // this rank's (serially: `next` itself)
-  // The whole lists are gathered only for the readers of the whole (the
-  // impulse record's runs, the advance from the whole detection); else
-  // whole_detection() gathers them when a step needs them.
-  const bool whole = !advance_share_options_.on_part || impulse_options_.record;
+  // The whole lists are gathered only for the advance from the whole
+  // detection; else whole_detection() gathers them when a step needs them
+  // (record runs too: the record's places are keyed by pair, ContactPlace).
+  const bool whole = !advance_share_options_.on_part;
   contact::Detection next = parallel::detect(comm_, owners_, scenario_.floes, shapes_, detection_options_,
                                              comm_.serial() ? nullptr : &part, whole);
   // The first overlapping pair and its distance at t, found from the ranks'

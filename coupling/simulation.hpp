@@ -162,10 +162,11 @@ public:
   // energies() and the budget.
   Vec2 momentum() const;
   LcpCounters lcp_counters() const;
-  // The contact detection at the present positions. On several ranks with
-  // [run] advance_on_part and no impulse record, it may be empty after a
-  // step: each rank then holds only its part, gathered when needed.
-  const contact::Detection& detection() const { return detection_; }
+  // The contact detection at the present positions, whole. On several ranks
+  // with [run] advance_on_part each rank holds only its part between steps,
+  // and this gathers the parts (once until the next detection): collective
+  // then, every rank must call it at the same point between the same steps.
+  const contact::Detection& detection() { return whole_detection(); }
   // The floes' owners by place for the drift and detection (one rank: all 0).
   const parallel::FloeOwners& floe_owners() const { return owners_; }
   const contact::SubstepReport& substep_report() const { return substeps_; }
@@ -246,9 +247,9 @@ private:
   // whose detection is made whole on every rank.
   std::optional<contact::Detection> detection_part_;
   // Whether detection_ holds the whole detection. On several ranks with the
-  // advance from the parts and no impulse record, detect_and_check gathers
-  // it only when a step needs it (whole_detection(): a fallback, a step the
-  // back-off does whole), every rank alike.
+  // advance from the parts, detect_and_check gathers it only when a step
+  // needs it (whole_detection(): a fallback, a step the back-off does whole,
+  // detection()), every rank alike.
   bool detection_whole_ = true;
   const contact::Detection& whole_detection();
   contact::CollisionStats stats_;

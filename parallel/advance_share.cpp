@@ -322,8 +322,7 @@ void advance_on_part(const Communicator& comm, std::span<const int> owner, Floes
                      const contact::SubstepOptions& options, contact::CollisionStats& stats,
                      contact::SubstepReport& report, AdvanceShareCounts& counts,
                      const AdvanceShareOptions& share_options) {
-  // The record's places number the whole call's lists: such a run keeps the whole detection.
-  if (options.impulse.record || comm.serial())
+  if (comm.serial())
     return advance_by_owner(comm, owner, floes, shapes, whole(), dt, options, stats, report, counts, share_options);
   if (counts.whole_now()) {
     contact::advance_with_collisions(floes, shapes, whole(), dt, options, stats, report);
@@ -332,7 +331,13 @@ void advance_on_part(const Communicator& comm, std::span<const int> owner, Floes
   const std::vector<FloeState> start = floes.state;
   bool combined = false;
   {
-    contact::ShareAdvance share(floes, shapes, part, dt, options, {owner, comm.rank()}, true);
+    // A run that keeps the impulse record: as advance_by_owner (the events'
+    // places are the queue's keys, which read no list of the detection).
+    contact::ImpulseRecord* const record = options.impulse.record;
+    contact::ImpulseRecord own;
+    contact::SubstepOptions own_options = options;
+    if (record) own_options.impulse.record = &own;
+    contact::ShareAdvance share(floes, shapes, part, dt, own_options, {owner, comm.rank()}, true);
     const std::vector<contact::ShareRooms> rooms = comm.allgather_parts(pack(share.rooms()), unpack_share_rooms);
     contact::ShareRooms all;
     // The gathered conflicts and the clusters are the same on every rank:
@@ -355,11 +360,11 @@ void advance_on_part(const Communicator& comm, std::span<const int> owner, Floes
           const std::vector<std::pair<int, std::uint32_t>> to = share.routes(candidates);
           share.hold(exchange_pairs(comm, part, routed_pairs(part, to, comm.size())));
         }
-        const AdvancePart mine = share_part(share, share.advance(), floes);
+        const AdvancePart mine = share_part(share, share.advance(), floes, record ? &own : nullptr);
         const std::vector<AdvancePart> parts = comm.allgather_parts(pack(mine), unpack_advance_part);
         counts.clusters.resize(parts.size(), 0);
         counts.rooms.resize(parts.size(), 0);
-        combined = combine_parts(parts, floes, stats, report, nullptr);
+        combined = combine_parts(parts, floes, stats, report, record);
         if (combined) {
           for (std::size_t r = 0; r < parts.size(); ++r) {
             counts.clusters[r] += parts[r].outcome.clusters;

@@ -167,10 +167,11 @@ void advance_by_owner(const Communicator& comm, std::span<const int> owner, Floe
 // alltoall_bytes: two collective calls), the share's advance on its part
 // and the pairs received, the exchange of the parts. `whole` gives the whole
 // detection (collective: every rank calls it at the same point, or none
-// does) for a record run, the back-off's whole steps and the fallback, which
-// is taken also when a floe joins a share's cluster without being its
-// candidate (Conflict::missing_pairs). Equal to the serial advance bit for
-// bit.
+// does) for the back-off's whole steps and the fallback, which is taken
+// also when a floe joins a share's cluster without being its candidate
+// (Conflict::missing_pairs). With options.impulse.record the shares record
+// and merge as in advance_by_owner. Equal to the serial advance bit for
+// bit, states, counts and record.
 void advance_on_part(const Communicator& comm, std::span<const int> owner, Floes& floes,
                      const contact::CollisionShapes& shapes, const contact::Detection& part,
                      const std::function<const contact::Detection&()>& whole, double dt,

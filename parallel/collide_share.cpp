@@ -21,7 +21,8 @@ constexpr std::size_t kStats = std::tuple_size_v<decltype(contact::collision_cou
 // The header's longs: conflict, moved, groups, speculative, the states'
 // count (the moved floes' when the share had no conflict, else none), the
 // load places' count, the stats; then the moved floes, their states, the
-// places (3 uint32 each) and the record (append_record).
+// places (segment, a, b, index as uint32, then the shift's x and y: 32
+// bytes each) and the record (append_record).
 constexpr std::size_t kHeader = 6 + kStats;
 
 }  // namespace
@@ -42,8 +43,10 @@ std::vector<std::byte> pack(const CollidePart& p) {
   at = put(at, p.outcome.moved.data(), p.outcome.moved.size());
   put(at, p.states.data(), p.states.size());
   for (const contact::ContactPlace& c : p.outcome.places) {
-    const std::array<std::uint32_t, 3> place{c.segment, c.first, c.second};
-    append(out, std::span<const std::uint32_t>(place));
+    const std::array<std::uint32_t, 4> ints{c.segment, c.a, c.b, c.index};
+    const std::array<double, 2> shift{c.shift_x, c.shift_y};
+    append(out, std::span<const std::uint32_t>(ints));
+    append(out, std::span<const double>(shift));
   }
   append_record(out, p.record);
   return out;
@@ -68,8 +71,9 @@ CollidePart unpack_collide_part(std::span<const std::byte> bytes) {
   p.states = take<FloeState>(in, states);
   p.outcome.places.resize(places);
   for (contact::ContactPlace& c : p.outcome.places) {
-    const std::vector<std::uint32_t> place = take<std::uint32_t>(in, 3);
-    c = {place[0], place[1], place[2]};
+    const std::vector<std::uint32_t> ints = take<std::uint32_t>(in, 4);
+    const std::vector<double> shift = take<double>(in, 2);
+    c = {ints[0], ints[1], ints[2], shift[0], shift[1], ints[3]};
   }
   p.record = take_record(in);
   FLOESIM_ASSERT(in == bytes.data() + bytes.size());
@@ -173,8 +177,7 @@ std::size_t collide_on_part(const Communicator& comm, std::span<const int> owner
                             std::span<const FloeState> start, const contact::Detection& part, double step,
                             const contact::ImpulseOptions& options, contact::CollisionStats& stats,
                             AdvanceShareCounts& counts, const AdvanceShareOptions& share_options) {
-  // The record's places number the whole call's lists: such a run keeps the whole detection.
-  if (options.record || comm.serial())
+  if (comm.serial())
     return collide_by_owner(comm, owner, floes, start, gather(comm, part), step, options, stats, counts,
                             share_options);
   if (counts.whole_now())
@@ -185,8 +188,10 @@ std::size_t collide_on_part(const Communicator& comm, std::span<const int> owner
   const contact::StepGroups groups = contact::step_groups(floes, edges, options);
   // No step group on any rank (the same groups on all): the serial call
   // solves nothing and changes nothing, and every rank skips the exchanges.
+  // Its record still counts its one event, with no load.
   if (std::none_of(groups.lowest.begin(), groups.lowest.end(),
                    [](std::uint32_t g) { return g != contact::StepGroups::kNone; })) {
+    if (options.record) contact::merge_step_record(*options.record, {});
     counts.clusters.resize(static_cast<std::size_t>(comm.size()), 0);
     counts.combined();
     return 0;
@@ -195,13 +200,15 @@ std::size_t collide_on_part(const Communicator& comm, std::span<const int> owner
   const std::vector<contact::Detection> out =
       pairs_for_groups(floes, part, groups, owner, comm.size(), comm.rank(), options.collision_distance);
   const contact::Detection local = exchange_pairs(comm, part, out);
-  // The share on its pairs, then collide_by_owner's exchange.
+  // The share on its pairs, then collide_by_owner's exchange (with the
+  // share's record and its loads' places keyed by pair: the serial record
+  // merged from the parts).
   const std::vector<FloeState> entry = floes.state;
   const CollidePart share = run_collide_share(floes, start, local, step, options, owner, comm.rank(), &groups);
   const std::vector<CollidePart> shares = comm.allgather_parts(pack(share), unpack_collide_part);
   counts.clusters.resize(shares.size(), 0);
   std::size_t speculative = 0;
-  if (combine_collide_parts(shares, floes, stats, speculative)) {
+  if (combine_collide_parts(shares, floes, stats, speculative, options.record)) {
     for (std::size_t r = 0; r < shares.size(); ++r) counts.clusters[r] += shares[r].outcome.groups;
     counts.combined();
     return speculative;

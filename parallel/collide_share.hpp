@@ -87,10 +87,11 @@ std::vector<contact::Detection> pairs_for_groups(const Floes& floes, const conta
 // (contact::step_groups), the pairs of groups owned elsewhere sent to their
 // owners (one alltoall_bytes: two collective calls), this rank's share on
 // its pairs and those received, then collide_by_owner's exchange and
-// combination. A fallback, a step the back-off does whole, and a run that
-// keeps the impulse record (its places number the whole lists) gather the
-// whole detection first (parallel::gather). Equal to the serial solve bit
-// for bit, states, counts and record.
+// combination; with options.record each share records its loads with
+// their places keyed by pair (contact::ContactPlace) and every rank merges
+// the parts into options.record. A fallback and a step the back-off does
+// whole gather the whole detection first (parallel::gather). Equal to the
+// serial solve bit for bit, states, counts and record.
 std::size_t collide_on_part(const Communicator& comm, std::span<const int> owner, Floes& floes,
                             std::span<const FloeState> start, const contact::Detection& part, double step,
                             const contact::ImpulseOptions& options, contact::CollisionStats& stats,

@@ -466,19 +466,26 @@ namespace {
 // when a cluster is jam-sized: `pads` counts those). Returns whether they
 // combined (else `f` holds the whole advance); `sent` counts the routed
 // pairs, `missing` the shares that stopped at a floe they did not hold.
+// With `merged`, each share records into a record of its own, whose events
+// are merged into `merged` (or the whole advance records into it), and
+// `events` gets each share's event count.
 bool play_parts(const Case& c, const parallel::FloeOwners& strips, std::span<const int> owner, int ranks, Floes& f,
                 contact::CollisionStats& stats, contact::SubstepReport& report, long& sent, long& missing,
-                long& pads, bool candidates = true) {
+                long& pads, bool candidates = true, contact::ImpulseRecord* merged = nullptr,
+                std::vector<std::uint32_t>* events = nullptr) {
   const auto n = static_cast<std::size_t>(ranks);
   std::vector<Floes> copies(n, c.floes);
   std::vector<contact::Detection> parts;
   std::vector<std::unique_ptr<contact::ShareAdvance>> shares;
   std::vector<contact::ShareRooms> rooms;
+  std::vector<contact::ImpulseRecord> own(n);
   for (int r = 0; r < ranks; ++r)
     parts.push_back(parallel::detect_part(strips, r, c.floes, c.shapes, c.detect_options));
   for (int r = 0; r < ranks; ++r) {
     const std::size_t k = static_cast<std::size_t>(r);
-    shares.push_back(std::make_unique<contact::ShareAdvance>(copies[k], c.shapes, parts[k], c.dt, c.options,
+    contact::SubstepOptions o = c.options;
+    if (merged) o.impulse.record = &own[k];
+    shares.push_back(std::make_unique<contact::ShareAdvance>(copies[k], c.shapes, parts[k], c.dt, o,
                                                              contact::ClusterShare{owner, r}, true));
     rooms.push_back(parallel::unpack_share_rooms(parallel::pack(shares.back()->rooms())));
   }
@@ -517,18 +524,22 @@ bool play_parts(const Case& c, const parallel::FloeOwners& strips, std::span<con
           held.push_back(parallel::unpack_detection(parallel::pack(out[s][k])));
         }
       shares[k]->hold(parallel::merge(std::move(held)));
-      const parallel::AdvancePart part = parallel::share_part(*shares[k], shares[k]->advance(), copies[k]);
+      const parallel::AdvancePart part =
+          parallel::share_part(*shares[k], shares[k]->advance(), copies[k], merged ? &own[k] : nullptr);
       if (part.outcome.conflict == contact::ShareOutcome::Conflict::missing_pairs) ++missing;
+      if (merged) events->push_back(part.record.events);
       advanced.push_back(parallel::unpack_advance_part(parallel::pack(part)));
     }
     f = std::move(copies.front());
-    ok = parallel::combine_parts(advanced, f, stats, report);
+    ok = parallel::combine_parts(advanced, f, stats, report, merged);
   }
   if (ok) return true;
   f = c.floes;
   stats = {};
   report = {};
-  contact::advance_with_collisions(f, c.shapes, c.detection, c.dt, c.options, stats, report);
+  contact::SubstepOptions whole = c.options;
+  if (merged) whole.impulse.record = merged;
+  contact::advance_with_collisions(f, c.shapes, c.detection, c.dt, whole, stats, report);
   return false;
 }
 
@@ -540,14 +551,18 @@ struct PartsPlay {
   contact::CollisionStats stats;
   contact::SubstepReport report;
   long sent = 0, stopped = 0, pads = 0;
+  contact::ImpulseRecord record;        // with `record`: the merged record (after one earlier event)
+  std::vector<std::uint32_t> events;    // with `record`: each share's event count
 };
-PartsPlay play_shifted(const Case& c, int ranks, int shift, bool candidates = true) {
+PartsPlay play_shifted(const Case& c, int ranks, int shift, bool candidates = true, bool record = false) {
   parallel::FloeOwners strips(0, ranks, c.domain);
   strips.assign(c.floes);
   std::vector<int> owner(strips.owner().begin(), strips.owner().end());
   for (int& o : owner) o = (o + shift) % ranks;
   PartsPlay p;
-  p.ok = play_parts(c, strips, owner, ranks, p.f, p.stats, p.report, p.sent, p.stopped, p.pads, candidates);
+  p.record.events = 1;  // the step-start collisions' event
+  p.ok = play_parts(c, strips, owner, ranks, p.f, p.stats, p.report, p.sent, p.stopped, p.pads, candidates,
+                    record ? &p.record : nullptr, &p.events);
   return p;
 }
 // The played advance is the serial one: states to the bit, counts, report.
@@ -641,4 +656,52 @@ TEST_CASE("the advance from each rank's part with jam-sized clusters gathers the
   }
   CHECK(padded == 12);  // every split had a jam-sized cluster
   CHECK(combined >= 1);
+}
+
+TEST_CASE("the advance's records from each rank's part merge into the serial record") {
+  // The packs of the advance from the parts (events of many clusters at
+  // many sub-step times, free floes joining), and with jams of two floes
+  // (time steps and their pads' exchange), over 1, 2, 3 and 7 strips, the
+  // clusters' owners the strips and shifted by one rank: where the shares
+  // combine, their events merged are the serial record's, in the serial
+  // queue's order, numbered after the step-start event; where they fall
+  // back, the whole advance records the serial record itself.
+  int combined = 0;
+  const std::pair<unsigned, double> packs[] = {{3u, 2.0}, {11u, 2.0}, {9u, 1.8}};
+  for (const auto& [seed, speed] : packs)
+    for (const std::size_t jam : {std::size_t{0}, std::size_t{2}}) {
+      CAPTURE(seed);
+      CAPTURE(jam);
+      Case c = dense_pack(speed, seed, 0.5);
+      if (jam > 0) c.options.impulse.jam.floes = jam;
+      contact::ImpulseRecord serial;
+      serial.events = 1;
+      Serial whole;
+      {
+        Floes f = c.floes;
+        contact::SubstepOptions o = c.options;
+        o.impulse.record = &serial;
+        contact::advance_with_collisions(f, c.shapes, c.detection, c.dt, o, whole.stats, whole.report);
+        whole.state = f.state;
+      }
+      MESSAGE("serial: " << serial.events - 1 << " events, " << serial.loads.size() << " loads");
+      REQUIRE(serial.events > 20);
+      REQUIRE(!serial.loads.empty());
+      for (const int ranks : {1, 2, 3, 7})
+        for (const int shift : {0, 1}) {
+          CAPTURE(ranks);
+          CAPTURE(shift);
+          const PartsPlay p = play_shifted(c, ranks, shift, true, true);
+          MESSAGE(ranks << " ranks, shift " << shift << ": " << std::string(p.ok ? "combined" : "fell back"));
+          if (ranks == 1) CHECK(p.ok);
+          check_serial(p, whole);
+          CHECK(test::same_record(p.record, serial));
+          if (p.ok && ranks > 1) {
+            ++combined;
+            CHECK(std::count_if(p.events.begin(), p.events.end(), [](std::uint32_t e) { return e > 0; }) >= 2);
+          }
+        }
+    }
+  MESSAGE(combined << " splits over several ranks combined");
+  CHECK(combined >= 6);
 }

@@ -306,10 +306,11 @@ TEST_CASE("the step-start collisions' impulse records by owner merge into the se
 }
 
 TEST_CASE("merge_step_record orders the loads by their contacts' places, not by rank") {
-  // Two simulated shares whose loads interleave in the serial list: rank 0
-  // has places (0, 1), (2, 0, 5), rank 1 (0, 0) with two loads (a's and b's)
-  // and (1, 4, 2). The merge: (0, 0) twice, (0, 1), (1, 4, 2), (2, 0, 5),
-  // all event 7, and the count 8.
+  // Two simulated shares whose loads interleave in the serial list (places
+  // as segment, pair (a, b, shift), index): rank 0 has (0, (1, 2), 1) and
+  // (2, (0, 3), 5), rank 1 (0, (1, 2), 0) with two loads (a's and b's) and
+  // (1, (1, 2, shift -100 m), 2). The merge: (0, (1, 2), 0) twice,
+  // (0, (1, 2), 1), (1, ...), (2, ...), all event 7, and the count 8.
   auto load = [](std::uint32_t floe) {
     contact::ImpulseRecord::Load l;
     l.floe = floe;
@@ -319,10 +320,11 @@ TEST_CASE("merge_step_record orders the loads by their contacts' places, not by 
   contact::ImpulseRecord a, b;
   a.loads = {load(10), load(11)};
   a.events = 1;
-  const std::vector<contact::ContactPlace> a_places{{0, 1, 0}, {2, 0, 5}};
+  const std::vector<contact::ContactPlace> a_places{{0, 1, 2, 0.0, 0.0, 1}, {2, 0, 3, 0.0, 0.0, 5}};
   b.loads = {load(20), load(21), load(22)};
   b.events = 1;
-  const std::vector<contact::ContactPlace> b_places{{0, 0, 0}, {0, 0, 0}, {1, 4, 2}};
+  const std::vector<contact::ContactPlace> b_places{
+      {0, 1, 2, 0.0, 0.0, 0}, {0, 1, 2, 0.0, 0.0, 0}, {1, 1, 2, -100.0, 0.0, 2}};
   contact::ImpulseRecord into;
   into.events = 7;
   const std::vector<contact::RecordPart> parts{{&a, a_places, {}}, {&b, b_places, {}}};

@@ -7,7 +7,10 @@
 // those received. Over 1, 2, 3 and 7 strips, with the groups' owners not the
 // detection's, the shares combined are the serial solve bit for bit (states
 // by memcmp, counts, speculative contacts), the pairs sent are a small part
-// of the lists, and a share that needs the warm store falls back.
+// of the lists, and a share that needs the warm store falls back. In a run
+// that keeps the impulse record, the shares on their parts record their
+// loads keyed by pair (contact::ContactPlace), and the parts merged are the
+// serial record.
 #include <doctest/doctest.h>
 
 #include <algorithm>
@@ -45,12 +48,16 @@ struct Played {
   std::vector<long> groups;
   std::size_t sent = 0, whole = 0;  // pairs sent between ranks; pairs in the detection
   bool combined = false;
+  std::vector<std::size_t> loads;  // with a record: each rank's loads
 };
 
 // `ranks` ranks: rank r detected the pairs whose floe a detected[a] == r;
 // the step groups belong to the owners `owner` (of the step, after the
-// drift). Each rank's share runs on its own copy of W^-.
-Played play(const CollideCase& c, const std::vector<int>& detected, const std::vector<int>& owner, int ranks) {
+// drift). Each rank's share runs on its own copy of W^-. With `merged`, the
+// shares record (each into its part's own record) and the parts' records
+// are merged into `merged`.
+Played play(const CollideCase& c, const std::vector<int>& detected, const std::vector<int>& owner, int ranks,
+            contact::ImpulseRecord* merged = nullptr) {
   Played out;
   out.whole = c.detection.pairs.size();
   std::vector<contact::Detection> part(static_cast<std::size_t>(ranks));
@@ -74,6 +81,9 @@ Played play(const CollideCase& c, const std::vector<int>& detected, const std::v
     to[static_cast<std::size_t>(r)] = parallel::pairs_for_groups(c.floes, part[static_cast<std::size_t>(r)], groups,
                                                                 owner, ranks, r, c.options.collision_distance);
   std::vector<parallel::CollidePart> parts;
+  contact::ImpulseRecord unused;  // the options' record: the shares record into their parts'
+  contact::ImpulseOptions options = c.options;
+  if (merged) options.record = &unused;
   for (int s = 0; s < ranks; ++s) {
     std::vector<contact::Detection> held{part[static_cast<std::size_t>(s)]};
     for (int r = 0; r < ranks; ++r) {
@@ -86,12 +96,19 @@ Played play(const CollideCase& c, const std::vector<int>& detected, const std::v
     const contact::Detection local = parallel::merge(std::move(held));
     Floes mine = c.floes;
     const parallel::CollidePart p =
-        parallel::run_collide_share(mine, c.start, local, c.dt, c.options, owner, s, &groups);
+        parallel::run_collide_share(mine, c.start, local, c.dt, options, owner, s, &groups);
     out.groups.push_back(p.outcome.groups);
+    if (merged) {
+      REQUIRE(p.outcome.places.size() == p.record.loads.size());
+      out.loads.push_back(p.record.loads.size());
+    }
     parts.push_back(parallel::unpack_collide_part(parallel::pack(p)));
+    if (merged) CHECK(parts.back().outcome.places == p.outcome.places);  // the bytes carry the places
     if (s == 0) out.floes = std::move(mine);
   }
-  out.combined = parallel::combine_collide_parts(parts, out.floes, out.stats, out.speculative);
+  CHECK(unused.loads.empty());
+  CHECK(unused.events == 0);
+  out.combined = parallel::combine_collide_parts(parts, out.floes, out.stats, out.speculative, merged);
   return out;
 }
 
@@ -130,6 +147,54 @@ TEST_CASE("the step-start collisions from each rank's detected pairs and its gro
         CHECK(p.sent <= p.whole);
       }
     }
+  }
+}
+
+TEST_CASE("the step-start collisions' records from each rank's part merge into the serial record") {
+  // The rows of four (contact points and a speculative contact in every
+  // row), and the same rows as jams of two floes solved at the step's start
+  // (their speculative points: segment 1 of the places), over 1, 2, 3 and 7
+  // strips, the groups' owners the strips and shifted by one rank: each
+  // share holds only its part and the pairs sent to it, places its loads by
+  // pair, and the parts merged are the serial record (every load field for
+  // field, the doubles bit for bit, in its order, one event numbered after
+  // the record's earlier ones).
+  for (const bool jams : {false, true}) {
+    CAPTURE(jams);
+    CollideCase c = test::rows_of_four(7);
+    if (jams) {
+      c.options.jam.floes = 2;
+      c.options.jam.at_step_start = true;
+    }
+    contact::ImpulseRecord serial;
+    serial.events = 3;  // an earlier try's events, say
+    Floes serial_floes = c.floes;
+    contact::CollisionStats serial_stats;
+    {
+      contact::ImpulseOptions o = c.options;
+      o.record = &serial;
+      contact::resolve_step_collisions(serial_floes, c.start, c.detection, c.dt, o, serial_stats);
+    }
+    MESSAGE("serial record: " << serial.loads.size() << " loads");
+    REQUIRE(serial.events == 4);
+    REQUIRE(serial.loads.size() > 100);
+    for (const int ranks : {1, 2, 3, 7})
+      for (const int shift : {0, 1}) {
+        CAPTURE(ranks);
+        CAPTURE(shift);
+        const std::vector<int> detected = strips(c, ranks);
+        std::vector<int> owner = detected;
+        for (int& o : owner) o = (o + shift) % ranks;
+        contact::ImpulseRecord merged;
+        merged.events = 3;
+        const Played p = play(c, detected, owner, ranks, &merged);
+        REQUIRE(p.combined);
+        CHECK(same_states(p.floes.state, serial_floes.state));
+        CHECK(same_stats(p.stats, serial_stats));
+        CHECK(test::same_record(merged, serial));
+        // The loads came from several ranks (the merge had work to do).
+        if (ranks > 1) CHECK(std::count_if(p.loads.begin(), p.loads.end(), [](std::size_t l) { return l > 0; }) >= 2);
+      }
   }
 }
 
