@@ -20,6 +20,12 @@ usage: check_record_ranks.py FLOESIM MPIEXEC WORKDIR [--floes N] [--t-end T] [--
    the strips (every one > 0), and the summary's fracture.* counts equal the
    serial ones (the splits decided by their floe's owner and again when
    concluding, fracture.splits_redone, included).
+   The record is made from each rank's part of the detection (its places
+   keyed by pair); the same run on 2 ranks with advance_on_part = false
+   (the whole lists gathered at every detection, the advance from the
+   whole) is bit for bit too, and its detect phase receives more bytes
+   (printed; check_advance_part.py asserts the drop on a larger pack, where
+   the lists outweigh the detect phase's fixed reductions).
 2. examples/pack_fracture.toml (a jam against a coast, breaking; its jam
    LCPs take the warm store, so some steps fall back): bit for bit on 2
    ranks, with both kinds of step (kept and redone) present.
@@ -73,6 +79,27 @@ def kept_mostly(p, n, what):
     return steps, fell, whole
 
 
+def detect_bytes(p):
+    """The bytes the detect phase received (summary: `N calls, B bytes`)."""
+    return int(summary(p)["parallel.phase.detect"].split()[2])
+
+
+# The whole lists gathered at every detection (advance_on_part = false), on
+# 2 ranks: the detect phase's bytes the record run from the parts must stay
+# well below.
+whole_config = os.path.join(W, "record_whole.toml")
+with open(whole_config, "w") as f:
+    f.write(text.replace("[run]\n", "[run]\nrecord_collisions = true\nadvance_on_part = false\n", 1) + FRACTURE)
+whole_bytes = None
+p = mpirun(2, "run", whole_config, "-o", "ranks2_whole.h5", "-q")
+c = harness.compare("ranks2_whole.h5", "serial.h5", 0)
+print(f"2 ranks, the whole lists gathered: {'equal' if p.returncode == 0 and c.returncode == 0 else 'DIFFERENT'} "
+      f"to the serial run; detect {summary(p).get('parallel.phase.detect') if p.returncode == 0 else '-'}")
+if p.returncode != 0 or c.returncode != 0:
+    failures.append(f"2 ranks, advance_on_part false: exit {p.returncode}\n{p.stderr}\n{c.stdout}")
+else:
+    whole_bytes = detect_bytes(p)
+
 for n in args.ranks:
     out = f"ranks{n}.h5"
     p = mpirun(n, "run", config, "-o", out, "-q")
@@ -80,9 +107,13 @@ for n in args.ranks:
         failures.append(f"{n} ranks: exit {p.returncode}\n{p.stdout}\n{p.stderr}")
         continue
     c = harness.compare(out, "serial.h5", 0)
-    print(f"{n} ranks: {'equal' if c.returncode == 0 else 'DIFFERENT'} to the serial run (bit for bit)")
+    print(f"{n} ranks: {'equal' if c.returncode == 0 else 'DIFFERENT'} to the serial run (bit for bit); "
+          f"detect {summary(p).get('parallel.phase.detect')}")
     if c.returncode != 0:
         failures.append(f"{n} ranks differ from the serial run:\n{c.stdout}")
+    if n == 2 and whole_bytes is not None and not detect_bytes(p) < whole_bytes:
+        failures.append(f"2 ranks: the record run's detect phase received {detect_bytes(p)} bytes, not fewer than "
+                        f"{whole_bytes} with the whole lists gathered")
     k = summary(p)
     by_rank = [int(x) for x in k.get("parallel.fracture_checks", "").split()]
     print(f"{n} ranks: fracture checks by rank {by_rank} (serial {s.get('fracture.checks')}), "
