@@ -4,7 +4,6 @@
 #include <array>
 #include <cmath>
 #include <limits>
-#include <numeric>
 #include <queue>
 #include <sstream>
 
@@ -112,34 +111,26 @@ std::vector<JoinCandidate> Stepper::candidates() const {
 std::vector<std::pair<int, std::uint32_t>> Stepper::routes(std::span<const JoinCandidate> candidates) {
   std::vector<std::pair<int, std::uint32_t>> out;
   if (!holds_part()) return out;
-  // Per floe, the shares that must hold every pair of it: its cluster's
-  // runner and the shares it is a candidate of (compressed rows).
   const std::size_t n = floes_.size();
   // The closure over the near pairs (every share's, the same on every
   // share), from the candidates gathered: a set, so the same whatever the
   // order.
   std::vector<JoinCandidate> all(candidates.begin(), candidates.end());
   {
-    std::vector<std::size_t> near_at(n + 1, 0);
-    for (const PairRoom& q : tight_) {
-      ++near_at[q.a + 1];
-      ++near_at[q.b + 1];
-    }
-    std::partial_sum(near_at.begin(), near_at.end(), near_at.begin());
-    std::vector<std::uint32_t> near(near_at[n]);
-    std::vector<std::size_t> fill(near_at.begin(), near_at.end() - 1);
-    for (std::uint32_t t = 0; t < tight_.size(); ++t) {
-      near[fill[tight_[t].a]++] = t;
-      near[fill[tight_[t].b]++] = t;
-    }
+    // Per floe, its near pairs (indices into tight_).
+    const CompressedRows<std::uint32_t> near =
+        compressed_rows<std::uint32_t>(n, tight_.size(), [&](std::size_t t, auto&& put) {
+          put(tight_[t].a, static_cast<std::uint32_t>(t));
+          put(tight_[t].b, static_cast<std::uint32_t>(t));
+        });
     sort_unique(all);
     std::vector<JoinCandidate> grow = all;
     while (!grow.empty()) {
       std::vector<JoinCandidate> next;
       for (const JoinCandidate& c : grow) {
         const double left = det_->reach[c.floe] - lin_[c.floe];
-        for (std::size_t m = near_at[c.floe]; m < near_at[c.floe + 1]; ++m) {
-          const PairRoom& q = tight_[near[m]];
+        for (const std::uint32_t t : near.row(c.floe)) {
+          const PairRoom& q = tight_[t];
           const std::uint32_t l = q.a == c.floe ? q.b : q.a;
           if (floes_.is_static[l] || cluster_of_[l] != kFree || !(q.room < 2.0 * left)) continue;
           const JoinCandidate d{l, c.rank};
@@ -153,16 +144,15 @@ std::vector<std::pair<int, std::uint32_t>> Stepper::routes(std::span<const JoinC
       grow = std::move(next);
     }
   }
-  std::vector<std::size_t> at(n + 1, 0);
-  for (const JoinCandidate& c : all) ++at[c.floe + 1];
-  std::partial_sum(at.begin(), at.end(), at.begin());
-  std::vector<int> to(at[n]);
-  std::vector<std::size_t> fill(at.begin(), at.end() - 1);
-  for (const JoinCandidate& c : all) to[fill[c.floe]++] = c.rank;
+  // Per floe, the shares it is a candidate of; with its cluster's runner,
+  // the shares that must hold every pair of it.
+  const CompressedRows<int> to = compressed_rows<int>(n, all.size(), [&](std::size_t k, auto&& put) {
+    put(all[k].floe, all[k].rank);
+  });
   held_floe_.assign(n, 0);
   for (std::uint32_t i = 0; i < n; ++i) {
     held_floe_[i] = runner(i) == share_->rank;
-    for (std::size_t m = at[i]; m < at[i + 1]; ++m) held_floe_[i] = held_floe_[i] || to[m] == share_->rank;
+    for (const int r : to.row(i)) held_floe_[i] = held_floe_[i] || r == share_->rank;
   }
   std::vector<int> ranks;
   for (std::uint32_t p = 0; p < det_->pairs.size(); ++p) {
@@ -170,8 +160,8 @@ std::vector<std::pair<int, std::uint32_t>> Stepper::routes(std::span<const JoinC
     ranks.clear();
     for (const std::uint32_t i : {q.a, q.b}) {
       ranks.push_back(runner(i));
-      ranks.insert(ranks.end(), to.begin() + static_cast<std::ptrdiff_t>(at[i]),
-                   to.begin() + static_cast<std::ptrdiff_t>(at[i + 1]));
+      const std::span<const int> shares = to.row(i);
+      ranks.insert(ranks.end(), shares.begin(), shares.end());
     }
     std::sort(ranks.begin(), ranks.end());
     ranks.erase(std::unique(ranks.begin(), ranks.end()), ranks.end());
@@ -282,19 +272,10 @@ void Stepper::rebuild_pairs() {
 }
 
 void Stepper::build_pair_index() {
-  const std::size_t n = floes_.size();
-  pair_offsets_.assign(n + 1, 0);
-  for (const NearPair& q : det_->pairs) {
-    ++pair_offsets_[q.a + 1];
-    ++pair_offsets_[q.b + 1];
-  }
-  std::partial_sum(pair_offsets_.begin(), pair_offsets_.end(), pair_offsets_.begin());
-  pair_list_.resize(pair_offsets_[n]);
-  std::vector<std::size_t> fill(pair_offsets_.begin(), pair_offsets_.end() - 1);
-  for (std::size_t p = 0; p < det_->pairs.size(); ++p) {
-    pair_list_[fill[det_->pairs[p].a]++] = static_cast<std::uint32_t>(p);
-    pair_list_[fill[det_->pairs[p].b]++] = static_cast<std::uint32_t>(p);
-  }
+  pairs_by_floe_ = compressed_rows<std::uint32_t>(floes_.size(), det_->pairs.size(), [&](std::size_t p, auto&& put) {
+    put(det_->pairs[p].a, static_cast<std::uint32_t>(p));
+    put(det_->pairs[p].b, static_cast<std::uint32_t>(p));
+  });
   stamp_.assign(det_->pairs.size(), 0);
 }
 

@@ -29,6 +29,30 @@ inline constexpr double kHalvingFloor = 0x1.0p-20;
 // depth two on the 1500- and 10 000-floe packs had rooms of a few mm.
 inline constexpr double kNearRooms = 10.0;
 
+// Compressed rows (CSR): row r holds entries[offsets[r], offsets[r + 1]).
+// Built by compressed_rows: the stepper's pair index (each pair in the rows
+// of its two floes) and routes' near pairs and candidates' shares by floe.
+template <class T>
+struct CompressedRows {
+  std::vector<std::size_t> offsets{0};
+  std::vector<T> entries;
+  std::span<const T> row(std::size_t r) const { return {entries.data() + offsets[r], offsets[r + 1] - offsets[r]}; }
+};
+// `rows` rows from `count` items: each(k, put) calls put(row, value) for
+// each entry item k adds (any number); a row's entries keep the items'
+// order. Two passes over the items (count, then fill), O(rows + entries).
+template <class T, class Each>
+CompressedRows<T> compressed_rows(std::size_t rows, std::size_t count, Each&& each) {
+  CompressedRows<T> out;
+  out.offsets.assign(rows + 1, 0);
+  for (std::size_t k = 0; k < count; ++k) each(k, [&](std::size_t r, const T&) { ++out.offsets[r + 1]; });
+  for (std::size_t r = 0; r < rows; ++r) out.offsets[r + 1] += out.offsets[r];
+  out.entries.resize(out.offsets[rows]);
+  std::vector<std::size_t> fill(out.offsets.begin(), out.offsets.end() - 1);
+  for (std::size_t k = 0; k < count; ++k) each(k, [&](std::size_t r, const T& v) { out.entries[fill[r]++] = v; });
+  return out;
+}
+
 // Pairs measured with their contact points and witnesses.
 struct Measured {
   std::vector<NearPair> pairs;
@@ -195,9 +219,7 @@ private:
 
   // pairs_of(i): indices of the candidate pairs of floe i (compressed rows).
   void build_pair_index();
-  std::span<const std::uint32_t> pairs_of(std::uint32_t i) const {
-    return {pair_list_.data() + pair_offsets_[i], pair_offsets_[i + 1] - pair_offsets_[i]};
-  }
+  std::span<const std::uint32_t> pairs_of(std::uint32_t i) const { return pairs_by_floe_.row(i); }
 
   // Clusters: connected components of the hot pairs between dynamic floes,
   // grown through tight pairs (room below xi: a floe of the cluster that
@@ -305,8 +327,7 @@ private:
   long rooms_ = 0;                     // rooms computed by this call (pair_room)
   long pairs_ = 0;                     // pairs in the list set_up saw (on a part: the part's)
   bool moving_ = false;                // floes moved: the start's states are start_ only
-  std::vector<std::size_t> pair_offsets_;
-  std::vector<std::uint32_t> pair_list_;
+  CompressedRows<std::uint32_t> pairs_by_floe_;  // the pair index (pairs_of)
   std::vector<int> cluster_of_;        // kFree or a cluster
   std::vector<Cluster> clusters_;
   std::vector<double> budget_, reach_left_;  // m, per floe

@@ -14,6 +14,9 @@
 //    momentum, the energies and the state must be the same bits, each
 //    rank must own a strict, non-empty subset on 2 and 3 ranks, and there
 //    must be collisions and a wind's push (so that the budget is not 0).
+//    Simulation::detection(), read on every rank after the steps (each rank
+//    then holds only its part: the read gathers them, collectively), must
+//    be the serial detection, pair by pair.
 // 3. Four floes blown to infinity by a 1e200 m/s wind, floe 0 in the top
 //    strip (on 2 ranks, the last rank's): every rank must throw the serial
 //    run's message, which names floe 0 (the ranks agree on the lowest bad
@@ -162,6 +165,20 @@ void check_simulation(const parallel::Communicator& comm, std::vector<std::strin
       failures.push_back("floe " + std::to_string(i) + "'s state differs");
       break;
     }
+  // The whole detection when read: gathered from the parts on every rank alike.
+  const contact::Detection &da = ranks.detection(), &db = serial.detection();
+  bool same_detection = da.pairs.size() == db.pairs.size() && da.contacts.size() == db.contacts.size() &&
+                        da.witnesses.size() == db.witnesses.size();
+  for (std::size_t p = 0; same_detection && p < db.pairs.size(); ++p) {
+    const contact::NearPair &x = da.pairs[p], &y = db.pairs[p];
+    same_detection = x.a == y.a && x.b == y.b && same2(x.shift, y.shift) && same_bits(x.distance, y.distance) &&
+                     x.first_contact == y.first_contact && x.contact_count == y.contact_count &&
+                     x.first_witness == y.first_witness && x.witness_count == y.witness_count;
+  }
+  for (std::size_t k = 0; same_detection && k < db.contacts.size(); ++k)
+    same_detection = same2(da.contacts[k].point, db.contacts[k].point) && same_bits(da.contacts[k].gap, db.contacts[k].gap);
+  if (!same_detection) failures.push_back("detection() differs from the serial detection");
+  if (db.contacts.empty()) failures.push_back("no contact point in the detection: a weak test");
   if (!strict_subset) failures.push_back("a rank owned no floe or every floe: the sums by owner were not tried");
   if (serial.collision_stats().lcps == 0) failures.push_back("no collision: a weak test");
   if (b.external.norm() == 0.0) failures.push_back("no external momentum: a weak test");
