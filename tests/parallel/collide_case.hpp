@@ -96,4 +96,28 @@ inline bool same_record(const contact::ImpulseRecord& a, const contact::ImpulseR
   return true;
 }
 
+// The rows of four with their serial step-start collisions recorded: as
+// jams of two floes solved at the step's start (`jams`: a jam's speculative
+// points, segment 1 of the places) or not, the record begun after three
+// earlier events (a redone try's, say), so that a merge must number on.
+struct RecordedRows {
+  CollideCase c;
+  contact::ImpulseRecord record;  // the serial call's
+  Floes floes;                    // W^+ of the serial call
+  contact::CollisionStats stats;
+};
+inline RecordedRows recorded_rows_of_four(bool jams, unsigned seed = 7) {
+  RecordedRows r{rows_of_four(seed), {}, {}, {}};
+  if (jams) {
+    r.c.options.jam.floes = 2;
+    r.c.options.jam.at_step_start = true;
+  }
+  r.record.events = 3;
+  r.floes = r.c.floes;
+  contact::ImpulseOptions o = r.c.options;
+  o.record = &r.record;
+  contact::resolve_step_collisions(r.floes, r.c.start, r.c.detection, r.c.dt, o, r.stats);
+  return r;
+}
+
 }  // namespace floesim::test

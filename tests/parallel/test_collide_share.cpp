@@ -271,19 +271,9 @@ TEST_CASE("the step-start collisions' impulse records by owner merge into the se
   // one event numbered after the record's earlier ones.
   for (const bool jams : {false, true}) {
     CAPTURE(jams);
-    CollideCase c = test::rows_of_four(7);
-    if (jams) {
-      c.options.jam.floes = 2;
-      c.options.jam.at_step_start = true;
-    }
-    contact::ImpulseRecord serial = begun();
-    {
-      Floes f = c.floes;
-      contact::ImpulseOptions o = c.options;
-      o.record = &serial;
-      contact::CollisionStats stats;
-      contact::resolve_step_collisions(f, c.start, c.detection, c.dt, o, stats);
-    }
+    const test::RecordedRows r = test::recorded_rows_of_four(jams);
+    const CollideCase& c = r.c;
+    const contact::ImpulseRecord& serial = r.record;
     MESSAGE("serial record: " << serial.loads.size() << " loads, " << serial.events << " events");
     REQUIRE(serial.events == 4);
     REQUIRE(serial.loads.size() > 100);

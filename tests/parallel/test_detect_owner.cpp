@@ -161,20 +161,11 @@ TEST_CASE("the step-start collisions' records from each rank's part merge into t
   // the record's earlier ones).
   for (const bool jams : {false, true}) {
     CAPTURE(jams);
-    CollideCase c = test::rows_of_four(7);
-    if (jams) {
-      c.options.jam.floes = 2;
-      c.options.jam.at_step_start = true;
-    }
-    contact::ImpulseRecord serial;
-    serial.events = 3;  // an earlier try's events, say
-    Floes serial_floes = c.floes;
-    contact::CollisionStats serial_stats;
-    {
-      contact::ImpulseOptions o = c.options;
-      o.record = &serial;
-      contact::resolve_step_collisions(serial_floes, c.start, c.detection, c.dt, o, serial_stats);
-    }
+    const test::RecordedRows r = test::recorded_rows_of_four(jams);
+    const CollideCase& c = r.c;
+    const contact::ImpulseRecord& serial = r.record;
+    const Floes& serial_floes = r.floes;
+    const contact::CollisionStats& serial_stats = r.stats;
     MESSAGE("serial record: " << serial.loads.size() << " loads");
     REQUIRE(serial.events == 4);
     REQUIRE(serial.loads.size() > 100);
