@@ -453,6 +453,12 @@ private:
     // place there (piece_at).
     std::vector<std::uint32_t> first, keys, piece_at;
     std::vector<double> values;
+    // Routed: the pieces of the cells of `cells` (index into the
+    // footprints' pieces) in order_'s order, each with its floe's position.
+    struct RoutedPiece {
+      std::uint32_t piece, key;
+    };
+    std::vector<RoutedPiece> routed_pieces;
     // Routed: this rank's terms of the penalty energy, per floe with terms
     // (its position and count), in order_.
     std::vector<std::uint32_t> energy_keys, energy_counts;

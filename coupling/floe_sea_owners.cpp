@@ -161,15 +161,18 @@ void FloeSeaContact::clear_cells_by_owner() {
   // last pieces lie.
   for (std::uint32_t c : routed() ? routes_.owned() : std::span<const std::uint32_t>(owner_.touched)) pressure_[c] = 0.0;
   for (std::uint32_t c : routes_.alone_owned()) pressure_[c] = 0.0;
-  for (std::uint32_t c : owner_.cells) cells_[c] = {};
-  if (!routed()) return;
-  const Footprints& fp = footprints_.pieces();
-  for (std::uint32_t i : order_)
-    for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k)
-      if (owner_.piece_slot[k] == kInteriorCell) {
-        pressure_[fp.cell[k]] = 0.0;
-        cells_[fp.cell[k]] = {};
-      }
+  if (!routed()) {
+    for (std::uint32_t c : owner_.cells) cells_[c] = {};
+    return;
+  }
+  // Every cell of this rank's pieces, as the serial clear_footprint_cells:
+  // the cells summed here alone and those of owner_.cells. One pass over
+  // the pieces' cells as stored (no per-piece kind or slot read); a cell
+  // zeroed here that held no sum was zero already.
+  for (std::uint32_t c : footprints_.pieces().cell) {
+    pressure_[c] = 0.0;
+    cells_[c] = {};
+  }
 }
 
 void FloeSeaContact::sum_coverage_by_owner() {
@@ -191,8 +194,9 @@ void FloeSeaContact::sum_coverage_by_owner() {
     if (reach != o.interior_reach) {
       o.interior_row = routes_.interior_rows(reach);
       o.kind.resize(grid_.size());
-      for (std::size_t c = 0; c < grid_.size(); ++c)
-        o.kind[c] = o.interior_row[c / nx] ? OwnerCells::kInteriorRow : OwnerCells::kRoutedRow;
+      for (std::size_t y = 0; y < o.interior_row.size(); ++y)
+        std::fill_n(o.kind.begin() + static_cast<std::ptrdiff_t>(y * nx), nx,
+                    o.interior_row[y] ? OwnerCells::kInteriorRow : OwnerCells::kRoutedRow);
       o.interior_reach = reach;
     }
     // The cells other ranks' floes may have pieces in, outside the slabs'
@@ -232,6 +236,7 @@ void FloeSeaContact::sum_coverage_by_owner() {
   o.alone.clear();
   o.first.assign(1, 0);  // routed: then each cell's piece count, made offsets below
   o.piece_slot.resize(fp.cell.size());
+  o.routed_pieces.clear();
   const double inv_cell_area = 1.0 / cell_area_;
   const int rank = comm_.rank();
   std::size_t alone_here = 0;
@@ -260,9 +265,14 @@ void FloeSeaContact::sum_coverage_by_owner() {
       }
       o.piece_slot[k] = o.slot[c] - 1;
       // Routed, the cell's owner sums the pieces (its total replaces this
-      // rank's part below): only counted here.
-      if (routed_cells) ++o.first[o.slot[c]];
-      else o.coverage[o.piece_slot[k]] += fp.area[k] * inv_cell_area;
+      // rank's part below): only counted here, and the piece listed with
+      // its floe's key (in order_, the serial order).
+      if (routed_cells) {
+        ++o.first[o.slot[c]];
+        o.routed_pieces.push_back({static_cast<std::uint32_t>(k), o.position[i]});
+      } else {
+        o.coverage[o.piece_slot[k]] += fp.area[k] * inv_cell_area;
+      }
     }
   // The kinds back to the rows' (the boxes move with the floes).
   for (std::uint32_t c : o.painted) o.kind[c] = OwnerCells::kRoutedRow;
@@ -273,15 +283,15 @@ void FloeSeaContact::sum_coverage_by_owner() {
     o.keys.resize(o.first.back());
     o.values.resize(o.first.back());
     o.piece_at.resize(fp.cell.size());
+    // (From the list of the routed pieces made above, in the same order:
+    // the few routed pieces, not a second pass over all of them.)
     std::vector<std::uint32_t> next(o.first.begin(), o.first.end() - 1);
-    for (std::uint32_t i : order_)
-      for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k) {
-        if (o.piece_slot[k] == kInteriorCell) continue;
-        const std::uint32_t p = next[o.piece_slot[k]]++;
-        o.piece_at[k] = p;
-        o.keys[p] = o.position[i];
-        o.values[p] = fp.area[k] * inv_cell_area;
-      }
+    for (const OwnerCells::RoutedPiece& r : o.routed_pieces) {
+      const std::uint32_t p = next[o.piece_slot[r.piece]]++;
+      o.piece_at[r.piece] = p;
+      o.keys[p] = r.key;
+      o.values[p] = fp.area[r.piece] * inv_cell_area;
+    }
     o.routed_counts.shared += static_cast<long>(o.cells.size());
     o.routed_counts.pieces += static_cast<long>(o.first.back());
     o.routed_counts.alone_here += static_cast<long>(alone_here);
