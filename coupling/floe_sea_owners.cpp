@@ -67,6 +67,13 @@ namespace floesim {
 using parallel::at;
 using parallel::put;
 
+namespace {
+// The loops over a floe's pieces read and write the grid-sized cells_ and
+// pressure_ at the pieces' cells, a new cache line at each row of the floe:
+// the line of the piece this many ahead is asked for early.
+constexpr std::size_t kPrefetchPieces = 16;
+}  // namespace
+
 void FloeSeaContact::set_slabs(std::vector<int> first_row) {
   FLOESIM_ASSERT(!slab_rows_.empty() && first_row.size() == slab_rows_.size());
   if (first_row == slab_rows_) return;
@@ -256,7 +263,9 @@ void FloeSeaContact::sum_coverage_by_owner() {
       // cell is this rank's alone and its kind is not read.
       std::size_t row_base = grid_.size();
       bool interior = false;
-      for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k) {
+      const std::size_t end = fp.offsets[i + 1];
+      for (std::size_t k = fp.offsets[i]; k < end; ++k) {
+        if (k + kPrefetchPieces < end) __builtin_prefetch(&cells_[fp.cell[k + kPrefetchPieces]], 1);
         const std::uint32_t c = fp.cell[k];
         if (c < row_base || c - row_base >= nx) {
           const std::size_t row = c / nx;
@@ -390,7 +399,12 @@ double FloeSeaContact::sum_cells_by_owner(double ks) {
     std::size_t next = 0;
     for (std::uint32_t i : order_) {
       const std::size_t terms = o.energy_terms.size();
-      for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k) {
+      const std::size_t end = fp.offsets[i + 1];
+      for (std::size_t k = fp.offsets[i]; k < end; ++k) {
+        if (k + kPrefetchPieces < end) {
+          __builtin_prefetch(&cells_[fp.cell[k + kPrefetchPieces]], 1);
+          __builtin_prefetch(&pressure_[fp.cell[k + kPrefetchPieces]], 1);
+        }
         const bool routed_piece = next < routed_pieces.size() && routed_pieces[next].piece == k;
         const std::uint32_t at = routed_piece ? routed_pieces[next++].at : 0;
         if (u[k] <= 0.0) continue;
