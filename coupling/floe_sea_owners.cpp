@@ -163,9 +163,9 @@ void FloeSeaContact::settle_energy() const {
 
 void FloeSeaContact::clear_cells_by_owner() {
   // The pressure where the last evaluation put it: every rank's cells (not
-  // routed) or this rank's slab's routed cells; the coverage and sums in
-  // this rank's cells; and, routed, the cells deep in its slab, where its
-  // last pieces lie.
+  // routed) or the routed cells received and this rank's slab's alone
+  // cells; the coverage and sums in this rank's cells; and, routed, the
+  // cells of its last pieces, where it summed alone.
   for (std::uint32_t c : routed() ? routes_.owned() : std::span<const std::uint32_t>(owner_.touched)) pressure_[c] = 0.0;
   for (std::uint32_t c : routes_.alone_owned()) pressure_[c] = 0.0;
   if (!routed()) {
@@ -174,8 +174,9 @@ void FloeSeaContact::clear_cells_by_owner() {
   }
   // Every cell of this rank's pieces, as the serial clear_footprint_cells:
   // the cells summed here alone and those of owner_.cells. One pass over
-  // the pieces' cells as stored (no per-piece kind or slot read); a cell
-  // zeroed here that held no sum was zero already.
+  // the pieces' cells as stored (no per-piece kind or slot read); zeroing
+  // a cell this rank did not write changes nothing, every sum of the next
+  // evaluation being made after this clear.
   for (std::uint32_t c : footprints_.pieces().cell) {
     pressure_[c] = 0.0;
     cells_[c] = {};
@@ -243,6 +244,7 @@ void FloeSeaContact::sum_coverage_by_owner() {
   o.alone.clear();
   o.first.assign(1, 0);  // routed: then each cell's piece count, made offsets below
   o.routed_pieces.clear();
+  FLOESIM_ASSERT(fp.cell.size() <= 0xffffffffu);  // RoutedPiece::piece
   const double inv_cell_area = 1.0 / cell_area_;
   const int rank = comm_.rank();
   std::size_t alone_here = 0;
