@@ -410,11 +410,10 @@ private:
   // The contact by owner: the cells of this rank's pieces and its partial
   // sums there, and every rank's cells. The next evaluation clears pressure_
   // in every rank's cells and cells_ in this rank's.
-  static constexpr std::uint32_t kInteriorCell = 0xffffffffu;
   struct OwnerCells {
     std::vector<std::uint32_t> slot;   // per grid cell: 1 + its index in `cells`, 0: none of this rank's pieces
     std::vector<std::uint32_t> cells;  // this rank's cells, in the order its pieces meet them
-    std::vector<std::uint32_t> piece_slot;  // per area piece of this rank's floes: its cell's index in `cells`, or kInteriorCell
+    std::vector<std::uint32_t> piece_slot;  // not routed: per area piece of this rank's floes, its cell's index in `cells`
     std::vector<double> coverage, sum, pressure;  // per cell of `cells`: this rank's part
     std::vector<std::uint32_t> touched;  // every rank's cells, in rank order (where pressure_ may be nonzero)
     std::vector<std::size_t> counts;     // cells per rank in `touched`
@@ -424,8 +423,8 @@ private:
     // rank has pieces; else, during sum_coverage_by_owner, whether another
     // rank's floe's box covers it (shared: its pieces are routed), and
     // whether it is in `alone`. A cell with this rank's pieces that is not
-    // shared is summed into cells_ and pressure_ directly (piece_slot
-    // kInteriorCell; `cells` holds the others); `alone` lists those of them
+    // shared is summed into cells_ and pressure_ directly (`cells` and
+    // routed_pieces hold the others); `alone` lists those of them
     // another rank owns, whose pressure goes to the owner as a total
     // (alone_totals); and the parts sent, per cell of `cells`.
     enum CellKind : std::uint8_t { kRoutedRow = 0, kInteriorRow = 1, kShared = 2, kAloneListed = 3 };
@@ -449,10 +448,17 @@ private:
     std::vector<std::uint32_t> position, serial;
     // Routed: the pieces of the cells of `cells` grouped by cell (cell j's
     // are [first[j], first[j + 1])), each with its floe's position (keys)
-    // and its coverage (values); per area piece of this rank's floes, its
-    // place there (piece_at).
-    std::vector<std::uint32_t> first, keys, piece_at;
+    // and its coverage (values).
+    std::vector<std::uint32_t> first, keys;
     std::vector<double> values;
+    // Routed: the pieces of the cells of `cells` in order_'s order (the
+    // pieces' loops meet them so), each with its index among the
+    // footprints' pieces, its floe's position, its cell's index in `cells`
+    // and its place among the pieces grouped by cell.
+    struct RoutedPiece {
+      std::uint32_t piece, key, cell, at;
+    };
+    std::vector<RoutedPiece> routed_pieces;
     // Routed: this rank's terms of the penalty energy, per floe with terms
     // (its position and count), in order_.
     std::vector<std::uint32_t> energy_keys, energy_counts;

@@ -67,6 +67,13 @@ namespace floesim {
 using parallel::at;
 using parallel::put;
 
+namespace {
+// The loops over a floe's pieces read and write the grid-sized cells_ and
+// pressure_ at the pieces' cells, a new cache line at each row of the floe:
+// the line of the piece this many ahead is asked for early.
+constexpr std::size_t kPrefetchPieces = 16;
+}  // namespace
+
 void FloeSeaContact::set_slabs(std::vector<int> first_row) {
   FLOESIM_ASSERT(!slab_rows_.empty() && first_row.size() == slab_rows_.size());
   if (first_row == slab_rows_) return;
@@ -156,20 +163,24 @@ void FloeSeaContact::settle_energy() const {
 
 void FloeSeaContact::clear_cells_by_owner() {
   // The pressure where the last evaluation put it: every rank's cells (not
-  // routed) or this rank's slab's routed cells; the coverage and sums in
-  // this rank's cells; and, routed, the cells deep in its slab, where its
-  // last pieces lie.
+  // routed) or the routed cells received and this rank's slab's alone
+  // cells; the coverage and sums in this rank's cells; and, routed, the
+  // cells of its last pieces, where it summed alone.
   for (std::uint32_t c : routed() ? routes_.owned() : std::span<const std::uint32_t>(owner_.touched)) pressure_[c] = 0.0;
   for (std::uint32_t c : routes_.alone_owned()) pressure_[c] = 0.0;
-  for (std::uint32_t c : owner_.cells) cells_[c] = {};
-  if (!routed()) return;
-  const Footprints& fp = footprints_.pieces();
-  for (std::uint32_t i : order_)
-    for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k)
-      if (owner_.piece_slot[k] == kInteriorCell) {
-        pressure_[fp.cell[k]] = 0.0;
-        cells_[fp.cell[k]] = {};
-      }
+  if (!routed()) {
+    for (std::uint32_t c : owner_.cells) cells_[c] = {};
+    return;
+  }
+  // Every cell of this rank's pieces, as the serial clear_footprint_cells:
+  // the cells summed here alone and those of owner_.cells. One pass over
+  // the pieces' cells as stored (no per-piece kind or slot read); zeroing
+  // a cell this rank did not write changes nothing, every sum of the next
+  // evaluation being made after this clear.
+  for (std::uint32_t c : footprints_.pieces().cell) {
+    pressure_[c] = 0.0;
+    cells_[c] = {};
+  }
 }
 
 void FloeSeaContact::sum_coverage_by_owner() {
@@ -191,8 +202,9 @@ void FloeSeaContact::sum_coverage_by_owner() {
     if (reach != o.interior_reach) {
       o.interior_row = routes_.interior_rows(reach);
       o.kind.resize(grid_.size());
-      for (std::size_t c = 0; c < grid_.size(); ++c)
-        o.kind[c] = o.interior_row[c / nx] ? OwnerCells::kInteriorRow : OwnerCells::kRoutedRow;
+      for (std::size_t y = 0; y < o.interior_row.size(); ++y)
+        std::fill_n(o.kind.begin() + static_cast<std::ptrdiff_t>(y * nx), nx,
+                    o.interior_row[y] ? OwnerCells::kInteriorRow : OwnerCells::kRoutedRow);
       o.interior_reach = reach;
     }
     // The cells other ranks' floes may have pieces in, outside the slabs'
@@ -231,17 +243,39 @@ void FloeSeaContact::sum_coverage_by_owner() {
   o.coverage.clear();
   o.alone.clear();
   o.first.assign(1, 0);  // routed: then each cell's piece count, made offsets below
-  o.piece_slot.resize(fp.cell.size());
+  o.routed_pieces.clear();
+  FLOESIM_ASSERT(fp.cell.size() <= 0xffffffffu);  // RoutedPiece::piece
   const double inv_cell_area = 1.0 / cell_area_;
   const int rank = comm_.rank();
   std::size_t alone_here = 0;
-  for (std::uint32_t i : order_)
-    for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k) {
-      const std::uint32_t c = fp.cell[k];
-      if (routed_cells) {
-        const std::uint8_t kind = o.kind[c];
+  // A new cell of `cells`: its slot.
+  auto listed = [&](std::uint32_t c) {
+    if (o.slot[c] == 0) {
+      o.cells.push_back(c);
+      o.coverage.push_back(0.0);
+      o.first.push_back(0);
+      o.slot[c] = static_cast<std::uint32_t>(o.cells.size());
+    }
+    return o.slot[c] - 1;
+  };
+  if (routed_cells) {
+    for (std::uint32_t i : order_) {
+      // The row of a piece's cell, found by a division only when it
+      // changes (a floe's cells come row by row); in an interior row the
+      // cell is this rank's alone and its kind is not read.
+      std::size_t row_base = grid_.size();
+      bool interior = false;
+      const std::size_t end = fp.offsets[i + 1];
+      for (std::size_t k = fp.offsets[i]; k < end; ++k) {
+        if (k + kPrefetchPieces < end) __builtin_prefetch(&cells_[fp.cell[k + kPrefetchPieces]], 1);
+        const std::uint32_t c = fp.cell[k];
+        if (c < row_base || c - row_base >= nx) {
+          const std::size_t row = c / nx;
+          row_base = row * nx;
+          interior = o.interior_row[row] != 0;
+        }
+        const std::uint8_t kind = interior ? std::uint8_t{OwnerCells::kInteriorRow} : o.kind[c];
         if (kind == OwnerCells::kInteriorRow || (boxes && kind != OwnerCells::kShared)) {
-          o.piece_slot[k] = kInteriorCell;
           cells_[c].coverage += fp.area[k] * inv_cell_area;
           if (kind == OwnerCells::kRoutedRow) {  // first met: listed, and its total sent if another rank owns it
             o.kind[c] = OwnerCells::kAloneListed;
@@ -251,19 +285,23 @@ void FloeSeaContact::sum_coverage_by_owner() {
           }
           continue;
         }
+        // The cell's receivers sum the pieces (the total replaces this
+        // rank's part below): only counted here, and the piece listed with
+        // its floe's key, in order_ (the serial order) as this loop meets it.
+        const std::uint32_t j = listed(c);
+        ++o.first[j + 1];
+        o.routed_pieces.push_back({static_cast<std::uint32_t>(k), o.position[i], j, 0});
       }
-      if (o.slot[c] == 0) {
-        o.cells.push_back(c);
-        o.coverage.push_back(0.0);
-        o.first.push_back(0);
-        o.slot[c] = static_cast<std::uint32_t>(o.cells.size());
-      }
-      o.piece_slot[k] = o.slot[c] - 1;
-      // Routed, the cell's owner sums the pieces (its total replaces this
-      // rank's part below): only counted here.
-      if (routed_cells) ++o.first[o.slot[c]];
-      else o.coverage[o.piece_slot[k]] += fp.area[k] * inv_cell_area;
     }
+  } else {
+    o.piece_slot.resize(fp.cell.size());
+    for (std::uint32_t i : order_)
+      for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k) {
+        const std::uint32_t j = listed(fp.cell[k]);
+        o.piece_slot[k] = j;
+        o.coverage[j] += fp.area[k] * inv_cell_area;
+      }
+  }
   // The kinds back to the rows' (the boxes move with the floes).
   for (std::uint32_t c : o.painted) o.kind[c] = OwnerCells::kRoutedRow;
   if (routed()) {
@@ -272,16 +310,14 @@ void FloeSeaContact::sum_coverage_by_owner() {
     for (std::size_t j = 0; j < o.cells.size(); ++j) o.first[j + 1] += o.first[j];
     o.keys.resize(o.first.back());
     o.values.resize(o.first.back());
-    o.piece_at.resize(fp.cell.size());
+    // (From the list of the routed pieces made above, in the same order:
+    // the few routed pieces, not a second pass over all of them.)
     std::vector<std::uint32_t> next(o.first.begin(), o.first.end() - 1);
-    for (std::uint32_t i : order_)
-      for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k) {
-        if (o.piece_slot[k] == kInteriorCell) continue;
-        const std::uint32_t p = next[o.piece_slot[k]]++;
-        o.piece_at[k] = p;
-        o.keys[p] = o.position[i];
-        o.values[p] = fp.area[k] * inv_cell_area;
-      }
+    for (OwnerCells::RoutedPiece& r : o.routed_pieces) {
+      r.at = next[r.cell]++;
+      o.keys[r.at] = r.key;
+      o.values[r.at] = fp.area[r.piece] * inv_cell_area;
+    }
     o.routed_counts.shared += static_cast<long>(o.cells.size());
     o.routed_counts.pieces += static_cast<long>(o.first.back());
     o.routed_counts.alone_here += static_cast<long>(alone_here);
@@ -359,20 +395,31 @@ double FloeSeaContact::sum_cells_by_owner(double ks) {
     o.energy_keys.clear();
     o.energy_counts.clear();
     o.energy_terms.clear();
+    // The routed pieces come listed in this loop's order (the coverage's
+    // pass met them so): the next one listed is this piece or a later one.
+    const std::span<const OwnerCells::RoutedPiece> routed_pieces = o.routed_pieces;
+    std::size_t next = 0;
     for (std::uint32_t i : order_) {
       const std::size_t terms = o.energy_terms.size();
-      for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k) {
+      const std::size_t end = fp.offsets[i + 1];
+      for (std::size_t k = fp.offsets[i]; k < end; ++k) {
+        if (k + kPrefetchPieces < end) {
+          __builtin_prefetch(&cells_[fp.cell[k + kPrefetchPieces]], 1);
+          __builtin_prefetch(&pressure_[fp.cell[k + kPrefetchPieces]], 1);
+        }
+        const bool routed_piece = next < routed_pieces.size() && routed_pieces[next].piece == k;
+        const std::uint32_t at = routed_piece ? routed_pieces[next++].at : 0;
         if (u[k] <= 0.0) continue;
         const double term = 0.5 * ks * psi[k] * fp.area[k] * u[k] * u[k];
         energy += term;
         o.energy_terms.push_back(term);
-        if (o.piece_slot[k] == kInteriorCell) {
+        if (!routed_piece) {
           cells_[fp.cell[k]].sum += fp.area[k] * u[k] * u[k];
           pressure_[fp.cell[k]] += force[k] * inv_cell_area;
           continue;
         }
-        o.parts[2 * o.piece_at[k]] = fp.area[k] * u[k] * u[k];
-        o.parts[2 * o.piece_at[k] + 1] = force[k] * inv_cell_area;
+        o.parts[2 * at] = fp.area[k] * u[k] * u[k];
+        o.parts[2 * at + 1] = force[k] * inv_cell_area;
       }
       if (o.energy_terms.size() > terms) {
         o.energy_keys.push_back(o.position[i]);

@@ -95,12 +95,15 @@ struct CellBox {
     const int row0 = static_cast<int>(first_cell / static_cast<std::uint32_t>(columns));
     const int column0 = static_cast<int>(first_cell % static_cast<std::uint32_t>(columns));
     const int row_count = std::min(row_hi - row_lo + 1, rows), column_count = std::min(column_hi - column_lo + 1, columns);
+    // The first column wrapped once; the others step from it (at most one
+    // seam crossed: column_count <= columns), with no division a cell.
+    const int x0 = ((column0 + column_lo) % columns + columns) % columns;
     for (int dy = 0; dy < row_count; ++dy) {
       const int y = ((row0 + row_lo + dy) % rows + rows) % rows;
       if (!keep_row(y)) continue;
       const std::size_t base = static_cast<std::size_t>(y) * static_cast<std::size_t>(columns);
-      for (int dx = 0; dx < column_count; ++dx)
-        visit(static_cast<std::uint32_t>(base + static_cast<std::size_t>(((column0 + column_lo + dx) % columns + columns) % columns)));
+      for (int dx = 0, x = x0; dx < column_count; ++dx, x = x + 1 == columns ? 0 : x + 1)
+        visit(static_cast<std::uint32_t>(base + static_cast<std::size_t>(x)));
     }
   }
 };
