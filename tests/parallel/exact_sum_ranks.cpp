@@ -34,6 +34,8 @@
 #include <string>
 #include <vector>
 
+#include <unistd.h>
+
 #include "core/config.hpp"
 #include "core/error.hpp"
 #include "core/exact_sum.hpp"
@@ -110,7 +112,12 @@ void check_sums(const parallel::Communicator& comm, std::vector<std::string>& fa
   if (comm.min(100 - comm.rank()) != 101 - comm.size()) failures.push_back("Communicator::min is not the least");
 }
 
-std::string pack_config(int rank) {
+// The run's config and the pack file it reads (removed once loaded).
+struct PackConfig {
+  std::string text, path;
+};
+
+PackConfig pack_config(const parallel::Communicator& comm) {
   PackOptions o;
   o.floes = 300;
   o.concentration = 0.55;
@@ -124,21 +131,26 @@ std::string pack_config(int rank) {
     s.vy = 0.1 * u(rng);
     s.yaw_rate = 1e-4 * u(rng);
   }
-  // One file per rank: the ranks write at once.
-  const std::string path =
-      (std::filesystem::temp_directory_path() / ("floesim_exact_sum_ranks_" + std::to_string(rank) + ".h5")).string();
+  // One file per process: the ranks write at once, and ctest runs the
+  // test's 1-, 2- and 3-rank cases side by side (a name by rank alone was
+  // written by two runs at once).
+  const std::string path = (std::filesystem::temp_directory_path() /
+                            ("floesim_exact_sum_ranks_" + std::to_string(comm.size()) + "_" +
+                             std::to_string(comm.rank()) + "_" + std::to_string(::getpid()) + ".h5"))
+                               .string();
   write_pack(path, g.floes, g.window);
   std::ostringstream t;
   t << "[run]\ndt_max = 10\nthreads = 1\n[floes]\npack = \"" << path << "\"\n"
     << "[contact]\ndomain = \"periodic\"\nrestitution = 0.4\nfriction = 0.7\n"
     << "[forcing]\nwind = [10.0, 3.0]\ncurrent = [0.0, 0.05]\nlatitude = 80.2\n";
-  return t.str();
+  return {t.str(), path};
 }
 
 void check_simulation(const parallel::Communicator& comm, std::vector<std::string>& failures) {
-  const std::string text = pack_config(comm.rank());
-  Simulation ranks(build_scenario(parse_config(text, "pack.toml", ".")), comm);
-  Simulation serial(build_scenario(parse_config(text, "pack.toml", ".")));
+  const PackConfig pack = pack_config(comm);
+  Simulation ranks(build_scenario(parse_config(pack.text, "pack.toml", ".")), comm);
+  Simulation serial(build_scenario(parse_config(pack.text, "pack.toml", ".")));
+  std::filesystem::remove(pack.path);
   const std::size_t n = serial.floes().size();
   bool strict_subset = true;
   for (int k = 0; k < 40; ++k) {
