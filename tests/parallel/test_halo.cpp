@@ -1,0 +1,517 @@
+// The state held by owner with a halo, its first proof (docs/parallel.md,
+// "The state held by owner with a halo (plan)"): the phases that already run
+// by place read only the floes a rank would hold. The poison tool below sets
+// to NaN the state of every floe a simulated rank should not need, and the
+// per-floe data held with it (its mass, inertia, drag, vertices, collision
+// shape, reach, drift quadrature, the step's start); each phase, run on the
+// poisoned copy, must give the rank's part bit for bit as on the whole state:
+//
+// - detection by place (parallel::detect_part): the rank holds its strip's
+//   floes and the halo band, the floes whose place lies within H + h_j of
+//   its strip (h_j = R_j + reach_j + xi/2, H the largest h of the pack),
+//   across the periodic seam by the nearest image; the band holds the
+//   detection subset's posed floes, and a band of one pad (H only) loses
+//   pairs across the cuts: the comparison has teeth;
+// - the drift of the rank's floes: its own floes only;
+// - the collisions at the step's start from the rank's part
+//   (parallel::collide_on_part's pieces): the edges from the band, then each
+//   share on the members of its step groups only, wherever they lie.
+//
+// A NaN read whose only use is a comparison that comes out false either way
+// is not seen; every read that changes a result is.
+#include <doctest/doctest.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <random>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "contact/detection.hpp"
+#include "contact/impulse.hpp"
+#include "contact/shapes.hpp"
+#include "core/pack_generator.hpp"
+#include "coupling/drift.hpp"
+#include "parallel/collide_share.hpp"
+#include "parallel/detect.hpp"
+#include "parallel/place.hpp"
+#include "tests/parallel/collide_case.hpp"
+
+TEST_SUITE_BEGIN("mpi");
+
+using namespace floesim;
+
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+// Per floe: 1 if the simulated rank holds it.
+using Held = std::vector<std::uint8_t>;
+
+// ---- The poison tool ----------------------------------------------------
+
+void poison(double& x) { x = kNaN; }
+void poison(FloeState& s) {
+  double* d = reinterpret_cast<double*>(&s);
+  std::fill_n(d, kStateColumns, kNaN);
+}
+
+// A copy of `floes` with every floe not held poisoned: its state and its
+// per-floe numbers (the flags and ids, which are not state, stay).
+Floes poisoned(const Floes& floes, const Held& held) {
+  Floes out = floes;
+  for (std::size_t i = 0; i < out.size(); ++i) {
+    if (held[i]) continue;
+    poison(out.state[i]);
+    for (std::vector<double>* v : {&out.thickness, &out.density, &out.area, &out.mass, &out.inertia_z, &out.inertia_x,
+                                   &out.inertia_y, &out.ocean_drag})
+      poison((*v)[i]);
+    for (std::size_t k = out.offsets[i]; k < out.offsets[i + 1]; ++k) out.body[k] = Vec2::Constant(kNaN);
+  }
+  return out;
+}
+std::vector<FloeState> poisoned(std::vector<FloeState> states, const Held& held) {
+  for (std::size_t i = 0; i < states.size(); ++i)
+    if (!held[i]) poison(states[i]);
+  return states;
+}
+std::vector<double> poisoned(std::vector<double> per_floe, const Held& held) {
+  for (std::size_t i = 0; i < per_floe.size(); ++i)
+    if (!held[i]) poison(per_floe[i]);
+  return per_floe;
+}
+contact::CollisionShapes poisoned(contact::CollisionShapes shapes, const Held& held) {
+  for (std::size_t i = 0; i < held.size(); ++i) {
+    if (held[i]) continue;
+    poison(shapes.radius[i]);
+    for (std::size_t p = shapes.part_offsets[i]; p < shapes.part_offsets[i + 1]; ++p)
+      for (std::size_t k = shapes.vertex_offsets[p]; k < shapes.vertex_offsets[p + 1]; ++k)
+        shapes.vertices[k] = Vec2::Constant(kNaN);
+  }
+  return shapes;
+}
+FootprintQuadrature poisoned(FootprintQuadrature q, const Held& held) {
+  for (std::size_t i = 0; i < held.size(); ++i) {
+    if (held[i]) continue;
+    for (std::size_t k = q.offsets[i]; k < q.offsets[i + 1]; ++k) {
+      q.point[k] = Vec2::Constant(kNaN);
+      q.weight[k] = kNaN;
+    }
+  }
+  return q;
+}
+
+bool all_nan(const FloeState& s) {
+  const double* d = reinterpret_cast<const double*>(&s);
+  return std::all_of(d, d + kStateColumns, [](double x) { return std::isnan(x); });
+}
+std::size_t count_held(const Held& held) { return static_cast<std::size_t>(std::count(held.begin(), held.end(), 1)); }
+
+// ---- The halo band (docs/parallel.md, the plan's detection row) ----------
+
+// Floe j's half band: R_j + reach_j + xi/2, with detection_subset's
+// round-off margin.
+double half_band(const parallel::FloeOwners& owners, const Floes& floes, const contact::CollisionShapes& shapes,
+                 const contact::DetectionOptions& d, std::size_t j) {
+  const double y = owners.place(floes.state[j]);
+  const double h = shapes.radius[j] + d.reach_of(j) + 0.5 * d.collision_distance;
+  return h + 1e-9 * (1.0 + std::abs(y) + h);
+}
+
+// The floes rank `rank` holds: those whose place lies within H + h_j of its
+// strip [cut[rank-1], cut[rank]) (the box's edges for the end strips of a
+// periodic box), across the seam by the nearest image. A candidate pair's
+// padded boxes overlap, so |y_a - y_b| <= h_a + h_b, and floe a lies in the
+// strip: b lies within h_a + h_b <= H + h_b of it. With `one_pad` the band is
+// the strip widened by H alone (too thin: the mutation the tests name).
+Held halo_band(const parallel::FloeOwners& owners, int rank, const Floes& floes, const contact::CollisionShapes& shapes,
+               const contact::DetectionOptions& d, bool one_pad = false) {
+  const std::size_t n = floes.size();
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  double largest = 0.0;  // H: in a run, one reduction (a max) over the ranks' held floes
+  for (std::size_t j = 0; j < n; ++j) largest = std::max(largest, half_band(owners, floes, shapes, d, j));
+  const std::vector<double>& cuts = owners.cuts();
+  double lo = rank == 0 ? -kInf : cuts[static_cast<std::size_t>(rank) - 1];
+  double hi = rank == owners.ranks() - 1 ? kInf : cuts[static_cast<std::size_t>(rank)];
+  const contact::Domain& box = d.domain;
+  if (box.periodic) {
+    lo = std::max(lo, box.ymin);
+    hi = std::min(hi, box.ymax);
+  }
+  Held held(n, 0);
+  for (std::size_t j = 0; j < n; ++j) {
+    if (owners.owner()[j] == rank) {
+      held[j] = 1;
+      continue;
+    }
+    const double y = owners.place(floes.state[j]);
+    auto distance = [&](double at) { return std::max({0.0, lo - at, at - hi}); };
+    double gap = distance(y);
+    if (box.periodic) gap = std::min({gap, distance(y - box.height()), distance(y + box.height())});
+    const double band = largest + (one_pad ? 0.0 : half_band(owners, floes, shapes, d, j));
+    held[j] = gap <= band ? 1 : 0;
+  }
+  return held;
+}
+
+// ---- Comparisons, bit for bit -------------------------------------------
+
+bool bits(double a, double b) { return std::memcmp(&a, &b, sizeof(double)) == 0; }
+bool bits(const Vec2& a, const Vec2& b) { return bits(a.x(), b.x()) && bits(a.y(), b.y()); }
+bool same(const contact::NearPair& x, const contact::NearPair& y) {
+  return x.a == y.a && x.b == y.b && bits(x.shift, y.shift) && bits(x.distance, y.distance) &&
+         bits(x.normal, y.normal) && bits(x.pa, y.pa) && bits(x.pb, y.pb) && x.exact == y.exact &&
+         x.overlap == y.overlap && bits(x.axis_distance, y.axis_distance) && bits(x.axis_normal, y.axis_normal) &&
+         x.axis_any == y.axis_any && bits(x.far_distance, y.far_distance) && x.first_witness == y.first_witness &&
+         x.witness_count == y.witness_count && x.first_contact == y.first_contact && x.contact_count == y.contact_count;
+}
+bool same(const contact::ContactPoint& x, const contact::ContactPoint& y) {
+  return x.a == y.a && x.b == y.b && bits(x.point, y.point) && bits(x.normal, y.normal) && bits(x.gap, y.gap) &&
+         bits(x.shift, y.shift) && x.speculative == y.speculative && x.vertex_of_b == y.vertex_of_b &&
+         bits(x.turning, y.turning);
+}
+bool same(const contact::Witness& x, const contact::Witness& y) {
+  return bits(x.pa, y.pa) && bits(x.pb, y.pb) && bits(x.normal, y.normal) && bits(x.distance, y.distance) &&
+         x.vertex_of_b == y.vertex_of_b;
+}
+bool same(const contact::GroupEdge& x, const contact::GroupEdge& y) {
+  return x.a == y.a && x.b == y.b && x.flags == y.flags;
+}
+template <class T>
+bool same_lists(const std::vector<T>& a, const std::vector<T>& b) {
+  if (a.size() != b.size()) return false;
+  for (std::size_t k = 0; k < a.size(); ++k)
+    if (!same(a[k], b[k])) return false;
+  return true;
+}
+bool same_detection(const contact::Detection& a, const contact::Detection& b) {
+  return same_lists(a.pairs, b.pairs) && same_lists(a.contacts, b.contacts) && same_lists(a.witnesses, b.witnesses);
+}
+bool same_states(const std::vector<FloeState>& a, const std::vector<FloeState>& b) {
+  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(FloeState)) == 0;
+}
+
+// ---- The cases -----------------------------------------------------------
+
+// A dense pack whose floes move at up to `speed` (m/s) and turn, with the
+// reach of Simulation::set_reach (dt 10 s): pairs with contact points and
+// witnesses, many across every cut.
+struct Pack {
+  Floes floes;
+  contact::CollisionShapes shapes;
+  contact::DetectionOptions detect;
+  std::array<double, 4> window{};
+};
+Pack moving_pack(unsigned seed, bool periodic, double speed = 0.5) {
+  PackOptions o;
+  o.floes = 400;
+  o.concentration = 0.75;
+  o.min_gap = 0.05;
+  o.width = o.height = 2000.0;
+  o.seed = seed;
+  GeneratedPack g = generate_pack(o);
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u(-speed, speed);
+  for (FloeState& s : g.floes.state) {
+    s.vx = u(rng);
+    s.vy = u(rng);
+    s.yaw_rate = 1e-3 * u(rng);
+  }
+  Pack p;
+  p.floes = std::move(g.floes);
+  p.shapes = contact::build_collision_shapes(p.floes);
+  p.window = g.window;
+  const double dt = 10.0;
+  contact::DetectionOptions& d = p.detect;
+  d.collision_distance = 20.0;  // m: wide, so that many pairs have contact points
+  d.horizon = dt;
+  d.domain = {periodic, g.window[0], g.window[1], g.window[2], g.window[3]};
+  d.reach.assign(p.floes.size(), 0.0);
+  for (std::size_t i = 0; i < p.floes.size(); ++i) {
+    const FloeState& s = p.floes.state[i];
+    d.reach[i] = dt * (1.5 * (std::hypot(s.vx, s.vy) + std::abs(s.yaw_rate) * p.shapes.radius[i]) + 0.5 * speed) +
+                 d.collision_distance;
+  }
+  return p;
+}
+
+// Equal counts (as a run starts) and uneven strips: one empty (two equal
+// cuts) and one beyond the pack.
+std::vector<double> uneven_cuts(const Pack& p, int ranks) {
+  const double y0 = p.window[2], h = p.window[3] - p.window[2];
+  switch (ranks) {
+    case 2: return {y0 + 0.2 * h};
+    case 3: return {y0 + 0.3 * h, y0 + 0.3 * h};
+    default: return {y0 + 0.1 * h, y0 + 0.15 * h, y0 + 0.5 * h, y0 + 0.5 * h, y0 + 0.9 * h, y0 + 2.0 * h};
+  }
+}
+
+// A rank's part of the detection from its band only.
+struct BandPart {
+  contact::Detection part;
+  Held held;
+};
+BandPart part_from_band(const Pack& p, const parallel::FloeOwners& owners, int rank, bool one_pad) {
+  BandPart out;
+  out.held = halo_band(owners, rank, p.floes, p.shapes, p.detect, one_pad);
+  contact::DetectionOptions d = p.detect;
+  d.reach = poisoned(d.reach, out.held);
+  out.part = parallel::detect_part(owners, rank, poisoned(p.floes, out.held), poisoned(p.shapes, out.held), d);
+  return out;
+}
+
+}  // namespace
+
+TEST_CASE("detection by place on a rank holding only its strip and halo band is its part of the serial detection") {
+  // Over 2, 3 and 7 strips, equal and uneven, in a periodic box (pairs
+  // across the seam) and the open plane: rank r's part from the poisoned
+  // copy (every floe outside its band NaN: state, shape, reach, mass) equals
+  // its part from the whole state field by field, bit for bit, with the
+  // held floes' reach, and the parts merged are the serial detection.
+  for (const bool periodic : {true, false})
+  for (const double speed : {0.5, 2.0}) {
+    CAPTURE(periodic);
+    CAPTURE(speed);
+    const Pack p = moving_pack(7, periodic, speed);
+    const std::size_t n = p.floes.size();
+    const contact::Detection serial = contact::detect(p.floes, p.shapes, p.detect);
+    MESSAGE("serial: " << serial.pairs.size() << " pairs, " << serial.contacts.size() << " contact points, "
+                       << serial.witnesses.size() << " witnesses");
+    REQUIRE(serial.pairs.size() > 300);
+    REQUIRE(serial.contacts.size() > 10);
+    REQUIRE(serial.witnesses.size() > 10);
+    for (const bool equal : {true, false})
+      for (const int ranks : {2, 3, 7}) {
+        CAPTURE(equal);
+        CAPTURE(ranks);
+        parallel::FloeOwners owners(0, ranks, p.detect.domain);
+        if (!equal) owners.set_cuts(uneven_cuts(p, ranks));
+        owners.assign(p.floes);
+        std::vector<contact::Detection> parts;
+        std::size_t across = 0, held_total = 0;
+        for (const contact::NearPair& q : serial.pairs) across += owners.owner()[q.a] != owners.owner()[q.b] ? 1 : 0;
+        CHECK(across > 0);  // pairs whose floes lie in different strips
+        for (int r = 0; r < ranks; ++r) {
+          CAPTURE(r);
+          const contact::Detection whole = parallel::detect_part(owners, r, p.floes, p.shapes, p.detect);
+          BandPart b = part_from_band(p, owners, r, false);
+          // The band holds every floe the subset poses (the detection's own halo).
+          const contact::DetectionSubset subset = parallel::detection_subset(owners, r, p.floes, p.shapes, p.detect);
+          CHECK(std::all_of(subset.posed.begin(), subset.posed.end(), [&](std::uint32_t i) { return b.held[i] != 0; }));
+          CHECK(same_detection(b.part, whole));
+          for (std::size_t i = 0; i < n; ++i)
+            if (b.held[i]) REQUIRE(bits(b.part.reach[i], whole.reach[i]));
+          held_total += count_held(b.held);
+          b.part.reach = serial.reach;  // the merge takes the first part's (poisoned outside its band)
+          parts.push_back(std::move(b.part));
+        }
+        // The bands hold a part of the pack: on 7 strips about a third each.
+        MESSAGE(std::string(periodic ? "periodic, " : "open, ") << "speeds up to " << speed << " m/s, " << ranks << " strips"
+                                                     << std::string(equal ? "" : " (uneven)") << ": the bands hold " << held_total
+                                                     << " floes of " << ranks * n << " (the whole pack on every rank)");
+        if (ranks == 7) CHECK(held_total < static_cast<std::size_t>(ranks) * n / 2);
+        const contact::Detection merged = parallel::merge(std::move(parts));
+        CHECK(same_detection(merged, serial));
+      }
+  }
+}
+
+TEST_CASE("a halo band of one pad (the strip widened by the largest half band alone) loses pairs across the cuts") {
+  // The mutation of the band's rule: floe b of a pair lies within h_a + h_b
+  // of the strip, not within the largest h alone. With the thin band some
+  // rank's part differs from its part on the whole state: the poisoned
+  // floes it should have held are not posed, and their pairs are lost.
+  std::size_t differ_all = 0, lost_all = 0;
+  for (const bool periodic : {true, false})
+  for (const double speed : {0.5, 2.0}) {
+    CAPTURE(periodic);
+    CAPTURE(speed);
+    const Pack p = moving_pack(7, periodic, speed);
+    std::size_t differ = 0, lost = 0;
+    for (const int ranks : {2, 3, 7}) {
+      parallel::FloeOwners owners(0, ranks, p.detect.domain);
+      owners.assign(p.floes);
+      for (int r = 0; r < ranks; ++r) {
+        const contact::Detection whole = parallel::detect_part(owners, r, p.floes, p.shapes, p.detect);
+        const BandPart thin = part_from_band(p, owners, r, true);
+        if (!same_detection(thin.part, whole)) ++differ;
+        if (thin.part.pairs.size() < whole.pairs.size()) lost += whole.pairs.size() - thin.part.pairs.size();
+      }
+    }
+    MESSAGE("one pad, " << std::string(periodic ? "periodic" : "open") << ", speeds up to " << speed << " m/s: " << differ
+                        << " of 12 parts differ, " << lost << " pairs lost");
+    differ_all += differ;
+    lost_all += lost;
+  }
+  CHECK(differ_all > 0);
+  CHECK(lost_all > 0);
+}
+
+TEST_CASE("the drift of a rank's floes reads only its own floes") {
+  // Every floe not owned poisoned (state, mass, inertia, drag, quadrature,
+  // the water velocity under it): the owned floes' states after
+  // drift_velocities over the rank's list equal the serial drift's bit for
+  // bit, and nothing is written to the others.
+  const Pack p = moving_pack(5, true);
+  const std::size_t n = p.floes.size();
+  Floes varied = p.floes;
+  for (std::size_t i = 0; i < n; i += 3) varied.ocean_drag[i] = 4e-3 + 1e-5 * static_cast<double>(i % 7);
+  const FootprintQuadrature q = build_footprint_quadrature(varied, 1);
+  const DriftParams params{1025.0, 5e-3, 1.341, 1.7e-3, 1.4e-4};
+  const Vec2 current{0.12, -0.05}, wind{8.0, 3.0};
+  const double dt = 10.0;
+  std::vector<Vec2> water(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const double k = static_cast<double>(i);
+    water[i] = current + Vec2{1e-3 * std::sin(0.1 * k), 1e-3 * std::cos(0.2 * k)};
+  }
+  for (const bool uniform : {true, false}) {
+    CAPTURE(uniform);
+    Floes serial = varied;
+    drift_velocities(serial, q, params, current, wind, dt, 0, n,
+                     uniform ? std::span<const Vec2>{} : std::span<const Vec2>(water));
+    for (const int ranks : {2, 3, 7}) {
+      CAPTURE(ranks);
+      parallel::FloeOwners owners(0, ranks, p.detect.domain);
+      owners.assign(varied);
+      for (int r = 0; r < ranks; ++r) {
+        CAPTURE(r);
+        Held held(n, 0);
+        for (std::size_t i = 0; i < n; ++i) held[i] = owners.owner()[i] == r ? 1 : 0;
+        Floes f = poisoned(varied, held);
+        std::vector<Vec2> w = water;
+        for (std::size_t i = 0; i < n; ++i)
+          if (!held[i]) w[i] = Vec2::Constant(kNaN);
+        std::vector<std::uint32_t> mine;
+        for (std::size_t i = 0; i < n; ++i)
+          if (held[i]) mine.push_back(static_cast<std::uint32_t>(i));
+        drift_velocities(f, poisoned(q, held), params, current, wind, dt, mine,
+                         uniform ? std::span<const Vec2>{} : std::span<const Vec2>(w));
+        bool own = true, others = true;
+        for (std::size_t i = 0; i < n; ++i) {
+          if (held[i]) own = own && std::memcmp(&f.state[i], &serial.state[i], sizeof(FloeState)) == 0;
+          else others = others && all_nan(f.state[i]);
+        }
+        CHECK(own);
+        CHECK(others);
+        CHECK(!mine.empty());
+      }
+    }
+  }
+}
+
+namespace {
+
+// The step-start collisions from each simulated rank's part, each rank
+// holding only what the plan gives it: its band for its part of the
+// detection and its pairs' edges (compared with the edges on the whole
+// state), then, for its share, the members of its step groups only (the
+// groups' owners: `owner`, the strips shifted by `shift` ranks). The shares'
+// parts combined into W^- (clean) are returned with the counts.
+struct PoisonedCollide {
+  Floes floes;
+  contact::CollisionStats stats;
+  std::size_t speculative = 0;
+  bool combined = false;
+  bool parts_equal = true, edges_equal = true;
+  std::size_t held_by_shares = 0;  // the floes the shares held, summed over the ranks
+};
+PoisonedCollide collide_poisoned(const test::CollideCase& c, int ranks, int shift, contact::ImpulseRecord* merged) {
+  PoisonedCollide out;
+  const std::size_t n = c.floes.size();
+  Pack p;  // the case's detection set-up (test::rows_of_four: reach 6 m)
+  p.floes = c.floes;
+  p.shapes = contact::build_collision_shapes(c.floes);
+  p.detect.domain = c.domain;
+  p.detect.horizon = c.dt;
+  p.detect.reach.assign(n, 6.0);
+  parallel::FloeOwners strips(0, ranks, c.domain);
+  strips.assign(c.floes);
+  std::vector<int> owner(strips.owner().begin(), strips.owner().end());
+  for (int& o : owner) o = (o + shift) % ranks;
+  // Each rank: its part and edges from its band.
+  std::vector<contact::Detection> part(static_cast<std::size_t>(ranks));
+  std::vector<Floes> band_floes;
+  std::vector<contact::GroupEdge> edges;
+  for (int r = 0; r < ranks; ++r) {
+    const contact::Detection whole_part =
+        parallel::select_pairs(c.detection, [&](const contact::NearPair& q) { return strips.owner()[q.a] == r; });
+    const BandPart b = part_from_band(p, strips, r, false);
+    out.parts_equal = out.parts_equal && same_detection(b.part, whole_part);
+    part[static_cast<std::size_t>(r)] = b.part;
+    band_floes.push_back(poisoned(c.floes, b.held));
+    const std::vector<contact::GroupEdge> e =
+        contact::group_edges(band_floes.back(), poisoned(c.start, b.held), b.part, c.dt, c.options);
+    out.edges_equal =
+        out.edges_equal && same_lists(e, contact::group_edges(c.floes, c.start, whole_part, c.dt, c.options));
+    edges.insert(edges.end(), e.begin(), e.end());
+  }
+  const contact::StepGroups groups = contact::step_groups(c.floes, edges, c.options);
+  std::vector<std::vector<contact::Detection>> to(static_cast<std::size_t>(ranks));
+  for (int r = 0; r < ranks; ++r)
+    to[static_cast<std::size_t>(r)] =
+        parallel::pairs_for_groups(band_floes[static_cast<std::size_t>(r)], part[static_cast<std::size_t>(r)], groups,
+                                   owner, ranks, r, c.options.collision_distance);
+  // Each share on the members of its groups (and the obstacles) only.
+  std::vector<parallel::CollidePart> parts;
+  contact::ImpulseRecord unused;
+  contact::ImpulseOptions options = c.options;
+  if (merged) options.record = &unused;
+  for (int s = 0; s < ranks; ++s) {
+    std::vector<contact::Detection> held_pairs{part[static_cast<std::size_t>(s)]};
+    for (int r = 0; r < ranks; ++r)
+      if (!to[static_cast<std::size_t>(r)][static_cast<std::size_t>(s)].pairs.empty())
+        held_pairs.push_back(to[static_cast<std::size_t>(r)][static_cast<std::size_t>(s)]);
+    const contact::Detection local = parallel::merge(std::move(held_pairs));
+    Held members(n, 0);
+    for (std::size_t i = 0; i < n; ++i)
+      members[i] = c.floes.is_static[i] || groups.mine(static_cast<std::uint32_t>(i), {owner, s}) ? 1 : 0;
+    out.held_by_shares += count_held(members);
+    Floes mine = poisoned(c.floes, members);
+    const std::vector<FloeState> start = poisoned(c.start, members);
+    parts.push_back(parallel::unpack_collide_part(
+        parallel::pack(parallel::run_collide_share(mine, start, local, c.dt, options, owner, s, &groups))));
+  }
+  out.floes = c.floes;  // W^-, whole and clean: each part's moved floes take its states
+  out.combined = parallel::combine_collide_parts(parts, out.floes, out.stats, out.speculative, merged);
+  return out;
+}
+
+}  // namespace
+
+TEST_CASE("the step-start collisions read the band for the edges and only the members of the rank's step groups") {
+  // The rows of four (one step group a row, joined by a speculative
+  // contact), with and without the impulse record (jams of two solved at the
+  // step's start or not), over 2, 3 and 7 strips, the groups' owners the
+  // strips or shifted by one rank (every group's members then lie on other
+  // ranks' strips: the owner would fetch them with the routed pairs). The
+  // combined states equal the serial solve by memcmp, with the counts, the
+  // speculative contacts' count and the record.
+  for (const bool jams : {false, true}) {
+    CAPTURE(jams);
+    const test::RecordedRows r = test::recorded_rows_of_four(jams);
+    const test::CollideCase& c = r.c;
+    for (const int ranks : {2, 3, 7})
+      for (const int shift : {0, 1}) {
+        CAPTURE(ranks);
+        CAPTURE(shift);
+        contact::ImpulseRecord merged;
+        merged.events = 3;
+        const PoisonedCollide p = collide_poisoned(c, ranks, shift, &merged);
+        CHECK(p.parts_equal);
+        CHECK(p.edges_equal);
+        REQUIRE(p.combined);
+        CHECK(same_states(p.floes.state, r.floes.state));
+        CHECK(test::same_stats(p.stats, r.stats));
+        CHECK(test::same_record(merged, r.record));
+        // The shares held the 256 floes of the 64 rows between them, once.
+        CHECK(p.held_by_shares == c.floes.size());
+      }
+  }
+}
+
+TEST_SUITE_END();
