@@ -12,6 +12,7 @@
 #include "contact/impulse.hpp"
 #include "contact/shapes.hpp"
 #include "core/floe.hpp"
+#include "core/pack_generator.hpp"
 
 namespace floesim::test {
 
@@ -118,6 +119,27 @@ inline RecordedRows recorded_rows_of_four(bool jams, unsigned seed = 7) {
   o.record = &r.record;
   contact::resolve_step_collisions(r.floes, r.c.start, r.c.detection, r.c.dt, o, r.stats);
   return r;
+}
+
+// A dense 400-floe pack in a 2000 m box (seeded), its floes moving at up to
+// `speed` (m/s) each way and turning at up to 1e-3 `speed` rad/s: many small
+// clusters, some merging, some floes joining.
+inline GeneratedPack moving_generated_pack(unsigned seed, double speed, double concentration = 0.75) {
+  PackOptions o;
+  o.floes = 400;
+  o.concentration = concentration;
+  o.min_gap = 0.05;
+  o.width = o.height = 2000.0;
+  o.seed = seed;
+  GeneratedPack g = generate_pack(o);
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u(-speed, speed);
+  for (FloeState& s : g.floes.state) {
+    s.vx = u(rng);
+    s.vy = u(rng);
+    s.yaw_rate = 1e-3 * u(rng);
+  }
+  return g;
 }
 
 }  // namespace floesim::test

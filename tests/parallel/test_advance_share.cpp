@@ -45,20 +45,7 @@ struct Case {
 // A dense periodic pack whose floes move at up to `speed` towards random
 // neighbours: many small clusters, some merging, some floes joining.
 Case dense_pack(double speed, unsigned seed, double concentration = 0.75) {
-  PackOptions o;
-  o.floes = 400;
-  o.concentration = concentration;
-  o.min_gap = 0.05;
-  o.width = o.height = 2000.0;
-  o.seed = seed;
-  GeneratedPack g = generate_pack(o);
-  std::mt19937_64 rng(seed);
-  std::uniform_real_distribution<double> u(-speed, speed);
-  for (FloeState& s : g.floes.state) {
-    s.vx = u(rng);
-    s.vy = u(rng);
-    s.yaw_rate = 1e-3 * u(rng);
-  }
+  GeneratedPack g = test::moving_generated_pack(seed, speed, concentration);
   Case c;
   c.floes = std::move(g.floes);
   c.shapes = contact::build_collision_shapes(c.floes);

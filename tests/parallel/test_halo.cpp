@@ -207,20 +207,7 @@ struct Pack {
   std::array<double, 4> window{};
 };
 Pack moving_pack(unsigned seed, bool periodic, double speed = 0.5) {
-  PackOptions o;
-  o.floes = 400;
-  o.concentration = 0.75;
-  o.min_gap = 0.05;
-  o.width = o.height = 2000.0;
-  o.seed = seed;
-  GeneratedPack g = generate_pack(o);
-  std::mt19937_64 rng(seed);
-  std::uniform_real_distribution<double> u(-speed, speed);
-  for (FloeState& s : g.floes.state) {
-    s.vx = u(rng);
-    s.vy = u(rng);
-    s.yaw_rate = 1e-3 * u(rng);
-  }
+  GeneratedPack g = test::moving_generated_pack(seed, speed);
   Pack p;
   p.floes = std::move(g.floes);
   p.shapes = contact::build_collision_shapes(p.floes);
