@@ -14,10 +14,12 @@
 #include "parallel/comm.hpp"
 #include "parallel/detect.hpp"
 #include "parallel/place.hpp"
+#include "tests/parallel/same_detection.hpp"
 
 TEST_SUITE_BEGIN("mpi");
 
 using namespace floesim;
+using test::same_lists;
 
 TEST_CASE("shares are contiguous in rank order and cover n with sizes within one") {
   for (int ranks = 1; ranks <= 7; ++ranks)
@@ -87,32 +89,6 @@ TEST_CASE("together on one rank throws the original error with its type") {
   CHECK_THROWS_AS(comm.together([] { throw RunError("overlap"); }), RunError);
   CHECK_THROWS_WITH(comm.together([] { throw RunError("overlap of floes 3 and 4"); }), "overlap of floes 3 and 4");
 }
-
-namespace {
-// Field by field (structs' padding bytes are not values), doubles compared with == (bit for bit but for -0).
-bool same(const contact::NearPair& x, const contact::NearPair& y) {
-  return x.a == y.a && x.b == y.b && x.shift == y.shift && x.distance == y.distance && x.normal == y.normal &&
-         x.pa == y.pa && x.pb == y.pb && x.exact == y.exact && x.overlap == y.overlap &&
-         x.axis_distance == y.axis_distance && x.axis_normal == y.axis_normal && x.axis_any == y.axis_any &&
-         x.far_distance == y.far_distance && x.first_witness == y.first_witness &&
-         x.witness_count == y.witness_count && x.first_contact == y.first_contact && x.contact_count == y.contact_count;
-}
-bool same(const contact::ContactPoint& x, const contact::ContactPoint& y) {
-  return x.a == y.a && x.b == y.b && x.point == y.point && x.normal == y.normal && x.gap == y.gap &&
-         x.shift == y.shift && x.speculative == y.speculative && x.vertex_of_b == y.vertex_of_b && x.turning == y.turning;
-}
-bool same(const contact::Witness& x, const contact::Witness& y) {
-  return x.pa == y.pa && x.pb == y.pb && x.normal == y.normal && x.distance == y.distance &&
-         x.vertex_of_b == y.vertex_of_b;
-}
-template <class T>
-bool same_lists(const std::vector<T>& a, const std::vector<T>& b) {
-  if (a.size() != b.size()) return false;
-  for (std::size_t k = 0; k < a.size(); ++k)
-    if (!same(a[k], b[k])) return false;
-  return true;
-}
-}  // namespace
 
 TEST_CASE("detection by place over 1, 2, 3 and 7 strips, merged, is the serial detection field by field") {
   // A dense pack with floes moved towards their neighbours, so that some
