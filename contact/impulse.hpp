@@ -91,6 +91,7 @@
 // Components are built from dynamic floes joined by contacts; an obstacle
 // (static floe) does not join components since it transmits no impulse.
 
+#include <algorithm>
 #include <array>
 #include <compare>
 #include <cstdint>
@@ -468,29 +469,59 @@ StepCollisionShare resolve_step_collisions_share(Floes& floes, std::span<const F
 // (`speculative`). A function of the pair and the states alone, so the rank
 // that detected the pair can say it; every rank then finds the same groups
 // from every rank's edges (step_groups), whatever the order of the list.
+// The edge also says both floes' owners (ClusterShare::owner at the step,
+// which the detecting rank knows for the floes it holds), so that a group's
+// owner, its lowest floe's, is known from the edges alone: 20 bytes.
 struct GroupEdge {
   static constexpr std::uint32_t contacts = 1, witnesses = 2, speculative = 4;
   std::uint32_t a = 0, b = 0;  // floes, a < b
   std::uint32_t flags = 0;
+  std::int32_t owner_a = 0, owner_b = 0;  // the ranks owning a and b (0 without owners)
 };
 // The edges of `detection`'s pairs that have a flag (in its order). `floes`
-// holds W^-, `start` the step's start, as for resolve_step_collisions.
+// holds W^-, `start` the step's start, as for resolve_step_collisions;
+// `owner` (per floe, read for the pairs' floes only; empty: every floe 0).
 std::vector<GroupEdge> group_edges(const Floes& floes, std::span<const FloeState> start, const Detection& detection,
-                                   double step, const ImpulseOptions& options);
+                                   double step, const ImpulseOptions& options, std::span<const int> owner = {});
 
-// The step groups of a step: per floe, whether it is in a jam (a component
-// of at least options.jam.floes dynamic floes joined by contact points) and
-// the lowest floe of its step group (kNone: in none).
+// The step groups of a step, over the edges' floes only (a compact index:
+// no array over the whole pack): per such floe, whether it is in a jam (a
+// component of at least options.jam.floes dynamic floes joined by contact
+// points), the lowest floe of its step group (kNone: in none) and the rank
+// owning that lowest floe (-1: in none), as the edges say it. A floe that
+// is in no edge is in no jam and no group.
 struct StepGroups {
   static constexpr std::uint32_t kNone = 0xffffffffu;
-  std::vector<std::uint8_t> jam;
-  std::vector<std::uint32_t> lowest;
-  // Whether the floe's group is share.rank's: its lowest floe is owned there.
-  bool mine(std::uint32_t f, const ClusterShare& share) const {
-    return lowest[f] != kNone && share.owner[lowest[f]] == share.rank;
+  std::vector<std::uint32_t> floes;   // ascending: the edges' floes
+  std::vector<std::uint8_t> jam;      // per entry of `floes`
+  std::vector<std::uint32_t> lowest;  // per entry: its group's lowest floe, or kNone
+  std::vector<int> owner;             // per entry: the owner of its group's lowest floe, or -1
+
+  // Floe f's entry, or floes.size() if no edge has it (a binary search).
+  std::size_t entry(std::uint32_t f) const {
+    const auto at = std::lower_bound(floes.begin(), floes.end(), f);
+    return at != floes.end() && *at == f ? static_cast<std::size_t>(at - floes.begin()) : floes.size();
   }
+  bool in_jam(std::uint32_t f) const {
+    const std::size_t k = entry(f);
+    return k < floes.size() && jam[k];
+  }
+  std::uint32_t lowest_of(std::uint32_t f) const {
+    const std::size_t k = entry(f);
+    return k < floes.size() ? lowest[k] : kNone;
+  }
+  int owner_of(std::uint32_t f) const {
+    const std::size_t k = entry(f);
+    return k < floes.size() ? owner[k] : -1;
+  }
+  // Whether floe f's group is rank's: its lowest floe is owned there.
+  bool mine(std::uint32_t f, int rank) const { return lowest_of(f) != kNone && owner_of(f) == rank; }
+  // Whether there is a group at all; the count of rank's groups.
+  bool any() const;
+  long count(int rank) const;
 };
-// The step groups from every pair's edges (any order, each pair once).
+// The step groups from every pair's edges (any order, each pair once): the
+// same groups, lowest floes and owners whatever the order.
 StepGroups step_groups(const Floes& floes, std::span<const GroupEdge> edges, const ImpulseOptions& options);
 
 // Adds the counts of `part` (a share's) to `total`: sums, `largest` a maximum.

@@ -114,8 +114,8 @@ std::size_t step_collisions(Floes& floes, std::span<const FloeState> start, cons
   // (A share is given them with its groups: its detection may be a part.)
   std::vector<std::uint8_t> whole_jam;
   if (!share) whole_jam = jam_floes(floes, detection.contacts, opt.jam.floes);
-  const std::vector<std::uint8_t>& in_jam = share ? step_groups->jam : whole_jam;
-  auto jammed = [&](std::uint32_t a, std::uint32_t b) { return in_jam[a] || in_jam[b]; };
+  auto in_jam = [&](std::uint32_t f) { return share ? step_groups->in_jam(f) : whole_jam[f] != 0; };
+  auto jammed = [&](std::uint32_t a, std::uint32_t b) { return in_jam(a) || in_jam(b); };
   // The contacts solved here (a jam's are left to its time step unless
   // jam.at_step_start) and where each came from in detection.contacts.
   std::vector<ContactPoint> contacts;
@@ -164,12 +164,10 @@ std::size_t step_collisions(Floes& floes, std::span<const FloeState> start, cons
   auto kept = [&](std::uint32_t a, std::uint32_t b) {
     if (!share) return true;
     const bool da = !floes.is_static[a], db = !floes.is_static[b];
-    return (da || db) && (!da || step_groups->mine(a, *share)) && (!db || step_groups->mine(b, *share));
+    return (da || db) && (!da || step_groups->mine(a, share->rank)) && (!db || step_groups->mine(b, share->rank));
   };
   if (share) {
-    *groups = 0;
-    for (std::uint32_t f = 0; f < floes.size(); ++f)
-      if (step_groups->lowest[f] == f && share->owner[f] == share->rank) ++*groups;
+    *groups = step_groups->count(share->rank);
     std::erase_if(candidates, [&](const Candidate& c) {
       return !kept(detection.pairs[c.pair].a, detection.pairs[c.pair].b);
     });
@@ -293,7 +291,7 @@ StepCollisionShare resolve_step_collisions_share(Floes& floes, std::span<const F
   try {
     // The groups from the whole detection's edges, before any solve (W^-).
     StepGroups found;
-    if (!groups) found = step_groups(floes, group_edges(floes, start, detection, step, o), o);
+    if (!groups) found = step_groups(floes, group_edges(floes, start, detection, step, o, share.owner), o);
     outcome.speculative = step_collisions(floes, start, detection, step, o, stats, nullptr, &share,
                                           groups ? groups : &found, &outcome.moved, &outcome.groups, &outcome.places);
   } catch (const RunError&) {
@@ -307,11 +305,15 @@ StepCollisionShare resolve_step_collisions_share(Floes& floes, std::span<const F
 }
 
 std::vector<GroupEdge> group_edges(const Floes& floes, std::span<const FloeState> start, const Detection& detection,
-                                   double step, const ImpulseOptions& options) {
+                                   double step, const ImpulseOptions& options, std::span<const int> owner) {
   const double xi = options.collision_distance;
   std::vector<GroupEdge> out;
   for (const NearPair& p : detection.pairs) {
     GroupEdge e{p.a, p.b, p.contact_count > 0 ? GroupEdge::contacts : 0u};
+    if (!owner.empty()) {
+      e.owner_a = owner[p.a];
+      e.owner_b = owner[p.b];
+    }
     if (!p.overlap)
       for (std::uint32_t k = p.first_witness; k < p.first_witness + p.witness_count; ++k) {
         const Witness& w = detection.witnesses[k];
@@ -332,48 +334,92 @@ StepGroups step_groups(const Floes& floes, std::span<const GroupEdge> edges, con
   // the step's contacts are a pair's contact points unless a jam leaves them
   // to its time step, and a jam's speculative points when it does not; the
   // rounds' candidates are the witnesses beyond xi of the pairs outside jams.
-  const std::size_t n = floes.size();
+  // Over the edges' floes (entries ascending by floe): a floe in no edge is
+  // in no jam and no group, so the whole pack's arrays are not needed.
   StepGroups g;
-  {
-    std::vector<ContactPoint> contacts;  // one per pair with contact points: the components are the same
-    for (const GroupEdge& e : edges)
-      if (e.flags & GroupEdge::contacts) contacts.push_back({e.a, e.b});
-    g.jam = jam_floes(floes, contacts, options.jam.floes);
+  g.floes.reserve(2 * edges.size());
+  for (const GroupEdge& e : edges) {
+    g.floes.push_back(e.a);
+    g.floes.push_back(e.b);
   }
-  auto jammed = [&](const GroupEdge& e) { return g.jam[e.a] || g.jam[e.b]; };
-  DisjointSets sets(n);
-  std::vector<std::uint8_t> grouped(n, 0);
+  std::sort(g.floes.begin(), g.floes.end());
+  g.floes.erase(std::unique(g.floes.begin(), g.floes.end()), g.floes.end());
+  const std::size_t m = g.floes.size();
+  // The edges on the entries, and each entry's owner from its edges.
+  struct Local {
+    std::uint32_t a, b, flags;
+  };
+  std::vector<Local> local;
+  local.reserve(edges.size());
+  std::vector<int> owner(m, -1);
+  for (const GroupEdge& e : edges) {
+    const auto a = static_cast<std::uint32_t>(g.entry(e.a)), b = static_cast<std::uint32_t>(g.entry(e.b));
+    local.push_back({a, b, e.flags});
+    owner[a] = e.owner_a;
+    owner[b] = e.owner_b;
+  }
+  std::vector<std::uint8_t> dynamic(m);
+  for (std::size_t k = 0; k < m; ++k) dynamic[k] = !floes.is_static[g.floes[k]];
+  // Jams: components of dynamic floes joined by contact points.
+  {
+    DisjointSets sets(m);
+    std::vector<std::uint8_t> joined(m, 0);
+    for (const Local& e : local)
+      if ((e.flags & GroupEdge::contacts) && dynamic[e.a] && dynamic[e.b]) {
+        sets.join(e.a, e.b);
+        joined[e.a] = joined[e.b] = 1;
+      }
+    std::vector<std::uint32_t> count(m, 0);
+    for (std::uint32_t k = 0; k < m; ++k)
+      if (joined[k]) ++count[sets.find(k)];
+    g.jam.resize(m);
+    for (std::uint32_t k = 0; k < m; ++k) g.jam[k] = joined[k] && count[sets.find(k)] >= options.jam.floes;
+  }
+  auto jammed = [&](const Local& e) { return g.jam[e.a] || g.jam[e.b]; };
+  DisjointSets sets(m);
+  std::vector<std::uint8_t> grouped(m, 0);
   auto link = [&](std::uint32_t a, std::uint32_t b) {  // obstacles join nothing
-    const bool da = !floes.is_static[a], db = !floes.is_static[b];
-    if (da) grouped[a] = 1;
-    if (db) grouped[b] = 1;
-    if (da && db) sets.join(a, b);
+    if (dynamic[a]) grouped[a] = 1;
+    if (dynamic[b]) grouped[b] = 1;
+    if (dynamic[a] && dynamic[b]) sets.join(a, b);
   };
   const bool at_start = options.jam.at_step_start;
-  for (const GroupEdge& e : edges)
+  for (const Local& e : local)
     if (((e.flags & GroupEdge::contacts) && (at_start || !jammed(e))) ||
         (at_start && jammed(e) && (e.flags & GroupEdge::witnesses)))
       link(e.a, e.b);
   const std::vector<std::uint8_t> v0 = grouped;  // round 0 may change these
   std::vector<std::uint8_t> v1 = v0;
-  auto candidate = [&](const GroupEdge& e) { return (e.flags & GroupEdge::witnesses) && !jammed(e); };
-  for (const GroupEdge& e : edges)
+  auto candidate = [&](const Local& e) { return (e.flags & GroupEdge::witnesses) && !jammed(e); };
+  for (const Local& e : local)
     if (candidate(e) && (v0[e.a] || v0[e.b] || (e.flags & GroupEdge::speculative))) {
-      if (!floes.is_static[e.a]) v1[e.a] = 1;
-      if (!floes.is_static[e.b]) v1[e.b] = 1;
+      if (dynamic[e.a]) v1[e.a] = 1;
+      if (dynamic[e.b]) v1[e.b] = 1;
     }
-  for (const GroupEdge& e : edges)
+  for (const Local& e : local)
     if (candidate(e) && (v1[e.a] || v1[e.b])) link(e.a, e.b);
-  // A group's lowest floe: the first seen, ascending.
-  std::vector<std::uint32_t> lowest_of_root(n, StepGroups::kNone);
-  g.lowest.assign(n, StepGroups::kNone);
-  for (std::uint32_t f = 0; f < n; ++f) {
-    if (!grouped[f]) continue;
-    std::uint32_t& low = lowest_of_root[sets.find(f)];
-    if (low == StepGroups::kNone) low = f;
-    g.lowest[f] = low;
+  // A group's lowest floe: the first seen, ascending (the entries are).
+  std::vector<std::uint32_t> lowest_of_root(m, StepGroups::kNone);
+  g.lowest.assign(m, StepGroups::kNone);
+  g.owner.assign(m, -1);
+  for (std::uint32_t k = 0; k < m; ++k) {
+    if (!grouped[k]) continue;
+    std::uint32_t& low = lowest_of_root[sets.find(k)];
+    if (low == StepGroups::kNone) low = k;
+    g.lowest[k] = g.floes[low];
+    g.owner[k] = owner[low];
   }
   return g;
+}
+
+bool StepGroups::any() const {
+  return std::any_of(lowest.begin(), lowest.end(), [](std::uint32_t l) { return l != kNone; });
+}
+
+long StepGroups::count(int rank) const {
+  long n = 0;
+  for (std::size_t k = 0; k < floes.size(); ++k) n += lowest[k] == floes[k] && owner[k] == rank ? 1 : 0;
+  return n;
 }
 
 void add_collision_counts(CollisionStats& total, const CollisionStats& part) {

@@ -144,12 +144,13 @@ std::size_t collide_by_owner(const Communicator& comm, std::span<const int> owne
 }
 
 std::vector<contact::Detection> pairs_for_groups(const Floes& floes, const contact::Detection& part,
-                                                 const contact::StepGroups& groups, std::span<const int> owner,
-                                                 int ranks, int rank, double collision_distance) {
+                                                 const contact::StepGroups& groups, int ranks, int rank,
+                                                 double collision_distance) {
   // The rank whose share reads pair p (resolve_step_collisions_share keeps
   // the contacts and witnesses whose dynamic floes are all in its groups),
   // or -1: none does, or p has nothing a share reads (no contact point and
-  // no witness at or beyond xi of a pair that does not overlap).
+  // no witness at or beyond xi of a pair that does not overlap). The group's
+  // owner is its lowest floe's, as the edges said it.
   auto reader = [&](const contact::NearPair& p) {
     bool read = p.contact_count > 0;
     if (!p.overlap)
@@ -158,9 +159,10 @@ std::vector<contact::Detection> pairs_for_groups(const Floes& floes, const conta
     if (!read) return -1;
     const bool da = !floes.is_static[p.a], db = !floes.is_static[p.b];
     if (!da && !db) return -1;
-    const std::uint32_t low = da ? groups.lowest[p.a] : groups.lowest[p.b];
-    if (low == contact::StepGroups::kNone || (da && db && groups.lowest[p.b] != low)) return -1;
-    return owner[low];
+    const std::size_t k = groups.entry(da ? p.a : p.b);
+    if (k == groups.floes.size() || groups.lowest[k] == contact::StepGroups::kNone) return -1;
+    if (da && db && groups.lowest_of(p.b) != groups.lowest[k]) return -1;
+    return groups.owner[k];
   };
   std::vector<contact::Detection> out(static_cast<std::size_t>(ranks));
   std::vector<int> to(part.pairs.size());
@@ -182,24 +184,35 @@ std::size_t collide_on_part(const Communicator& comm, std::span<const int> owner
                             share_options);
   if (counts.whole_now())
     return contact::resolve_step_collisions(floes, start, gather(comm, part), step, options, stats);
-  // Every rank's edges (12 bytes a pair with a flag), the same groups on every rank.
-  const std::vector<contact::GroupEdge> mine = contact::group_edges(floes, start, part, step, options);
+  // Every rank's edges (20 bytes a pair with a flag: the floes' owners in
+  // them), the same step groups and group owners on every rank.
+  const std::vector<contact::GroupEdge> mine = contact::group_edges(floes, start, part, step, options, owner);
   const std::vector<contact::GroupEdge> edges = comm.allgather<contact::GroupEdge>(mine);
   const contact::StepGroups groups = contact::step_groups(floes, edges, options);
   // No step group on any rank (the same groups on all): the serial call
   // solves nothing and changes nothing, and every rank skips the exchanges.
   // Its record still counts its one event, with no load.
-  if (std::none_of(groups.lowest.begin(), groups.lowest.end(),
-                   [](std::uint32_t g) { return g != contact::StepGroups::kNone; })) {
+  if (!groups.any()) {
     if (options.record) contact::merge_step_record(*options.record, {});
     counts.clusters.resize(static_cast<std::size_t>(comm.size()), 0);
     counts.combined();
     return 0;
   }
-  // The pairs of the groups owned elsewhere, to their owners.
+  // The pairs of the groups owned elsewhere, to their owners, with their
+  // floes (W^-, the step's start, mass and inertia), which the share then
+  // reads from the message.
   const std::vector<contact::Detection> out =
-      pairs_for_groups(floes, part, groups, owner, comm.size(), comm.rank(), options.collision_distance);
-  const contact::Detection local = exchange_pairs(comm, part, out);
+      pairs_for_groups(floes, part, groups, comm.size(), comm.rank(), options.collision_distance);
+  std::vector<RoutedFloes> carried(out.size()), received;
+  for (std::size_t s = 0; s < out.size(); ++s)
+    if (!out[s].pairs.empty()) carried[s] = routed_floes(floes, start, out[s]);
+  const contact::Detection local = exchange_pairs(comm, part, out, &carried, &received);
+  std::vector<FloeState> held_start;
+  if (!received.empty()) {
+    held_start.assign(start.begin(), start.end());
+    for (const RoutedFloes& r : received) hold(r, floes, held_start);
+    start = held_start;
+  }
   // The share on its pairs, then collide_by_owner's exchange (with the
   // share's record and its loads' places keyed by pair: the serial record
   // merged from the parts).

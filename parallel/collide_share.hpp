@@ -75,18 +75,22 @@ std::size_t collide_by_owner(const Communicator& comm, std::span<const int> owne
 // pair order). Per rank s, the pairs of `part` that s's step groups read and
 // s did not detect: a pair with contact points or a witness at or beyond xi
 // (contact::group_edges' flags) whose dynamic floes are in one group whose
-// lowest floe s owns. Entry `rank` (this rank's) is empty.
+// lowest floe s owns (the group's owner as the edges say it: no owner array
+// is read). Entry `rank` (this rank's) is empty. Reads of `floes` only the
+// pairs' floes' flags.
 std::vector<contact::Detection> pairs_for_groups(const Floes& floes, const contact::Detection& part,
-                                                 const contact::StepGroups& groups, std::span<const int> owner,
-                                                 int ranks, int rank, double collision_distance);
+                                                 const contact::StepGroups& groups, int ranks, int rank,
+                                                 double collision_distance);
 
 // The collisions at the step's start on every rank of `comm` from this
 // rank's part of the detection (`part`, as parallel::detect gives it)
 // instead of the whole: its edges (contact::group_edges) gathered to every
-// rank (one allgather_bytes), the same step groups on every rank
+// rank (one allgather_bytes; each edge says its floes' owners, so the
+// groups' owners come from the edges), the same step groups on every rank
 // (contact::step_groups), the pairs of groups owned elsewhere sent to their
-// owners (one alltoall_bytes: two collective calls), this rank's share on
-// its pairs and those received, then collide_by_owner's exchange and
+// owners with their floes (parallel::RoutedFloes: one alltoall_bytes, two
+// collective calls), this rank's share on its pairs and those received,
+// reading the received floes from the message, then collide_by_owner's exchange and
 // combination; with options.record each share records its loads with
 // their places keyed by pair (contact::ContactPlace) and every rank merges
 // the parts into options.record. A fallback and a step the back-off does

@@ -1,6 +1,9 @@
 #include "parallel/detect.hpp"
 
+#include <algorithm>
 #include <cstdint>
+
+#include "core/error.hpp"
 
 #include "parallel/bytes.hpp"
 
@@ -48,22 +51,97 @@ void append_pair(contact::Detection& to, const contact::Detection& from, const c
   to.pairs.push_back(q);
 }
 
+RoutedFloes routed_floes(const Floes& floes, std::span<const FloeState> start, const contact::Detection& pairs) {
+  RoutedFloes out;
+  for (const contact::NearPair& p : pairs.pairs) {
+    out.floe.push_back(p.a);
+    out.floe.push_back(p.b);
+  }
+  std::sort(out.floe.begin(), out.floe.end());
+  out.floe.erase(std::unique(out.floe.begin(), out.floe.end()), out.floe.end());
+  for (const std::uint32_t i : out.floe) {
+    out.now.push_back(floes.state[i]);
+    out.start.push_back(start[i]);
+    out.mass.push_back(floes.mass[i]);
+    out.inertia_z.push_back(floes.inertia_z[i]);
+  }
+  return out;
+}
+
+void hold(const RoutedFloes& routed, Floes& floes, std::span<FloeState> start) {
+  for (std::size_t k = 0; k < routed.floe.size(); ++k) {
+    const std::uint32_t i = routed.floe[k];
+    floes.state[i] = routed.now[k];
+    start[i] = routed.start[k];
+    floes.mass[i] = routed.mass[k];
+    floes.inertia_z[i] = routed.inertia_z[k];
+  }
+}
+
+std::vector<std::byte> pack(const RoutedFloes& r) {
+  const std::uint64_t n = r.floe.size();
+  std::vector<std::byte> out;
+  append(out, std::span<const std::uint64_t>(&n, 1));
+  append(out, std::span<const std::uint32_t>(r.floe));
+  append(out, std::span<const FloeState>(r.now));
+  append(out, std::span<const FloeState>(r.start));
+  append(out, std::span<const double>(r.mass));
+  append(out, std::span<const double>(r.inertia_z));
+  return out;
+}
+
+RoutedFloes unpack_routed_floes(std::span<const std::byte> bytes) {
+  const std::byte* at = bytes.data();
+  RoutedFloes r;
+  const auto n = static_cast<std::size_t>(take<std::uint64_t>(at, 1)[0]);
+  r.floe = take<std::uint32_t>(at, n);
+  r.now = take<FloeState>(at, n);
+  r.start = take<FloeState>(at, n);
+  r.mass = take<double>(at, n);
+  r.inertia_z = take<double>(at, n);
+  FLOESIM_ASSERT(at == bytes.data() + bytes.size());
+  return r;
+}
+
 contact::Detection exchange_pairs(const Communicator& comm, const contact::Detection& part,
-                                  const std::vector<contact::Detection>& outgoing) {
+                                  const std::vector<contact::Detection>& outgoing,
+                                  const std::vector<RoutedFloes>* carried, std::vector<RoutedFloes>* received) {
+  // A message: the pairs (pack), or with `carried` the pairs' byte count,
+  // the pairs and the floes.
   std::vector<std::byte> send;
   std::vector<std::size_t> send_counts;
-  for (const contact::Detection& d : outgoing) {
-    const std::vector<std::byte> bytes = d.pairs.empty() ? std::vector<std::byte>{} : pack(d);
+  for (std::size_t s = 0; s < outgoing.size(); ++s) {
+    const contact::Detection& d = outgoing[s];
+    std::vector<std::byte> bytes = d.pairs.empty() ? std::vector<std::byte>{} : pack(d);
+    if (carried && !bytes.empty()) {
+      const std::uint64_t size = bytes.size();
+      std::vector<std::byte> message;
+      append(message, std::span<const std::uint64_t>(&size, 1));
+      message.insert(message.end(), bytes.begin(), bytes.end());
+      const std::vector<std::byte> floes = pack((*carried)[s]);
+      message.insert(message.end(), floes.begin(), floes.end());
+      bytes = std::move(message);
+    }
     send.insert(send.end(), bytes.begin(), bytes.end());
     send_counts.push_back(bytes.size());
   }
-  std::vector<std::byte> received;
-  std::vector<std::size_t> received_counts;
-  comm.alltoall_bytes(send, send_counts, received, received_counts);
+  std::vector<std::byte> got;
+  std::vector<std::size_t> got_counts;
+  comm.alltoall_bytes(send, send_counts, got, got_counts);
   std::vector<contact::Detection> parts{part};
+  if (received) received->clear();
   std::size_t from = 0;
-  for (const std::size_t n : received_counts) {
-    if (n) parts.push_back(unpack_detection(std::span<const std::byte>(received.data() + from, n)));
+  for (const std::size_t n : got_counts) {
+    if (n && carried) {
+      const std::byte* at = got.data() + from;
+      const auto size = static_cast<std::size_t>(take<std::uint64_t>(at, 1)[0]);
+      parts.push_back(unpack_detection(std::span<const std::byte>(at, size)));
+      const std::byte* floes = at + size;
+      const std::span<const std::byte> rest(floes, got.data() + from + n);
+      if (received) received->push_back(unpack_routed_floes(rest));
+    } else if (n) {
+      parts.push_back(unpack_detection(std::span<const std::byte>(got.data() + from, n)));
+    }
     from += n;
   }
   return merge(std::move(parts));

@@ -10,6 +10,8 @@
 // the same data, so the result is the serial one, field by field, on any
 // number of ranks and whatever the strips.
 
+#include <cstdint>
+#include <span>
 #include <vector>
 
 #include "contact/detection.hpp"
@@ -77,12 +79,35 @@ contact::Detection select_pairs(const contact::Detection& d, Keep&& keep) {
   return out;
 }
 
+// The floes of routed pairs (docs/parallel.md, "The state held by owner
+// with a halo", piece 2): what a share's solves read of a floe it need not
+// hold (a step group's member or obstacle beyond its band), sent with the
+// pairs once a floe and receiver. Per floe, ascending: its state on entry
+// (W^-), its state at the step's start, its mass and yaw inertia: 212
+// bytes a floe.
+struct RoutedFloes {
+  std::vector<std::uint32_t> floe;
+  std::vector<FloeState> now, start;
+  std::vector<double> mass, inertia_z;
+};
+// Both floes of every pair of `pairs`, as `floes` (W^-) and `start` hold them.
+RoutedFloes routed_floes(const Floes& floes, std::span<const FloeState> start, const contact::Detection& pairs);
+// Writes `routed`'s floes into `floes` (state, mass, inertia) and `start`.
+void hold(const RoutedFloes& routed, Floes& floes, std::span<FloeState> start);
+std::vector<std::byte> pack(const RoutedFloes& routed);
+RoutedFloes unpack_routed_floes(std::span<const std::byte> bytes);
+
 // The routed pairs' exchange: `outgoing[s]` (pairs of this rank's part, in
 // pair order) sent to rank s (none to itself; an empty one sends nothing),
 // and `part` merged with what every rank sent here, in pair order
-// (merge). Collective: one alltoall_bytes, two calls.
+// (merge). Collective: one alltoall_bytes, two calls. With `carried`
+// (per rank, as outgoing; every rank alike), each non-empty message carries
+// carried[s] too, and `received` gets what every rank sent here (in rank
+// order).
 contact::Detection exchange_pairs(const Communicator& comm, const contact::Detection& part,
-                                  const std::vector<contact::Detection>& outgoing);
+                                  const std::vector<contact::Detection>& outgoing,
+                                  const std::vector<RoutedFloes>* carried = nullptr,
+                                  std::vector<RoutedFloes>* received = nullptr);
 
 // Rank `rank`'s part of the detection by place (no communication): the
 // serial detection's pairs whose floe a `rank` owns, with their contact

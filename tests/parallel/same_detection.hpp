@@ -30,7 +30,7 @@ inline bool same(const contact::Witness& x, const contact::Witness& y) {
          x.vertex_of_b == y.vertex_of_b;
 }
 inline bool same(const contact::GroupEdge& x, const contact::GroupEdge& y) {
-  return x.a == y.a && x.b == y.b && x.flags == y.flags;
+  return x.a == y.a && x.b == y.b && x.flags == y.flags && x.owner_a == y.owner_a && x.owner_b == y.owner_b;
 }
 template <class T>
 inline bool same_lists(const std::vector<T>& a, const std::vector<T>& b) {

@@ -66,20 +66,22 @@ Played play(const CollideCase& c, const std::vector<int>& detected, const std::v
     part[static_cast<std::size_t>(r)] =
         parallel::select_pairs(c.detection, [&](const contact::NearPair& p) { return detected[p.a] == r; });
     const std::vector<contact::GroupEdge> e =
-        contact::group_edges(c.floes, c.start, part[static_cast<std::size_t>(r)], c.dt, c.options);
+        contact::group_edges(c.floes, c.start, part[static_cast<std::size_t>(r)], c.dt, c.options, owner);
     edges.insert(edges.end(), e.begin(), e.end());
   }
   const contact::StepGroups groups = contact::step_groups(c.floes, edges, c.options);
   // The groups do not depend on the edges' order.
   std::reverse(edges.begin(), edges.end());
   const contact::StepGroups reversed = contact::step_groups(c.floes, edges, c.options);
+  CHECK(reversed.floes == groups.floes);
   CHECK(reversed.lowest == groups.lowest);
   CHECK(reversed.jam == groups.jam);
+  CHECK(reversed.owner == groups.owner);
   // What each rank receives: the pairs of its groups that others detected.
   std::vector<std::vector<contact::Detection>> to(static_cast<std::size_t>(ranks));
   for (int r = 0; r < ranks; ++r)
     to[static_cast<std::size_t>(r)] = parallel::pairs_for_groups(c.floes, part[static_cast<std::size_t>(r)], groups,
-                                                                owner, ranks, r, c.options.collision_distance);
+                                                                ranks, r, c.options.collision_distance);
   std::vector<parallel::CollidePart> parts;
   contact::ImpulseRecord unused;  // the options' record: the shares record into their parts'
   contact::ImpulseOptions options = c.options;

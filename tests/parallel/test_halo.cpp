@@ -14,8 +14,10 @@
 //   pairs across the cuts: the comparison has teeth;
 // - the drift of the rank's floes: its own floes only;
 // - the collisions at the step's start from the rank's part
-//   (parallel::collide_on_part's pieces): the edges from the band, then each
-//   share on the members of its step groups only, wherever they lie.
+//   (parallel::collide_on_part's pieces): the edges from the band (the
+//   floes' owners too, which the edges carry), then each share on the
+//   members of its step groups its band holds and the floes the routed
+//   pairs carry, no owner read.
 //
 // A NaN read whose only use is a comparison that comes out false either way
 // is not seen; every read that changes a result is.
@@ -370,8 +372,11 @@ namespace {
 // The step-start collisions from each simulated rank's part, each rank
 // holding only what the plan gives it: its band for its part of the
 // detection and its pairs' edges (compared with the edges on the whole
-// state), then, for its share, the members of its step groups only (the
-// groups' owners: `owner`, the strips shifted by `shift` ranks). The shares'
+// state), the owners (`owner`: the strips shifted by `shift` ranks) of its
+// band's floes only (-1 elsewhere), which the edges carry; then, for its
+// share, the members of its step groups that its band holds and the floes
+// the routed pairs carry (W^-, the step's start, mass, inertia: through
+// their bytes), every other floe poisoned, and no owner at all. The shares'
 // parts combined into W^- (clean) are returned with the counts.
 struct PoisonedCollide {
   Floes floes;
@@ -379,7 +384,9 @@ struct PoisonedCollide {
   std::size_t speculative = 0;
   bool combined = false;
   bool parts_equal = true, edges_equal = true;
-  std::size_t held_by_shares = 0;  // the floes the shares held, summed over the ranks
+  std::size_t held_by_shares = 0;  // the members and obstacles the shares held, summed over the ranks
+  std::size_t fetched = 0;         // of those, members beyond the share's band, held from the routed floes
+  std::size_t routed = 0;          // floes carried with routed pairs, summed over the receivers
 };
 PoisonedCollide collide_poisoned(const test::CollideCase& c, int ranks, int shift, contact::ImpulseRecord* merged) {
   PoisonedCollide out;
@@ -394,9 +401,11 @@ PoisonedCollide collide_poisoned(const test::CollideCase& c, int ranks, int shif
   strips.assign(c.floes);
   std::vector<int> owner(strips.owner().begin(), strips.owner().end());
   for (int& o : owner) o = (o + shift) % ranks;
-  // Each rank: its part and edges from its band.
+  // Each rank: its part and edges from its band (the owners of its band only).
   std::vector<contact::Detection> part(static_cast<std::size_t>(ranks));
   std::vector<Floes> band_floes;
+  std::vector<std::vector<FloeState>> band_start;
+  std::vector<Held> band;
   std::vector<contact::GroupEdge> edges;
   for (int r = 0; r < ranks; ++r) {
     const contact::Detection whole_part =
@@ -404,38 +413,61 @@ PoisonedCollide collide_poisoned(const test::CollideCase& c, int ranks, int shif
     const BandPart b = part_from_band(p, strips, r, false);
     out.parts_equal = out.parts_equal && same_detection(b.part, whole_part);
     part[static_cast<std::size_t>(r)] = b.part;
+    band.push_back(b.held);
     band_floes.push_back(poisoned(c.floes, b.held));
+    band_start.push_back(poisoned(c.start, b.held));
+    std::vector<int> band_owner(n, -1);
+    for (std::size_t i = 0; i < n; ++i)
+      if (b.held[i]) band_owner[i] = owner[i];
     const std::vector<contact::GroupEdge> e =
-        contact::group_edges(band_floes.back(), poisoned(c.start, b.held), b.part, c.dt, c.options);
+        contact::group_edges(band_floes.back(), band_start.back(), b.part, c.dt, c.options, band_owner);
     out.edges_equal =
-        out.edges_equal && same_lists(e, contact::group_edges(c.floes, c.start, whole_part, c.dt, c.options));
+        out.edges_equal && same_lists(e, contact::group_edges(c.floes, c.start, whole_part, c.dt, c.options, owner));
     edges.insert(edges.end(), e.begin(), e.end());
   }
   const contact::StepGroups groups = contact::step_groups(c.floes, edges, c.options);
+  // The pairs each rank sends and the floes they carry, through their bytes.
   std::vector<std::vector<contact::Detection>> to(static_cast<std::size_t>(ranks));
-  for (int r = 0; r < ranks; ++r)
-    to[static_cast<std::size_t>(r)] =
-        parallel::pairs_for_groups(band_floes[static_cast<std::size_t>(r)], part[static_cast<std::size_t>(r)], groups,
-                                   owner, ranks, r, c.options.collision_distance);
-  // Each share on the members of its groups (and the obstacles) only.
+  std::vector<std::vector<parallel::RoutedFloes>> carried(static_cast<std::size_t>(ranks));
+  for (int r = 0; r < ranks; ++r) {
+    const auto ru = static_cast<std::size_t>(r);
+    to[ru] = parallel::pairs_for_groups(band_floes[ru], part[ru], groups, ranks, r, c.options.collision_distance);
+    for (const contact::Detection& d : to[ru])
+      carried[ru].push_back(parallel::unpack_routed_floes(
+          parallel::pack(parallel::routed_floes(band_floes[ru], band_start[ru], d))));
+  }
+  // Each share on its band's members and the routed floes only.
   std::vector<parallel::CollidePart> parts;
   contact::ImpulseRecord unused;
   contact::ImpulseOptions options = c.options;
   if (merged) options.record = &unused;
+  const std::vector<int> no_owner(n, -1);  // with the groups given, the share reads no owner
   for (int s = 0; s < ranks; ++s) {
-    std::vector<contact::Detection> held_pairs{part[static_cast<std::size_t>(s)]};
+    const auto su = static_cast<std::size_t>(s);
+    std::vector<contact::Detection> held_pairs{part[su]};
     for (int r = 0; r < ranks; ++r)
-      if (!to[static_cast<std::size_t>(r)][static_cast<std::size_t>(s)].pairs.empty())
-        held_pairs.push_back(to[static_cast<std::size_t>(r)][static_cast<std::size_t>(s)]);
+      if (!to[static_cast<std::size_t>(r)][su].pairs.empty()) held_pairs.push_back(to[static_cast<std::size_t>(r)][su]);
     const contact::Detection local = parallel::merge(std::move(held_pairs));
-    Held members(n, 0);
-    for (std::size_t i = 0; i < n; ++i)
-      members[i] = c.floes.is_static[i] || groups.mine(static_cast<std::uint32_t>(i), {owner, s}) ? 1 : 0;
-    out.held_by_shares += count_held(members);
-    Floes mine = poisoned(c.floes, members);
-    const std::vector<FloeState> start = poisoned(c.start, members);
+    Held members(n, 0), held(n, 0);
+    for (std::size_t i = 0; i < n; ++i) {
+      members[i] = c.floes.is_static[i] || groups.mine(static_cast<std::uint32_t>(i), s) ? 1 : 0;
+      held[i] = members[i] && band[su][i];
+    }
+    Floes mine = poisoned(c.floes, held);
+    std::vector<FloeState> start = poisoned(c.start, held);
+    Held routed(n, 0);
+    for (int r = 0; r < ranks; ++r) {
+      const parallel::RoutedFloes& f = carried[static_cast<std::size_t>(r)][su];
+      parallel::hold(f, mine, start);
+      for (const std::uint32_t i : f.floe) routed[i] = 1;
+      out.routed += f.floe.size();
+    }
+    for (std::size_t i = 0; i < n; ++i) {
+      out.held_by_shares += members[i];
+      out.fetched += members[i] && !c.floes.is_static[i] && !band[su][i] ? 1 : 0;
+    }
     parts.push_back(parallel::unpack_collide_part(
-        parallel::pack(parallel::run_collide_share(mine, start, local, c.dt, options, owner, s, &groups))));
+        parallel::pack(parallel::run_collide_share(mine, start, local, c.dt, options, no_owner, s, &groups))));
   }
   out.floes = c.floes;  // W^-, whole and clean: each part's moved floes take its states
   out.combined = parallel::combine_collide_parts(parts, out.floes, out.stats, out.speculative, merged);
@@ -449,9 +481,12 @@ TEST_CASE("the step-start collisions read the band for the edges and only the me
   // contact), with and without the impulse record (jams of two solved at the
   // step's start or not), over 2, 3 and 7 strips, the groups' owners the
   // strips or shifted by one rank (every group's members then lie on other
-  // ranks' strips: the owner would fetch them with the routed pairs). The
+  // ranks' strips: the owner fetches those beyond its band with the routed
+  // pairs). The owners are read from each rank's band only (the edges carry
+  // them); a share holds its band's members and the routed floes. The
   // combined states equal the serial solve by memcmp, with the counts, the
   // speculative contacts' count and the record.
+  std::size_t fetched = 0;
   for (const bool jams : {false, true}) {
     CAPTURE(jams);
     const test::RecordedRows r = test::recorded_rows_of_four(jams);
@@ -469,10 +504,15 @@ TEST_CASE("the step-start collisions read the band for the edges and only the me
         CHECK(same_states(p.floes.state, r.floes.state));
         CHECK(test::same_stats(p.stats, r.stats));
         CHECK(test::same_record(merged, r.record));
-        // The shares held the 256 floes of the 64 rows between them, once.
+        // The shares' members and obstacles: the 256 floes of the 64 rows, once.
         CHECK(p.held_by_shares == c.floes.size());
+        MESSAGE(std::string(jams ? "jams, " : "") << ranks << " strips, shift " << shift << ": " << p.routed
+                                       << " floes routed, " << p.fetched << " members beyond the share's band");
+        fetched += p.fetched;
       }
   }
+  // Some members lie beyond their share's band and come from the routed floes only.
+  CHECK(fetched > 0);
 }
 
 TEST_SUITE_END();
