@@ -185,6 +185,15 @@ void Stepper::hold(Detection held) {
   }
   held_ = std::move(held);
   det_ = &held_;
+  // The held pairs' floes as the caller holds them now (the routed ones
+  // arrived with their pairs, after set_up): their straight paths and
+  // travel. Nothing has moved yet, so floes_.state is the step's start.
+  for (const NearPair& q : held_.pairs)
+    for (const std::uint32_t i : {q.a, q.b}) {
+      start_[i] = floes_.state[i];
+      if (!floes_.is_static[i])
+        lin_[i] = (std::hypot(start_[i].vx, start_[i].vy) + std::abs(start_[i].yaw_rate) * shapes_.radius[i]) * dt_;
+    }
   room_ = std::move(room);
   known_ = std::move(known);
   build_pair_index();

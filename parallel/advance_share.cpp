@@ -358,7 +358,16 @@ void advance_on_part(const Communicator& comm, std::span<const int> owner, Floes
               comm.allgather<contact::JoinCandidate>(routes.candidates);
           counts.candidates += static_cast<long>(candidates.size());
           const std::vector<std::pair<int, std::uint32_t>> to = share.routes(candidates);
-          share.hold(exchange_pairs(comm, part, routed_pairs(part, to, comm.size())));
+          // The pairs with their floes (state at the start, mass, inertia),
+          // which the share then reads from the message (ShareAdvance::hold
+          // takes their start states into its straight paths).
+          const std::vector<contact::Detection> out = routed_pairs(part, to, comm.size());
+          std::vector<RoutedFloes> carried(out.size()), received;
+          for (std::size_t s = 0; s < out.size(); ++s)
+            if (!out[s].pairs.empty()) carried[s] = routed_floes(floes, {}, out[s]);
+          const contact::Detection held = exchange_pairs(comm, part, out, &carried, &received);
+          for (const RoutedFloes& r : received) parallel::hold(r, floes, {});
+          share.hold(held);
         }
         const AdvancePart mine = share_part(share, share.advance(), floes, record ? &own : nullptr);
         const std::vector<AdvancePart> parts = comm.allgather_parts(pack(mine), unpack_advance_part);

@@ -61,7 +61,7 @@ RoutedFloes routed_floes(const Floes& floes, std::span<const FloeState> start, c
   out.floe.erase(std::unique(out.floe.begin(), out.floe.end()), out.floe.end());
   for (const std::uint32_t i : out.floe) {
     out.now.push_back(floes.state[i]);
-    out.start.push_back(start[i]);
+    if (!start.empty()) out.start.push_back(start[i]);
     out.mass.push_back(floes.mass[i]);
     out.inertia_z.push_back(floes.inertia_z[i]);
   }
@@ -72,16 +72,16 @@ void hold(const RoutedFloes& routed, Floes& floes, std::span<FloeState> start) {
   for (std::size_t k = 0; k < routed.floe.size(); ++k) {
     const std::uint32_t i = routed.floe[k];
     floes.state[i] = routed.now[k];
-    start[i] = routed.start[k];
+    if (!routed.start.empty()) start[i] = routed.start[k];
     floes.mass[i] = routed.mass[k];
     floes.inertia_z[i] = routed.inertia_z[k];
   }
 }
 
 std::vector<std::byte> pack(const RoutedFloes& r) {
-  const std::uint64_t n = r.floe.size();
+  const std::uint64_t n[2] = {r.floe.size(), r.start.size()};
   std::vector<std::byte> out;
-  append(out, std::span<const std::uint64_t>(&n, 1));
+  append(out, std::span<const std::uint64_t>(n, 2));
   append(out, std::span<const std::uint32_t>(r.floe));
   append(out, std::span<const FloeState>(r.now));
   append(out, std::span<const FloeState>(r.start));
@@ -93,10 +93,11 @@ std::vector<std::byte> pack(const RoutedFloes& r) {
 RoutedFloes unpack_routed_floes(std::span<const std::byte> bytes) {
   const std::byte* at = bytes.data();
   RoutedFloes r;
-  const auto n = static_cast<std::size_t>(take<std::uint64_t>(at, 1)[0]);
+  const std::vector<std::uint64_t> counts = take<std::uint64_t>(at, 2);
+  const auto n = static_cast<std::size_t>(counts[0]);
   r.floe = take<std::uint32_t>(at, n);
   r.now = take<FloeState>(at, n);
-  r.start = take<FloeState>(at, n);
+  r.start = take<FloeState>(at, static_cast<std::size_t>(counts[1]));
   r.mass = take<double>(at, n);
   r.inertia_z = take<double>(at, n);
   FLOESIM_ASSERT(at == bytes.data() + bytes.size());

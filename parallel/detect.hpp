@@ -81,18 +81,22 @@ contact::Detection select_pairs(const contact::Detection& d, Keep&& keep) {
 
 // The floes of routed pairs (docs/parallel.md, "The state held by owner
 // with a halo", piece 2): what a share's solves read of a floe it need not
-// hold (a step group's member or obstacle beyond its band), sent with the
-// pairs once a floe and receiver. Per floe, ascending: its state on entry
-// (W^-), its state at the step's start, its mass and yaw inertia: 212
-// bytes a floe.
+// hold (a step group's member or obstacle beyond its band; for the
+// advance, a cluster's member, candidate or obstacle), sent with the pairs
+// once a floe and receiver. Per floe, ascending: its present state (the
+// collisions' W^-, the advance's start), its state at the step's start
+// (the collisions only: `start` empty for the advance), its mass and yaw
+// inertia: 212 bytes a floe (116 without `start`).
 struct RoutedFloes {
   std::vector<std::uint32_t> floe;
   std::vector<FloeState> now, start;
   std::vector<double> mass, inertia_z;
 };
-// Both floes of every pair of `pairs`, as `floes` (W^-) and `start` hold them.
+// Both floes of every pair of `pairs`, as `floes` and `start` (if not
+// empty) hold them.
 RoutedFloes routed_floes(const Floes& floes, std::span<const FloeState> start, const contact::Detection& pairs);
-// Writes `routed`'s floes into `floes` (state, mass, inertia) and `start`.
+// Writes `routed`'s floes into `floes` (state, mass, inertia) and, if it
+// carries them, their states at the step's start into `start`.
 void hold(const RoutedFloes& routed, Floes& floes, std::span<FloeState> start);
 std::vector<std::byte> pack(const RoutedFloes& routed);
 RoutedFloes unpack_routed_floes(std::span<const std::byte> bytes);

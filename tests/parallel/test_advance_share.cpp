@@ -12,6 +12,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <memory>
 #include <numeric>
 #include <random>
@@ -456,18 +457,46 @@ namespace {
 // With `merged`, each share records into a record of its own, whose events
 // are merged into `merged` (or the whole advance records into it), and
 // `events` gets each share's event count.
+//
+// With `poisoned` (the halo plan's piece 2, docs/parallel.md): each share's
+// copy has every floe NaN (state, mass, inertia, vertices) but its strip's
+// and its part's pairs' floes, and then holds the floes the routed pairs
+// carry (parallel::RoutedFloes, through their bytes) before it runs;
+// `packed` gets each share's part as bytes and `fetched` counts the floes
+// a share received that its copy did not hold. `f` is then not the answer
+// (the copies are poisoned): compare the parts with a clean play's.
+struct Poisoned {
+  bool poison = true;  // false: the parts' bytes only, from the whole state
+  std::vector<std::vector<std::byte>> packed;
+  long fetched = 0;
+};
+void poison_floe(Floes& f, std::size_t i) {
+  constexpr double nan = std::numeric_limits<double>::quiet_NaN();
+  double* d = reinterpret_cast<double*>(&f.state[i]);
+  std::fill_n(d, sizeof(FloeState) / sizeof(double), nan);
+  f.mass[i] = f.inertia_z[i] = nan;
+  for (std::size_t k = f.offsets[i]; k < f.offsets[i + 1]; ++k) f.body[k] = Vec2::Constant(nan);
+}
 bool play_parts(const Case& c, const parallel::FloeOwners& strips, std::span<const int> owner, int ranks, Floes& f,
                 contact::CollisionStats& stats, contact::SubstepReport& report, long& sent, long& missing,
                 long& pads, bool candidates = true, contact::ImpulseRecord* merged = nullptr,
-                std::vector<std::uint32_t>* events = nullptr) {
+                std::vector<std::uint32_t>* events = nullptr, Poisoned* poisoned = nullptr) {
   const auto n = static_cast<std::size_t>(ranks);
   std::vector<Floes> copies(n, c.floes);
+  std::vector<std::vector<std::uint8_t>> held(n, std::vector<std::uint8_t>(c.floes.size(), 0));
   std::vector<contact::Detection> parts;
   std::vector<std::unique_ptr<contact::ShareAdvance>> shares;
   std::vector<contact::ShareRooms> rooms;
   std::vector<contact::ImpulseRecord> own(n);
   for (int r = 0; r < ranks; ++r)
     parts.push_back(parallel::detect_part(strips, r, c.floes, c.shapes, c.detect_options));
+  if (poisoned && poisoned->poison)
+    for (std::size_t k = 0; k < n; ++k) {
+      for (std::size_t i = 0; i < c.floes.size(); ++i) held[k][i] = strips.owner()[i] == static_cast<int>(k);
+      for (const contact::NearPair& q : parts[k].pairs) held[k][q.a] = held[k][q.b] = 1;
+      for (std::size_t i = 0; i < c.floes.size(); ++i)
+        if (!held[k][i]) poison_floe(copies[k], i);
+    }
   for (int r = 0; r < ranks; ++r) {
     const std::size_t k = static_cast<std::size_t>(r);
     contact::SubstepOptions o = c.options;
@@ -501,20 +530,35 @@ bool play_parts(const Case& c, const parallel::FloeOwners& strips, std::span<con
   std::vector<std::vector<contact::Detection>> out;
   for (std::size_t k = 0; ok && k < n; ++k)
     out.push_back(parallel::routed_pairs(parts[k], shares[k]->routes(joins), ranks));
+  if (ok && poisoned && poisoned->poison) {
+    // The routed pairs' floes, from each sender's copy before any share
+    // moves a floe (a rank sends them before it advances), through their bytes.
+    std::vector<std::vector<parallel::RoutedFloes>> carried(n);
+    for (std::size_t s = 0; s < n; ++s)
+      for (std::size_t k = 0; k < n; ++k)
+        carried[s].push_back(parallel::unpack_routed_floes(
+            parallel::pack(parallel::routed_floes(copies[s], {}, out[s][k]))));
+    for (std::size_t k = 0; k < n; ++k)
+      for (std::size_t s = 0; s < n; ++s) {
+        for (const std::uint32_t i : carried[s][k].floe) poisoned->fetched += held[k][i] ? 0 : 1;
+        parallel::hold(carried[s][k], copies[k], {});
+      }
+  }
   if (ok) {
     std::vector<parallel::AdvancePart> advanced;
     for (std::size_t k = 0; k < n; ++k) {
-      std::vector<contact::Detection> held{parts[k]};
+      std::vector<contact::Detection> pairs{parts[k]};
       for (std::size_t s = 0; s < n; ++s)
         if (!out[s][k].pairs.empty()) {
           sent += static_cast<long>(out[s][k].pairs.size());
-          held.push_back(parallel::unpack_detection(parallel::pack(out[s][k])));
+          pairs.push_back(parallel::unpack_detection(parallel::pack(out[s][k])));
         }
-      shares[k]->hold(parallel::merge(std::move(held)));
+      shares[k]->hold(parallel::merge(std::move(pairs)));
       const parallel::AdvancePart part =
           parallel::share_part(*shares[k], shares[k]->advance(), copies[k], merged ? &own[k] : nullptr);
       if (part.outcome.conflict == contact::ShareOutcome::Conflict::missing_pairs) ++missing;
       if (merged) events->push_back(part.record.events);
+      if (poisoned) poisoned->packed.push_back(parallel::pack(part));
       advanced.push_back(parallel::unpack_advance_part(parallel::pack(part)));
     }
     f = std::move(copies.front());
@@ -541,7 +585,8 @@ struct PartsPlay {
   contact::ImpulseRecord record;        // with `record`: the merged record (after one earlier event)
   std::vector<std::uint32_t> events;    // with `record`: each share's event count
 };
-PartsPlay play_shifted(const Case& c, int ranks, int shift, bool candidates = true, bool record = false) {
+PartsPlay play_shifted(const Case& c, int ranks, int shift, bool candidates = true, bool record = false,
+                       Poisoned* poisoned = nullptr) {
   parallel::FloeOwners strips(0, ranks, c.domain);
   strips.assign(c.floes);
   std::vector<int> owner(strips.owner().begin(), strips.owner().end());
@@ -549,7 +594,7 @@ PartsPlay play_shifted(const Case& c, int ranks, int shift, bool candidates = tr
   PartsPlay p;
   p.record.events = 1;  // the step-start collisions' event
   p.ok = play_parts(c, strips, owner, ranks, p.f, p.stats, p.report, p.sent, p.stopped, p.pads, candidates,
-                    record ? &p.record : nullptr, &p.events);
+                    record ? &p.record : nullptr, &p.events, poisoned);
   return p;
 }
 // The played advance is the serial one: states to the bit, counts, report.
@@ -615,6 +660,61 @@ TEST_CASE("the advance from each rank's part of the detection over 1, 2, 3 and 7
   CHECK(missing_bare > 0);  // the packs do have floes joining across parts
   CHECK(combined > combined_bare);
   CHECK(missing < missing_bare);
+}
+
+TEST_CASE("the advance's share reads its strip, its part's floes and the floes the routed pairs carry") {
+  // The halo plan's piece 2 for the advance: each share's copy has every
+  // floe poisoned but its strip's and its part's pairs' floes, and holds
+  // the routed pairs' floes from their bytes (state at the step's start,
+  // mass, inertia) before it runs (ShareAdvance::hold takes their straight
+  // paths from them). Each share's part, as bytes, equals its part on the
+  // whole state, over 2, 3 and 7 strips, the clusters' owners the strips
+  // and shifted by one rank (the members then lie on other strips), and
+  // where they combine, the combination is the advance's. The
+  // collision shapes are not poisoned: the substeps pose the members' and
+  // candidates' shapes, which the pairs do not carry yet.
+  long fetched = 0;
+  int compared = 0;
+  const std::pair<unsigned, double> packs[] = {{3u, 2.0}, {11u, 2.0}, {9u, 1.8}};
+  for (const auto& [seed, speed] : packs) {
+    CAPTURE(seed);
+    const Case c = dense_pack(speed, seed, 0.5);
+    for (const int ranks : {2, 3, 7})
+      for (const int shift : {0, 1}) {
+        CAPTURE(ranks);
+        CAPTURE(shift);
+        Poisoned clean, poisoned;
+        clean.poison = false;
+        const PartsPlay whole = play_shifted(c, ranks, shift, true, false, &clean);
+        const PartsPlay p = play_shifted(c, ranks, shift, true, false, &poisoned);
+        CHECK(p.ok == whole.ok);
+        // Each share's part, as bytes: the poisoned copy's equals the whole state's.
+        CHECK(poisoned.packed == clean.packed);
+        MESSAGE(ranks << " ranks, shift " << shift << ": " << std::string(whole.ok ? "combined" : "fell back") << ", "
+                      << poisoned.fetched << " floes fetched with the routed pairs");
+        fetched += poisoned.fetched;
+        if (poisoned.packed.size() == static_cast<std::size_t>(ranks)) {
+          // Combined on the whole state: the poisoned parts combined are its answer.
+          if (whole.ok) {
+            std::vector<parallel::AdvancePart> parts;
+            for (const auto& b : poisoned.packed) parts.push_back(parallel::unpack_advance_part(b));
+            Floes f = c.floes;
+            contact::CollisionStats stats;
+            contact::SubstepReport report;
+            // Free floes: where the whole play put them (every rank moves them itself).
+            f.state = whole.f.state;
+            REQUIRE(parallel::combine_parts(parts, f, stats, report, nullptr));
+            CHECK(std::memcmp(f.state.data(), whole.f.state.data(), f.state.size() * sizeof(FloeState)) == 0);
+            CHECK(same_stats(stats, whole.stats));
+            CHECK(same_report(report, whole.report));
+            ++compared;
+          }
+        }
+      }
+  }
+  MESSAGE(compared << " splits compared, " << fetched << " floes fetched with the routed pairs");
+  CHECK(compared >= 6);
+  CHECK(fetched > 0);
 }
 
 TEST_CASE("the advance from each rank's part with jam-sized clusters gathers their pads and is the serial advance") {
