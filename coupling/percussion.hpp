@@ -249,7 +249,7 @@ public:
   // why there is none. It reads floe i and the floes whose centroid lies
   // within R_i + R_j + gap of its centroid (R the radius about the
   // centroid), no other: within the halo band of floe i's owner
-  // (docs/parallel.md, "Splits"; tests/parallel/test_halo.cpp).
+  // (docs/parallel.md, "Splits"; tests/parallel/test_halo_split.cpp).
   SplitDecision decide_split(const Floes& floes, std::size_t i, const FloeInitiation& fi) const;
 
   // The initiations since the last call.

@@ -295,12 +295,9 @@ void Simulation::collide(StepContext& ctx) {
   // are keyed by pair, so record runs too).
   if (comm_.serial())
     contact::resolve_step_collisions(scenario_.floes, ctx.start, detection_, ctx.dt, impulse_options_, stats_);
-  else if (detection_part_)
+  else  // every detection on several ranks leaves this rank's part (the start's and a split's too)
     parallel::collide_on_part(comm_, owners_.owner(), scenario_.floes, ctx.start, *detection_part_, ctx.dt,
                               impulse_options_, stats_, collide_share_);
-  else
-    parallel::collide_by_owner(comm_, owners_.owner(), scenario_.floes, ctx.start, detection_, ctx.dt,
-                               impulse_options_, stats_, collide_share_);
   add_owned_momentum(std::span(ctx.momenta).subspan<StepContext::kAfterCollide, 2>());
 }
 

@@ -9,6 +9,10 @@
 //   is the decision on the whole state, bit for bit (verdict and opening);
 //   the decisions made so, concluded in floe order as every rank does, give
 //   the serial floes and events;
+// - a decision taken again when concluding (an earlier split of the step came
+//   within reach) reads the owner's band and the pieces of the splits whose
+//   parent it holds: each crack's decision at its turn, on that copy, is the
+//   decision on the whole state;
 // - a split's pieces (Percussion::conclude with the decision) are built from
 //   the parent alone: on the owner's poisoned copy they are the pieces made on
 //   the whole state, at the same indices with the same ids, and no floe
@@ -221,6 +225,69 @@ TEST_CASE("a split decided and built by its floe's owner reads only the owner's 
       CHECK(built == static_cast<std::size_t>(st.splits));
       CHECK(pieces);
       CHECK(untouched);
+    }
+  }
+}
+
+TEST_CASE("a split decided again when concluding reads only its owner's band and the pieces of the parents it holds") {
+  // Percussion::conclude decides a split again against the floes as they
+  // are at its turn (an earlier split of the step came within reach of
+  // it). Each crack's decision at its turn in the serial conclusion (the
+  // floes after the splits of the cracks before it, in floe order), made on
+  // its owner's copy poisoned outside the owner's band (at the step's end)
+  // and the pieces of the splits whose parent the band holds, equals the
+  // decision on the whole state, bit for bit.
+  for (const bool periodic : {true, false}) {
+    CAPTURE(periodic);
+    const Pack p = moving_pack(11, periodic, 0.5, kConcentration);
+    const std::size_t n = p.floes.size();
+    Percussion share(split_params(), opening(p));
+    std::vector<FloeInitiation> decided = cracks(p.floes);
+    for (FloeInitiation& fi : decided) fi.split = share.decide_split(p.floes, fi.floe, fi);
+    // The floes at each crack's turn, and the parents of the splits before
+    // it in order (the m-th split's second piece is floe n + m).
+    std::vector<Floes> at_turn;
+    std::vector<std::size_t> parents;
+    std::vector<std::size_t> parents_before;  // per crack: how many of `parents` precede it
+    {
+      Percussion all(split_params(), opening(p));
+      Floes whole = p.floes;
+      all.conclude(whole, analyses_of(decided));
+      const std::vector<FractureEventRow> events = all.take_events();
+      REQUIRE(events.size() == decided.size());
+      for (std::size_t k = 0; k < decided.size(); ++k) {
+        Percussion prefix(split_params(), opening(p));
+        Floes f = p.floes;
+        prefix.conclude(f, analyses_of(std::vector<FloeInitiation>(decided.begin(), decided.begin() + static_cast<std::ptrdiff_t>(k))));
+        at_turn.push_back(std::move(f));
+        parents_before.push_back(parents.size());
+        if (events[k].piece_a >= 0.0) parents.push_back(decided[k].floe);
+      }
+    }
+    std::size_t changed = 0;  // decisions at their turn other than at the step's end
+    for (std::size_t k = 0; k < decided.size(); ++k)
+      if (!same_decision(share.decide_split(at_turn[k], decided[k].floe, decided[k]), decided[k].split)) ++changed;
+    MESSAGE(std::string(periodic ? "periodic" : "open") << ": " << changed << " of " << decided.size()
+                                                        << " decisions change by the earlier splits of the step");
+    REQUIRE(changed > 0);
+    for (const int ranks : {2, 3, 7}) {
+      CAPTURE(ranks);
+      parallel::FloeOwners owners(0, ranks, p.detect.domain);
+      owners.assign(p.floes);
+      std::vector<Held> band;
+      for (int r = 0; r < ranks; ++r) band.push_back(halo_band(owners, r, p.floes, p.shapes, p.detect));
+      bool decisions = true;
+      for (std::size_t k = 0; k < decided.size(); ++k) {
+        const FloeInitiation& fi = decided[k];
+        const Held& b = band[static_cast<std::size_t>(owners.owner()[fi.floe])];
+        const Floes& f = at_turn[k];
+        Held held(f.size(), 0);
+        for (std::size_t j = 0; j < n; ++j) held[j] = b[j];
+        for (std::size_t m = 0; m < parents_before[k]; ++m) held[n + m] = b[parents[m]];
+        decisions = decisions && same_decision(share.decide_split(poisoned(f, held), fi.floe, fi),
+                                               share.decide_split(f, fi.floe, fi));
+      }
+      CHECK(decisions);
     }
   }
 }
