@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cerrno>
+#include <chrono>
 #include <csignal>
 #include <cstdio>
 #include <cstring>
@@ -192,6 +193,7 @@ int run(const Args& args, const parallel::Session& session) {
   Config config;
   Checkpoint checkpoint;
   std::unique_ptr<Simulation> simulation;
+  double setup_seconds = 0.0;  // s
   // Every rank reads and checks the input and builds the scenario before
   // any work is shared: bad input on any rank stops every rank with its
   // message (the same on each, as they read the same files).
@@ -240,9 +242,14 @@ int run(const Args& args, const parallel::Session& session) {
           throw InputError(m.str());
         }
     share_cores(config, session);
-    simulation = std::make_unique<Simulation>(build_scenario(config), comm);
+    Scenario scenario = build_scenario(config);
+    const auto setup_begin = std::chrono::steady_clock::now();
+    simulation = std::make_unique<Simulation>(std::move(scenario), comm);
+    if (restart) simulation->restore(checkpoint);
+    // The summary's setup_time: the run's set-up on this rank (shapes, the
+    // start's detection, the sea), not the reading of the input.
+    setup_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - setup_begin).count();
     if (restart) {
-      simulation->restore(checkpoint);
       release_restored(checkpoint);  // the simulation holds that state now; the run keeps the marks
       // A new output starts as a copy of the run; the records after the checkpoint are dropped from it.
       if (comm.writer() && !(path_exists(output) && fs::equivalent(output, args.restart))) {
@@ -292,7 +299,7 @@ int run(const Args& args, const parallel::Session& session) {
   o << "\ncheckpoint: " << (s.checkpoint_time >= 0.0 ? std::to_string(s.checkpoint_time) + " s" : "none") << "\noutput: " << fs::absolute(s.output).string()
     << "\nparaview: " << fs::absolute(s.xdmf).string() << "\nfloes: " << sim.floes().size() << "\nsteps: " << s.steps
     << "\nrecords: " << s.records << "\nsimulated: " << s.t_end << " s\nwall_time: " << std::setprecision(4)
-    << s.wall_seconds << " s\nsteps_per_second: " << (s.wall_seconds > 0 ? static_cast<double>(run_steps) / s.wall_seconds : 0.0)
+    << s.wall_seconds << " s\nsetup_time: " << setup_seconds << " s\nsteps_per_second: " << (s.wall_seconds > 0 ? static_cast<double>(run_steps) / s.wall_seconds : 0.0)
     << "\n";
   o << std::setprecision(8);
   for (std::size_t k = 0; k < s.energy_last.names.size(); ++k)

@@ -243,6 +243,15 @@ public:
   // floes changed.
   bool conclude(Floes& floes, PercussionAnalyses all);
 
+  // Floe i's split along the crack of `fi` (mesh frame), worked out against
+  // `floes`: the pieces at the widest opening (from gap, quartered down to
+  // 1e-3 gap) at which neither overlaps a floe within reach of floe i, or
+  // why there is none. It reads floe i and the floes whose centroid lies
+  // within R_i + R_j + gap of its centroid (R the radius about the
+  // centroid), no other: within the halo band of floe i's owner
+  // (docs/parallel.md, "Splits"; tests/parallel/test_halo_split.cpp).
+  SplitDecision decide_split(const Floes& floes, std::size_t i, const FloeInitiation& fi) const;
+
   // The initiations since the last call.
   std::vector<FractureEventRow> take_events();
   const PercussionStats& stats() const { return stats_; }
@@ -255,11 +264,6 @@ public:
 
 private:
   fracture::FloeFracture& model_of(const Floes& floes, std::size_t i);
-  // Floe i's split along the crack of `fi` (mesh frame), worked out against
-  // `floes`: the pieces at the widest opening (from gap, quartered down to
-  // 1e-3 gap) at which neither overlaps a floe within reach of floe i, or
-  // why there is none.
-  SplitDecision decide_split(const Floes& floes, std::size_t i, const FloeInitiation& fi) const;
   // Makes `decision` (a split: floe i becomes the first piece, the second is
   // appended; the event gets their numbers) and counts it. Returns whether
   // the floes changed.

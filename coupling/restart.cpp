@@ -6,6 +6,7 @@
 
 #include "core/error.hpp"
 #include "coupling/simulation.hpp"
+#include "fluid/fft2d.hpp"
 #include "fluid/sea.hpp"
 
 namespace floesim {
@@ -134,8 +135,13 @@ void Simulation::restore(const Checkpoint& c) {
   quadrature_ = build_footprint_quadrature(scenario_.floes);
   shapes_ = contact::build_collision_shapes(scenario_.floes);
   set_reach();
-  detection_ = contact::detect(scenario_.floes, shapes_, detection_options_);
-  detection_whole_ = true;
+  // The owners by place start again from the restored places, as at a
+  // run's start (the strips by equal counts, or the sea's slabs), and the
+  // detection is made by place.
+  owners_ = parallel::FloeOwners(comm_.rank(), comm_.size(), detection_options_.domain);
+  if (sea_ && !sea_->slab_rows().empty())
+    owners_.set_slabs({sea_->slab_rows(), sea_->grid().dy(), fluid::RealFft2d::kRows});
+  detect_in_place();
   if (sea_) restore_modal(*sea_, c.sea, "the sea");
   if (incident_) incident_->restore(c.incident);
   if (floe_sea_) floe_sea_->restore(c.floe_sea, scenario_.floes, *sea_, incident_.get());

@@ -99,11 +99,6 @@ Simulation::Simulation(Scenario scenario, parallel::Communicator comm)
   advance_share_options_.on_part = c.run.advance_on_part;
   wrap_periodic();
   set_reach();
-  detection_ = contact::detect(scenario_.floes, shapes_, detection_options_);
-  for (const contact::NearPair& p : detection_.pairs)
-    if (p.overlap)
-      throw InputError(where(c.file, 0, "", "floes " + std::to_string(p.a) + " and " + std::to_string(p.b) +
-                                                " overlap at t = 0 (floes are numbered from 0: pack floes first, then inline ones)"));
   fluid::SeaOptions sea_options;
   sea_options.tank = {c.sea.tank.enabled, c.sea.tank.generation_length, c.sea.tank.absorption_length,
                       c.sea.tank.rate, c.sea.tank.ramp_periods};
@@ -140,6 +135,15 @@ Simulation::Simulation(Scenario scenario, parallel::Communicator comm)
   // transform's rows (drift()); otherwise the strips' cuts are free in y.
   if (sea_ && !sea_->slab_rows().empty())
     owners_.set_slabs({sea_->slab_rows(), sea_->grid().dy(), fluid::RealFft2d::kRows});
+  // The start's detection, by place as each step's (the strips known). The
+  // first overlapping pair in pair order, found from the parts (the serial
+  // scan's), is the error on every rank.
+  detect_in_place();
+  const parallel::Overlap overlap = parallel::first_overlap(comm_, comm_.serial() ? detection_ : *detection_part_,
+                                                            comm_.serial() ? detection_ : *detection_part_);
+  if (overlap.any)
+    throw InputError(where(c.file, 0, "", "floes " + std::to_string(overlap.a) + " and " + std::to_string(overlap.b) +
+                                              " overlap at t = 0 (floes are numbered from 0: pack floes first, then inline ones)"));
   // Pieces of a split are opened by the gap that collisions keep between floes.
   if (c.fracture.enabled) percussion_ = std::make_unique<Percussion>(c.fracture, impulse_options_.min_gap);
   record_collisions_ = c.run.record_collisions;
@@ -291,12 +295,9 @@ void Simulation::collide(StepContext& ctx) {
   // are keyed by pair, so record runs too).
   if (comm_.serial())
     contact::resolve_step_collisions(scenario_.floes, ctx.start, detection_, ctx.dt, impulse_options_, stats_);
-  else if (detection_part_)
+  else  // every detection on several ranks leaves this rank's part (the start's and a split's too)
     parallel::collide_on_part(comm_, owners_.owner(), scenario_.floes, ctx.start, *detection_part_, ctx.dt,
                               impulse_options_, stats_, collide_share_);
-  else
-    parallel::collide_by_owner(comm_, owners_.owner(), scenario_.floes, ctx.start, detection_, ctx.dt,
-                               impulse_options_, stats_, collide_share_);
   add_owned_momentum(std::span(ctx.momenta).subspan<StepContext::kAfterCollide, 2>());
 }
 
@@ -335,9 +336,10 @@ void Simulation::on_floes_changed() {
   quadrature_ = build_footprint_quadrature(scenario_.floes);
   shapes_ = contact::build_collision_shapes(scenario_.floes);
   set_reach();  // one reach per floe: detect reads reach[i] for every floe, new pieces included
-  detection_ = contact::detect(scenario_.floes, shapes_, detection_options_);
-  detection_whole_ = true;
-  detection_part_.reset();
+  // The pieces are placed (appended at the same indices with the same ids
+  // on every rank: Percussion::conclude on the same initiations in floe
+  // order) and the detection made by place, as after a step.
+  detect_in_place();
   if (floe_sea_) {
     // A split piece keeps its parent's reference bottom (same thickness);
     // the loads are evaluated afresh for the new footprints.
@@ -488,6 +490,24 @@ bool Simulation::detect_and_check(StepContext& ctx) {
   detection_whole_ = comm_.serial() || whole;
   if (!comm_.serial()) detection_part_ = std::move(part);
   return true;
+}
+
+void Simulation::detect_in_place() {
+  // Each rank its part, the pairs of the floes it owns at their present
+  // places (parallel::detect, as detect_and_check's); the whole lists
+  // gathered only for the advance from the whole detection, else by
+  // whole_detection() when a step needs them.
+  if (comm_.serial()) {
+    detection_ = contact::detect(scenario_.floes, shapes_, detection_options_);
+    detection_whole_ = true;
+    return;
+  }
+  owners_.assign(scenario_.floes);
+  contact::Detection part;
+  const bool whole = !advance_share_options_.on_part;
+  detection_ = parallel::detect(comm_, owners_, scenario_.floes, shapes_, detection_options_, &part, whole);
+  detection_whole_ = whole;
+  detection_part_ = std::move(part);
 }
 
 const contact::Detection& Simulation::whole_detection() {

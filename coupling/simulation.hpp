@@ -209,6 +209,9 @@ private:
   void on_floes_changed();  // rebuilds every per-floe structure (after a split)
   void advance(StepContext& ctx);
   bool detect_and_check(StepContext& ctx);  // false: the step overlapped, dt halved
+  // The detection at the present places outside a step (the start, a
+  // restore, after a split): by place, this rank's part (collective).
+  void detect_in_place();
   void wrap_periodic();
   // Detection reach of each floe for the next step. Collective: the pack's
   // rms speed is summed by owner; `along` (exact sums of this rank's part)
@@ -243,8 +246,7 @@ private:
   std::unique_ptr<contact::WarmStart> warm_ = std::make_unique<contact::WarmStart>();  // jam LCPs' last bases
   contact::Detection detection_;  // at the present positions
   // On several ranks, this rank's part of detection_ (the pairs it
-  // detected, parallel::detect); empty at the start and after a split,
-  // whose detection is made whole on every rank.
+  // detected, parallel::detect; at the start and after a split too).
   std::optional<contact::Detection> detection_part_;
   // Whether detection_ holds the whole detection. On several ranks with the
   // advance from the parts, detect_and_check gathers it only when a step
