@@ -238,15 +238,19 @@ void Simulation::floes_half_kick(StepContext& ctx) {
 void Simulation::drift(StepContext& ctx) {
   const Vec2 current{ctx.forcing.current[0], ctx.forcing.current[1]};
   const Vec2 wind{ctx.forcing.wind[0], ctx.forcing.wind[1]};
+  // Drag relative to the current plus the incident waves' orbital velocity
+  // at t (on several ranks, of the floes this rank drifts: after the owners'
+  // update below).
   std::vector<Vec2> water;
-  if (floe_sea_) {
-    // Drag relative to the current plus the incident waves' orbital velocity at t.
+  const auto water_at = [&] {
+    if (!floe_sea_) return;
     const std::span<const Vec2> orbital = floe_sea_->water_velocity();
     water.assign(orbital.begin(), orbital.end());
     for (Vec2& w : water) w += current;
-  }
+  };
   moorings_.kick(scenario_.floes, ctx.dt);
   if (comm_.serial()) {
+    water_at();
     drift_velocities(scenario_.floes, quadrature_, drift_params_, current, wind, ctx.dt, 0, scenario_.floes.size(),
                      water);
   } else {
@@ -259,6 +263,9 @@ void Simulation::drift(StepContext& ctx) {
     if (owners_.has_slabs() && floe_sea_) owners_.charge_coupling(floe_sea_->take_owned_seconds());
     // Floes migrate; every few steps the strips move (with slabs, the sea's and the coupling's too).
     if (owners_.update(comm_, scenario_.floes, steps_) && owners_.has_slabs()) follow_slabs();
+    // The coupling's owners computed the water velocities; the drift's read them.
+    if (floe_sea_) floe_sea_->hand_water_over(owners_.owner());
+    water_at();
     const double start = parallel::thread_seconds();
     drift_velocities(scenario_.floes, quadrature_, drift_params_, current, wind, ctx.dt, owners_.mine(), water);
     owners_.charge(parallel::thread_seconds() - start);
