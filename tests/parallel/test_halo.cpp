@@ -12,7 +12,9 @@
 //   across the periodic seam by the nearest image; the band holds the
 //   detection subset's posed floes, and a band of one pad (H only) loses
 //   pairs across the cuts: the comparison has teeth;
-// - the drift of the rank's floes: its own floes only;
+// - the drift of the rank's floes: its own floes only, and their water
+//   velocities reach it from the coupling's owners by the hand-over
+//   (parallel::plan_hand_over, the ranks simulated);
 // - the collisions at the step's start from the rank's part
 //   (parallel::collide_on_part's pieces): the edges from the band, then each
 //   share on the members of its step groups only, wherever they lie.
