@@ -488,22 +488,15 @@ void FloeSeaContact::advance_vertical(Floes& floes, std::span<const FloeState> s
   sea.flow(h);
 }
 
-double FloeSeaContact::floes_vertical_kinetic(const Floes& floes) const {
-  double e = 0.0;
-  for (std::size_t i = 0; i < floes.size(); ++i) {
-    if (!dynamic_[i]) continue;
-    const FloeState& st = floes.state[i];
-    const Eigen::Vector2d ar(st.pitch_rate, st.roll_rate);
-    e += 0.5 * floes.mass[i] * st.heave_rate * st.heave_rate + 0.5 * ar.dot(tilt_inertia(floes, i) * ar);
-  }
-  return e;
+double FloeSeaContact::vertical_kinetic(const Floes& floes, std::size_t i) const {
+  if (!dynamic_[i]) return 0.0;
+  const FloeState& st = floes.state[i];
+  const Eigen::Vector2d ar(st.pitch_rate, st.roll_rate);
+  return 0.5 * floes.mass[i] * st.heave_rate * st.heave_rate + 0.5 * ar.dot(tilt_inertia(floes, i) * ar);
 }
 
-double FloeSeaContact::floes_weight_energy(const Floes& floes) const {
-  double e = 0.0;
-  for (std::size_t i = 0; i < floes.size(); ++i)
-    if (dynamic_[i]) e += floes.mass[i] * g_ * floes.state[i].heave;
-  return e;
+double FloeSeaContact::weight_energy(const Floes& floes, std::size_t i) const {
+  return dynamic_[i] ? floes.mass[i] * g_ * floes.state[i].heave : 0.0;
 }
 
 }  // namespace floesim

@@ -256,17 +256,21 @@ public:
   // linear limit 2 / omega; the contact is not linear, see floe_sea.cpp).
   double stable_step() const { return stable_step_; }
 
-  // Energies (J) at the last evaluate(): the penalty spring's, and the floes'
-  // vertical kinetic and weight (M g zeta) energies at the present state.
-  // By owner with the sea in slabs the first call after an evaluation is
+  // Energies (J): the penalty spring's at the last evaluate(), and (below)
+  // each floe's vertical kinetic and weight (M g zeta) energies at the
+  // present state. By owner with the sea in slabs the first call after an evaluation is
   // collective (every rank's terms gathered and summed in the serial order:
   // settle_energy).
   double penalty_energy() const {
     if (energy_pending_) settle_energy();
     return penalty_energy_;
   }
-  double floes_vertical_kinetic(const Floes& floes) const;
-  double floes_weight_energy(const Floes& floes) const;
+  // Floe i's terms of the floes' vertical kinetic energy (heave, pitch and
+  // roll rates) and of their weight energy M g zeta (0 for a floe the sea
+  // does not move): the caller sums them exactly over the floes it owns
+  // (Simulation::energies), so the sums do not depend on the ranks.
+  double vertical_kinetic(const Floes& floes, std::size_t i) const;
+  double weight_energy(const Floes& floes, std::size_t i) const;
 
   // Height of floe i's bottom at its centroid, z_b(G) = zeta + z0 (m).
   double bottom(const Floes& floes, std::size_t i) const { return floes.state[i].heave + bottom0_[i]; }

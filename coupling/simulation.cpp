@@ -575,22 +575,24 @@ void Simulation::close_step(StepContext& ctx) {
 }
 
 Energies Simulation::energies() const {
-  // The floes' horizontal kinetic energy: each floe's term, then their
-  // exact sum by owner, combined over the ranks (one call; the same bits on
-  // any number of ranks).
+  // The floes' kinetic energies (horizontal; with a sea, vertical) and
+  // their weight energy: each floe's terms, then their exact sums by owner,
+  // combined over the ranks (one call; the same bits on any number of ranks).
   const Floes& f = scenario_.floes;
-  std::array<ExactSum, 1> horizontal;
+  std::array<ExactSum, 3> sums;  // horizontal kinetic, vertical kinetic, weight
   for_owned([&](std::size_t i) {
     if (f.is_static[i]) return;
     const FloeState& s = f.state[i];
-    horizontal[0].add(0.5 * f.mass[i] * (s.vx * s.vx + s.vy * s.vy) + 0.5 * f.inertia_z[i] * s.yaw_rate * s.yaw_rate);
+    sums[0].add(0.5 * f.mass[i] * (s.vx * s.vx + s.vy * s.vy) + 0.5 * f.inertia_z[i] * s.yaw_rate * s.yaw_rate);
+    if (!floe_sea_) return;
+    sums[1].add(floe_sea_->vertical_kinetic(f, i));
+    sums[2].add(floe_sea_->weight_energy(f, i));
   });
-  comm_.sum(horizontal);
-  Energies e{{"floes_horizontal_kinetic"}, {horizontal[0].value()}};
+  comm_.sum(floe_sea_ ? std::span<ExactSum>(sums) : std::span<ExactSum>(sums).first(1));
+  Energies e{{"floes_horizontal_kinetic"}, {sums[0].value()}};
   if (floe_sea_) {
     e.names.insert(e.names.end(), {"floes_vertical_kinetic", "floes_weight", "penalty"});
-    e.values.insert(e.values.end(), {floe_sea_->floes_vertical_kinetic(f), floe_sea_->floes_weight_energy(f),
-                                     floe_sea_->penalty_energy()});
+    e.values.insert(e.values.end(), {sums[1].value(), sums[2].value(), floe_sea_->penalty_energy()});
   }
   if (sea_) {
     const fluid::SeaEnergy se = sea_->energy();
