@@ -377,7 +377,7 @@ void FloeSeaContact::horizontal_loads(std::span<const double> u) {
 void FloeSeaContact::evaluate_loads(const Floes& floes, fluid::Sea& sea, IncidentSea* incident, double h) {
   evaluate(floes, sea, h);
   update_water(floes, sea, incident);
-  share_owned(true);
+  share_owned();
   // After an implicit step the horizontal loads are that step's mean (zero
   // on a floe that had no pieces on the step's midpoint footprint).
   if (step_mean_pending_)
@@ -392,7 +392,9 @@ void FloeSeaContact::ready_loads(const Floes& floes, fluid::Sea& sea, IncidentSe
 
 void FloeSeaContact::update_water(const Floes& floes, const fluid::Sea& sea, IncidentSea* incident) {
   water_.assign(floes.size(), Vec2::Zero());
+  water_by_owner_ = false;  // zero on every rank
   if (!incident) return;
+  water_by_owner_ = !comm_.serial();
   // Routed with the floes owned by place, this rank's floes' pieces lie
   // within reach_rows_from(first_slab_rows_) of the first slabs (the
   // owners follow the sea's slabs, which may have moved from them), which
@@ -403,7 +405,7 @@ void FloeSeaContact::update_water(const Floes& floes, const fluid::Sea& sea, Inc
   const double w = incident->weight(sea.time());
   const fluid::RowWindow u0 = incident->u0(), v0 = incident->v0(), u1 = incident->u1(), v1 = incident->v1();
   const Footprints& fp = footprints_.pieces();
-  // Each rank its own floes; the caller shares them (share_owned).
+  // Each rank its own floes; the drift's owners get them (hand_water_over).
   const std::span<const std::uint32_t> mine = footprints_.mine();
   const std::ptrdiff_t count = static_cast<std::ptrdiff_t>(mine.size());
   const double start = owned_clock();
@@ -486,22 +488,15 @@ void FloeSeaContact::advance_vertical(Floes& floes, std::span<const FloeState> s
   sea.flow(h);
 }
 
-double FloeSeaContact::floes_vertical_kinetic(const Floes& floes) const {
-  double e = 0.0;
-  for (std::size_t i = 0; i < floes.size(); ++i) {
-    if (!dynamic_[i]) continue;
-    const FloeState& st = floes.state[i];
-    const Eigen::Vector2d ar(st.pitch_rate, st.roll_rate);
-    e += 0.5 * floes.mass[i] * st.heave_rate * st.heave_rate + 0.5 * ar.dot(tilt_inertia(floes, i) * ar);
-  }
-  return e;
+double FloeSeaContact::vertical_kinetic(const Floes& floes, std::size_t i) const {
+  if (!dynamic_[i]) return 0.0;
+  const FloeState& st = floes.state[i];
+  const Eigen::Vector2d ar(st.pitch_rate, st.roll_rate);
+  return 0.5 * floes.mass[i] * st.heave_rate * st.heave_rate + 0.5 * ar.dot(tilt_inertia(floes, i) * ar);
 }
 
-double FloeSeaContact::floes_weight_energy(const Floes& floes) const {
-  double e = 0.0;
-  for (std::size_t i = 0; i < floes.size(); ++i)
-    if (dynamic_[i]) e += floes.mass[i] * g_ * floes.state[i].heave;
-  return e;
+double FloeSeaContact::weight_energy(const Floes& floes, std::size_t i) const {
+  return dynamic_[i] ? floes.mass[i] * g_ * floes.state[i].heave : 0.0;
 }
 
 }  // namespace floesim

@@ -177,8 +177,16 @@ public:
   void kick_floes(Floes& floes, double h);
   void kick_sea(fluid::Sea& sea, double h);
   // The incident waves' orbital velocity under each floe (m/s, world), the
-  // mean over its footprint, at the time of the loads' evaluation.
+  // mean over its footprint, at the time of the loads' evaluation. On
+  // several ranks, of this rank's floes (MovingFootprints::mine) only, until
+  // hand_water_over gives each floe's to the rank that drifts it.
   std::span<const Vec2> water_velocity() const { return water_; }
+  // On several ranks: the water velocity of each floe whose coupling owner
+  // (MovingFootprints::owners) is not drift_owner[i] goes from the first to
+  // the second (one all-to-all, none when the owners agree; collective).
+  // After it water_velocity() holds the floes this rank drifts. The drift is
+  // its only reader (docs/parallel.md, "The coupling by owner").
+  void hand_water_over(std::span<const int> drift_owner);
 
   // Implicit integrator: advances the floes' vertical DOFs and the sea over h
   // (the floes' horizontal positions already at t + h, `start` the floes at
@@ -248,17 +256,21 @@ public:
   // linear limit 2 / omega; the contact is not linear, see floe_sea.cpp).
   double stable_step() const { return stable_step_; }
 
-  // Energies (J) at the last evaluate(): the penalty spring's, and the floes'
-  // vertical kinetic and weight (M g zeta) energies at the present state.
-  // By owner with the sea in slabs the first call after an evaluation is
+  // Energies (J): the penalty spring's at the last evaluate(), and (below)
+  // each floe's vertical kinetic and weight (M g zeta) energies at the
+  // present state. By owner with the sea in slabs the first call after an evaluation is
   // collective (every rank's terms gathered and summed in the serial order:
   // settle_energy).
   double penalty_energy() const {
     if (energy_pending_) settle_energy();
     return penalty_energy_;
   }
-  double floes_vertical_kinetic(const Floes& floes) const;
-  double floes_weight_energy(const Floes& floes) const;
+  // Floe i's terms of the floes' vertical kinetic energy (heave, pitch and
+  // roll rates) and of their weight energy M g zeta (0 for a floe the sea
+  // does not move): the caller sums them exactly over the floes it owns
+  // (Simulation::energies), so the sums do not depend on the ranks.
+  double vertical_kinetic(const Floes& floes, std::size_t i) const;
+  double weight_energy(const Floes& floes, std::size_t i) const;
 
   // Height of floe i's bottom at its centroid, z_b(G) = zeta + z0 (m).
   double bottom(const Floes& floes, std::size_t i) const { return floes.state[i].heave + bottom0_[i]; }
@@ -366,15 +378,15 @@ private:
   // slope_ already set for them.
   // On several ranks, for this rank's floes only (share_owned completes them).
   void horizontal_loads(std::span<const double> u);
-  // The owners' horizontal loads, and with `water` their water velocities,
-  // to every rank, in one call (nothing when serial).
-  void share_owned(bool water);
+  // The owners' loads to every rank, in one call (nothing when serial).
+  void share_owned();
   // Implicit: the step's mean horizontal loads (the header's "Horizontal
   // loads of the implicit step") into step_horizontal_.
   void step_mean_horizontal(const Floes& floes, std::span<const FloeState> start);
   // Mean over each floe's footprint (weights a_c) of the incident waves'
   // velocity at the sea's time (zero without incident waves).
-  // On several ranks, for this rank's floes only (share_owned completes them).
+  // On several ranks, for this rank's floes only (hand_water_over gives
+  // them to the ranks that drift them).
   void update_water(const Floes& floes, const fluid::Sea& sea, IncidentSea* incident);
   void implicit_step(Floes& floes, std::span<const FloeState> start, fluid::Sea& sea, double h);
   // The static start's pressure, held by a sea with a static part (a
@@ -479,6 +491,7 @@ private:
   bool pressure_kicked_ = false;  // the sea's last kick was with pressure_ as it is
   double loads_h_ = -1.0;         // the kick length of the last evaluation (< 0: stale)
   std::vector<Vec2> water_;       // incident velocity under each floe, with the loads
+  bool water_by_owner_ = false;   // water_ holds this rank's floes' only (several ranks, incident waves)
   std::vector<Vec2> slope_;       // per floe: the bottom slope the horizontal loads are taken at
   // Implicit integrator, per floe: the last step's mean horizontal load, and
   // the impulse the present step's first half kick applied; pending: the

@@ -219,7 +219,7 @@ void FloeSeaContact::step_mean_horizontal(const Floes& floes, std::span<const Fl
     for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k)
       if (u[k] > 0.0) cells_[fp.cell[k]].sum += fp.area[k] * u[k] * u[k];
   horizontal_loads(u);
-  share_owned(false);
+  share_owned();
   std::fill(step_horizontal_.begin(), step_horizontal_.end(), Eigen::Vector3d::Zero());
   for (std::uint32_t i : order_) step_horizontal_[i] = loads_[i].horizontal;
   step_mean_pending_ = true;

@@ -485,27 +485,37 @@ double FloeSeaContact::sum_cells_by_owner(double ks) {
   return total;
 }
 
-void FloeSeaContact::share_owned(bool water) {
+void FloeSeaContact::share_owned() {
   if (comm_.serial()) return;
   // The vertical loads too: by owner only the owner has them (replicated,
   // the owner's are every rank's, to the bit).
   struct Owned {
-    double fx, fy, torque, u, v, fz, mx, my;
+    double fx, fy, torque, fz, mx, my;
   };
   std::vector<Owned> owned(loads_.size());
   for (std::uint32_t i : footprints_.mine()) {
     const Eigen::Vector3d& f = loads_[i].horizontal;
     const Eigen::Vector3d& v = loads_[i].vertical;
-    const Vec2 w = water ? water_[i] : Vec2::Zero();
-    owned[i] = {f[0], f[1], f[2], w.x(), w.y(), v[0], v[1], v[2]};
+    owned[i] = {f[0], f[1], f[2], v[0], v[1], v[2]};
   }
   comm_.complete_owned(owned, footprints_.owners());
   for (std::size_t i = 0; i < owned.size(); ++i) {
     if (footprints_.owns(i)) continue;
     loads_[i].horizontal = {owned[i].fx, owned[i].fy, owned[i].torque};
     loads_[i].vertical = {owned[i].fz, owned[i].mx, owned[i].my};
-    if (water) water_[i] = {owned[i].u, owned[i].v};
   }
+}
+
+void FloeSeaContact::hand_water_over(std::span<const int> drift_owner) {
+  // Only the drift reads the water velocity, and each rank drifts its floes
+  // by place (parallel::FloeOwners); the coupling's owner of a floe is
+  // mostly the same rank (both by place on the same slabs), but not always:
+  // the coupling's owners are set at the footprints' last rebuild and follow
+  // a move of the slabs only at the next one, and without a sea in slabs (or
+  // with the implicit step) they are by index.
+  if (comm_.serial() || !water_by_owner_) return;
+  FLOESIM_ASSERT(drift_owner.size() == water_.size() && footprints_.owners().size() == water_.size());
+  comm_.hand_over(water_, footprints_.owners(), drift_owner);
 }
 
 }  // namespace floesim

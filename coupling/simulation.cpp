@@ -242,15 +242,19 @@ void Simulation::floes_half_kick(StepContext& ctx) {
 void Simulation::drift(StepContext& ctx) {
   const Vec2 current{ctx.forcing.current[0], ctx.forcing.current[1]};
   const Vec2 wind{ctx.forcing.wind[0], ctx.forcing.wind[1]};
+  // Drag relative to the current plus the incident waves' orbital velocity
+  // at t (on several ranks, of the floes this rank drifts: after the owners'
+  // update below).
   std::vector<Vec2> water;
-  if (floe_sea_) {
-    // Drag relative to the current plus the incident waves' orbital velocity at t.
+  const auto water_at = [&] {
+    if (!floe_sea_) return;
     const std::span<const Vec2> orbital = floe_sea_->water_velocity();
     water.assign(orbital.begin(), orbital.end());
     for (Vec2& w : water) w += current;
-  }
+  };
   moorings_.kick(scenario_.floes, ctx.dt);
   if (comm_.serial()) {
+    water_at();
     drift_velocities(scenario_.floes, quadrature_, drift_params_, current, wind, ctx.dt, 0, scenario_.floes.size(),
                      water);
   } else {
@@ -263,6 +267,9 @@ void Simulation::drift(StepContext& ctx) {
     if (owners_.has_slabs() && floe_sea_) owners_.charge_coupling(floe_sea_->take_owned_seconds());
     // Floes migrate; every few steps the strips move (with slabs, the sea's and the coupling's too).
     if (owners_.update(comm_, scenario_.floes, steps_) && owners_.has_slabs()) follow_slabs();
+    // The coupling's owners computed the water velocities; the drift's read them.
+    if (floe_sea_) floe_sea_->hand_water_over(owners_.owner());
+    water_at();
     const double start = parallel::thread_seconds();
     drift_velocities(scenario_.floes, quadrature_, drift_params_, current, wind, ctx.dt, owners_.mine(), water);
     owners_.charge(parallel::thread_seconds() - start);
@@ -588,22 +595,24 @@ void Simulation::close_step(StepContext& ctx) {
 }
 
 Energies Simulation::energies() const {
-  // The floes' horizontal kinetic energy: each floe's term, then their
-  // exact sum by owner, combined over the ranks (one call; the same bits on
-  // any number of ranks).
+  // The floes' kinetic energies (horizontal; with a sea, vertical) and
+  // their weight energy: each floe's terms, then their exact sums by owner,
+  // combined over the ranks (one call; the same bits on any number of ranks).
   const Floes& f = scenario_.floes;
-  std::array<ExactSum, 1> horizontal;
+  std::array<ExactSum, 3> sums;  // horizontal kinetic, vertical kinetic, weight
   for_owned([&](std::size_t i) {
     if (f.is_static[i]) return;
     const FloeState& s = f.state[i];
-    horizontal[0].add(0.5 * f.mass[i] * (s.vx * s.vx + s.vy * s.vy) + 0.5 * f.inertia_z[i] * s.yaw_rate * s.yaw_rate);
+    sums[0].add(0.5 * f.mass[i] * (s.vx * s.vx + s.vy * s.vy) + 0.5 * f.inertia_z[i] * s.yaw_rate * s.yaw_rate);
+    if (!floe_sea_) return;
+    sums[1].add(floe_sea_->vertical_kinetic(f, i));
+    sums[2].add(floe_sea_->weight_energy(f, i));
   });
-  comm_.sum(horizontal);
-  Energies e{{"floes_horizontal_kinetic"}, {horizontal[0].value()}};
+  comm_.sum(floe_sea_ ? std::span<ExactSum>(sums) : std::span<ExactSum>(sums).first(1));
+  Energies e{{"floes_horizontal_kinetic"}, {sums[0].value()}};
   if (floe_sea_) {
     e.names.insert(e.names.end(), {"floes_vertical_kinetic", "floes_weight", "penalty"});
-    e.values.insert(e.values.end(), {floe_sea_->floes_vertical_kinetic(f), floe_sea_->floes_weight_energy(f),
-                                     floe_sea_->penalty_energy()});
+    e.values.insert(e.values.end(), {sums[1].value(), sums[2].value(), floe_sea_->penalty_energy()});
   }
   if (sea_) {
     const fluid::SeaEnergy se = sea_->energy();

@@ -131,6 +131,40 @@ Range share(std::size_t n, int rank, int ranks) {
   return {begin, begin + base + (r < extra ? 1 : 0)};
 }
 
+HandOver plan_hand_over(std::span<const int> held_by, std::span<const int> wanted_by, int rank, int ranks,
+                        std::size_t item_bytes) {
+  HandOver plan;
+  const auto p = static_cast<std::size_t>(ranks);
+  std::vector<std::size_t> sent(p, 0), received(p, 0);
+  for (std::size_t i = 0; i < held_by.size(); ++i) {
+    if (held_by[i] == wanted_by[i]) continue;
+    plan.any = true;
+    if (held_by[i] == rank) ++sent[static_cast<std::size_t>(wanted_by[i])];
+    if (wanted_by[i] == rank) ++received[static_cast<std::size_t>(held_by[i])];
+  }
+  // Grouped by rank, floe order within a group: each group's start, then a
+  // second pass in floe order places every item.
+  std::vector<std::size_t> send_at(p, 0), receive_at(p, 0);
+  for (std::size_t r = 1; r < p; ++r) {
+    send_at[r] = send_at[r - 1] + sent[r - 1];
+    receive_at[r] = receive_at[r - 1] + received[r - 1];
+  }
+  plan.send.resize(send_at[p - 1] + sent[p - 1]);
+  plan.receive.resize(receive_at[p - 1] + received[p - 1]);
+  for (std::size_t i = 0; i < held_by.size(); ++i) {
+    if (held_by[i] == wanted_by[i]) continue;
+    if (held_by[i] == rank) plan.send[send_at[static_cast<std::size_t>(wanted_by[i])]++] = static_cast<std::uint32_t>(i);
+    if (wanted_by[i] == rank) plan.receive[receive_at[static_cast<std::size_t>(held_by[i])]++] = static_cast<std::uint32_t>(i);
+  }
+  plan.send_bytes.resize(p);
+  plan.receive_bytes.resize(p);
+  for (std::size_t r = 0; r < p; ++r) {
+    plan.send_bytes[r] = sent[r] * item_bytes;
+    plan.receive_bytes[r] = received[r] * item_bytes;
+  }
+  return plan;
+}
+
 std::vector<std::byte> Communicator::allgather_bytes(std::span<const std::byte> mine,
                                                      std::vector<std::size_t>& counts) const {
   std::vector<std::byte> out;

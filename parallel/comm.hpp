@@ -118,6 +118,15 @@ public:
     }
   }
 
+  // Items held by one rank and read by another: values[i] is valid on rank
+  // held_by[i] and is wanted on rank wanted_by[i] (both arrays the same on
+  // every rank). Each item whose two ranks differ goes from the first to the
+  // second, in floe order from each rank (HandOver); values the rank neither
+  // holds nor wants are left as they are. One all-to-all, none when no item
+  // changes rank (every rank sees that alike).
+  template <class T>
+  void hand_over(std::vector<T>& values, std::span<const int> held_by, std::span<const int> wanted_by) const;
+
   // Bytes: every rank's `mine` concatenated in rank order; `counts` gets
   // each rank's byte count. Two collective calls (the counts, then the bytes).
   std::vector<std::byte> allgather_bytes(std::span<const std::byte> mine, std::vector<std::size_t>& counts) const;
@@ -231,6 +240,33 @@ private:
   int rank_ = 0, size_ = 1;
   friend class Session;
 };
+
+// The plan of Communicator::hand_over for one rank (plain data, so that
+// simulated ranks can be tested in one process): the items this rank sends,
+// grouped by receiving rank in rank order and in floe order within each,
+// those it receives, grouped by sending rank alike, and the byte counts.
+struct HandOver {
+  std::vector<std::uint32_t> send, receive;
+  std::vector<std::size_t> send_bytes, receive_bytes;  // per rank
+  bool any = false;  // some item changes rank (on any rank: the same everywhere)
+};
+HandOver plan_hand_over(std::span<const int> held_by, std::span<const int> wanted_by, int rank, int ranks,
+                        std::size_t item_bytes);
+
+template <class T>
+void Communicator::hand_over(std::vector<T>& values, std::span<const int> held_by,
+                             std::span<const int> wanted_by) const {
+  static_assert(kSentAsBytes<T>);
+  if (serial()) return;
+  const HandOver plan = plan_hand_over(held_by, wanted_by, rank_, size_, sizeof(T));
+  if (!plan.any) return;
+  std::vector<T> out, in(plan.receive.size());
+  out.reserve(plan.send.size());
+  for (const std::uint32_t i : plan.send) out.push_back(values[i]);
+  alltoall(std::as_bytes(std::span<const T>(out)), plan.send_bytes, std::as_writable_bytes(std::span<T>(in)),
+           plan.receive_bytes);
+  for (std::size_t k = 0; k < in.size(); ++k) values[plan.receive[k]] = in[k];
+}
 
 // The MPI environment of a process: MPI_Init when the process was started
 // by mpirun (or another launcher that sets the PMI/PMIx variables), else

@@ -12,7 +12,9 @@
 //   across the periodic seam by the nearest image; the band holds the
 //   detection subset's posed floes, and a band of one pad (H only) loses
 //   pairs across the cuts: the comparison has teeth;
-// - the drift of the rank's floes: its own floes only;
+// - the drift of the rank's floes: its own floes only, and their water
+//   velocities reach it from the coupling's owners by the hand-over
+//   (parallel::plan_hand_over, the ranks simulated);
 // - the collisions at the step's start from the rank's part
 //   (parallel::collide_on_part's pieces): the edges from the band (the
 //   floes' owners too, which the edges carry), then each share on the
@@ -39,6 +41,7 @@
 #include "core/pack_generator.hpp"
 #include "coupling/drift.hpp"
 #include "parallel/collide_share.hpp"
+#include "parallel/comm.hpp"
 #include "parallel/detect.hpp"
 #include "parallel/place.hpp"
 #include "tests/parallel/collide_case.hpp"
@@ -187,6 +190,110 @@ TEST_CASE("the drift of a rank's floes reads only its own floes") {
         CHECK(own);
         CHECK(others);
         CHECK(!mine.empty());
+      }
+    }
+  }
+}
+
+namespace {
+
+// Communicator::hand_over among simulated ranks: rank r's values[r] hold
+// the items with held_by == r; each rank's plan (parallel::plan_hand_over)
+// packs its sends in order, the parts are moved as MPI_Alltoallv moves
+// them (sender s's part for r, after those of the ranks before s), and
+// each rank unpacks what it receives. Returns the items moved.
+template <class T>
+std::size_t simulated_hand_over(std::vector<std::vector<T>>& values, std::span<const int> held_by,
+                                std::span<const int> wanted_by) {
+  const int ranks = static_cast<int>(values.size());
+  std::vector<parallel::HandOver> plan;
+  std::vector<std::vector<std::byte>> out(values.size());
+  for (int r = 0; r < ranks; ++r) {
+    plan.push_back(parallel::plan_hand_over(held_by, wanted_by, r, ranks, sizeof(T)));
+    for (const std::uint32_t i : plan[r].send) {
+      const auto* b = reinterpret_cast<const std::byte*>(&values[r][i]);
+      out[r].insert(out[r].end(), b, b + sizeof(T));
+    }
+  }
+  std::size_t moved = 0;
+  for (int r = 0; r < ranks; ++r) {
+    std::vector<std::byte> in;
+    for (int s = 0; s < ranks; ++s) {
+      std::size_t at = 0;
+      for (int q = 0; q < r; ++q) at += plan[s].send_bytes[q];
+      REQUIRE(plan[s].send_bytes[r] == plan[r].receive_bytes[s]);
+      in.insert(in.end(), out[s].begin() + static_cast<std::ptrdiff_t>(at),
+                out[s].begin() + static_cast<std::ptrdiff_t>(at + plan[s].send_bytes[r]));
+    }
+    REQUIRE(in.size() == plan[r].receive.size() * sizeof(T));
+    for (std::size_t k = 0; k < plan[r].receive.size(); ++k)
+      std::memcpy(static_cast<void*>(&values[r][plan[r].receive[k]]), in.data() + k * sizeof(T), sizeof(T));
+    moved += plan[r].receive.size();
+  }
+  return moved;
+}
+
+}  // namespace
+
+TEST_CASE("the water velocities handed over from the coupling's owners are the drift's own floes' (simulated ranks)") {
+  // The coupling's owner of each floe computes its water velocity (the
+  // others' are poisoned); Communicator::hand_over's plan gives each floe's
+  // to its drift owner when that is another rank; each rank's drift with
+  // the water it then holds (and every floe it does not drift poisoned)
+  // equals the serial drift bit for bit. The coupling's owners: the drift's
+  // (nothing moves, no call), the strips shifted by one rank (as after a
+  // move of the slabs the coupling's owners follow one rebuild later), and
+  // by index (the implicit step's, a sea not in slabs).
+  const Pack p = moving_pack(5, true);
+  const std::size_t n = p.floes.size();
+  const FootprintQuadrature q = build_footprint_quadrature(p.floes, 1);
+  const DriftParams params{1025.0, 5e-3, 1.341, 1.7e-3, 1.4e-4};
+  const Vec2 current{0.12, -0.05}, wind{8.0, 3.0};
+  const double dt = 10.0;
+  std::vector<Vec2> water(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const double k = static_cast<double>(i);
+    water[i] = current + Vec2{1e-3 * std::sin(0.1 * k), 1e-3 * std::cos(0.2 * k)};
+  }
+  Floes serial = p.floes;
+  drift_velocities(serial, q, params, current, wind, dt, 0, n, water);
+  for (const int ranks : {2, 3, 7}) {
+    parallel::FloeOwners owners(0, ranks, p.detect.domain);
+    owners.assign(p.floes);
+    const std::span<const int> drift_owner = owners.owner();
+    for (const int kind : {0, 1, 2}) {
+      CAPTURE(ranks);
+      CAPTURE(kind);
+      std::vector<int> coupling(n);
+      for (std::size_t i = 0; i < n; ++i)
+        coupling[i] = kind == 0   ? drift_owner[i]
+                      : kind == 1 ? (drift_owner[i] + 1) % ranks
+                                  : static_cast<int>(i * static_cast<std::size_t>(ranks) / n);
+      std::vector<std::vector<Vec2>> held(static_cast<std::size_t>(ranks), std::vector<Vec2>(n, Vec2::Constant(kNaN)));
+      for (std::size_t i = 0; i < n; ++i) held[coupling[i]][i] = water[i];
+      std::size_t mismatched = 0;
+      for (std::size_t i = 0; i < n; ++i) mismatched += coupling[i] != drift_owner[i] ? 1 : 0;
+      CHECK(parallel::plan_hand_over(coupling, drift_owner, 0, ranks, sizeof(Vec2)).any == (mismatched > 0));
+      CHECK(simulated_hand_over(held, coupling, drift_owner) == mismatched);
+      if (kind > 0) CHECK(mismatched > 0);
+      for (int r = 0; r < ranks; ++r) {
+        CAPTURE(r);
+        Held mine_held(n, 0);
+        std::vector<std::uint32_t> mine;
+        for (std::size_t i = 0; i < n; ++i)
+          if (drift_owner[i] == r) {
+            mine_held[i] = 1;
+            mine.push_back(static_cast<std::uint32_t>(i));
+          }
+        // Only the floes the rank drifts are read: the rest of what it holds poisoned too.
+        std::vector<Vec2> w = held[r];
+        for (std::size_t i = 0; i < n; ++i)
+          if (!mine_held[i]) w[i] = Vec2::Constant(kNaN);
+        Floes f = poisoned(p.floes, mine_held);
+        drift_velocities(f, poisoned(q, mine_held), params, current, wind, dt, mine, w);
+        bool own = true;
+        for (const std::uint32_t i : mine) own = own && std::memcmp(&f.state[i], &serial.state[i], sizeof(FloeState)) == 0;
+        CHECK(own);
       }
     }
   }
