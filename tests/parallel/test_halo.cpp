@@ -57,6 +57,31 @@ using test::same_detection;
 using test::same_lists;
 using namespace floesim::test;  // the poison tool (halo_case.hpp)
 
+namespace {
+
+// The drift's forcing shared by the drift's proofs: a uniform current and
+// wind, and a water velocity per floe (the current and a small field that
+// varies floe by floe, so that a floe read in another's place changes the
+// answer).
+struct DriftCase {
+  DriftParams params{1025.0, 5e-3, 1.341, 1.7e-3, 1.4e-4};
+  Vec2 current{0.12, -0.05}, wind{8.0, 3.0};
+  double dt = 10.0;
+  std::vector<Vec2> water;
+};
+
+DriftCase drift_case(std::size_t n) {
+  DriftCase c;
+  c.water.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const double k = static_cast<double>(i);
+    c.water[i] = c.current + Vec2{1e-3 * std::sin(0.1 * k), 1e-3 * std::cos(0.2 * k)};
+  }
+  return c;
+}
+
+}  // namespace
+
 TEST_CASE("detection by place on a rank holding only its strip and halo band is its part of the serial detection") {
   // Over 2, 3 and 7 strips, equal and uneven, in a periodic box (pairs
   // across the seam) and the open plane: rank r's part from the poisoned
@@ -152,14 +177,11 @@ TEST_CASE("the drift of a rank's floes reads only its own floes") {
   Floes varied = p.floes;
   for (std::size_t i = 0; i < n; i += 3) varied.ocean_drag[i] = 4e-3 + 1e-5 * static_cast<double>(i % 7);
   const FootprintQuadrature q = build_footprint_quadrature(varied, 1);
-  const DriftParams params{1025.0, 5e-3, 1.341, 1.7e-3, 1.4e-4};
-  const Vec2 current{0.12, -0.05}, wind{8.0, 3.0};
-  const double dt = 10.0;
-  std::vector<Vec2> water(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    const double k = static_cast<double>(i);
-    water[i] = current + Vec2{1e-3 * std::sin(0.1 * k), 1e-3 * std::cos(0.2 * k)};
-  }
+  const DriftCase drift = drift_case(n);
+  const DriftParams& params = drift.params;
+  const Vec2 current = drift.current, wind = drift.wind;
+  const double dt = drift.dt;
+  const std::vector<Vec2>& water = drift.water;
   for (const bool uniform : {true, false}) {
     CAPTURE(uniform);
     Floes serial = varied;
@@ -247,14 +269,11 @@ TEST_CASE("the water velocities handed over from the coupling's owners are the d
   const Pack p = moving_pack(5, true);
   const std::size_t n = p.floes.size();
   const FootprintQuadrature q = build_footprint_quadrature(p.floes, 1);
-  const DriftParams params{1025.0, 5e-3, 1.341, 1.7e-3, 1.4e-4};
-  const Vec2 current{0.12, -0.05}, wind{8.0, 3.0};
-  const double dt = 10.0;
-  std::vector<Vec2> water(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    const double k = static_cast<double>(i);
-    water[i] = current + Vec2{1e-3 * std::sin(0.1 * k), 1e-3 * std::cos(0.2 * k)};
-  }
+  const DriftCase drift = drift_case(n);
+  const DriftParams& params = drift.params;
+  const Vec2 current = drift.current, wind = drift.wind;
+  const double dt = drift.dt;
+  const std::vector<Vec2>& water = drift.water;
   Floes serial = p.floes;
   drift_velocities(serial, q, params, current, wind, dt, 0, n, water);
   for (const int ranks : {2, 3, 7}) {
