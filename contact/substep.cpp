@@ -40,7 +40,7 @@ ShareRooms Stepper::set_up() {
     // On a part the near pairs too (Stepper::candidates, depth three and on).
     const auto [oa, ob] = owners(q);
     if (r < (holds_part() ? kNearRooms : 1.0) * opt_.collision_distance)
-      out.tight.push_back({q.a, q.b, q.shift, r, oa, ob});
+      out.tight.push_back({q.a, q.b, q.shift, r, oa, ob, det_->reach[q.a] - lin_[q.a], det_->reach[q.b] - lin_[q.b]});
     if (q.contact_count > 0 && !floes_.is_static[q.a] && !floes_.is_static[q.b])
       out.touching.push_back({q.a, q.b, oa, ob});
   }
@@ -129,12 +129,19 @@ std::vector<std::pair<int, std::uint32_t>> Stepper::routes(std::span<const JoinC
           put(tight_[t].a, static_cast<std::uint32_t>(t));
           put(tight_[t].b, static_cast<std::uint32_t>(t));
         });
+    // Per floe with a near pair, its reach less its travel as the pair's
+    // share gave it (every share the same numbers, whatever floes it holds).
+    std::vector<double> left_of(n, kInf);
+    for (const PairRoom& q : tight_) {
+      left_of[q.a] = q.left_a;
+      left_of[q.b] = q.left_b;
+    }
     sort_unique(all);
     std::vector<JoinCandidate> grow = all;
     while (!grow.empty()) {
       std::vector<JoinCandidate> next;
       for (const JoinCandidate& c : grow) {
-        const double left = det_->reach[c.floe] - lin_[c.floe];
+        const double left = left_of[c.floe];
         for (const std::uint32_t t : near.row(c.floe)) {
           const PairRoom& q = tight_[t];
           const std::uint32_t l = q.a == c.floe ? q.b : q.a;

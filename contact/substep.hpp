@@ -155,12 +155,15 @@ void advance_with_collisions(Floes& floes, const CollisionShapes& shapes, const 
 // ClusterShare::owner as the share that computed the room read them (it
 // holds both floes); every cluster's lowest floe is a floe of a tight pair
 // or contact edge, so the clusters' runners come from the edges, not from
-// an owner array (-1 without a share).
+// an owner array (-1 without a share). left_a and left_b (m) are the
+// floes' reach less their straight travel over the step, as that share
+// holds them: the join candidates' closure reads them (Stepper::routes).
 struct PairRoom {
   std::uint32_t a = 0, b = 0;
   Vec2 shift = Vec2::Zero();
   double room = 0.0;
   std::int32_t owner_a = -1, owner_b = -1;
+  double left_a = 0.0, left_b = 0.0;
 };
 
 // A pair with contact points between two dynamic floes: the jams

@@ -35,7 +35,7 @@ constexpr std::size_t kLoadBytes = kLoadInts * sizeof(std::uint32_t) + kLoadDoub
 
 // A tight pair in a message: a, b (uint32), then shift x, y and the room
 // (doubles); a contact edge: a, b.
-constexpr std::size_t kTight = 2 * sizeof(std::uint32_t) + 3 * sizeof(double) + 2 * sizeof(std::int32_t);
+constexpr std::size_t kTight = 2 * sizeof(std::uint32_t) + 5 * sizeof(double) + 2 * sizeof(std::int32_t);
 constexpr std::size_t kEdge = 2 * sizeof(std::uint32_t) + 2 * sizeof(std::int32_t);
 
 }  // namespace
@@ -144,7 +144,7 @@ std::vector<std::byte> pack(const contact::ShareRooms& rooms) {
   std::byte* at = put(out.data(), head.data(), head.size());
   for (const contact::PairRoom& t : rooms.tight) {
     const std::array<std::uint32_t, 2> ab{t.a, t.b};
-    const std::array<double, 3> d{t.shift.x(), t.shift.y(), t.room};
+    const std::array<double, 5> d{t.shift.x(), t.shift.y(), t.room, t.left_a, t.left_b};
     const std::array<std::int32_t, 2> owners{t.owner_a, t.owner_b};
     at = put(at, ab.data(), ab.size());
     at = put(at, d.data(), d.size());
@@ -170,9 +170,9 @@ contact::ShareRooms unpack_share_rooms(std::span<const std::byte> bytes) {
   rooms.tight.resize(count);
   for (contact::PairRoom& t : rooms.tight) {
     const std::vector<std::uint32_t> ab = take<std::uint32_t>(in, 2);
-    const std::vector<double> d = take<double>(in, 3);
+    const std::vector<double> d = take<double>(in, 5);
     const std::vector<std::int32_t> owners = take<std::int32_t>(in, 2);
-    t = {ab[0], ab[1], {d[0], d[1]}, d[2], owners[0], owners[1]};
+    t = {ab[0], ab[1], {d[0], d[1]}, d[2], owners[0], owners[1], d[3], d[4]};
   }
   rooms.touching.resize(edges);
   for (contact::ContactEdge& e : rooms.touching) {

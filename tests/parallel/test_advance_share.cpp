@@ -469,6 +469,7 @@ namespace {
 struct Poisoned {
   bool poison = true;  // false: the parts' bytes only, from the whole state
   std::vector<std::vector<std::byte>> packed;
+  std::vector<std::vector<std::pair<int, std::uint32_t>>> routes;  // each share's routes (the candidates' closure)
   long fetched = 0;
 };
 void poison_floe(Floes& f, std::size_t i) {
@@ -534,8 +535,11 @@ bool play_parts(const Case& c, const parallel::FloeOwners& strips, std::span<con
   for (std::size_t k = 0; ok && candidates && k < n; ++k)
     joins.insert(joins.end(), routes[k].candidates.begin(), routes[k].candidates.end());
   std::vector<std::vector<contact::Detection>> out;
-  for (std::size_t k = 0; ok && k < n; ++k)
-    out.push_back(parallel::routed_pairs(parts[k], shares[k]->routes(joins), ranks));
+  for (std::size_t k = 0; ok && k < n; ++k) {
+    const std::vector<std::pair<int, std::uint32_t>> to = shares[k]->routes(joins);
+    if (poisoned) poisoned->routes.push_back(to);
+    out.push_back(parallel::routed_pairs(parts[k], to, ranks));
+  }
   if (ok && poisoned && poisoned->poison) {
     // The routed pairs' floes, from each sender's copy before any share
     // moves a floe (a rank sends them before it advances), through their bytes.
@@ -695,7 +699,10 @@ TEST_CASE("the advance's share reads its strip, its part's floes and the floes t
         const PartsPlay whole = play_shifted(c, ranks, shift, true, false, &clean);
         const PartsPlay p = play_shifted(c, ranks, shift, true, false, &poisoned);
         CHECK(p.ok == whole.ok);
-        // Each share's part, as bytes: the poisoned copy's equals the whole state's.
+        // Each share's routes (the join candidates' closure over the near
+        // pairs, reading their ends' reach less travel as the pairs carry
+        // them) and part, as bytes: the poisoned copy's equal the whole state's.
+        CHECK(poisoned.routes == clean.routes);
         CHECK(poisoned.packed == clean.packed);
         MESSAGE(ranks << " ranks, shift " << shift << ": " << std::string(whole.ok ? "combined" : "fell back") << ", "
                       << poisoned.fetched << " floes fetched with the routed pairs");
