@@ -230,10 +230,10 @@ void Stepper::run_share() {
     return;
   }
   // The clusters this call runs: a share's, those whose lowest floe
-  // (members.front()) it owns, as the edges carried its owner (runner). Posed: the obstacles (they never move) and
-  // these clusters' members (posed again before each measure); a measure
-  // reads no other floe (internal pairs: members with members and with
-  // obstacles).
+  // (members.front()) it owns, as the edges carried its owner (runner).
+  // Posed: the obstacles (they never move) and these clusters' members
+  // (posed again before each measure); a measure reads no other floe
+  // (internal pairs: members with members and with obstacles).
   own_.assign(clusters_.size(), 1);
   std::vector<std::uint32_t> posed;
   for (std::uint32_t i = 0; i < n; ++i)

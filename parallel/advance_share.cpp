@@ -33,8 +33,9 @@ constexpr std::size_t kHeader = 9 + kStats + kReport;
 constexpr std::size_t kLoadInts = 4, kLoadDoubles = 7;
 constexpr std::size_t kLoadBytes = kLoadInts * sizeof(std::uint32_t) + kLoadDoubles * sizeof(double);
 
-// A tight pair in a message: a, b (uint32), then shift x, y and the room
-// (doubles); a contact edge: a, b.
+// A tight or near pair in a message: a, b (uint32), then shift x, y, the
+// room and each floe's reach less travel (doubles), then the floes' owners
+// (int32); a contact edge: a, b, then their owners.
 constexpr std::size_t kTight = 2 * sizeof(std::uint32_t) + 5 * sizeof(double) + 2 * sizeof(std::int32_t);
 constexpr std::size_t kEdge = 2 * sizeof(std::uint32_t) + 2 * sizeof(std::int32_t);
 
