@@ -38,8 +38,11 @@ ShareRooms Stepper::set_up() {
     const NearPair& q = det_->pairs[p];
     const double r = room(p);
     // On a part the near pairs too (Stepper::candidates, depth three and on).
-    if (r < (holds_part() ? kNearRooms : 1.0) * opt_.collision_distance) out.tight.push_back({q.a, q.b, q.shift, r});
-    if (q.contact_count > 0 && !floes_.is_static[q.a] && !floes_.is_static[q.b]) out.touching.push_back({q.a, q.b});
+    const auto [oa, ob] = owners(q);
+    if (r < (holds_part() ? kNearRooms : 1.0) * opt_.collision_distance)
+      out.tight.push_back({q.a, q.b, q.shift, r, oa, ob, det_->reach[q.a] - lin_[q.a], det_->reach[q.b] - lin_[q.b]});
+    if (q.contact_count > 0 && !floes_.is_static[q.a] && !floes_.is_static[q.b])
+      out.touching.push_back({q.a, q.b, oa, ob});
   }
   return out;
 }
@@ -57,6 +60,9 @@ void Stepper::clusters(std::span<const PairRoom> tight, std::span<const ContactE
     }
   }
   touching_.assign(touching.begin(), touching.end());
+  edge_owner_.assign(floes_.size(), -1);
+  take_owners(std::span<const PairRoom>(tight_));
+  take_owners(std::span<const ContactEdge>(touching_));
   make_clusters();
 }
 
@@ -123,12 +129,19 @@ std::vector<std::pair<int, std::uint32_t>> Stepper::routes(std::span<const JoinC
           put(tight_[t].a, static_cast<std::uint32_t>(t));
           put(tight_[t].b, static_cast<std::uint32_t>(t));
         });
+    // Per floe with a near pair, its reach less its travel as the pair's
+    // share gave it (every share the same numbers, whatever floes it holds).
+    std::vector<double> left_of(n, kInf);
+    for (const PairRoom& q : tight_) {
+      left_of[q.a] = q.left_a;
+      left_of[q.b] = q.left_b;
+    }
     sort_unique(all);
     std::vector<JoinCandidate> grow = all;
     while (!grow.empty()) {
       std::vector<JoinCandidate> next;
       for (const JoinCandidate& c : grow) {
-        const double left = det_->reach[c.floe] - lin_[c.floe];
+        const double left = left_of[c.floe];
         for (const std::uint32_t t : near.row(c.floe)) {
           const PairRoom& q = tight_[t];
           const std::uint32_t l = q.a == c.floe ? q.b : q.a;
@@ -217,17 +230,17 @@ void Stepper::run_share() {
     return;
   }
   // The clusters this call runs: a share's, those whose lowest floe
-  // (members.front()) it owns. Posed: the obstacles (they never move) and
-  // these clusters' members (posed again before each measure); a measure
-  // reads no other floe (internal pairs: members with members and with
-  // obstacles).
+  // (members.front()) it owns, as the edges carried its owner (runner).
+  // Posed: the obstacles (they never move) and these clusters' members
+  // (posed again before each measure); a measure reads no other floe
+  // (internal pairs: members with members and with obstacles).
   own_.assign(clusters_.size(), 1);
   std::vector<std::uint32_t> posed;
   for (std::uint32_t i = 0; i < n; ++i)
     if (floes_.is_static[i]) posed.push_back(i);
   for (std::size_t k = 0; k < clusters_.size(); ++k) {
     const Cluster& c = clusters_[k];
-    if (share_) own_[k] = share_->owner[c.members.front()] == share_->rank;
+    if (share_) own_[k] = edge_owner_[c.members.front()] == share_->rank;
     if (own_[k]) posed.insert(posed.end(), c.members.begin(), c.members.end());
   }
   posed_ = PosedShapes(floes_, shapes_, posed);
@@ -352,7 +365,8 @@ std::vector<ContactEdge> Stepper::pad_edges() {
     for (const std::uint32_t p : pairs_of(i)) {
       const NearPair& q = det_->pairs[p];
       if (floes_.is_static[q.a] || floes_.is_static[q.b] || !(room(p) < pad)) continue;
-      out.push_back({q.a, q.b});
+      const auto [oa, ob] = owners(q);
+      out.push_back({q.a, q.b, oa, ob});
     }
   }
   return out;
@@ -362,6 +376,7 @@ void Stepper::apply_pads(std::span<const ContactEdge> pads) {
   // Joins and flags are the same in any order (the components and the hot
   // floes do not depend on it), and an edge given twice changes nothing:
   // every share's edges, concatenated, give the serial clusters.
+  take_owners(pads);
   for (const ContactEdge& e : pads) {
     hot_[e.a] = hot_[e.a] || big_[e.a];
     hot_[e.b] = hot_[e.b] || big_[e.b];
@@ -388,6 +403,10 @@ void Stepper::form_clusters() {
     cluster_of_[i] = of_root[r];
     clusters_[static_cast<std::size_t>(of_root[r])].members.push_back(i);
   }
+  // A cluster's floes are joined by tight pairs, contact edges or pads, or
+  // it is one floe hot through a tight pair: its lowest floe is an end of
+  // an edge, whose owner the edge carried (runner, run_share).
+  for ([[maybe_unused]] const Cluster& c : clusters_) FLOESIM_ASSERT(!share_ || edge_owner_[c.members.front()] >= 0);
 }
 
 void Stepper::find_jams() {

@@ -151,18 +151,29 @@ void advance_with_collisions(Floes& floes, const CollisionShapes& shapes, const 
 // A pair's room over the step (m), as one share gives it to the others,
 // keyed by the pair itself (floes a < b and b's periodic shift), not by its
 // place in one rank's list: a key every share can look up in whatever list
-// of pairs it holds.
+// of pairs it holds. On a share, owner_a and owner_b are the floes'
+// ClusterShare::owner as the share that computed the room read them (it
+// holds both floes); every cluster's lowest floe is a floe of a tight pair
+// or contact edge, so the clusters' runners come from the edges, not from
+// an owner array (-1 without a share). left_a and left_b (m) are the
+// floes' reach less their straight travel over the step, as that share
+// holds them: the join candidates' closure reads them (Stepper::routes).
 struct PairRoom {
   std::uint32_t a = 0, b = 0;
   Vec2 shift = Vec2::Zero();
   double room = 0.0;
+  std::int32_t owner_a = -1, owner_b = -1;
+  double left_a = 0.0, left_b = 0.0;
 };
 
 // A pair with contact points between two dynamic floes: the jams
 // (find_jams; jam.hpp) are the components of these edges, so the shares
 // find the same jams from every share's edges, without every contact point.
+// The pads' edges (ShareAdvance::pad_edges) are of this type too. Owners
+// as in PairRoom.
 struct ContactEdge {
   std::uint32_t a = 0, b = 0;
+  std::int32_t owner_a = -1, owner_b = -1;
 };
 
 // On a part of the detection: a free floe that a cluster run by share `rank`

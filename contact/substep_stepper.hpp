@@ -148,10 +148,26 @@ public:
   void run_share();
 
 private:
-  // The share that runs floe i's cluster, or -1 for a free floe.
+  // The share that runs floe i's cluster, or -1 for a free floe: the owner
+  // of its lowest floe as the edges say (edge_owner_).
   int runner(std::uint32_t i) const {
     const int k = cluster_of_[i];
-    return k == kFree ? -1 : share_->owner[clusters_[static_cast<std::size_t>(k)].members.front()];
+    return k == kFree ? -1 : edge_owner_[clusters_[static_cast<std::size_t>(k)].members.front()];
+  }
+  // The owners the tight pairs', contact edges' or pads' ends carry, into
+  // edge_owner_ (every share is given the same edges: the same owners).
+  template <class Edge>
+  void take_owners(std::span<const Edge> edges) {
+    for (const Edge& e : edges) {
+      edge_owner_[e.a] = e.owner_a;
+      edge_owner_[e.b] = e.owner_b;
+    }
+  }
+  // The owners of pair q's floes as this share reads them (its part's
+  // pairs: floes it holds), -1 without a share.
+  std::pair<std::int32_t, std::int32_t> owners(const NearPair& q) const {
+    if (!share_) return {-1, -1};
+    return {share_->owner[q.a], share_->owner[q.b]};
   }
 
   std::uint32_t other(std::uint32_t p, std::uint32_t i) const {
@@ -329,6 +345,7 @@ private:
   bool moving_ = false;                // floes moved: the start's states are start_ only
   CompressedRows<std::uint32_t> pairs_by_floe_;  // the pair index (pairs_of)
   std::vector<int> cluster_of_;        // kFree or a cluster
+  std::vector<std::int32_t> edge_owner_;  // per floe: its owner as the gathered edges carry it, or -1
   std::vector<Cluster> clusters_;
   std::vector<double> budget_, reach_left_;  // m, per floe
   std::vector<std::uint8_t> outran_;

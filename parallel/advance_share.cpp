@@ -33,10 +33,11 @@ constexpr std::size_t kHeader = 9 + kStats + kReport;
 constexpr std::size_t kLoadInts = 4, kLoadDoubles = 7;
 constexpr std::size_t kLoadBytes = kLoadInts * sizeof(std::uint32_t) + kLoadDoubles * sizeof(double);
 
-// A tight pair in a message: a, b (uint32), then shift x, y and the room
-// (doubles); a contact edge: a, b.
-constexpr std::size_t kTight = 2 * sizeof(std::uint32_t) + 3 * sizeof(double);
-constexpr std::size_t kEdge = 2 * sizeof(std::uint32_t);
+// A tight or near pair in a message: a, b (uint32), then shift x, y, the
+// room and each floe's reach less travel (doubles), then the floes' owners
+// (int32); a contact edge: a, b, then their owners.
+constexpr std::size_t kTight = 2 * sizeof(std::uint32_t) + 5 * sizeof(double) + 2 * sizeof(std::int32_t);
+constexpr std::size_t kEdge = 2 * sizeof(std::uint32_t) + 2 * sizeof(std::int32_t);
 
 }  // namespace
 
@@ -144,13 +145,17 @@ std::vector<std::byte> pack(const contact::ShareRooms& rooms) {
   std::byte* at = put(out.data(), head.data(), head.size());
   for (const contact::PairRoom& t : rooms.tight) {
     const std::array<std::uint32_t, 2> ab{t.a, t.b};
-    const std::array<double, 3> d{t.shift.x(), t.shift.y(), t.room};
+    const std::array<double, 5> d{t.shift.x(), t.shift.y(), t.room, t.left_a, t.left_b};
+    const std::array<std::int32_t, 2> owners{t.owner_a, t.owner_b};
     at = put(at, ab.data(), ab.size());
     at = put(at, d.data(), d.size());
+    at = put(at, owners.data(), owners.size());
   }
   for (const contact::ContactEdge& e : rooms.touching) {
     const std::array<std::uint32_t, 2> ab{e.a, e.b};
+    const std::array<std::int32_t, 2> owners{e.owner_a, e.owner_b};
     at = put(at, ab.data(), ab.size());
+    at = put(at, owners.data(), owners.size());
   }
   return out;
 }
@@ -166,13 +171,15 @@ contact::ShareRooms unpack_share_rooms(std::span<const std::byte> bytes) {
   rooms.tight.resize(count);
   for (contact::PairRoom& t : rooms.tight) {
     const std::vector<std::uint32_t> ab = take<std::uint32_t>(in, 2);
-    const std::vector<double> d = take<double>(in, 3);
-    t = {ab[0], ab[1], {d[0], d[1]}, d[2]};
+    const std::vector<double> d = take<double>(in, 5);
+    const std::vector<std::int32_t> owners = take<std::int32_t>(in, 2);
+    t = {ab[0], ab[1], {d[0], d[1]}, d[2], owners[0], owners[1], d[3], d[4]};
   }
   rooms.touching.resize(edges);
   for (contact::ContactEdge& e : rooms.touching) {
     const std::vector<std::uint32_t> ab = take<std::uint32_t>(in, 2);
-    e = {ab[0], ab[1]};
+    const std::vector<std::int32_t> owners = take<std::int32_t>(in, 2);
+    e = {ab[0], ab[1], owners[0], owners[1]};
   }
   return rooms;
 }

@@ -459,8 +459,9 @@ namespace {
 // `events` gets each share's event count.
 //
 // With `poisoned` (the halo plan's piece 2, docs/parallel.md): each share's
-// copy has every floe NaN (state, mass, inertia, vertices) but its strip's
-// and its part's pairs' floes, and then holds the floes the routed pairs
+// copy has every floe NaN (state, mass, inertia, vertices) and its owner -1
+// but its strip's and its part's pairs' floes (the clusters' runners come
+// from the owners the tight pairs and edges carry), and then holds the floes the routed pairs
 // carry (parallel::RoutedFloes, through their bytes) before it runs;
 // `packed` gets each share's part as bytes and `fetched` counts the floes
 // a share received that its copy did not hold. `f` is then not the answer
@@ -468,6 +469,7 @@ namespace {
 struct Poisoned {
   bool poison = true;  // false: the parts' bytes only, from the whole state
   std::vector<std::vector<std::byte>> packed;
+  std::vector<std::vector<std::pair<int, std::uint32_t>>> routes;  // each share's routes (the candidates' closure)
   long fetched = 0;
 };
 void poison_floe(Floes& f, std::size_t i) {
@@ -488,6 +490,8 @@ bool play_parts(const Case& c, const parallel::FloeOwners& strips, std::span<con
   std::vector<std::unique_ptr<contact::ShareAdvance>> shares;
   std::vector<contact::ShareRooms> rooms;
   std::vector<contact::ImpulseRecord> own(n);
+  // Each share's owners: all of them, or poisoned (-1) beyond its floes.
+  std::vector<std::vector<int>> owners(n, std::vector<int>(owner.begin(), owner.end()));
   for (int r = 0; r < ranks; ++r)
     parts.push_back(parallel::detect_part(strips, r, c.floes, c.shapes, c.detect_options));
   if (poisoned && poisoned->poison)
@@ -495,14 +499,17 @@ bool play_parts(const Case& c, const parallel::FloeOwners& strips, std::span<con
       for (std::size_t i = 0; i < c.floes.size(); ++i) held[k][i] = strips.owner()[i] == static_cast<int>(k);
       for (const contact::NearPair& q : parts[k].pairs) held[k][q.a] = held[k][q.b] = 1;
       for (std::size_t i = 0; i < c.floes.size(); ++i)
-        if (!held[k][i]) poison_floe(copies[k], i);
+        if (!held[k][i]) {
+          poison_floe(copies[k], i);
+          owners[k][i] = -1;
+        }
     }
   for (int r = 0; r < ranks; ++r) {
     const std::size_t k = static_cast<std::size_t>(r);
     contact::SubstepOptions o = c.options;
     if (merged) o.impulse.record = &own[k];
     shares.push_back(std::make_unique<contact::ShareAdvance>(copies[k], c.shapes, parts[k], c.dt, o,
-                                                             contact::ClusterShare{owner, r}, true));
+                                                             contact::ClusterShare{owners[k], r}, true));
     rooms.push_back(parallel::unpack_share_rooms(parallel::pack(shares.back()->rooms())));
   }
   contact::ShareRooms all;
@@ -528,8 +535,11 @@ bool play_parts(const Case& c, const parallel::FloeOwners& strips, std::span<con
   for (std::size_t k = 0; ok && candidates && k < n; ++k)
     joins.insert(joins.end(), routes[k].candidates.begin(), routes[k].candidates.end());
   std::vector<std::vector<contact::Detection>> out;
-  for (std::size_t k = 0; ok && k < n; ++k)
-    out.push_back(parallel::routed_pairs(parts[k], shares[k]->routes(joins), ranks));
+  for (std::size_t k = 0; ok && k < n; ++k) {
+    const std::vector<std::pair<int, std::uint32_t>> to = shares[k]->routes(joins);
+    if (poisoned) poisoned->routes.push_back(to);
+    out.push_back(parallel::routed_pairs(parts[k], to, ranks));
+  }
   if (ok && poisoned && poisoned->poison) {
     // The routed pairs' floes, from each sender's copy before any share
     // moves a floe (a rank sends them before it advances), through their bytes.
@@ -664,7 +674,8 @@ TEST_CASE("the advance from each rank's part of the detection over 1, 2, 3 and 7
 
 TEST_CASE("the advance's share reads its strip, its part's floes and the floes the routed pairs carry") {
   // The halo plan's piece 2 for the advance: each share's copy has every
-  // floe poisoned but its strip's and its part's pairs' floes, and holds
+  // floe poisoned, its owner too (-1), but its strip's and its part's
+  // pairs' floes, and holds
   // the routed pairs' floes from their bytes (state at the step's start,
   // mass, inertia) before it runs (ShareAdvance::hold takes their straight
   // paths from them). Each share's part, as bytes, equals its part on the
@@ -688,7 +699,10 @@ TEST_CASE("the advance's share reads its strip, its part's floes and the floes t
         const PartsPlay whole = play_shifted(c, ranks, shift, true, false, &clean);
         const PartsPlay p = play_shifted(c, ranks, shift, true, false, &poisoned);
         CHECK(p.ok == whole.ok);
-        // Each share's part, as bytes: the poisoned copy's equals the whole state's.
+        // Each share's routes (the join candidates' closure over the near
+        // pairs, reading their ends' reach less travel as the pairs carry
+        // them) and part, as bytes: the poisoned copy's equal the whole state's.
+        CHECK(poisoned.routes == clean.routes);
         CHECK(poisoned.packed == clean.packed);
         MESSAGE(ranks << " ranks, shift " << shift << ": " << std::string(whole.ok ? "combined" : "fell back") << ", "
                       << poisoned.fetched << " floes fetched with the routed pairs");
