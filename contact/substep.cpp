@@ -22,8 +22,7 @@ ShareRooms Stepper::set_up() {
   bool outrun = false;
   for (std::size_t i = 0; i < n; ++i) {
     if (floes_.is_static[i]) continue;
-    const FloeState& s = start_[i];
-    lin_[i] = (std::hypot(s.vx, s.vy) + std::abs(s.yaw_rate) * shapes_.radius[i]) * dt_;
+    lin_[i] = travel(i);
     outrun = outrun || lin_[i] > det_->reach[i];
   }
   if (outrun) rebuild_pairs();
@@ -204,8 +203,7 @@ void Stepper::hold(Detection held) {
   for (const NearPair& q : held_.pairs)
     for (const std::uint32_t i : {q.a, q.b}) {
       start_[i] = floes_.state[i];
-      if (!floes_.is_static[i])
-        lin_[i] = (std::hypot(start_[i].vx, start_[i].vy) + std::abs(start_[i].yaw_rate) * shapes_.radius[i]) * dt_;
+      if (!floes_.is_static[i]) lin_[i] = travel(i);
     }
   room_ = std::move(room);
   known_ = std::move(known);

@@ -170,6 +170,13 @@ private:
     return {share_->owner[q.a], share_->owner[q.b]};
   }
 
+  // Floe i's straight-path travel over the step from its start state: the
+  // bound |v| dt + |omega| R dt on any of its points' displacement (m).
+  double travel(std::size_t i) const {
+    const FloeState& s = start_[i];
+    return (std::hypot(s.vx, s.vy) + std::abs(s.yaw_rate) * shapes_.radius[i]) * dt_;
+  }
+
   std::uint32_t other(std::uint32_t p, std::uint32_t i) const {
     const NearPair& q = det_->pairs[p];
     return q.a == i ? q.b : q.a;

@@ -6,7 +6,6 @@
 
 #include "core/error.hpp"
 #include "coupling/simulation.hpp"
-#include "fluid/fft2d.hpp"
 #include "fluid/sea.hpp"
 
 namespace floesim {
@@ -138,9 +137,7 @@ void Simulation::restore(const Checkpoint& c) {
   // The owners by place start again from the restored places, as at a
   // run's start (the strips by equal counts, or the sea's slabs), and the
   // detection is made by place.
-  owners_ = parallel::FloeOwners(comm_.rank(), comm_.size(), detection_options_.domain);
-  if (sea_ && !sea_->slab_rows().empty())
-    owners_.set_slabs({sea_->slab_rows(), sea_->grid().dy(), fluid::RealFft2d::kRows});
+  start_owners();
   detect_in_place();
   if (sea_) restore_modal(*sea_, c.sea, "the sea");
   if (incident_) incident_->restore(c.incident);

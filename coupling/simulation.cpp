@@ -87,7 +87,6 @@ Simulation::Simulation(Scenario scenario, parallel::Communicator comm)
   detection_options_.collision_distance = c.contact.collision_distance;
   detection_options_.domain = make_domain(scenario_);
   detection_options_.horizon = c.run.dt_max;
-  owners_ = parallel::FloeOwners(comm_.rank(), comm_.size(), detection_options_.domain);
   impulse_options_.restitution = c.contact.restitution;
   impulse_options_.friction = c.contact.friction;
   impulse_options_.rest_speed = c.contact.rest_speed;
@@ -130,11 +129,7 @@ Simulation::Simulation(Scenario scenario, parallel::Communicator comm)
     floe_sea_->start(scenario_.floes, *sea_, c.coupling.start_given);
     floe_sea_->ready_loads(scenario_.floes, *sea_, incident_.get(), 0.5 * c.run.dt_max);
   }
-  // One decomposition (docs/parallel.md, stage seven): with a sea in slabs
-  // the floes' strips are its slabs, moved by whole blocks of the
-  // transform's rows (drift()); otherwise the strips' cuts are free in y.
-  if (sea_ && !sea_->slab_rows().empty())
-    owners_.set_slabs({sea_->slab_rows(), sea_->grid().dy(), fluid::RealFft2d::kRows});
+  start_owners();
   // The start's detection, by place as each step's (the strips known). The
   // first overlapping pair in pair order, found from the parts (the serial
   // scan's), is the error on every rank.
@@ -497,6 +492,15 @@ bool Simulation::detect_and_check(StepContext& ctx) {
   detection_whole_ = comm_.serial() || whole;
   if (!comm_.serial()) detection_part_ = std::move(part);
   return true;
+}
+
+void Simulation::start_owners() {
+  // One decomposition (docs/parallel.md, stage seven): with a sea in slabs
+  // the floes' strips are its slabs, moved by whole blocks of the
+  // transform's rows (drift()); otherwise the strips' cuts are free in y.
+  owners_ = parallel::FloeOwners(comm_.rank(), comm_.size(), detection_options_.domain);
+  if (sea_ && !sea_->slab_rows().empty())
+    owners_.set_slabs({sea_->slab_rows(), sea_->grid().dy(), fluid::RealFft2d::kRows});
 }
 
 void Simulation::detect_in_place() {

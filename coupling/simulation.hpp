@@ -209,6 +209,9 @@ private:
   void on_floes_changed();  // rebuilds every per-floe structure (after a split)
   void advance(StepContext& ctx);
   bool detect_and_check(StepContext& ctx);  // false: the step overlapped, dt halved
+  // The owners by place afresh (the start, a restore): the strips by equal
+  // counts, or the sea's slabs.
+  void start_owners();
   // The detection at the present places outside a step (the start, a
   // restore, after a split): by place, this rank's part (collective).
   void detect_in_place();
