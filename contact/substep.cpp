@@ -15,8 +15,39 @@ namespace floesim::contact {
 
 namespace detail {
 
+namespace {
+// The floes of `pairs` (both ends) merged into the ascending set `into`.
+void add_floes(std::vector<std::uint32_t>& into, std::span<const NearPair> pairs) {
+  const std::size_t old = into.size();
+  for (const NearPair& q : pairs) into.insert(into.end(), {q.a, q.b});
+  std::sort(into.begin() + static_cast<std::ptrdiff_t>(old), into.end());
+  std::inplace_merge(into.begin(), into.begin() + static_cast<std::ptrdiff_t>(old), into.end());
+  into.erase(std::unique(into.begin(), into.end()), into.end());
+}
+}  // namespace
+
 ShareRooms Stepper::set_up() {
   const std::size_t n = floes_.size();
+  if (holds_part()) {
+    // The floes the share holds: its own and its part's pairs' (the routed
+    // pairs' join them in hold()). Their straight paths only; the other
+    // entries of start_ and lin_ are never read (piece 9 of the halo plan
+    // makes the arrays the held floes').
+    held_floes_.assign(mine_.begin(), mine_.end());
+    add_floes(held_floes_, det_->pairs);
+    start_.resize(n);
+    lin_.assign(n, 0.0);
+    for (const std::uint32_t i : held_floes_) {
+      start_[i] = floes_.state[i];
+      if (!floes_.is_static[i]) lin_[i] = travel(i);
+    }
+    // Every floe is some share's own: the shares' flags, gathered, are the
+    // serial check over every floe.
+    ShareRooms out;
+    for (const std::uint32_t i : mine_) out.outrun = out.outrun || lin_[i] > det_->reach[i];
+    if (out.outrun) return out;
+    return set_up_rooms();
+  }
   start_ = floes_.state;
   lin_.assign(n, 0.0);
   bool outrun = false;
@@ -26,6 +57,23 @@ ShareRooms Stepper::set_up() {
     outrun = outrun || lin_[i] > det_->reach[i];
   }
   if (outrun) rebuild_pairs();
+  return set_up_rooms();
+}
+
+ShareRooms Stepper::set_up_rebuilt() {
+  // As the serial set-up whose check found a floe outrunning: every floe.
+  const std::size_t n = floes_.size();
+  start_ = floes_.state;
+  lin_.assign(n, 0.0);
+  for (std::size_t i = 0; i < n; ++i)
+    if (!floes_.is_static[i]) lin_[i] = travel(i);
+  rebuild_pairs();
+  held_floes_.resize(n);
+  for (std::uint32_t i = 0; i < n; ++i) held_floes_[i] = i;
+  return set_up_rooms();
+}
+
+ShareRooms Stepper::set_up_rooms() {
   build_pair_index();
   const std::size_t pairs = det_->pairs.size();
   pairs_ = static_cast<long>(pairs);
@@ -205,6 +253,7 @@ void Stepper::hold(Detection held) {
       start_[i] = floes_.state[i];
       if (!floes_.is_static[i]) lin_[i] = travel(i);
     }
+  add_floes(held_floes_, held_.pairs);
   room_ = std::move(room);
   known_ = std::move(known);
   build_pair_index();
@@ -220,11 +269,16 @@ void Stepper::run_share() {
   reach_left_.assign(n, kInf);
   budget_.assign(n, kInf);
   outran_.assign(n, 0);
-  for (std::size_t i = 0; i < n; ++i)
+  // On a part, the floes the share holds only (for_held): a member's pairs
+  // are all held, so are its obstacles, and the free floes it moves are its
+  // own and its pairs' (the caller keeps the others).
+  for_held([&](std::uint32_t i) {
     if (!floes_.is_static[i]) reach_left_[i] = det_->reach[i] - lin_[i];
+  });
   if (clusters_.empty()) {
-    for (std::size_t i = 0; i < n; ++i)
-      if (!floes_.is_static[i]) floes_.state[i] = linear(static_cast<std::uint32_t>(i), dt_);
+    for_held([&](std::uint32_t i) {
+      if (!floes_.is_static[i]) floes_.state[i] = linear(i, dt_);
+    });
     return;
   }
   // The clusters this call runs: a share's, those whose lowest floe
@@ -234,8 +288,9 @@ void Stepper::run_share() {
   // (internal pairs: members with members and with obstacles).
   own_.assign(clusters_.size(), 1);
   std::vector<std::uint32_t> posed;
-  for (std::uint32_t i = 0; i < n; ++i)
+  for_held([&](std::uint32_t i) {
     if (floes_.is_static[i]) posed.push_back(i);
+  });
   for (std::size_t k = 0; k < clusters_.size(); ++k) {
     const Cluster& c = clusters_[k];
     if (share_) own_[k] = edge_owner_[c.members.front()] == share_->rank;
@@ -245,8 +300,9 @@ void Stepper::run_share() {
   moving_ = true;
   // Free floes go to the end of the step now: nobody reads them before, and
   // a floe that joins a cluster is put back on its straight path.
-  for (std::size_t i = 0; i < n; ++i)
-    if (!floes_.is_static[i] && cluster_of_[i] == kFree) floes_.state[i] = linear(static_cast<std::uint32_t>(i), dt_);
+  for_held([&](std::uint32_t i) {
+    if (!floes_.is_static[i] && cluster_of_[i] == kFree) floes_.state[i] = linear(i, dt_);
+  });
   // Time order: a min-heap of (tau, cluster); stale entries are skipped.
   using Entry = std::pair<double, int>;
   std::priority_queue<Entry, std::vector<Entry>, std::greater<Entry>> queue;
@@ -624,7 +680,8 @@ void advance_with_collisions(Floes& floes, const CollisionShapes& shapes, const 
 }
 
 ShareAdvance::ShareAdvance(Floes& floes, const CollisionShapes& shapes, const Detection& detection, double dt,
-                           const SubstepOptions& options, const ClusterShare& share, bool on_part)
+                           const SubstepOptions& options, const ClusterShare& share, bool on_part,
+                           std::span<const std::uint32_t> mine)
     : options_(options), share_(share) {
   // The warm store is replaced by an empty probe that only says whether a
   // solve of the share would have used it (ClusterShare above). A failure's
@@ -633,7 +690,8 @@ ShareAdvance::ShareAdvance(Floes& floes, const CollisionShapes& shapes, const De
   // the run's first dumps).
   if (options.impulse.warm) options_.impulse.warm = &probe_;
   options_.impulse.dump_failed_lcps.clear();
-  stepper_ = std::make_unique<detail::Stepper>(floes, shapes, detection, dt, options_, stats_, report_, &share_, on_part);
+  stepper_ =
+      std::make_unique<detail::Stepper>(floes, shapes, detection, dt, options_, stats_, report_, &share_, on_part, mine);
 }
 
 ShareAdvance::~ShareAdvance() = default;
@@ -648,6 +706,21 @@ ShareRooms ShareAdvance::rooms() {
   set_up_ = out.conflict;
   return out;
 }
+
+ShareRooms ShareAdvance::rooms_rebuilt() {
+  ShareRooms out;
+  out.conflict = set_up_;
+  if (set_up_ != ShareOutcome::Conflict::none) return out;
+  try {
+    out = stepper_->set_up_rebuilt();
+  } catch (const RunError&) {
+    out.conflict = ShareOutcome::Conflict::error;
+  }
+  set_up_ = out.conflict;
+  return out;
+}
+
+std::span<const std::uint32_t> ShareAdvance::held() const { return stepper_->held_floes(); }
 
 ShareOutcome ShareAdvance::advance(const ShareRooms& all) {
   if (set_up_ == ShareOutcome::Conflict::none) {

@@ -217,8 +217,13 @@ struct ShareOutcome {
 // contact edges, each in pair order, or a conflict (a RunError in the
 // set-up). Concatenated over the shares (in any order), the second half's
 // input.
+// On a part, `outrun`: a floe the share owns would outrun its reach over
+// the step (step 4 above), and the share computed no room: every share then
+// rebuilds the pair list alike (ShareAdvance::rooms_rebuilt); the callers
+// agree on it through this flag, gathered with the rooms.
 struct ShareRooms {
   ShareOutcome::Conflict conflict = ShareOutcome::Conflict::none;
+  bool outrun = false;
   std::vector<PairRoom> tight;
   std::vector<ContactEdge> touching;
 };
@@ -227,8 +232,8 @@ struct ShareRooms {
 // the tight pairs (contact/ knows nothing of ranks: the exchange is the
 // caller's, parallel::advance_by_owner's gather, and each half is a plain
 // call). Between the two halves `floes` must stay at the step's start.
-// advance() moves the free floes (all of them, linearly) and the clusters of
-// `share` only; stats() and report() get this share's counts (report.rebuilt,
+// advance() moves the free floes (linearly: all of them, or on a part those
+// it holds) and the clusters of `share` only; stats() and report() get this share's counts (report.rebuilt,
 // the pair list's rebuild, is counted on every share: it is not the share's
 // own). The impulse record (options.impulse.record, if any) receives the
 // share's events, and ShareOutcome::events their places in the serial
@@ -239,15 +244,34 @@ public:
   // pair in exactly one share's part; the part's reach the whole reach):
   // the share computes the rooms of all its pairs, and between advance()'s
   // two halves below (clusters(), advance()) the caller routes the pairs.
+  // `mine` (on a part; ascending): the floes the share's rank owns by place.
+  // On a part the share reads and moves only the floes it holds (held()):
+  // `mine`, its part's pairs' floes and, after hold(), the floes of the
+  // pairs routed to it (their states, shapes and reach); its outrun check
+  // reads `mine` (rooms(), ShareRooms::outrun).
   ShareAdvance(Floes& floes, const CollisionShapes& shapes, const Detection& detection, double dt,
-               const SubstepOptions& options, const ClusterShare& share, bool on_part = false);
+               const SubstepOptions& options, const ClusterShare& share, bool on_part = false,
+               std::span<const std::uint32_t> mine = {});
   ~ShareAdvance();
   ShareAdvance(const ShareAdvance&) = delete;
   ShareAdvance& operator=(const ShareAdvance&) = delete;
 
   // The set-up of the share's pairs: the straight paths, the pair list (and
   // its rebuild), and the rooms of the pairs whose lower floe the share owns.
+  // On a part the rebuild is not the share's alone: when its own floes
+  // would outrun their reach it says so (ShareRooms::outrun) and computes
+  // nothing; when any share's did (the gathered flags, the same on every
+  // share), every share calls rooms_rebuilt(): every floe's straight path
+  // and the pair list rebuilt whole (the serial set-up; it reads the whole
+  // pack, as before: the halo plan's piece 3 replaces it), the rooms by
+  // lower floe's owner as off a part, to be gathered as rooms()'s are.
   ShareRooms rooms();
+  ShareRooms rooms_rebuilt();
+  // On a part, the floes the share holds (ascending; every floe once the
+  // pair list was rebuilt whole): those it reads and moves. The caller
+  // keeps the others (the share moves none of them). Off a part, empty (the
+  // share holds every floe).
+  std::span<const std::uint32_t> held() const;
   // The rest, given the tight pairs and contact edges of every share
   // (concatenated, in any order; this share's included): the clusters, and
   // the share's advance.

@@ -83,9 +83,9 @@ class Stepper {
 public:
   Stepper(Floes& floes, const CollisionShapes& shapes, const Detection& detection, double dt,
           const SubstepOptions& options, CollisionStats& stats, SubstepReport& report,
-          const ClusterShare* share = nullptr, bool part = false)
+          const ClusterShare* share = nullptr, bool part = false, std::span<const std::uint32_t> mine = {})
       : floes_(floes), shapes_(shapes), det_(&detection), dt_(dt), opt_(options), stats_(stats), report_(report),
-        share_(share), part_(part) {}
+        share_(share), part_(part), mine_(mine) {}
 
   ShareOutcome::Conflict conflict() const { return conflict_; }
   // A share's run (ShareAdvance): what it did.
@@ -117,8 +117,17 @@ public:
   // lower floe it owns; else all): the straight paths, the pair list
   // (rebuilt if a floe would outrun its reach), its index, and those pairs'
   // rooms. Returns the tight ones (room below xi) and the contact edges of
-  // those pairs, in pair order.
+  // those pairs, in pair order. On a part: the straight paths of the floes
+  // it holds (held_floes_) only, and, when one of its own floes (mine_)
+  // would outrun its reach, only that (ShareRooms::outrun): the caller
+  // agrees on it with the other shares and calls set_up_rebuilt.
   ShareRooms set_up();
+  // On a part, after any share's set_up said outrun: every floe's straight
+  // path and the pair list rebuilt whole, then set_up's rooms.
+  ShareRooms set_up_rebuilt();
+  // The floes this call reads and moves, ascending (every floe off a part
+  // or once rebuilt whole).
+  std::span<const std::uint32_t> held_floes() const { return held_floes_; }
 
   // Steps 1 to 5 from there, given the tight pairs and contact edges of
   // every share (this call's included, in any order): the clusters, then
@@ -195,6 +204,17 @@ private:
   }
 
   void rebuild_pairs();
+  // set_up's rest: the pair index and the rooms this call computes.
+  ShareRooms set_up_rooms();
+  // f(i) for each floe this call holds: held_floes_ on a part, else every floe.
+  template <class F>
+  void for_held(F&& f) const {
+    if (holds_part()) {
+      for (const std::uint32_t i : held_floes_) f(i);
+    } else {
+      for (std::uint32_t i = 0; i < floes_.size(); ++i) f(i);
+    }
+  }
   // A share given only its part of the detection (each pair in one part),
   // and the pair list not rebuilt whole.
   bool holds_part() const { return part_ && det_ != &rebuilt_; }
@@ -333,6 +353,8 @@ private:
   SubstepReport& report_;
   const ClusterShare* share_;          // null: every cluster (the serial advance)
   bool part_ = false;                  // det_ is the share's part of the detection (until rebuilt)
+  std::span<const std::uint32_t> mine_; // on a part: the floes the share's rank owns by place (ascending)
+  std::vector<std::uint32_t> held_floes_;  // on a part: mine_ and the held pairs' floes (ascending)
   Detection held_;                     // on a part: its pairs and those routed to the share
   std::vector<std::uint8_t> held_floe_;  // on a part: per floe, every pair of it held (members, candidates)
   std::vector<std::uint8_t> own_;      // per cluster: run by this call

@@ -404,7 +404,7 @@ void Simulation::advance(StepContext& ctx) {
   if (comm_.serial())
     contact::advance_with_collisions(scenario_.floes, shapes_, detection_, ctx.dt, o, stats_, substeps_);
   else if (detection_part_ && advance_share_options_.on_part)
-    parallel::advance_on_part(comm_, owners_.owner(), scenario_.floes, shapes_, *detection_part_,
+    parallel::advance_on_part(comm_, owners_.owner(), owners_.mine(), scenario_.floes, shapes_, *detection_part_,
                               [this]() -> const contact::Detection& { return whole_detection(); }, ctx.dt, o, stats_,
                               substeps_, advance_share_, advance_share_options_);
   else

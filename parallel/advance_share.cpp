@@ -139,8 +139,8 @@ AdvancePart unpack_advance_part(std::span<const std::byte> bytes) {
 }
 
 std::vector<std::byte> pack(const contact::ShareRooms& rooms) {
-  const std::array<long, 3> head{static_cast<long>(rooms.conflict), static_cast<long>(rooms.tight.size()),
-                                 static_cast<long>(rooms.touching.size())};
+  const std::array<long, 4> head{static_cast<long>(rooms.conflict), rooms.outrun ? 1L : 0L,
+                                 static_cast<long>(rooms.tight.size()), static_cast<long>(rooms.touching.size())};
   std::vector<std::byte> out(sizeof(head) + rooms.tight.size() * kTight + rooms.touching.size() * kEdge);
   std::byte* at = put(out.data(), head.data(), head.size());
   for (const contact::PairRoom& t : rooms.tight) {
@@ -164,10 +164,11 @@ contact::ShareRooms unpack_share_rooms(std::span<const std::byte> bytes) {
   contact::ShareRooms rooms;
   const std::byte* in = bytes.data();
   rooms.conflict = static_cast<ShareOutcome::Conflict>(at<long>(in, 0));
-  const auto count = static_cast<std::size_t>(at<long>(in, 1));
-  const auto edges = static_cast<std::size_t>(at<long>(in, 2));
-  FLOESIM_ASSERT(bytes.size() == 3 * sizeof(long) + count * kTight + edges * kEdge);
-  in += 3 * sizeof(long);
+  rooms.outrun = at<long>(in, 1) != 0;
+  const auto count = static_cast<std::size_t>(at<long>(in, 2));
+  const auto edges = static_cast<std::size_t>(at<long>(in, 3));
+  FLOESIM_ASSERT(bytes.size() == 4 * sizeof(long) + count * kTight + edges * kEdge);
+  in += 4 * sizeof(long);
   rooms.tight.resize(count);
   for (contact::PairRoom& t : rooms.tight) {
     const std::vector<std::uint32_t> ab = take<std::uint32_t>(in, 2);
@@ -323,8 +324,135 @@ std::vector<contact::Detection> routed_pairs(const contact::Detection& part,
   return out;
 }
 
-void advance_on_part(const Communicator& comm, std::span<const int> owner, Floes& floes,
-                     const contact::CollisionShapes& shapes, const contact::Detection& part,
+RoutedShapes routed_shapes(const contact::CollisionShapes& shapes, std::span<const double> reach,
+                           std::span<const std::uint32_t> floes) {
+  RoutedShapes out;
+  out.floe.assign(floes.begin(), floes.end());
+  for (const std::uint32_t i : floes) {
+    out.radius.push_back(shapes.radius[i]);
+    out.reach.push_back(reach[i]);
+    out.parts.push_back(static_cast<std::uint32_t>(shapes.parts_of(i)));
+    for (std::size_t p = shapes.part_offsets[i]; p < shapes.part_offsets[i + 1]; ++p) {
+      const std::span<const Vec2> v = shapes.part(p);
+      out.vertices.push_back(static_cast<std::uint32_t>(v.size()));
+      out.vertex.insert(out.vertex.end(), v.begin(), v.end());
+    }
+  }
+  return out;
+}
+
+void hold(const RoutedShapes& routed, contact::CollisionShapes& shapes, std::span<double> reach) {
+  std::size_t part = 0, vertex = 0;
+  for (std::size_t k = 0; k < routed.floe.size(); ++k) {
+    const std::uint32_t i = routed.floe[k];
+    shapes.radius[i] = routed.radius[k];
+    reach[i] = routed.reach[k];
+    FLOESIM_ASSERT(shapes.parts_of(i) == routed.parts[k]);
+    for (std::size_t p = shapes.part_offsets[i]; p < shapes.part_offsets[i + 1]; ++p, ++part) {
+      FLOESIM_ASSERT(shapes.vertex_offsets[p + 1] - shapes.vertex_offsets[p] == routed.vertices[part]);
+      std::copy_n(routed.vertex.begin() + static_cast<std::ptrdiff_t>(vertex), routed.vertices[part],
+                  shapes.vertices.begin() + static_cast<std::ptrdiff_t>(shapes.vertex_offsets[p]));
+      vertex += routed.vertices[part];
+    }
+  }
+}
+
+std::vector<std::byte> pack(const RoutedShapes& r) {
+  const std::array<std::uint64_t, 3> n{r.floe.size(), r.vertices.size(), r.vertex.size()};
+  std::vector<std::byte> out(sizeof(n) + r.floe.size() * (2 * sizeof(std::uint32_t) + 2 * sizeof(double)) +
+                             r.vertices.size() * sizeof(std::uint32_t) + r.vertex.size() * sizeof(Vec2));
+  std::byte* at = put(out.data(), n.data(), n.size());
+  at = put(at, r.floe.data(), r.floe.size());
+  at = put(at, r.radius.data(), r.radius.size());
+  at = put(at, r.reach.data(), r.reach.size());
+  at = put(at, r.parts.data(), r.parts.size());
+  at = put(at, r.vertices.data(), r.vertices.size());
+  put(at, r.vertex.data(), r.vertex.size());
+  return out;
+}
+
+RoutedShapes unpack_routed_shapes(std::span<const std::byte> bytes) {
+  const std::byte* in = bytes.data();
+  RoutedShapes r;
+  const std::vector<std::uint64_t> n = take<std::uint64_t>(in, 3);
+  const auto floes = static_cast<std::size_t>(n[0]);
+  r.floe = take<std::uint32_t>(in, floes);
+  r.radius = take<double>(in, floes);
+  r.reach = take<double>(in, floes);
+  r.parts = take<std::uint32_t>(in, floes);
+  r.vertices = take<std::uint32_t>(in, static_cast<std::size_t>(n[1]));
+  r.vertex = take<Vec2>(in, static_cast<std::size_t>(n[2]));
+  FLOESIM_ASSERT(in == bytes.data() + bytes.size());
+  return r;
+}
+
+contact::Detection exchange_advance_pairs(const Communicator& comm, const contact::Detection& part,
+                                          const std::vector<contact::Detection>& outgoing, Floes& floes,
+                                          contact::CollisionShapes& shapes, long* shape_bytes) {
+  // A message (none for no pair): three byte counts (the pairs, their
+  // floes' states, their shapes), then those three.
+  std::vector<std::byte> send;
+  std::vector<std::size_t> send_counts;
+  for (const contact::Detection& d : outgoing) {
+    if (d.pairs.empty()) {
+      send_counts.push_back(0);
+      continue;
+    }
+    const RoutedFloes carried = routed_floes(floes, {}, d);
+    const std::array<std::vector<std::byte>, 3> pieces{pack(d), pack(carried),
+                                                       pack(routed_shapes(shapes, part.reach, carried.floe))};
+    const std::array<std::uint64_t, 3> sizes{pieces[0].size(), pieces[1].size(), pieces[2].size()};
+    if (shape_bytes) *shape_bytes += static_cast<long>(sizes[2]);
+    const std::size_t from = send.size();
+    append(send, std::span<const std::uint64_t>(sizes));
+    for (const std::vector<std::byte>& b : pieces) send.insert(send.end(), b.begin(), b.end());
+    send_counts.push_back(send.size() - from);
+  }
+  std::vector<std::byte> got;
+  std::vector<std::size_t> got_counts;
+  comm.alltoall_bytes(send, send_counts, got, got_counts);
+  std::vector<contact::Detection> parts{part};
+  std::vector<RoutedShapes> received;
+  std::size_t from = 0;
+  for (const std::size_t n : got_counts) {
+    if (n) {
+      const std::byte* at = got.data() + from;
+      const std::vector<std::uint64_t> sizes = take<std::uint64_t>(at, 3);
+      const auto piece = [&](std::size_t k) {
+        const std::span<const std::byte> b(at, static_cast<std::size_t>(sizes[k]));
+        at += sizes[k];
+        return b;
+      };
+      parts.push_back(unpack_detection(piece(0)));
+      parallel::hold(unpack_routed_floes(piece(1)), floes, {});
+      received.push_back(unpack_routed_shapes(piece(2)));
+    }
+    from += n;
+  }
+  contact::Detection held = merge(std::move(parts));
+  for (const RoutedShapes& r : received) hold(r, shapes, held.reach);
+  return held;
+}
+
+bool any_outrun(std::span<const contact::ShareRooms> rooms) {
+  return std::any_of(rooms.begin(), rooms.end(), [](const contact::ShareRooms& r) { return r.outrun; });
+}
+
+void move_not_held(Floes& floes, std::span<const std::uint32_t> held, double dt) {
+  // The formula of the share's free floes (contact::drifted from the step's
+  // start): the same bits as the rank holding the floe computes.
+  std::size_t k = 0;
+  for (std::uint32_t i = 0; i < floes.size(); ++i) {
+    if (k < held.size() && held[k] == i) {
+      ++k;
+      continue;
+    }
+    if (!floes.is_static[i]) floes.state[i] = drifted(floes.state[i], dt);
+  }
+}
+
+void advance_on_part(const Communicator& comm, std::span<const int> owner, std::span<const std::uint32_t> mine,
+                     Floes& floes, contact::CollisionShapes& shapes, const contact::Detection& part,
                      const std::function<const contact::Detection&()>& whole, double dt,
                      const contact::SubstepOptions& options, contact::CollisionStats& stats,
                      contact::SubstepReport& report, AdvanceShareCounts& counts,
@@ -344,8 +472,15 @@ void advance_on_part(const Communicator& comm, std::span<const int> owner, Floes
     contact::ImpulseRecord own;
     contact::SubstepOptions own_options = options;
     if (record) own_options.impulse.record = &own;
-    contact::ShareAdvance share(floes, shapes, part, dt, own_options, {owner, comm.rank()}, true);
-    const std::vector<contact::ShareRooms> rooms = comm.allgather_parts(pack(share.rooms()), unpack_share_rooms);
+    contact::ShareAdvance share(floes, shapes, part, dt, own_options, {owner, comm.rank()}, true, mine);
+    std::vector<contact::ShareRooms> rooms = comm.allgather_parts(pack(share.rooms()), unpack_share_rooms);
+    // A floe outrunning its reach on some rank (the flags gathered with the
+    // rooms: the same on every rank): every rank rebuilds the pair list and
+    // gathers the rooms again.
+    if (any_outrun(rooms)) {
+      ++counts.rebuilds;
+      rooms = comm.allgather_parts(pack(share.rooms_rebuilt()), unpack_share_rooms);
+    }
     contact::ShareRooms all;
     // The gathered conflicts and the clusters are the same on every rank:
     // all skip the next exchanges alike.
@@ -365,19 +500,15 @@ void advance_on_part(const Communicator& comm, std::span<const int> owner, Floes
               comm.allgather<contact::JoinCandidate>(routes.candidates);
           counts.candidates += static_cast<long>(candidates.size());
           const std::vector<std::pair<int, std::uint32_t>> to = share.routes(candidates);
-          // The pairs with their floes (state at the start, mass, inertia),
-          // which the share then reads from the message (ShareAdvance::hold
-          // takes their start states into its straight paths).
-          const std::vector<contact::Detection> out = routed_pairs(part, to, comm.size());
-          std::vector<RoutedFloes> carried(out.size()), received;
-          for (std::size_t s = 0; s < out.size(); ++s)
-            if (!out[s].pairs.empty()) carried[s] = routed_floes(floes, {}, out[s]);
-          const contact::Detection held = exchange_pairs(comm, part, out, &carried, &received);
-          for (const RoutedFloes& r : received) parallel::hold(r, floes, {});
-          share.hold(held);
+          // The pairs with their floes (state at the start, mass, inertia,
+          // collision shape, reach), which the share then reads from the
+          // message (ShareAdvance::hold takes their start states into its
+          // straight paths).
+          share.hold(exchange_advance_pairs(comm, part, routed_pairs(part, to, comm.size()), floes, shapes));
         }
-        const AdvancePart mine = share_part(share, share.advance(), floes, record ? &own : nullptr);
-        const std::vector<AdvancePart> parts = comm.allgather_parts(pack(mine), unpack_advance_part);
+        const AdvancePart done = share_part(share, share.advance(), floes, record ? &own : nullptr);
+        move_not_held(floes, share.held(), dt);
+        const std::vector<AdvancePart> parts = comm.allgather_parts(pack(done), unpack_advance_part);
         counts.clusters.resize(parts.size(), 0);
         counts.rooms.resize(parts.size(), 0);
         combined = combine_parts(parts, floes, stats, report, record);

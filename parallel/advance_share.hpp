@@ -22,6 +22,7 @@
 
 #include "contact/substep.hpp"
 #include "parallel/comm.hpp"
+#include "parallel/detect.hpp"
 
 namespace floesim::parallel {
 
@@ -46,8 +47,9 @@ std::vector<std::byte> pack(const AdvancePart& part);
 AdvancePart unpack_advance_part(std::span<const std::byte> bytes);
 
 // The first exchange: a share's tight pairs and contact edges
-// (contact::ShareRooms), 32 bytes a tight pair (a, b, shift, room) and 8 an
-// edge (a, b) after a header (conflict, the two counts).
+// (contact::ShareRooms), 56 bytes a tight or near pair (a, b, shift, room,
+// the floes' reach less travel, their owners) and 16 an edge (a, b, their
+// owners) after a header (conflict, outrun, the two counts: 32 bytes).
 std::vector<std::byte> pack(const contact::ShareRooms& rooms);
 contact::ShareRooms unpack_share_rooms(std::span<const std::byte> bytes);
 
@@ -70,6 +72,54 @@ AdvancePart share_part(const contact::ShareAdvance& share, contact::ShareOutcome
 // to each of `ranks` ranks (none to itself).
 std::vector<contact::Detection> routed_pairs(const contact::Detection& part,
                                              std::span<const std::pair<int, std::uint32_t>> routes, int ranks);
+
+// Whether a gathered share's set-up said a floe of its own would outrun
+// its reach (contact::ShareRooms::outrun): then every rank rebuilds.
+bool any_outrun(std::span<const contact::ShareRooms> rooms);
+
+// Until the halo exchange (docs/parallel.md, the halo plan's piece 8) every
+// rank holds every floe: the dynamic floes not in `held` (ascending: the
+// share's held floes, ShareAdvance::held), which the share did not move,
+// put at the end of the step on their straight paths from the state they
+// hold (the step's start), as their holders' shares move them when free
+// (the same formula, the same bits). Those a cluster moved come in the
+// parts (combine_parts, after this). Piece 8 replaces this pass: each rank
+// then holds only its floes and its band.
+void move_not_held(Floes& floes, std::span<const std::uint32_t> held, double dt);
+
+// What the advance's sub-steps read of a routed pair's floe besides its
+// state, mass and inertia (parallel::RoutedFloes): its collision shape (the
+// members and obstacles are posed and measured) and its reach (a member's
+// reach left, reach less its straight travel). Sent with the routed floes,
+// in the same order, once a floe and receiver: 4 + 8 + 8 + 4 bytes a floe,
+// 4 a part and 16 a vertex.
+struct RoutedShapes {
+  std::vector<std::uint32_t> floe;  // ascending (RoutedFloes::floe)
+  std::vector<double> radius, reach;
+  std::vector<std::uint32_t> parts;     // per floe: its parts
+  std::vector<std::uint32_t> vertices;  // per part: its vertices
+  std::vector<Vec2> vertex;             // m, body frame
+};
+RoutedShapes routed_shapes(const contact::CollisionShapes& shapes, std::span<const double> reach,
+                           std::span<const std::uint32_t> floes);
+// Writes the shapes into `shapes` (the floes' parts and vertices in their
+// places: the layout is every rank's until piece 9 of the halo plan) and
+// the reaches into `reach`.
+void hold(const RoutedShapes& routed, contact::CollisionShapes& shapes, std::span<double> reach);
+std::vector<std::byte> pack(const RoutedShapes& routed);
+RoutedShapes unpack_routed_shapes(std::span<const std::byte> bytes);
+
+// The advance's routed pairs' exchange (parallel::exchange_pairs' with the
+// floes' shapes too): `outgoing[s]` (pairs of this rank's part, in pair
+// order) to rank s with the states (RoutedFloes) and shapes (RoutedShapes)
+// of their floes as `floes`, `shapes` and `part.reach` hold them; the
+// floes received written into `floes`, `shapes` and the returned list's
+// reach (hold), which is `part` merged with the pairs received, in pair
+// order. Collective: one alltoall_bytes, two calls. `shape_bytes` adds the
+// shapes' bytes this rank sent.
+contact::Detection exchange_advance_pairs(const Communicator& comm, const contact::Detection& part,
+                                          const std::vector<contact::Detection>& outgoing, Floes& floes,
+                                          contact::CollisionShapes& shapes, long* shape_bytes = nullptr);
 
 // Combines every rank's part (rank order) into `floes` (each rank's moved
 // floes get its states; the free floes are already at the end of the step on
@@ -115,6 +165,9 @@ struct AdvanceShareCounts {
   long missing = 0;
   long pads = 0;
   long candidates = 0;
+  // From the rank's part: the tries where a floe would outrun its reach
+  // (every rank rebuilt the pair list and gathered the rooms again).
+  long rebuilds = 0;
   long wait = 0;                // advances still to do whole
   long next_wait = 1;           // the wait after the next fallback
 
@@ -159,21 +212,27 @@ void advance_by_owner(const Communicator& comm, std::span<const int> owner, Floe
 
 // The same from this rank's part of the detection (parallel::detect's part,
 // docs/parallel.md "The advance from the rank's part"): the share's set-up
-// on its part (every pair of the part its own), the exchange of the tight
+// on its part (every pair of the part its own; the straight paths of the
+// floes it holds: `mine`, the rank's floes by place, ascending, and its
+// pairs'), the exchange of the tight
 // and near pairs and contact edges, the clusters (with every rank's pad
 // edges gathered first when a cluster is jam-sized), then, when the step has
 // a cluster, the gather of every rank's join candidates and the pairs
 // touching each cluster's members or candidates sent to its runner (one
 // alltoall_bytes: two collective calls), the share's advance on its part
-// and the pairs received, the exchange of the parts. `whole` gives the whole
+// and the pairs received (it moves the free floes it holds;
+// move_not_held the others, until piece 8), the exchange of the parts. A
+// floe of any rank outrunning its reach (the flags gathered with the rooms)
+// makes every rank rebuild the pair list and gather the rooms again (one
+// more allgather_bytes in such a step). `whole` gives the whole
 // detection (collective: every rank calls it at the same point, or none
 // does) for the back-off's whole steps and the fallback, which is taken
 // also when a floe joins a share's cluster without being its candidate
 // (Conflict::missing_pairs). With options.impulse.record the shares record
 // and merge as in advance_by_owner. Equal to the serial advance bit for
 // bit, states, counts and record.
-void advance_on_part(const Communicator& comm, std::span<const int> owner, Floes& floes,
-                     const contact::CollisionShapes& shapes, const contact::Detection& part,
+void advance_on_part(const Communicator& comm, std::span<const int> owner, std::span<const std::uint32_t> mine,
+                     Floes& floes, contact::CollisionShapes& shapes, const contact::Detection& part,
                      const std::function<const contact::Detection&()>& whole, double dt,
                      const contact::SubstepOptions& options, contact::CollisionStats& stats,
                      contact::SubstepReport& report, AdvanceShareCounts& counts,

@@ -26,6 +26,7 @@
 #include "parallel/detect.hpp"
 #include "parallel/place.hpp"
 #include "tests/parallel/collide_case.hpp"
+#include "tests/parallel/halo_case.hpp"
 
 TEST_SUITE_BEGIN("mpi");
 
@@ -458,31 +459,46 @@ namespace {
 // are merged into `merged` (or the whole advance records into it), and
 // `events` gets each share's event count.
 //
-// With `poisoned` (the halo plan's piece 2, docs/parallel.md): each share's
-// copy has every floe NaN (state, mass, inertia, vertices) and its owner -1
-// but its strip's and its part's pairs' floes (the clusters' runners come
-// from the owners the tight pairs and edges carry), and then holds the floes the routed pairs
-// carry (parallel::RoutedFloes, through their bytes) before it runs;
-// `packed` gets each share's part as bytes and `fetched` counts the floes
-// a share received that its copy did not hold. `f` is then not the answer
-// (the copies are poisoned): compare the parts with a clean play's.
+// Each share is given its strip's floes (`mine`, the rank's by place) and
+// moves the free floes it holds; every copy then moves the rest as
+// parallel::advance_on_part does while every rank holds every floe
+// (move_not_held). A floe outrunning its reach on some share (the flags
+// gathered with the rooms) makes every share rebuild (rooms_rebuilt) and
+// the rooms be gathered again (`rebuilds` counts those plays).
+//
+// With `poisoned` (the halo plan's pieces 2 and 9, docs/parallel.md): each
+// share's copy has every floe NaN (state, mass, inertia, vertices, its
+// collision shape, its reach in the part) and its owner -1 but its strip's
+// and its part's pairs' floes (the clusters' runners come from the owners
+// the tight pairs and edges carry), and then holds the floes the routed
+// pairs carry (parallel::RoutedFloes, through their bytes) before it runs;
+// a poisoned floe's x is kSentinel (finite: a share that moved it would
+// write NaN there). `packed` gets each share's part as bytes, `fetched`
+// counts the floes a share received that its copy did not hold, `held` and
+// `states` each share's held floes and its copy's states after its
+// advance (no move_not_held). `f` is then not the answer (the copies are
+// poisoned): compare the parts with a clean play's.
+constexpr double kSentinel = 1.0e30;
 struct Poisoned {
   bool poison = true;  // false: the parts' bytes only, from the whole state
   std::vector<std::vector<std::byte>> packed;
   std::vector<std::vector<std::pair<int, std::uint32_t>>> routes;  // each share's routes (the candidates' closure)
+  std::vector<std::vector<std::uint32_t>> held;                      // each share's held floes (ShareAdvance::held)
+  std::vector<std::vector<FloeState>> states;                        // each share's copy after its advance
   long fetched = 0;
 };
 void poison_floe(Floes& f, std::size_t i) {
   constexpr double nan = std::numeric_limits<double>::quiet_NaN();
   double* d = reinterpret_cast<double*>(&f.state[i]);
   std::fill_n(d, sizeof(FloeState) / sizeof(double), nan);
+  f.state[i].x = kSentinel;
   f.mass[i] = f.inertia_z[i] = nan;
   for (std::size_t k = f.offsets[i]; k < f.offsets[i + 1]; ++k) f.body[k] = Vec2::Constant(nan);
 }
 bool play_parts(const Case& c, const parallel::FloeOwners& strips, std::span<const int> owner, int ranks, Floes& f,
                 contact::CollisionStats& stats, contact::SubstepReport& report, long& sent, long& missing,
                 long& pads, bool candidates = true, contact::ImpulseRecord* merged = nullptr,
-                std::vector<std::uint32_t>* events = nullptr, Poisoned* poisoned = nullptr) {
+                std::vector<std::uint32_t>* events = nullptr, Poisoned* poisoned = nullptr, long* rebuilds = nullptr) {
   const auto n = static_cast<std::size_t>(ranks);
   std::vector<Floes> copies(n, c.floes);
   std::vector<std::vector<std::uint8_t>> held(n, std::vector<std::uint8_t>(c.floes.size(), 0));
@@ -492,8 +508,14 @@ bool play_parts(const Case& c, const parallel::FloeOwners& strips, std::span<con
   std::vector<contact::ImpulseRecord> own(n);
   // Each share's owners: all of them, or poisoned (-1) beyond its floes.
   std::vector<std::vector<int>> owners(n, std::vector<int>(owner.begin(), owner.end()));
+  // Each rank's floes by place (FloeOwners::mine on that rank).
+  std::vector<std::vector<std::uint32_t>> strip_floes(n);
+  for (std::uint32_t i = 0; i < c.floes.size(); ++i)
+    strip_floes[static_cast<std::size_t>(strips.owner()[i])].push_back(i);
   for (int r = 0; r < ranks; ++r)
     parts.push_back(parallel::detect_part(strips, r, c.floes, c.shapes, c.detect_options));
+  // Each share's collision shapes: the case's, or poisoned beyond its floes.
+  std::vector<contact::CollisionShapes> shapes(n, c.shapes);
   if (poisoned && poisoned->poison)
     for (std::size_t k = 0; k < n; ++k) {
       for (std::size_t i = 0; i < c.floes.size(); ++i) held[k][i] = strips.owner()[i] == static_cast<int>(k);
@@ -502,15 +524,23 @@ bool play_parts(const Case& c, const parallel::FloeOwners& strips, std::span<con
         if (!held[k][i]) {
           poison_floe(copies[k], i);
           owners[k][i] = -1;
+          parts[k].reach[i] = std::numeric_limits<double>::quiet_NaN();
         }
+      shapes[k] = test::poisoned(c.shapes, held[k]);
     }
   for (int r = 0; r < ranks; ++r) {
     const std::size_t k = static_cast<std::size_t>(r);
     contact::SubstepOptions o = c.options;
     if (merged) o.impulse.record = &own[k];
-    shares.push_back(std::make_unique<contact::ShareAdvance>(copies[k], c.shapes, parts[k], c.dt, o,
-                                                             contact::ClusterShare{owners[k], r}, true));
+    shares.push_back(std::make_unique<contact::ShareAdvance>(copies[k], shapes[k], parts[k], c.dt, o,
+                                                             contact::ClusterShare{owners[k], r}, true, strip_floes[k]));
     rooms.push_back(parallel::unpack_share_rooms(parallel::pack(shares.back()->rooms())));
+  }
+  if (parallel::any_outrun(rooms)) {
+    // Every share rebuilds alike and the rooms are gathered again.
+    if (rebuilds) ++*rebuilds;
+    for (std::size_t k = 0; k < n; ++k)
+      rooms[k] = parallel::unpack_share_rooms(parallel::pack(shares[k]->rooms_rebuilt()));
   }
   contact::ShareRooms all;
   bool ok = parallel::combine_rooms(rooms, all);
@@ -540,14 +570,20 @@ bool play_parts(const Case& c, const parallel::FloeOwners& strips, std::span<con
     if (poisoned) poisoned->routes.push_back(to);
     out.push_back(parallel::routed_pairs(parts[k], to, ranks));
   }
+  // The routed floes' shapes and reaches (parallel::RoutedShapes), per
+  // sender and receiver, written into the receiver's with its held pairs.
+  std::vector<std::vector<parallel::RoutedShapes>> carried_shapes(n);
   if (ok && poisoned && poisoned->poison) {
     // The routed pairs' floes, from each sender's copy before any share
     // moves a floe (a rank sends them before it advances), through their bytes.
     std::vector<std::vector<parallel::RoutedFloes>> carried(n);
     for (std::size_t s = 0; s < n; ++s)
-      for (std::size_t k = 0; k < n; ++k)
+      for (std::size_t k = 0; k < n; ++k) {
         carried[s].push_back(parallel::unpack_routed_floes(
             parallel::pack(parallel::routed_floes(copies[s], {}, out[s][k]))));
+        carried_shapes[s].push_back(parallel::unpack_routed_shapes(
+            parallel::pack(parallel::routed_shapes(shapes[s], parts[s].reach, carried[s][k].floe))));
+      }
     for (std::size_t k = 0; k < n; ++k)
       for (std::size_t s = 0; s < n; ++s) {
         for (const std::uint32_t i : carried[s][k].floe) poisoned->fetched += held[k][i] ? 0 : 1;
@@ -563,9 +599,18 @@ bool play_parts(const Case& c, const parallel::FloeOwners& strips, std::span<con
           sent += static_cast<long>(out[s][k].pairs.size());
           pairs.push_back(parallel::unpack_detection(parallel::pack(out[s][k])));
         }
-      shares[k]->hold(parallel::merge(std::move(pairs)));
+      contact::Detection with = parallel::merge(std::move(pairs));
+      for (std::size_t s = 0; s < carried_shapes.size(); ++s)
+        if (!carried_shapes[s].empty()) parallel::hold(carried_shapes[s][k], shapes[k], with.reach);
+      shares[k]->hold(std::move(with));
       const parallel::AdvancePart part =
           parallel::share_part(*shares[k], shares[k]->advance(), copies[k], merged ? &own[k] : nullptr);
+      const std::span<const std::uint32_t> held_floes = shares[k]->held();
+      if (poisoned) {
+        poisoned->held.emplace_back(held_floes.begin(), held_floes.end());
+        poisoned->states.push_back(copies[k].state);
+      }
+      parallel::move_not_held(copies[k], held_floes, c.dt);
       if (part.outcome.conflict == contact::ShareOutcome::Conflict::missing_pairs) ++missing;
       if (merged) events->push_back(part.record.events);
       if (poisoned) poisoned->packed.push_back(parallel::pack(part));
@@ -591,7 +636,7 @@ struct PartsPlay {
   Floes f;
   contact::CollisionStats stats;
   contact::SubstepReport report;
-  long sent = 0, stopped = 0, pads = 0;
+  long sent = 0, stopped = 0, pads = 0, rebuilds = 0;
   contact::ImpulseRecord record;        // with `record`: the merged record (after one earlier event)
   std::vector<std::uint32_t> events;    // with `record`: each share's event count
 };
@@ -604,7 +649,7 @@ PartsPlay play_shifted(const Case& c, int ranks, int shift, bool candidates = tr
   PartsPlay p;
   p.record.events = 1;  // the step-start collisions' event
   p.ok = play_parts(c, strips, owner, ranks, p.f, p.stats, p.report, p.sent, p.stopped, p.pads, candidates,
-                    record ? &p.record : nullptr, &p.events, poisoned);
+                    record ? &p.record : nullptr, &p.events, poisoned, &p.rebuilds);
   return p;
 }
 // The played advance is the serial one: states to the bit, counts, report.
@@ -673,18 +718,18 @@ TEST_CASE("the advance from each rank's part of the detection over 1, 2, 3 and 7
 }
 
 TEST_CASE("the advance's share reads its strip, its part's floes and the floes the routed pairs carry") {
-  // The halo plan's piece 2 for the advance: each share's copy has every
-  // floe poisoned, its owner too (-1), but its strip's and its part's
-  // pairs' floes, and holds
-  // the routed pairs' floes from their bytes (state at the step's start,
-  // mass, inertia) before it runs (ShareAdvance::hold takes their straight
+  // The halo plan's piece 2 for the advance, and its set-up over the held
+  // floes: each share's copy has every floe poisoned (state, mass,
+  // inertia, vertices, collision shape, reach), its owner too (-1), but its
+  // strip's and its part's pairs' floes, and holds the routed pairs' floes
+  // from their bytes (state at the step's start, mass, inertia, collision
+  // shape, reach) before it runs (ShareAdvance::hold takes their straight
   // paths from them). Each share's part, as bytes, equals its part on the
   // whole state, over 2, 3 and 7 strips, the clusters' owners the strips
   // and shifted by one rank (the members then lie on other strips), and
-  // where they combine, the combination is the advance's. The
-  // collision shapes are not poisoned: the substeps pose the members' and
-  // candidates' shapes, which the pairs do not carry yet.
-  long fetched = 0;
+  // where they combine, the combination is the advance's; each share moved
+  // the free floes it holds to the whole play's bits and wrote no other.
+  long fetched = 0, free_moved = 0;
   int compared = 0;
   const std::pair<unsigned, double> packs[] = {{3u, 2.0}, {11u, 2.0}, {9u, 1.8}};
   for (const auto& [seed, speed] : packs) {
@@ -704,6 +749,31 @@ TEST_CASE("the advance's share reads its strip, its part's floes and the floes t
         // them) and part, as bytes: the poisoned copy's equal the whole state's.
         CHECK(poisoned.routes == clean.routes);
         CHECK(poisoned.packed == clean.packed);
+        if (whole.ok && poisoned.packed.size() == static_cast<std::size_t>(ranks)) {
+          // Each share moved the free floes it holds, to the whole play's
+          // bits, and wrote no floe it does not hold (x still kSentinel).
+          std::vector<std::uint8_t> moved(c.floes.size(), 0);
+          for (const auto& b : poisoned.packed)
+            for (const std::uint32_t i : parallel::unpack_advance_part(b).outcome.moved) moved[i] = 1;
+          long wrong = 0, written = 0, free_held = 0;
+          for (std::size_t k = 0; k < poisoned.held.size(); ++k) {
+            const std::vector<std::uint32_t>& h = poisoned.held[k];
+            for (std::uint32_t i = 0; i < c.floes.size(); ++i) {
+              const FloeState& s = poisoned.states[k][i];
+              if (!std::binary_search(h.begin(), h.end(), i)) {
+                written += s.x == kSentinel ? 0 : 1;
+              } else if (!moved[i]) {
+                ++free_held;
+                wrong += std::memcmp(&s, &whole.f.state[i], sizeof(FloeState)) == 0 ? 0 : 1;
+              }
+            }
+            CHECK(h.size() < c.floes.size());
+          }
+          CHECK(free_held > 0);
+          CHECK(wrong == 0);
+          CHECK(written == 0);
+          free_moved += free_held;
+        }
         MESSAGE(ranks << " ranks, shift " << shift << ": " << std::string(whole.ok ? "combined" : "fell back") << ", "
                       << poisoned.fetched << " floes fetched with the routed pairs");
         fetched += poisoned.fetched;
@@ -726,7 +796,8 @@ TEST_CASE("the advance's share reads its strip, its part's floes and the floes t
         }
       }
   }
-  MESSAGE(compared << " splits compared, " << fetched << " floes fetched with the routed pairs");
+  MESSAGE(compared << " splits compared, " << fetched << " floes fetched with the routed pairs, " << free_moved
+                   << " free floes moved by the shares holding them");
   CHECK(compared >= 6);
   CHECK(fetched > 0);
 }
@@ -805,4 +876,40 @@ TEST_CASE("the advance's records from each rank's part merge into the serial rec
     }
   MESSAGE(combined << " splits over several ranks combined");
   CHECK(combined >= 6);
+}
+
+TEST_CASE("a floe outrunning its reach on one rank's strip makes every share rebuild the pair list") {
+  // One floe of the last strip is sped up past its reach (the detection
+  // was made before): the serial set-up rebuilds the pair list once. On a
+  // part only that floe's owner sees it (each share checks its own floes);
+  // the flag gathered with the rooms makes every share rebuild
+  // (rooms_rebuilt) and the rooms be gathered again: the serial advance,
+  // the clusters' owners the strips and shifted by one rank.
+  Case c = dense_pack(2.0, 11, 0.5);
+  std::size_t fast = 0;
+  for (std::size_t i = 1; i < c.floes.size(); ++i)
+    if (c.floes.state[i].y > c.floes.state[fast].y) fast = i;
+  FloeState& s = c.floes.state[fast];
+  const double speed = std::hypot(s.vx, s.vy);
+  REQUIRE(speed > 0.0);
+  const double scale = 1.3 * c.detection.reach[fast] / (c.dt * speed);
+  s.vx *= scale;
+  s.vy *= scale;
+  const Serial serial = serial_advance(c);
+  MESSAGE("serial: rebuilt " << serial.report.rebuilt << ", " << serial.report.clusters << " clusters");
+  REQUIRE(serial.report.rebuilt == 1);
+  REQUIRE(serial.report.clusters > 20);
+  int combined = 0;
+  for (const int ranks : {2, 3, 7})
+    for (const int shift : {0, 1}) {
+      CAPTURE(ranks);
+      CAPTURE(shift);
+      const PartsPlay p = play_shifted(c, ranks, shift);
+      MESSAGE(ranks << " ranks, shift " << shift << ": " << std::string(p.ok ? "combined" : "fell back") << ", "
+                    << p.rebuilds << " rebuilds agreed");
+      CHECK(p.rebuilds == 1);
+      combined += p.ok ? 1 : 0;
+      check_serial(p, serial);
+    }
+  CHECK(combined >= 2);  // the shares' advance on the rebuilt list, not only the fallback
 }
