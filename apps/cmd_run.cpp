@@ -383,10 +383,12 @@ int run(const Args& args, const parallel::Session& session) {
     o << "\nparallel.advance_pairs: " << share.pairs;
     // From the rank's part ([run] advance_on_part): the tries redone for a
     // join the share did not hold, the tries with a jam-sized cluster's pads
-    // gathered, the join candidates gathered, and the tries where a floe
-    // would outrun its reach (the pair list rebuilt on every rank).
+    // gathered, the join candidates gathered, the tries where a floe
+    // would outrun its reach (the pair list rebuilt on every rank), and the
+    // bytes of the shapes this rank sent with the routed floes.
     o << "\nparallel.advance_missing: " << share.missing << "\nparallel.advance_pads: " << share.pads
-      << "\nparallel.advance_candidates: " << share.candidates << "\nparallel.advance_rebuilds: " << share.rebuilds;
+      << "\nparallel.advance_candidates: " << share.candidates << "\nparallel.advance_rebuilds: " << share.rebuilds
+      << "\nparallel.advance_shape_bytes: " << share.shape_bytes;
     // The collisions at the step's start by owner, the same way: tried,
     // redone whole, done whole by the back-off, each rank's step groups.
     const parallel::AdvanceShareCounts& collide = sim.collide_share();

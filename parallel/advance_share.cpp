@@ -504,7 +504,8 @@ void advance_on_part(const Communicator& comm, std::span<const int> owner, std::
           // collision shape, reach), which the share then reads from the
           // message (ShareAdvance::hold takes their start states into its
           // straight paths).
-          share.hold(exchange_advance_pairs(comm, part, routed_pairs(part, to, comm.size()), floes, shapes));
+          share.hold(exchange_advance_pairs(comm, part, routed_pairs(part, to, comm.size()), floes, shapes,
+                                            &counts.shape_bytes));
         }
         const AdvancePart done = share_part(share, share.advance(), floes, record ? &own : nullptr);
         move_not_held(floes, share.held(), dt);

@@ -168,6 +168,9 @@ struct AdvanceShareCounts {
   // From the rank's part: the tries where a floe would outrun its reach
   // (every rank rebuilt the pair list and gathered the rooms again).
   long rebuilds = 0;
+  // From the rank's part: the bytes of the collision shapes and reaches
+  // this rank sent with its routed pairs' floes (RoutedShapes).
+  long shape_bytes = 0;
   long wait = 0;                // advances still to do whole
   long next_wait = 1;           // the wait after the next fallback
 
