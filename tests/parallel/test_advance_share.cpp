@@ -913,3 +913,63 @@ TEST_CASE("a floe outrunning its reach on one rank's strip makes every share reb
     }
   CHECK(combined >= 2);  // the shares' advance on the rebuilt list, not only the fallback
 }
+
+TEST_CASE("joins at depth three and on: the share on the poisoned copy takes in a row of free floes as the clean play") {
+  // A column of 10 m squares along y: a1 (floe 0, 1 m/s up) hits a2
+  // (floe 1) 0.5 m ahead; above a2 six floes at rest, 0.05 m apart (beyond
+  // xi = 0.01 m, below the near pairs' 10 xi): each floe hit leaves its
+  // straight path (rest) and brings in the next, a Newton's cradle, so the
+  // cluster takes them in one after another (joins at depth one to six).
+  // The column crosses every cut of 2 and 3 strips, and with the owners
+  // shifted by one rank the cluster's runner holds none of the chain's
+  // pairs: they reach it only through the candidates' closure over the
+  // gathered near pairs. Each share's part and routes on the poisoned copy
+  // (state, shape, reach, owners beyond its floes) equal the clean play's,
+  // and the played advance is the serial one.
+  auto box = [](double y0, double vy) {
+    FloeInput f;
+    f.vertices = {{0.0, y0}, {10.0, y0}, {10.0, y0 + 10.0}, {0.0, y0 + 10.0}};
+    f.velocity = {0.0, vy};
+    return f;
+  };
+  Case c;
+  double y = 0.0;
+  for (int k = 0; k < 8; ++k) {
+    const FloeInput in = box(y, k == 0 ? 1.0 : 0.0);
+    c.floes.add(make_floe_shape(in), in);
+    y += 10.0 + (k == 0 ? 0.5 : 0.05);
+  }
+  c.shapes = contact::build_collision_shapes(c.floes);
+  c.domain = {false, -50.0, 60.0, -50.0, 150.0};
+  contact::DetectionOptions d;
+  d.domain = c.domain;
+  d.horizon = c.dt;
+  d.reach.assign(c.floes.size(), 15.0);  // m: a1 travels 10 m (no rebuild)
+  c.detection = contact::detect(c.floes, c.shapes, d);
+  c.detect_options = d;
+  c.options.floor = 1e-3 * c.dt;
+  c.options.domain = c.domain;
+  const Serial serial = serial_advance(c);
+  MESSAGE("serial: " << serial.report.clusters << " clusters, " << serial.report.joined << " joined, "
+                     << serial.report.merges << " merges");
+  REQUIRE(serial.report.joined >= 3);  // in a row: the third joined through the second, through the first
+  REQUIRE(serial.report.rebuilt == 0);
+  int combined = 0;
+  for (const int ranks : {2, 3})
+    for (const int shift : {0, 1}) {
+      CAPTURE(ranks);
+      CAPTURE(shift);
+      Poisoned clean, poisoned;
+      clean.poison = false;
+      const PartsPlay whole = play_shifted(c, ranks, shift, true, false, &clean);
+      const PartsPlay p = play_shifted(c, ranks, shift, true, false, &poisoned);
+      MESSAGE(ranks << " ranks, shift " << shift << ": " << std::string(whole.ok ? "combined" : "fell back") << ", "
+                    << whole.sent << " pairs routed, " << poisoned.fetched << " floes fetched");
+      check_serial(whole, serial);
+      CHECK(p.ok == whole.ok);
+      CHECK(poisoned.routes == clean.routes);
+      CHECK(poisoned.packed == clean.packed);
+      combined += whole.ok ? 1 : 0;
+    }
+  CHECK(combined == 4);
+}
