@@ -348,17 +348,9 @@ void Stepper::rebuild_pairs() {
 }
 
 void Stepper::build_pair_index() {
-  compact_index_ = holds_part();
-  const auto row = [&](std::uint32_t i) -> std::size_t {
-    if (!compact_index_) return i;
-    const auto at = std::lower_bound(held_floes_.begin(), held_floes_.end(), i);
-    FLOESIM_ASSERT(at != held_floes_.end() && *at == i);
-    return static_cast<std::size_t>(at - held_floes_.begin());
-  };
-  const std::size_t rows = compact_index_ ? held_floes_.size() : floes_.size();
-  pairs_by_floe_ = compressed_rows<std::uint32_t>(rows, det_->pairs.size(), [&](std::size_t p, auto&& put) {
-    put(row(det_->pairs[p].a), static_cast<std::uint32_t>(p));
-    put(row(det_->pairs[p].b), static_cast<std::uint32_t>(p));
+  pairs_by_floe_ = compressed_rows<std::uint32_t>(floes_.size(), det_->pairs.size(), [&](std::size_t p, auto&& put) {
+    put(det_->pairs[p].a, static_cast<std::uint32_t>(p));
+    put(det_->pairs[p].b, static_cast<std::uint32_t>(p));
   });
   stamp_.assign(det_->pairs.size(), 0);
 }

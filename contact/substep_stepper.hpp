@@ -261,16 +261,8 @@ private:
   }
 
   // pairs_of(i): indices of the candidate pairs of floe i (compressed rows).
-  // On a part the rows are the held floes' (held_floes_, a compact index:
-  // every held pair's floes are held), found by binary search; a floe not
-  // held has no pair the share holds.
   void build_pair_index();
-  std::span<const std::uint32_t> pairs_of(std::uint32_t i) const {
-    if (!compact_index_) return pairs_by_floe_.row(i);
-    const auto at = std::lower_bound(held_floes_.begin(), held_floes_.end(), i);
-    if (at == held_floes_.end() || *at != i) return {};
-    return pairs_by_floe_.row(static_cast<std::size_t>(at - held_floes_.begin()));
-  }
+  std::span<const std::uint32_t> pairs_of(std::uint32_t i) const { return pairs_by_floe_.row(i); }
 
   // Clusters: connected components of the hot pairs between dynamic floes,
   // grown through tight pairs (room below xi: a floe of the cluster that
@@ -381,7 +373,6 @@ private:
   long pairs_ = 0;                     // pairs in the list set_up saw (on a part: the part's)
   bool moving_ = false;                // floes moved: the start's states are start_ only
   CompressedRows<std::uint32_t> pairs_by_floe_;  // the pair index (pairs_of)
-  bool compact_index_ = false;                   // its rows are held_floes_' (on a part), else every floe's
   std::vector<int> cluster_of_;        // kFree or a cluster
   std::vector<std::int32_t> edge_owner_;  // per floe: its owner as the gathered edges carry it, or -1
   std::vector<Cluster> clusters_;
