@@ -179,3 +179,64 @@ TEST_CASE("the shared cells' marks on a rank read only the boxes of other ranks'
       CHECK(thin_misses > 0);
     }
 }
+
+TEST_CASE("the explicit vertical drift by the coupling's owners, completed from them, is the serial drift bit for bit (simulated ranks)") {
+  // FloeSeaContact::advance_vertical by owner: each rank drifts its own
+  // floes (MovingFootprints::mine) on a copy where every other floe is
+  // poisoned, then complete_vertical gives each floe's heave, pitch and roll
+  // from its owner to every rank: every rank then holds the serial drift.
+  // The mutation named: completed from the drift's owners when the
+  // coupling's differ (the strips shifted by one rank, as between a move of
+  // the slabs and the next rebuild) reads poisoned floes.
+  const SeaPack s = sea_pack(11);
+  const std::size_t n = s.floes.size();
+  Floes base = s.floes;
+  for (std::size_t i = 0; i < n; ++i) {
+    FloeState& st = base.state[i];
+    st.heave = 0.01 * std::sin(0.3 * static_cast<double>(i));
+    st.pitch = 1e-3 * std::cos(0.7 * static_cast<double>(i));
+    st.roll = -1e-3 * std::sin(1.1 * static_cast<double>(i));
+    st.heave_rate = 0.1 * std::cos(0.2 * static_cast<double>(i));
+    st.pitch_rate = 1e-2 * std::sin(0.5 * static_cast<double>(i));
+    st.roll_rate = 1e-2 * std::cos(0.9 * static_cast<double>(i));
+  }
+  const double h = 0.0173;
+  Floes serial = base;
+  drift_vertical(serial, h);
+  for (const int ranks : {2, 3, 7})
+    for (const int shift : {0, 1}) {
+      CAPTURE(ranks);
+      CAPTURE(shift);
+      const std::vector<int> row_owner = parallel::row_owners(slabs(ranks, s.grid.ny, true));
+      std::vector<int> owner(n);
+      for (std::size_t i = 0; i < n; ++i)
+        owner[i] = row_owner[static_cast<std::size_t>(parallel::grid_row(s.poses[i].y, s.grid.dy(), s.grid.ny))];
+      std::vector<Floes> held;
+      for (int r = 0; r < ranks; ++r) {
+        Held mine(n, 0);
+        std::vector<std::uint32_t> list;
+        for (std::size_t i = 0; i < n; ++i)
+          if (owner[i] == r) {
+            mine[i] = 1;
+            list.push_back(static_cast<std::uint32_t>(i));
+          }
+        Floes f = poisoned(base, mine);
+        drift_vertical(f, list, h);
+        held.push_back(std::move(f));
+      }
+      // complete_vertical's exchange: each floe's three DOFs from the rank
+      // it is taken from (its owner; the mutation: the next rank).
+      bool whole = true;
+      for (int r = 0; r < ranks; ++r) {
+        Floes f = base;
+        for (std::size_t i = 0; i < n; ++i) {
+          const FloeState& from = held[static_cast<std::size_t>((owner[i] + shift) % ranks)].state[i];
+          f.state[i].heave = from.heave;
+          f.state[i].pitch = from.pitch;
+          f.state[i].roll = from.roll;
+        }
+        whole = whole && same_states(f.state, serial.state);
+      }
+      CHECK(whole == (shift == 0));
+    }
+}
