@@ -513,8 +513,9 @@ void FloeSeaContact::complete_vertical(Floes& floes) const {
   // floe's vertical DOFs before the drift's complete_owned makes the state
   // whole: the writer's records and the checkpoints (every floe), the
   // energies (the drift's owners), a split's pieces (their parent's, on
-  // every rank), a rejected step's restore (ctx.start) and the next
-  // evaluation's law on a floe's new coupling owner after a rebuild. So
+  // every rank), the drift owner's state that complete_owned sends, and
+  // the next evaluation's law on a floe's new coupling owner after a
+  // rebuild; and between two steps every rank holds the whole state. So
   // the owners' heave, pitch and roll go to every rank (24 B a floe, one
   // call; the rates are already whole: every rank kicks every floe).
   struct Vertical {
