@@ -478,60 +478,14 @@ void FloeSeaContact::kick_floes(Floes& floes, double h) {
 
 void FloeSeaContact::advance_vertical(Floes& floes, std::span<const FloeState> start, fluid::Sea& sea, double h) {
   if (implicit_) return implicit_step(floes, start, sea, h);
-  // By owner each rank drifts its own floes (the coupling's owners of the
-  // last rebuild, which the next evaluation's law reads on them), then
-  // every rank takes the others' (complete_vertical).
-  if (by_owner() && footprints_.owners().size() == floes.size()) {
-    drift_vertical(floes, footprints_.mine(), h);
-    complete_vertical(floes);
-  } else {
-    drift_vertical(floes, h);
+  for (std::size_t i = 0; i < floes.size(); ++i) {
+    if (floes.is_static[i]) continue;
+    FloeState& st = floes.state[i];
+    st.heave += h * st.heave_rate;
+    st.pitch += h * st.pitch_rate;
+    st.roll += h * st.roll_rate;
   }
   sea.flow(h);
-}
-
-namespace {
-void drift_floe_vertical(Floes& floes, std::size_t i, double h) {
-  if (floes.is_static[i]) return;
-  FloeState& st = floes.state[i];
-  st.heave += h * st.heave_rate;
-  st.pitch += h * st.pitch_rate;
-  st.roll += h * st.roll_rate;
-}
-}  // namespace
-
-void drift_vertical(Floes& floes, std::span<const std::uint32_t> which, double h) {
-  for (const std::uint32_t i : which) drift_floe_vertical(floes, i, h);
-}
-
-void drift_vertical(Floes& floes, double h) {
-  for (std::size_t i = 0; i < floes.size(); ++i) drift_floe_vertical(floes, i, h);
-}
-
-void FloeSeaContact::complete_vertical(Floes& floes) const {
-  // Until the state is held by owner with a halo, every rank reads every
-  // floe's vertical DOFs before the drift's complete_owned makes the state
-  // whole: the writer's records and the checkpoints (every floe), the
-  // energies (the drift's owners), a split's pieces (their parent's, on
-  // every rank), the drift owner's state that complete_owned sends, and
-  // the next evaluation's law on a floe's new coupling owner after a
-  // rebuild; and between two steps every rank holds the whole state. So
-  // the owners' heave, pitch and roll go to every rank (24 B a floe, one
-  // call; the rates are already whole: every rank kicks every floe).
-  struct Vertical {
-    double heave, pitch, roll;
-  };
-  std::vector<Vertical> vertical(floes.size());
-  for (const std::uint32_t i : footprints_.mine())
-    vertical[i] = {floes.state[i].heave, floes.state[i].pitch, floes.state[i].roll};
-  comm_.complete_owned(vertical, footprints_.owners());
-  for (std::size_t i = 0; i < floes.size(); ++i) {
-    if (footprints_.owns(i) || floes.is_static[i]) continue;
-    FloeState& st = floes.state[i];
-    st.heave = vertical[i].heave;
-    st.pitch = vertical[i].pitch;
-    st.roll = vertical[i].roll;
-  }
 }
 
 double FloeSeaContact::vertical_kinetic(const Floes& floes, std::size_t i) const {

@@ -142,12 +142,6 @@ struct FloeSeaLoad {
   Eigen::Vector3d horizontal = Eigen::Vector3d::Zero();  // Fx, Fy (N), torque about z (N m)
 };
 
-// The explicit step's vertical drift over h: heave, pitch and roll move at
-// their rates, for the dynamic floes among `which` (reads and writes those
-// floes' states only), or for every floe.
-void drift_vertical(Floes& floes, std::span<const std::uint32_t> which, double h);
-void drift_vertical(Floes& floes, double h);
-
 class FloeSeaContact {
 public:
   // Resolves the law (blend from a requested restitution through the
@@ -199,9 +193,8 @@ public:
   // (the floes' horizontal positions already at t + h, `start` the floes at
   // t, their vertical DOFs and the sea at t), on the footprint at the
   // midpoint of the horizontal motion. Explicit: the floes' vertical drift
-  // and the sea's free flow (by owner on several ranks: each rank its
-  // floes, MovingFootprints::mine, then every floe's from its owner to every
-  // rank). Throws RunError if the Newton iteration does not converge.
+  // and the sea's free flow. Throws RunError if the Newton iteration does not
+  // converge.
   void advance_vertical(Floes& floes, std::span<const FloeState> start, fluid::Sea& sea, double h);
   bool implicit() const { return implicit_; }
   // Threads for the per-floe and per-piece work (results do not depend on it).
@@ -388,9 +381,6 @@ private:
   void horizontal_loads(std::span<const double> u);
   // The owners' loads to every rank, in one call (nothing when serial).
   void share_owned();
-  // By owner, after the explicit vertical drift of this rank's floes: every
-  // floe's heave, pitch and roll from its coupling owner (one call).
-  void complete_vertical(Floes& floes) const;
   // Implicit: the step's mean horizontal loads (the header's "Horizontal
   // loads of the implicit step") into step_horizontal_.
   void step_mean_horizontal(const Floes& floes, std::span<const FloeState> start);
