@@ -128,6 +128,7 @@
 #include "coupling/footprint.hpp"
 #include "coupling/moving_footprint.hpp"
 #include "coupling/penalty_step.hpp"
+#include "coupling/shared_cells.hpp"
 #include "parallel/cell_routes.hpp"
 
 namespace floesim {
@@ -443,14 +444,16 @@ private:
     std::vector<std::uint8_t> kind, interior_row;
     int interior_reach = -1;
     std::vector<double> parts;
-    std::vector<std::uint32_t> alone, painted;  // painted: the cells whose kind is not their row's
-    // With the boxes (boxed()), during sum_coverage_by_owner: per grid cell
-    // 1 + its index among the shared cells (0: not shared), and per shared
-    // cell the ranks whose floes' boxes cover it (`rank_words` 64-bit words
-    // of bits); per cell of `cells`, the ranks that sum it (receivers_first
-    // into receivers: those ranks, the cell's slab's rank and this one).
-    std::vector<std::uint32_t> shared_at, receivers_first;
-    std::vector<std::uint64_t> shared_ranks;
+    std::vector<std::uint32_t> alone;
+    // marks.painted: the cells whose kind is not their row's. With the boxes
+    // (boxed()), during sum_coverage_by_owner: marks.shared_at, per grid
+    // cell 1 + its index among the shared cells (0: not shared), and
+    // marks.shared_ranks, per shared cell the ranks whose floes' boxes cover
+    // it (`rank_words` 64-bit words of bits; coupling/shared_cells.hpp); per
+    // cell of `cells`, the ranks that sum it (receivers_first into
+    // receivers: those ranks, the cell's slab's rank and this one).
+    SharedMarks marks;
+    std::vector<std::uint32_t> receivers_first;
     std::vector<int> receivers;
     std::vector<double> alone_totals;
     // The serial order (order_by_owner): per floe the box of its pieces'

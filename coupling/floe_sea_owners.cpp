@@ -211,28 +211,24 @@ void FloeSeaContact::sum_coverage_by_owner() {
     // interiors (where no other rank's floe reaches).
     // With each such cell, the ranks of those floes: each sums the cell
     // too.
-    o.painted.clear();
-    o.shared_ranks.clear();
     if (boxes) {
-      o.shared_at.resize(grid_.size(), 0);
-      const std::span<const int> owners = footprints_.owners();
-      std::uint32_t shared = 0;
-      for (std::uint32_t i : o.serial) {
-        if (footprints_.owns(i)) continue;
-        const std::size_t word = static_cast<std::size_t>(owners[i]) / 64;
-        const std::uint64_t bit = std::uint64_t{1} << (static_cast<unsigned>(owners[i]) % 64);
-        o.box[i].for_each(
-            grid_.nx, grid_.ny, [&](int y) { return o.interior_row[static_cast<std::size_t>(y)] == 0; },
-            [&](std::uint32_t c) {
-              if (o.kind[c] == OwnerCells::kRoutedRow) {
-                o.kind[c] = OwnerCells::kShared;
-                o.painted.push_back(c);
-                o.shared_at[c] = ++shared;
-                o.shared_ranks.resize(shared * rank_words, 0);
-              }
-              o.shared_ranks[(o.shared_at[c] - 1) * rank_words + word] |= bit;
-            });
+      // The boxes of the other ranks' floes that may cover a cell of this
+      // rank's pieces (coupling/shared_cells.hpp: within R_j + R_max and
+      // about two cells of its slab of the owners); no other box is read.
+      std::vector<std::uint32_t> near;
+      if (footprints_.by_place()) {
+        near = box_neighbours(o.serial, footprints_.owners(), comm_.rank(), footprints_.owner_slabs(),
+                              footprints_.reference(), footprints_.radius(), grid_, footprints_.reach(),
+                              footprints_.piece_rows());
+      } else {
+        for (const std::uint32_t i : o.serial)
+          if (!footprints_.owns(i)) near.push_back(i);
       }
+      mark_shared_cells(near, o.box, footprints_.owners(), grid_.nx, grid_.ny, o.interior_row, o.kind,
+                        OwnerCells::kRoutedRow, OwnerCells::kShared, rank_words, o.marks);
+    } else {
+      o.marks.painted.clear();
+      o.marks.shared_ranks.clear();
     }
   }
   // This rank's other cells, in the order its floes' pieces meet them, and
@@ -279,7 +275,7 @@ void FloeSeaContact::sum_coverage_by_owner() {
           cells_[c].coverage += fp.area[k] * inv_cell_area;
           if (kind == OwnerCells::kRoutedRow) {  // first met: listed, and its total sent if another rank owns it
             o.kind[c] = OwnerCells::kAloneListed;
-            o.painted.push_back(c);
+            o.marks.painted.push_back(c);
             if (routes_.owner(c) != rank) o.alone.push_back(c);
             else ++alone_here;
           }
@@ -303,7 +299,7 @@ void FloeSeaContact::sum_coverage_by_owner() {
       }
   }
   // The kinds back to the rows' (the boxes move with the floes).
-  for (std::uint32_t c : o.painted) o.kind[c] = OwnerCells::kRoutedRow;
+  for (std::uint32_t c : o.marks.painted) o.kind[c] = OwnerCells::kRoutedRow;
   if (routed()) {
     // The routed cells' pieces grouped by cell, in the serial order within
     // each (order_ is), with their floes' positions.
@@ -337,7 +333,7 @@ void FloeSeaContact::sum_coverage_by_owner() {
     // (Ascending, each once: the covering ranks' bits, with this rank and
     // the slab's; a cell's cost is its covering ranks', not every rank's.)
     for (const std::uint32_t c : o.cells) {
-      const std::uint64_t* ranks = o.shared_ranks.data() + (o.shared_at[c] - 1) * rank_words;
+      const std::uint64_t* ranks = o.marks.shared_ranks.data() + (o.marks.shared_at[c] - 1) * rank_words;
       const auto first = static_cast<std::ptrdiff_t>(o.receivers.size());
       o.receivers.push_back(rank);
       o.receivers.push_back(routes_.owner(c));
@@ -348,7 +344,7 @@ void FloeSeaContact::sum_coverage_by_owner() {
       o.receivers.erase(std::unique(o.receivers.begin() + first, o.receivers.end()), o.receivers.end());
       o.receivers_first.push_back(static_cast<std::uint32_t>(o.receivers.size()));
     }
-    for (const std::uint32_t c : o.painted) o.shared_at[c] = 0;
+    for (const std::uint32_t c : o.marks.painted) o.marks.shared_at[c] = 0;
     routes_.open_shared(comm_, o.cells, o.first, o.keys, o.values, 1, o.receivers_first, o.receivers, o.alone);
     for (const std::uint32_t c : o.cells) cells_[c].coverage = routes_.total(routes_.index(c), 0);
     return;

@@ -7,6 +7,7 @@
 
 #include "core/error.hpp"
 #include "coupling/parallel.hpp"
+#include "coupling/shared_cells.hpp"
 #include "parallel/cell_routes.hpp"
 #include "parallel/place.hpp"
 
@@ -116,7 +117,7 @@ void MovingFootprints::rebuild_at(const Floes& floes, std::span<const std::uint8
     for (const Vec2& v : floes.vertices(i)) radius_[i] = std::max(radius_[i], v.norm());
     if (include[i]) largest = std::max(largest, radius_[i]);
   }
-  piece_rows_ = static_cast<int>(std::ceil((largest + (1.0 + options_.reach) * grid_.dy()) / grid_.dy())) + 1;
+  piece_rows_ = piece_rows_of(largest, options_.reach, grid_.dy());
   area0_ = pieces_.area;
   moment0_.resize(area0_.size());
   for (std::size_t k = 0; k < area0_.size(); ++k) moment0_[k] = area0_[k] * pieces_.centroid[k];

@@ -112,6 +112,12 @@ public:
   // largest move of a cut is added: the pieces then lie within that many
   // rows of their owner's slab of the sea.
   bool by_place() const { return by_place_; }
+  // The rows a floe's pieces may lie from its centroid's row at the last
+  // rebuild (the largest floe's), its window's reach (cells) and, per floe,
+  // R (coupling/shared_cells.hpp bounds one floe's rows with them).
+  int piece_rows() const { return piece_rows_; }
+  double reach() const { return options_.reach; }
+  std::span<const double> radius() const { return radius_; }
   // The slabs the owners were set by at the last rebuild (empty: by index).
   std::span<const int> owner_slabs() const { return owner_rows_; }
   int reach_rows() const { return reach_rows_from(sea_rows_); }

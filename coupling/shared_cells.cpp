@@ -1,0 +1,63 @@
+#include "coupling/shared_cells.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "core/error.hpp"
+
+namespace floesim {
+
+int piece_rows_of(double radius, double reach, double dy) {
+  return static_cast<int>(std::ceil((radius + (1.0 + reach) * dy) / dy)) + 1;
+}
+
+std::vector<std::uint32_t> box_neighbours(std::span<const std::uint32_t> candidates, std::span<const int> owner, int rank,
+                                          std::span<const int> first_row, std::span<const FloePose> reference,
+                                          std::span<const double> radius, const fluid::SurfaceGrid& grid, double reach,
+                                          int own_rows) {
+  FLOESIM_ASSERT(static_cast<std::size_t>(rank) + 1 < first_row.size());
+  const int rows = grid.ny, lo = first_row[static_cast<std::size_t>(rank)],
+            hi = first_row[static_cast<std::size_t>(rank) + 1];
+  const double dy = grid.dy();
+  // The distance in rows from row y to the slab [lo, hi), on the circle.
+  const auto distance = [&](int y) {
+    if (lo >= hi) return rows;  // an empty slab: no pieces of its own
+    if (y >= lo && y < hi) return 0;
+    const int below = ((lo - y) % rows + rows) % rows, above = ((y - (hi - 1)) % rows + rows) % rows;
+    return std::min(below, above);
+  };
+  std::vector<std::uint32_t> out;
+  for (const std::uint32_t j : candidates) {
+    if (owner[j] == rank) continue;
+    const int row = parallel::grid_row(reference[j].y, dy, rows);
+    if (distance(row) <= piece_rows_of(radius[j], reach, dy) + own_rows) out.push_back(j);
+  }
+  return out;
+}
+
+void mark_shared_cells(std::span<const std::uint32_t> floes, std::span<const parallel::CellBox> box,
+                       std::span<const int> owner, int columns, int rows, std::span<const std::uint8_t> interior_row,
+                       std::span<std::uint8_t> kind, std::uint8_t open, std::uint8_t shared, std::size_t rank_words,
+                       SharedMarks& marks) {
+  marks.painted.clear();
+  marks.shared_ranks.clear();
+  marks.shared_at.resize(static_cast<std::size_t>(columns) * static_cast<std::size_t>(rows), 0);
+  std::uint32_t count = 0;
+  for (const std::uint32_t j : floes) {
+    const std::size_t word = static_cast<std::size_t>(owner[j]) / 64;
+    const std::uint64_t bit = std::uint64_t{1} << (static_cast<unsigned>(owner[j]) % 64);
+    box[j].for_each(
+        columns, rows, [&](int y) { return interior_row[static_cast<std::size_t>(y)] == 0; },
+        [&](std::uint32_t c) {
+          if (kind[c] == open) {
+            kind[c] = shared;
+            marks.painted.push_back(c);
+            marks.shared_at[c] = ++count;
+            marks.shared_ranks.resize(count * rank_words, 0);
+          }
+          marks.shared_ranks[(marks.shared_at[c] - 1) * rank_words + word] |= bit;
+        });
+  }
+}
+
+}  // namespace floesim

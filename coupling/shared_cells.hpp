@@ -1,0 +1,67 @@
+#pragma once
+// The cells a rank's floes may share with other ranks' floes, for the
+// contact by owner on a sea in slabs (docs/parallel.md, stage eight, and
+// "The coupling's passes over the held floes"): which other floes' boxes of
+// cells (parallel::CellBox) a rank reads, and the marking of the cells they
+// cover. Plain functions of plain data, so that simulated ranks can be
+// tested in one process (tests/parallel/test_halo_coupling.cpp).
+//
+// Which boxes are enough. Rank r reads, for each cell of its own floes'
+// pieces, whether another rank's floe may have pieces there and which
+// ranks' (FloeSeaContact::sum_coverage_by_owner). Floe j's pieces lie in
+// the cells built at its reference pose (the footprints' last rebuild),
+// within
+//     rows_j = ceil((R_j + (1 + reach) dy) / dy) + 1
+// rows of the row of its centroid there (R_j its largest vertex distance
+// from the centroid, one cell for the tent's spread, the window's reach;
+// MovingFootprints::reach_rows' bound for one floe), and rank r's floes'
+// pieces within own_rows = max over its floes of rows_i of its slab of the
+// owners (each owns the floes whose centroid's row its slab held then). A
+// cell holds pieces of both only if its row lies within both bands, so only
+// the floes j of other ranks with
+//     dist(row_j, slab_r) <= rows_j + own_rows
+// (rows on the grid's circle: a superset on a walled grid) can cover a cell
+// of rank r's pieces: in lengths, R_j + R_max + about two cells and the
+// window's reach from the slab. Their boxes are the only ones read.
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "coupling/footprint.hpp"
+#include "fluid/grid.hpp"
+#include "parallel/cell_routes.hpp"
+
+namespace floesim {
+
+// rows_j above: the rows floe j's pieces may lie from its centroid's row.
+int piece_rows_of(double radius, double reach, double dy);
+
+// The floes among `candidates` (the floes the rank holds) that another rank
+// owns (owner[j] != rank) and whose boxes may cover a cell of rank `rank`'s
+// pieces: the criterion above, with first_row the owners' slabs (as
+// fluid::Sea::slab_rows gives them), reference and radius per floe (read for
+// the candidates only), reach the footprints' window in cells and own_rows
+// the rows the rank's floes' pieces may lie from its slab. In the
+// candidates' order.
+std::vector<std::uint32_t> box_neighbours(std::span<const std::uint32_t> candidates, std::span<const int> owner, int rank,
+                                          std::span<const int> first_row, std::span<const FloePose> reference,
+                                          std::span<const double> radius, const fluid::SurfaceGrid& grid, double reach,
+                                          int own_rows);
+
+// The cells of the boxes of `floes` (each another rank's, owner[j]) in
+// rows outside the slab's interior (interior_row[y] == 0): each cell whose
+// kind is `open` becomes `shared` (listed in `painted`, numbered in
+// shared_at from 1), and every cell gets its floes' owners' bits in
+// shared_ranks (rank_words 64-bit words a shared cell). Reads box[j] and
+// owner[j] of `floes` only.
+struct SharedMarks {
+  std::vector<std::uint32_t> painted, shared_at;
+  std::vector<std::uint64_t> shared_ranks;
+};
+void mark_shared_cells(std::span<const std::uint32_t> floes, std::span<const parallel::CellBox> box,
+                       std::span<const int> owner, int columns, int rows, std::span<const std::uint8_t> interior_row,
+                       std::span<std::uint8_t> kind, std::uint8_t open, std::uint8_t shared, std::size_t rank_words,
+                       SharedMarks& marks);
+
+}  // namespace floesim

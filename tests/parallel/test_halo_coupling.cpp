@@ -1,0 +1,181 @@
+// The coupling's passes over the floes a rank needs (docs/parallel.md, "The
+// coupling's passes over the held floes"), on simulated ranks in one process:
+// each pass, given a copy poisoned outside the set it claims to need, gives
+// bit for bit what it gives on the whole state, and a thinner set (the
+// mutation each names) does not.
+#include <doctest/doctest.h>
+
+#include <algorithm>
+#include <cstring>
+#include <numeric>
+#include <vector>
+
+#include "coupling/floe_sea.hpp"
+#include "coupling/footprint.hpp"
+#include "coupling/shared_cells.hpp"
+#include "parallel/cell_routes.hpp"
+#include "tests/parallel/halo_case.hpp"
+#include "tests/parallel/sea_case.hpp"
+
+using namespace floesim;
+using namespace floesim::test;
+
+namespace {
+
+// The dense moving pack of the halo proofs (400 floes, 2 km square) on the
+// distributed sea tests' grid (8 m x 10 m cells, tests/parallel/sea_case.hpp),
+// periodic, the pack's window moved to the grid's origin.
+struct SeaPack {
+  Floes floes;
+  fluid::SurfaceGrid grid;
+  std::vector<FloePose> poses;
+  std::vector<double> radius;
+};
+SeaPack sea_pack(unsigned seed) {
+  Pack p = moving_pack(seed, true);
+  SeaPack s;
+  s.floes = std::move(p.floes);
+  const SeaParams sea = slab_sea_params(250, 200);
+  s.grid.dims = 2;
+  s.grid.nx = sea.cells[0];
+  s.grid.ny = sea.cells[1];
+  s.grid.lx = sea.size[0];
+  s.grid.ly = sea.size[1];
+  s.grid.edge = fluid::GridEdge::periodic;
+  for (FloeState& st : s.floes.state) {
+    st.x -= p.window[0];
+    st.y -= p.window[2];
+    s.poses.push_back({st.x, st.y, st.yaw});
+  }
+  s.radius.assign(s.floes.size(), 0.0);
+  for (std::size_t i = 0; i < s.floes.size(); ++i)
+    for (const Vec2& v : s.floes.vertices(i)) s.radius[i] = std::max(s.radius[i], v.norm());
+  return s;
+}
+
+// The slabs of `ranks` ranks on `rows` rows: equal, or uneven (as after
+// moves of the cuts: one slab twice the others, one empty with 7).
+std::vector<int> slabs(int ranks, int rows, bool uneven) {
+  std::vector<int> first(static_cast<std::size_t>(ranks) + 1);
+  for (int r = 0; r <= ranks; ++r) first[static_cast<std::size_t>(r)] = r * rows / ranks;
+  if (uneven) {
+    first[1] = std::min(first[1] + rows / (2 * ranks), first[2]);
+    if (ranks >= 7) first[3] = first[2];
+  }
+  return first;
+}
+
+constexpr std::uint8_t kOpen = 0, kInterior = 1, kShared = 2;
+
+// What rank `rank` reads of the marks: at each cell of its own floes' pieces
+// in a row outside the interior, whether it is shared and by which ranks.
+struct Read {
+  std::vector<std::uint8_t> shared;
+  std::vector<std::uint64_t> ranks;
+};
+Read read_marks(const Footprints& fp, std::span<const int> owner, int rank, std::span<const std::uint8_t> interior_row,
+                std::span<const std::uint8_t> kind, const SharedMarks& marks, int nx) {
+  Read out;
+  for (std::size_t i = 0; i < owner.size(); ++i) {
+    if (owner[i] != rank) continue;
+    for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k) {
+      const std::uint32_t c = fp.cell[k];
+      if (interior_row[c / static_cast<std::uint32_t>(nx)]) continue;
+      const bool shared = kind[c] == kShared;
+      out.shared.push_back(shared ? 1 : 0);
+      out.ranks.push_back(shared ? marks.shared_ranks[marks.shared_at[c] - 1] : 0);
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+TEST_CASE("the shared cells' marks on a rank read only the boxes of other ranks' floes within R_j + R_max and two cells of its slab (simulated ranks)") {
+  // FloeSeaContact::sum_coverage_by_owner's marking of the cells other
+  // ranks' floes' boxes cover, on the cells of each rank's own pieces: from
+  // every other floe's box (as before), and from box_neighbours' floes only
+  // with every other box poisoned (a box over the whole grid, which would
+  // mark every cell shared if read). Equal on every rank, for 2, 3 and 7
+  // slabs, equal and uneven, both kernels, footprints rebuilt at every
+  // placement and with a window of 0.3 cells. The mutation named: the set
+  // without the own floes' rows (dist(row_j, slab) <= rows_j alone) misses
+  // shared cells on some rank.
+  const SeaPack s = sea_pack(7);
+  const std::size_t n = s.floes.size();
+  const int nx = s.grid.nx, ny = s.grid.ny;
+  std::vector<std::uint32_t> all(n);
+  std::iota(all.begin(), all.end(), 0u);
+  for (const FootprintKernel kernel : {FootprintKernel::cell, FootprintKernel::tent})
+    for (const double reach : {0.0, 0.3}) {
+      Footprints fp;
+      const std::vector<std::uint8_t> include(n, 1);
+      build_footprints(s.floes, include, s.grid, fp, kernel, 1, s.poses);
+      std::vector<parallel::CellBox> box(n);
+      for (std::size_t i = 0; i < n; ++i)
+        box[i] = parallel::CellBox::of(std::span(fp.cell.data() + fp.offsets[i], fp.offsets[i + 1] - fp.offsets[i]), nx, ny);
+      const int own_rows = piece_rows_of(*std::max_element(s.radius.begin(), s.radius.end()), reach, s.grid.dy());
+      std::size_t read_full = 0, read_near = 0, thin_misses = 0;
+      for (const int ranks : {2, 3, 7})
+        for (const bool uneven : {false, true}) {
+          CAPTURE(ranks);
+          CAPTURE(uneven);
+          const std::vector<int> first = slabs(ranks, ny, uneven);
+          const std::vector<int> row_owner = parallel::row_owners(first);
+          std::vector<int> owner(n);
+          for (std::size_t i = 0; i < n; ++i)
+            owner[i] = row_owner[static_cast<std::size_t>(parallel::grid_row(s.poses[i].y, s.grid.dy(), ny))];
+          const std::vector<std::uint8_t> interior_row = parallel::CellRoutes(first, static_cast<std::size_t>(nx)).interior_rows(own_rows);
+          std::vector<std::uint8_t> kind0(s.grid.size());
+          for (std::size_t c = 0; c < kind0.size(); ++c) kind0[c] = interior_row[c / static_cast<std::size_t>(nx)] ? kInterior : kOpen;
+          const std::size_t words = (static_cast<std::size_t>(ranks) + 63) / 64;
+          for (int r = 0; r < ranks; ++r) {
+            CAPTURE(r);
+            // As before: every other rank's floe's box.
+            std::vector<std::uint32_t> others;
+            for (const std::uint32_t i : all)
+              if (owner[i] != r) others.push_back(i);
+            std::vector<std::uint8_t> kind_full = kind0;
+            SharedMarks full;
+            mark_shared_cells(others, box, owner, nx, ny, interior_row, kind_full, kOpen, kShared, words, full);
+            // The claimed set, every other box poisoned.
+            const std::vector<std::uint32_t> near =
+                box_neighbours(all, owner, r, first, s.poses, s.radius, s.grid, reach, own_rows);
+            std::vector<parallel::CellBox> poisoned_box(n);
+            for (parallel::CellBox& b : poisoned_box) {
+              b.first_cell = 0;
+              b.row_lo = 0;
+              b.row_hi = static_cast<std::int16_t>(ny - 1);
+              b.column_lo = 0;
+              b.column_hi = static_cast<std::int16_t>(nx - 1);
+            }
+            for (const std::uint32_t j : near) poisoned_box[j] = box[j];
+            std::vector<std::uint8_t> kind_near = kind0;
+            SharedMarks marks;
+            mark_shared_cells(near, poisoned_box, owner, nx, ny, interior_row, kind_near, kOpen, kShared, words, marks);
+            const Read a = read_marks(fp, owner, r, interior_row, kind_full, full, nx);
+            const Read b = read_marks(fp, owner, r, interior_row, kind_near, marks, nx);
+            CHECK(a.shared == b.shared);
+            CHECK(a.ranks == b.ranks);
+            read_full += others.size();
+            read_near += near.size();
+            // The mutation: without the own floes' rows.
+            std::vector<std::uint32_t> thin;
+            for (const std::uint32_t j : near) {
+              const std::vector<std::uint32_t> one{j};
+              if (!box_neighbours(one, owner, r, first, s.poses, s.radius, s.grid, reach, 0).empty()) thin.push_back(j);
+            }
+            std::vector<std::uint8_t> kind_thin = kind0;
+            SharedMarks thin_marks;
+            mark_shared_cells(thin, box, owner, nx, ny, interior_row, kind_thin, kOpen, kShared, words, thin_marks);
+            const Read t = read_marks(fp, owner, r, interior_row, kind_thin, thin_marks, nx);
+            if (t.shared != a.shared || t.ranks != a.ranks) ++thin_misses;
+          }
+        }
+      MESSAGE("kernel " << (kernel == FootprintKernel::cell ? "cell" : "tent") << ", reach " << reach
+                        << ": boxes read " << read_near << " of " << read_full << " (all ranks and slabs); the thin set missed on "
+                        << thin_misses << " of 24 ranks");
+      CHECK(read_near < read_full);
+      CHECK(thin_misses > 0);
+    }
+}
