@@ -1,12 +1,15 @@
 // Simulation::save and restore (coupling/simulation.hpp): which state each
 // part of a run carries from one step to the next, and what is computed again
-// from it (core/checkpoint.hpp).
+// from it (core/checkpoint.hpp); and the floes' states the writer writes,
+// gathered from their holders (writer_states).
 #include <algorithm>
+#include <cmath>
 #include <cstring>
 
 #include "core/error.hpp"
 #include "coupling/simulation.hpp"
 #include "fluid/sea.hpp"
+#include "parallel/writer_gather.hpp"
 
 namespace floesim {
 
@@ -62,12 +65,77 @@ void restore_warm(const WarmStartState& s, contact::WarmStart& w) {
 
 }  // namespace
 
-Checkpoint Simulation::save() {
+std::vector<FloeState> Simulation::writer_states() const {
+  const std::vector<FloeState>& whole = scenario_.floes.state;
+  if (comm_.serial()) return whole;
+  const std::size_t n = whole.size();
+  // Who holds what between two steps: the drift's owners by place hold the
+  // states (its complete_owned sends theirs at the next drift), the
+  // coupling's owners the heave, pitch and roll they drifted (the same
+  // owners' once a split has added floes the owners do not cover yet: the
+  // shares by index, as for_owned's).
+  std::vector<int> owner;
+  if (owners_.owner().size() == n) {
+    owner.assign(owners_.owner().begin(), owners_.owner().end());
+  } else {
+    owner.resize(n);
+    for (int r = 0; r < comm_.size(); ++r) {
+      const parallel::Range share = parallel::share(n, r, comm_.size());
+      for (std::size_t i = share.begin; i < share.end; ++i) owner[i] = r;
+    }
+  }
+  std::span<const int> vertical_owner;
+  if (floe_sea_ && floe_sea_->vertical_owners().size() == n) vertical_owner = floe_sea_->vertical_owners();
+  const int writer = 0;
+  std::vector<FloeState> states = whole;
+  if (writer_test_ != WriterTest::off) {
+    const double nan = std::nan("");
+    for (std::size_t i = 0; i < n; ++i) {
+      const bool state_held = owner[i] == comm_.rank();
+      const bool vertical_held = (vertical_owner.empty() ? owner[i] : vertical_owner[i]) == comm_.rank();
+      if (!state_held) {
+        const FloeState kept = states[i];
+        states[i] = FloeState{nan, nan, nan, nan, nan, nan, nan, nan, nan, nan, nan, nan};
+        if (vertical_held) {
+          states[i].heave = kept.heave;
+          states[i].pitch = kept.pitch;
+          states[i].roll = kept.roll;
+        }
+      } else if (!vertical_held) {
+        states[i].heave = states[i].pitch = states[i].roll = nan;
+      }
+    }
+  }
+  const std::vector<std::size_t> counts = parallel::writer_counts(owner, vertical_owner, comm_.size(), writer);
+  const std::vector<std::byte> message = parallel::writer_message(states, owner, vertical_owner, comm_.rank(), writer);
+  std::vector<std::size_t> send(static_cast<std::size_t>(comm_.size()), 0), receive(send.size(), 0);
+  send[static_cast<std::size_t>(writer)] = message.size();
+  if (comm_.rank() == writer) receive = counts;
+  std::size_t total = 0;
+  for (const std::size_t c : receive) total += c;
+  std::vector<std::byte> received(total);
+  comm_.alltoall(message, send, received, receive);
+  if (comm_.rank() != writer) return {};
+  if (writer_test_ == WriterTest::poison_unread) return states;
+  parallel::writer_assemble(states, received, owner, vertical_owner, comm_.size(), writer);
+  return states;
+}
+
+Checkpoint Simulation::save() { return save(writer_states()); }
+
+Checkpoint Simulation::save(std::vector<FloeState> states) {
   Checkpoint c;
   c.time = t_;
   c.steps = static_cast<long long>(steps_);
   c.equal_dt = equal_dt_;
   c.floes = scenario_.floes;
+  // The writer keeps the checkpoint: its floes' states come from their
+  // holders, as a record's. The rest of the checkpoint is whole on every
+  // rank today (docs/parallel.md, "One writer gathers").
+  if (comm_.writer()) {
+    FLOESIM_ASSERT(states.size() == c.floes.size());
+    c.floes.state = std::move(states);
+  }
   if (sea_) c.sea = save_modal(*sea_);
   if (incident_) c.incident = incident_->saved_state();
   if (floe_sea_) c.floe_sea = floe_sea_->saved_state();

@@ -137,6 +137,25 @@ public:
   // InputError if the checkpoint does not fit this run (sea, sizes).
   Checkpoint save();
   void restore(const Checkpoint& checkpoint);
+  // save() with the writer's states already gathered at this state
+  // (writer_states(), a record's): no second gather. Collective alike.
+  Checkpoint save(std::vector<FloeState> writer_states);
+
+  // The floes' states the writer writes at a record and a checkpoint
+  // (collective): on the writer rank, every floe's state from the rank that
+  // holds it (the drift's owners by place, the heave, pitch and roll from
+  // the coupling's owners where they differ; parallel/writer_gather.hpp),
+  // not from the writer's own arrays; empty on the other ranks. Serial: the
+  // states. One call, rank 0 receiving 96 B a floe it does not own.
+  std::vector<FloeState> writer_states() const;
+  // Test option (not a user key): `poison`: each rank's copy of the floes
+  // it does not hold is set to NaN before writer_states() gathers, so a
+  // record or a checkpoint is right only if the gather reads every floe
+  // from its holder; `poison_unread`: the same and the writer keeps its own
+  // poisoned copy (the gather's messages are sent but not read: the
+  // mutation that shows the poison reaches the file).
+  enum class WriterTest { off, poison, poison_unread };
+  void set_writer_test(WriterTest mode) { writer_test_ = mode; }
 
   double time() const { return t_; }
   std::size_t steps() const { return steps_; }
@@ -271,6 +290,7 @@ private:
   parallel::AdvanceShareOptions advance_share_options_;  // their back-off, and whether from the rank's part
   parallel::AdvanceShareCounts collide_share_;  // the step-start collisions by owner (stage seven)
   long rejected_steps_ = 0;       // steps redone after an overlap
+  WriterTest writer_test_ = WriterTest::off;  // set_writer_test
   Profile profile_;
   double t_ = 0.0;
   std::size_t steps_ = 0;
