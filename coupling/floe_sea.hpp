@@ -277,13 +277,6 @@ public:
   double bottom(const Floes& floes, std::size_t i) const { return floes.state[i].heave + bottom0_[i]; }
   // Evaluated by owner (above), this rank's floes' pieces only.
   const Footprints& footprints() const { return footprints_.pieces(); }
-  // The ranks holding each floe's heave, pitch and roll between two steps:
-  // the coupling's owners when the explicit vertical drift is by owner (the
-  // next evaluation's law reads them there, complete_vertical), else empty
-  // (every rank drifts every floe). Per floe once the footprints are built.
-  std::span<const int> vertical_owners() const {
-    return by_owner() ? footprints_.owners() : std::span<const int>{};
-  }
   // Placements of the footprints and how many of them were rebuilds
   // (coupling/moving_footprint.hpp; [coupling] footprint_reach).
   long footprint_placements() const { return footprints_.placements(); }

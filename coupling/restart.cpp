@@ -65,15 +65,27 @@ void restore_warm(const WarmStartState& s, contact::WarmStart& w) {
 
 }  // namespace
 
+static FloeState unheld_state() {  // a floe this rank does not hold
+  const double nan = std::nan("");
+  return FloeState{nan, nan, nan, nan, nan, nan, nan, nan, nan, nan, nan, nan};
+}
+
+std::vector<std::uint8_t> Simulation::held_floes() const {
+  // The rule (docs/parallel.md, "One writer gathers the records and
+  // checkpoints"): a rank holds its floes by place and the band B_r about
+  // its strip. Until the arrays are held by band (the halo plan's piece 9)
+  // every rank holds every floe; that piece changes only this set.
+  return std::vector<std::uint8_t>(scenario_.floes.size(), 1);
+}
+
 std::vector<FloeState> Simulation::writer_states() const {
   const std::vector<FloeState>& whole = scenario_.floes.state;
   if (comm_.serial()) return whole;
   const std::size_t n = whole.size();
-  // Who holds what between two steps: the drift's owners by place hold the
-  // states (its complete_owned sends theirs at the next drift), the
-  // coupling's owners the heave, pitch and roll they drifted (the same
-  // owners' once a split has added floes the owners do not cover yet: the
-  // shares by index, as for_owned's).
+  // The drift's owners by place hold the states between two steps (the
+  // next drift's complete_owned sends theirs; the vertical DOFs too, which
+  // every rank drifts); once a split has added floes the owners do not
+  // cover yet, the shares by index (as for_owned's).
   std::vector<int> owner;
   if (owners_.owner().size() == n) {
     owner.assign(owners_.owner().begin(), owners_.owner().end());
@@ -84,40 +96,22 @@ std::vector<FloeState> Simulation::writer_states() const {
       for (std::size_t i = share.begin; i < share.end; ++i) owner[i] = r;
     }
   }
-  std::span<const int> vertical_owner;
-  if (floe_sea_ && floe_sea_->vertical_owners().size() == n) vertical_owner = floe_sea_->vertical_owners();
   const int writer = 0;
   std::vector<FloeState> states = whole;
-  if (writer_test_ != WriterTest::off) {
-    const double nan = std::nan("");
-    for (std::size_t i = 0; i < n; ++i) {
-      const bool state_held = owner[i] == comm_.rank();
-      const bool vertical_held = (vertical_owner.empty() ? owner[i] : vertical_owner[i]) == comm_.rank();
-      if (!state_held) {
-        const FloeState kept = states[i];
-        states[i] = FloeState{nan, nan, nan, nan, nan, nan, nan, nan, nan, nan, nan, nan};
-        if (vertical_held) {
-          states[i].heave = kept.heave;
-          states[i].pitch = kept.pitch;
-          states[i].roll = kept.roll;
-        }
-      } else if (!vertical_held) {
-        states[i].heave = states[i].pitch = states[i].roll = nan;
-      }
-    }
-  }
-  const std::vector<std::size_t> counts = parallel::writer_counts(owner, vertical_owner, comm_.size(), writer);
-  const std::vector<std::byte> message = parallel::writer_message(states, owner, vertical_owner, comm_.rank(), writer);
+  if (writer_test_ != WriterTest::off)
+    for (std::size_t i = 0; i < n; ++i)
+      if (owner[i] != comm_.rank()) states[i] = unheld_state();
+  const std::vector<std::byte> message = parallel::writer_message(states, owner, comm_.rank(), writer);
   std::vector<std::size_t> send(static_cast<std::size_t>(comm_.size()), 0), receive(send.size(), 0);
   send[static_cast<std::size_t>(writer)] = message.size();
-  if (comm_.rank() == writer) receive = counts;
+  if (comm_.rank() == writer) receive = parallel::writer_counts(owner, comm_.size(), writer);
   std::size_t total = 0;
   for (const std::size_t c : receive) total += c;
   std::vector<std::byte> received(total);
   comm_.alltoall(message, send, received, receive);
   if (comm_.rank() != writer) return {};
   if (writer_test_ == WriterTest::poison_unread) return states;
-  parallel::writer_assemble(states, received, owner, vertical_owner, comm_.size(), writer);
+  parallel::writer_assemble(states, received, owner, comm_.size(), writer);
   return states;
 }
 
@@ -206,6 +200,12 @@ void Simulation::restore(const Checkpoint& c) {
   // run's start (the strips by equal counts, or the sea's slabs), and the
   // detection is made by place.
   start_owners();
+  // Every rank has read the whole checkpoint (the file on every rank) and
+  // keeps the floes it holds at the restored places; the others' states are
+  // let go (NaN), so that a reader of a floe it does not hold is seen.
+  const std::vector<std::uint8_t> held = held_floes();
+  for (std::size_t i = 0; i < held.size(); ++i)
+    if (!held[i]) scenario_.floes.state[i] = unheld_state();
   detect_in_place();
   if (sea_) restore_modal(*sea_, c.sea, "the sea");
   if (incident_) incident_->restore(c.incident);

@@ -143,8 +143,7 @@ public:
 
   // The floes' states the writer writes at a record and a checkpoint
   // (collective): on the writer rank, every floe's state from the rank that
-  // holds it (the drift's owners by place, the heave, pitch and roll from
-  // the coupling's owners where they differ; parallel/writer_gather.hpp),
+  // holds it (the drift's owners by place; parallel/writer_gather.hpp),
   // not from the writer's own arrays; empty on the other ranks. Serial: the
   // states. One call, rank 0 receiving 96 B a floe it does not own.
   std::vector<FloeState> writer_states() const;
@@ -231,6 +230,10 @@ private:
   // The owners by place afresh (the start, a restore): the strips by equal
   // counts, or the sea's slabs.
   void start_owners();
+  // The floes this rank holds (1) at the present places: those a restore
+  // keeps from the checkpoint every rank reads whole (every floe until the
+  // arrays are held by band).
+  std::vector<std::uint8_t> held_floes() const;
   // The detection at the present places outside a step (the start, a
   // restore, after a split): by place, this rank's part (collective).
   void detect_in_place();

@@ -21,10 +21,10 @@ usage: check_writer_ranks.py FLOESIM MPIEXEC WORKDIR
    checkpoint serially and on 3 ranks (poisoned), the run equals the serial
    run bit for bit: the checkpoint's states were gathered too.
 2. A small ocean (120 floes in half of a 200 m periodic box on a 128^2
-   spectral sea, the footprints moved between rebuilds so that the
-   coupling's owners lag the drift's; the explicit vertical drift by the
-   coupling's owners): on 2 and 3 ranks, poisoned, bit for bit with the
-   serial run; stopped half-way on 2 ranks and continued serially, too.
+   spectral sea in slabs, the footprints moved between rebuilds, the
+   floes' vertical DOFs in the states): on 2 and 3 ranks, poisoned, bit for
+   bit with the serial run, the mutation different; stopped at 1 s on 2
+   ranks and continued serially, bit for bit too.
 """
 import os
 import sys
@@ -97,7 +97,7 @@ same("rest1.h5", "serial.h5", f"stopped at {half} s on 2 ranks (poisoned), conti
 need(mpirun(3, "1", "run", "--restart", "half.h5", "-o", "rest3.h5", "-q"), "the rest on 3 ranks, poisoned")
 same("rest3.h5", "serial.h5", f"stopped at {half} s on 2 ranks, continued on 3 ranks (both poisoned), against the serial run")
 
-# 2. The sea: the coupling's owners hold the vertical DOFs.
+# 2. The sea: the vertical DOFs and a sea in slabs.
 need(run([args.floesim, "pack", "--floes", "120", "--concentration", "0.5", "--box", "200", "100", "--seed", "3",
           "--min-size", "6", "--max-size", "15", "--thickness", "1", "-o", "half_pack.h5"]), "floesim pack")
 ocean = os.path.join(W, "ocean.toml")
