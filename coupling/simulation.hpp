@@ -196,7 +196,9 @@ public:
 
   // Fracture initiations since the last call ([fracture] enabled), and counts.
   std::vector<FractureEventRow> take_fracture_events();
-  // The collisions since the last call ([run] record_collisions; rows of /events/collisions).
+  // The collisions since the last call ([run] record_collisions; rows of
+  // /events/collisions). On several ranks the writer's (rank 0) only; the
+  // other ranks get none.
   std::vector<CollisionEventRow> take_collision_events() { return std::exchange(collision_events_, {}); }
   const PercussionStats* percussion_stats() const { return percussion_ ? &percussion_->stats() : nullptr; }
   // The fracture analyses by owner on several ranks, per rank (empty when serial).
