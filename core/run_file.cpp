@@ -259,7 +259,13 @@ void RunWriter::note_floes(const Floes& floes) {
 
 void RunWriter::record(double t, const Floes& floes, std::span<const double> energy,
                        const LcpCounters& lcp, std::span<const double> eta) {
+  record(t, floes, floes.state, energy, lcp, eta);
+}
+
+void RunWriter::record(double t, const Floes& floes, std::span<const FloeState> states,
+                       std::span<const double> energy, const LcpCounters& lcp, std::span<const double> eta) {
   Impl& w = *impl_;
+  FLOESIM_ASSERT(states.size() == floes.size());
   FLOESIM_ASSERT(energy.size() == w.energy_columns.size());
   if (w.eta.valid() && eta.empty()) throw RunError("run file: the sea elevation is missing from a record");
   note_floes(floes);
@@ -269,7 +275,7 @@ void RunWriter::record(double t, const Floes& floes, std::span<const double> ene
     h5::append_row(w.time, &t);
     w.scratch.assign(w.n * kStateColumns, std::nan(""));
     for (std::size_t i = 0; i < floes.size(); ++i)
-      std::copy_n(reinterpret_cast<const double*>(&floes.state[i]), kStateColumns,
+      std::copy_n(reinterpret_cast<const double*>(&states[i]), kStateColumns,
                   w.scratch.begin() + static_cast<std::ptrdiff_t>(id_of(floes, i) * kStateColumns));
     h5::append_row(w.state, w.scratch.data());
     h5::append_row(w.energy, energy.data());
@@ -279,11 +285,12 @@ void RunWriter::record(double t, const Floes& floes, std::span<const double> ene
     w.scratch.assign(3 * w.nverts, std::nan(""));
     for (std::size_t i = 0; i < floes.size(); ++i) {
       std::size_t k = static_cast<std::size_t>(w.offsets[id_of(floes, i)]);
+      const FloeState& s = states[i];
       for (const Vec2& b : floes.vertices(i)) {
-        const Vec2 p = floes.to_world(i, b);
+        const Vec2 p = Vec2{s.x, s.y} + rotate(b, s.yaw);  // Floes::to_world at this state
         w.scratch[3 * k] = p.x();
         w.scratch[3 * k + 1] = p.y();
-        w.scratch[3 * k + 2] = floes.state[i].heave;
+        w.scratch[3 * k + 2] = s.heave;
         ++k;
       }
     }

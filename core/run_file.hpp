@@ -41,6 +41,7 @@
 namespace floesim {
 
 struct Floes;
+struct FloeState;
 struct Checkpoint;
 
 inline constexpr const char* kRunFormat = "floesim-1";
@@ -131,6 +132,11 @@ public:
   // empty when there is no sea. Floes new since the last call are added to
   // the /floes tables first (note_floes).
   void record(double t, const Floes& floes, std::span<const double> energy,
+              const LcpCounters& lcp, std::span<const double> eta = {});
+  // The same with the floes' states taken from `states` (one per floe of
+  // `floes`, which gives the numbers, outlines and constants): the writer
+  // rank's copy gathered from the floes' owners (docs/parallel.md).
+  void record(double t, const Floes& floes, std::span<const FloeState> states, std::span<const double> energy,
               const LcpCounters& lcp, std::span<const double> eta = {});
   // Adds to the /floes tables the floes with numbers not seen yet (call it
   // after every step that may create floes, so none is missed).

@@ -1,12 +1,15 @@
 // Simulation::save and restore (coupling/simulation.hpp): which state each
 // part of a run carries from one step to the next, and what is computed again
-// from it (core/checkpoint.hpp).
+// from it (core/checkpoint.hpp); and the floes' states the writer writes,
+// gathered from their holders (writer_states).
 #include <algorithm>
+#include <cmath>
 #include <cstring>
 
 #include "core/error.hpp"
 #include "coupling/simulation.hpp"
 #include "fluid/sea.hpp"
+#include "parallel/writer_gather.hpp"
 
 namespace floesim {
 
@@ -62,12 +65,71 @@ void restore_warm(const WarmStartState& s, contact::WarmStart& w) {
 
 }  // namespace
 
-Checkpoint Simulation::save() {
+static FloeState unheld_state() {  // a floe this rank does not hold
+  const double nan = std::nan("");
+  return FloeState{nan, nan, nan, nan, nan, nan, nan, nan, nan, nan, nan, nan};
+}
+
+std::vector<std::uint8_t> Simulation::held_floes() const {
+  // The rule (docs/parallel.md, "One writer gathers the records and
+  // checkpoints"): a rank holds its floes by place and the band B_r about
+  // its strip. Until the arrays are held by band (the halo plan's piece 9)
+  // every rank holds every floe; that piece changes only this set.
+  return std::vector<std::uint8_t>(scenario_.floes.size(), 1);
+}
+
+std::vector<FloeState> Simulation::writer_states() const {
+  const std::vector<FloeState>& whole = scenario_.floes.state;
+  if (comm_.serial()) return whole;
+  const std::size_t n = whole.size();
+  // The drift's owners by place hold the states between two steps (the
+  // next drift's complete_owned sends theirs; the vertical DOFs too, which
+  // every rank drifts); once a split has added floes the owners do not
+  // cover yet, the shares by index (as for_owned's).
+  std::vector<int> owner;
+  if (owners_.owner().size() == n) {
+    owner.assign(owners_.owner().begin(), owners_.owner().end());
+  } else {
+    owner.resize(n);
+    for (int r = 0; r < comm_.size(); ++r) {
+      const parallel::Range share = parallel::share(n, r, comm_.size());
+      for (std::size_t i = share.begin; i < share.end; ++i) owner[i] = r;
+    }
+  }
+  const int writer = 0;
+  std::vector<FloeState> states = whole;
+  if (writer_test_ != WriterTest::off)
+    for (std::size_t i = 0; i < n; ++i)
+      if (owner[i] != comm_.rank()) states[i] = unheld_state();
+  const std::vector<std::byte> message = parallel::writer_message(states, owner, comm_.rank(), writer);
+  std::vector<std::size_t> send(static_cast<std::size_t>(comm_.size()), 0), receive(send.size(), 0);
+  send[static_cast<std::size_t>(writer)] = message.size();
+  if (comm_.rank() == writer) receive = parallel::writer_counts(owner, comm_.size(), writer);
+  std::size_t total = 0;
+  for (const std::size_t c : receive) total += c;
+  std::vector<std::byte> received(total);
+  comm_.alltoall(message, send, received, receive);
+  if (comm_.rank() != writer) return {};
+  if (writer_test_ == WriterTest::poison_unread) return states;
+  parallel::writer_assemble(states, received, owner, comm_.size(), writer);
+  return states;
+}
+
+Checkpoint Simulation::save() { return save(writer_states()); }
+
+Checkpoint Simulation::save(std::vector<FloeState> states) {
   Checkpoint c;
   c.time = t_;
   c.steps = static_cast<long long>(steps_);
   c.equal_dt = equal_dt_;
   c.floes = scenario_.floes;
+  // The writer keeps the checkpoint: its floes' states come from their
+  // holders, as a record's. The rest of the checkpoint is whole on every
+  // rank today (docs/parallel.md, "One writer gathers").
+  if (comm_.writer()) {
+    FLOESIM_ASSERT(states.size() == c.floes.size());
+    c.floes.state = std::move(states);
+  }
   if (sea_) c.sea = save_modal(*sea_);
   if (incident_) c.incident = incident_->saved_state();
   if (floe_sea_) c.floe_sea = floe_sea_->saved_state();
@@ -138,6 +200,12 @@ void Simulation::restore(const Checkpoint& c) {
   // run's start (the strips by equal counts, or the sea's slabs), and the
   // detection is made by place.
   start_owners();
+  // Every rank has read the whole checkpoint (the file on every rank) and
+  // keeps the floes it holds at the restored places; the others' states are
+  // let go (NaN), so that a reader of a floe it does not hold is seen.
+  const std::vector<std::uint8_t> held = held_floes();
+  for (std::size_t i = 0; i < held.size(); ++i)
+    if (!held[i]) scenario_.floes.state[i] = unheld_state();
   detect_in_place();
   if (sea_) restore_modal(*sea_, c.sea, "the sea");
   if (incident_) incident_->restore(c.incident);

@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <cstdlib>
 #include <memory>
 
 #include "core/checkpoint.hpp"
@@ -18,6 +19,14 @@ RunSummary run_simulation(Simulation& sim, const RunOptions& options) {
   const double checkpoint_interval = cfg.run.checkpoint_interval;
   const auto start = std::chrono::steady_clock::now();
   const parallel::Communicator& comm = sim.communicator();
+  // Test hook, not a user key (tests/parallel/check_writer_ranks.py): "1":
+  // each rank's copy of the floes it does not hold is poisoned before the
+  // writer's gathers, so the run file is right only if they read every
+  // floe from its holder; "unread": the writer writes its poisoned copy
+  // (Simulation::set_writer_test).
+  if (const char* test = std::getenv("FLOESIM_TEST_POISON_UNHELD"))
+    sim.set_writer_test(std::string(test) == "unread" ? Simulation::WriterTest::poison_unread
+                                                      : Simulation::WriterTest::poison);
 
   RunSummary summary;
   summary.output = options.output;
@@ -36,11 +45,18 @@ RunSummary run_simulation(Simulation& sim, const RunOptions& options) {
     summary.xdmf = writer->xdmf_path();
   });
 
+  // The writer's states at the last record, which the state kept at that
+  // record (take_good, right after it) reuses: one gather a record.
+  std::vector<FloeState> recorded;
+  std::size_t recorded_steps = static_cast<std::size_t>(-1);  // steps() at that record
   auto record = [&] {
     PhaseTimer _(sim.profile(), Phase::record, comm);
     const Energies e = sim.energies();
     const std::span<const double> elevation = sim.sea_elevation();  // on every rank: it applies the sea's deferred kicks
-    if (writer) writer->record(sim.time(), sim.floes(), e.values, sim.lcp_counters(), elevation);
+    // The states from the floes' holders (collective), not the writer's own arrays.
+    recorded = sim.writer_states();
+    recorded_steps = sim.steps();
+    if (writer) writer->record(sim.time(), sim.floes(), recorded, e.values, sim.lcp_counters(), elevation);
   };
   auto wall = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); };
   const double t_start = sim.time();
@@ -68,7 +84,8 @@ RunSummary run_simulation(Simulation& sim, const RunOptions& options) {
   auto take_good = [&] {
     have_good = false;
     good = Checkpoint{};
-    Checkpoint saved = sim.save();
+    Checkpoint saved = recorded_steps == sim.steps() ? sim.save(std::move(recorded)) : sim.save();
+    recorded_steps = static_cast<std::size_t>(-1);
     good_steps = saved.steps;
     if (writer) {
       good = std::move(saved);

@@ -305,7 +305,9 @@ void Simulation::collide(StepContext& ctx) {
 
 void Simulation::note_collisions() {
   // Before percussion: a split renumbers the floes the record refers to.
-  if (!record_collisions_) return;
+  // The rows are the writer's alone: the other ranks' merged record is the
+  // same, and only the writer writes /events/collisions.
+  if (!record_collisions_ || !comm_.writer()) return;
   const std::vector<CollisionEventRow> rows = collision_rows(scenario_.floes, *impulse_record_, t_);
   collision_events_.insert(collision_events_.end(), rows.begin(), rows.end());
 }

@@ -137,6 +137,24 @@ public:
   // InputError if the checkpoint does not fit this run (sea, sizes).
   Checkpoint save();
   void restore(const Checkpoint& checkpoint);
+  // save() with the writer's states already gathered at this state
+  // (writer_states(), a record's): no second gather. Collective alike.
+  Checkpoint save(std::vector<FloeState> writer_states);
+
+  // The floes' states the writer writes at a record and a checkpoint
+  // (collective): on the writer rank, every floe's state from the rank that
+  // holds it (the drift's owners by place; parallel/writer_gather.hpp),
+  // not from the writer's own arrays; empty on the other ranks. Serial: the
+  // states. One call, rank 0 receiving 96 B a floe it does not own.
+  std::vector<FloeState> writer_states() const;
+  // Test option (not a user key): `poison`: each rank's copy of the floes
+  // it does not hold is set to NaN before writer_states() gathers, so a
+  // record or a checkpoint is right only if the gather reads every floe
+  // from its holder; `poison_unread`: the same and the writer keeps its own
+  // poisoned copy (the gather's messages are sent but not read: the
+  // mutation that shows the poison reaches the file).
+  enum class WriterTest { off, poison, poison_unread };
+  void set_writer_test(WriterTest mode) { writer_test_ = mode; }
 
   double time() const { return t_; }
   std::size_t steps() const { return steps_; }
@@ -178,7 +196,9 @@ public:
 
   // Fracture initiations since the last call ([fracture] enabled), and counts.
   std::vector<FractureEventRow> take_fracture_events();
-  // The collisions since the last call ([run] record_collisions; rows of /events/collisions).
+  // The collisions since the last call ([run] record_collisions; rows of
+  // /events/collisions). On several ranks the writer's (rank 0) only; the
+  // other ranks get none.
   std::vector<CollisionEventRow> take_collision_events() { return std::exchange(collision_events_, {}); }
   const PercussionStats* percussion_stats() const { return percussion_ ? &percussion_->stats() : nullptr; }
   // The fracture analyses by owner on several ranks, per rank (empty when serial).
@@ -212,6 +232,10 @@ private:
   // The owners by place afresh (the start, a restore): the strips by equal
   // counts, or the sea's slabs.
   void start_owners();
+  // The floes this rank holds (1) at the present places: those a restore
+  // keeps from the checkpoint every rank reads whole (every floe until the
+  // arrays are held by band).
+  std::vector<std::uint8_t> held_floes() const;
   // The detection at the present places outside a step (the start, a
   // restore, after a split): by place, this rank's part (collective).
   void detect_in_place();
@@ -271,6 +295,7 @@ private:
   parallel::AdvanceShareOptions advance_share_options_;  // their back-off, and whether from the rank's part
   parallel::AdvanceShareCounts collide_share_;  // the step-start collisions by owner (stage seven)
   long rejected_steps_ = 0;       // steps redone after an overlap
+  WriterTest writer_test_ = WriterTest::off;  // set_writer_test
   Profile profile_;
   double t_ = 0.0;
   std::size_t steps_ = 0;
