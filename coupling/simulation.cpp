@@ -464,6 +464,9 @@ bool Simulation::detect_and_check(StepContext& ctx) {
   set_reach(std::span(ctx.momenta).first<StepContext::kTry>());  // combines the try's momenta too (one call)
   read_try_budget(ctx);
   if (!comm_.serial()) owners_.assign(scenario_.floes);  // the owners at the advanced places
+  // The held floes at the advanced places, kept when the step is accepted
+  // (a rejected try's places are undone).
+  parallel::HeldFloes held = hold_band();
   contact::Detection part;  // this rank's (serially: `next` itself)
   // The whole lists are gathered only for the advance from the whole
   // detection; else whole_detection() gathers them when a step needs them
@@ -489,6 +492,7 @@ bool Simulation::detect_and_check(StepContext& ctx) {
     return false;
   }
   detection_ = std::move(next);
+  held_ = std::move(held);
   detection_whole_ = comm_.serial() || whole;
   if (!comm_.serial()) detection_part_ = std::move(part);
   return true;
@@ -511,14 +515,26 @@ void Simulation::detect_in_place() {
   if (comm_.serial()) {
     detection_ = contact::detect(scenario_.floes, shapes_, detection_options_);
     detection_whole_ = true;
+    held_ = hold_band();
     return;
   }
   owners_.assign(scenario_.floes);
+  held_ = hold_band();
   contact::Detection part;
   const bool whole = !advance_share_options_.on_part;
   detection_ = parallel::detect(comm_, owners_, scenario_.floes, shapes_, detection_options_, &part, whole);
   detection_whole_ = whole;
   detection_part_ = std::move(part);
+}
+
+parallel::HeldFloes Simulation::hold_band() {
+  const std::size_t n = scenario_.floes.size();
+  if (comm_.serial()) return held_.mask.size() == n ? std::move(held_) : parallel::every_floe(n);
+  // H, the largest half band over the pack: each rank's own floes', one
+  // reduction (8 bytes a rank).
+  const double largest =
+      comm_.max(parallel::largest_half_band(owners_, comm_.rank(), scenario_.floes, shapes_, detection_options_));
+  return parallel::held_floes(owners_, comm_.rank(), scenario_.floes, shapes_, detection_options_, largest);
 }
 
 const contact::Detection& Simulation::whole_detection() {

@@ -169,6 +169,9 @@ public:
   const contact::Detection& detection() { return whole_detection(); }
   // The floes' owners by place for the drift and detection (one rank: all 0).
   const parallel::FloeOwners& floe_owners() const { return owners_; }
+  // The floes this rank holds (its own and its halo band, parallel::held_floes)
+  // at the places and reaches of the last detection; one rank: every floe.
+  const parallel::HeldFloes& held_floes() const { return held_; }
   const contact::SubstepReport& substep_report() const { return substeps_; }
   const parallel::AdvanceShareCounts& advance_share() const { return advance_share_; }  // stage seven
   const parallel::AdvanceShareCounts& collide_share() const { return collide_share_; }  // the step-start collisions
@@ -215,6 +218,10 @@ private:
   // The detection at the present places outside a step (the start, a
   // restore, after a split): by place, this rank's part (collective).
   void detect_in_place();
+  // The floes this rank holds at the present places (owners assigned,
+  // reaches set): H by one reduction (a max), then its band. Collective on
+  // several ranks; one rank holds every floe.
+  parallel::HeldFloes hold_band();
   void wrap_periodic();
   // Detection reach of each floe for the next step. Collective: the pack's
   // rms speed is summed by owner; `along` (exact sums of this rank's part)
@@ -245,6 +252,7 @@ private:
   contact::CollisionShapes shapes_;
   contact::DetectionOptions detection_options_;
   parallel::FloeOwners owners_;  // drift and detection by place (stage six)
+  parallel::HeldFloes held_;     // own floes and band at the last detection (held_floes())
   contact::ImpulseOptions impulse_options_;
   std::unique_ptr<contact::WarmStart> warm_ = std::make_unique<contact::WarmStart>();  // jam LCPs' last bases
   contact::Detection detection_;  // at the present positions
