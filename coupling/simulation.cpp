@@ -247,8 +247,8 @@ void Simulation::drift(StepContext& ctx) {
     water.assign(orbital.begin(), orbital.end());
     for (Vec2& w : water) w += current;
   };
-  moorings_.kick(scenario_.floes, ctx.dt);
   if (comm_.serial()) {
+    moorings_.kick(scenario_.floes, ctx.dt);
     water_at();
     drift_velocities(scenario_.floes, quadrature_, drift_params_, current, wind, ctx.dt, 0, scenario_.floes.size(),
                      water);
@@ -262,6 +262,9 @@ void Simulation::drift(StepContext& ctx) {
     if (owners_.has_slabs() && floe_sea_) owners_.charge_coupling(floe_sea_->take_owned_seconds());
     // Floes migrate; every few steps the strips move (with slabs, the sea's and the coupling's too).
     if (owners_.update(comm_, scenario_.floes, steps_) && owners_.has_slabs()) follow_slabs();
+    // The moorings of the floes this rank drifts: each kick is its floe's
+    // own, and the other floes' states come whole from their owners below.
+    moorings_.kick(scenario_.floes, ctx.dt, owners_.mine());
     // The coupling's owners computed the water velocities; the drift's read them.
     if (floe_sea_) floe_sea_->hand_water_over(owners_.owner());
     water_at();
@@ -464,8 +467,9 @@ bool Simulation::detect_and_check(StepContext& ctx) {
   set_reach(std::span(ctx.momenta).first<StepContext::kTry>());  // combines the try's momenta too (one call)
   read_try_budget(ctx);
   if (!comm_.serial()) owners_.assign(scenario_.floes);  // the owners at the advanced places
-  // The held floes at the advanced places, kept when the step is accepted
-  // (a rejected try's places are undone).
+  // The held floes at the advanced places: the detection's subset reads
+  // only those. Kept when the step is accepted (a rejected try's places
+  // are undone).
   parallel::HeldFloes held = hold_band();
   contact::Detection part;  // this rank's (serially: `next` itself)
   // The whole lists are gathered only for the advance from the whole
@@ -473,7 +477,7 @@ bool Simulation::detect_and_check(StepContext& ctx) {
   // (record runs too: the record's places are keyed by pair, ContactPlace).
   const bool whole = !advance_share_options_.on_part;
   contact::Detection next = parallel::detect(comm_, owners_, scenario_.floes, shapes_, detection_options_,
-                                             comm_.serial() ? nullptr : &part, whole);
+                                             comm_.serial() ? nullptr : &part, whole, &held);
   // The first overlapping pair and its distance at t, found from the ranks'
   // parts (a reduction): the serial scan's on every rank.
   const parallel::Overlap overlap = parallel::first_overlap(comm_, comm_.serial() ? next : part,
@@ -522,7 +526,7 @@ void Simulation::detect_in_place() {
   held_ = hold_band();
   contact::Detection part;
   const bool whole = !advance_share_options_.on_part;
-  detection_ = parallel::detect(comm_, owners_, scenario_.floes, shapes_, detection_options_, &part, whole);
+  detection_ = parallel::detect(comm_, owners_, scenario_.floes, shapes_, detection_options_, &part, whole, &held_);
   detection_whole_ = whole;
   detection_part_ = std::move(part);
 }

@@ -19,6 +19,11 @@
 //   does not show a pass over every floe (a band test with a NaN is
 //   false, so a poisoned floe is never posed): hence the lure.
 //
+// - Moorings::kick over the floes a rank drifts (the drift's owners after
+//   their update): its moored floes get the whole kick's bits, on a copy
+//   poisoned outside them, and no other floe is written; the named
+//   mutation: the kick over every floe writes the others.
+//
 // Strips: equal counts, uneven (an empty strip, a cut beyond the pack) and
 // the sea's slabs (owners by grid row), on 2, 3 and 7 ranks, in a periodic
 // box and the open plane, the pack moving at up to 0.5 and 2 m/s.
@@ -26,11 +31,14 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <string>
 #include <vector>
 
 #include "contact/detection.hpp"
 #include "contact/shapes.hpp"
+#include "core/floe.hpp"
+#include "coupling/mooring.hpp"
 #include "parallel/detect.hpp"
 #include "parallel/place.hpp"
 #include "tests/parallel/halo_case.hpp"
@@ -197,6 +205,72 @@ TEST_CASE("the detection subset over the held floes reads only them (lured and p
                 << "); a subset over every floe of the lured copies poses " << lures_posed << " lures in "
                 << lured_parts << " parts");
   CHECK(lures_posed > 0);
+}
+
+TEST_CASE("the moorings' kick over the floes a rank drifts reads and writes only those") {
+  // A third of the pack moored (period 300 s, damping 0.2) where it
+  // starts, then moved 40 m off its anchors and given its velocities: the
+  // kick over each rank's floes, on a copy whose other floes are NaN, gives
+  // its moored floes the bits of the kick over every floe, and leaves every
+  // other floe as it was (a lure copy: finite values that a kick would change).
+  const Pack p = moving_pack(5, true);
+  const std::size_t n = p.floes.size();
+  std::vector<FloeInput> inputs(n);
+  for (std::size_t i = 0; i < n; i += 3) {
+    inputs[i].mooring_period = 300.0;
+    inputs[i].mooring_damping = 0.2;
+  }
+  const Moorings moorings(p.floes, inputs);
+  Floes moved = p.floes;
+  for (FloeState& s : moved.state) {
+    s.x += 40.0;
+    s.y -= 25.0;
+  }
+  const double dt = 10.0;
+  Floes serial = moved;
+  moorings.kick(serial, dt);
+  std::size_t kicked = 0;
+  for (std::size_t i = 0; i < n; ++i) kicked += std::memcmp(&serial.state[i], &moved.state[i], sizeof(FloeState)) != 0;
+  REQUIRE(kicked > 100);
+  std::size_t others_written_by_every = 0;
+  for (const int ranks : {2, 3, 7})
+    for (const Strips kind : {Strips::equal, Strips::uneven, Strips::slabs}) {
+      CAPTURE(ranks);
+      CAPTURE(name(kind));
+      Pack at = p;
+      at.floes = moved;
+      const parallel::FloeOwners owners = owners_of(at, ranks, kind);
+      for (int r = 0; r < ranks; ++r) {
+        CAPTURE(r);
+        Held mine(n, 0);
+        std::vector<std::uint32_t> list;
+        for (std::size_t i = 0; i < n; ++i)
+          if (owners.owner()[i] == r) {
+            mine[i] = 1;
+            list.push_back(static_cast<std::uint32_t>(i));
+          }
+        Floes poisoned_copy = poisoned(moved, mine);
+        moorings.kick(poisoned_copy, dt, list);
+        Floes lure = moved;
+        moorings.kick(lure, dt, list);
+        Floes every = moved;  // the mutation: the kick over every floe
+        moorings.kick(every, dt);
+        bool own = true, others = true;
+        for (std::size_t i = 0; i < n; ++i) {
+          if (mine[i]) {
+            own = own && std::memcmp(&poisoned_copy.state[i], &serial.state[i], sizeof(FloeState)) == 0;
+          } else {
+            others = others && std::memcmp(&lure.state[i], &moved.state[i], sizeof(FloeState)) == 0;
+            others_written_by_every += std::memcmp(&every.state[i], &moved.state[i], sizeof(FloeState)) != 0;
+          }
+        }
+        CHECK(own);
+        CHECK(others);
+      }
+    }
+  MESSAGE(kicked << " moored floes of " << n << "; the kick over every floe writes " << others_written_by_every
+                 << " floes that ranks do not drift (over 2, 3, 7 ranks and three kinds of strips)");
+  CHECK(others_written_by_every > 0);
 }
 
 TEST_SUITE_END();
