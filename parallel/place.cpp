@@ -224,11 +224,18 @@ bool FloeOwners::update(const Communicator& comm, const Floes& floes, std::size_
   return moved;
 }
 
-double half_band(const FloeOwners& owners, const Floes& floes, const contact::CollisionShapes& shapes,
-                 const contact::DetectionOptions& options, std::size_t j) {
-  const double y = owners.place(floes.state[j]);
+namespace {
+// h_j at floe j's place y (the one formula of half_band, held_floes and detection_subset).
+double half_band_at(double y, const contact::CollisionShapes& shapes, const contact::DetectionOptions& options,
+                    std::size_t j) {
   const double h = shapes.radius[j] + options.reach_of(j) + 0.5 * options.collision_distance;
   return h + 1e-9 * (1.0 + std::abs(y) + h);  // posing rounds; a floe held in excess costs only time
+}
+}  // namespace
+
+double half_band(const FloeOwners& owners, const Floes& floes, const contact::CollisionShapes& shapes,
+                 const contact::DetectionOptions& options, std::size_t j) {
+  return half_band_at(owners.place(floes.state[j]), shapes, options, j);
 }
 
 double largest_half_band(const FloeOwners& owners, int rank, const Floes& floes,
@@ -271,7 +278,7 @@ HeldFloes held_floes(const FloeOwners& owners, int rank, const Floes& floes, con
       const double y = owners.place(floes.state[j]);
       double gap = distance(y);
       if (box.periodic) gap = std::min({gap, distance(y - box.height()), distance(y + box.height())});
-      held = gap <= largest + half_band(owners, floes, shapes, options, j);
+      held = gap <= largest + half_band_at(y, shapes, options, j);
     }
     if (!held) continue;
     out.mask[j] = 1;
@@ -312,7 +319,7 @@ contact::DetectionSubset detection_subset(const FloeOwners& owners, int rank, co
   for (std::size_t k = 0; k < read.size(); ++k) {
     const std::uint32_t i = read[k];
     y[k] = owners.place(floes.state[i]);
-    half[k] = half_band(owners, floes, shapes, options, i);
+    half[k] = half_band_at(y[k], shapes, options, i);
     if (owner[i] != rank) continue;
     subset.keep[i] = 1;
     lo = std::min(lo, y[k] - half[k]);
