@@ -16,7 +16,11 @@
 //    must be collisions and a wind's push (so that the budget is not 0).
 //    Simulation::detection(), read on every rank after the steps (each rank
 //    then holds only its part: the read gathers them, collectively), must
-//    be the serial detection, pair by pair.
+//    be the serial detection, pair by pair; Simulation::held_floes() (the
+//    band at the last detection, docs/parallel.md "The band in the
+//    library") must hold the rank's own floes and both floes of every pair
+//    whose floe a it owns, with the same H on every rank, and every floe
+//    serially. Communicator::max must give the largest value.
 // 3. Four floes blown to infinity by a 1e200 m/s wind, floe 0 in the top
 //    strip (on 2 ranks, the last rank's): every rank must throw the serial
 //    run's message, which names floe 0 (the ranks agree on the lowest bad
