@@ -268,6 +268,17 @@ HeldFloes held_floes(const FloeOwners& owners, int rank, const Floes& floes, con
     lo = std::max(lo, box.ymin);
     hi = std::min(hi, box.ymax);
   }
+  // The strip widened to the rank's own floes' places: they lie in it but
+  // for round-off (the slabs own by grid row), or but for the grid's wrap
+  // (with the sea's slabs, a floe beyond the grid in an open box is owned
+  // by the row it wraps to). The band's argument needs y_a in S_r for each
+  // own floe a.
+  for (std::size_t j = 0; j < n; ++j)
+    if (owner[j] == rank) {
+      const double y = owners.place(floes.state[j]);
+      lo = std::min(lo, y);
+      hi = std::max(hi, y);
+    }
   const auto distance = [&](double y) { return std::max({0.0, lo - y, y - hi}); };
   HeldFloes out;
   out.largest = largest;

@@ -215,8 +215,10 @@ private:
 //     dist(y_j, S_r) <= H + h_j,
 //
 // S_r = [c_{r-1}, c_r) its strip (cut[-1] = -inf, cut[ranks-1] = +inf; the
-// box's edges for the end strips of a periodic box), the distance taken on
-// the circle in a periodic box (the nearest image). Rank r holds its floes
+// box's edges for the end strips of a periodic box), widened to the places
+// of the floes r owns where one lies outside it (round-off at a cut, or a
+// floe beyond the sea's grid in an open box, owned by the row it wraps to),
+// the distance taken on the circle in a periodic box (the nearest image). Rank r holds its floes
 // and B_r. Why that is enough for its part of the detection: a pair is a
 // candidate only when its padded boxes overlap, so |y_a - y_b| <= h_a + h_b
 // (nearest image), and rank r keeps the pairs whose floe a it owns, y_a in

@@ -207,6 +207,53 @@ TEST_CASE("the detection subset over the held floes reads only them (lured and p
   CHECK(lures_posed > 0);
 }
 
+TEST_CASE("the held floes hold the detection's floes when the sea's slabs own floes beyond the grid (open box)") {
+  // Slabs on a grid from y = 0 to the window's height, the pack moved 150 m
+  // down in an open box: the floes below y = 0 are owned by the rows they
+  // wrap to (the last slab's), far from that slab in y. The band is taken
+  // about the strip widened to the rank's own floes' places: each rank's
+  // subset from every floe poses only floes it holds, and its part from a
+  // copy poisoned outside them is its part from the whole state. Without
+  // the widening (the band by the strip alone, test::halo_band_by_rule)
+  // some posed floes are not held: counted and asserted.
+  std::size_t beyond = 0, missed_by_strip = 0;
+  for (const double speed : {0.5, 2.0}) {
+    Pack p = moving_pack(7, false, speed);
+    for (FloeState& s : p.floes.state) s.y -= 150.0;
+    const std::size_t n = p.floes.size();
+    for (std::size_t i = 0; i < n; ++i) beyond += p.floes.state[i].y < 0.0;
+    for (const int ranks : {2, 3, 7}) {
+      CAPTURE(speed);
+      CAPTURE(ranks);
+      parallel::FloeOwners owners(0, ranks, p.detect.domain);
+      parallel::RowSlabs slabs;
+      slabs.dy = (p.window[3] - p.window[2]) / 256.0;
+      slabs.block = 8;
+      for (int r = 0; r < ranks; ++r) slabs.first_row.push_back(8 * ((32 * r) / ranks));
+      slabs.first_row.push_back(256);
+      owners.set_slabs(slabs);
+      owners.assign(p.floes);
+      const double largest = largest_by_ranks(owners, p.floes, p.shapes, p.detect);
+      for (int r = 0; r < ranks; ++r) {
+        CAPTURE(r);
+        const parallel::HeldFloes held = parallel::held_floes(owners, r, p.floes, p.shapes, p.detect, largest);
+        const contact::DetectionSubset every = parallel::detection_subset(owners, r, p.floes, p.shapes, p.detect);
+        CHECK(std::all_of(every.posed.begin(), every.posed.end(), [&](std::uint32_t i) { return held.holds(i); }));
+        const Held by_strip = halo_band_by_rule(owners, r, p.floes, p.shapes, p.detect);
+        for (const std::uint32_t i : every.posed) missed_by_strip += by_strip[i] ? 0 : 1;
+        contact::DetectionOptions d = p.detect;
+        d.reach = poisoned(d.reach, held.mask);
+        CHECK(same_detection(parallel::detect_part(owners, r, poisoned(p.floes, held.mask), poisoned(p.shapes, held.mask), d, &held),
+                             parallel::detect_part(owners, r, p.floes, p.shapes, p.detect)));
+      }
+    }
+  }
+  MESSAGE(beyond << " floes below the grid (two packs); the band about the strip alone misses " << missed_by_strip
+                 << " posed floes (2, 3, 7 slabs)");
+  CHECK(beyond > 0);
+  CHECK(missed_by_strip > 0);
+}
+
 TEST_CASE("the moorings' kick over the floes a rank drifts reads and writes only those") {
   // A third of the pack moored (period 300 s, damping 0.2) where it
   // starts, then moved 40 m off its anchors and given its velocities: the
