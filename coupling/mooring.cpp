@@ -19,17 +19,24 @@ Moorings::Moorings(const Floes& floes, std::span<const FloeInput> inputs) {
 
 void Moorings::kick(Floes& floes, double dt) const {
   if (list_.empty()) return;
+  for (std::size_t i = 0; i < floes.size(); ++i) kick_one(floes, i, dt);
+}
+
+void Moorings::kick(Floes& floes, double dt, std::span<const std::uint32_t> only) const {
+  if (list_.empty()) return;
+  for (const std::uint32_t i : only) kick_one(floes, i, dt);
+}
+
+void Moorings::kick_one(Floes& floes, std::size_t i, double dt) const {
   // Floes are found by their number (list_ is in increasing numbers): a
   // split renumbers the run's floes.
-  for (std::size_t i = 0; i < floes.size(); ++i) {
-    const auto it = std::lower_bound(list_.begin(), list_.end(), floes.id[i],
-                                     [](const Mooring& m, std::uint32_t id) { return m.id < id; });
-    if (it == list_.end() || it->id != floes.id[i] || floes.is_static[i]) continue;
-    FloeState& s = floes.state[i];
-    const double w2 = it->omega * it->omega, shrink = 1.0 / (1.0 + 2.0 * it->damping * it->omega * dt);
-    s.vx = (s.vx - dt * w2 * (s.x - it->anchor.x())) * shrink;
-    s.vy = (s.vy - dt * w2 * (s.y - it->anchor.y())) * shrink;
-  }
+  const auto it = std::lower_bound(list_.begin(), list_.end(), floes.id[i],
+                                   [](const Mooring& m, std::uint32_t id) { return m.id < id; });
+  if (it == list_.end() || it->id != floes.id[i] || floes.is_static[i]) return;
+  FloeState& s = floes.state[i];
+  const double w2 = it->omega * it->omega, shrink = 1.0 / (1.0 + 2.0 * it->damping * it->omega * dt);
+  s.vx = (s.vx - dt * w2 * (s.x - it->anchor.x())) * shrink;
+  s.vy = (s.vy - dt * w2 * (s.y - it->anchor.y())) * shrink;
 }
 
 }  // namespace floesim

@@ -33,8 +33,14 @@ public:
   bool empty() const { return list_.empty(); }
   // The kick above over dt for every moored floe still in the run.
   void kick(Floes& floes, double dt) const;
+  // The same for the moored floes among `only` (ascending floe indices: on
+  // several ranks the floes the rank drifts); no other floe is read or
+  // written. Each floe's kick reads and writes that floe alone, so these
+  // floes get the bits the whole kick gives them.
+  void kick(Floes& floes, double dt, std::span<const std::uint32_t> only) const;
 
 private:
+  void kick_one(Floes& floes, std::size_t i, double dt) const;
   struct Mooring {
     std::uint32_t id = 0;  // the floe's number (Floes::id)
     Vec2 anchor = Vec2::Zero();

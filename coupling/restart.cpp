@@ -70,7 +70,7 @@ static FloeState unheld_state() {  // a floe this rank does not hold
   return FloeState{nan, nan, nan, nan, nan, nan, nan, nan, nan, nan, nan, nan};
 }
 
-std::vector<std::uint8_t> Simulation::held_floes() const {
+std::vector<std::uint8_t> Simulation::kept_on_restore() const {
   // The rule (docs/parallel.md, "One writer gathers the records and
   // checkpoints"): a rank holds its floes by place and the band B_r about
   // its strip. Until the arrays are held by band (the halo plan's piece 9)
@@ -203,7 +203,7 @@ void Simulation::restore(const Checkpoint& c) {
   // Every rank has read the whole checkpoint (the file on every rank) and
   // keeps the floes it holds at the restored places; the others' states are
   // let go (NaN), so that a reader of a floe it does not hold is seen.
-  const std::vector<std::uint8_t> held = held_floes();
+  const std::vector<std::uint8_t> held = kept_on_restore();
   for (std::size_t i = 0; i < held.size(); ++i)
     if (!held[i]) scenario_.floes.state[i] = unheld_state();
   detect_in_place();

@@ -247,8 +247,8 @@ void Simulation::drift(StepContext& ctx) {
     water.assign(orbital.begin(), orbital.end());
     for (Vec2& w : water) w += current;
   };
-  moorings_.kick(scenario_.floes, ctx.dt);
   if (comm_.serial()) {
+    moorings_.kick(scenario_.floes, ctx.dt);
     water_at();
     drift_velocities(scenario_.floes, quadrature_, drift_params_, current, wind, ctx.dt, 0, scenario_.floes.size(),
                      water);
@@ -262,6 +262,9 @@ void Simulation::drift(StepContext& ctx) {
     if (owners_.has_slabs() && floe_sea_) owners_.charge_coupling(floe_sea_->take_owned_seconds());
     // Floes migrate; every few steps the strips move (with slabs, the sea's and the coupling's too).
     if (owners_.update(comm_, scenario_.floes, steps_) && owners_.has_slabs()) follow_slabs();
+    // The moorings of the floes this rank drifts: each kick is its floe's
+    // own, and the other floes' states come whole from their owners below.
+    moorings_.kick(scenario_.floes, ctx.dt, owners_.mine());
     // The coupling's owners computed the water velocities; the drift's read them.
     if (floe_sea_) floe_sea_->hand_water_over(owners_.owner());
     water_at();
@@ -466,13 +469,17 @@ bool Simulation::detect_and_check(StepContext& ctx) {
   set_reach(std::span(ctx.momenta).first<StepContext::kTry>());  // combines the try's momenta too (one call)
   read_try_budget(ctx);
   if (!comm_.serial()) owners_.assign(scenario_.floes);  // the owners at the advanced places
+  // The held floes at the advanced places: the detection's subset reads
+  // only those. Kept when the step is accepted (a rejected try's places
+  // are undone).
+  parallel::HeldFloes held = hold_band();
   contact::Detection part;  // this rank's (serially: `next` itself)
   // The whole lists are gathered only for the advance from the whole
   // detection; else whole_detection() gathers them when a step needs them
   // (record runs too: the record's places are keyed by pair, ContactPlace).
   const bool whole = !advance_share_options_.on_part;
   contact::Detection next = parallel::detect(comm_, owners_, scenario_.floes, shapes_, detection_options_,
-                                             comm_.serial() ? nullptr : &part, whole);
+                                             comm_.serial() ? nullptr : &part, whole, &held);
   // The first overlapping pair and its distance at t, found from the ranks'
   // parts (a reduction): the serial scan's on every rank.
   const parallel::Overlap overlap = parallel::first_overlap(comm_, comm_.serial() ? next : part,
@@ -491,6 +498,7 @@ bool Simulation::detect_and_check(StepContext& ctx) {
     return false;
   }
   detection_ = std::move(next);
+  held_ = std::move(held);
   detection_whole_ = comm_.serial() || whole;
   if (!comm_.serial()) detection_part_ = std::move(part);
   return true;
@@ -513,14 +521,26 @@ void Simulation::detect_in_place() {
   if (comm_.serial()) {
     detection_ = contact::detect(scenario_.floes, shapes_, detection_options_);
     detection_whole_ = true;
+    held_ = hold_band();
     return;
   }
   owners_.assign(scenario_.floes);
+  held_ = hold_band();
   contact::Detection part;
   const bool whole = !advance_share_options_.on_part;
-  detection_ = parallel::detect(comm_, owners_, scenario_.floes, shapes_, detection_options_, &part, whole);
+  detection_ = parallel::detect(comm_, owners_, scenario_.floes, shapes_, detection_options_, &part, whole, &held_);
   detection_whole_ = whole;
   detection_part_ = std::move(part);
+}
+
+parallel::HeldFloes Simulation::hold_band() {
+  const std::size_t n = scenario_.floes.size();
+  if (comm_.serial()) return held_.mask.size() == n ? std::move(held_) : parallel::every_floe(n);
+  // H, the largest half band over the pack: each rank's own floes', one
+  // reduction (8 bytes a rank).
+  const double largest =
+      comm_.max(parallel::largest_half_band(owners_, comm_.rank(), scenario_.floes, shapes_, detection_options_));
+  return parallel::held_floes(owners_, comm_.rank(), scenario_.floes, shapes_, detection_options_, largest);
 }
 
 const contact::Detection& Simulation::whole_detection() {

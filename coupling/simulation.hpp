@@ -187,6 +187,9 @@ public:
   const contact::Detection& detection() { return whole_detection(); }
   // The floes' owners by place for the drift and detection (one rank: all 0).
   const parallel::FloeOwners& floe_owners() const { return owners_; }
+  // The floes this rank holds (its own and its halo band, parallel::held_floes)
+  // at the places and reaches of the last detection; one rank: every floe.
+  const parallel::HeldFloes& held_floes() const { return held_; }
   const contact::SubstepReport& substep_report() const { return substeps_; }
   const parallel::AdvanceShareCounts& advance_share() const { return advance_share_; }  // stage seven
   const parallel::AdvanceShareCounts& collide_share() const { return collide_share_; }  // the step-start collisions
@@ -232,13 +235,17 @@ private:
   // The owners by place afresh (the start, a restore): the strips by equal
   // counts, or the sea's slabs.
   void start_owners();
-  // The floes this rank holds (1) at the present places: those a restore
-  // keeps from the checkpoint every rank reads whole (every floe until the
-  // arrays are held by band).
-  std::vector<std::uint8_t> held_floes() const;
+  // The floes a restore keeps (1) from the checkpoint every rank reads
+  // whole: those this rank holds at the restored places (every floe until
+  // the arrays are held by band, piece 9).
+  std::vector<std::uint8_t> kept_on_restore() const;
   // The detection at the present places outside a step (the start, a
   // restore, after a split): by place, this rank's part (collective).
   void detect_in_place();
+  // The floes this rank holds at the present places (owners assigned,
+  // reaches set): H by one reduction (a max), then its band. Collective on
+  // several ranks; one rank holds every floe.
+  parallel::HeldFloes hold_band();
   void wrap_periodic();
   // Detection reach of each floe for the next step. Collective: the pack's
   // rms speed is summed by owner; `along` (exact sums of this rank's part)
@@ -269,6 +276,7 @@ private:
   contact::CollisionShapes shapes_;
   contact::DetectionOptions detection_options_;
   parallel::FloeOwners owners_;  // drift and detection by place (stage six)
+  parallel::HeldFloes held_;     // own floes and band at the last detection (held_floes())
   contact::ImpulseOptions impulse_options_;
   std::unique_ptr<contact::WarmStart> warm_ = std::make_unique<contact::WarmStart>();  // jam LCPs' last bases
   contact::Detection detection_;  // at the present positions

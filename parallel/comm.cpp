@@ -306,6 +306,18 @@ long long Communicator::min(long long value) const {
 #endif
 }
 
+double Communicator::max(double value) const {
+  if (serial() || !impl_) return value;
+#ifdef FLOESIM_HAVE_MPI
+  Counted counted(impl_->traffic, static_cast<long long>(sizeof(double)) * size_);
+  double out = 0.0;
+  check(MPI_Allreduce(&value, &out, 1, MPI_DOUBLE, MPI_MAX, impl_->comm), "MPI_Allreduce");
+  return out;
+#else
+  return value;
+#endif
+}
+
 void Communicator::sum(std::span<ExactSum> sums, std::span<long long> counts) const {
   if (serial() || !impl_) return;
 #ifdef FLOESIM_HAVE_MPI

@@ -10,8 +10,9 @@
 // where a count is an argument. The results do not depend on
 // the number of ranks: gathers concatenate the ranks' parts in rank order, so
 // a list split in contiguous shares (share()) comes back in its serial order,
-// and reductions here are only of integers (exact in any order): a sum of
-// doubles goes through ExactSum's integer limbs (core/exact_sum.hpp).
+// and reductions here are only of integers (exact in any order) and the
+// largest of doubles (a max picks one of the values: exact in any order): a
+// sum of doubles goes through ExactSum's integer limbs (core/exact_sum.hpp).
 //
 // Errors: a failure on one rank must stop every rank with the same message
 // and exit code. together() runs a piece of work on every rank and then
@@ -178,6 +179,9 @@ public:
   long long sum(long long value) const;
   // The least of one integer over the ranks.
   long long min(long long value) const;
+  // The largest of one double over the ranks (exact: one of the values,
+  // whichever order the ranks are combined in). One call.
+  double max(double value) const;
   // Exact sums over the ranks: on exit each of `sums` holds the sum of every
   // rank's terms (its own and the others' accumulators merged), and each of
   // `counts` the sum of every rank's; the same on every rank, and the same

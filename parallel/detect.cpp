@@ -149,8 +149,9 @@ contact::Detection exchange_pairs(const Communicator& comm, const contact::Detec
 }
 
 contact::Detection detect_part(const FloeOwners& owners, int rank, const Floes& floes,
-                               const contact::CollisionShapes& shapes, contact::DetectionOptions options) {
-  options.subset = detection_subset(owners, rank, floes, shapes, options);
+                               const contact::CollisionShapes& shapes, contact::DetectionOptions options,
+                               const HeldFloes* held) {
+  options.subset = detection_subset(owners, rank, floes, shapes, options, held);
   return contact::detect(floes, shapes, options);
 }
 
@@ -222,14 +223,14 @@ Overlap first_overlap(const Communicator& comm, const contact::Detection& part, 
 
 contact::Detection detect(const Communicator& comm, FloeOwners& owners, const Floes& floes,
                           const contact::CollisionShapes& shapes, contact::DetectionOptions options,
-                          contact::Detection* part, bool whole_too) {
+                          contact::Detection* part, bool whole_too, const HeldFloes* held) {
   if (comm.serial()) {
     contact::Detection whole = contact::detect(floes, shapes, options);
     if (part) *part = whole;
     return whole;
   }
   const double start = thread_seconds();
-  contact::Detection mine = detect_part(owners, comm.rank(), floes, shapes, std::move(options));
+  contact::Detection mine = detect_part(owners, comm.rank(), floes, shapes, std::move(options), held);
   owners.charge(thread_seconds() - start);
   contact::Detection whole = whole_too || !part ? gather(comm, mine) : contact::Detection{};
   if (part) *part = std::move(mine);

@@ -26,10 +26,12 @@ namespace floesim::parallel {
 // gather) to `owners`, for the load balance.
 contact::Detection detect(const Communicator& comm, FloeOwners& owners, const Floes& floes,
                           const contact::CollisionShapes& shapes, contact::DetectionOptions options,
-                          contact::Detection* part = nullptr, bool whole = true);
+                          contact::Detection* part = nullptr, bool whole = true, const HeldFloes* held = nullptr);
 // (`part`, if not null, receives this rank's part: detect_part's. Serially, the whole detection.
 // With `whole` false on several ranks (and `part` given) the parts are not
-// gathered and the result is empty: the caller gathers later if it must.)
+// gathered and the result is empty: the caller gathers later if it must.
+// With `held`, this rank's held floes (held_floes), its subset reads only
+// those: detection_subset.)
 
 // The whole detection from every rank's part (each rank's detect_part, in
 // pair order): the parts gathered to every rank (one allgather_bytes) and
@@ -115,9 +117,11 @@ contact::Detection exchange_pairs(const Communicator& comm, const contact::Detec
 
 // Rank `rank`'s part of the detection by place (no communication): the
 // serial detection's pairs whose floe a `rank` owns, with their contact
-// points and witnesses.
+// points and witnesses. With `held` (rank's held_floes) the subset reads
+// only the held floes.
 contact::Detection detect_part(const FloeOwners& owners, int rank, const Floes& floes,
-                               const contact::CollisionShapes& shapes, contact::DetectionOptions options);
+                               const contact::CollisionShapes& shapes, contact::DetectionOptions options,
+                               const HeldFloes* held = nullptr);
 
 // The parts of one detection (each in pair order, no pair in two parts)
 // merged into pair order: pairs, and each pair's contact points and

@@ -224,41 +224,132 @@ bool FloeOwners::update(const Communicator& comm, const Floes& floes, std::size_
   return moved;
 }
 
-contact::DetectionSubset detection_subset(const FloeOwners& owners, int rank, const Floes& floes,
-                                          const contact::CollisionShapes& shapes,
-                                          const contact::DetectionOptions& options) {
+namespace {
+// h_j at floe j's place y (the one formula of half_band, held_floes and detection_subset).
+double half_band_at(double y, const contact::CollisionShapes& shapes, const contact::DetectionOptions& options,
+                    std::size_t j) {
+  const double h = shapes.radius[j] + options.reach_of(j) + 0.5 * options.collision_distance;
+  return h + 1e-9 * (1.0 + std::abs(y) + h);  // posing rounds; a floe held in excess costs only time
+}
+}  // namespace
+
+double half_band(const FloeOwners& owners, const Floes& floes, const contact::CollisionShapes& shapes,
+                 const contact::DetectionOptions& options, std::size_t j) {
+  return half_band_at(owners.place(floes.state[j]), shapes, options, j);
+}
+
+double largest_half_band(const FloeOwners& owners, int rank, const Floes& floes,
+                         const contact::CollisionShapes& shapes, const contact::DetectionOptions& options) {
+  const std::span<const int> owner = owners.owner();
+  FLOESIM_ASSERT(owner.size() == floes.size());
+  double largest = 0.0;
+  if (rank == owners.rank()) {
+    for (const std::uint32_t i : owners.mine()) largest = std::max(largest, half_band(owners, floes, shapes, options, i));
+  } else {  // a simulated rank (tests): its floes from the owners
+    for (std::size_t i = 0; i < floes.size(); ++i)
+      if (owner[i] == rank) largest = std::max(largest, half_band(owners, floes, shapes, options, i));
+  }
+  return largest;
+}
+
+HeldFloes held_floes(const FloeOwners& owners, int rank, const Floes& floes, const contact::CollisionShapes& shapes,
+                     const contact::DetectionOptions& options, double largest) {
   const std::size_t n = floes.size();
   const std::span<const int> owner = owners.owner();
-  FLOESIM_ASSERT(owner.size() == n);
+  FLOESIM_ASSERT(owner.size() == n && rank >= 0 && rank < owners.ranks());
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  // The strip S_r; in a periodic box the end strips end at the box's edges
+  // (every place lies in the box).
+  const std::vector<double>& cuts = owners.cuts();
+  double lo = rank == 0 ? -kInf : cuts[static_cast<std::size_t>(rank) - 1];
+  double hi = rank == owners.ranks() - 1 ? kInf : cuts[static_cast<std::size_t>(rank)];
+  const contact::Domain& box = options.domain;
+  if (box.periodic) {
+    lo = std::max(lo, box.ymin);
+    hi = std::min(hi, box.ymax);
+  }
+  // The strip widened to the rank's own floes' places: they lie in it but
+  // for round-off (the slabs own by grid row), or but for the grid's wrap
+  // (with the sea's slabs, a floe beyond the grid in an open box is owned
+  // by the row it wraps to). The band's argument needs y_a in S_r for each
+  // own floe a.
+  for (std::size_t j = 0; j < n; ++j)
+    if (owner[j] == rank) {
+      const double y = owners.place(floes.state[j]);
+      lo = std::min(lo, y);
+      hi = std::max(hi, y);
+    }
+  const auto distance = [&](double y) { return std::max({0.0, lo - y, y - hi}); };
+  HeldFloes out;
+  out.largest = largest;
+  out.mask.assign(n, 0);
+  for (std::size_t j = 0; j < n; ++j) {
+    bool held = owner[j] == rank;
+    if (!held) {
+      const double y = owners.place(floes.state[j]);
+      double gap = distance(y);
+      if (box.periodic) gap = std::min({gap, distance(y - box.height()), distance(y + box.height())});
+      held = gap <= largest + half_band_at(y, shapes, options, j);
+    }
+    if (!held) continue;
+    out.mask[j] = 1;
+    out.index.push_back(static_cast<std::uint32_t>(j));
+  }
+  return out;
+}
+
+HeldFloes every_floe(std::size_t n) {
+  HeldFloes out;
+  out.mask.assign(n, 1);
+  out.index.resize(n);
+  std::iota(out.index.begin(), out.index.end(), 0u);
+  out.largest = std::numeric_limits<double>::infinity();
+  return out;
+}
+
+contact::DetectionSubset detection_subset(const FloeOwners& owners, int rank, const Floes& floes,
+                                          const contact::CollisionShapes& shapes,
+                                          const contact::DetectionOptions& options, const HeldFloes* held) {
+  const std::size_t n = floes.size();
+  const std::span<const int> owner = owners.owner();
+  FLOESIM_ASSERT(owner.size() == n && (!held || held->mask.size() == n));
   const contact::Domain& d = options.domain;
   contact::DetectionSubset subset;
   subset.keep.assign(n, 0);
+  // The floes read: the held ones (the posed floes are among them), or every floe.
+  std::vector<std::uint32_t> all;
+  if (!held) {
+    all.resize(n);
+    std::iota(all.begin(), all.end(), 0u);
+  }
+  const std::span<const std::uint32_t> read = held ? std::span<const std::uint32_t>(held->index) : std::span<const std::uint32_t>(all);
   // Each floe's band: centre y (wrapped), half width R + reach + xi/2, widened
-  // by a round-off margin (posing rounds; a floe posed in excess costs only time).
-  std::vector<double> y(n), half(n);
+  // by a round-off margin (half_band).
+  std::vector<double> y(read.size()), half(read.size());
   double lo = std::numeric_limits<double>::infinity(), hi = -lo;
-  for (std::size_t i = 0; i < n; ++i) {
-    y[i] = owners.place(floes.state[i]);
-    const double h = shapes.radius[i] + options.reach_of(i) + 0.5 * options.collision_distance;
-    half[i] = h + 1e-9 * (1.0 + std::abs(y[i]) + h);
+  for (std::size_t k = 0; k < read.size(); ++k) {
+    const std::uint32_t i = read[k];
+    y[k] = owners.place(floes.state[i]);
+    half[k] = half_band_at(y[k], shapes, options, i);
     if (owner[i] != rank) continue;
     subset.keep[i] = 1;
-    lo = std::min(lo, y[i] - half[i]);
-    hi = std::max(hi, y[i] + half[i]);
+    lo = std::min(lo, y[k] - half[k]);
+    hi = std::max(hi, y[k] + half[k]);
   }
   if (!(lo <= hi)) return subset;  // no floe of its own: nothing to pose
   const double centre = 0.5 * (lo + hi), width = 0.5 * (hi - lo);
-  for (std::size_t i = 0; i < n; ++i) {
+  for (std::size_t k = 0; k < read.size(); ++k) {
+    const std::uint32_t i = read[k];
     bool near = subset.keep[i] != 0;
     if (!near && d.periodic) {
       // The nearest image of the floe's centre (any whole number of periods).
-      double gap = y[i] - centre;
+      double gap = y[k] - centre;
       gap -= d.height() * std::round(gap / d.height());
-      near = std::abs(gap) <= width + half[i];
+      near = std::abs(gap) <= width + half[k];
     } else if (!near) {
-      near = y[i] + half[i] >= lo && y[i] - half[i] <= hi;
+      near = y[k] + half[k] >= lo && y[k] - half[k] <= hi;
     }
-    if (near) subset.posed.push_back(static_cast<std::uint32_t>(i));
+    if (near) subset.posed.push_back(i);
   }
   return subset;
 }

@@ -203,6 +203,58 @@ private:
   std::vector<double> window_seconds_, total_seconds_, coupling_seconds_, fracture_seconds_;
 };
 
+// ---- The halo band (docs/parallel.md, "The state held by owner with a
+// halo", "The band") ----
+//
+// Floe j's half band h_j = R_j + reach_j + xi/2 (R_j its bounding radius
+// about the centroid, reach_j its detection reach, xi the collision
+// distance): the y extent of its padded box lies within [y_j - h_j, y_j +
+// h_j] about its place y_j (FloeOwners::place). H = max_j h_j over the pack.
+// Rank r's halo band B_r: the floes j it does not own with
+//
+//     dist(y_j, S_r) <= H + h_j,
+//
+// S_r = [c_{r-1}, c_r) its strip (cut[-1] = -inf, cut[ranks-1] = +inf; the
+// box's edges for the end strips of a periodic box), widened to the places
+// of the floes r owns where one lies outside it (round-off at a cut, or a
+// floe beyond the sea's grid in an open box, owned by the row it wraps to),
+// the distance taken on the circle in a periodic box (the nearest image). Rank r holds its floes
+// and B_r. Why that is enough for its part of the detection: a pair is a
+// candidate only when its padded boxes overlap, so |y_a - y_b| <= h_a + h_b
+// (nearest image), and rank r keeps the pairs whose floe a it owns, y_a in
+// S_r: dist(y_b, S_r) <= h_a + h_b <= H + h_b. The strip widened by H alone
+// is too thin (b may lie h_a + h_b beyond the cut). detection_subset poses
+// only held floes (its hull of the owned floes' bands lies within S_r
+// widened by H).
+//
+// Every h_j carries detection_subset's round-off margin, 1e-9 (1 + |y_j| +
+// h_j), the same bits in both.
+double half_band(const FloeOwners& owners, const Floes& floes, const contact::CollisionShapes& shapes,
+                 const contact::DetectionOptions& options, std::size_t j);
+// This rank's part of H: the largest h_j of the floes `rank` owns (owners
+// assigned for these floes), 0 if it owns none. H is its largest over the
+// ranks, one reduction (Communicator::max): every floe is owned by one rank,
+// so that is max_j h_j over the pack.
+double largest_half_band(const FloeOwners& owners, int rank, const Floes& floes,
+                         const contact::CollisionShapes& shapes, const contact::DetectionOptions& options);
+
+// The floes a rank holds: its own and its band.
+struct HeldFloes {
+  std::vector<std::uint32_t> index;  // ascending
+  std::vector<std::uint8_t> mask;    // per floe: 1 if held
+  double largest = 0.0;              // H (m), the band's largest half band
+  bool holds(std::size_t i) const { return mask[i] != 0; }
+};
+// Rank `rank`'s held floes for the owners assigned at the floes' present
+// places, their reaches in options, and H = `largest` (the ranks' largest
+// largest_half_band). A pass over every floe's place: with the state held by
+// owner each owner would test its own floes against the strips instead
+// (the halo exchange, piece 8 of the plan).
+HeldFloes held_floes(const FloeOwners& owners, int rank, const Floes& floes, const contact::CollisionShapes& shapes,
+                     const contact::DetectionOptions& options, double largest);
+// Every floe held (one rank, or the serial reference).
+HeldFloes every_floe(std::size_t n);
+
 // The halo rule: the part of the detection that `rank` makes. It keeps the
 // pairs whose floe a it owns, and poses its floes and every floe whose padded
 // box can reach one of theirs: the floes whose band
@@ -211,8 +263,14 @@ private:
 // bands, across the periodic seam too. A pair is a candidate only when its
 // padded boxes overlap, so both floes of every kept pair are posed, and the
 // kept pairs are the serial detection's pairs of the owned floes.
+//
+// With `held` (rank's held_floes, for the same floes, owners and reaches)
+// only the held floes are read: every floe it poses is held (the band's
+// rule, above), so the subset is the one from every floe, and the floes
+// outside the band may hold anything (stale, or nothing at all).
 contact::DetectionSubset detection_subset(const FloeOwners& owners, int rank, const Floes& floes,
                                           const contact::CollisionShapes& shapes,
-                                          const contact::DetectionOptions& options);
+                                          const contact::DetectionOptions& options,
+                                          const HeldFloes* held = nullptr);
 
 }  // namespace floesim::parallel

@@ -16,7 +16,11 @@
 //    must be collisions and a wind's push (so that the budget is not 0).
 //    Simulation::detection(), read on every rank after the steps (each rank
 //    then holds only its part: the read gathers them, collectively), must
-//    be the serial detection, pair by pair.
+//    be the serial detection, pair by pair; Simulation::held_floes() (the
+//    band at the last detection, docs/parallel.md "The band in the
+//    library") must hold the rank's own floes and both floes of every pair
+//    whose floe a it owns, with the same H on every rank, and every floe
+//    serially. Communicator::max must give the largest value.
 // 3. Four floes blown to infinity by a 1e200 m/s wind, floe 0 in the top
 //    strip (on 2 ranks, the last rank's): every rank must throw the serial
 //    run's message, which names floe 0 (the ranks agree on the lowest bad
@@ -44,6 +48,7 @@
 #include "coupling/scenario.hpp"
 #include "coupling/simulation.hpp"
 #include "parallel/comm.hpp"
+#include "parallel/place.hpp"
 
 using namespace floesim;
 
@@ -110,6 +115,8 @@ void check_sums(const parallel::Communicator& comm, std::vector<std::string>& fa
       if (!same_bits(w, v)) failures.push_back(std::string(how) + ": the ranks disagree");
   }
   if (comm.min(100 - comm.rank()) != 101 - comm.size()) failures.push_back("Communicator::min is not the least");
+  if (!same_bits(comm.max(0.25 * comm.rank() - 3.0), 0.25 * (comm.size() - 1) - 3.0))
+    failures.push_back("Communicator::max is not the largest");
 }
 
 // The run's config and the pack file it reads (removed once loaded).
@@ -190,6 +197,23 @@ void check_simulation(const parallel::Communicator& comm, std::vector<std::strin
   for (std::size_t k = 0; same_detection && k < db.contacts.size(); ++k)
     same_detection = same2(da.contacts[k].point, db.contacts[k].point) && same_bits(da.contacts[k].gap, db.contacts[k].gap);
   if (!same_detection) failures.push_back("detection() differs from the serial detection");
+  // The held floes at the last detection (Simulation::held_floes): the
+  // rank's own and both floes of every pair whose floe a it owns, H the
+  // same on every rank; serially every floe.
+  const parallel::HeldFloes& held = ranks.held_floes();
+  const std::span<const int> owner = ranks.floe_owners().owner();
+  bool holds = held.mask.size() == n && (comm.serial() || owner.size() == n);  // one rank assigns no owners
+  const auto owns = [&](std::size_t i) { return comm.serial() || owner[i] == comm.rank(); };
+  for (std::size_t i = 0; holds && i < n; ++i) holds = !owns(i) || held.holds(i);
+  for (const contact::NearPair& q : da.pairs)
+    if (holds && owns(q.a)) holds = held.holds(q.a) && held.holds(q.b);
+  if (!holds) failures.push_back("held_floes() misses an own floe or a floe of the rank's pairs");
+  for (const double h : comm.allgather(std::span<const double>(&held.largest, 1)))
+    if (!same_bits(h, held.largest)) failures.push_back("the ranks' H differ");
+  if (serial.held_floes().index.size() != n) failures.push_back("the serial run does not hold every floe");
+  if (comm.rank() == 0)
+    std::printf("%d ranks: rank 0 holds %zu of %zu floes at the last detection (H = %.3f m)\n", comm.size(),
+                held.index.size(), n, held.largest);
   if (db.contacts.empty()) failures.push_back("no contact point in the detection: a weak test");
   if (!strict_subset) failures.push_back("a rank owned no floe or every floe: the sums by owner were not tried");
   if (serial.collision_stats().lcps == 0) failures.push_back("no collision: a weak test");

@@ -88,29 +88,39 @@ inline bool all_nan(const FloeState& s) {
 }
 inline std::size_t count_held(const Held& held) { return static_cast<std::size_t>(std::count(held.begin(), held.end(), 1)); }
 
-// ---- The halo band (docs/parallel.md, the plan's detection row) ----------
+// ---- The halo band (docs/parallel.md, "The band"; parallel::held_floes) ---
 
-// Floe j's half band: R_j + reach_j + xi/2, with detection_subset's
-// round-off margin.
-inline double half_band(const parallel::FloeOwners& owners, const Floes& floes, const contact::CollisionShapes& shapes,
-                 const contact::DetectionOptions& d, std::size_t j) {
-  const double y = owners.place(floes.state[j]);
-  const double h = shapes.radius[j] + d.reach_of(j) + 0.5 * d.collision_distance;
-  return h + 1e-9 * (1.0 + std::abs(y) + h);
+// H as a run gets it: each simulated rank's largest_half_band (its own
+// floes'), then their largest (the reduction, Communicator::max).
+inline double largest_by_ranks(const parallel::FloeOwners& owners, const Floes& floes,
+                               const contact::CollisionShapes& shapes, const contact::DetectionOptions& d) {
+  double largest = 0.0;
+  for (int r = 0; r < owners.ranks(); ++r)
+    largest = std::max(largest, parallel::largest_half_band(owners, r, floes, shapes, d));
+  return largest;
 }
 
-// The floes rank `rank` holds: those whose place lies within H + h_j of its
-// strip [cut[rank-1], cut[rank]) (the box's edges for the end strips of a
-// periodic box), across the seam by the nearest image. A candidate pair's
-// padded boxes overlap, so |y_a - y_b| <= h_a + h_b, and floe a lies in the
-// strip: b lies within h_a + h_b <= H + h_b of it. With `one_pad` the band is
-// the strip widened by H alone (too thin: the mutation the tests name).
-inline Held halo_band(const parallel::FloeOwners& owners, int rank, const Floes& floes, const contact::CollisionShapes& shapes,
-               const contact::DetectionOptions& d, bool one_pad = false) {
+// The band's rule written out here, from the definition (the reference the
+// library's held_floes is checked against): the floes whose place lies
+// within H + h_j of the strip [cut[rank-1], cut[rank]) (the box's edges for
+// the end strips of a periodic box), across the seam by the nearest image,
+// H the largest h_j over the whole pack. A candidate pair's padded boxes
+// overlap, so |y_a - y_b| <= h_a + h_b, and floe a lies in the strip: b
+// lies within h_a + h_b <= H + h_b of it. With `one_pad` the band is the
+// strip widened by H alone (too thin: the mutation the tests name).
+inline Held halo_band_by_rule(const parallel::FloeOwners& owners, int rank, const Floes& floes,
+                              const contact::CollisionShapes& shapes, const contact::DetectionOptions& d,
+                              bool one_pad = false) {
   const std::size_t n = floes.size();
   constexpr double kInf = std::numeric_limits<double>::infinity();
-  double largest = 0.0;  // H: in a run, one reduction (a max) over the ranks' held floes
-  for (std::size_t j = 0; j < n; ++j) largest = std::max(largest, half_band(owners, floes, shapes, d, j));
+  // h_j = R_j + reach_j + xi/2, with detection_subset's round-off margin.
+  const auto half_band = [&](std::size_t j) {
+    const double y = owners.place(floes.state[j]);
+    const double h = shapes.radius[j] + d.reach_of(j) + 0.5 * d.collision_distance;
+    return h + 1e-9 * (1.0 + std::abs(y) + h);
+  };
+  double largest = 0.0;  // H over the whole pack
+  for (std::size_t j = 0; j < n; ++j) largest = std::max(largest, half_band(j));
   const std::vector<double>& cuts = owners.cuts();
   double lo = rank == 0 ? -kInf : cuts[static_cast<std::size_t>(rank) - 1];
   double hi = rank == owners.ranks() - 1 ? kInf : cuts[static_cast<std::size_t>(rank)];
@@ -129,10 +139,19 @@ inline Held halo_band(const parallel::FloeOwners& owners, int rank, const Floes&
     auto distance = [&](double at) { return std::max({0.0, lo - at, at - hi}); };
     double gap = distance(y);
     if (box.periodic) gap = std::min({gap, distance(y - box.height()), distance(y + box.height())});
-    const double band = largest + (one_pad ? 0.0 : half_band(owners, floes, shapes, d, j));
+    const double band = largest + (one_pad ? 0.0 : half_band(j));
     held[j] = gap <= band ? 1 : 0;
   }
   return held;
+}
+
+// The floes rank `rank` holds, as a run computes them
+// (parallel::held_floes, H by the simulated ranks' reduction); with
+// `one_pad`, the thin band of the named mutation (halo_band_by_rule).
+inline Held halo_band(const parallel::FloeOwners& owners, int rank, const Floes& floes, const contact::CollisionShapes& shapes,
+               const contact::DetectionOptions& d, bool one_pad = false) {
+  if (one_pad) return halo_band_by_rule(owners, rank, floes, shapes, d, true);
+  return parallel::held_floes(owners, rank, floes, shapes, d, largest_by_ranks(owners, floes, shapes, d)).mask;
 }
 
 // ---- Comparisons, bit for bit -------------------------------------------
