@@ -260,6 +260,15 @@ int run(const Args& args, const parallel::Session& session) {
     }
   });
   Simulation& sim = *simulation;
+  // Test hook, not a user key (tests/parallel/check_writer_ranks.py): "1":
+  // each rank's copy of the floes it does not hold is poisoned before the
+  // writer's gathers, so the run file is right only if they read every
+  // floe from its holder; "unread": the writer writes its poisoned copy
+  // (Simulation::set_writer_test). Read here, by the command, so that the
+  // library reads no environment.
+  if (const char* test = std::getenv("FLOESIM_TEST_POISON_UNHELD"))
+    sim.set_writer_test(std::string(test) == "unread" ? Simulation::WriterTest::poison_unread
+                                                      : Simulation::WriterTest::poison);
   for (const std::string& note : sim.notes()) std::cerr << "floesim: note: " << note << "\n";
 
   ProgressLine progress(!args.quiet && comm.writer(), isatty(STDERR_FILENO) != 0, args.log_every);

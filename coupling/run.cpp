@@ -19,14 +19,6 @@ RunSummary run_simulation(Simulation& sim, const RunOptions& options) {
   const double checkpoint_interval = cfg.run.checkpoint_interval;
   const auto start = std::chrono::steady_clock::now();
   const parallel::Communicator& comm = sim.communicator();
-  // Test hook, not a user key (tests/parallel/check_writer_ranks.py): "1":
-  // each rank's copy of the floes it does not hold is poisoned before the
-  // writer's gathers, so the run file is right only if they read every
-  // floe from its holder; "unread": the writer writes its poisoned copy
-  // (Simulation::set_writer_test).
-  if (const char* test = std::getenv("FLOESIM_TEST_POISON_UNHELD"))
-    sim.set_writer_test(std::string(test) == "unread" ? Simulation::WriterTest::poison_unread
-                                                      : Simulation::WriterTest::poison);
 
   RunSummary summary;
   summary.output = options.output;

@@ -8,8 +8,8 @@ usage: check_advance_part.py FLOESIM MPIEXEC WORKDIR [--floes N] [--t-end T] [--
 The moving pack of check_ranks.py run serially, then on each of --ranks with
 advance_on_part = true and = false: every run file must equal the serial one
 bit for bit (`floesim compare`, rtol 0, atol 0). With it on the advances ran
-from the parts (join candidates gathered) and combined in at least as many
-steps as from the whole detection, and the detect phase received less than a
+from the parts (join candidates gathered), none redone for a floe not held (a
+join candidate not gathered), and the detect phase received less than a
 tenth of the bytes (the whole lists gathered only when a step needs them);
 with it off no candidate was gathered. Then the same pack with
 record_collisions (the impulse record, its places keyed by pair, made from
@@ -35,6 +35,7 @@ for on in (True, False):
 
 need(run([args.floesim, "run", configs[True], "-o", "serial.h5", "-q"]), "serial run")
 whole_detect = None  # the detect phase's bytes on 2 ranks with the whole lists gathered
+on_missing = {}  # ranks -> the advances redone for a floe not held, from the parts
 for n in args.ranks:
     combined, detect = {}, {}
     for on in (True, False):
@@ -48,6 +49,8 @@ for n in args.ranks:
         steps, fallbacks = int(s["parallel.advance_steps"]), int(s["parallel.advance_fallbacks"])
         candidates, missing = int(s["parallel.advance_candidates"]), int(s["parallel.advance_missing"])
         combined[on] = steps - fallbacks
+        if on:
+            on_missing[n] = missing
         detect[on] = int(s["parallel.phase.detect"].split()[2])
         print(f"{n} ranks, advance_on_part {on}: {'equal' if c.returncode == 0 else 'DIFFERENT'} to the serial run; "
               f"{steps} advances tried, {fallbacks} redone ({missing} for a floe not held), "
@@ -65,9 +68,15 @@ for n in args.ranks:
     if len(detect) == 2 and not detect[True] * 10 < detect[False]:
         failures.append(f"{n} ranks: the detect phase received {detect[True]} bytes from the parts, "
                         f"not a tenth of {detect[False]} with the whole lists gathered")
-    if len(combined) == 2 and combined[True] < combined[False]:
-        failures.append(f"{n} ranks: from the parts {combined[True]} advances combined, "
-                        f"fewer than {combined[False]} from the whole detection")
+    # Fallbacks for a foreign cluster depend on where the strips' cuts are,
+    # which move by measured time (a noisy machine moves them differently
+    # from run to run), so the two runs' counts of combined advances are not
+    # comparable bit for bit. What the parts alone could lose is a join whose
+    # candidate no share gathered (a `missing_pairs` fallback): none may.
+    if on_missing.get(n):
+        failures.append(f"{n} ranks: from the parts {on_missing[n]} advances fell back for a floe not held "
+                        f"(a join candidate not gathered); {combined.get(True)} combined against "
+                        f"{combined.get(False)} from the whole detection")
     if n == 2:
         whole_detect = detect.get(False)
 
