@@ -266,9 +266,17 @@ int run(const Args& args, const parallel::Session& session) {
   // floe from its holder; "unread": the writer writes its poisoned copy
   // (Simulation::set_writer_test). Read here, by the command, so that the
   // library reads no environment.
-  if (const char* test = std::getenv("FLOESIM_TEST_POISON_UNHELD"))
-    sim.set_writer_test(std::string(test) == "unread" ? Simulation::WriterTest::poison_unread
-                                                      : Simulation::WriterTest::poison);
+  // "step", "step-lure", "step-mutant" (optionally "@drift", "@detect",
+  // "@percussion"): the poison mode of the run (Simulation::set_poison_test,
+  // tests/parallel/check_poison_run.py), the writer's gathers as in a plain run.
+  if (const char* test = std::getenv("FLOESIM_TEST_POISON_UNHELD")) {
+    PoisonOptions poison;
+    if (parse_poison_options(test, poison))
+      sim.set_poison_test(poison);
+    else
+      sim.set_writer_test(std::string(test) == "unread" ? Simulation::WriterTest::poison_unread
+                                                        : Simulation::WriterTest::poison);
+  }
   for (const std::string& note : sim.notes()) std::cerr << "floesim: note: " << note << "\n";
 
   ProgressLine progress(!args.quiet && comm.writer(), isatty(STDERR_FILENO) != 0, args.log_every);
@@ -295,6 +303,7 @@ int run(const Args& args, const parallel::Session& session) {
   }
   progress.done();
   restore_signals();
+  if (const std::string poison = sim.poison_summary(); !poison.empty()) std::cerr << "floesim: " << poison << "\n";
   const int status = s.status == "complete" ? 0 : kInterruptedExit;
   if (!comm.writer()) return status;  // rank 0 reports the run
 

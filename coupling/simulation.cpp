@@ -162,23 +162,26 @@ double Simulation::step(double t_stop) {
     t_ = t_stop;
     return 0.0;
   }
+  // probe(): the poison mode's hooks between phases (a test option, off in a
+  // run: set_poison_test, coupling/poison_mode.hpp).
   StepContext ctx;
-  { PhaseTimer _(profile_, Phase::choose_dt, comm_); ctx = choose_dt(t_stop); }
+  { PhaseTimer _(profile_, Phase::choose_dt, comm_); ctx = choose_dt(t_stop); }  probe("choose_dt", ctx);
   for (bool accepted = false; !accepted;) {
-    { PhaseTimer _(profile_, Phase::forcing, comm_); sample_forcing(ctx); }
-    { PhaseTimer _(profile_, Phase::penalty, comm_); floes_half_kick(ctx); }
-    { PhaseTimer _(profile_, Phase::drift, comm_);   drift(ctx); }
-    { PhaseTimer _(profile_, Phase::collide, comm_); collide(ctx); }
-    { PhaseTimer _(profile_, Phase::advance, comm_); advance(ctx); }
+    { PhaseTimer _(profile_, Phase::forcing, comm_); sample_forcing(ctx); }       probe("forcing", ctx);
+    { PhaseTimer _(profile_, Phase::penalty, comm_); floes_half_kick(ctx); }      probe("first half kick", ctx);
+    { PhaseTimer _(profile_, Phase::drift, comm_);   drift(ctx); }                probe("drift", ctx);
+    { PhaseTimer _(profile_, Phase::collide, comm_); collide(ctx); }              probe("collide", ctx);
+    { PhaseTimer _(profile_, Phase::advance, comm_); advance(ctx); }              probe("advance", ctx);
     { PhaseTimer _(profile_, Phase::detect, comm_);  accepted = detect_and_check(ctx); }
   }
-  { PhaseTimer _(profile_, Phase::sea, comm_);       sea_flow(ctx); }
-  { PhaseTimer _(profile_, Phase::penalty, comm_);   sea_half_kick(ctx); }
+  probe("detect", ctx);
+  { PhaseTimer _(profile_, Phase::sea, comm_);       sea_flow(ctx); }             probe("sea", ctx);
+  { PhaseTimer _(profile_, Phase::penalty, comm_);   sea_half_kick(ctx); }        probe("second half kick", ctx);
   // Land exactly on t_stop when the step was cut to reach it.
   t_ = ctx.dt == t_stop - ctx.t ? t_stop : ctx.t + ctx.dt;
-  { PhaseTimer _(profile_, Phase::record, comm_);     note_collisions(); }
-  { PhaseTimer _(profile_, Phase::percussion, comm_); percussion(ctx); }
-  { PhaseTimer _(profile_, Phase::check, comm_);      close_step(ctx); }
+  { PhaseTimer _(profile_, Phase::record, comm_);     note_collisions(); }       probe("record", ctx);
+  { PhaseTimer _(profile_, Phase::percussion, comm_); percussion(ctx); }         probe("percussion", ctx);
+  { PhaseTimer _(profile_, Phase::check, comm_);      close_step(ctx); }         probe("check", ctx);
   ++steps_;
   warm_->tick();  // the jam LCPs' warm starts age by one step
   return ctx.dt;

@@ -53,6 +53,7 @@
 #include "coupling/incident.hpp"
 #include "coupling/mooring.hpp"
 #include "coupling/percussion.hpp"
+#include "coupling/poison_mode.hpp"
 #include "contact/detection.hpp"
 #include "contact/impulse.hpp"
 #include "contact/shapes.hpp"
@@ -155,6 +156,14 @@ public:
   // mutation that shows the poison reaches the file).
   enum class WriterTest { off, poison, poison_unread };
   void set_writer_test(WriterTest mode) { writer_test_ = mode; }
+  // Test option (not a user key): the poison mode of the run
+  // (coupling/poison_mode.hpp): on several ranks, each rank poisons its
+  // copies of the floes it does not hold where the halo exchange will be,
+  // and reports the first NaN it finds in a held floe after each phase.
+  // Nothing changes on one rank. Its reports (also said on stderr):
+  void set_poison_test(PoisonOptions options);
+  std::vector<std::string> poison_reports() const;
+  std::string poison_summary() const;  // windows, floes poisoned, phases reported (empty when off)
 
   double time() const { return t_; }
   std::size_t steps() const { return steps_; }
@@ -247,6 +256,12 @@ private:
   // several ranks; one rank holds every floe.
   parallel::HeldFloes hold_band();
   void wrap_periodic();
+  // The poison mode's hook after the phase `phase` (poison_mode.cpp): opens,
+  // checks and closes its windows; nothing when the mode is off.
+  void probe(const char* phase, StepContext& ctx) {
+    if (poison_) poison_step(phase, ctx);
+  }
+  void poison_step(const char* phase, StepContext& ctx);
   // Detection reach of each floe for the next step. Collective: the pack's
   // rms speed is summed by owner; `along` (exact sums of this rank's part)
   // are combined over the ranks in the same call.
@@ -304,6 +319,7 @@ private:
   parallel::AdvanceShareCounts collide_share_;  // the step-start collisions by owner (stage seven)
   long rejected_steps_ = 0;       // steps redone after an overlap
   WriterTest writer_test_ = WriterTest::off;  // set_writer_test
+  std::unique_ptr<UnheldPoison> poison_;      // set_poison_test
   Profile profile_;
   double t_ = 0.0;
   std::size_t steps_ = 0;
