@@ -181,6 +181,12 @@ void add_run_command(CLI::App& app, Registry& registry) {
 
 namespace {
 
+// The poison mode's summary (a test option: Simulation::set_poison_test),
+// every rank's: stdio, as the other ranks' streams are silenced by run().
+void say_poison(const Simulation& sim) {
+  if (const std::string poison = sim.poison_summary(); !poison.empty()) std::fprintf(stderr, "floesim: %s\n", poison.c_str());
+}
+
 int run(const Args& args, const parallel::Session& session) {
   const parallel::Communicator& comm = session.world();
   // Rank 0 speaks for the run: the other ranks' output would repeat it.
@@ -295,15 +301,17 @@ int run(const Args& args, const parallel::Session& session) {
   } catch (const RunError&) {
     progress.done();
     restore_signals();
+    say_poison(sim);
     throw;
   } catch (...) {
     progress.done();
     restore_signals();
+    say_poison(sim);
     throw;
   }
   progress.done();
   restore_signals();
-  if (const std::string poison = sim.poison_summary(); !poison.empty()) std::cerr << "floesim: " << poison << "\n";
+  say_poison(sim);
   const int status = s.status == "complete" ? 0 : kInterruptedExit;
   if (!comm.writer()) return status;  // rank 0 reports the run
 

@@ -2,7 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
-#include <iostream>
+#include <cstdio>
 #include <limits>
 #include <sstream>
 
@@ -112,6 +112,7 @@ void UnheldPoison::restore(const parallel::Communicator& comm, std::vector<FloeS
 void UnheldPoison::check(const char* phase, const std::vector<FloeState>& state,
                          const std::vector<FloeState>* start, std::span<const double> reach) {
   if (!open_) return;
+  last_checked_ = phase;
   if (std::find(reported_phases_.begin(), reported_phases_.end(), phase) != reported_phases_.end()) return;
   const std::size_t n = std::min(held_.size(), state.size());
   for (std::size_t i = 0; i < n; ++i) {
@@ -126,7 +127,10 @@ void UnheldPoison::check(const char* phase, const std::vector<FloeState>& state,
     m << "poison: rank " << rank_ << ": after " << phase << ": held floe " << i << "'s " << field << " is NaN";
     reports_.push_back(m.str());
     reported_phases_.emplace_back(phase);
-    std::cerr << "floesim: " << m.str() << std::endl;
+    // stdio, not std::cerr: the command silences the other ranks' streams
+    // (rank 0 speaks for the run), and each rank's report is wanted.
+    std::fprintf(stderr, "floesim: %s\n", m.str().c_str());
+    std::fflush(stderr);
     return;
   }
 }
@@ -152,7 +156,8 @@ std::string Simulation::poison_summary() const {
   if (!poison_) return {};
   return "poison: rank " + std::to_string(comm_.rank()) + ": " + std::to_string(poison_->windows()) +
          " windows, " + std::to_string(poison_->poisoned()) + " floes poisoned in them, " +
-         std::to_string(poison_->reports().size()) + " phases reported";
+         std::to_string(poison_->reports().size()) + " phases reported, the last check after " +
+         (poison_->last_checked().empty() ? std::string("none") : poison_->last_checked());
 }
 
 void Simulation::poison_step(const char* phase, StepContext& ctx) {

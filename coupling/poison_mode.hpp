@@ -91,6 +91,9 @@ public:
   // Windows opened and floes poisoned in them (summed over the windows).
   long long windows() const { return windows_; }
   long long poisoned() const { return poisoned_; }
+  // The phase after which the last check was made (a run that fails or
+  // crashes failed in the phase after it); empty before the first.
+  const std::string& last_checked() const { return last_checked_; }
   const std::vector<std::string>& reports() const { return reports_; }
 
 private:
@@ -98,6 +101,7 @@ private:
   int rank_ = 0;
   bool open_ = false;
   long long windows_ = 0, poisoned_ = 0;
+  std::string last_checked_;
   std::vector<std::uint8_t> held_;
   std::vector<int> owner_;
   std::vector<std::uint32_t> unheld_;

@@ -1,0 +1,133 @@
+#!/usr/bin/env python3
+"""The poison mode of the run (docs/parallel.md, "The poison mode of the run
+(piece 7; poison18)"): with the test hook FLOESIM_TEST_POISON_UNHELD=step
+(NaN), step-lure (finite, wrong values) or step-mutant, each rank poisons
+its copies of the floes it does not hold (its own floes and its halo band)
+where the halo exchange of piece 8 will be, and reports the first NaN it
+finds in a held floe after each phase.
+
+usage: check_poison_run.py FLOESIM MPIEXEC WORKDIR
+       check_poison_run.py --no-mpi    (MPI not built: exits 77, ctest's skip code)
+
+On 2 ranks (`mpirun --oversubscribe`):
+(a) no reader left: the collisions-only periodic pack of
+    scripts/scenarios/moving_pack.py (400 floes to 250 s), NaN and lure, is
+    bit for bit the serial run, every rank poisoning floes and reporting no
+    phase; on 1 rank the mode poisons nothing and the run is the serial one.
+(b) known readers are found: the same pack with the advance from the whole
+    detection (`advance_on_part = false`, whose set-up and clusters read
+    every floe by design) with the lure does not give the serial run; a small
+    ocean with the implicit floe-sea step (whole on every rank) with NaN does
+    not either, and the phase it names (a report, or the phase after the last
+    clean check where the run failed) is one after the detection.
+(c) the mutation: each rank poisons one floe it holds too; the run fails,
+    and each rank reports it after the drift, the first phase checked.
+Only what is stable is pinned: other readers are being removed.
+"""
+import os
+import re
+import subprocess
+import sys
+
+from ranks_harness import ENV, moving_pack_check, need, ocean_toml, summary
+
+args, harness, base = moving_pack_check(
+    "floesim was built without MPI (FLOESIM_MPI=OFF): the poison mode is not checked", 400, 250.0, [2])
+W = args.workdir
+run = harness.run
+failures = []
+
+
+def mpirun(n, poison, config, out):
+    env = dict(ENV, FLOESIM_TEST_POISON_UNHELD=poison)
+    return subprocess.run([args.mpiexec, "--oversubscribe", "-np", str(n), "-x", "FLOESIM_TEST_POISON_UNHELD",
+                           args.floesim, "run", config, "-o", out, "-q"],
+                          cwd=W, capture_output=True, text=True, timeout=600, env=env)
+
+
+def equal(a, b):
+    return harness.compare(a, b, 0).returncode == 0
+
+
+def summaries(p):
+    """Each rank's poison summary: rank -> (windows, floes poisoned, phases reported, last check)."""
+    out = {}
+    for m in re.finditer(r"poison: rank (\d+): (\d+) windows, (\d+) floes poisoned in them, (\d+) phases reported, "
+                         r"the last check after (.+)", p.stderr):
+        out[int(m.group(1))] = (int(m.group(2)), int(m.group(3)), int(m.group(4)), m.group(5).strip())
+    return out
+
+
+def reports(p):
+    """Each report: (rank, phase, floe, field)."""
+    return [(int(m.group(1)), m.group(2), int(m.group(3)), m.group(4))
+            for m in re.finditer(r"poison: rank (\d+): after (.+?): held floe (\d+)'s (.+) is NaN", p.stderr)]
+
+
+need(run([args.floesim, "run", base, "-o", "serial.h5", "-q"]), "the pack, serial")
+
+# (a) No reader left on the collisions-only pack.
+for poison in ["step", "step-lure"]:
+    p = mpirun(2, poison, base, f"{poison}2.h5")
+    s = summaries(p)
+    what = f"the pack on 2 ranks, {poison}"
+    if p.returncode != 0:
+        failures.append(f"{what}: exit {p.returncode}\n{p.stderr}")
+        continue
+    print(f"{what}: {'equal' if equal(f'{poison}2.h5', 'serial.h5') else 'DIFFERENT'} to the serial run; {s}")
+    if not equal(f"{poison}2.h5", "serial.h5"):
+        failures.append(f"{what} differs from the serial run: a phase reads a floe outside its rank's held set\n{p.stderr}")
+    if sorted(s) != [0, 1] or any(w == 0 or f == 0 or r != 0 for w, f, r, _ in s.values()):
+        failures.append(f"{what}: every rank must open windows, poison floes and report no phase: {s}\n{p.stderr}")
+p = mpirun(1, "step", base, "one.h5")
+if p.returncode != 0 or not equal("one.h5", "serial.h5") or summaries(p):
+    failures.append(f"1 rank, step: exit {p.returncode}, the mode must poison nothing and equal the serial run\n{p.stderr}")
+else:
+    print("1 rank, step: nothing poisoned, equal to the serial run")
+
+# (b) Known readers. The advance from the whole detection, with the lure.
+whole = os.path.join(W, "whole.toml")
+with open(base) as f:
+    text = f.read()
+with open(whole, "w") as f:
+    f.write(text.replace("[run]\n", "[run]\nadvance_on_part = false\n", 1))
+need(run([args.floesim, "run", whole, "-o", "whole_serial.h5", "-q"]), "the pack from the whole detection, serial")
+p = mpirun(2, "step-lure", whole, "whole_lure2.h5")
+found = p.returncode != 0 or not equal("whole_lure2.h5", "whole_serial.h5")
+print(f"the pack from the whole detection on 2 ranks, step-lure: exit {p.returncode}, "
+      f"{'found (the run failed or differs)' if found else 'NOT FOUND'}")
+if not found:
+    failures.append(f"the lure did not reach the advance from the whole detection (it reads every floe)\n{p.stderr}")
+# The implicit floe-sea step (whole on every rank), with NaN.
+need(run([args.floesim, "pack", "--floes", "120", "--concentration", "0.5", "--box", "200", "100", "--seed", "3",
+          "--min-size", "6", "--max-size", "15", "--thickness", "1", "-o", "half_pack.h5"]), "floesim pack")
+implicit = os.path.join(W, "implicit.toml")
+with open(implicit, "w") as f:
+    f.write(ocean_toml("half_pack.h5", 0.5, 0.25, contact="box = [0.0, 200.0, 0.0, 200.0]\n",
+                       coupling='integrator = "implicit"\n'))
+need(run([args.floesim, "run", implicit, "-o", "implicit_serial.h5", "-q"]), "the implicit ocean, serial")
+p = mpirun(2, "step", implicit, "implicit2.h5")
+s, r = summaries(p), reports(p)
+named = {phase for _, phase, _, _ in r} | ({"(failed after) " + last for _, _, _, last in s.values()}
+                                          if p.returncode != 0 else set())
+after_detection = {"sea", "second half kick", "record", "(failed after) detect", "(failed after) sea",
+                   "(failed after) second half kick"}
+print(f"the implicit ocean on 2 ranks, step: exit {p.returncode}, named {sorted(named)}")
+if p.returncode == 0 and equal("implicit2.h5", "implicit_serial.h5"):
+    failures.append(f"the NaN did not reach the implicit step (whole on every rank)\n{p.stderr}")
+elif not named & after_detection:
+    failures.append(f"the implicit ocean's reader is named {sorted(named)}, not a phase after the detection\n{p.stderr}")
+
+# (c) The mutation: a held floe poisoned too is reported at the first check.
+p = mpirun(2, "step-mutant", base, "mutant2.h5")
+r = reports(p)
+first = {rank: phase for rank, phase, _, _ in reversed(r)}
+print(f"the mutation on 2 ranks: exit {p.returncode}, first reports {first}")
+if p.returncode == 0 or first != {0: "drift", 1: "drift"}:
+    failures.append(f"the mutation (a held floe poisoned) must fail the run and be reported after the drift on "
+                    f"both ranks: exit {p.returncode}, {first}\n{p.stderr}")
+
+if failures:
+    print("FAILED:\n" + "\n".join(failures))
+    sys.exit(1)
+print("ok")
