@@ -47,11 +47,17 @@ bool parse_poison_options(const std::string& text, PoisonOptions& options) {
   if (kind == "step-lure") o.kind = PoisonOptions::Kind::lure;
   else if (kind == "step-mutant") o.mutant = true;
   else if (kind != "step") return false;
-  if (!window.empty()) {
-    o.after_drift = window == "drift";
-    o.after_detect = window == "detect";
-    o.after_percussion = window == "percussion";
-    if (!o.after_drift && !o.after_detect && !o.after_percussion) return false;
+  if (!window.empty()) {  // one or more windows, joined by '+'
+    o.after_drift = o.after_detect = o.after_percussion = false;
+    for (std::size_t at = 0; at <= window.size();) {
+      const std::size_t end = std::min(window.find('+', at), window.size());
+      const std::string w = window.substr(at, end - at);
+      if (w == "drift") o.after_drift = true;
+      else if (w == "detect") o.after_detect = true;
+      else if (w == "percussion") o.after_percussion = true;
+      else return false;
+      at = end + 1;
+    }
   }
   options = o;
   return true;

@@ -60,8 +60,9 @@ struct PoisonOptions {
 };
 
 // Parses the test hook's value: "step" (NaN), "step-lure", "step-mutant",
-// optionally followed by "@drift", "@detect" or "@percussion" to open that
-// window only. Returns false if `text` is not one of them.
+// optionally followed by "@" and the windows to open, of "drift", "detect"
+// and "percussion" joined by '+' (e.g. "step-lure@drift+percussion"); all
+// three without. Returns false if `text` is not of this form.
 bool parse_poison_options(const std::string& text, PoisonOptions& options);
 
 class UnheldPoison {

@@ -13,7 +13,8 @@ On 2 ranks (`mpirun --oversubscribe`):
 (a) no reader left: the collisions-only periodic pack of
     scripts/scenarios/moving_pack.py (400 floes to 250 s), NaN and lure, is
     bit for bit the serial run, every rank poisoning floes and reporting no
-    phase; on 1 rank the mode poisons nothing and the run is the serial one.
+    phase (unless a step fell back to the whole solve, a known reader: then
+    said, not failed); on 1 rank the mode poisons nothing and the run is the serial one.
 (b) known readers are found: the same pack with the advance from the whole
     detection (`advance_on_part = false`, whose set-up and clusters read
     every floe by design) with the lure does not give the serial run; a small
@@ -74,8 +75,15 @@ for poison in ["step", "step-lure"]:
     if p.returncode != 0:
         failures.append(f"{what}: exit {p.returncode}\n{p.stderr}")
         continue
-    print(f"{what}: {'equal' if equal(f'{poison}2.h5', 'serial.h5') else 'DIFFERENT'} to the serial run; {s}")
-    if not equal(f"{poison}2.h5", "serial.h5"):
+    same = equal(f"{poison}2.h5", "serial.h5")
+    # The fallbacks (a conflict: the whole step on every rank) read every
+    # floe (piece 3, a known reader); whether one happens depends on the
+    # cuts, which move by measured time (none in the runs measured).
+    whole = {k: summary(p).get(f"parallel.{k}", "0") for k in ["advance_whole", "collide_whole"]}
+    print(f"{what}: {'equal' if same else 'DIFFERENT'} to the serial run; {s}; whole steps {whole}")
+    if not same and any(v != "0" for v in whole.values()):
+        print(f"{what}: a step fell back to the whole solve (a known reader): (a) not tested by this run")
+    elif not same:
         failures.append(f"{what} differs from the serial run: a phase reads a floe outside its rank's held set\n{p.stderr}")
     if sorted(s) != [0, 1] or any(w == 0 or f == 0 or r != 0 for w, f, r, _ in s.values()):
         failures.append(f"{what}: every rank must open windows, poison floes and report no phase: {s}\n{p.stderr}")
