@@ -238,6 +238,21 @@ double half_band(const FloeOwners& owners, const Floes& floes, const contact::Co
 double largest_half_band(const FloeOwners& owners, int rank, const Floes& floes,
                          const contact::CollisionShapes& shapes, const contact::DetectionOptions& options);
 
+// Rank r's strip as its band's rule reads it: S_r = [lo, hi] widened to
+// the places of the floes r owns (above), and r's part of H, the largest
+// h_j of its own floes (0 if it owns none; largest_half_band's bits). A
+// pass over r's own floes (owners assigned for these floes).
+struct BandStrip {
+  double lo = 0.0, hi = 0.0;  // m
+  double largest = 0.0;       // m
+};
+BandStrip band_strip(const FloeOwners& owners, int rank, const Floes& floes, const contact::CollisionShapes& shapes,
+                     const contact::DetectionOptions& options);
+// dist(y, strip) along y, on the circle in a periodic box (the nearest of
+// y's images y - L, y, y + L: every place lies in the box, so no other
+// image is nearer); 0 inside.
+double strip_distance(double y, const BandStrip& strip, const contact::Domain& box);
+
 // The floes a rank holds: its own and its band.
 struct HeldFloes {
   std::vector<std::uint32_t> index;  // ascending
