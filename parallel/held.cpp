@@ -1,11 +1,14 @@
 #include "parallel/held.hpp"
 
 #include <algorithm>
+#include <cstring>
 
 #include "core/error.hpp"
 #include "parallel/bytes.hpp"
 
 namespace floesim::parallel {
+
+static_assert(kSentAsBytes<BandStrip>);
 
 std::vector<std::uint32_t> own_floes(const FloeOwners& owners, int rank) {
   if (rank == owners.rank()) return owners.mine();
@@ -60,7 +63,10 @@ HeldFloes announce_held(const Communicator& comm, const FloeOwners& owners, cons
   FLOESIM_ASSERT(owners.owner().size() == n && options.reach.size() == n && owners.rank() == comm.rank());
   // Every rank's strip and part of H (one call); H their largest.
   const BandStrip mine = band_strip(owners, comm.rank(), floes, shapes, options);
-  const std::vector<BandStrip> strips = comm.allgather<BandStrip>(std::span<const BandStrip>(&mine, 1));
+  const std::vector<std::size_t> strip_bytes(static_cast<std::size_t>(comm.size()), sizeof(BandStrip));
+  const std::vector<std::byte> gathered = comm.allgather_known(std::as_bytes(std::span<const BandStrip>(&mine, 1)), strip_bytes);
+  std::vector<BandStrip> strips(strip_bytes.size());
+  std::memcpy(static_cast<void*>(strips.data()), gathered.data(), gathered.size());
   double largest = 0.0;
   for (const BandStrip& s : strips) largest = std::max(largest, s.largest);
   // The notices as one message a rank: the indices, then the reaches.
