@@ -261,13 +261,14 @@ void Simulation::drift(StepContext& ctx) {
     // rows, like the drift's (FloeOwners::charge_coupling).
     if (owners_.has_slabs() && floe_sea_) owners_.charge_coupling(floe_sea_->take_owned_seconds());
     // Floes migrate; every few steps the strips move (with slabs, the sea's and the coupling's too).
-    const std::vector<int> detected(owners_.owner().begin(), owners_.owner().end());  // the last detection's owners
-    const bool moved = owners_.update(comm_, scenario_.floes, steps_);
-    if (moved && owners_.has_slabs()) follow_slabs();
     // A floe that migrates across a cut was in its new owner's band (its
     // reach held there); a move of the cuts can give a rank floes its band
     // did not hold, whose reaches the advance reads (its own floes' outrun
     // check): from their owners at the detection, who computed them.
+    std::vector<int> detected;  // the last detection's owners, when the cuts may move
+    if (owners_.may_move(steps_)) detected.assign(owners_.owner().begin(), owners_.owner().end());
+    const bool moved = owners_.update(comm_, scenario_.floes, steps_);
+    if (moved && owners_.has_slabs()) follow_slabs();
     if (moved && detection_part_) comm_.hand_over(detection_part_->reach, detected, owners_.owner());
     // The moorings of the floes this rank drifts: each kick is its floe's
     // own, and the other floes' states come whole from their owners below.

@@ -129,6 +129,9 @@ public:
   // Returns whether the cuts moved (with slabs: the slabs, which the sea and
   // the coupling must then be given, on every rank alike).
   bool update(const Communicator& comm, const Floes& floes, std::size_t step);
+  // Whether update(step) closes a window, and so may move the cuts (the
+  // same on every rank).
+  bool may_move(std::size_t step) const { return started_ && step >= next_move_; }
   // Charges this rank's CPU time (s, thread_seconds()) in by-place work since the last move.
   void charge(double seconds) { charged_ += seconds; }
   // With slabs: charges this rank's CPU time in the sea's row work.
