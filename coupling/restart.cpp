@@ -195,7 +195,6 @@ void Simulation::restore(const Checkpoint& c) {
   // list and contacts as detect_and_check left them at the end of the step.
   quadrature_ = build_footprint_quadrature(scenario_.floes);
   shapes_ = contact::build_collision_shapes(scenario_.floes);
-  set_reach();
   // The owners by place start again from the restored places, as at a
   // run's start (the strips by equal counts, or the sea's slabs), and the
   // detection is made by place.

@@ -14,6 +14,7 @@
 #include "parallel/advance_share.hpp"
 #include "parallel/collide_share.hpp"
 #include "parallel/detect.hpp"
+#include "parallel/held.hpp"
 #include "parallel/sea_ranks.hpp"
 
 namespace floesim {
@@ -97,7 +98,6 @@ Simulation::Simulation(Scenario scenario, parallel::Communicator comm)
   impulse_options_.dump_failed_lcps = c.contact.dump_failed_lcps;
   advance_share_options_.on_part = c.run.advance_on_part;
   wrap_periodic();
-  set_reach();
   fluid::SeaOptions sea_options;
   sea_options.tank = {c.sea.tank.enabled, c.sea.tank.generation_length, c.sea.tank.absorption_length,
                       c.sea.tank.rate, c.sea.tank.ramp_periods};
@@ -264,7 +264,15 @@ void Simulation::drift(StepContext& ctx) {
     // rows, like the drift's (FloeOwners::charge_coupling).
     if (owners_.has_slabs() && floe_sea_) owners_.charge_coupling(floe_sea_->take_owned_seconds());
     // Floes migrate; every few steps the strips move (with slabs, the sea's and the coupling's too).
-    if (owners_.update(comm_, scenario_.floes, steps_) && owners_.has_slabs()) follow_slabs();
+    // A floe that migrates across a cut was in its new owner's band (its
+    // reach held there); a move of the cuts can give a rank floes its band
+    // did not hold, whose reaches the advance reads (its own floes' outrun
+    // check): from their owners at the detection, who computed them.
+    std::vector<int> detected;  // the last detection's owners, when the cuts may move
+    if (owners_.may_move(steps_)) detected.assign(owners_.owner().begin(), owners_.owner().end());
+    const bool moved = owners_.update(comm_, scenario_.floes, steps_);
+    if (moved && owners_.has_slabs()) follow_slabs();
+    if (moved && detection_part_) comm_.hand_over(detection_part_->reach, detected, owners_.owner());
     // The moorings of the floes this rank drifts: each kick is its floe's
     // own, and the other floes' states come whole from their owners below.
     moorings_.kick(scenario_.floes, ctx.dt, owners_.mine());
@@ -345,8 +353,7 @@ void Simulation::percussion(const StepContext& ctx) {
 void Simulation::on_floes_changed() {
   quadrature_ = build_footprint_quadrature(scenario_.floes);
   shapes_ = contact::build_collision_shapes(scenario_.floes);
-  set_reach();  // one reach per floe: detect reads reach[i] for every floe, new pieces included
-  // The pieces are placed (appended at the same indices with the same ids
+  // The reaches (new pieces included) are set and the pieces are placed (appended at the same indices with the same ids
   // on every rank: Percussion::conclude on the same initiations in floe
   // order) and the detection made by place, as after a step.
   detect_in_place();
@@ -430,20 +437,22 @@ void Simulation::set_reach(std::span<ExactSum> along) {
   // still outrun its reach makes the sub-stepper rebuild the list.
   // The rms is the same bits on any number of ranks: each rank sums the
   // squares of the floes it owns exactly, and counts them; one call
-  // combines both (and `along`).
+  // combines both (and `along`). Each rank writes the reaches of its own
+  // floes (the owners assigned at the present places); those of its band
+  // come from their owners (hold_band), and the others are not written.
   const Floes& f = scenario_.floes;
   const double dt_max = scenario_.config.run.dt_max;
-  std::vector<double> speed(f.size(), 0.0);
-  for (std::size_t i = 0; i < f.size(); ++i) {
-    if (f.is_static[i]) continue;
+  FLOESIM_ASSERT(comm_.serial() || owners_.owner().size() == f.size());
+  const auto speed = [&](std::size_t i) {
     const FloeState& s = f.state[i];
-    speed[i] = std::hypot(s.vx, s.vy) + std::abs(s.yaw_rate) * shapes_.radius[i];
-  }
+    return std::hypot(s.vx, s.vy) + std::abs(s.yaw_rate) * shapes_.radius[i];
+  };
   std::vector<ExactSum> sums(1 + along.size());
   std::array<long long, 1> dynamic{0};
   for_owned([&](std::size_t i) {
     if (f.is_static[i]) return;
-    sums[0].add(speed[i] * speed[i]);
+    const double v = speed(i);
+    sums[0].add(v * v);
     ++dynamic[0];
   });
   std::copy(along.begin(), along.end(), sums.begin() + 1);
@@ -451,9 +460,10 @@ void Simulation::set_reach(std::span<ExactSum> along) {
   std::copy(sums.begin() + 1, sums.end(), along.begin());
   const double rms = dynamic[0] ? std::sqrt(sums[0].value() / static_cast<double>(dynamic[0])) : 0.0;
   detection_options_.reach.resize(f.size());
-  for (std::size_t i = 0; i < f.size(); ++i)
+  for_owned([&](std::size_t i) {
     detection_options_.reach[i] =
-        f.is_static[i] ? 0.0 : dt_max * (1.5 * speed[i] + 0.5 * rms) + detection_options_.collision_distance;
+        f.is_static[i] ? 0.0 : dt_max * (1.5 * speed(i) + 0.5 * rms) + detection_options_.collision_distance;
+  });
 }
 
 void Simulation::read_try_budget(const StepContext& ctx) {
@@ -469,12 +479,12 @@ void Simulation::read_try_budget(const StepContext& ctx) {
 }
 
 bool Simulation::detect_and_check(StepContext& ctx) {
+  if (!comm_.serial()) owners_.assign(scenario_.floes);  // the owners at the advanced places
   set_reach(std::span(ctx.momenta).first<StepContext::kTry>());  // combines the try's momenta too (one call)
   read_try_budget(ctx);
-  if (!comm_.serial()) owners_.assign(scenario_.floes);  // the owners at the advanced places
-  // The held floes at the advanced places: the detection's subset reads
-  // only those. Kept when the step is accepted (a rejected try's places
-  // are undone).
+  // The held floes at the advanced places, their reaches from their owners:
+  // the detection's subset reads only those. Kept when the step is
+  // accepted (a rejected try's places are undone).
   parallel::HeldFloes held = hold_band();
   contact::Detection part;  // this rank's (serially: `next` itself)
   // The whole lists are gathered only for the advance from the whole
@@ -503,7 +513,10 @@ bool Simulation::detect_and_check(StepContext& ctx) {
   detection_ = std::move(next);
   held_ = std::move(held);
   detection_whole_ = comm_.serial() || whole;
-  if (!comm_.serial()) detection_part_ = std::move(part);
+  if (!comm_.serial()) {
+    detection_part_ = std::move(part);
+    detection_own_ = owners_.mine();
+  }
   return true;
 }
 
@@ -522,34 +535,36 @@ void Simulation::detect_in_place() {
   // gathered only for the advance from the whole detection, else by
   // whole_detection() when a step needs them.
   if (comm_.serial()) {
+    set_reach();
     detection_ = contact::detect(scenario_.floes, shapes_, detection_options_);
     detection_whole_ = true;
     held_ = hold_band();
     return;
   }
   owners_.assign(scenario_.floes);
+  set_reach();
   held_ = hold_band();
   contact::Detection part;
   const bool whole = !advance_share_options_.on_part;
   detection_ = parallel::detect(comm_, owners_, scenario_.floes, shapes_, detection_options_, &part, whole, &held_);
   detection_whole_ = whole;
   detection_part_ = std::move(part);
+  detection_own_ = owners_.mine();
 }
 
 parallel::HeldFloes Simulation::hold_band() {
   const std::size_t n = scenario_.floes.size();
   if (comm_.serial()) return held_.mask.size() == n ? std::move(held_) : parallel::every_floe(n);
-  // H, the largest half band over the pack: each rank's own floes', one
-  // reduction (8 bytes a rank).
-  const double largest =
-      comm_.max(parallel::largest_half_band(owners_, comm_.rank(), scenario_.floes, shapes_, detection_options_));
-  return parallel::held_floes(owners_, comm_.rank(), scenario_.floes, shapes_, detection_options_, largest);
+  // Each owner tests its own floes against the ranks' strips and announces
+  // them, with their reaches, to the ranks whose band holds them
+  // (parallel::announce_held: the band's rule, H the ranks' largest h_j).
+  return parallel::announce_held(comm_, owners_, scenario_.floes, shapes_, detection_options_);
 }
 
 const contact::Detection& Simulation::whole_detection() {
   // Collective: every rank reaches it at the same point of the same step.
   if (!detection_whole_) {
-    detection_ = parallel::gather(comm_, *detection_part_);
+    detection_ = parallel::gather(comm_, *detection_part_, detection_own_);
     detection_whole_ = true;
   }
   return detection_;

@@ -251,9 +251,10 @@ private:
   // The detection at the present places outside a step (the start, a
   // restore, after a split): by place, this rank's part (collective).
   void detect_in_place();
-  // The floes this rank holds at the present places (owners assigned,
-  // reaches set): H by one reduction (a max), then its band. Collective on
-  // several ranks; one rank holds every floe.
+  // The floes this rank holds at the present places (owners assigned, its
+  // own floes' reaches set): announced by their owners with their reaches,
+  // which it writes (parallel::announce_held). Collective on several ranks;
+  // one rank holds every floe.
   parallel::HeldFloes hold_band();
   void wrap_periodic();
   // The poison mode's hook after the phase `phase` (poison_mode.cpp): opens,
@@ -262,9 +263,10 @@ private:
     if (poison_) poison_step(phase, ctx);
   }
   void poison_step(const char* phase, StepContext& ctx);
-  // Detection reach of each floe for the next step. Collective: the pack's
-  // rms speed is summed by owner; `along` (exact sums of this rank's part)
-  // are combined over the ranks in the same call.
+  // Detection reach of this rank's own floes for the next step (owners
+  // assigned at the present places; one rank: every floe). Collective: the
+  // pack's rms speed is summed by owner; `along` (exact sums of this rank's
+  // part) are combined over the ranks in the same call.
   void set_reach(std::span<ExactSum> along = {});
   void read_try_budget(const StepContext& ctx);  // the try's momenta, combined, into step_budget_
   // The state check (the ranks agree on the first non-finite value) and the
@@ -298,6 +300,10 @@ private:
   // On several ranks, this rank's part of detection_ (the pairs it
   // detected, parallel::detect; at the start and after a split too).
   std::optional<contact::Detection> detection_part_;
+  // The floes this rank owned at that detection: their reaches are the
+  // ones it sends when the whole detection is gathered (its others are its
+  // band's or not written).
+  std::vector<std::uint32_t> detection_own_;
   // Whether detection_ holds the whole detection. On several ranks with the
   // advance from the parts, detect_and_check gathers it only when a step
   // needs it (whole_detection(): a fallback, a step the back-off does whole,

@@ -177,10 +177,43 @@ contact::Detection unpack_detection(std::span<const std::byte> bytes) {
   return part;
 }
 
-contact::Detection gather(const Communicator& comm, const contact::Detection& part) {
+contact::Detection gather(const Communicator& comm, const contact::Detection& part,
+                          std::span<const std::uint32_t> own) {
   if (comm.serial()) return part;
-  std::vector<contact::Detection> parts = comm.allgather_parts(pack(part), unpack_detection);
-  parts.front().reach = part.reach;  // the same on every rank
+  // One message a rank: its part, then its own floes and their reaches.
+  std::vector<std::byte> message = pack(part);
+  const std::uint64_t count = own.size();
+  append(message, std::span<const std::uint64_t>(&count, 1));
+  append(message, own);
+  std::vector<double> reach(own.size());
+  for (std::size_t k = 0; k < own.size(); ++k) reach[k] = part.reach[own[k]];
+  append(message, std::span<const double>(reach));
+  struct Received {
+    contact::Detection part;
+    std::vector<std::uint32_t> own;
+    std::vector<double> reach;
+  };
+  std::vector<Received> got = comm.allgather_parts(message, [](std::span<const std::byte> bytes) {
+    Received r;
+    const std::byte* at = bytes.data();
+    const std::vector<std::uint64_t> n = take<std::uint64_t>(at, 3);
+    r.part.pairs = take<contact::NearPair>(at, n[0]);
+    r.part.contacts = take<contact::ContactPoint>(at, n[1]);
+    r.part.witnesses = take<contact::Witness>(at, n[2]);
+    const auto k = static_cast<std::size_t>(take<std::uint64_t>(at, 1)[0]);
+    r.own = take<std::uint32_t>(at, k);
+    r.reach = take<double>(at, k);
+    FLOESIM_ASSERT(at == bytes.data() + bytes.size());
+    return r;
+  });
+  std::vector<contact::Detection> parts;
+  parts.reserve(got.size());
+  for (Received& r : got) parts.push_back(std::move(r.part));
+  // Every floe's reach from its owner at the detection (the ranks' own
+  // floes partition the pack); a rank holds only its band's others.
+  parts.front().reach = part.reach;
+  for (const Received& r : got)
+    for (std::size_t k = 0; k < r.own.size(); ++k) parts.front().reach[r.own[k]] = r.reach[k];
   return merge(std::move(parts));
 }
 
@@ -232,7 +265,7 @@ contact::Detection detect(const Communicator& comm, FloeOwners& owners, const Fl
   const double start = thread_seconds();
   contact::Detection mine = detect_part(owners, comm.rank(), floes, shapes, std::move(options), held);
   owners.charge(thread_seconds() - start);
-  contact::Detection whole = whole_too || !part ? gather(comm, mine) : contact::Detection{};
+  contact::Detection whole = whole_too || !part ? gather(comm, mine, owners.mine()) : contact::Detection{};
   if (part) *part = std::move(mine);
   return whole;
 }

@@ -35,8 +35,14 @@ contact::Detection detect(const Communicator& comm, FloeOwners& owners, const Fl
 
 // The whole detection from every rank's part (each rank's detect_part, in
 // pair order): the parts gathered to every rank (one allgather_bytes) and
-// merged. Collective.
-contact::Detection gather(const Communicator& comm, const contact::Detection& part);
+// merged. Collective. The whole reach: each rank's part.reach holds the
+// reaches of the floes it held at the detection (its own and its band's,
+// Simulation::set_reach and parallel::announce_held), and sends those of
+// `own`, the floes it owned then (12 bytes a floe), which partition the
+// pack; a caller that reads no reach passes none (the reach is then this
+// rank's, whole only where it holds every floe's).
+contact::Detection gather(const Communicator& comm, const contact::Detection& part,
+                          std::span<const std::uint32_t> own = {});
 
 // The overlap check by parts (Simulation::detect_and_check): the first
 // overlapping pair of a detection in pair order, and the distance at t of the

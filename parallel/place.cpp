@@ -252,34 +252,54 @@ double largest_half_band(const FloeOwners& owners, int rank, const Floes& floes,
   return largest;
 }
 
-HeldFloes held_floes(const FloeOwners& owners, int rank, const Floes& floes, const contact::CollisionShapes& shapes,
-                     const contact::DetectionOptions& options, double largest) {
-  const std::size_t n = floes.size();
+BandStrip band_strip(const FloeOwners& owners, int rank, const Floes& floes, const contact::CollisionShapes& shapes,
+                     const contact::DetectionOptions& options) {
   const std::span<const int> owner = owners.owner();
-  FLOESIM_ASSERT(owner.size() == n && rank >= 0 && rank < owners.ranks());
+  FLOESIM_ASSERT(owner.size() == floes.size() && rank >= 0 && rank < owners.ranks());
   constexpr double kInf = std::numeric_limits<double>::infinity();
   // The strip S_r; in a periodic box the end strips end at the box's edges
   // (every place lies in the box).
   const std::vector<double>& cuts = owners.cuts();
-  double lo = rank == 0 ? -kInf : cuts[static_cast<std::size_t>(rank) - 1];
-  double hi = rank == owners.ranks() - 1 ? kInf : cuts[static_cast<std::size_t>(rank)];
+  BandStrip out;
+  out.lo = rank == 0 ? -kInf : cuts[static_cast<std::size_t>(rank) - 1];
+  out.hi = rank == owners.ranks() - 1 ? kInf : cuts[static_cast<std::size_t>(rank)];
   const contact::Domain& box = options.domain;
   if (box.periodic) {
-    lo = std::max(lo, box.ymin);
-    hi = std::min(hi, box.ymax);
+    out.lo = std::max(out.lo, box.ymin);
+    out.hi = std::min(out.hi, box.ymax);
   }
   // The strip widened to the rank's own floes' places: they lie in it but
   // for round-off (the slabs own by grid row), or but for the grid's wrap
   // (with the sea's slabs, a floe beyond the grid in an open box is owned
   // by the row it wraps to). The band's argument needs y_a in S_r for each
   // own floe a.
-  for (std::size_t j = 0; j < n; ++j)
-    if (owner[j] == rank) {
-      const double y = owners.place(floes.state[j]);
-      lo = std::min(lo, y);
-      hi = std::max(hi, y);
-    }
-  const auto distance = [&](double y) { return std::max({0.0, lo - y, y - hi}); };
+  const auto widen = [&](std::size_t j) {
+    const double y = owners.place(floes.state[j]);
+    out.lo = std::min(out.lo, y);
+    out.hi = std::max(out.hi, y);
+    out.largest = std::max(out.largest, half_band_at(y, shapes, options, j));
+  };
+  if (rank == owners.rank()) {
+    for (const std::uint32_t j : owners.mine()) widen(j);
+  } else {  // a simulated rank (tests): its floes from the owners
+    for (std::size_t j = 0; j < floes.size(); ++j)
+      if (owner[j] == rank) widen(j);
+  }
+  return out;
+}
+
+double strip_distance(double y, const BandStrip& strip, const contact::Domain& box) {
+  const auto distance = [&](double at) { return std::max({0.0, strip.lo - at, at - strip.hi}); };
+  double gap = distance(y);
+  if (box.periodic) gap = std::min({gap, distance(y - box.height()), distance(y + box.height())});
+  return gap;
+}
+
+HeldFloes held_floes(const FloeOwners& owners, int rank, const Floes& floes, const contact::CollisionShapes& shapes,
+                     const contact::DetectionOptions& options, double largest) {
+  const std::size_t n = floes.size();
+  const std::span<const int> owner = owners.owner();
+  const BandStrip strip = band_strip(owners, rank, floes, shapes, options);
   HeldFloes out;
   out.largest = largest;
   out.mask.assign(n, 0);
@@ -287,9 +307,7 @@ HeldFloes held_floes(const FloeOwners& owners, int rank, const Floes& floes, con
     bool held = owner[j] == rank;
     if (!held) {
       const double y = owners.place(floes.state[j]);
-      double gap = distance(y);
-      if (box.periodic) gap = std::min({gap, distance(y - box.height()), distance(y + box.height())});
-      held = gap <= largest + half_band_at(y, shapes, options, j);
+      held = strip_distance(y, strip, options.domain) <= largest + half_band_at(y, shapes, options, j);
     }
     if (!held) continue;
     out.mask[j] = 1;

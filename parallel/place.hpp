@@ -129,6 +129,9 @@ public:
   // Returns whether the cuts moved (with slabs: the slabs, which the sea and
   // the coupling must then be given, on every rank alike).
   bool update(const Communicator& comm, const Floes& floes, std::size_t step);
+  // Whether update(step) closes a window, and so may move the cuts (the
+  // same on every rank).
+  bool may_move(std::size_t step) const { return started_ && step >= next_move_; }
   // Charges this rank's CPU time (s, thread_seconds()) in by-place work since the last move.
   void charge(double seconds) { charged_ += seconds; }
   // With slabs: charges this rank's CPU time in the sea's row work.
@@ -237,6 +240,21 @@ double half_band(const FloeOwners& owners, const Floes& floes, const contact::Co
 // so that is max_j h_j over the pack.
 double largest_half_band(const FloeOwners& owners, int rank, const Floes& floes,
                          const contact::CollisionShapes& shapes, const contact::DetectionOptions& options);
+
+// Rank r's strip as its band's rule reads it: S_r = [lo, hi] widened to
+// the places of the floes r owns (above), and r's part of H, the largest
+// h_j of its own floes (0 if it owns none; largest_half_band's bits). A
+// pass over r's own floes (owners assigned for these floes).
+struct BandStrip {
+  double lo = 0.0, hi = 0.0;  // m
+  double largest = 0.0;       // m
+};
+BandStrip band_strip(const FloeOwners& owners, int rank, const Floes& floes, const contact::CollisionShapes& shapes,
+                     const contact::DetectionOptions& options);
+// dist(y, strip) along y, on the circle in a periodic box (the nearest of
+// y's images y - L, y, y + L: every place lies in the box, so no other
+// image is nearer); 0 inside.
+double strip_distance(double y, const BandStrip& strip, const contact::Domain& box);
 
 // The floes a rank holds: its own and its band.
 struct HeldFloes {

@@ -12,7 +12,9 @@
 // are kicked by the floes' drift owners, after the owners' update), and
 // the rank's held floes (Simulation::held_floes, the band at the last
 // detection) must hold its own floes and both floes of every pair whose
-// floe a it owns. On 2 and 3 ranks every rank must own a moored floe at
+// floe a it owns; at the end the whole detection gathered (each rank
+// sending its own floes' reaches: it writes only its held floes') must
+// carry the serial run's reaches. On 2 and 3 ranks every rank must own a moored floe at
 // some step and the serial run must have collisions (else the test is
 // weak).
 #include <bit>
@@ -92,6 +94,13 @@ void check_moored(const parallel::Communicator& comm, std::vector<std::string>& 
       failures.push_back("held_floes() misses a floe of a pair the rank detected");
       break;
     }
+  // Each rank writes the reaches of the floes it holds only (band18); the
+  // whole detection gathered carries every floe's from its owner: the
+  // serial run's, bit for bit.
+  const contact::Detection& whole_serial = serial.detection();
+  if (d.reach.size() != n || whole_serial.reach.size() != n ||
+      std::memcmp(d.reach.data(), whole_serial.reach.data(), n * sizeof(double)) != 0)
+    failures.push_back("the gathered detection's reaches differ from the serial run's");
   if (!owned_moored) failures.push_back("the rank never owned a moored floe: a weak test");
   if (serial.collision_stats().lcps == 0) failures.push_back("no collision: a weak test");
   if (comm.rank() == 0)
