@@ -193,6 +193,11 @@ Eigen::Matrix2d FloeSeaContact::tilt_inertia(const Floes& floes, std::size_t i) 
   return R * body_moments_[i] * R.transpose() + floes.mass[i] * h * h / 12.0 * Eigen::Matrix2d::Identity();
 }
 
+void FloeSeaContact::pose_at_states(const Floes& floes, std::span<const std::uint32_t> which) {
+  poses_.resize(floes.size());
+  for (const std::uint32_t i : which) poses_[i] = {floes.state[i].x, floes.state[i].y, floes.state[i].yaw};
+}
+
 void FloeSeaContact::pose_at_states(const Floes& floes) {
   poses_.resize(floes.size());
   for (std::size_t i = 0; i < floes.size(); ++i) poses_[i] = {floes.state[i].x, floes.state[i].y, floes.state[i].yaw};
@@ -214,9 +219,9 @@ void FloeSeaContact::clear_footprint_cells() {
   }
 }
 
-void FloeSeaContact::place_footprints(const Floes& floes) {
+void FloeSeaContact::place_footprints(const Floes& floes, bool move) {
   clear_footprint_cells();
-  footprints_.place(floes, dynamic_, poses_, threads_);
+  footprints_.place(floes, dynamic_, poses_, threads_, move);
   // By owner, this rank's floes only, in the serial order (the others'
   // pieces are not here).
   if (by_owner()) {
@@ -241,8 +246,14 @@ void FloeSeaContact::evaluate(const Floes& floes, fluid::Sea& sea, double h) {
   pressure_kicked_ = false;
   energy_pending_ = false;
   loads_h_ = h;
-  pose_at_states(floes);
-  place_footprints(floes);
+  // The poses a placement reads: a move and the window's test that allows
+  // it, this rank's floes' (MovingFootprints::mine, whose pieces it moves;
+  // the verdict agreed over the ranks); a rebuild, every floe's (the owners
+  // by place are set from them, and the reference poses kept).
+  pose_at_states(floes, footprints_.mine());
+  const bool move = footprints_.movable(dynamic_, poses_);
+  if (!move) pose_at_states(floes);
+  place_footprints(floes, move);
   const Footprints& fp = footprints_.pieces();
   const std::span<const double> area0 = footprints_.reference_area();
   // Routed with the floes owned by place, this rank's pieces lie within

@@ -330,9 +330,10 @@ private:
   double subcell_weight(double coverage) const;
   Eigen::Matrix2d tilt_inertia(const Floes& floes, std::size_t i) const;
   // Clears the cells of the present footprints, places them with floe i at
-  // poses_[i] (moved or rebuilt: coupling/moving_footprint.hpp) and sums the
-  // cells' coverage (cells_[c].coverage).
-  void place_footprints(const Floes& floes);
+  // poses_[i] (moved if `move`, MovingFootprints::movable's verdict, else
+  // rebuilt: coupling/moving_footprint.hpp) and sums the cells' coverage
+  // (cells_[c].coverage).
+  void place_footprints(const Floes& floes, bool move);
   // Zeroes pressure_ and cells_ where the present footprints lie.
   void clear_footprint_cells();
   // The contact is evaluated by owner: several ranks, explicit kicks.
@@ -370,8 +371,10 @@ private:
   // By owner, routed: the penalty energy from every rank's terms
   // (owner_.energy_*), summed in the serial order (one gather).
   void settle_energy() const;
-  // poses_ <- the floes' present poses.
+  // poses_ <- the floes' present poses: every floe's, or those of `which`
+  // (the others' entries are left as they were, and not read).
   void pose_at_states(const Floes& floes);
+  void pose_at_states(const Floes& floes, std::span<const std::uint32_t> which);
   // The contact at the present state for a kick of length h (see evaluate_loads).
   void evaluate(const Floes& floes, fluid::Sea& sea, double h);
   // loads_[i].horizontal = -dV/dG, -dV/dyaw (the header's formulas) for the

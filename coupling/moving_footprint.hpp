@@ -30,7 +30,13 @@
 // more than `reach` cells along x or y,
 //     |delta_x| + R |phi| > reach dx  or  |delta_y| + R |phi| > reach dy,
 // R the floe's largest vertex distance from its centroid. reach = 0 rebuilds
-// at every placement (the exact pieces).
+// at every placement (the exact pieces). On several ranks each rank tests
+// its own floes (mine()) and one reduction agrees on the verdict: "every
+// floe inside" is the conjunction over a partition of the floes, so the
+// ranks' verdicts combined by a minimum are the serial verdict, on every
+// rank alike (every rank must rebuild or move together: the rebuild sets the
+// owners and the gathers are collective). A move reads the own floes' poses
+// only; a rebuild reads the poses set_owners reads (every floe's).
 //
 // On several ranks (a parallel::Communicator, docs/parallel.md) each rank
 // builds or moves the pieces of the floes it owns (mine()) and receives
@@ -59,6 +65,16 @@
 
 namespace floesim {
 
+// Floe i's displacement (delta, phi) from `reference` to `at`, the grid's
+// seam crossed the short way (periodic).
+FloePose window_displacement(const fluid::SurfaceGrid& grid, const FloePose& reference, const FloePose& at);
+// Whether every floe of `floes` with include[i] lies within its window
+// (above: reach in cells, radius[i] = R) about reference[i] at poses[i].
+// Reads the entries of `floes` only.
+bool inside_windows(std::span<const std::uint32_t> floes, std::span<const std::uint8_t> include,
+                    std::span<const FloePose> reference, std::span<const FloePose> poses, std::span<const double> radius,
+                    const fluid::SurfaceGrid& grid, double reach);
+
 struct FootprintMotionOptions {
   // Cells a floe's vertices may move before its pieces are rebuilt ([coupling]
   // footprint_reach). 0: rebuilt at every placement.
@@ -76,6 +92,15 @@ public:
   // new reference. Returns true when rebuilt.
   bool place(const Floes& floes, std::span<const std::uint8_t> include, std::span<const FloePose> poses,
              int threads);
+  // The same in two steps, for a caller that poses the floes it needs only:
+  // whether the pieces can move to `poses` (the window's test above over
+  // this rank's floes, poses[i] read for i in mine() only; on several ranks
+  // collective, one reduction of 8 bytes when the window may hold), then
+  // the placement with that verdict (moved: poses of mine() read; rebuilt:
+  // every floe's, which set_owners reads).
+  bool movable(std::span<const std::uint8_t> include, std::span<const FloePose> poses) const;
+  bool place(const Floes& floes, std::span<const std::uint8_t> include, std::span<const FloePose> poses, int threads,
+             bool move);
   // Builds at `reference` and makes it the reference (a restart).
   void rebuild_at(const Floes& floes, std::span<const std::uint8_t> include, std::span<const FloePose> reference,
                   int threads);
@@ -125,8 +150,11 @@ public:
   // floe's pieces may lie from those slabs' slab of its owner.
   int reach_rows_from(std::span<const int> first_row) const;
 
-  // The next placement rebuilds (the floes changed).
-  void forget() { reference_.clear(); }
+  // The next placement rebuilds (the floes changed; so may their radii).
+  void forget() {
+    reference_.clear();
+    radius_.clear();
+  }
 
   // The calling thread's CPU time (s, parallel::thread_seconds) spent
   // building and moving this rank's floes' pieces since the last take, the
@@ -144,10 +172,7 @@ public:
   long rebuilds() const { return rebuilds_; }
 
 private:
-  bool inside_windows(const Floes& floes, std::span<const FloePose> poses) const;
   void move(std::span<const FloePose> poses, int threads);
-  // (delta, phi) of floe i from its reference, the grid's seam crossed the short way.
-  FloePose displacement(std::size_t i, const FloePose& at) const;
   // owner_ and mine_ for floes at `poses` (the rebuild's).
   void set_owners(std::span<const FloePose> poses);
   // After this rank built its floes' pieces alone: every floe's area pieces
@@ -162,7 +187,7 @@ private:
   Footprints pieces_;
   std::vector<FloePose> reference_;
   std::vector<std::uint8_t> include_;
-  std::vector<double> radius_;  // per floe, R
+  std::vector<double> radius_;  // per floe, R (a constant of its outline: made again when the floes change)
   std::vector<double> area0_;   // per area piece, a_c(P0)
   std::vector<Vec2> moment0_;   // per area piece, m_c(P0)
   long placements_ = 0, rebuilds_ = 0;

@@ -6,12 +6,14 @@
 #include <doctest/doctest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <numeric>
 #include <vector>
 
 #include "coupling/floe_sea.hpp"
 #include "coupling/footprint.hpp"
+#include "coupling/moving_footprint.hpp"
 #include "coupling/shared_cells.hpp"
 #include "parallel/cell_routes.hpp"
 #include "tests/parallel/halo_case.hpp"
@@ -178,4 +180,79 @@ TEST_CASE("the shared cells' marks on a rank read only the boxes of other ranks'
       CHECK(read_near < read_full);
       CHECK(thin_misses > 0);
     }
+}
+
+TEST_CASE("the footprints' window test over each rank's own floes, agreed by one minimum, is the whole verdict (simulated ranks, lured poses)") {
+  // MovingFootprints::movable: each rank tests the floes it owns for the
+  // coupling (mine(), by the row of the centroid at the reference poses)
+  // and the ranks' verdicts are combined by a minimum (Communicator::min).
+  // On 2, 3 and 7 slabs, equal and uneven, periodic and walled grids, a
+  // window of 0.3 cells: with every floe inside its window, and with one
+  // floe (each of a few) pushed out of it. Each rank reads its own floes'
+  // poses only: every other pose is a lure (moved 10 cells, out of any
+  // window), which a read would turn into "outside". The mutation, named:
+  // each rank's own verdict with no reduction differs from the whole
+  // verdict on some rank whenever one floe is out.
+  SeaPack s = sea_pack(11);
+  const std::size_t n = s.floes.size();
+  const double reach = 0.3;
+  std::vector<std::uint32_t> all(n);
+  std::iota(all.begin(), all.end(), 0u);
+  std::vector<std::uint8_t> include(n, 1);
+  include[5] = 0;  // a static floe is never tested
+  // Poses within the window: a small displacement and turn, each floe its own.
+  std::vector<FloePose> inside = s.poses;
+  for (std::size_t i = 0; i < n; ++i) {
+    const double f = static_cast<double>((i * 37) % 11) / 11.0 - 0.5;  // in [-0.5, 0.5)
+    inside[i].x += 0.2 * reach * s.grid.dx() * f;
+    inside[i].y -= 0.2 * reach * s.grid.dy() * f;
+    inside[i].yaw += 0.1 * reach * s.grid.dy() * f / std::max(s.radius[i], 1.0);
+  }
+  std::size_t cases = 0, lone_verdicts_wrong = 0, lured_whole_wrong = 0;
+  for (const fluid::GridEdge edge : {fluid::GridEdge::periodic, fluid::GridEdge::wall}) {
+    fluid::SurfaceGrid grid = s.grid;
+    grid.edge = edge;
+    // The floe pushed out: none, or one of a few (each along y, or by a turn;
+    // floe 5 is not included, so pushing it changes nothing).
+    for (const int out : {-1, 0, 5, 123, 399}) {
+      std::vector<FloePose> poses = inside;
+      if (out >= 0) {
+        const std::size_t j = static_cast<std::size_t>(out);
+        if (out % 2) poses[j].y += 2.0 * reach * grid.dy();
+        else poses[j].yaw += 2.0 * reach * grid.dx() / s.radius[j];
+      }
+      const bool whole = inside_windows(all, include, s.poses, poses, s.radius, grid, reach);
+      CHECK(whole == (out < 0 || out == 5));
+      for (const int ranks : {2, 3, 7})
+        for (const bool uneven : {false, true}) {
+          CAPTURE(ranks);
+          CAPTURE(uneven);
+          CAPTURE(out);
+          const std::vector<int> row_owner = parallel::row_owners(slabs(ranks, grid.ny, uneven));
+          int agreed = 1;
+          for (int r = 0; r < ranks; ++r) {
+            std::vector<std::uint32_t> mine;
+            std::vector<FloePose> lured = poses;
+            for (std::size_t i = 0; i < n; ++i) {
+              if (row_owner[static_cast<std::size_t>(parallel::grid_row(s.poses[i].y, grid.dy(), grid.ny))] == r) {
+                mine.push_back(static_cast<std::uint32_t>(i));
+              } else {
+                lured[i].x += 10.0 * grid.dx();
+                lured[i].y += 10.0 * grid.dy();
+              }
+            }
+            const bool own = inside_windows(mine, include, s.poses, lured, s.radius, grid, reach);
+            agreed = std::min(agreed, own ? 1 : 0);
+            if (own != whole) ++lone_verdicts_wrong;
+            if (inside_windows(all, include, s.poses, lured, s.radius, grid, reach) != whole) ++lured_whole_wrong;
+          }
+          CHECK((agreed == 1) == whole);
+          ++cases;
+        }
+    }
+  }
+  MESSAGE("window verdicts: " << cases << " cases; a rank's own verdict alone wrong " << lone_verdicts_wrong
+                              << " times, the test over every floe on the lured copy wrong " << lured_whole_wrong << " times");
+  CHECK(lone_verdicts_wrong > 0);
+  CHECK(lured_whole_wrong > 0);
 }
