@@ -188,6 +188,20 @@ public:
   // After it water_velocity() holds the floes this rank drifts. The drift is
   // its only reader (docs/parallel.md, "The coupling by owner").
   void hand_water_over(std::span<const int> drift_owner);
+  // On several ranks, for the next evaluation only: the drift's owners by
+  // place (parallel::FloeOwners with the sea's slabs first_row), assigned
+  // at the floes' present places, every floe's owner and this rank's floes
+  // (`mine`). A rebuild of the footprints on those slabs takes them as the
+  // coupling's owners (MovingFootprints::takes_owners: the same rule, the
+  // row of the centroid, so the same owners) and poses this rank's floes
+  // only, instead of posing every floe to find its owner. The spans must
+  // stay valid until the evaluation.
+  void take_place_owners(std::span<const int> owner, std::span<const std::uint32_t> mine,
+                         std::span<const int> first_row) {
+    place_owner_ = owner;
+    place_mine_ = mine;
+    place_rows_ = first_row;
+  }
 
   // Implicit integrator: advances the floes' vertical DOFs and the sea over h
   // (the floes' horizontal positions already at t + h, `start` the floes at
@@ -333,7 +347,8 @@ private:
   // poses_[i] (moved if `move`, MovingFootprints::movable's verdict, else
   // rebuilt: coupling/moving_footprint.hpp) and sums the cells' coverage
   // (cells_[c].coverage).
-  void place_footprints(const Floes& floes, bool move);
+  // With `owners` given by place (take_place_owners), a rebuild takes them.
+  void place_footprints(const Floes& floes, bool move, std::span<const int> owners = {});
   // Zeroes pressure_ and cells_ where the present footprints lie.
   void clear_footprint_cells();
   // The contact is evaluated by owner: several ranks, explicit kicks.
@@ -415,7 +430,10 @@ private:
   double free_level_ = 0.0;                 // the calm sea's free level (m; eta has zero mean)
   std::vector<Eigen::Matrix2d> body_moments_;  // rho h ∫ r r^T in the body frame
   MovingFootprints footprints_;
-  std::vector<FloePose> poses_;  // where the next placement puts each floe
+  std::vector<FloePose> poses_;  // where the next placement puts each floe (the floes it reads)
+  // take_place_owners' owners, for the next evaluation (empty: none given).
+  std::span<const int> place_owner_, place_rows_;
+  std::span<const std::uint32_t> place_mine_;
   std::vector<FloeSeaLoad> loads_;
   std::vector<double> pressure_;
   struct CellSums {

@@ -57,14 +57,27 @@ bool MovingFootprints::place(const Floes& floes, std::span<const std::uint8_t> i
 }
 
 bool MovingFootprints::place(const Floes& floes, std::span<const std::uint8_t> include,
-                             std::span<const FloePose> poses, int threads, bool move_pieces) {
+                             std::span<const FloePose> poses, int threads, bool move_pieces,
+                             std::span<const int> owners) {
   ++placements_;
   if (move_pieces) {
     move(poses, threads);
     return false;
   }
-  rebuild_at(floes, include, poses, threads);
+  rebuild_at(floes, include, poses, threads, owners);
   return true;
+}
+
+bool MovingFootprints::takes_owners(std::span<const int> first_row) const {
+  if (comm_.serial() || row_owner_.empty()) return false;
+  const std::vector<int>& rows = next_owner_rows_.empty() ? owner_rows_ : next_owner_rows_;
+  return std::equal(rows.begin(), rows.end(), first_row.begin(), first_row.end());
+}
+
+std::vector<FloePose> MovingFootprints::whole_reference() const {
+  std::vector<FloePose> all = reference_;
+  if (!reference_whole_ && !comm_.serial()) comm_.complete_owned(all, owner_);
+  return all;
 }
 
 void MovingFootprints::set_slabs(std::vector<int> first_row) {
@@ -85,7 +98,7 @@ int MovingFootprints::reach_rows_from(std::span<const int> first_row) const {
   return piece_rows_ + moved;
 }
 
-void MovingFootprints::set_owners(std::span<const FloePose> poses) {
+void MovingFootprints::set_owners(std::span<const FloePose> poses, std::span<const int> owners) {
   const std::size_t n = poses.size();
   owner_.assign(n, 0);
   by_place_ = !comm_.serial() && !row_owner_.empty();
@@ -95,7 +108,14 @@ void MovingFootprints::set_owners(std::span<const FloePose> poses) {
     owner_rows_ = std::move(next_owner_rows_);
     next_owner_rows_.clear();
   }
-  if (by_place_) {
+  reference_whole_ = true;
+  if (by_place_ && !owners.empty()) {
+    // Given by place on these slabs (takes_owners): the rule below, applied
+    // by their maker at the same poses.
+    FLOESIM_ASSERT(owners.size() == n);
+    std::copy(owners.begin(), owners.end(), owner_.begin());
+    reference_whole_ = false;
+  } else if (by_place_) {
     // The row of the centroid, the grid's seam crossed (periodic).
     const double dy = grid_.dy();
     for (std::size_t i = 0; i < n; ++i) owner_[i] = row_owner_[static_cast<std::size_t>(parallel::grid_row(poses[i].y, dy, grid_.ny))];
@@ -111,9 +131,9 @@ void MovingFootprints::set_owners(std::span<const FloePose> poses) {
 }
 
 void MovingFootprints::rebuild_at(const Floes& floes, std::span<const std::uint8_t> include,
-                                  std::span<const FloePose> reference, int threads) {
+                                  std::span<const FloePose> reference, int threads, std::span<const int> owners) {
   ++rebuilds_;
-  set_owners(reference);
+  set_owners(reference, owners);
   if (comm_.serial()) {
     build_footprints(floes, include, grid_, pieces_, kernel_, threads, reference);
   } else {

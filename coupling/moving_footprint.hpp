@@ -99,11 +99,26 @@ public:
   // the placement with that verdict (moved: poses of mine() read; rebuilt:
   // every floe's, which set_owners reads).
   bool movable(std::span<const std::uint8_t> include, std::span<const FloePose> poses) const;
+  // With `owners` (by place: takes_owners), a rebuild takes its owners from
+  // them instead of from the poses, and reads the poses of its own floes
+  // (owners[i] == rank) only.
   bool place(const Floes& floes, std::span<const std::uint8_t> include, std::span<const FloePose> poses, int threads,
-             bool move);
+             bool move, std::span<const int> owners = {});
+  // Whether the next rebuild may take its owners given: the owners by place
+  // (set_slabs) on the slabs first_row, which are those its owners follow
+  // (the grid's rows, the row of the centroid: parallel::grid_row, the rule
+  // parallel::FloeOwners applies with the same slabs, so that owners
+  // assigned by it at the poses of the rebuild are the ones set_owners
+  // would set, to the bit). The same on every rank.
+  bool takes_owners(std::span<const int> first_row) const;
+  // Every floe's reference pose (a checkpoint's): as kept here when the
+  // last rebuild posed every floe; when it took its owners given (and posed
+  // this rank's floes only), each floe's from its owner (collective then:
+  // one gather, 24 bytes a floe; every rank calls it alike).
+  std::vector<FloePose> whole_reference() const;
   // Builds at `reference` and makes it the reference (a restart).
   void rebuild_at(const Floes& floes, std::span<const std::uint8_t> include, std::span<const FloePose> reference,
-                  int threads);
+                  int threads, std::span<const int> owners = {});
   // Share the work among these ranks (by default the serial run: one rank).
   void set_communicator(const parallel::Communicator& comm) { comm_ = comm; }
   // Whether the next builds and moves send every floe's area pieces to every
@@ -166,15 +181,18 @@ public:
   const Footprints& pieces() const { return pieces_; }
   // Each area piece's a_c at the reference pose (m^2).
   std::span<const double> reference_area() const { return area0_; }
-  // The reference poses (empty before the first placement).
+  // The reference poses (empty before the first placement): this rank's
+  // floes' (mine()); every floe's only when the last rebuild posed every
+  // floe (whole_reference()).
   std::span<const FloePose> reference() const { return reference_; }
   long placements() const { return placements_; }
   long rebuilds() const { return rebuilds_; }
 
 private:
   void move(std::span<const FloePose> poses, int threads);
-  // owner_ and mine_ for floes at `poses` (the rebuild's).
-  void set_owners(std::span<const FloePose> poses);
+  // owner_ and mine_ for floes at `poses` (the rebuild's), or `owners`
+  // given by place (takes_owners).
+  void set_owners(std::span<const FloePose> poses, std::span<const int> owners);
   // After this rank built its floes' pieces alone: every floe's area pieces
   // from their owners, in floe order; the edge pieces are this rank's.
   void gather_built();
@@ -198,6 +216,7 @@ private:
   std::vector<int> owner_;      // per floe
   std::vector<std::uint32_t> mine_;
   bool by_place_ = false;
+  bool reference_whole_ = true;  // the last rebuild posed every floe (else mine_ only)
   int piece_rows_ = 0;  // the rows a floe's pieces may lie from its centroid's row (last rebuild)
   // The slabs that gave the owners at the last rebuild, the sea's now
   // (set_sea_slabs), and those the next rebuild's owners follow (empty:
