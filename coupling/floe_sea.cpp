@@ -153,7 +153,9 @@ void FloeSeaContact::floes_changed(const Floes& floes) {
 
 FloeSeaState FloeSeaContact::saved_state() const {
   FloeSeaState s{true, bottom0_, loads_h_, penalty_energy(), {}, {}};
-  for (const FloePose& p : footprints_.reference()) s.footprint_reference.push_back({p.x, p.y, p.yaw});
+  // Every floe's reference pose (from the floes' owners when the last
+  // rebuild posed each rank's own floes only: collective, as save() is).
+  for (const FloePose& p : footprints_.whole_reference()) s.footprint_reference.push_back({p.x, p.y, p.yaw});
   // The implicit step's mean horizontal loads cannot be evaluated again from the state.
   if (step_mean_loads_ && loads_h_ >= 0.0)
     for (const FloeSeaLoad& load : loads_) s.mean_horizontal.push_back({load.horizontal[0], load.horizontal[1], load.horizontal[2]});
@@ -193,6 +195,11 @@ Eigen::Matrix2d FloeSeaContact::tilt_inertia(const Floes& floes, std::size_t i) 
   return R * body_moments_[i] * R.transpose() + floes.mass[i] * h * h / 12.0 * Eigen::Matrix2d::Identity();
 }
 
+void FloeSeaContact::pose_at_states(const Floes& floes, std::span<const std::uint32_t> which) {
+  poses_.resize(floes.size());
+  for (const std::uint32_t i : which) poses_[i] = {floes.state[i].x, floes.state[i].y, floes.state[i].yaw};
+}
+
 void FloeSeaContact::pose_at_states(const Floes& floes) {
   poses_.resize(floes.size());
   for (std::size_t i = 0; i < floes.size(); ++i) poses_[i] = {floes.state[i].x, floes.state[i].y, floes.state[i].yaw};
@@ -214,9 +221,9 @@ void FloeSeaContact::clear_footprint_cells() {
   }
 }
 
-void FloeSeaContact::place_footprints(const Floes& floes) {
+void FloeSeaContact::place_footprints(const Floes& floes, bool move, std::span<const int> owners) {
   clear_footprint_cells();
-  footprints_.place(floes, dynamic_, poses_, threads_);
+  footprints_.place(floes, dynamic_, poses_, threads_, move, owners);
   // By owner, this rank's floes only, in the serial order (the others'
   // pieces are not here).
   if (by_owner()) {
@@ -241,8 +248,22 @@ void FloeSeaContact::evaluate(const Floes& floes, fluid::Sea& sea, double h) {
   pressure_kicked_ = false;
   energy_pending_ = false;
   loads_h_ = h;
-  pose_at_states(floes);
-  place_footprints(floes);
+  // The poses a placement reads: a move and the window's test that allows
+  // it, this rank's floes' (MovingFootprints::mine, whose pieces it moves;
+  // the verdict agreed over the ranks); a rebuild with the drift's owners
+  // by place (take_place_owners), this rank's floes' by them (the pieces it
+  // builds); any other rebuild, every floe's (set_owners finds the owners
+  // by place from them).
+  pose_at_states(floes, footprints_.mine());
+  const bool move = footprints_.movable(dynamic_, poses_);
+  std::span<const int> owners;
+  if (!move && place_owner_.size() == floes.size() && footprints_.takes_owners(place_rows_)) owners = place_owner_;
+  if (!move && !owners.empty()) pose_at_states(floes, place_mine_);
+  else if (!move) pose_at_states(floes);
+  place_owner_ = {};
+  place_rows_ = {};
+  place_mine_ = {};
+  place_footprints(floes, move, owners);
   const Footprints& fp = footprints_.pieces();
   const std::span<const double> area0 = footprints_.reference_area();
   // Routed with the floes owned by place, this rank's pieces lie within

@@ -188,6 +188,20 @@ public:
   // After it water_velocity() holds the floes this rank drifts. The drift is
   // its only reader (docs/parallel.md, "The coupling by owner").
   void hand_water_over(std::span<const int> drift_owner);
+  // On several ranks, for the next evaluation only: the drift's owners by
+  // place (parallel::FloeOwners with the sea's slabs first_row), assigned
+  // at the floes' present places, every floe's owner and this rank's floes
+  // (`mine`). A rebuild of the footprints on those slabs takes them as the
+  // coupling's owners (MovingFootprints::takes_owners: the same rule, the
+  // row of the centroid, so the same owners) and poses this rank's floes
+  // only, instead of posing every floe to find its owner. The spans must
+  // stay valid until the evaluation.
+  void take_place_owners(std::span<const int> owner, std::span<const std::uint32_t> mine,
+                         std::span<const int> first_row) {
+    place_owner_ = owner;
+    place_mine_ = mine;
+    place_rows_ = first_row;
+  }
 
   // Implicit integrator: advances the floes' vertical DOFs and the sea over h
   // (the floes' horizontal positions already at t + h, `start` the floes at
@@ -330,9 +344,11 @@ private:
   double subcell_weight(double coverage) const;
   Eigen::Matrix2d tilt_inertia(const Floes& floes, std::size_t i) const;
   // Clears the cells of the present footprints, places them with floe i at
-  // poses_[i] (moved or rebuilt: coupling/moving_footprint.hpp) and sums the
-  // cells' coverage (cells_[c].coverage).
-  void place_footprints(const Floes& floes);
+  // poses_[i] (moved if `move`, MovingFootprints::movable's verdict, else
+  // rebuilt: coupling/moving_footprint.hpp) and sums the cells' coverage
+  // (cells_[c].coverage).
+  // With `owners` given by place (take_place_owners), a rebuild takes them.
+  void place_footprints(const Floes& floes, bool move, std::span<const int> owners = {});
   // Zeroes pressure_ and cells_ where the present footprints lie.
   void clear_footprint_cells();
   // The contact is evaluated by owner: several ranks, explicit kicks.
@@ -370,8 +386,10 @@ private:
   // By owner, routed: the penalty energy from every rank's terms
   // (owner_.energy_*), summed in the serial order (one gather).
   void settle_energy() const;
-  // poses_ <- the floes' present poses.
+  // poses_ <- the floes' present poses: every floe's, or those of `which`
+  // (the others' entries are left as they were, and not read).
   void pose_at_states(const Floes& floes);
+  void pose_at_states(const Floes& floes, std::span<const std::uint32_t> which);
   // The contact at the present state for a kick of length h (see evaluate_loads).
   void evaluate(const Floes& floes, fluid::Sea& sea, double h);
   // loads_[i].horizontal = -dV/dG, -dV/dyaw (the header's formulas) for the
@@ -412,7 +430,10 @@ private:
   double free_level_ = 0.0;                 // the calm sea's free level (m; eta has zero mean)
   std::vector<Eigen::Matrix2d> body_moments_;  // rho h ∫ r r^T in the body frame
   MovingFootprints footprints_;
-  std::vector<FloePose> poses_;  // where the next placement puts each floe
+  std::vector<FloePose> poses_;  // where the next placement puts each floe (the floes it reads)
+  // take_place_owners' owners, for the next evaluation (empty: none given).
+  std::span<const int> place_owner_, place_rows_;
+  std::span<const std::uint32_t> place_mine_;
   std::vector<FloeSeaLoad> loads_;
   std::vector<double> pressure_;
   struct CellSums {

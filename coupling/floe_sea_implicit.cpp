@@ -60,7 +60,7 @@ void FloeSeaContact::place_midpoint_footprints(const Floes& floes, std::span<con
     p.y -= 0.5 * dy;
     p.yaw = 0.5 * (p.yaw + start[i].yaw);
   }
-  place_footprints(floes);
+  place_footprints(floes, footprints_.movable(dynamic_, poses_));
 }
 
 void FloeSeaContact::implicit_step(Floes& floes, std::span<const FloeState> start, fluid::Sea& sea, double h) {

@@ -213,12 +213,11 @@ void FloeSeaContact::sum_coverage_by_owner() {
     // too.
     if (boxes) {
       // The boxes of the other ranks' floes that may cover a cell of this
-      // rank's pieces (coupling/shared_cells.hpp: within R_j + R_max and
+      // rank's pieces (coupling/shared_cells.hpp: a row within R_max and
       // about two cells of its slab of the owners); no other box is read.
       std::vector<std::uint32_t> near;
       if (footprints_.by_place()) {
-        near = box_neighbours(o.serial, footprints_.owners(), comm_.rank(), footprints_.owner_slabs(),
-                              footprints_.reference(), footprints_.radius(), grid_, footprints_.reach(),
+        near = box_neighbours(o.serial, footprints_.owners(), comm_.rank(), footprints_.owner_slabs(), o.box, grid_,
                               footprints_.piece_rows());
       } else {
         for (const std::uint32_t i : o.serial)

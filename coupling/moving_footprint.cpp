@@ -17,39 +17,67 @@ MovingFootprints::MovingFootprints(const fluid::SurfaceGrid& grid, FootprintKern
                                    FootprintMotionOptions options)
     : grid_(grid), kernel_(kernel), options_(options) {}
 
-FloePose MovingFootprints::displacement(std::size_t i, const FloePose& at) const {
-  const FloePose& p0 = reference_[i];
-  FloePose d{at.x - p0.x, at.y - p0.y, at.yaw - p0.yaw};
-  if (grid_.edge == fluid::GridEdge::periodic) {
-    d.x -= grid_.lx * std::round(d.x / grid_.lx);
-    if (grid_.dims == 2) d.y -= grid_.ly * std::round(d.y / grid_.ly);
+FloePose window_displacement(const fluid::SurfaceGrid& grid, const FloePose& reference, const FloePose& at) {
+  FloePose d{at.x - reference.x, at.y - reference.y, at.yaw - reference.yaw};
+  if (grid.edge == fluid::GridEdge::periodic) {
+    d.x -= grid.lx * std::round(d.x / grid.lx);
+    if (grid.dims == 2) d.y -= grid.ly * std::round(d.y / grid.ly);
   }
   return d;
 }
 
-bool MovingFootprints::inside_windows(const Floes& floes, std::span<const FloePose> poses) const {
-  if (options_.reach <= 0.0 || reference_.size() != floes.size()) return false;
-  const double reach_x = options_.reach * grid_.dx(), reach_y = options_.reach * grid_.dy();
-  for (std::size_t i = 0; i < floes.size(); ++i) {
-    if (!include_[i]) continue;
-    const FloePose d = displacement(i, poses[i]);
-    const double turn = radius_[i] * std::abs(d.yaw);
+bool inside_windows(std::span<const std::uint32_t> floes, std::span<const std::uint8_t> include,
+                    std::span<const FloePose> reference, std::span<const FloePose> poses, std::span<const double> radius,
+                    const fluid::SurfaceGrid& grid, double reach) {
+  const double reach_x = reach * grid.dx(), reach_y = reach * grid.dy();
+  for (const std::uint32_t i : floes) {
+    if (!include[i]) continue;
+    const FloePose d = window_displacement(grid, reference[i], poses[i]);
+    const double turn = radius[i] * std::abs(d.yaw);
     // A long-crested sea's strips span its width: only x moves a floe across them.
-    if (std::abs(d.x) + turn > reach_x || (grid_.dims == 2 && std::abs(d.y) + turn > reach_y)) return false;
+    if (std::abs(d.x) + turn > reach_x || (grid.dims == 2 && std::abs(d.y) + turn > reach_y)) return false;
   }
   return true;
 }
 
+bool MovingFootprints::movable(std::span<const std::uint8_t> include, std::span<const FloePose> poses) const {
+  // The same on every rank: the reach, the reference's size and the
+  // included floes are replicated, so the ranks return here together.
+  if (options_.reach <= 0.0 || reference_.size() != poses.size()) return false;
+  if (include_.size() != include.size() || !std::equal(include.begin(), include.end(), include_.begin())) return false;
+  const bool inside = inside_windows(mine_, include_, reference_, poses, radius_, grid_, options_.reach);
+  if (comm_.serial()) return inside;
+  // Every rank's floes inside (mine_ partitions the floes: set_owners).
+  return comm_.min(inside ? 1 : 0) == 1;
+}
+
 bool MovingFootprints::place(const Floes& floes, std::span<const std::uint8_t> include,
                              std::span<const FloePose> poses, int threads) {
+  return place(floes, include, poses, threads, movable(include, poses));
+}
+
+bool MovingFootprints::place(const Floes& floes, std::span<const std::uint8_t> include,
+                             std::span<const FloePose> poses, int threads, bool move_pieces,
+                             std::span<const int> owners) {
   ++placements_;
-  const bool same_floes = include_.size() == include.size() && std::equal(include.begin(), include.end(), include_.begin());
-  if (same_floes && inside_windows(floes, poses)) {
+  if (move_pieces) {
     move(poses, threads);
     return false;
   }
-  rebuild_at(floes, include, poses, threads);
+  rebuild_at(floes, include, poses, threads, owners);
   return true;
+}
+
+bool MovingFootprints::takes_owners(std::span<const int> first_row) const {
+  if (comm_.serial() || row_owner_.empty()) return false;
+  const std::vector<int>& rows = next_owner_rows_.empty() ? owner_rows_ : next_owner_rows_;
+  return std::equal(rows.begin(), rows.end(), first_row.begin(), first_row.end());
+}
+
+std::vector<FloePose> MovingFootprints::whole_reference() const {
+  std::vector<FloePose> all = reference_;
+  if (!reference_whole_ && !comm_.serial()) comm_.complete_owned(all, owner_);
+  return all;
 }
 
 void MovingFootprints::set_slabs(std::vector<int> first_row) {
@@ -70,7 +98,7 @@ int MovingFootprints::reach_rows_from(std::span<const int> first_row) const {
   return piece_rows_ + moved;
 }
 
-void MovingFootprints::set_owners(std::span<const FloePose> poses) {
+void MovingFootprints::set_owners(std::span<const FloePose> poses, std::span<const int> owners) {
   const std::size_t n = poses.size();
   owner_.assign(n, 0);
   by_place_ = !comm_.serial() && !row_owner_.empty();
@@ -80,7 +108,14 @@ void MovingFootprints::set_owners(std::span<const FloePose> poses) {
     owner_rows_ = std::move(next_owner_rows_);
     next_owner_rows_.clear();
   }
-  if (by_place_) {
+  reference_whole_ = true;
+  if (by_place_ && !owners.empty()) {
+    // Given by place on these slabs (takes_owners): the rule below, applied
+    // by their maker at the same poses.
+    FLOESIM_ASSERT(owners.size() == n);
+    std::copy(owners.begin(), owners.end(), owner_.begin());
+    reference_whole_ = false;
+  } else if (by_place_) {
     // The row of the centroid, the grid's seam crossed (periodic).
     const double dy = grid_.dy();
     for (std::size_t i = 0; i < n; ++i) owner_[i] = row_owner_[static_cast<std::size_t>(parallel::grid_row(poses[i].y, dy, grid_.ny))];
@@ -96,9 +131,9 @@ void MovingFootprints::set_owners(std::span<const FloePose> poses) {
 }
 
 void MovingFootprints::rebuild_at(const Floes& floes, std::span<const std::uint8_t> include,
-                                  std::span<const FloePose> reference, int threads) {
+                                  std::span<const FloePose> reference, int threads, std::span<const int> owners) {
   ++rebuilds_;
-  set_owners(reference);
+  set_owners(reference, owners);
   if (comm_.serial()) {
     build_footprints(floes, include, grid_, pieces_, kernel_, threads, reference);
   } else {
@@ -111,12 +146,17 @@ void MovingFootprints::rebuild_at(const Floes& floes, std::span<const std::uint8
   }
   reference_.assign(reference.begin(), reference.end());
   include_.assign(include.begin(), include.end());
-  radius_.assign(floes.size(), 0.0);
-  double largest = 0.0;
-  for (std::size_t i = 0; i < floes.size(); ++i) {
-    for (const Vec2& v : floes.vertices(i)) radius_[i] = std::max(radius_[i], v.norm());
-    if (include[i]) largest = std::max(largest, radius_[i]);
+  // R of every floe: its outline's, so made again only when the floes
+  // changed (forget()); the largest over the included floes bounds the
+  // pieces' rows on every rank alike.
+  if (radius_.size() != floes.size()) {
+    radius_.assign(floes.size(), 0.0);
+    for (std::size_t i = 0; i < floes.size(); ++i)
+      for (const Vec2& v : floes.vertices(i)) radius_[i] = std::max(radius_[i], v.norm());
   }
+  double largest = 0.0;
+  for (std::size_t i = 0; i < floes.size(); ++i)
+    if (include[i]) largest = std::max(largest, radius_[i]);
   piece_rows_ = piece_rows_of(largest, options_.reach, grid_.dy());
   area0_ = pieces_.area;
   moment0_.resize(area0_.size());
@@ -129,7 +169,7 @@ void MovingFootprints::move(std::span<const FloePose> poses, int threads) {
   parallel::for_each_index(mine_.size(), threads, [&](std::size_t j) {
     const std::size_t i = mine_[j];
     if (fp.offsets[i] == fp.offsets[i + 1]) return;
-    const FloePose d = displacement(i, poses[i]);
+    const FloePose d = window_displacement(grid_, reference_[i], poses[i]);
     const Vec2 delta{d.x, d.y};
     // Interior nodes stay where they are while G moves by delta.
     for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k) {

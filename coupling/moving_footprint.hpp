@@ -30,7 +30,13 @@
 // more than `reach` cells along x or y,
 //     |delta_x| + R |phi| > reach dx  or  |delta_y| + R |phi| > reach dy,
 // R the floe's largest vertex distance from its centroid. reach = 0 rebuilds
-// at every placement (the exact pieces).
+// at every placement (the exact pieces). On several ranks each rank tests
+// its own floes (mine()) and one reduction agrees on the verdict: "every
+// floe inside" is the conjunction over a partition of the floes, so the
+// ranks' verdicts combined by a minimum are the serial verdict, on every
+// rank alike (every rank must rebuild or move together: the rebuild sets the
+// owners and the gathers are collective). A move reads the own floes' poses
+// only; a rebuild reads the poses set_owners reads (every floe's).
 //
 // On several ranks (a parallel::Communicator, docs/parallel.md) each rank
 // builds or moves the pieces of the floes it owns (mine()) and receives
@@ -59,6 +65,16 @@
 
 namespace floesim {
 
+// Floe i's displacement (delta, phi) from `reference` to `at`, the grid's
+// seam crossed the short way (periodic).
+FloePose window_displacement(const fluid::SurfaceGrid& grid, const FloePose& reference, const FloePose& at);
+// Whether every floe of `floes` with include[i] lies within its window
+// (above: reach in cells, radius[i] = R) about reference[i] at poses[i].
+// Reads the entries of `floes` only.
+bool inside_windows(std::span<const std::uint32_t> floes, std::span<const std::uint8_t> include,
+                    std::span<const FloePose> reference, std::span<const FloePose> poses, std::span<const double> radius,
+                    const fluid::SurfaceGrid& grid, double reach);
+
 struct FootprintMotionOptions {
   // Cells a floe's vertices may move before its pieces are rebuilt ([coupling]
   // footprint_reach). 0: rebuilt at every placement.
@@ -76,9 +92,33 @@ public:
   // new reference. Returns true when rebuilt.
   bool place(const Floes& floes, std::span<const std::uint8_t> include, std::span<const FloePose> poses,
              int threads);
+  // The same in two steps, for a caller that poses the floes it needs only:
+  // whether the pieces can move to `poses` (the window's test above over
+  // this rank's floes, poses[i] read for i in mine() only; on several ranks
+  // collective, one reduction of 8 bytes when the window may hold), then
+  // the placement with that verdict (moved: poses of mine() read; rebuilt:
+  // every floe's, which set_owners reads).
+  bool movable(std::span<const std::uint8_t> include, std::span<const FloePose> poses) const;
+  // With `owners` (by place: takes_owners), a rebuild takes its owners from
+  // them instead of from the poses, and reads the poses of its own floes
+  // (owners[i] == rank) only.
+  bool place(const Floes& floes, std::span<const std::uint8_t> include, std::span<const FloePose> poses, int threads,
+             bool move, std::span<const int> owners = {});
+  // Whether the next rebuild may take its owners given: the owners by place
+  // (set_slabs) on the slabs first_row, which are those its owners follow
+  // (the grid's rows, the row of the centroid: parallel::grid_row, the rule
+  // parallel::FloeOwners applies with the same slabs, so that owners
+  // assigned by it at the poses of the rebuild are the ones set_owners
+  // would set, to the bit). The same on every rank.
+  bool takes_owners(std::span<const int> first_row) const;
+  // Every floe's reference pose (a checkpoint's): as kept here when the
+  // last rebuild posed every floe; when it took its owners given (and posed
+  // this rank's floes only), each floe's from its owner (collective then:
+  // one gather, 24 bytes a floe; every rank calls it alike).
+  std::vector<FloePose> whole_reference() const;
   // Builds at `reference` and makes it the reference (a restart).
   void rebuild_at(const Floes& floes, std::span<const std::uint8_t> include, std::span<const FloePose> reference,
-                  int threads);
+                  int threads, std::span<const int> owners = {});
   // Share the work among these ranks (by default the serial run: one rank).
   void set_communicator(const parallel::Communicator& comm) { comm_ = comm; }
   // Whether the next builds and moves send every floe's area pieces to every
@@ -125,8 +165,11 @@ public:
   // floe's pieces may lie from those slabs' slab of its owner.
   int reach_rows_from(std::span<const int> first_row) const;
 
-  // The next placement rebuilds (the floes changed).
-  void forget() { reference_.clear(); }
+  // The next placement rebuilds (the floes changed; so may their radii).
+  void forget() {
+    reference_.clear();
+    radius_.clear();
+  }
 
   // The calling thread's CPU time (s, parallel::thread_seconds) spent
   // building and moving this rank's floes' pieces since the last take, the
@@ -138,18 +181,18 @@ public:
   const Footprints& pieces() const { return pieces_; }
   // Each area piece's a_c at the reference pose (m^2).
   std::span<const double> reference_area() const { return area0_; }
-  // The reference poses (empty before the first placement).
+  // The reference poses (empty before the first placement): this rank's
+  // floes' (mine()); every floe's only when the last rebuild posed every
+  // floe (whole_reference()).
   std::span<const FloePose> reference() const { return reference_; }
   long placements() const { return placements_; }
   long rebuilds() const { return rebuilds_; }
 
 private:
-  bool inside_windows(const Floes& floes, std::span<const FloePose> poses) const;
   void move(std::span<const FloePose> poses, int threads);
-  // (delta, phi) of floe i from its reference, the grid's seam crossed the short way.
-  FloePose displacement(std::size_t i, const FloePose& at) const;
-  // owner_ and mine_ for floes at `poses` (the rebuild's).
-  void set_owners(std::span<const FloePose> poses);
+  // owner_ and mine_ for floes at `poses` (the rebuild's), or `owners`
+  // given by place (takes_owners).
+  void set_owners(std::span<const FloePose> poses, std::span<const int> owners);
   // After this rank built its floes' pieces alone: every floe's area pieces
   // from their owners, in floe order; the edge pieces are this rank's.
   void gather_built();
@@ -162,7 +205,7 @@ private:
   Footprints pieces_;
   std::vector<FloePose> reference_;
   std::vector<std::uint8_t> include_;
-  std::vector<double> radius_;  // per floe, R
+  std::vector<double> radius_;  // per floe, R (a constant of its outline: made again when the floes change)
   std::vector<double> area0_;   // per area piece, a_c(P0)
   std::vector<Vec2> moment0_;   // per area piece, m_c(P0)
   long placements_ = 0, rebuilds_ = 0;
@@ -173,6 +216,7 @@ private:
   std::vector<int> owner_;      // per floe
   std::vector<std::uint32_t> mine_;
   bool by_place_ = false;
+  bool reference_whole_ = true;  // the last rebuild posed every floe (else mine_ only)
   int piece_rows_ = 0;  // the rows a floe's pieces may lie from its centroid's row (last rebuild)
   // The slabs that gave the owners at the last rebuild, the sea's now
   // (set_sea_slabs), and those the next rebuild's owners follow (empty:

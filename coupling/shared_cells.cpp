@@ -12,13 +12,12 @@ int piece_rows_of(double radius, double reach, double dy) {
 }
 
 std::vector<std::uint32_t> box_neighbours(std::span<const std::uint32_t> candidates, std::span<const int> owner, int rank,
-                                          std::span<const int> first_row, std::span<const FloePose> reference,
-                                          std::span<const double> radius, const fluid::SurfaceGrid& grid, double reach,
-                                          int own_rows) {
+                                          std::span<const int> first_row, std::span<const parallel::CellBox> box,
+                                          const fluid::SurfaceGrid& grid, int own_rows) {
   FLOESIM_ASSERT(static_cast<std::size_t>(rank) + 1 < first_row.size());
   const int rows = grid.ny, lo = first_row[static_cast<std::size_t>(rank)],
             hi = first_row[static_cast<std::size_t>(rank) + 1];
-  const double dy = grid.dy();
+  const auto columns = static_cast<std::uint32_t>(grid.nx);
   // The distance in rows from row y to the slab [lo, hi), on the circle.
   const auto distance = [&](int y) {
     if (lo >= hi) return rows;  // an empty slab: no pieces of its own
@@ -28,9 +27,16 @@ std::vector<std::uint32_t> box_neighbours(std::span<const std::uint32_t> candida
   };
   std::vector<std::uint32_t> out;
   for (const std::uint32_t j : candidates) {
-    if (owner[j] == rank) continue;
-    const int row = parallel::grid_row(reference[j].y, dy, rows);
-    if (distance(row) <= piece_rows_of(radius[j], reach, dy) + own_rows) out.push_back(j);
+    const parallel::CellBox& b = box[j];
+    if (owner[j] == rank || b.first_cell == parallel::CellBox::kNone) continue;
+    // The box's rows as CellBox::for_each visits them: from the first
+    // cell's row, offsets row_lo to row_hi, the seam crossed.
+    const int row0 = static_cast<int>(b.first_cell / columns), count = std::min(b.row_hi - b.row_lo + 1, rows);
+    for (int k = 0; k < count; ++k)
+      if (distance(((row0 + b.row_lo + k) % rows + rows) % rows) <= own_rows) {
+        out.push_back(j);
+        break;
+      }
   }
   return out;
 }

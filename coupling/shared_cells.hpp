@@ -8,21 +8,22 @@
 //
 // Which boxes are enough. Rank r reads, for each cell of its own floes'
 // pieces, whether another rank's floe may have pieces there and which
-// ranks' (FloeSeaContact::sum_coverage_by_owner). Floe j's pieces lie in
+// ranks' (FloeSeaContact::sum_coverage_by_owner). A floe's pieces lie in
 // the cells built at its reference pose (the footprints' last rebuild),
 // within
-//     rows_j = ceil((R_j + (1 + reach) dy) / dy) + 1
-// rows of the row of its centroid there (R_j its largest vertex distance
+//     rows_i = ceil((R_i + (1 + reach) dy) / dy) + 1
+// rows of the row of its centroid there (R_i its largest vertex distance
 // from the centroid, one cell for the tent's spread, the window's reach;
-// MovingFootprints::reach_rows' bound for one floe), and rank r's floes'
-// pieces within own_rows = max over its floes of rows_i of its slab of the
-// owners (each owns the floes whose centroid's row its slab held then). A
-// cell holds pieces of both only if its row lies within both bands, so only
-// the floes j of other ranks with
-//     dist(row_j, slab_r) <= rows_j + own_rows
-// (rows on the grid's circle: a superset on a walled grid) can cover a cell
-// of rank r's pieces: in lengths, R_j + R_max + about two cells and the
-// window's reach from the slab. Their boxes are the only ones read.
+// MovingFootprints::reach_rows' bound for one floe), so rank r's floes'
+// pieces lie within own_rows = max_i rows_i of its slab of the owners (each
+// owns the floes whose centroid's row its slab held then). A box covers a
+// cell of rank r's pieces only if one of its rows lies within own_rows of
+// the slab (on the grid's circle: a superset on a walled grid), so only the
+// boxes of the floes j of other ranks with such a row are read: in lengths,
+// the boxes reaching within R_max + about two cells and the window's reach
+// of the slab. The test reads the boxes themselves (gathered from their
+// owners with the serial order), no floe's pose or radius: a rank needs no
+// other rank's floe's reference pose.
 
 #include <cstdint>
 #include <span>
@@ -37,17 +38,15 @@ namespace floesim {
 // rows_j above: the rows floe j's pieces may lie from its centroid's row.
 int piece_rows_of(double radius, double reach, double dy);
 
-// The floes among `candidates` (the floes the rank holds) that another rank
-// owns (owner[j] != rank) and whose boxes may cover a cell of rank `rank`'s
-// pieces: the criterion above, with first_row the owners' slabs (as
-// fluid::Sea::slab_rows gives them), reference and radius per floe (read for
-// the candidates only), reach the footprints' window in cells and own_rows
-// the rows the rank's floes' pieces may lie from its slab. In the
+// The floes among `candidates` that another rank owns (owner[j] != rank)
+// and whose boxes may cover a cell of rank `rank`'s pieces: the criterion
+// above, with first_row the owners' slabs (as fluid::Sea::slab_rows gives
+// them), box[j] the floes' boxes (read for the candidates only) and
+// own_rows the rows the rank's floes' pieces may lie from its slab. In the
 // candidates' order.
 std::vector<std::uint32_t> box_neighbours(std::span<const std::uint32_t> candidates, std::span<const int> owner, int rank,
-                                          std::span<const int> first_row, std::span<const FloePose> reference,
-                                          std::span<const double> radius, const fluid::SurfaceGrid& grid, double reach,
-                                          int own_rows);
+                                          std::span<const int> first_row, std::span<const parallel::CellBox> box,
+                                          const fluid::SurfaceGrid& grid, int own_rows);
 
 // The cells of the boxes of `floes` (each another rank's, owner[j]) in
 // rows outside the slab's interior (interior_row[y] == 0): each cell whose

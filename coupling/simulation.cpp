@@ -594,6 +594,12 @@ void Simulation::sea_half_kick(StepContext& ctx) {
   // the next drag): the second half kick of the sea and of the floes, and,
   // while they hold, the first of the next step (FloeSeaContact's loads cache).
   if (!floe_sea_) return;
+  // The drift's owners by place were assigned at the detection, at the
+  // places the loads are evaluated at (the sea's flow moves no floe
+  // across): a rebuild of the footprints takes them, and poses this rank's
+  // floes only.
+  if (!comm_.serial() && owners_.has_slabs() && owners_.owner().size() == scenario_.floes.size())
+    floe_sea_->take_place_owners(owners_.owner(), owners_.mine(), owners_.slabs().first_row);
   floe_sea_->evaluate_loads(scenario_.floes, *sea_, incident_.get(), 0.5 * ctx.dt);
   add_owned_momentum(std::span(ctx.momenta).subspan<StepContext::kBeforeSeaKick, 2>());
   floe_sea_->kick_floes(scenario_.floes, 0.5 * ctx.dt);

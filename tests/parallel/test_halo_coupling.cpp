@@ -6,14 +6,17 @@
 #include <doctest/doctest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <numeric>
 #include <vector>
 
 #include "coupling/floe_sea.hpp"
 #include "coupling/footprint.hpp"
+#include "coupling/moving_footprint.hpp"
 #include "coupling/shared_cells.hpp"
 #include "parallel/cell_routes.hpp"
+#include "parallel/place.hpp"
 #include "tests/parallel/halo_case.hpp"
 #include "tests/parallel/sea_case.hpp"
 
@@ -91,16 +94,16 @@ Read read_marks(const Footprints& fp, std::span<const int> owner, int rank, std:
 
 }  // namespace
 
-TEST_CASE("the shared cells' marks on a rank read only the boxes of other ranks' floes within R_j + R_max and two cells of its slab (simulated ranks)") {
+TEST_CASE("the shared cells' marks on a rank read only the boxes of other ranks' floes with a row within R_max and two cells of its slab (simulated ranks)") {
   // FloeSeaContact::sum_coverage_by_owner's marking of the cells other
   // ranks' floes' boxes cover, on the cells of each rank's own pieces: from
   // every other floe's box (as before), and from box_neighbours' floes only
-  // with every other box poisoned (a box over the whole grid, which would
-  // mark every cell shared if read). Equal on every rank, for 2, 3 and 7
-  // slabs, equal and uneven, both kernels, footprints rebuilt at every
-  // placement and with a window of 0.3 cells. The mutation named: the set
-  // without the own floes' rows (dist(row_j, slab) <= rows_j alone) misses
-  // shared cells on some rank.
+  // (chosen by their boxes' rows, no pose read) with every other box
+  // poisoned (a box over the whole grid, which would mark every cell shared
+  // if read). Equal on every rank, for 2, 3 and 7 slabs, equal and uneven,
+  // both kernels, footprints rebuilt at every placement and with a window of
+  // 0.3 cells. The mutation named: the boxes with a row in the slab alone
+  // (own_rows = 0) miss shared cells on some rank.
   const SeaPack s = sea_pack(7);
   const std::size_t n = s.floes.size();
   const int nx = s.grid.nx, ny = s.grid.ny;
@@ -140,7 +143,7 @@ TEST_CASE("the shared cells' marks on a rank read only the boxes of other ranks'
             mark_shared_cells(others, box, owner, nx, ny, interior_row, kind_full, kOpen, kShared, words, full);
             // The claimed set, every other box poisoned.
             const std::vector<std::uint32_t> near =
-                box_neighbours(all, owner, r, first, s.poses, s.radius, s.grid, reach, own_rows);
+                box_neighbours(all, owner, r, first, box, s.grid, own_rows);
             std::vector<parallel::CellBox> poisoned_box(n);
             for (parallel::CellBox& b : poisoned_box) {
               b.first_cell = 0;
@@ -163,7 +166,7 @@ TEST_CASE("the shared cells' marks on a rank read only the boxes of other ranks'
             std::vector<std::uint32_t> thin;
             for (const std::uint32_t j : near) {
               const std::vector<std::uint32_t> one{j};
-              if (!box_neighbours(one, owner, r, first, s.poses, s.radius, s.grid, reach, 0).empty()) thin.push_back(j);
+              if (!box_neighbours(one, owner, r, first, box, s.grid, 0).empty()) thin.push_back(j);
             }
             std::vector<std::uint8_t> kind_thin = kind0;
             SharedMarks thin_marks;
@@ -178,4 +181,147 @@ TEST_CASE("the shared cells' marks on a rank read only the boxes of other ranks'
       CHECK(read_near < read_full);
       CHECK(thin_misses > 0);
     }
+}
+
+TEST_CASE("the footprints' window test over each rank's own floes, agreed by one minimum, is the whole verdict (simulated ranks, lured poses)") {
+  // MovingFootprints::movable: each rank tests the floes it owns for the
+  // coupling (mine(), by the row of the centroid at the reference poses)
+  // and the ranks' verdicts are combined by a minimum (Communicator::min).
+  // On 2, 3 and 7 slabs, equal and uneven, periodic and walled grids, a
+  // window of 0.3 cells: with every floe inside its window, and with one
+  // floe (each of a few) pushed out of it. Each rank reads its own floes'
+  // poses only: every other pose is a lure (moved 10 cells, out of any
+  // window), which a read would turn into "outside". The mutation, named:
+  // each rank's own verdict with no reduction differs from the whole
+  // verdict on some rank whenever one floe is out.
+  SeaPack s = sea_pack(11);
+  const std::size_t n = s.floes.size();
+  const double reach = 0.3;
+  std::vector<std::uint32_t> all(n);
+  std::iota(all.begin(), all.end(), 0u);
+  std::vector<std::uint8_t> include(n, 1);
+  include[5] = 0;  // a static floe is never tested
+  // Poses within the window: a small displacement and turn, each floe its own.
+  std::vector<FloePose> inside = s.poses;
+  for (std::size_t i = 0; i < n; ++i) {
+    const double f = static_cast<double>((i * 37) % 11) / 11.0 - 0.5;  // in [-0.5, 0.5)
+    inside[i].x += 0.2 * reach * s.grid.dx() * f;
+    inside[i].y -= 0.2 * reach * s.grid.dy() * f;
+    inside[i].yaw += 0.1 * reach * s.grid.dy() * f / std::max(s.radius[i], 1.0);
+  }
+  std::size_t cases = 0, lone_verdicts_wrong = 0, lured_whole_wrong = 0;
+  for (const fluid::GridEdge edge : {fluid::GridEdge::periodic, fluid::GridEdge::wall}) {
+    fluid::SurfaceGrid grid = s.grid;
+    grid.edge = edge;
+    // The floe pushed out: none, or one of a few (each along y, or by a turn;
+    // floe 5 is not included, so pushing it changes nothing).
+    for (const int out : {-1, 0, 5, 123, 399}) {
+      std::vector<FloePose> poses = inside;
+      if (out >= 0) {
+        const std::size_t j = static_cast<std::size_t>(out);
+        if (out % 2) poses[j].y += 2.0 * reach * grid.dy();
+        else poses[j].yaw += 2.0 * reach * grid.dx() / s.radius[j];
+      }
+      const bool whole = inside_windows(all, include, s.poses, poses, s.radius, grid, reach);
+      CHECK(whole == (out < 0 || out == 5));
+      for (const int ranks : {2, 3, 7})
+        for (const bool uneven : {false, true}) {
+          CAPTURE(ranks);
+          CAPTURE(uneven);
+          CAPTURE(out);
+          const std::vector<int> row_owner = parallel::row_owners(slabs(ranks, grid.ny, uneven));
+          int agreed = 1;
+          for (int r = 0; r < ranks; ++r) {
+            std::vector<std::uint32_t> mine;
+            std::vector<FloePose> lured = poses;
+            for (std::size_t i = 0; i < n; ++i) {
+              if (row_owner[static_cast<std::size_t>(parallel::grid_row(s.poses[i].y, grid.dy(), grid.ny))] == r) {
+                mine.push_back(static_cast<std::uint32_t>(i));
+              } else {
+                lured[i].x += 10.0 * grid.dx();
+                lured[i].y += 10.0 * grid.dy();
+              }
+            }
+            const bool own = inside_windows(mine, include, s.poses, lured, s.radius, grid, reach);
+            agreed = std::min(agreed, own ? 1 : 0);
+            if (own != whole) ++lone_verdicts_wrong;
+            if (inside_windows(all, include, s.poses, lured, s.radius, grid, reach) != whole) ++lured_whole_wrong;
+          }
+          CHECK((agreed == 1) == whole);
+          ++cases;
+        }
+    }
+  }
+  MESSAGE("window verdicts: " << cases << " cases; a rank's own verdict alone wrong " << lone_verdicts_wrong
+                              << " times, the test over every floe on the lured copy wrong " << lured_whole_wrong << " times");
+  CHECK(lone_verdicts_wrong > 0);
+  CHECK(lured_whole_wrong > 0);
+}
+
+TEST_CASE("the drift's owners by place are the footprints' owners by place at a rebuild, and name each rank's floes to pose (simulated ranks)") {
+  // FloeSeaContact::take_place_owners: a rebuild of the footprints takes the
+  // drift's owners (parallel::FloeOwners with the sea's slabs, assigned at
+  // the floes' present places) instead of posing every floe to find them
+  // (MovingFootprints::set_owners: the row of the centroid at the rebuild's
+  // pose). Both rules on the same poses, on 2, 3 and 7 slabs, equal and
+  // uneven, the pack on the periodic grid, moved half a grid up (some floes
+  // beyond the seam, unwrapped) and 150 m below the grid (floes beyond an
+  // open box's grid, owned by the row they wrap to), and with floes put on
+  // the slabs' first rows' lines exactly: every floe's owner is the same,
+  // and each rank's `mine` lists its floes. The owners by the coupling's
+  // rule read only each floe's own pose (a rank poses its own floes: the
+  // others' poses are NaN on its copy, and its own floes' owners are still
+  // its rank). The mutation, named: the drift's owners on the slabs before
+  // a move of the cuts (one block of rows) are not the rebuild's owners
+  // (MovingFootprints::takes_owners refuses them).
+  const SeaPack s = sea_pack(5);
+  const std::size_t n = s.floes.size();
+  const double dy = s.grid.dy();
+  std::size_t compared = 0, moved_differs = 0;
+  for (const double shift : {0.0, 0.5 * s.grid.ly, -150.0})
+    for (const int ranks : {2, 3, 7})
+      for (const bool uneven : {false, true}) {
+        CAPTURE(shift);
+        CAPTURE(ranks);
+        CAPTURE(uneven);
+        const std::vector<int> first = slabs(ranks, s.grid.ny, uneven);
+        Floes floes = s.floes;
+        for (std::size_t i = 0; i < n; ++i) floes.state[i].y += shift;
+        // A few floes on a slab's first row's line, exactly.
+        for (int r = 1; r < ranks; ++r) floes.state[static_cast<std::size_t>(17 * r)].y = dy * first[static_cast<std::size_t>(r)];
+        contact::Domain domain;
+        domain.periodic = shift >= 0.0;
+        domain.xmin = 0.0;
+        domain.xmax = s.grid.lx;
+        domain.ymin = 0.0;
+        domain.ymax = s.grid.ly;
+        const std::vector<int> row_owner = parallel::row_owners(first);
+        for (int r = 0; r < ranks; ++r) {
+          parallel::FloeOwners drift(r, ranks, domain);
+          drift.set_slabs({first, dy, 8});
+          drift.assign(floes);
+          // The coupling's rule, each rank posing its own floes only.
+          std::vector<FloePose> poses(n, FloePose{std::nan(""), std::nan(""), std::nan("")});
+          for (const std::uint32_t i : drift.mine()) poses[i] = {floes.state[i].x, floes.state[i].y, floes.state[i].yaw};
+          for (std::size_t i = 0; i < n; ++i) {
+            const FloePose at{floes.state[i].x, floes.state[i].y, floes.state[i].yaw};
+            const int coupling = row_owner[static_cast<std::size_t>(parallel::grid_row(at.y, dy, s.grid.ny))];
+            CHECK(drift.owner()[i] == coupling);
+            if (drift.owner()[i] == r)
+              CHECK(row_owner[static_cast<std::size_t>(parallel::grid_row(poses[i].y, dy, s.grid.ny))] == r);
+            ++compared;
+          }
+          for (const std::uint32_t i : drift.mine()) CHECK(drift.owner()[i] == r);
+          // The mutation: the cuts one block of rows off.
+          std::vector<int> before = first;
+          before[1] = std::max(0, before[1] - 8);
+          parallel::FloeOwners old(r, ranks, domain);
+          old.set_slabs({before, dy, 8});
+          old.assign(floes);
+          if (!std::ranges::equal(old.owner(), drift.owner())) ++moved_differs;
+        }
+      }
+  MESSAGE("owners compared " << compared << "; the slabs before a move give other owners in " << moved_differs << " of "
+                             << (3 * (2 + 3 + 7) * 2) << " rank cases");
+  CHECK(moved_differs > 0);
 }
