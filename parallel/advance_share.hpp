@@ -109,14 +109,14 @@ void hold(const RoutedShapes& routed, contact::CollisionShapes& shapes, std::spa
 std::vector<std::byte> pack(const RoutedShapes& routed);
 RoutedShapes unpack_routed_shapes(std::span<const std::byte> bytes);
 
-// The advance's routed pairs' exchange (parallel::exchange_pairs' with the
-// floes' shapes too): `outgoing[s]` (pairs of this rank's part, in pair
-// order) to rank s with the states (RoutedFloes) and shapes (RoutedShapes)
-// of their floes as `floes`, `shapes` and `part.reach` hold them; the
-// floes received written into `floes`, `shapes` and the returned list's
-// reach (hold), which is `part` merged with the pairs received, in pair
-// order. Collective: one alltoall_bytes, two calls. `shape_bytes` adds the
-// shapes' bytes this rank sent.
+// The advance's routed pairs' exchange (parallel::exchange_pairs, with two
+// pieces: the floes' states, RoutedFloes, and shapes, RoutedShapes):
+// `outgoing[s]` (pairs of this rank's part, in pair order) to rank s with
+// the states and shapes of their floes as `floes`, `shapes` and
+// `part.reach` hold them; the floes received written into `floes`,
+// `shapes` and the returned list's reach (hold), which is `part` merged
+// with the pairs received, in pair order. Collective: one alltoall_bytes,
+// two calls. `shape_bytes` adds the shapes' bytes this rank sent.
 contact::Detection exchange_advance_pairs(const Communicator& comm, const contact::Detection& part,
                                           const std::vector<contact::Detection>& outgoing, Floes& floes,
                                           contact::CollisionShapes& shapes, long* shape_bytes = nullptr);
