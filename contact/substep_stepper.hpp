@@ -1,7 +1,9 @@
 #pragma once
-// The multirate advance's stepper (contact/substep.hpp): internal to
-// substep.cpp and substep_jam.cpp, which define its members (the jams' time
-// steps in the latter).
+// The multirate advance's stepper (contact/substep.hpp): internal to the
+// files that define its members: substep_setup.cpp (the set-up: paths,
+// rooms, clusters), substep.cpp (the clusters' events), substep_share.cpp
+// (a share on a part: candidates, routes, held pairs) and substep_jam.cpp
+// (the jams' time steps).
 
 #include <algorithm>
 #include <array>
@@ -51,6 +53,16 @@ CompressedRows<T> compressed_rows(std::size_t rows, std::size_t count, Each&& ea
   std::vector<std::size_t> fill(out.offsets.begin(), out.offsets.end() - 1);
   for (std::size_t k = 0; k < count; ++k) each(k, [&](std::size_t r, const T& v) { out.entries[fill[r]++] = v; });
   return out;
+}
+
+// The floes of `pairs` (both ends) merged into the ascending set `into`
+// (a share's held floes: set_up, hold).
+inline void add_floes(std::vector<std::uint32_t>& into, std::span<const NearPair> pairs) {
+  const std::size_t old = into.size();
+  for (const NearPair& q : pairs) into.insert(into.end(), {q.a, q.b});
+  std::sort(into.begin() + static_cast<std::ptrdiff_t>(old), into.end());
+  std::inplace_merge(into.begin(), into.begin() + static_cast<std::ptrdiff_t>(old), into.end());
+  into.erase(std::unique(into.begin(), into.end()), into.end());
 }
 
 // Pairs measured with their contact points and witnesses.
