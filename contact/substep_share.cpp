@@ -6,6 +6,7 @@
 #include "contact/substep.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <vector>
 
 #include "contact/substep_stepper.hpp"
@@ -134,8 +135,18 @@ std::vector<std::pair<int, std::uint32_t>> Stepper::routes(std::span<const JoinC
   return out;
 }
 
-void Stepper::hold(Detection held) {
-  if (!holds_part()) return;  // the pair list was rebuilt whole
+bool Stepper::whole(std::uint32_t i) const {
+  const FloeState& s = floes_.state[i];
+  bool finite = std::isfinite(s.x) && std::isfinite(s.y) && std::isfinite(s.yaw) && std::isfinite(s.vx) &&
+                std::isfinite(s.vy) && std::isfinite(s.yaw_rate) && std::isfinite(shapes_.radius[i]) &&
+                std::isfinite(det_->reach[i]) && (floes_.is_static[i] || std::isfinite(floes_.mass[i]));
+  for (std::size_t p = shapes_.part_offsets[i]; finite && p < shapes_.part_offsets[i + 1]; ++p)
+    for (const Vec2& v : shapes_.part(p)) finite = finite && std::isfinite(v.x()) && std::isfinite(v.y());
+  return finite;
+}
+
+long Stepper::hold(Detection held) {
+  if (!holds_part()) return -1;  // the pair list was rebuilt whole
   std::vector<double> room(held.pairs.size(), kInf);
   std::vector<std::uint8_t> known(held.pairs.size(), 0);
   for (std::size_t p = 0; p < held.pairs.size(); ++p) {
@@ -155,6 +166,13 @@ void Stepper::hold(Detection held) {
       start_[i] = floes_.state[i];
       if (!floes_.is_static[i]) lin_[i] = travel(i);
     }
+  // The floes the routed pairs brought in: each must have come whole.
+  long missing = -1;
+  std::vector<std::uint32_t> routed;
+  add_floes(routed, held_.pairs);
+  for (const std::uint32_t i : routed)
+    if (missing < 0 && !std::binary_search(held_floes_.begin(), held_floes_.end(), i) && !whole(i))
+      missing = i;
   add_floes(held_floes_, held_.pairs);
   room_ = std::move(room);
   known_ = std::move(known);
@@ -164,6 +182,7 @@ void Stepper::hold(Detection held) {
       room_[p] = t.room;
       known_[p] = 1;
     }
+  return missing;
 }
 
 
@@ -263,12 +282,16 @@ std::vector<std::pair<int, std::uint32_t>> ShareAdvance::routes(std::span<const 
 }
 
 void ShareAdvance::hold(Detection held) {
-  if (set_up_ == ShareOutcome::Conflict::none) stepper_->hold(std::move(held));
+  if (set_up_ != ShareOutcome::Conflict::none) return;
+  missing_ = stepper_->hold(std::move(held));
+  if (missing_ >= 0) set_up_ = ShareOutcome::Conflict::missing_floe;
 }
 
 ShareOutcome ShareAdvance::advance() {
   ShareOutcome outcome;
   outcome.conflict = set_up_;
+  if (outcome.conflict == ShareOutcome::Conflict::missing_floe)
+    outcome.moved.push_back(static_cast<std::uint32_t>(missing_));
   if (outcome.conflict != ShareOutcome::Conflict::none) return outcome;
   try {
     stepper_->run_share();

@@ -164,8 +164,10 @@ public:
   std::vector<std::pair<int, std::uint32_t>> routes(std::span<const JoinCandidate> candidates);
   // On a part: the pairs the share holds from now on (its part and the
   // pairs routed to it, in pair order: every pair of its clusters' members),
-  // the rooms known so far carried over by key.
-  void hold(Detection held);
+  // the rooms known so far carried over by key. Returns the first floe the
+  // routed pairs brought in whose state, mass, collision shape or reach is
+  // not finite (it came without them), or -1.
+  long hold(Detection held);
   void run_share();
 
 private:
@@ -214,6 +216,10 @@ private:
     const FloeState& s = floes_.state[i];
     return std::hypot(s.x - l.x, s.y - l.y) + shapes_.radius[i] * std::abs(s.yaw - l.yaw);
   }
+
+  // Whether floe i's state, mass (dynamic floes), collision shape and reach
+  // are finite where this call holds them.
+  bool whole(std::uint32_t i) const;
 
   void rebuild_pairs();
   // set_up's rest: the pair index and the rooms this call computes.

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cstring>
+#include <string>
 #include <tuple>
 #include <utility>
 
@@ -405,6 +406,17 @@ contact::Detection exchange_advance_pairs(const Communicator& comm, const contac
   return held;
 }
 
+void check_routed_floes(std::span<const AdvancePart> parts) {
+  for (std::size_t r = 0; r < parts.size(); ++r) {
+    const contact::ShareOutcome& o = parts[r].outcome;
+    if (o.conflict != contact::ShareOutcome::Conflict::missing_floe) continue;
+    throw RunError("the advance's share on rank " + std::to_string(r) + ": floe " +
+                   (o.moved.empty() ? std::string("?") : std::to_string(o.moved.front())) +
+                   " of its routed pairs came without its state, mass, collision shape or reach "
+                   "(not finite where the share holds it)");
+  }
+}
+
 bool any_outrun(std::span<const contact::ShareRooms> rooms) {
   return std::any_of(rooms.begin(), rooms.end(), [](const contact::ShareRooms& r) { return r.outrun; });
 }
@@ -481,6 +493,7 @@ void advance_on_part(const Communicator& comm, std::span<const int> owner, std::
         const AdvancePart done = share_part(share, share.advance(), floes, record ? &own : nullptr);
         move_not_held(floes, share.held(), dt);
         const std::vector<AdvancePart> parts = comm.allgather_parts(pack(done), unpack_advance_part);
+        check_routed_floes(parts);
         counts.clusters.resize(parts.size(), 0);
         counts.rooms.resize(parts.size(), 0);
         combined = combine_parts(parts, floes, stats, report, record);

@@ -121,6 +121,12 @@ contact::Detection exchange_advance_pairs(const Communicator& comm, const contac
                                           const std::vector<contact::Detection>& outgoing, Floes& floes,
                                           contact::CollisionShapes& shapes, long* shape_bytes = nullptr);
 
+// Throws RunError, naming the lowest such rank and its floe, when a part
+// says a routed floe came to it without its state, mass, shape or reach
+// (contact::ShareOutcome::Conflict::missing_floe): a fault of the routing,
+// not a fallback. Every rank reads the same parts and throws the same.
+void check_routed_floes(std::span<const AdvancePart> parts);
+
 // Combines every rank's part (rank order) into `floes` (each rank's moved
 // floes get its states; the free floes are already at the end of the step on
 // every rank), `stats`, `report` and `record` (if not null: the parts'

@@ -288,7 +288,7 @@ TEST_CASE("the first overlapping pair and its distance at t from the ranks' part
   CHECK_FALSE(parallel::first_overlap(parallel::Communicator(), c.detection, c.detection).any);
 }
 
-TEST_CASE("a routed pairs' message carries its pairs and pieces back whole, at 8 bytes a piece's count") {
+TEST_CASE("a routed pairs' message (the collisions' and the advance's exchange) carries its pairs and pieces back whole, at 8 bytes a piece's count") {
   // parallel::pack_routed / unpack_routed, the one framing of exchange_pairs
   // (the collisions' pairs with their floes, the advance's with their floes
   // and shapes): the pairs, contact points and witnesses and every piece
