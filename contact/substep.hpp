@@ -285,7 +285,7 @@ public:
   // On a part, advance(all) in pieces around the caller's exchanges.
   // clusters(): the clusters (the same on every share) and the free floes
   // the part says a cluster may take in (`candidates`: the rule in
-  // substep.cpp, Stepper::candidates). routes(every share's candidates):
+  // substep_share.cpp, Stepper::candidates). routes(every share's candidates):
   // the pairs of the part to send, (share, index in the part), each pair to
   // every other share that runs a cluster with one of its floes or has one
   // of its floes as a candidate. hold(): the part and the pairs received,

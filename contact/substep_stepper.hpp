@@ -155,7 +155,7 @@ public:
   // cluster (its pads read pairs no share holds whole) is a conflict.
   void clusters(std::span<const PairRoom> tight, std::span<const ContactEdge> touching);
   // On a part: the free floes the part's pairs say a cluster may take in,
-  // with the share that runs it (sorted, unique; substep.cpp).
+  // with the share that runs it (sorted, unique; substep_share.cpp).
   std::vector<JoinCandidate> candidates() const;
   // On a part, given every share's candidates: for each held pair touching
   // a member of a cluster another share runs or a candidate of another

@@ -10,6 +10,7 @@
 // the same data, so the result is the serial one, field by field, on any
 // number of ranks and whatever the strips.
 
+#include <cstddef>
 #include <cstdint>
 #include <span>
 #include <vector>
