@@ -197,10 +197,15 @@ struct JoinCandidate {
 struct ShareOutcome {
   // missing_pairs: on a part of the detection, a free floe would join a
   // cluster of the share without being its candidate (JoinCandidate): the
-  // share may not hold its pairs.
-  enum class Conflict { none, foreign_cluster, warm_start, failed_lcp, error, missing_pairs };
+  // share may not hold its pairs. missing_floe: on a part, a floe of the
+  // pairs routed to the share came without its state, mass, collision shape
+  // or reach (not finite where the share holds it: ShareAdvance::hold); not
+  // a fallback but a fault of the routing, which the caller reports.
+  enum class Conflict { none, foreign_cluster, warm_start, failed_lcp, error, missing_pairs, missing_floe };
   Conflict conflict = Conflict::none;
-  std::vector<std::uint32_t> moved;  // ascending: the floes of the share's clusters (joined free floes included)
+  // Ascending: the floes of the share's clusters (joined free floes
+  // included); on missing_floe, the floe that came incomplete.
+  std::vector<std::uint32_t> moved;
   long clusters = 0;                 // clusters of the share at the start of the step
   // The share's last floor step (floor_steps counted in its report): its key
   // (tau, cluster) and pair text; the serial floor_pair is the largest key's.
@@ -280,11 +285,14 @@ public:
   // On a part, advance(all) in pieces around the caller's exchanges.
   // clusters(): the clusters (the same on every share) and the free floes
   // the part says a cluster may take in (`candidates`: the rule in
-  // substep.cpp, Stepper::candidates). routes(every share's candidates):
+  // substep_share.cpp, Stepper::candidates). routes(every share's candidates):
   // the pairs of the part to send, (share, index in the part), each pair to
   // every other share that runs a cluster with one of its floes or has one
   // of its floes as a candidate. hold(): the part and the pairs received,
-  // merged in pair order. advance(): the share's advance on them; a free
+  // merged in pair order; a routed pair's floe whose state, mass, shape or
+  // reach is not finite there makes advance() a missing_floe conflict
+  // without running (its sub-steps would read NaN: a sub-step that makes
+  // no progress never ends). advance(): the share's advance on them; a free
   // floe that would join one of its clusters and is not its candidate (its
   // pairs are not all held) is a conflict (missing_pairs).
   // When a cluster is jam-sized (`pads`, the same on every share) its pads'
@@ -314,6 +322,7 @@ private:
   SubstepReport report_;
   ClusterShare share_;
   ShareOutcome::Conflict set_up_ = ShareOutcome::Conflict::none;
+  long missing_ = -1;  // on missing_floe: the floe (hold)
   std::unique_ptr<detail::Stepper> stepper_;
 };
 

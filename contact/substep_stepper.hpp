@@ -1,7 +1,9 @@
 #pragma once
-// The multirate advance's stepper (contact/substep.hpp): internal to
-// substep.cpp and substep_jam.cpp, which define its members (the jams' time
-// steps in the latter).
+// The multirate advance's stepper (contact/substep.hpp): internal to the
+// files that define its members: substep_setup.cpp (the set-up: paths,
+// rooms, clusters), substep.cpp (the clusters' events), substep_share.cpp
+// (a share on a part: candidates, routes, held pairs) and substep_jam.cpp
+// (the jams' time steps).
 
 #include <algorithm>
 #include <array>
@@ -51,6 +53,16 @@ CompressedRows<T> compressed_rows(std::size_t rows, std::size_t count, Each&& ea
   std::vector<std::size_t> fill(out.offsets.begin(), out.offsets.end() - 1);
   for (std::size_t k = 0; k < count; ++k) each(k, [&](std::size_t r, const T& v) { out.entries[fill[r]++] = v; });
   return out;
+}
+
+// The floes of `pairs` (both ends) merged into the ascending set `into`
+// (a share's held floes: set_up, hold).
+inline void add_floes(std::vector<std::uint32_t>& into, std::span<const NearPair> pairs) {
+  const std::size_t old = into.size();
+  for (const NearPair& q : pairs) into.insert(into.end(), {q.a, q.b});
+  std::sort(into.begin() + static_cast<std::ptrdiff_t>(old), into.end());
+  std::inplace_merge(into.begin(), into.begin() + static_cast<std::ptrdiff_t>(old), into.end());
+  into.erase(std::unique(into.begin(), into.end()), into.end());
 }
 
 // Pairs measured with their contact points and witnesses.
@@ -143,7 +155,7 @@ public:
   // cluster (its pads read pairs no share holds whole) is a conflict.
   void clusters(std::span<const PairRoom> tight, std::span<const ContactEdge> touching);
   // On a part: the free floes the part's pairs say a cluster may take in,
-  // with the share that runs it (sorted, unique; substep.cpp).
+  // with the share that runs it (sorted, unique; substep_share.cpp).
   std::vector<JoinCandidate> candidates() const;
   // On a part, given every share's candidates: for each held pair touching
   // a member of a cluster another share runs or a candidate of another
@@ -152,8 +164,10 @@ public:
   std::vector<std::pair<int, std::uint32_t>> routes(std::span<const JoinCandidate> candidates);
   // On a part: the pairs the share holds from now on (its part and the
   // pairs routed to it, in pair order: every pair of its clusters' members),
-  // the rooms known so far carried over by key.
-  void hold(Detection held);
+  // the rooms known so far carried over by key. Returns the first floe the
+  // routed pairs brought in whose state, mass, collision shape or reach is
+  // not finite (it came without them), or -1.
+  long hold(Detection held);
   void run_share();
 
 private:
@@ -202,6 +216,10 @@ private:
     const FloeState& s = floes_.state[i];
     return std::hypot(s.x - l.x, s.y - l.y) + shapes_.radius[i] * std::abs(s.yaw - l.yaw);
   }
+
+  // Whether floe i's state, mass (dynamic floes), collision shape and reach
+  // are finite where this call holds them.
+  bool whole(std::uint32_t i) const;
 
   void rebuild_pairs();
   // set_up's rest: the pair index and the rooms this call computes.

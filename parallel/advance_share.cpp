@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cstring>
+#include <string>
 #include <tuple>
 #include <utility>
 
@@ -389,49 +390,31 @@ RoutedShapes unpack_routed_shapes(std::span<const std::byte> bytes) {
 contact::Detection exchange_advance_pairs(const Communicator& comm, const contact::Detection& part,
                                           const std::vector<contact::Detection>& outgoing, Floes& floes,
                                           contact::CollisionShapes& shapes, long* shape_bytes) {
-  // A message (none for no pair): three byte counts (the pairs, their
-  // floes' states, their shapes), then those three.
-  std::vector<std::byte> send;
-  std::vector<std::size_t> send_counts;
-  for (const contact::Detection& d : outgoing) {
-    if (d.pairs.empty()) {
-      send_counts.push_back(0);
-      continue;
-    }
-    const RoutedFloes carried = routed_floes(floes, {}, d);
-    const std::array<std::vector<std::byte>, 3> pieces{pack(d), pack(carried),
-                                                       pack(routed_shapes(shapes, part.reach, carried.floe))};
-    const std::array<std::uint64_t, 3> sizes{pieces[0].size(), pieces[1].size(), pieces[2].size()};
-    if (shape_bytes) *shape_bytes += static_cast<long>(sizes[2]);
-    const std::size_t from = send.size();
-    append(send, std::span<const std::uint64_t>(sizes));
-    for (const std::vector<std::byte>& b : pieces) send.insert(send.end(), b.begin(), b.end());
-    send_counts.push_back(send.size() - from);
+  // Two pieces with each message's pairs: their floes' states, their shapes.
+  Carried carried{2, std::vector<Pieces>(outgoing.size()), {}};
+  for (std::size_t s = 0; s < outgoing.size(); ++s) {
+    if (outgoing[s].pairs.empty()) continue;
+    const RoutedFloes routed = routed_floes(floes, {}, outgoing[s]);
+    carried.outgoing[s] = {pack(routed), pack(routed_shapes(shapes, part.reach, routed.floe))};
+    if (shape_bytes) *shape_bytes += static_cast<long>(carried.outgoing[s][1].size());
   }
-  std::vector<std::byte> got;
-  std::vector<std::size_t> got_counts;
-  comm.alltoall_bytes(send, send_counts, got, got_counts);
-  std::vector<contact::Detection> parts{part};
-  std::vector<RoutedShapes> received;
-  std::size_t from = 0;
-  for (const std::size_t n : got_counts) {
-    if (n) {
-      const std::byte* at = got.data() + from;
-      const std::vector<std::uint64_t> sizes = take<std::uint64_t>(at, 3);
-      const auto piece = [&](std::size_t k) {
-        const std::span<const std::byte> b(at, static_cast<std::size_t>(sizes[k]));
-        at += sizes[k];
-        return b;
-      };
-      parts.push_back(unpack_detection(piece(0)));
-      parallel::hold(unpack_routed_floes(piece(1)), floes, {});
-      received.push_back(unpack_routed_shapes(piece(2)));
-    }
-    from += n;
+  contact::Detection held = exchange_pairs(comm, part, outgoing, &carried);
+  for (const Pieces& r : carried.received) {
+    parallel::hold(unpack_routed_floes(r[0]), floes, {});
+    hold(unpack_routed_shapes(r[1]), shapes, held.reach);
   }
-  contact::Detection held = merge(std::move(parts));
-  for (const RoutedShapes& r : received) hold(r, shapes, held.reach);
   return held;
+}
+
+void check_routed_floes(std::span<const AdvancePart> parts) {
+  for (std::size_t r = 0; r < parts.size(); ++r) {
+    const contact::ShareOutcome& o = parts[r].outcome;
+    if (o.conflict != contact::ShareOutcome::Conflict::missing_floe) continue;
+    throw RunError("the advance's share on rank " + std::to_string(r) + ": floe " +
+                   (o.moved.empty() ? std::string("?") : std::to_string(o.moved.front())) +
+                   " of its routed pairs came without its state, mass, collision shape or reach "
+                   "(not finite where the share holds it)");
+  }
 }
 
 bool any_outrun(std::span<const contact::ShareRooms> rooms) {
@@ -510,6 +493,7 @@ void advance_on_part(const Communicator& comm, std::span<const int> owner, std::
         const AdvancePart done = share_part(share, share.advance(), floes, record ? &own : nullptr);
         move_not_held(floes, share.held(), dt);
         const std::vector<AdvancePart> parts = comm.allgather_parts(pack(done), unpack_advance_part);
+        check_routed_floes(parts);
         counts.clusters.resize(parts.size(), 0);
         counts.rooms.resize(parts.size(), 0);
         combined = combine_parts(parts, floes, stats, report, record);

@@ -109,17 +109,23 @@ void hold(const RoutedShapes& routed, contact::CollisionShapes& shapes, std::spa
 std::vector<std::byte> pack(const RoutedShapes& routed);
 RoutedShapes unpack_routed_shapes(std::span<const std::byte> bytes);
 
-// The advance's routed pairs' exchange (parallel::exchange_pairs' with the
-// floes' shapes too): `outgoing[s]` (pairs of this rank's part, in pair
-// order) to rank s with the states (RoutedFloes) and shapes (RoutedShapes)
-// of their floes as `floes`, `shapes` and `part.reach` hold them; the
-// floes received written into `floes`, `shapes` and the returned list's
-// reach (hold), which is `part` merged with the pairs received, in pair
-// order. Collective: one alltoall_bytes, two calls. `shape_bytes` adds the
-// shapes' bytes this rank sent.
+// The advance's routed pairs' exchange (parallel::exchange_pairs, with two
+// pieces: the floes' states, RoutedFloes, and shapes, RoutedShapes):
+// `outgoing[s]` (pairs of this rank's part, in pair order) to rank s with
+// the states and shapes of their floes as `floes`, `shapes` and
+// `part.reach` hold them; the floes received written into `floes`,
+// `shapes` and the returned list's reach (hold), which is `part` merged
+// with the pairs received, in pair order. Collective: one alltoall_bytes,
+// two calls. `shape_bytes` adds the shapes' bytes this rank sent.
 contact::Detection exchange_advance_pairs(const Communicator& comm, const contact::Detection& part,
                                           const std::vector<contact::Detection>& outgoing, Floes& floes,
                                           contact::CollisionShapes& shapes, long* shape_bytes = nullptr);
+
+// Throws RunError, naming the lowest such rank and its floe, when a part
+// says a routed floe came to it without its state, mass, shape or reach
+// (contact::ShareOutcome::Conflict::missing_floe): a fault of the routing,
+// not a fallback. Every rank reads the same parts and throws the same.
+void check_routed_floes(std::span<const AdvancePart> parts);
 
 // Combines every rank's part (rank order) into `floes` (each rank's moved
 // floes get its states; the free floes are already at the end of the step on

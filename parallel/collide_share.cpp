@@ -203,14 +203,14 @@ std::size_t collide_on_part(const Communicator& comm, std::span<const int> owner
   // reads from the message.
   const std::vector<contact::Detection> out =
       pairs_for_groups(floes, part, groups, comm.size(), comm.rank(), options.collision_distance);
-  std::vector<RoutedFloes> carried(out.size()), received;
+  Carried carried{1, std::vector<Pieces>(out.size()), {}};
   for (std::size_t s = 0; s < out.size(); ++s)
-    if (!out[s].pairs.empty()) carried[s] = routed_floes(floes, start, out[s]);
-  const contact::Detection local = exchange_pairs(comm, part, out, &carried, &received);
+    if (!out[s].pairs.empty()) carried.outgoing[s] = {pack(routed_floes(floes, start, out[s]))};
+  const contact::Detection local = exchange_pairs(comm, part, out, &carried);
   std::vector<FloeState> held_start;
-  if (!received.empty()) {
+  if (!carried.received.empty()) {
     held_start.assign(start.begin(), start.end());
-    for (const RoutedFloes& r : received) hold(r, floes, held_start);
+    for (const Pieces& r : carried.received) hold(unpack_routed_floes(r[0]), floes, held_start);
     start = held_start;
   }
   // The share on its pairs, then collide_by_owner's exchange (with the

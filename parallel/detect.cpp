@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <numeric>
+#include <utility>
 
 #include "core/error.hpp"
 
@@ -104,44 +106,64 @@ RoutedFloes unpack_routed_floes(std::span<const std::byte> bytes) {
   return r;
 }
 
+std::vector<std::byte> pack_routed(const contact::Detection& pairs, const Pieces& pieces) {
+  const std::vector<std::byte> bytes = pack(pairs);
+  std::vector<std::uint64_t> sizes;
+  for (std::size_t k = 0; k < pieces.size(); ++k) sizes.push_back(k == 0 ? bytes.size() : pieces[k - 1].size());
+  std::vector<std::byte> out;
+  append(out, std::span<const std::uint64_t>(sizes));
+  out.insert(out.end(), bytes.begin(), bytes.end());
+  for (const std::vector<std::byte>& piece : pieces) out.insert(out.end(), piece.begin(), piece.end());
+  return out;
+}
+
+contact::Detection unpack_routed(std::span<const std::byte> message, std::size_t count, Pieces& pieces) {
+  const std::byte* at = message.data();
+  const std::byte* const end = at + message.size();
+  // The sizes written (the pairs' and every piece's but the last), then the
+  // last's: the rest of the message (the pairs' without pieces).
+  std::vector<std::uint64_t> sizes = take<std::uint64_t>(at, count);
+  const std::uint64_t written = std::accumulate(sizes.begin(), sizes.end(), std::uint64_t{0});
+  FLOESIM_ASSERT(static_cast<std::uint64_t>(end - at) >= written);
+  sizes.push_back(static_cast<std::uint64_t>(end - at) - written);
+  contact::Detection pairs = unpack_detection(std::span<const std::byte>(at, static_cast<std::size_t>(sizes[0])));
+  at += sizes[0];
+  pieces.clear();
+  for (std::size_t k = 1; k <= count; ++k) {
+    pieces.emplace_back(at, at + sizes[k]);
+    at += sizes[k];
+  }
+  return pairs;
+}
+
 contact::Detection exchange_pairs(const Communicator& comm, const contact::Detection& part,
-                                  const std::vector<contact::Detection>& outgoing,
-                                  const std::vector<RoutedFloes>* carried, std::vector<RoutedFloes>* received) {
-  // A message: the pairs (pack), or with `carried` the pairs' byte count,
-  // the pairs and the floes.
+                                  const std::vector<contact::Detection>& outgoing, Carried* carried) {
+  const std::size_t count = carried ? carried->pieces : 0;
+  static const Pieces none;
   std::vector<std::byte> send;
   std::vector<std::size_t> send_counts;
   for (std::size_t s = 0; s < outgoing.size(); ++s) {
-    const contact::Detection& d = outgoing[s];
-    std::vector<std::byte> bytes = d.pairs.empty() ? std::vector<std::byte>{} : pack(d);
-    if (carried && !bytes.empty()) {
-      const std::uint64_t size = bytes.size();
-      std::vector<std::byte> message;
-      append(message, std::span<const std::uint64_t>(&size, 1));
-      message.insert(message.end(), bytes.begin(), bytes.end());
-      const std::vector<std::byte> floes = pack((*carried)[s]);
-      message.insert(message.end(), floes.begin(), floes.end());
-      bytes = std::move(message);
+    if (outgoing[s].pairs.empty()) {
+      send_counts.push_back(0);
+      continue;
     }
-    send.insert(send.end(), bytes.begin(), bytes.end());
-    send_counts.push_back(bytes.size());
+    const Pieces& pieces = count > 0 ? std::as_const(carried->outgoing[s]) : none;
+    FLOESIM_ASSERT(pieces.size() == count);
+    const std::vector<std::byte> message = pack_routed(outgoing[s], pieces);
+    send.insert(send.end(), message.begin(), message.end());
+    send_counts.push_back(message.size());
   }
   std::vector<std::byte> got;
   std::vector<std::size_t> got_counts;
   comm.alltoall_bytes(send, send_counts, got, got_counts);
   std::vector<contact::Detection> parts{part};
-  if (received) received->clear();
+  if (carried) carried->received.clear();
   std::size_t from = 0;
   for (const std::size_t n : got_counts) {
-    if (n && carried) {
-      const std::byte* at = got.data() + from;
-      const auto size = static_cast<std::size_t>(take<std::uint64_t>(at, 1)[0]);
-      parts.push_back(unpack_detection(std::span<const std::byte>(at, size)));
-      const std::byte* floes = at + size;
-      const std::span<const std::byte> rest(floes, got.data() + from + n);
-      if (received) received->push_back(unpack_routed_floes(rest));
-    } else if (n) {
-      parts.push_back(unpack_detection(std::span<const std::byte>(got.data() + from, n)));
+    if (n) {
+      Pieces pieces;
+      parts.push_back(unpack_routed(std::span<const std::byte>(got.data() + from, n), count, pieces));
+      if (carried) carried->received.push_back(std::move(pieces));
     }
     from += n;
   }

@@ -10,6 +10,7 @@
 // the same data, so the result is the serial one, field by field, on any
 // number of ranks and whatever the strips.
 
+#include <cstddef>
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -109,17 +110,35 @@ void hold(const RoutedFloes& routed, Floes& floes, std::span<FloeState> start);
 std::vector<std::byte> pack(const RoutedFloes& routed);
 RoutedFloes unpack_routed_floes(std::span<const std::byte> bytes);
 
-// The routed pairs' exchange: `outgoing[s]` (pairs of this rank's part, in
-// pair order) sent to rank s (none to itself; an empty one sends nothing),
-// and `part` merged with what every rank sent here, in pair order
-// (merge). Collective: one alltoall_bytes, two calls. With `carried`
-// (per rank, as outgoing; every rank alike), each non-empty message carries
-// carried[s] too, and `received` gets what every rank sent here (in rank
-// order).
+// What a routed pairs' message carries besides its pairs: packed pieces
+// (each a pack(...) of the caller's: the floes' states, their shapes).
+// `pieces` is the count per message with pairs, the same on every rank (the
+// receiver reads that many); `outgoing[s]` the pieces for rank s (as many,
+// when it gets pairs; else none); `received` is filled with the pieces of
+// each message with pairs received, in rank order.
+using Pieces = std::vector<std::vector<std::byte>>;
+struct Carried {
+  std::size_t pieces = 0;
+  std::vector<Pieces> outgoing;
+  std::vector<Pieces> received;
+};
+
+// One routed pairs' message: the byte counts (8 bytes each) of the pairs
+// and of every piece but the last (none without pieces: the pairs alone),
+// then the pairs (pack) and the pieces. unpack_routed reads `count` pieces
+// into `pieces` and returns the pairs.
+std::vector<std::byte> pack_routed(const contact::Detection& pairs, const Pieces& pieces);
+contact::Detection unpack_routed(std::span<const std::byte> message, std::size_t count, Pieces& pieces);
+
+// The routed pairs' exchange, the one framing of the collisions' and the
+// advance's (collide_on_part, advance_on_part): `outgoing[s]` (pairs of
+// this rank's part, in pair order) sent to rank s (none to itself; an empty
+// one sends nothing) as one message (pack_routed), and `part` merged with
+// what every rank sent here, in pair order (merge). Collective: one
+// alltoall_bytes, two calls. With `carried`, each message with pairs
+// carries its pieces too.
 contact::Detection exchange_pairs(const Communicator& comm, const contact::Detection& part,
-                                  const std::vector<contact::Detection>& outgoing,
-                                  const std::vector<RoutedFloes>* carried = nullptr,
-                                  std::vector<RoutedFloes>* received = nullptr);
+                                  const std::vector<contact::Detection>& outgoing, Carried* carried = nullptr);
 
 // Rank `rank`'s part of the detection by place (no communication): the
 // serial detection's pairs whose floe a `rank` owns, with their contact

@@ -17,7 +17,7 @@ the parts): serially and on 2 ranks, bit for bit (/events/collisions
 included), and its detect phase too receives less than a tenth of the bytes
 of the run with it off (the same detections: the record changes no state).
 """
-from ranks_harness import moving_pack_check, need, summary
+from ranks_harness import finish, moving_pack_check, need, ran, summary
 
 args, harness, config = moving_pack_check(
     "floesim was built without MPI (FLOESIM_MPI=OFF): the advance from the parts is not checked", 1500, 1000.0, [2, 3])
@@ -40,11 +40,10 @@ for n in args.ranks:
     combined, detect = {}, {}
     for on in (True, False):
         out = f"ranks{n}_{'on' if on else 'off'}.h5"
-        p = mpirun(n, "run", configs[on], "-o", out, "-q")
-        if p.returncode != 0:
-            failures.append(f"{n} ranks, advance_on_part {on}: exit {p.returncode}\n{p.stdout}\n{p.stderr}")
+        p = ran(mpirun(n, "run", configs[on], "-o", out, "-q"), f"{n} ranks, advance_on_part {on}", failures)
+        if not p:
             continue
-        c = harness.compare(out, "serial.h5", 0)
+        harness.same(out, "serial.h5", f"{n} ranks, advance_on_part {on}, against the serial run", failures)
         s = summary(p)
         steps, fallbacks = int(s["parallel.advance_steps"]), int(s["parallel.advance_fallbacks"])
         candidates, missing = int(s["parallel.advance_candidates"]), int(s["parallel.advance_missing"])
@@ -52,12 +51,9 @@ for n in args.ranks:
         if on:
             on_missing[n] = missing
         detect[on] = int(s["parallel.phase.detect"].split()[2])
-        print(f"{n} ranks, advance_on_part {on}: {'equal' if c.returncode == 0 else 'DIFFERENT'} to the serial run; "
-              f"{steps} advances tried, {fallbacks} redone ({missing} for a floe not held), "
-              f"{s['parallel.advance_whole']} whole, {candidates} join candidates; advance {s['parallel.phase.advance']}; "
-              f"detect {s['parallel.phase.detect']}")
-        if c.returncode != 0:
-            failures.append(f"{n} ranks, advance_on_part {on}: differs from the serial run\n{c.stdout}")
+        print(f"{n} ranks, advance_on_part {on}: {steps} advances tried, {fallbacks} redone ({missing} for a floe "
+              f"not held), {s['parallel.advance_whole']} whole, {candidates} join candidates; "
+              f"advance {s['parallel.phase.advance']}; detect {s['parallel.phase.detect']}")
         if on and not candidates > 0:
             failures.append(f"{n} ranks: advance_on_part on gathered no join candidate (not from the parts?)")
         if not on and candidates != 0:
@@ -85,26 +81,18 @@ record = config.replace(".toml", "_record.toml")
 with open(record, "w") as f:
     f.write(text.replace("[run]\n", "[run]\nrecord_collisions = true\n", 1))
 need(run([args.floesim, "run", record, "-o", "serial_record.h5", "-q"]), "serial record run")
-p = mpirun(2, "run", record, "-o", "ranks2_record.h5", "-q")
-if p.returncode != 0:
-    failures.append(f"2 ranks, record_collisions: exit {p.returncode}\n{p.stdout}\n{p.stderr}")
-else:
-    c = harness.compare("ranks2_record.h5", "serial_record.h5", 0)
+p = ran(mpirun(2, "run", record, "-o", "ranks2_record.h5", "-q"), "2 ranks, record_collisions", failures)
+if p:
+    harness.same("ranks2_record.h5", "serial_record.h5", "2 ranks, record_collisions, against the serial run", failures)
     s = summary(p)
     detect_record = int(s["parallel.phase.detect"].split()[2])
-    print(f"2 ranks, record_collisions: {'equal' if c.returncode == 0 else 'DIFFERENT'} to the serial run; "
-          f"collide {s['parallel.collide_steps']} tried, {s['parallel.collide_fallbacks']} redone; "
-          f"advance {s['parallel.advance_steps']} tried, {s['parallel.advance_fallbacks']} redone; "
-          f"detect {s['parallel.phase.detect']}")
-    if c.returncode != 0:
-        failures.append(f"2 ranks, record_collisions: differs from the serial run\n{c.stdout}")
+    print(f"2 ranks, record_collisions: collide {s['parallel.collide_steps']} tried, "
+          f"{s['parallel.collide_fallbacks']} redone; advance {s['parallel.advance_steps']} tried, "
+          f"{s['parallel.advance_fallbacks']} redone; detect {s['parallel.phase.detect']}")
     if int(s["parallel.advance_candidates"]) == 0:
         failures.append("2 ranks, record_collisions: no join candidate gathered (the advance not from the parts?)")
     if whole_detect is None or not detect_record * 10 < whole_detect:
         failures.append(f"2 ranks, record_collisions: the detect phase received {detect_record} bytes, "
                         f"not a tenth of {whole_detect} with the whole lists gathered")
 
-if failures:
-    print("FAILED:\n" + "\n".join(failures))
-    raise SystemExit(1)
-print("ok")
+finish(failures)

@@ -27,9 +27,8 @@ usage: check_writer_ranks.py FLOESIM MPIEXEC WORKDIR
    ranks and continued serially, bit for bit too.
 """
 import os
-import sys
 
-from ranks_harness import ENV, Ranks, moving_pack_check, need, ocean_toml, summary
+from ranks_harness import finish, moving_pack_check, need, ocean_toml, ran, summary
 
 args, harness, base = moving_pack_check(
     "floesim was built without MPI (FLOESIM_MPI=OFF): the writer's gather is not checked", 400, 500.0, [2, 3])
@@ -40,21 +39,11 @@ failures = []
 
 def mpirun(n, poison, *floesim_args):
     """floesim on n ranks with the test hook set to `poison` (None: unset)."""
-    env = dict(ENV)
-    if poison:
-        env["FLOESIM_TEST_POISON_UNHELD"] = poison
-    import subprocess
-    return subprocess.run([args.mpiexec, "--oversubscribe", "-np", str(n), "-x", "FLOESIM_TEST_POISON_UNHELD",
-                           args.floesim, *floesim_args] if poison else
-                          [args.mpiexec, "--oversubscribe", "-np", str(n), args.floesim, *floesim_args],
-                          cwd=W, capture_output=True, text=True, timeout=600, env=env)
+    return harness.mpirun(n, *floesim_args, hooks={"FLOESIM_TEST_POISON_UNHELD": poison} if poison else None)
 
 
 def same(a, b, what):
-    c = harness.compare(a, b, 0)
-    print(f"{what}: {'equal' if c.returncode == 0 else 'DIFFERENT'} (bit for bit)")
-    if c.returncode != 0:
-        failures.append(f"{what} differs:\n{c.stdout}")
+    harness.same(a, b, what, failures)
 
 
 FRACTURE = """
@@ -77,19 +66,13 @@ print(f"serial: {args.floes} floes to {args.t_end} s, {s.get('fracture.splits')}
 if s.get("fracture.splits", "0") == "0":
     failures.append("no floe split: the check would not test a changing floe count")
 for n in args.ranks:
-    p = mpirun(n, "1", "run", config, "-o", f"ranks{n}.h5", "-q")
-    if p.returncode != 0:
-        failures.append(f"{n} ranks, poisoned: exit {p.returncode}\n{p.stdout}\n{p.stderr}")
+    p = ran(mpirun(n, "1", "run", config, "-o", f"ranks{n}.h5", "-q"), f"{n} ranks, poisoned", failures)
+    if not p:
         continue
     print(f"{n} ranks, poisoned: record phase {summary(p).get('parallel.phase.record')}")
     same(f"ranks{n}.h5", "serial.h5", f"{n} ranks, each rank's unheld floes poisoned, against the serial run")
-p = mpirun(2, "unread", "run", config, "-o", "unread2.h5", "-q")
-c = harness.compare("unread2.h5", "serial.h5", 0)
-print(f"2 ranks, the writer's poisoned copy written (mutation): "
-      f"{'DIFFERENT, as it must be' if p.returncode == 0 and c.returncode != 0 else 'EQUAL or failed'}")
-if p.returncode != 0 or c.returncode == 0:
-    failures.append(f"the mutation (the writer's own poisoned copy) ran with exit {p.returncode} and compared "
-                    f"{'equal' if c.returncode == 0 else 'different'}: the poison does not reach the file\n{p.stderr}")
+harness.differs(mpirun(2, "unread", "run", config, "-o", "unread2.h5", "-q"), "unread2.h5", "serial.h5",
+                "2 ranks, the writer's poisoned copy written", failures)
 half = str(args.t_end / 2)
 need(mpirun(2, "1", "run", config, "-o", "half.h5", "-q", "--until", half), "the first half on 2 ranks, poisoned")
 need(run([args.floesim, "run", "--restart", "half.h5", "-o", "rest1.h5", "-q"]), "the rest serially")
@@ -106,22 +89,12 @@ with open(ocean, "w") as f:
                        coupling="footprint_reach = 0.3\n"))
 need(run([args.floesim, "run", ocean, "-o", "ocean_serial.h5", "-q"]), "the ocean, serial")
 for n in args.ranks:
-    p = mpirun(n, "1", "run", ocean, "-o", f"ocean{n}.h5", "-q")
-    if p.returncode != 0:
-        failures.append(f"the ocean on {n} ranks, poisoned: exit {p.returncode}\n{p.stdout}\n{p.stderr}")
-        continue
-    same(f"ocean{n}.h5", "ocean_serial.h5", f"the ocean on {n} ranks, poisoned, against the serial run")
-p = mpirun(2, "unread", "run", ocean, "-o", "ocean_unread2.h5", "-q")
-c = harness.compare("ocean_unread2.h5", "ocean_serial.h5", 0)
-print(f"the ocean on 2 ranks, the writer's poisoned copy written (mutation): "
-      f"{'DIFFERENT, as it must be' if p.returncode == 0 and c.returncode != 0 else 'EQUAL or failed'}")
-if p.returncode != 0 or c.returncode == 0:
-    failures.append("the ocean's mutation did not change the file")
+    if ran(mpirun(n, "1", "run", ocean, "-o", f"ocean{n}.h5", "-q"), f"the ocean on {n} ranks, poisoned", failures):
+        same(f"ocean{n}.h5", "ocean_serial.h5", f"the ocean on {n} ranks, poisoned, against the serial run")
+harness.differs(mpirun(2, "unread", "run", ocean, "-o", "ocean_unread2.h5", "-q"), "ocean_unread2.h5",
+                "ocean_serial.h5", "the ocean on 2 ranks, the writer's poisoned copy written", failures)
 need(mpirun(2, "1", "run", ocean, "-o", "ocean_half.h5", "-q", "--until", "1.0"), "the ocean's first half on 2 ranks")
 need(run([args.floesim, "run", "--restart", "ocean_half.h5", "-o", "ocean_rest1.h5", "-q"]), "the ocean's rest serially")
 same("ocean_rest1.h5", "ocean_serial.h5", "the ocean stopped at 1 s on 2 ranks (poisoned), continued serially")
 
-if failures:
-    print("FAILED:\n" + "\n".join(failures))
-    sys.exit(1)
-print("ok")
+finish(failures)

@@ -14,6 +14,7 @@
 // group: the serial answer with at most two collective calls.
 // Run by ctest as mpi.collide_share_ranks_N under `mpirun --oversubscribe
 // -np N` (N = 1, 2, 3), and serially without MPI.
+#include <algorithm>
 #include <cstdio>
 #include <cstring>
 #include <string>
@@ -24,6 +25,7 @@
 #include "parallel/detect.hpp"
 #include "parallel/place.hpp"
 #include "tests/parallel/collide_case.hpp"
+#include "tests/parallel/same_detection.hpp"
 
 using namespace floesim;
 
@@ -98,6 +100,54 @@ int main() {
       failures.push_back("no step group: " + std::to_string(made) + " collective calls, at most 2 expected");
     if (comm.writer())
       std::printf("no step group, %d ranks: %zu pairs, %lld collective calls\n", ranks, whole.pairs.size(), made);
+  }
+  {
+    // The routed pairs' exchange itself (parallel::exchange_pairs, the
+    // collisions' and the advance's one framing), with 0, 1 and 2 pieces a
+    // message: rank r sends rank s != r the pairs of its part with
+    // (a + b) mod ranks = s, with pieces that name (r, s, k). Every rank must get its part
+    // merged with every pair sent to it, in pair order (a pair once), and
+    // from each sender with pairs for it, in rank order, its pieces.
+    for (std::size_t count = 0; count <= 2; ++count) {
+      std::vector<contact::Detection> out(static_cast<std::size_t>(ranks));
+      parallel::Carried carried{count, std::vector<parallel::Pieces>(out.size()), {}};
+      const auto piece = [&](int from, int to, std::size_t k) {
+        std::vector<std::byte> b(3 * k + 2, static_cast<std::byte>(16 * from + to));
+        b.back() = static_cast<std::byte>(k);
+        return b;
+      };
+      const auto to = [&](const contact::NearPair& p) { return static_cast<int>((p.a + p.b) % ranks); };
+      for (int s = 0; s < ranks; ++s) {
+        if (s == comm.rank()) continue;
+        const auto su = static_cast<std::size_t>(s);
+        out[su] = parallel::select_pairs(part, [&](const contact::NearPair& p) { return to(p) == s; });
+        if (!out[su].pairs.empty())
+          for (std::size_t k = 0; k < count; ++k) carried.outgoing[su].push_back(piece(comm.rank(), s, k));
+      }
+      const contact::Detection got = parallel::exchange_pairs(comm, part, out, count > 0 ? &carried : nullptr);
+      // Expected: this rank's part and, from every other rank, its part's
+      // pairs sent here (the whole detection's, selected).
+      const contact::Detection want = parallel::select_pairs(c.detection, [&](const contact::NearPair& p) {
+        return owners.owner()[p.a] == comm.rank() || to(p) == comm.rank();
+      });
+      if (!test::same_lists(got.pairs, want.pairs) || !test::same_lists(got.contacts, want.contacts) ||
+          !test::same_lists(got.witnesses, want.witnesses) || got.reach != part.reach)
+        failures.push_back("exchange_pairs with " + std::to_string(count) + " pieces: the pairs held differ");
+      std::vector<parallel::Pieces> expected;
+      for (int r = 0; r < ranks && count > 0; ++r) {
+        const bool sends = r != comm.rank() && std::any_of(c.detection.pairs.begin(), c.detection.pairs.end(),
+                                                           [&](const contact::NearPair& p) {
+                                                             return owners.owner()[p.a] == r && to(p) == comm.rank();
+                                                           });
+        if (!sends) continue;
+        expected.emplace_back();
+        for (std::size_t k = 0; k < count; ++k) expected.back().push_back(piece(r, comm.rank(), k));
+      }
+      if (count > 0 && carried.received != expected)
+        failures.push_back("exchange_pairs with " + std::to_string(count) + " pieces: the pieces received differ");
+      if (ranks > 1 && count == 2 && comm.sum(static_cast<long long>(carried.received.size())) == 0)
+        failures.push_back("exchange_pairs: no pair crossed a cut: no test");
+    }
   }
   for (const std::string& m : failures) std::printf("rank %d: %s\n", comm.rank(), m.c_str());
   const long long failed = comm.sum(static_cast<long long>(failures.size()));

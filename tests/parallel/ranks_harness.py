@@ -1,10 +1,13 @@
 """What the distributed-run checks share (check_ranks.py, check_record_ranks.py,
-check_sea_ranks.py, check_slab_moves.py, check_rank_killed.py): commands run
-in the work folder with MPI allowed as root (CI containers) and one thread
-per rank, `mpirun --oversubscribe`, `floesim compare`, the run summary as a
-dict, the small ocean the sea checks run on, the moving pack's checks'
-set-up, and a stop with the command's output when a step that must work
-fails."""
+check_sea_ranks.py, check_slab_moves.py, check_rank_killed.py,
+check_writer_ranks.py, check_advance_part.py): commands run in the work
+folder with MPI allowed as root (CI containers) and one thread per rank,
+`mpirun --oversubscribe` (with test hooks' variables passed to every rank),
+`floesim compare`, the run summary as a dict, the small ocean the sea checks
+run on, the moving pack's checks' set-up, a stop with the command's output
+when a step that must work fails, and the failures' list a check collects:
+a run that must exit 0, a file that must equal another bit for bit (or
+must not: a mutation), and the check's end."""
 import argparse
 import os
 import subprocess
@@ -21,12 +24,58 @@ class Ranks:
     def run(self, cmd, timeout=600):
         return subprocess.run(cmd, cwd=self.workdir, capture_output=True, text=True, timeout=timeout, env=ENV)
 
-    def mpirun(self, n, *floesim_args):
-        return self.run([self.mpiexec, "--oversubscribe", "-np", str(n), self.floesim, *floesim_args])
+    def mpirun(self, n, *floesim_args, hooks=None):
+        """floesim on n ranks; `hooks` (name -> value) set in the environment
+        and passed to every rank (`mpirun -x`): test hooks such as
+        FLOESIM_TEST_POISON_UNHELD."""
+        if not hooks:
+            return self.run([self.mpiexec, "--oversubscribe", "-np", str(n), self.floesim, *floesim_args])
+        passed = [a for name in hooks for a in ("-x", name)]
+        return subprocess.run([self.mpiexec, "--oversubscribe", "-np", str(n), *passed, self.floesim, *floesim_args],
+                              cwd=self.workdir, capture_output=True, text=True, timeout=600,
+                              env=dict(ENV, **hooks))
 
     def compare(self, a, b, rtol):
         """`floesim compare` of two run files within the relative `rtol` (no absolute slack)."""
         return self.run([self.floesim, "compare", a, b, "--rtol", str(rtol), "--atol", "0"])
+
+    def same(self, a, b, what, failures, rtol=0):
+        """Whether run files a and b are equal within `rtol` (0: bit for bit),
+        said as `what: equal` or `DIFFERENT`; a difference goes to `failures`
+        with `floesim compare`'s output."""
+        c = self.compare(a, b, rtol)
+        print(f"{what}: {'equal' if c.returncode == 0 else 'DIFFERENT'} ({'bit for bit' if rtol == 0 else f'rtol {rtol}'})")
+        if c.returncode != 0:
+            failures.append(f"{what} differs:\n{c.stdout}")
+        return c.returncode == 0
+
+    def differs(self, p, a, b, what, failures):
+        """A mutation's run p (it must exit 0) and its file a, which must differ
+        from b: said, and a failure when it ran badly or compared equal (the
+        check would not see what the mutation breaks)."""
+        c = self.compare(a, b, 0)
+        ok = p.returncode == 0 and c.returncode != 0
+        print(f"{what} (mutation): {'DIFFERENT, as it must be' if ok else 'EQUAL or failed'}")
+        if not ok:
+            failures.append(f"{what} (mutation): exit {p.returncode}, compared "
+                            f"{'equal' if c.returncode == 0 else 'different'}: the check does not see it\n{p.stderr}")
+        return ok
+
+
+def ran(p, what, failures):
+    """p, if it exited 0; else None, and its exit and output go to `failures`."""
+    if p.returncode != 0:
+        failures.append(f"{what}: exit {p.returncode}\n{p.stdout}\n{p.stderr}")
+        return None
+    return p
+
+
+def finish(failures):
+    """The end of a check: FAILED and every failure (exit 1), or ok."""
+    if failures:
+        print("FAILED:\n" + "\n".join(failures))
+        sys.exit(1)
+    print("ok")
 
 
 def summary(p):

@@ -21,6 +21,7 @@
 #include "contact/detection.hpp"
 #include "contact/shapes.hpp"
 #include "contact/substep.hpp"
+#include "core/error.hpp"
 #include "core/pack_generator.hpp"
 #include "parallel/advance_share.hpp"
 #include "parallel/detect.hpp"
@@ -486,6 +487,15 @@ struct Poisoned {
   std::vector<std::vector<std::uint32_t>> held;                      // each share's held floes (ShareAdvance::held)
   std::vector<std::vector<FloeState>> states;                        // each share's copy after its advance
   long fetched = 0;
+  // Each share's held pairs' floes whose reach, after the routed floes'
+  // shapes and reaches were held, is not the detection's (bits).
+  long reach_wrong = 0, reach_checked = 0;
+  // drop_shape: the first floe routed to a share whose copy did not hold
+  // it has its collision shape removed (NaN again) after the hold: `dropped`
+  // that floe, `dropped_at` that share.
+  bool drop_shape = false;
+  long dropped = -1;
+  int dropped_at = -1;
 };
 void poison_floe(Floes& f, std::size_t i) {
   constexpr double nan = std::numeric_limits<double>::quiet_NaN();
@@ -602,6 +612,28 @@ bool play_parts(const Case& c, const parallel::FloeOwners& strips, std::span<con
       contact::Detection with = parallel::merge(std::move(pairs));
       for (std::size_t s = 0; s < carried_shapes.size(); ++s)
         if (!carried_shapes[s].empty()) parallel::hold(carried_shapes[s][k], shapes[k], with.reach);
+      if (poisoned && poisoned->poison) {
+        // The held pairs' floes' reaches: the detection's (the routed ones from their bytes).
+        for (const contact::NearPair& q : with.pairs)
+          for (const std::uint32_t i : {q.a, q.b}) {
+            ++poisoned->reach_checked;
+            poisoned->reach_wrong += std::memcmp(&with.reach[i], &c.detection.reach[i], sizeof(double)) == 0 ? 0 : 1;
+          }
+        for (std::size_t s = 0; poisoned->drop_shape && poisoned->dropped < 0 && s < carried_shapes.size(); ++s)
+          for (const std::uint32_t i : carried_shapes[s].empty() ? std::vector<std::uint32_t>{}
+                                                                : carried_shapes[s][k].floe)
+            if (!held[k][i] && poisoned->dropped < 0) {
+              // The routed floe's shape removed: as its copy had it before the hold.
+              constexpr double nan = std::numeric_limits<double>::quiet_NaN();
+              contact::CollisionShapes& sh = shapes[k];
+              sh.radius[i] = nan;
+              for (std::size_t q = sh.part_offsets[i]; q < sh.part_offsets[i + 1]; ++q)
+                for (std::size_t v = sh.vertex_offsets[q]; v < sh.vertex_offsets[q + 1]; ++v)
+                  sh.vertices[v] = Vec2::Constant(nan);
+              poisoned->dropped = i;
+              poisoned->dropped_at = static_cast<int>(k);
+            }
+      }
       shares[k]->hold(std::move(with));
       const parallel::AdvancePart part =
           parallel::share_part(*shares[k], shares[k]->advance(), copies[k], merged ? &own[k] : nullptr);
@@ -729,7 +761,7 @@ TEST_CASE("the advance's share reads its strip, its part's floes and the floes t
   // and shifted by one rank (the members then lie on other strips), and
   // where they combine, the combination is the advance's; each share moved
   // the free floes it holds to the whole play's bits and wrote no other.
-  long fetched = 0, free_moved = 0;
+  long fetched = 0, free_moved = 0, reach_checked = 0;
   int compared = 0;
   const std::pair<unsigned, double> packs[] = {{3u, 2.0}, {11u, 2.0}, {9u, 1.8}};
   for (const auto& [seed, speed] : packs) {
@@ -749,6 +781,8 @@ TEST_CASE("the advance's share reads its strip, its part's floes and the floes t
         // them) and part, as bytes: the poisoned copy's equal the whole state's.
         CHECK(poisoned.routes == clean.routes);
         CHECK(poisoned.packed == clean.packed);
+        CHECK(poisoned.reach_wrong == 0);
+        reach_checked += poisoned.reach_checked;
         if (whole.ok && poisoned.packed.size() == static_cast<std::size_t>(ranks)) {
           // Each share moved the free floes it holds, to the whole play's
           // bits, and wrote no floe it does not hold (x still kSentinel).
@@ -800,6 +834,48 @@ TEST_CASE("the advance's share reads its strip, its part's floes and the floes t
                    << " free floes moved by the shares holding them");
   CHECK(compared >= 6);
   CHECK(fetched > 0);
+  CHECK(reach_checked > 0);
+}
+
+TEST_CASE("the advance's share given a routed floe without its collision shape fails at once, naming the floe and the rank") {
+  // The poisoned play of the case above (each share's copy NaN beyond its
+  // strip and part), with the first routed floe a share did not hold left
+  // without its shape after the hold (NaN radius and vertices). Before the
+  // check (ShareAdvance::hold, Stepper::whole) such a share's sub-steps met
+  // NaN limits: a cluster near the step's end took sub-steps of length 0,
+  // which never end. Now its advance returns at once, a missing_floe
+  // conflict naming the floe, and parallel::check_routed_floes (what
+  // advance_on_part calls on the gathered parts) throws a RunError naming
+  // the rank and the floe.
+  const Case c = dense_pack(2.0, 3u, 0.5);
+  int failed = 0;
+  for (const int ranks : {2, 3})
+    for (const int shift : {0, 1}) {
+      CAPTURE(ranks);
+      CAPTURE(shift);
+      Poisoned poisoned;
+      poisoned.drop_shape = true;
+      play_shifted(c, ranks, shift, true, false, &poisoned);
+      if (poisoned.dropped < 0) continue;  // no floe routed to a share that did not hold it
+      ++failed;
+      REQUIRE(poisoned.packed.size() == static_cast<std::size_t>(ranks));
+      std::vector<parallel::AdvancePart> parts;
+      for (const auto& b : poisoned.packed) parts.push_back(parallel::unpack_advance_part(b));
+      const contact::ShareOutcome& o = parts[static_cast<std::size_t>(poisoned.dropped_at)].outcome;
+      CHECK(o.conflict == contact::ShareOutcome::Conflict::missing_floe);
+      REQUIRE(o.moved.size() == 1);
+      CHECK(o.moved.front() == poisoned.dropped);
+      std::string said;
+      try {
+        parallel::check_routed_floes(parts);
+      } catch (const RunError& e) {
+        said = e.what();
+      }
+      MESSAGE(ranks << " ranks, shift " << shift << ": " << said);
+      CHECK(said.find("rank " + std::to_string(poisoned.dropped_at) + ": floe " +
+                      std::to_string(poisoned.dropped) + " ") != std::string::npos);
+    }
+  CHECK(failed >= 2);
 }
 
 TEST_CASE("the advance from each rank's part with jam-sized clusters gathers their pads and is the serial advance") {

@@ -22,6 +22,7 @@
 #include "parallel/detect.hpp"
 #include "parallel/place.hpp"
 #include "tests/parallel/collide_case.hpp"
+#include "tests/parallel/same_detection.hpp"
 
 TEST_SUITE_BEGIN("mpi");
 
@@ -285,4 +286,40 @@ TEST_CASE("the first overlapping pair and its distance at t from the ranks' part
   CHECK(o.b == first->b);
   CHECK(o.before == before);
   CHECK_FALSE(parallel::first_overlap(parallel::Communicator(), c.detection, c.detection).any);
+}
+
+TEST_CASE("a routed pairs' message (the collisions' and the advance's exchange) carries its pairs and pieces back whole, at 8 bytes a piece's count") {
+  // parallel::pack_routed / unpack_routed, the one framing of exchange_pairs
+  // (the collisions' pairs with their floes, the advance's with their floes
+  // and shapes): the pairs, contact points and witnesses and every piece
+  // read back byte for byte, with 0, 1, 2 and 3 pieces (an empty one
+  // included), and the message no longer than the pairs and pieces and one
+  // 8-byte count a piece (the last piece's size is the message's rest).
+  const CollideCase c = test::rows_of_four(3);
+  const contact::Detection pairs =
+      parallel::select_pairs(c.detection, [](const contact::NearPair& p) { return p.a % 3 == 0; });
+  REQUIRE(!pairs.pairs.empty());
+  REQUIRE(!pairs.contacts.empty());
+  const std::vector<std::byte> bare = parallel::pack(pairs);
+  for (std::size_t count = 0; count <= 3; ++count) {
+    CAPTURE(count);
+    parallel::Pieces pieces;
+    std::size_t bytes = bare.size();
+    for (std::size_t k = 0; k < count; ++k) {
+      // Piece k: 5 k + 3 bytes, the last empty when there are three.
+      const std::size_t size = count == 3 && k == 2 ? 0 : 5 * k + 3;
+      std::vector<std::byte> piece(size);
+      for (std::size_t j = 0; j < size; ++j) piece[j] = static_cast<std::byte>(17 * k + j);
+      bytes += size;
+      pieces.push_back(std::move(piece));
+    }
+    const std::vector<std::byte> message = parallel::pack_routed(pairs, pieces);
+    CHECK(message.size() == bytes + 8 * count);
+    parallel::Pieces back{{std::byte{1}}};  // overwritten
+    const contact::Detection read = parallel::unpack_routed(message, count, back);
+    CHECK(test::same_lists(read.pairs, pairs.pairs));
+    CHECK(test::same_lists(read.contacts, pairs.contacts));
+    CHECK(test::same_lists(read.witnesses, pairs.witnesses));
+    CHECK(back == pieces);
+  }
 }
