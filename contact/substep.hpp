@@ -266,12 +266,14 @@ public:
   // On a part the rebuild is not the share's alone: when its own floes
   // would outrun their reach it says so (ShareRooms::outrun) and computes
   // nothing; when any share's did (the gathered flags, the same on every
-  // share), every share calls rooms_rebuilt(): every floe's straight path
-  // and the pair list rebuilt whole (the serial set-up; it reads the whole
-  // pack, as before: the halo plan's piece 3 replaces it), the rooms by
+  // share), every share calls rooms_rebuilt(reach): every floe's straight
+  // path and the pair list rebuilt whole (the serial set-up; it reads the
+  // whole pack, as before: the halo plan's piece 3 replaces it) with
+  // `reach`, every floe's detection reach (the part's hold only its band's,
+  // band18: the caller makes them whole from their owners), the rooms by
   // lower floe's owner as off a part, to be gathered as rooms()'s are.
   ShareRooms rooms();
-  ShareRooms rooms_rebuilt();
+  ShareRooms rooms_rebuilt(std::span<const double> reach);
   // On a part, the floes the share holds (ascending; every floe once the
   // pair list was rebuilt whole): those it reads and moves. The caller
   // keeps the others (the share moves none of them). Off a part, empty (the

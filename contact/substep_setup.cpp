@@ -41,18 +41,18 @@ ShareRooms Stepper::set_up() {
     lin_[i] = travel(i);
     outrun = outrun || lin_[i] > det_->reach[i];
   }
-  if (outrun) rebuild_pairs();
+  if (outrun) rebuild_pairs(det_->reach);
   return set_up_rooms();
 }
 
-ShareRooms Stepper::set_up_rebuilt() {
+ShareRooms Stepper::set_up_rebuilt(std::span<const double> reach) {
   // As the serial set-up whose check found a floe outrunning: every floe.
   const std::size_t n = floes_.size();
   start_ = floes_.state;
   lin_.assign(n, 0.0);
   for (std::size_t i = 0; i < n; ++i)
     if (!floes_.is_static[i]) lin_[i] = travel(i);
-  rebuild_pairs();
+  rebuild_pairs(reach);
   held_floes_.resize(n);
   for (std::uint32_t i = 0; i < n; ++i) held_floes_[i] = i;
   return set_up_rooms();
@@ -98,11 +98,11 @@ void Stepper::clusters(std::span<const PairRoom> tight, std::span<const ContactE
   make_clusters();
 }
 
-void Stepper::rebuild_pairs() {
+void Stepper::rebuild_pairs(std::span<const double> reach) {
   DetectionOptions o;
   o.collision_distance = opt_.collision_distance;
   o.domain = opt_.domain;
-  o.reach = det_->reach;
+  o.reach.assign(reach.begin(), reach.end());
   o.horizon = dt_;
   for (std::size_t i = 0; i < o.reach.size(); ++i) o.reach[i] = std::max(o.reach[i], 1.5 * lin_[i]);
   rebuilt_ = detect(floes_, shapes_, o);

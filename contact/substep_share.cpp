@@ -216,12 +216,12 @@ ShareRooms ShareAdvance::rooms() {
   return out;
 }
 
-ShareRooms ShareAdvance::rooms_rebuilt() {
+ShareRooms ShareAdvance::rooms_rebuilt(std::span<const double> reach) {
   ShareRooms out;
   out.conflict = set_up_;
   if (set_up_ != ShareOutcome::Conflict::none) return out;
   try {
-    out = stepper_->set_up_rebuilt();
+    out = stepper_->set_up_rebuilt(reach);
   } catch (const RunError&) {
     out.conflict = ShareOutcome::Conflict::error;
   }

@@ -135,8 +135,10 @@ public:
   // agrees on it with the other shares and calls set_up_rebuilt.
   ShareRooms set_up();
   // On a part, after any share's set_up said outrun: every floe's straight
-  // path and the pair list rebuilt whole, then set_up's rooms.
-  ShareRooms set_up_rebuilt();
+  // path and the pair list rebuilt whole with every floe's reach `reach`
+  // (a part holds only its band's: the caller has them from their owners),
+  // then set_up's rooms.
+  ShareRooms set_up_rebuilt(std::span<const double> reach);
   // The floes this call reads and moves, ascending (every floe off a part
   // or once rebuilt whole).
   std::span<const std::uint32_t> held_floes() const { return held_floes_; }
@@ -221,7 +223,9 @@ private:
   // are finite where this call holds them.
   bool whole(std::uint32_t i) const;
 
-  void rebuild_pairs();
+  // The pair list detected again over the step, each floe's reach at least
+  // 1.5 times its straight path's travel (the serial set-up: det_->reach).
+  void rebuild_pairs(std::span<const double> reach);
   // set_up's rest: the pair index and the rooms this call computes.
   ShareRooms set_up_rooms();
   // f(i) for each floe this call holds: held_floes_ on a part, else every floe.

@@ -462,7 +462,12 @@ void advance_on_part(const Communicator& comm, std::span<const int> owner, std::
     // gathers the rooms again.
     if (any_outrun(rooms)) {
       ++counts.rebuilds;
-      rooms = comm.allgather_parts(pack(share.rooms_rebuilt()), unpack_share_rooms);
+      // The rebuild detects over every floe: every floe's reach from its
+      // owner (a rank wrote only its band's at the detection, band18; 8
+      // bytes a floe, in such a step only).
+      std::vector<double> reach = part.reach;
+      comm.complete_owned(reach, owner);
+      rooms = comm.allgather_parts(pack(share.rooms_rebuilt(reach)), unpack_share_rooms);
     }
     contact::ShareRooms all;
     // The gathered conflicts and the clusters are the same on every rank:

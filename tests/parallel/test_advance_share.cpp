@@ -482,6 +482,10 @@ namespace {
 constexpr double kSentinel = 1.0e30;
 struct Poisoned {
   bool poison = true;  // false: the parts' bytes only, from the whole state
+  // With poison false: only the parts' reaches beyond each share's own and
+  // its part's pairs' floes are NaN (a rank writes only its band's reaches
+  // at the detection, band18), the state whole.
+  bool stale_reaches = false;
   std::vector<std::vector<std::byte>> packed;
   std::vector<std::vector<std::pair<int, std::uint32_t>>> routes;  // each share's routes (the candidates' closure)
   std::vector<std::vector<std::uint32_t>> held;                      // each share's held floes (ShareAdvance::held)
@@ -538,6 +542,14 @@ bool play_parts(const Case& c, const parallel::FloeOwners& strips, std::span<con
         }
       shapes[k] = test::poisoned(c.shapes, held[k]);
     }
+  if (poisoned && !poisoned->poison && poisoned->stale_reaches)
+    for (std::size_t k = 0; k < n; ++k) {
+      std::vector<std::uint8_t> known(c.floes.size(), 0);
+      for (std::size_t i = 0; i < c.floes.size(); ++i) known[i] = strips.owner()[i] == static_cast<int>(k);
+      for (const contact::NearPair& q : parts[k].pairs) known[q.a] = known[q.b] = 1;
+      for (std::size_t i = 0; i < c.floes.size(); ++i)
+        if (!known[i]) parts[k].reach[i] = std::numeric_limits<double>::quiet_NaN();
+    }
   for (int r = 0; r < ranks; ++r) {
     const std::size_t k = static_cast<std::size_t>(r);
     contact::SubstepOptions o = c.options;
@@ -547,10 +559,12 @@ bool play_parts(const Case& c, const parallel::FloeOwners& strips, std::span<con
     rooms.push_back(parallel::unpack_share_rooms(parallel::pack(shares.back()->rooms())));
   }
   if (parallel::any_outrun(rooms)) {
-    // Every share rebuilds alike and the rooms are gathered again.
+    // Every share rebuilds alike, with every floe's reach from its owner
+    // (the serial detection's: comm.complete_owned in advance_on_part), and
+    // the rooms are gathered again.
     if (rebuilds) ++*rebuilds;
     for (std::size_t k = 0; k < n; ++k)
-      rooms[k] = parallel::unpack_share_rooms(parallel::pack(shares[k]->rooms_rebuilt()));
+      rooms[k] = parallel::unpack_share_rooms(parallel::pack(shares[k]->rooms_rebuilt(c.detection.reach)));
   }
   contact::ShareRooms all;
   bool ok = parallel::combine_rooms(rooms, all);
@@ -980,7 +994,13 @@ TEST_CASE("a floe outrunning its reach on one rank's strip makes every share reb
     for (const int shift : {0, 1}) {
       CAPTURE(ranks);
       CAPTURE(shift);
-      const PartsPlay p = play_shifted(c, ranks, shift);
+      // Each share's part holds the reaches of its own floes and its
+      // pairs' floes only (band18), the others NaN: the rebuild reads the
+      // reaches from their owners, not the part's.
+      Poisoned stale;
+      stale.poison = false;
+      stale.stale_reaches = true;
+      const PartsPlay p = play_shifted(c, ranks, shift, true, false, &stale);
       MESSAGE(ranks << " ranks, shift " << shift << ": " << std::string(p.ok ? "combined" : "fell back") << ", "
                     << p.rebuilds << " rebuilds agreed");
       CHECK(p.rebuilds == 1);
