@@ -30,7 +30,7 @@ import re
 import subprocess
 import sys
 
-from ranks_harness import ENV, moving_pack_check, need, ocean_toml, summary
+from ranks_harness import ENV, half_pack, moving_pack_check, need, ocean_toml, summary
 
 args, harness, base = moving_pack_check(
     "floesim was built without MPI (FLOESIM_MPI=OFF): the poison mode is not checked", 400, 250.0, [2])
@@ -107,8 +107,7 @@ print(f"the pack from the whole detection on 2 ranks, step-lure: exit {p.returnc
 if not found:
     failures.append(f"the lure did not reach the advance from the whole detection (it reads every floe)\n{p.stderr}")
 # The implicit floe-sea step (whole on every rank), with NaN.
-need(run([args.floesim, "pack", "--floes", "120", "--concentration", "0.5", "--box", "200", "100", "--seed", "3",
-          "--min-size", "6", "--max-size", "15", "--thickness", "1", "-o", "half_pack.h5"]), "floesim pack")
+half_pack(run, args.floesim)
 implicit = os.path.join(W, "implicit.toml")
 with open(implicit, "w") as f:
     f.write(ocean_toml("half_pack.h5", 0.5, 0.25, contact="box = [0.0, 200.0, 0.0, 200.0]\n",

@@ -34,7 +34,7 @@ cuts move from the equal shares toward the floes (parallel.slab_rows, every
 import os
 import sys
 
-from ranks_harness import Ranks, need, ocean_toml, summary
+from ranks_harness import Ranks, half_pack, need, ocean_toml, summary
 
 if "--no-mpi" in sys.argv:
     print("floesim was built without MPI (FLOESIM_MPI=OFF): the moving slabs are not checked")
@@ -45,8 +45,7 @@ harness = Ranks(floesim, mpiexec, W)
 run, mpirun = harness.run, harness.mpirun
 failures = []
 
-need(run([floesim, "pack", "--floes", "120", "--concentration", "0.5", "--box", "200", "100", "--seed", "3",
-          "--min-size", "6", "--max-size", "15", "--thickness", "1", "-o", "half_pack.h5"]), "floesim pack")
+half_pack(run, floesim)
 config = os.path.join(W, "half.toml")
 with open(config, "w") as f:
     f.write(ocean_toml("half_pack.h5", 3.0, 0.5, contact="box = [0.0, 200.0, 0.0, 200.0]\n",

@@ -28,7 +28,7 @@ usage: check_writer_ranks.py FLOESIM MPIEXEC WORKDIR
 """
 import os
 
-from ranks_harness import finish, moving_pack_check, need, ocean_toml, ran, summary
+from ranks_harness import finish, half_pack, moving_pack_check, need, ocean_toml, ran, summary
 
 args, harness, base = moving_pack_check(
     "floesim was built without MPI (FLOESIM_MPI=OFF): the writer's gather is not checked", 400, 500.0, [2, 3])
@@ -81,8 +81,7 @@ need(mpirun(3, "1", "run", "--restart", "half.h5", "-o", "rest3.h5", "-q"), "the
 same("rest3.h5", "serial.h5", f"stopped at {half} s on 2 ranks, continued on 3 ranks (both poisoned), against the serial run")
 
 # 2. The sea: the vertical DOFs and a sea in slabs.
-need(run([args.floesim, "pack", "--floes", "120", "--concentration", "0.5", "--box", "200", "100", "--seed", "3",
-          "--min-size", "6", "--max-size", "15", "--thickness", "1", "-o", "half_pack.h5"]), "floesim pack")
+half_pack(run, args.floesim)
 ocean = os.path.join(W, "ocean.toml")
 with open(ocean, "w") as f:
     f.write(ocean_toml("half_pack.h5", 2.0, 0.5, contact="box = [0.0, 200.0, 0.0, 200.0]\n",

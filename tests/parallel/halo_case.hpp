@@ -11,6 +11,7 @@
 #include <cstring>
 #include <limits>
 #include <span>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -200,6 +201,67 @@ inline std::vector<double> uneven_cuts(const Pack& p, int ranks) {
     case 3: return {y0 + 0.3 * h, y0 + 0.3 * h};
     default: return {y0 + 0.1 * h, y0 + 0.15 * h, y0 + 0.5 * h, y0 + 0.5 * h, y0 + 0.9 * h, y0 + 2.0 * h};
   }
+}
+
+// The strips the band's tests run over: equal counts, uneven (uneven_cuts),
+// the sea's slabs (256 rows of the window's height from its bottom, blocks
+// of 8, equal blocks but for the last slab), and `beyond`: the same slabs
+// with the pack moved below the grid in an open box (the floes there are
+// owned by the rows they wrap to).
+enum class Strips { equal, uneven, slabs, beyond };
+inline const char* strips_name(Strips s) {
+  switch (s) {
+    case Strips::equal: return "equal";
+    case Strips::uneven: return "uneven";
+    case Strips::slabs: return "slabs";
+    default: return "beyond";
+  }
+}
+inline parallel::RowSlabs slabs_of(const Pack& p, int ranks) {
+  parallel::RowSlabs slabs;
+  slabs.dy = (p.window[3] - p.window[2]) / 256.0;
+  slabs.block = 8;
+  for (int r = 0; r < ranks; ++r) slabs.first_row.push_back(8 * ((32 * r) / ranks));
+  slabs.first_row.push_back(256);
+  return slabs;
+}
+// The owners of `p` on `ranks` simulated ranks (rank 0's object; the tests
+// pass each rank's number), with strips of the given kind.
+inline parallel::FloeOwners owners_of(const Pack& p, int ranks, Strips kind) {
+  if (kind == Strips::slabs && !(p.detect.domain.periodic && p.window[2] == 0.0))
+    throw std::logic_error("the sea's slabs are tested in a periodic box from y = 0");
+  parallel::FloeOwners owners(0, ranks, p.detect.domain);
+  if (kind == Strips::uneven) owners.set_cuts(uneven_cuts(p, ranks));
+  if (kind == Strips::slabs || kind == Strips::beyond) owners.set_slabs(slabs_of(p, ranks));
+  owners.assign(p.floes);
+  return owners;
+}
+
+// One configuration of the band's tests, and a line naming it (for CAPTURE).
+struct StripCase {
+  bool periodic = true;
+  double speed = 0.5;
+  Strips kind = Strips::equal;
+  int ranks = 2;
+  std::string name() const {
+    return std::string(periodic ? "periodic" : "open") + ", " + std::to_string(speed) + " m/s, " +
+           strips_name(kind) + ", " + std::to_string(ranks) + " ranks";
+  }
+};
+// f(pack, case) over a periodic and an open box, moving_pack(7) at 0.5 and
+// 2 m/s, strips of equal counts, uneven and the sea's slabs (periodic boxes
+// only), on 2, 3 and 7 ranks: 30 configurations.
+template <class F>
+void for_each_strip_case(F&& f) {
+  for (const bool periodic : {true, false})
+    for (const double speed : {0.5, 2.0}) {
+      const Pack p = moving_pack(7, periodic, speed);
+      for (const Strips kind : {Strips::equal, Strips::uneven, Strips::slabs})
+        for (const int ranks : {2, 3, 7}) {
+          if (kind == Strips::slabs && !periodic) continue;
+          f(p, StripCase{periodic, speed, kind, ranks});
+        }
+    }
 }
 
 // A rank's part of the detection from its band only.

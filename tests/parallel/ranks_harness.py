@@ -129,6 +129,15 @@ def need(p, what):
     return p
 
 
+def half_pack(run, floesim, out="half_pack.h5"):
+    """The small ocean's floes (for ocean_toml): 120 floes of 6 to 15 m, 1 m
+    thick, at 50 % cover in the lower half of a 200 m x 200 m box (`floesim
+    pack`, seed 3), written to `out` by run([...]) in the check's folder."""
+    need(run([floesim, "pack", "--floes", "120", "--concentration", "0.5", "--box", "200", "100", "--seed", "3",
+              "--min-size", "6", "--max-size", "15", "--thickness", "1", "-o", out]), "floesim pack")
+    return out
+
+
 def moving_pack_check(no_mpi, floes, t_end, ranks, options=None):
     """The set-up of the checks on the moving pack (check_ranks.py,
     check_record_ranks.py). With --no-mpi (MPI not built): says `no_mpi` and

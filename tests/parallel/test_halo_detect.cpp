@@ -51,29 +51,6 @@ using namespace floesim::test;
 
 namespace {
 
-enum class Strips { equal, uneven, slabs };
-const char* name(Strips s) { return s == Strips::equal ? "equal" : s == Strips::uneven ? "uneven" : "slabs"; }
-
-// The owners of `p` on `ranks` simulated ranks (rank 0's object; the tests
-// pass each rank's number), with strips of the given kind. Slabs: 256 rows
-// of the box's height from y = 0 (the window starts there), blocks of 8,
-// equal blocks but for the last slab.
-parallel::FloeOwners owners_of(const Pack& p, int ranks, Strips kind) {
-  REQUIRE((kind != Strips::slabs || (p.detect.domain.periodic && p.window[2] == 0.0)));
-  parallel::FloeOwners owners(0, ranks, p.detect.domain);
-  if (kind == Strips::uneven) owners.set_cuts(uneven_cuts(p, ranks));
-  if (kind == Strips::slabs) {
-    parallel::RowSlabs slabs;
-    slabs.dy = (p.window[3] - p.window[2]) / 256.0;
-    slabs.block = 8;
-    for (int r = 0; r < ranks; ++r) slabs.first_row.push_back(8 * ((32 * r) / ranks));
-    slabs.first_row.push_back(256);
-    owners.set_slabs(slabs);
-  }
-  owners.assign(p.floes);
-  return owners;
-}
-
 // A copy in which every floe not held is a lure: its centroid at `y` (a
 // place inside the rank's strip) and its reach `reach`, wide. A pass that
 // read it would pose it.
@@ -99,55 +76,48 @@ bool same_subset(const contact::DetectionSubset& a, const contact::DetectionSubs
 
 TEST_CASE("the held floes from the library are the band by its rule, H one max over the ranks' own floes") {
   std::size_t configs = 0, local_differs = 0, local_lost = 0, held_total = 0, local_total = 0;
-  for (const bool periodic : {true, false})
-    for (const double speed : {0.5, 2.0}) {
-      const Pack p = moving_pack(7, periodic, speed);
-      const std::size_t n = p.floes.size();
-      for (const Strips kind : {Strips::equal, Strips::uneven, Strips::slabs})
-        for (const int ranks : {2, 3, 7}) {
-          if (kind == Strips::slabs && !periodic) continue;  // the sea's slabs: a periodic box from y = 0
-          CAPTURE(periodic);
-          CAPTURE(speed);
-          CAPTURE(name(kind));
-          CAPTURE(ranks);
-          const parallel::FloeOwners owners = owners_of(p, ranks, kind);
-          // H: the simulated ranks' parts, their largest, is the pack's.
-          double pack_largest = 0.0;
-          for (std::size_t j = 0; j < n; ++j) pack_largest = std::max(pack_largest, parallel::half_band(owners, p.floes, p.shapes, p.detect, j));
-          const double largest = largest_by_ranks(owners, p.floes, p.shapes, p.detect);
-          CHECK(bits(largest, pack_largest));
-          for (int r = 0; r < ranks; ++r) {
-            CAPTURE(r);
-            const parallel::HeldFloes held = parallel::held_floes(owners, r, p.floes, p.shapes, p.detect, largest);
-            CHECK(bits(held.largest, largest));
-            CHECK(held.mask == halo_band_by_rule(owners, r, p.floes, p.shapes, p.detect));
-            // The index: the mask's floes, ascending; the rank's own among them.
-            std::vector<std::uint32_t> from_mask;
-            for (std::size_t i = 0; i < n; ++i)
-              if (held.mask[i]) from_mask.push_back(static_cast<std::uint32_t>(i));
-            CHECK(held.index == from_mask);
-            bool own = true;
-            for (std::size_t i = 0; i < n; ++i) own = own && (owners.owner()[i] != r || held.holds(i));
-            CHECK(own);
-            // H from this rank's own floes alone (no reduction): another
-            // band, which the comparison with the rule sees.
-            const double mine = parallel::largest_half_band(owners, r, p.floes, p.shapes, p.detect);
-            const parallel::HeldFloes local = parallel::held_floes(owners, r, p.floes, p.shapes, p.detect, mine);
-            held_total += held.index.size();
-            local_total += local.index.size();
-            if (local.mask != held.mask) {
-              ++local_differs;
-              contact::DetectionOptions d = p.detect;
-              d.reach = poisoned(d.reach, local.mask);
-              const contact::Detection thin = parallel::detect_part(owners, r, poisoned(p.floes, local.mask),
-                                                                    poisoned(p.shapes, local.mask), d);
-              const contact::Detection whole = parallel::detect_part(owners, r, p.floes, p.shapes, p.detect);
-              if (thin.pairs.size() < whole.pairs.size()) local_lost += whole.pairs.size() - thin.pairs.size();
-            }
-            ++configs;
-          }
-        }
+  for_each_strip_case([&](const Pack& p, const StripCase& c) {
+    const std::size_t n = p.floes.size();
+    const int ranks = c.ranks;
+    const std::string where = c.name();
+    CAPTURE(where);
+    const parallel::FloeOwners owners = owners_of(p, ranks, c.kind);
+    // H: the simulated ranks' parts, their largest, is the pack's.
+    double pack_largest = 0.0;
+    for (std::size_t j = 0; j < n; ++j) pack_largest = std::max(pack_largest, parallel::half_band(owners, p.floes, p.shapes, p.detect, j));
+    const double largest = largest_by_ranks(owners, p.floes, p.shapes, p.detect);
+    CHECK(bits(largest, pack_largest));
+    for (int r = 0; r < ranks; ++r) {
+      CAPTURE(r);
+      const parallel::HeldFloes held = parallel::held_floes(owners, r, p.floes, p.shapes, p.detect, largest);
+      CHECK(bits(held.largest, largest));
+      CHECK(held.mask == halo_band_by_rule(owners, r, p.floes, p.shapes, p.detect));
+      // The index: the mask's floes, ascending; the rank's own among them.
+      std::vector<std::uint32_t> from_mask;
+      for (std::size_t i = 0; i < n; ++i)
+        if (held.mask[i]) from_mask.push_back(static_cast<std::uint32_t>(i));
+      CHECK(held.index == from_mask);
+      bool own = true;
+      for (std::size_t i = 0; i < n; ++i) own = own && (owners.owner()[i] != r || held.holds(i));
+      CHECK(own);
+      // H from this rank's own floes alone (no reduction): another
+      // band, which the comparison with the rule sees.
+      const double mine = parallel::largest_half_band(owners, r, p.floes, p.shapes, p.detect);
+      const parallel::HeldFloes local = parallel::held_floes(owners, r, p.floes, p.shapes, p.detect, mine);
+      held_total += held.index.size();
+      local_total += local.index.size();
+      if (local.mask != held.mask) {
+        ++local_differs;
+        contact::DetectionOptions d = p.detect;
+        d.reach = poisoned(d.reach, local.mask);
+        const contact::Detection thin = parallel::detect_part(owners, r, poisoned(p.floes, local.mask),
+                                                              poisoned(p.shapes, local.mask), d);
+        const contact::Detection whole = parallel::detect_part(owners, r, p.floes, p.shapes, p.detect);
+        if (thin.pairs.size() < whole.pairs.size()) local_lost += whole.pairs.size() - thin.pairs.size();
+      }
+      ++configs;
     }
+  });
   // It is thinner and loses no pair: the rank's part needs h_a of its own
   // floes a only (dist(y_b, S_r) <= h_a + h_b). The run keeps the one H of
   // the plan (docs/parallel.md, "The band in the library").
@@ -159,48 +129,41 @@ TEST_CASE("the held floes from the library are the band by its rule, H one max o
 
 TEST_CASE("the detection subset over the held floes reads only them (lured and poisoned copies)") {
   std::size_t parts = 0, lures_posed = 0, lured_parts = 0, held_total = 0, whole_total = 0;
-  for (const bool periodic : {true, false})
-    for (const double speed : {0.5, 2.0}) {
-      const Pack p = moving_pack(7, periodic, speed);
-      const std::size_t n = p.floes.size();
-      for (const Strips kind : {Strips::equal, Strips::uneven, Strips::slabs})
-        for (const int ranks : {2, 3, 7}) {
-          if (kind == Strips::slabs && !periodic) continue;  // the sea's slabs: a periodic box from y = 0
-          CAPTURE(periodic);
-          CAPTURE(speed);
-          CAPTURE(name(kind));
-          CAPTURE(ranks);
-          const parallel::FloeOwners owners = owners_of(p, ranks, kind);
-          const double largest = largest_by_ranks(owners, p.floes, p.shapes, p.detect);
-          for (int r = 0; r < ranks; ++r) {
-            CAPTURE(r);
-            const parallel::HeldFloes held = parallel::held_floes(owners, r, p.floes, p.shapes, p.detect, largest);
-            const contact::DetectionSubset whole = parallel::detection_subset(owners, r, p.floes, p.shapes, p.detect);
-            // Poisoned (NaN) outside the held floes: the same part of the detection.
-            contact::DetectionOptions d = p.detect;
-            d.reach = poisoned(d.reach, held.mask);
-            const Floes nan_floes = poisoned(p.floes, held.mask);
-            const contact::CollisionShapes nan_shapes = poisoned(p.shapes, held.mask);
-            CHECK(same_subset(parallel::detection_subset(owners, r, nan_floes, nan_shapes, d, &held), whole));
-            CHECK(same_detection(parallel::detect_part(owners, r, nan_floes, nan_shapes, d, &held),
-                                 parallel::detect_part(owners, r, p.floes, p.shapes, p.detect)));
-            ++parts;
-            held_total += held.index.size();
-            whole_total += n;
-            if (owners.owner().end() == std::find(owners.owner().begin(), owners.owner().end(), r)) continue;
-            // Lured outside the held floes: the first own floe's place, a reach of 500 m.
-            const std::size_t first =
-                static_cast<std::size_t>(std::find(owners.owner().begin(), owners.owner().end(), r) - owners.owner().begin());
-            const Lured l = lured(p, held.mask, owners.place(p.floes.state[first]), 500.0);
-            CHECK(same_subset(parallel::detection_subset(owners, r, l.floes, p.shapes, l.detect, &held), whole));
-            // The mutation, named: the subset over every floe poses the lures.
-            const contact::DetectionSubset every = parallel::detection_subset(owners, r, l.floes, p.shapes, l.detect);
-            ++lured_parts;
-            if (every.posed.size() > whole.posed.size()) lures_posed += every.posed.size() - whole.posed.size();
-            if (held.index.size() < n) CHECK(!same_subset(every, whole));  // some floe is a lure
-          }
-        }
+  for_each_strip_case([&](const Pack& p, const StripCase& c) {
+    const std::size_t n = p.floes.size();
+    const int ranks = c.ranks;
+    const std::string where = c.name();
+    CAPTURE(where);
+    const parallel::FloeOwners owners = owners_of(p, ranks, c.kind);
+    const double largest = largest_by_ranks(owners, p.floes, p.shapes, p.detect);
+    for (int r = 0; r < ranks; ++r) {
+      CAPTURE(r);
+      const parallel::HeldFloes held = parallel::held_floes(owners, r, p.floes, p.shapes, p.detect, largest);
+      const contact::DetectionSubset whole = parallel::detection_subset(owners, r, p.floes, p.shapes, p.detect);
+      // Poisoned (NaN) outside the held floes: the same part of the detection.
+      contact::DetectionOptions d = p.detect;
+      d.reach = poisoned(d.reach, held.mask);
+      const Floes nan_floes = poisoned(p.floes, held.mask);
+      const contact::CollisionShapes nan_shapes = poisoned(p.shapes, held.mask);
+      CHECK(same_subset(parallel::detection_subset(owners, r, nan_floes, nan_shapes, d, &held), whole));
+      CHECK(same_detection(parallel::detect_part(owners, r, nan_floes, nan_shapes, d, &held),
+                           parallel::detect_part(owners, r, p.floes, p.shapes, p.detect)));
+      ++parts;
+      held_total += held.index.size();
+      whole_total += n;
+      if (owners.owner().end() == std::find(owners.owner().begin(), owners.owner().end(), r)) continue;
+      // Lured outside the held floes: the first own floe's place, a reach of 500 m.
+      const std::size_t first =
+          static_cast<std::size_t>(std::find(owners.owner().begin(), owners.owner().end(), r) - owners.owner().begin());
+      const Lured l = lured(p, held.mask, owners.place(p.floes.state[first]), 500.0);
+      CHECK(same_subset(parallel::detection_subset(owners, r, l.floes, p.shapes, l.detect, &held), whole));
+      // The mutation, named: the subset over every floe poses the lures.
+      const contact::DetectionSubset every = parallel::detection_subset(owners, r, l.floes, p.shapes, l.detect);
+      ++lured_parts;
+      if (every.posed.size() > whole.posed.size()) lures_posed += every.posed.size() - whole.posed.size();
+      if (held.index.size() < n) CHECK(!same_subset(every, whole));  // some floe is a lure
     }
+  });
   MESSAGE(parts << " parts from their held floes (" << held_total << " floes held of " << whole_total
                 << "); a subset over every floe of the lured copies poses " << lures_posed << " lures in "
                 << lured_parts << " parts");
@@ -225,14 +188,7 @@ TEST_CASE("the held floes hold the detection's floes when the sea's slabs own fl
     for (const int ranks : {2, 3, 7}) {
       CAPTURE(speed);
       CAPTURE(ranks);
-      parallel::FloeOwners owners(0, ranks, p.detect.domain);
-      parallel::RowSlabs slabs;
-      slabs.dy = (p.window[3] - p.window[2]) / 256.0;
-      slabs.block = 8;
-      for (int r = 0; r < ranks; ++r) slabs.first_row.push_back(8 * ((32 * r) / ranks));
-      slabs.first_row.push_back(256);
-      owners.set_slabs(slabs);
-      owners.assign(p.floes);
+      const parallel::FloeOwners owners = owners_of(p, ranks, Strips::beyond);
       const double largest = largest_by_ranks(owners, p.floes, p.shapes, p.detect);
       for (int r = 0; r < ranks; ++r) {
         CAPTURE(r);
@@ -283,7 +239,7 @@ TEST_CASE("the moorings' kick over the floes a rank drifts reads and writes only
   for (const int ranks : {2, 3, 7})
     for (const Strips kind : {Strips::equal, Strips::uneven, Strips::slabs}) {
       CAPTURE(ranks);
-      CAPTURE(name(kind));
+      CAPTURE(strips_name(kind));
       Pack at = p;
       at.floes = moved;
       const parallel::FloeOwners owners = owners_of(at, ranks, kind);

@@ -39,25 +39,6 @@ using namespace floesim::test;
 
 namespace {
 
-enum class Strips { equal, uneven, slabs, beyond };
-
-parallel::RowSlabs slabs_of(const Pack& p, int ranks) {
-  parallel::RowSlabs slabs;
-  slabs.dy = (p.window[3] - p.window[2]) / 256.0;
-  slabs.block = 8;
-  for (int r = 0; r < ranks; ++r) slabs.first_row.push_back(8 * ((32 * r) / ranks));
-  slabs.first_row.push_back(256);
-  return slabs;
-}
-
-parallel::FloeOwners owners_of(const Pack& p, int ranks, Strips kind) {
-  parallel::FloeOwners owners(0, ranks, p.detect.domain);
-  if (kind == Strips::uneven) owners.set_cuts(uneven_cuts(p, ranks));
-  if (kind == Strips::slabs || kind == Strips::beyond) owners.set_slabs(slabs_of(p, ranks));
-  owners.assign(p.floes);
-  return owners;
-}
-
 Held mask_of(std::span<const std::uint32_t> floes, std::size_t n) {
   Held out(n, 0);
   for (const std::uint32_t j : floes) out[j] = 1;
@@ -182,20 +163,12 @@ void check_case(const Pack& p, int ranks, Strips kind, Count& count) {
 TEST_CASE("the held sets announced by the owners are the band's rule, with the owners' reaches") {
   Count count;
   std::size_t periodic_configs = 0;
-  for (const bool periodic : {true, false})
-    for (const double speed : {0.5, 2.0}) {
-      const Pack p = moving_pack(7, periodic, speed);
-      for (const Strips kind : {Strips::equal, Strips::uneven, Strips::slabs})
-        for (const int ranks : {2, 3, 7}) {
-          if (kind == Strips::slabs && !periodic) continue;  // the sea's slabs: a periodic box from y = 0
-          CAPTURE(periodic);
-          CAPTURE(speed);
-          CAPTURE(static_cast<int>(kind));
-          CAPTURE(ranks);
-          check_case(p, ranks, kind, count);
-          periodic_configs += periodic ? 1 : 0;
-        }
-    }
+  for_each_strip_case([&](const Pack& p, const StripCase& c) {
+    const std::string where = c.name();
+    CAPTURE(where);
+    check_case(p, c.ranks, c.kind, count);
+    periodic_configs += c.periodic ? 1 : 0;
+  });
   // The sea's slabs in an open box, the pack moved 150 m below the grid:
   // the floes there are owned by the last slab's rows (the grid's wrap).
   std::size_t beyond = 0;
