@@ -25,6 +25,7 @@
 #include "parallel/detect.hpp"
 #include "parallel/place.hpp"
 #include "tests/parallel/collide_case.hpp"
+#include "tests/parallel/ranks_main.hpp"
 #include "tests/parallel/same_detection.hpp"
 
 using namespace floesim;
@@ -149,8 +150,5 @@ int main() {
         failures.push_back("exchange_pairs: no pair crossed a cut: no test");
     }
   }
-  for (const std::string& m : failures) std::printf("rank %d: %s\n", comm.rank(), m.c_str());
-  const long long failed = comm.sum(static_cast<long long>(failures.size()));
-  if (comm.writer()) std::printf("%s on %d ranks\n", failed == 0 ? "passed" : "FAILED", ranks);
-  return failed == 0 ? 0 : 1;
+  return test::verdict(comm, failures, "the step groups' solves equal the serial solve");
 }

@@ -49,6 +49,7 @@
 #include "coupling/simulation.hpp"
 #include "parallel/comm.hpp"
 #include "parallel/place.hpp"
+#include "tests/parallel/ranks_main.hpp"
 
 using namespace floesim;
 
@@ -245,17 +246,6 @@ void check_bad_state(const parallel::Communicator& comm, std::vector<std::string
 
 int main() {
   parallel::Session session;
-  const parallel::Communicator& comm = session.world();
-  std::vector<std::string> failures;
-  try {
-    check_sums(comm, failures);
-    check_simulation(comm, failures);
-    check_bad_state(comm, failures);
-  } catch (const std::exception& e) {
-    failures.push_back(std::string("threw: ") + e.what());
-  }
-  for (const std::string& f : failures) std::printf("rank %d of %d: FAILED: %s\n", comm.rank(), comm.size(), f.c_str());
-  const bool all = comm.sum(failures.empty() ? 0 : 1) == 0;
-  if (comm.rank() == 0 && all) std::printf("exact sums on %d rank(s): equal to the serial sums, bit for bit\n", comm.size());
-  return all ? 0 : 1;
+  return test::run_checks(session.world(), "exact sums equal to the serial sums, bit for bit", check_sums,
+                          check_simulation, check_bad_state);
 }

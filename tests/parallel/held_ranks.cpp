@@ -33,6 +33,7 @@
 #include "coupling/simulation.hpp"
 #include "parallel/comm.hpp"
 #include "parallel/place.hpp"
+#include "tests/parallel/ranks_main.hpp"
 
 using namespace floesim;
 
@@ -112,15 +113,5 @@ void check_moored(const parallel::Communicator& comm, std::vector<std::string>& 
 
 int main() {
   parallel::Session session;
-  const parallel::Communicator& comm = session.world();
-  std::vector<std::string> failures;
-  try {
-    check_moored(comm, failures);
-  } catch (const std::exception& e) {
-    failures.push_back(std::string("threw: ") + e.what());
-  }
-  for (const std::string& f : failures) std::printf("rank %d of %d: FAILED: %s\n", comm.rank(), comm.size(), f.c_str());
-  const bool all = comm.sum(failures.empty() ? 0 : 1) == 0;
-  if (all && comm.rank() == 0) std::printf("held floes on %d rank(s): the moored run equals the serial run, bit for bit\n", comm.size());
-  return all ? 0 : 1;
+  return test::run_checks(session.world(), "held floes: the moored run equals the serial run, bit for bit", check_moored);
 }

@@ -50,6 +50,7 @@
 
 #include "parallel/comm.hpp"
 #include "parallel/place.hpp"
+#include "tests/parallel/ranks_main.hpp"
 
 using namespace floesim;
 
@@ -225,8 +226,5 @@ int main() {
   }
   coupling_moves(comm, failures);
   fracture_moves(comm, failures);
-  for (const std::string& f : failures) std::printf("rank %d: %s\n", comm.rank(), f.c_str());
-  const long long failed = comm.sum(static_cast<long long>(failures.size()));
-  if (comm.writer()) std::printf("%s on %d ranks\n", failed == 0 ? "passed" : "FAILED", ranks);
-  return failed == 0 ? 0 : 1;
+  return test::verdict(comm, failures, "the strips balanced by measured cost, the same cuts and owners on every rank");
 }
