@@ -95,7 +95,13 @@ bool publish(Published& f) {
     f.written.assign(1, {0, static_cast<haddr_t>(size)});
   } else {
     unlink(f.previous.c_str());
-    if (link(f.path.c_str(), f.previous.c_str()) != 0) return false;
+    if (link(f.path.c_str(), f.previous.c_str()) != 0) {
+      // A file system without hard links (EPERM, EOPNOTSUPP, ...): the
+      // published inode is renamed away first. A kill between the two
+      // renames leaves no file under `path`, but the two whole copies under
+      // the helper names (docs/formats.md).
+      if (errno == EEXIST || std::rename(f.path.c_str(), f.previous.c_str()) != 0) return false;
+    }
     if (std::rename(f.work.c_str(), f.path.c_str()) != 0) return false;
   }
   std::sort(f.written.begin(), f.written.end());
