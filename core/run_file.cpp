@@ -446,8 +446,9 @@ void RunWriter::write_checkpoint(const Checkpoint& c) {
   Impl& w = *impl_;
   w.guarded([&] {
   try {
-    // A new group, then the old one replaced by it: a run killed while
-    // writing keeps the previous checkpoint.
+    // A new group, then the old one replaced by it: a write that fails
+    // midway (a full disk) keeps the previous checkpoint. (A kill keeps the
+    // file as of its last flush: h5_published.hpp.)
     h5::remove(w.file, "checkpoint_new");
     write_checkpoint_group(w.file, "checkpoint_new", c);
     h5::remove(w.file, "checkpoint");

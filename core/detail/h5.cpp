@@ -15,6 +15,7 @@
 #include <limits>
 #include <mutex>
 
+#include "core/detail/h5_published.hpp"
 #include "core/error.hpp"
 
 namespace floesim::h5 {
@@ -38,8 +39,12 @@ bool is_hdf5(const std::string& path) {
 Handle open_file(const std::string& path, bool write) {
   silence_errors();
   if (!is_hdf5(path)) fail(path + ": not an HDF5 file (or it cannot be read)");
-  hid_t f = H5Fopen(path.c_str(), write ? H5F_ACC_RDWR : H5F_ACC_RDONLY, H5P_DEFAULT);
-  if (f < 0) fail(path + ": cannot open the HDF5 file");
+  // A file continued (written) goes through the publishing driver, as one created.
+  Handle fapl{write ? published_fapl(path) : H5Pcreate(H5P_FILE_ACCESS), H5Pclose};
+  if (!fapl.valid()) fapl = Handle{H5Pcreate(H5P_FILE_ACCESS), H5Pclose};
+  if (write) H5Pset_file_locking(fapl, false, true);
+  hid_t f = H5Fopen(path.c_str(), write ? H5F_ACC_RDWR : H5F_ACC_RDONLY, fapl);
+  if (f < 0) fail(path + ": cannot open the HDF5 file" + (write ? " for writing" : ""));
   return {f, H5Fclose};
 }
 
@@ -110,10 +115,16 @@ void check_global_heaps(const std::string& path) {
 Handle create_file(const std::string& path) {
   silence_errors();
   // No file lock: a run file is written by one process and may be read by
-  // others (scripts, `floesim info`) while the run goes on; every record is
-  // flushed, so readers see whole records.
-  Handle fapl{H5Pcreate(H5P_FILE_ACCESS), H5Pclose};
-  H5Pset_fapl_sec2(fapl);  // reserve() needs the file descriptor
+  // others (scripts, `floesim info`) while the run goes on. Written through
+  // the publishing driver (h5_published.hpp): the name `path` holds the file
+  // as of its last flush, whole, whatever instant the writer is stopped at.
+  // A path that is not a regular file (/dev/full) is written in place, on
+  // the sec2 driver. Both give reserve() a file descriptor.
+  Handle fapl{published_fapl(path), H5Pclose};
+  if (!fapl.valid()) {
+    fapl = Handle{H5Pcreate(H5P_FILE_ACCESS), H5Pclose};
+    H5Pset_fapl_sec2(fapl);
+  }
   H5Pset_file_locking(fapl, false, true);
   errno = 0;
   hid_t f = H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, fapl);
@@ -137,23 +148,39 @@ int descriptor(hid_t file) {
   if (H5Fget_vfd_handle(file, fapl, &handle) < 0 || !handle) return -1;
   return *static_cast<int*>(handle);
 }
+
+// The descriptor of the file HDF5 writes and its end of allocation; for a
+// published file, also the other copy's descriptor (else -1). False when none.
+bool where_written(hid_t file, int& fd, int& other, haddr_t& eoa) {
+  other = -1;
+  if (const PublishedHandle* h = published_handle(file)) {
+    fd = h->fd[0];
+    other = h->fd[1];
+    eoa = h->eoa;
+    return fd >= 0;
+  }
+  fd = descriptor(file);
+  return fd >= 0 && H5Fget_eoa(file, &eoa) >= 0;
+}
 }  // namespace
 
 int reserve(hid_t file, hsize_t bytes) {
-  const int fd = descriptor(file);
+  int fd = -1, other = -1;
   haddr_t eoa = 0;
-  if (fd < 0 || H5Fget_eoa(file, &eoa) < 0) return 0;
+  if (!where_written(file, fd, other, eoa)) return 0;
   struct stat st {};
   if (fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) return 0;
-  const int err = posix_fallocate(fd, static_cast<off_t>(eoa), static_cast<off_t>(bytes));
+  int err = posix_fallocate(fd, static_cast<off_t>(eoa), static_cast<off_t>(bytes));
+  // A published file's other copy receives the same bytes at the next publication.
+  if (err == 0 && other >= 0) err = posix_fallocate(other, static_cast<off_t>(eoa), static_cast<off_t>(bytes));
   return err == EOPNOTSUPP || err == ENODEV || err == ESPIPE ? 0 : err;
 }
 
 void trim(hid_t file) {
-  const int fd = descriptor(file);
+  int fd = -1, other = -1;
   haddr_t eoa = 0;
   struct stat st {};
-  if (fd < 0 || H5Fget_eoa(file, &eoa) < 0 || fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) return;
+  if (!where_written(file, fd, other, eoa) || fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) return;
   if (static_cast<haddr_t>(st.st_size) > eoa && ftruncate(fd, static_cast<off_t>(eoa)) != 0) return;
 }
 

@@ -38,9 +38,15 @@ private:
 void silence_errors();  // once per process: no HDF5 error-stack dumps on stderr
 
 bool is_hdf5(const std::string& path);
+// A file opened to write, and a file created (an earlier one of that name is
+// removed), are written through the publishing driver (h5_published.hpp):
+// `path` holds the file as of its last flush, whole, whatever instant the
+// process is killed at. A path that is not a regular file is written in
+// place on the sec2 (POSIX) driver.
 Handle open_file(const std::string& path, bool write = false);
-Handle create_file(const std::string& path);  // truncates; on the sec2 (POSIX) driver
-// Writes every cached object of the file to disk; false when a write failed.
+Handle create_file(const std::string& path);
+// Writes every cached object of the file to disk (and publishes it); false
+// when a write failed.
 bool flush(hid_t file);
 // Disk space for the writes to come. HDF5 writes a file in place and keeps its
 // structure consistent only when every write lands: a write that fails for

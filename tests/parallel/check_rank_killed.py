@@ -12,7 +12,10 @@ Then:
 - every rank stops: mpirun exits non-zero within 60 s and no process of the
   run is left (no deadlock of rank 0 in a collective);
 - the run file stays readable: `floesim info` reads it, says the run has no
-  end mark and shows a checkpoint;
+  end mark and shows a checkpoint, and h5py reads every object and attribute
+  of it (rank 0, ended by `mpirun` wherever it was, perhaps inside a write,
+  leaves the file as of its last flush: docs/formats.md, "A killed run's
+  file");
 - the run continues from that checkpoint on 2 ranks (`--restart`) to 1500 s,
   and its file equals a serial run to 1500 s that was never stopped, bit for
   bit (`floesim compare --rtol 0 --atol 0`): nothing the killed run wrote
@@ -120,6 +123,19 @@ elif "no end mark" not in info.stdout or not re.search(r"^checkpoint: t = [0-9.]
     failures.append("floesim info should say the killed run has no end mark and show its checkpoint:\n" + info.stdout)
 else:
     print(re.search(r"^checkpoint: .*", info.stdout, re.M).group(0))
+
+try:
+    import h5py
+
+    def read(name, obj):
+        for a in obj.attrs:
+            obj.attrs[a]
+        if isinstance(obj, h5py.Dataset):
+            obj[()]
+    with h5py.File(killed_file, "r") as f:
+        f.visititems(read)
+except Exception as e:  # noqa: BLE001 (h5py raises OSError, KeyError, RuntimeError, ...)
+    failures.append(f"h5py cannot read the killed run's file whole: {e}")
 
 if not failures:
     continued = os.path.join(W, "continued.h5")
