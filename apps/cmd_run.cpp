@@ -440,11 +440,16 @@ int run(const Args& args, const parallel::Session& session) {
     if (const FloeSeaContact* fs = sim.floe_sea(); fs && !fs->owner_slabs().empty()) {
       o << "parallel.coupling_slab_rows:";
       for (const int r : fs->owner_slabs()) o << " " << r;
-      // Rank 0's cells outside its slab's interior, summed over the
-      // evaluations: sent as pieces (their pieces), summed alone here.
+      o << "\n";
+    }
+    // Rank 0's cells outside its slab's interior (every cell of its pieces
+    // on a sea not in slabs), summed over the evaluations: sent as pieces
+    // (their pieces), summed alone here (owned here, or sent as totals).
+    if (const FloeSeaContact* fs = sim.floe_sea(); fs) {
       const FloeSeaContact::RoutedCells& cells = fs->routed_cells();
-      o << "\nparallel.coupling_cells: " << cells.shared << " shared (" << cells.pieces << " pieces), "
-        << cells.alone_here << " alone owned, " << cells.alone_sent << " alone sent\n";
+      if (cells.shared + cells.alone_here + cells.alone_sent > 0)
+        o << "parallel.coupling_cells: " << cells.shared << " shared (" << cells.pieces << " pieces), "
+          << cells.alone_here << " alone owned, " << cells.alone_sent << " alone sent\n";
     }
     // Stage seven: with a sea in slabs the strips are its slabs, their first
     // rows (then the row count) now.

@@ -235,9 +235,12 @@ public:
   // which sends only the pressure's total to the cell's slab's rank. Every cell's sums are then the serial
   // run's to the bit, whichever rank owns which floe. pressure() then holds
   // this rank's slab's rows only, which is what its sea's kick reads. A sea
-  // not in slabs (stage three) sums each rank's part of a cell and then the
-  // parts in rank order: the serial sums where one rank's floes lie, to
-  // round-off where several ranks' floes share a cell. The implicit step
+  // not in slabs (BEM seas, a tank, dims = 1) is whole on every rank, whose
+  // kick reads every cell's pressure: its floes are owned by index, and
+  // the same routes make every cell's sums on every rank
+  // (parallel::CellRoutes::replicated: a cell under another rank's floe's
+  // box as pieces to every rank, any other cell's pressure as its total),
+  // the serial sums to the bit too. The implicit step
   // stays replicated on every floe's pieces (gathered), to the bit. Every
   // rank calls every method in the same order (they may exchange data).
   void set_communicator(const parallel::Communicator& comm) {
@@ -245,7 +248,10 @@ public:
     footprints_.set_communicator(comm);
     footprints_.set_gather(!by_owner());
     const bool slabs = by_owner() && !slab_rows_.empty();
-    routes_ = slabs ? parallel::CellRoutes(slab_rows_, static_cast<std::size_t>(grid_.nx)) : parallel::CellRoutes();
+    const auto nx = static_cast<std::size_t>(grid_.nx), ny = static_cast<std::size_t>(grid_.ny);
+    routes_ = slabs         ? parallel::CellRoutes(slab_rows_, nx)
+              : by_owner() ? parallel::CellRoutes::replicated(comm.size(), nx, ny)
+                           : parallel::CellRoutes();
     footprints_.set_slabs(slabs ? slab_rows_ : std::vector<int>{});
     owner_.interior_reach = -1;  // the interior cells are those of the new routes
   }
@@ -298,7 +304,7 @@ public:
   // By owner with the sea in slabs: the slabs (first rows) the floes' owners
   // were set by at the footprints' last rebuild (empty otherwise).
   std::span<const int> owner_slabs() const {
-    return routed() ? footprints_.owner_slabs() : std::span<const int>{};
+    return in_slabs() ? footprints_.owner_slabs() : std::span<const int>{};
   }
   // On several ranks: the calling thread's CPU time (s, parallel::
   // thread_seconds) in this rank's per-floe work since the last take: its
@@ -353,8 +359,11 @@ private:
   void clear_footprint_cells();
   // The contact is evaluated by owner: several ranks, explicit kicks.
   bool by_owner() const { return !comm_.serial() && !implicit_; }
-  // The cells' sums by owner go to the slabs' ranks (the sea in slabs).
+  // The cells' sums by owner go through routes_ (by owner, always): to the
+  // slabs' ranks on a sea in slabs (in_slabs()), to every rank on a sea
+  // whole on every rank.
   bool routed() const { return !routes_.empty(); }
+  bool in_slabs() const { return routed() && !routes_.replicated(); }
   // Routed, whether the floes' boxes (parallel::CellBox) tell each rank
   // which of its cells no other rank's floe may share: on grids of at most
   // CellBox::kMaxSide rows and columns; else every cell outside the slabs'
@@ -362,28 +371,33 @@ private:
   bool boxed() const {
     return routed() && grid_.nx <= parallel::CellBox::kMaxSide && grid_.ny <= parallel::CellBox::kMaxSide;
   }
+  // Whether every rank that needs a shared cell's totals sums its pieces
+  // itself (CellRoutes::open_shared, nothing sent back): with the boxes,
+  // and always on a sea whole on every rank (every rank needs every cell's
+  // pressure); else the slab's rank sums and replies (open, reply).
+  bool one_round() const { return routes_.replicated() || boxed(); }
   // By owner (floe_sea_owners.cpp): zeroes pressure_ and cells_ where the
   // last evaluation by owner wrote them.
   void clear_cells_by_owner();
   // By owner (floe_sea_owners.cpp): this rank's pieces' coverage into
   // cells_[c].coverage of this rank's cells (cells_ is zero in the others):
-  // routed, every rank's pieces of a shared cell summed in the serial order
-  // by each rank that needs it (without the boxes, by the cell's slab's rank);
-  // not routed, every rank's parts in rank order.
+  // every rank's pieces of a shared cell summed in the serial order by each
+  // rank that needs it (in slabs without the boxes, by the cell's slab's
+  // rank).
   void sum_coverage_by_owner();
   // By owner, after the law (eval_: penetrations u, weights psi, forces):
   // this rank's pieces' a u^2 and pressure in its cells and its part of the
   // penalty energy ks psi a u^2 / 2, in one pass; then, summed over the
-  // ranks as the coverage is, into pressure_ (every cell; routed, the cells
-  // of this rank's slab) and cells_[c].sum (this rank's cells); returns the
-  // energy, the ranks' parts summed in rank order (routed, until
+  // ranks as the coverage is, into pressure_ (the cells of this rank's
+  // slab; every cell not in slabs) and cells_[c].sum (this rank's cells);
+  // returns the energy, the ranks' parts summed in rank order (until
   // settle_energy sums the terms in the serial order).
   double sum_cells_by_owner(double ks);
   // By owner: order_ <- this rank's floes in the serial order, and
   // owner_.position every floe's place in that order (one gather of the
   // floes' first cells).
   void order_by_owner(std::size_t floes);
-  // By owner, routed: the penalty energy from every rank's terms
+  // By owner: the penalty energy from every rank's terms
   // (owner_.energy_*), summed in the serial order (one gather).
   void settle_energy() const;
   // poses_ <- the floes' present poses: every floe's, or those of `which`
@@ -441,18 +455,14 @@ private:
     double sum = 0.0;       // sum over the pieces in cell c of a_k [delta_k]^+^2
   };
   std::vector<CellSums> cells_;
-  // The contact by owner: the cells of this rank's pieces and its partial
-  // sums there, and every rank's cells. The next evaluation clears pressure_
-  // in every rank's cells and cells_ in this rank's.
+  // The contact by owner: the cells of this rank's pieces that travel as
+  // pieces. The next evaluation clears pressure_ where the routes put it
+  // and in this rank's pieces' cells, cells_ in the latter.
   struct OwnerCells {
     std::vector<std::uint32_t> slot;   // per grid cell: 1 + its index in `cells`, 0: none of this rank's pieces
-    std::vector<std::uint32_t> cells;  // this rank's cells, in the order its pieces meet them
-    std::vector<std::uint32_t> piece_slot;  // not routed: per area piece of this rank's floes, its cell's index in `cells`
-    std::vector<double> coverage, sum, pressure;  // per cell of `cells`: this rank's part
-    std::vector<std::uint32_t> touched;  // every rank's cells, in rank order (where pressure_ may be nonzero)
-    std::vector<std::size_t> counts;     // cells per rank in `touched`
-    std::vector<std::byte> message, received;  // the exchanges' buffers, kept from one evaluation to the next
-    // Routed: per grid cell, what kind (CellKind): deep in its slab (every
+    std::vector<std::uint32_t> cells;  // this rank's cells sent as pieces, in the order its pieces meet them
+    std::vector<double> coverage, sum;  // per cell of `cells`: the totals sent back (in slabs without the boxes)
+    // Per grid cell, what kind (CellKind): deep in its slab (every
     // row within `interior_reach` rows is the slab's), where only the slab's
     // rank has pieces; else, during sum_coverage_by_owner, whether another
     // rank's floe's box covers it (shared: its pieces are routed), and

@@ -42,19 +42,19 @@
 // serial order, is kept as this rank's terms and summed in that order on
 // demand (settle_energy: at records and checkpoints).
 //
-// Sea not in slabs (stage three): each rank sends, for the cells its pieces
-// lie in, its part of each sum: the cells and their coverage (12 bytes a
-// cell) before the law, the sums and pressures (16 bytes a cell) after it.
-// Every rank receives every rank's parts and adds them in rank order from
-// zero: the pressure in every cell (the sea, replicated, needs all of it),
-// the coverage and the sums only in the cells of its own pieces (the law and
-// the horizontal loads read no other: an edge piece's cell is its area
-// piece's). A cell where one rank's floes lie gets 0 + that rank's part, the
-// serial sum; a cell shared by several ranks' floes gets the parts' sum,
-// which groups the pieces by rank: equal to the serial sum up to round-off.
+// Sea not in slabs (BEM seas, a tank, dims = 1: every rank holds the whole
+// sea, whose kick reads every cell's pressure; CellRoutes::replicated). The
+// same two kinds of cells, every row being a boundary row: the floes are
+// owned by index, not by place, so no cell is deep in one rank's part. A
+// cell no other rank's floe's box covers is summed here from zero in
+// order_, the serial sums, and its pressure's total goes to every other
+// rank (4 bytes a cell, then 8). Every other cell travels as its pieces to
+// every rank (each needs its pressure; those with pieces there, its
+// coverage and sum), which adds them from zero in key order: the serial
+// sum to the bit on every rank, as on a sea in slabs. The penalty energy
+// is settled from the terms likewise.
 #include <algorithm>
 #include <bit>
-#include <cstring>
 #include <utility>
 
 #include "coupling/floe_sea.hpp"
@@ -79,12 +79,12 @@ void FloeSeaContact::set_slabs(std::vector<int> first_row) {
   if (first_row == slab_rows_) return;
   // The old routes' cells: this rank's sums there are no longer read by
   // its sea, and clear_cells_by_owner() will clear the new routes' cells.
-  if (routed() && pressure_.size() == grid_.size()) {
+  if (in_slabs() && pressure_.size() == grid_.size()) {
     for (std::uint32_t c : routes_.owned()) pressure_[c] = 0.0;
     for (std::uint32_t c : routes_.alone_owned()) pressure_[c] = 0.0;
   }
   slab_rows_ = std::move(first_row);
-  if (!routed()) return;
+  if (!in_slabs()) return;
   routes_ = parallel::CellRoutes(slab_rows_, static_cast<std::size_t>(grid_.nx));
   footprints_.set_sea_slabs(slab_rows_, true);
   owner_.interior_reach = -1;  // the interior cells are those of the new routes
@@ -162,16 +162,13 @@ void FloeSeaContact::settle_energy() const {
 }
 
 void FloeSeaContact::clear_cells_by_owner() {
-  // The pressure where the last evaluation put it: every rank's cells (not
-  // routed) or the routed cells received and this rank's slab's alone
-  // cells; the coverage and sums in this rank's cells; and, routed, the
-  // cells of its last pieces, where it summed alone.
-  for (std::uint32_t c : routed() ? routes_.owned() : std::span<const std::uint32_t>(owner_.touched)) pressure_[c] = 0.0;
+  // The pressure where the last evaluation put it: the cells received as
+  // pieces and the alone cells received as totals (this rank's slab's, or
+  // every other rank's not in slabs); the coverage and sums in this rank's
+  // cells; and the cells of its last pieces, where it summed alone.
+  FLOESIM_ASSERT(routed());
+  for (std::uint32_t c : routes_.owned()) pressure_[c] = 0.0;
   for (std::uint32_t c : routes_.alone_owned()) pressure_[c] = 0.0;
-  if (!routed()) {
-    for (std::uint32_t c : owner_.cells) cells_[c] = {};
-    return;
-  }
   // Every cell of this rank's pieces, as the serial clear_footprint_cells:
   // the cells summed here alone and those of owner_.cells. One pass over
   // the pieces' cells as stored (no per-piece kind or slot read); zeroing
@@ -186,49 +183,48 @@ void FloeSeaContact::clear_cells_by_owner() {
 void FloeSeaContact::sum_coverage_by_owner() {
   const Footprints& fp = footprints_.pieces();
   OwnerCells& o = owner_;
-  // Routed, a cell where this rank's floes' pieces lie alone gets no other
-  // rank's: its sums are made in cells_ and pressure_ directly, as the
-  // serial loop makes them (its pieces are all of the cell's, in order_,
-  // the serial order). Such are the cells deep in this rank's slab (no
-  // other rank's floe reaches them) and, with the floes' boxes (boxed()),
-  // every cell no other rank's floe's box covers; the pressure of those
-  // another rank owns goes to it as a total (`alone`). Every other cell
-  // goes to its owner as pieces. Not routed, no cell is summed alone.
-  const bool routed_cells = routed(), boxes = boxed();
+  // A cell where this rank's floes' pieces lie alone gets no other rank's:
+  // its sums are made in cells_ and pressure_ directly, as the serial loop
+  // makes them (its pieces are all of the cell's, in order_, the serial
+  // order). Such are the cells deep in this rank's slab (no other rank's
+  // floe reaches them; none when not in slabs) and, with the floes' boxes
+  // (boxed()), every cell no other rank's floe's box covers; the pressure
+  // of those another rank holds goes to it as a total (`alone`). Every
+  // other cell goes as pieces to the ranks that sum it.
+  FLOESIM_ASSERT(routed());
+  const bool boxes = boxed();
   const std::size_t nx = static_cast<std::size_t>(grid_.nx);
   const std::size_t rank_words = (static_cast<std::size_t>(comm_.size()) + 63) / 64;
-  if (routed_cells) {
-    const int reach = footprints_.by_place() ? footprints_.reach_rows() : grid_.ny;
-    if (reach != o.interior_reach) {
-      o.interior_row = routes_.interior_rows(reach);
-      o.kind.resize(grid_.size());
-      for (std::size_t y = 0; y < o.interior_row.size(); ++y)
-        std::fill_n(o.kind.begin() + static_cast<std::ptrdiff_t>(y * nx), nx,
-                    o.interior_row[y] ? OwnerCells::kInteriorRow : OwnerCells::kRoutedRow);
-      o.interior_reach = reach;
-    }
-    // The cells other ranks' floes may have pieces in, outside the slabs'
-    // interiors (where no other rank's floe reaches).
-    // With each such cell, the ranks of those floes: each sums the cell
-    // too.
-    if (boxes) {
-      // The boxes of the other ranks' floes that may cover a cell of this
-      // rank's pieces (coupling/shared_cells.hpp: a row within R_max and
-      // about two cells of its slab of the owners); no other box is read.
-      std::vector<std::uint32_t> near;
-      if (footprints_.by_place()) {
-        near = box_neighbours(o.serial, footprints_.owners(), comm_.rank(), footprints_.owner_slabs(), o.box, grid_,
-                              footprints_.piece_rows());
-      } else {
-        for (const std::uint32_t i : o.serial)
-          if (!footprints_.owns(i)) near.push_back(i);
-      }
-      mark_shared_cells(near, o.box, footprints_.owners(), grid_.nx, grid_.ny, o.interior_row, o.kind,
-                        OwnerCells::kRoutedRow, OwnerCells::kShared, rank_words, o.marks);
+  const int reach = footprints_.by_place() ? footprints_.reach_rows() : grid_.ny;
+  if (reach != o.interior_reach) {
+    o.interior_row = routes_.interior_rows(reach);
+    o.kind.resize(grid_.size());
+    for (std::size_t y = 0; y < o.interior_row.size(); ++y)
+      std::fill_n(o.kind.begin() + static_cast<std::ptrdiff_t>(y * nx), nx,
+                  o.interior_row[y] ? OwnerCells::kInteriorRow : OwnerCells::kRoutedRow);
+    o.interior_reach = reach;
+  }
+  // The cells other ranks' floes may have pieces in, outside the slabs'
+  // interiors (where no other rank's floe reaches).
+  // With each such cell, the ranks of those floes: each sums the cell
+  // too.
+  if (boxes) {
+    // The boxes of the other ranks' floes that may cover a cell of this
+    // rank's pieces (coupling/shared_cells.hpp: a row within R_max and
+    // about two cells of its slab of the owners); no other box is read.
+    std::vector<std::uint32_t> near;
+    if (footprints_.by_place()) {
+      near = box_neighbours(o.serial, footprints_.owners(), comm_.rank(), footprints_.owner_slabs(), o.box, grid_,
+                            footprints_.piece_rows());
     } else {
-      o.marks.painted.clear();
-      o.marks.shared_ranks.clear();
+      for (const std::uint32_t i : o.serial)
+        if (!footprints_.owns(i)) near.push_back(i);
     }
+    mark_shared_cells(near, o.box, footprints_.owners(), grid_.nx, grid_.ny, o.interior_row, o.kind,
+                      OwnerCells::kRoutedRow, OwnerCells::kShared, rank_words, o.marks);
+  } else {
+    o.marks.painted.clear();
+    o.marks.shared_ranks.clear();
   }
   // This rank's other cells, in the order its floes' pieces meet them, and
   // its part of each cell's coverage, summed as the serial loop sums it.
@@ -237,7 +233,7 @@ void FloeSeaContact::sum_coverage_by_owner() {
   o.cells.clear();
   o.coverage.clear();
   o.alone.clear();
-  o.first.assign(1, 0);  // routed: then each cell's piece count, made offsets below
+  o.first.assign(1, 0);  // then each cell's piece count, made offsets below
   o.routed_pieces.clear();
   FLOESIM_ASSERT(fp.cell.size() <= 0xffffffffu);  // RoutedPiece::piece
   const double inv_cell_area = 1.0 / cell_area_;
@@ -253,87 +249,80 @@ void FloeSeaContact::sum_coverage_by_owner() {
     }
     return o.slot[c] - 1;
   };
-  if (routed_cells) {
-    for (std::uint32_t i : order_) {
-      // The row of a piece's cell, found by a division only when it
-      // changes (a floe's cells come row by row); in an interior row the
-      // cell is this rank's alone and its kind is not read.
-      std::size_t row_base = grid_.size();
-      bool interior = false;
-      const std::size_t end = fp.offsets[i + 1];
-      for (std::size_t k = fp.offsets[i]; k < end; ++k) {
-        if (k + kPrefetchPieces < end) __builtin_prefetch(&cells_[fp.cell[k + kPrefetchPieces]], 1);
-        const std::uint32_t c = fp.cell[k];
-        if (c < row_base || c - row_base >= nx) {
-          const std::size_t row = c / nx;
-          row_base = row * nx;
-          interior = o.interior_row[row] != 0;
-        }
-        const std::uint8_t kind = interior ? std::uint8_t{OwnerCells::kInteriorRow} : o.kind[c];
-        if (kind == OwnerCells::kInteriorRow || (boxes && kind != OwnerCells::kShared)) {
-          cells_[c].coverage += fp.area[k] * inv_cell_area;
-          if (kind == OwnerCells::kRoutedRow) {  // first met: listed, and its total sent if another rank owns it
-            o.kind[c] = OwnerCells::kAloneListed;
-            o.marks.painted.push_back(c);
-            if (routes_.owner(c) != rank) o.alone.push_back(c);
-            else ++alone_here;
-          }
-          continue;
-        }
-        // The cell's receivers sum the pieces (the total replaces this
-        // rank's part below): only counted here, and the piece listed with
-        // its floe's key, in order_ (the serial order) as this loop meets it.
-        const std::uint32_t j = listed(c);
-        ++o.first[j + 1];
-        o.routed_pieces.push_back({static_cast<std::uint32_t>(k), o.position[i], j, 0});
+  for (std::uint32_t i : order_) {
+    // The row of a piece's cell, found by a division only when it
+    // changes (a floe's cells come row by row); in an interior row the
+    // cell is this rank's alone and its kind is not read.
+    std::size_t row_base = grid_.size();
+    bool interior = false;
+    const std::size_t end = fp.offsets[i + 1];
+    for (std::size_t k = fp.offsets[i]; k < end; ++k) {
+      if (k + kPrefetchPieces < end) __builtin_prefetch(&cells_[fp.cell[k + kPrefetchPieces]], 1);
+      const std::uint32_t c = fp.cell[k];
+      if (c < row_base || c - row_base >= nx) {
+        const std::size_t row = c / nx;
+        row_base = row * nx;
+        interior = o.interior_row[row] != 0;
       }
+      const std::uint8_t kind = interior ? std::uint8_t{OwnerCells::kInteriorRow} : o.kind[c];
+      if (kind == OwnerCells::kInteriorRow || (boxes && kind != OwnerCells::kShared)) {
+        cells_[c].coverage += fp.area[k] * inv_cell_area;
+        if (kind == OwnerCells::kRoutedRow) {  // first met: listed, and its total sent if another rank holds it
+          o.kind[c] = OwnerCells::kAloneListed;
+          o.marks.painted.push_back(c);
+          if (routes_.replicated() || routes_.owner(c) != rank) o.alone.push_back(c);
+          else ++alone_here;
+        }
+        continue;
+      }
+      // The cell's receivers sum the pieces (the total replaces this
+      // rank's part below): only counted here, and the piece listed with
+      // its floe's key, in order_ (the serial order) as this loop meets it.
+      const std::uint32_t j = listed(c);
+      ++o.first[j + 1];
+      o.routed_pieces.push_back({static_cast<std::uint32_t>(k), o.position[i], j, 0});
     }
-  } else {
-    o.piece_slot.resize(fp.cell.size());
-    for (std::uint32_t i : order_)
-      for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k) {
-        const std::uint32_t j = listed(fp.cell[k]);
-        o.piece_slot[k] = j;
-        o.coverage[j] += fp.area[k] * inv_cell_area;
-      }
   }
   // The kinds back to the rows' (the boxes move with the floes).
   for (std::uint32_t c : o.marks.painted) o.kind[c] = OwnerCells::kRoutedRow;
-  if (routed()) {
-    // The routed cells' pieces grouped by cell, in the serial order within
-    // each (order_ is), with their floes' positions.
-    for (std::size_t j = 0; j < o.cells.size(); ++j) o.first[j + 1] += o.first[j];
-    o.keys.resize(o.first.back());
-    o.values.resize(o.first.back());
-    // (From the list of the routed pieces made above, in the same order:
-    // the few routed pieces, not a second pass over all of them.)
-    std::vector<std::uint32_t> next(o.first.begin(), o.first.end() - 1);
-    for (OwnerCells::RoutedPiece& r : o.routed_pieces) {
-      r.at = next[r.cell]++;
-      o.keys[r.at] = r.key;
-      o.values[r.at] = fp.area[r.piece] * inv_cell_area;
-    }
-    o.routed_counts.shared += static_cast<long>(o.cells.size());
-    o.routed_counts.pieces += static_cast<long>(o.first.back());
-    o.routed_counts.alone_here += static_cast<long>(alone_here);
-    o.routed_counts.alone_sent += static_cast<long>(o.alone.size());
-    if (!boxes) {
-      // Each cell to its slab's rank, which sends the total back.
-      routes_.open(comm_, o.cells, o.first, o.keys, o.values, 1, o.alone);
-      routes_.reply(comm_, 0, o.coverage);  // the cells' totals, in place of this rank's parts
-      for (std::size_t j = 0; j < o.cells.size(); ++j) cells_[o.cells[j]].coverage = o.coverage[j];
-      return;
-    }
-    // Each shared cell to every rank that needs its total: the ranks whose
-    // floes' boxes cover it (all that may have pieces there), its slab's
-    // rank and this one; each sums every rank's pieces in the serial order.
-    o.receivers_first.assign(1, 0);
-    o.receivers.clear();
-    // (Ascending, each once: the covering ranks' bits, with this rank and
-    // the slab's; a cell's cost is its covering ranks', not every rank's.)
-    for (const std::uint32_t c : o.cells) {
+  // The routed cells' pieces grouped by cell, in the serial order within
+  // each (order_ is), with their floes' positions.
+  for (std::size_t j = 0; j < o.cells.size(); ++j) o.first[j + 1] += o.first[j];
+  o.keys.resize(o.first.back());
+  o.values.resize(o.first.back());
+  // (From the list of the routed pieces made above, in the same order:
+  // the few routed pieces, not a second pass over all of them.)
+  std::vector<std::uint32_t> next(o.first.begin(), o.first.end() - 1);
+  for (OwnerCells::RoutedPiece& r : o.routed_pieces) {
+    r.at = next[r.cell]++;
+    o.keys[r.at] = r.key;
+    o.values[r.at] = fp.area[r.piece] * inv_cell_area;
+  }
+  o.routed_counts.shared += static_cast<long>(o.cells.size());
+  o.routed_counts.pieces += static_cast<long>(o.first.back());
+  o.routed_counts.alone_here += static_cast<long>(alone_here);
+  o.routed_counts.alone_sent += static_cast<long>(o.alone.size());
+  if (!one_round()) {
+    // Each cell to its slab's rank, which sends the total back.
+    routes_.open(comm_, o.cells, o.first, o.keys, o.values, 1, o.alone);
+    routes_.reply(comm_, 0, o.coverage);  // the cells' totals, in place of this rank's parts
+    for (std::size_t j = 0; j < o.cells.size(); ++j) cells_[o.cells[j]].coverage = o.coverage[j];
+    return;
+  }
+  // Each shared cell to every rank that needs its total: the ranks whose
+  // floes' boxes cover it (all that may have pieces there), its slab's
+  // rank and this one; not in slabs, every rank (each sea reads every
+  // cell's pressure). Each sums every rank's pieces in the serial order.
+  o.receivers_first.assign(1, 0);
+  o.receivers.clear();
+  for (const std::uint32_t c : o.cells) {
+    const auto first = static_cast<std::ptrdiff_t>(o.receivers.size());
+    if (routes_.replicated()) {
+      for (int r = 0; r < comm_.size(); ++r) o.receivers.push_back(r);
+    } else {
+      // (Ascending, each once: the covering ranks' bits, with this rank and
+      // the slab's; a cell's cost is its covering ranks', not every rank's.)
       const std::uint64_t* ranks = o.marks.shared_ranks.data() + (o.marks.shared_at[c] - 1) * rank_words;
-      const auto first = static_cast<std::ptrdiff_t>(o.receivers.size());
       o.receivers.push_back(rank);
       o.receivers.push_back(routes_.owner(c));
       for (std::size_t w = 0; w < rank_words; ++w)
@@ -341,36 +330,12 @@ void FloeSeaContact::sum_coverage_by_owner() {
           o.receivers.push_back(static_cast<int>(64 * w) + std::countr_zero(bits));
       std::sort(o.receivers.begin() + first, o.receivers.end());
       o.receivers.erase(std::unique(o.receivers.begin() + first, o.receivers.end()), o.receivers.end());
-      o.receivers_first.push_back(static_cast<std::uint32_t>(o.receivers.size()));
     }
-    for (const std::uint32_t c : o.marks.painted) o.marks.shared_at[c] = 0;
-    routes_.open_shared(comm_, o.cells, o.first, o.keys, o.values, 1, o.receivers_first, o.receivers, o.alone);
-    for (const std::uint32_t c : o.cells) cells_[c].coverage = routes_.total(routes_.index(c), 0);
-    return;
+    o.receivers_first.push_back(static_cast<std::uint32_t>(o.receivers.size()));
   }
-  // Message: the cells, then their coverage.
-  o.message.resize(o.cells.size() * (sizeof(std::uint32_t) + sizeof(double)));
-  put(put(o.message.data(), o.cells.data(), o.cells.size()), o.coverage.data(), o.coverage.size());
-  std::vector<std::size_t> bytes;
-  comm_.allgather_bytes(o.message, bytes, o.received);
-  // clear_footprint_cells zeroed the last evaluation's cells; every other
-  // cell is zero, so the sums below start from zero.
-  constexpr std::size_t kCellBytes = sizeof(std::uint32_t) + sizeof(double);
-  o.touched.clear();
-  o.counts.assign(bytes.size(), 0);
-  const std::byte* in = o.received.data();
-  for (std::size_t r = 0; r < bytes.size(); ++r) {
-    const std::size_t n = bytes[r] / kCellBytes, first = o.touched.size();
-    o.counts[r] = n;
-    o.touched.resize(first + n);
-    std::memcpy(o.touched.data() + first, in, n * sizeof(std::uint32_t));
-    const std::byte* coverage = in + n * sizeof(std::uint32_t);
-    for (std::size_t j = 0; j < n; ++j) {
-      const std::uint32_t c = o.touched[first + j];
-      if (o.slot[c] != 0) cells_[c].coverage += at<double>(coverage, j);
-    }
-    in += bytes[r];
-  }
+  for (const std::uint32_t c : o.marks.painted) o.marks.shared_at[c] = 0;
+  routes_.open_shared(comm_, o.cells, o.first, o.keys, o.values, 1, o.receivers_first, o.receivers, o.alone);
+  for (const std::uint32_t c : o.cells) cells_[c].coverage = routes_.total(routes_.index(c), 0);
 }
 
 double FloeSeaContact::sum_cells_by_owner(double ks) {
@@ -382,101 +347,69 @@ double FloeSeaContact::sum_cells_by_owner(double ks) {
   const double inv_cell_area = 1.0 / cell_area_;
   const int rank = comm_.rank();
   double energy = 0.0;
-  if (routed()) {
-    // The routed pieces' a u^2 and pressure (zero where u <= 0, which the
-    // serial loop skips: adding +0 changes no sum that starts from +0), the
-    // interior cells' sums made here, and this rank's energy terms.
-    o.parts.assign(2 * o.first.back(), 0.0);
-    o.energy_keys.clear();
-    o.energy_counts.clear();
-    o.energy_terms.clear();
-    // The routed pieces come listed in this loop's order (the coverage's
-    // pass met them so): the next one listed is this piece or a later one.
-    const std::span<const OwnerCells::RoutedPiece> routed_pieces = o.routed_pieces;
-    std::size_t next = 0;
-    for (std::uint32_t i : order_) {
-      const std::size_t terms = o.energy_terms.size();
-      const std::size_t end = fp.offsets[i + 1];
-      for (std::size_t k = fp.offsets[i]; k < end; ++k) {
-        if (k + kPrefetchPieces < end) {
-          __builtin_prefetch(&cells_[fp.cell[k + kPrefetchPieces]], 1);
-          __builtin_prefetch(&pressure_[fp.cell[k + kPrefetchPieces]], 1);
-        }
-        const bool routed_piece = next < routed_pieces.size() && routed_pieces[next].piece == k;
-        const std::uint32_t at = routed_piece ? routed_pieces[next++].at : 0;
-        if (u[k] <= 0.0) continue;
-        const double term = 0.5 * ks * psi[k] * fp.area[k] * u[k] * u[k];
-        energy += term;
-        o.energy_terms.push_back(term);
-        if (!routed_piece) {
-          cells_[fp.cell[k]].sum += fp.area[k] * u[k] * u[k];
-          pressure_[fp.cell[k]] += force[k] * inv_cell_area;
-          continue;
-        }
-        o.parts[2 * at] = fp.area[k] * u[k] * u[k];
-        o.parts[2 * at + 1] = force[k] * inv_cell_area;
+  FLOESIM_ASSERT(routed());
+  // The routed pieces' a u^2 and pressure (zero where u <= 0, which the
+  // serial loop skips: adding +0 changes no sum that starts from +0), the
+  // interior cells' sums made here, and this rank's energy terms.
+  o.parts.assign(2 * o.first.back(), 0.0);
+  o.energy_keys.clear();
+  o.energy_counts.clear();
+  o.energy_terms.clear();
+  // The routed pieces come listed in this loop's order (the coverage's
+  // pass met them so): the next one listed is this piece or a later one.
+  const std::span<const OwnerCells::RoutedPiece> routed_pieces = o.routed_pieces;
+  std::size_t next = 0;
+  for (std::uint32_t i : order_) {
+    const std::size_t terms = o.energy_terms.size();
+    const std::size_t end = fp.offsets[i + 1];
+    for (std::size_t k = fp.offsets[i]; k < end; ++k) {
+      if (k + kPrefetchPieces < end) {
+        __builtin_prefetch(&cells_[fp.cell[k + kPrefetchPieces]], 1);
+        __builtin_prefetch(&pressure_[fp.cell[k + kPrefetchPieces]], 1);
       }
-      if (o.energy_terms.size() > terms) {
-        o.energy_keys.push_back(o.position[i]);
-        o.energy_counts.push_back(static_cast<std::uint32_t>(o.energy_terms.size() - terms));
-      }
-    }
-    // The pressure of the cells summed here alone that another rank owns:
-    // their totals to it (this rank's sea does not read them).
-    o.alone_totals.resize(o.alone.size());
-    for (std::size_t j = 0; j < o.alone.size(); ++j) o.alone_totals[j] = std::exchange(pressure_[o.alone[j]], 0.0);
-    const double total = routes_.add(comm_, o.parts, 2, energy, o.alone_totals);
-    // The pressure of this rank's slab's cells (zero before: 0 + the total;
-    // with the boxes some received cells are other slabs', summed here for
-    // their sums), then the sums of this rank's cells: with the boxes
-    // summed here, else sent back by the cells' slabs' ranks.
-    const std::span<const std::uint32_t> held = routes_.owned();
-    for (std::size_t j = 0; j < held.size(); ++j)
-      if (routes_.owner(held[j]) == rank) pressure_[held[j]] = routes_.total(j, 1);
-    const std::span<const std::uint32_t> alone = routes_.alone_owned();
-    for (std::size_t j = 0; j < alone.size(); ++j) pressure_[alone[j]] = routes_.alone_total(j);  // the sender's sum from zero
-    if (boxed()) {
-      for (const std::uint32_t c : o.cells) cells_[c].sum = routes_.total(routes_.index(c), 0);
-    } else {
-      o.sum.resize(o.cells.size());
-      routes_.reply(comm_, 0, o.sum);
-      for (std::size_t j = 0; j < o.cells.size(); ++j) cells_[o.cells[j]].sum = o.sum[j];
-    }
-    energy_pending_ = true;  // the ranks' parts summed in rank order until settled
-    return total;
-  }
-  o.sum.assign(o.cells.size(), 0.0);
-  o.pressure.assign(o.cells.size(), 0.0);
-  for (std::uint32_t i : order_)
-    for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k) {
+      const bool routed_piece = next < routed_pieces.size() && routed_pieces[next].piece == k;
+      const std::uint32_t at = routed_piece ? routed_pieces[next++].at : 0;
       if (u[k] <= 0.0) continue;
-      const std::uint32_t j = o.piece_slot[k];
-      energy += 0.5 * ks * psi[k] * fp.area[k] * u[k] * u[k];
-      o.sum[j] += fp.area[k] * u[k] * u[k];
-      o.pressure[j] += force[k] * inv_cell_area;
+      const double term = 0.5 * ks * psi[k] * fp.area[k] * u[k] * u[k];
+      energy += term;
+      o.energy_terms.push_back(term);
+      if (!routed_piece) {
+        cells_[fp.cell[k]].sum += fp.area[k] * u[k] * u[k];
+        pressure_[fp.cell[k]] += force[k] * inv_cell_area;
+        continue;
+      }
+      o.parts[2 * at] = fp.area[k] * u[k] * u[k];
+      o.parts[2 * at + 1] = force[k] * inv_cell_area;
     }
-  // Message: the energy, then the sums and pressures of the cells sent
-  // before (every rank knows how many).
-  o.message.resize(sizeof(double) * (1 + 2 * o.cells.size()));
-  put(put(put(o.message.data(), &energy, 1), o.sum.data(), o.sum.size()), o.pressure.data(), o.pressure.size());
-  std::vector<std::size_t> bytes(o.counts.size());
-  for (std::size_t r = 0; r < o.counts.size(); ++r) bytes[r] = sizeof(double) * (1 + 2 * o.counts[r]);
-  comm_.allgather_known(o.message, bytes, o.received);
-  double total = 0.0;
-  const std::byte* in = o.received.data();
-  const std::uint32_t* cell = o.touched.data();
-  for (std::size_t r = 0; r < o.counts.size(); ++r) {
-    const std::size_t n = o.counts[r];
-    total += at<double>(in, 0);
-    const std::byte* sum = in + sizeof(double);
-    const std::byte* pressure = sum + n * sizeof(double);
-    for (std::size_t j = 0; j < n; ++j) {
-      pressure_[cell[j]] += at<double>(pressure, j);
-      if (o.slot[cell[j]] != 0) cells_[cell[j]].sum += at<double>(sum, j);
+    if (o.energy_terms.size() > terms) {
+      o.energy_keys.push_back(o.position[i]);
+      o.energy_counts.push_back(static_cast<std::uint32_t>(o.energy_terms.size() - terms));
     }
-    cell += n;
-    in += bytes[r];
   }
+  // The pressure of the cells summed here alone that another rank holds:
+  // their totals to it (in slabs this rank's sea does not read them; not in
+  // slabs it does, and keeps them).
+  o.alone_totals.resize(o.alone.size());
+  for (std::size_t j = 0; j < o.alone.size(); ++j)
+    o.alone_totals[j] = routes_.replicated() ? pressure_[o.alone[j]] : std::exchange(pressure_[o.alone[j]], 0.0);
+  const double total = routes_.add(comm_, o.parts, 2, energy, o.alone_totals);
+  // The pressure of this rank's slab's cells, or of every cell not in
+  // slabs (zero before: 0 + the total; in slabs with the boxes some
+  // received cells are other slabs', summed here for their sums), then the sums of this rank's cells: with the boxes
+  // summed here, else sent back by the cells' slabs' ranks.
+  const std::span<const std::uint32_t> held = routes_.owned();
+  for (std::size_t j = 0; j < held.size(); ++j)
+    if (routes_.holds(rank, held[j])) pressure_[held[j]] = routes_.total(j, 1);
+  const std::span<const std::uint32_t> alone = routes_.alone_owned();
+  for (std::size_t j = 0; j < alone.size(); ++j) pressure_[alone[j]] = routes_.alone_total(j);  // the sender's sum from zero
+  if (one_round()) {
+    for (const std::uint32_t c : o.cells) cells_[c].sum = routes_.total(routes_.index(c), 0);
+  } else {
+    o.sum.resize(o.cells.size());
+    routes_.reply(comm_, 0, o.sum);
+    for (std::size_t j = 0; j < o.cells.size(); ++j) cells_[o.cells[j]].sum = o.sum[j];
+  }
+  energy_pending_ = true;  // the ranks' parts summed in rank order until settled
   return total;
 }
 

@@ -49,7 +49,6 @@ void FloeSeaContact::start(Floes& floes, fluid::Sea& sea, bool given) {
   const std::size_t n = floes.size();
   pressure_.assign(grid.size(), 0.0);  // evaluate() clears only the footprints' cells
   cells_.assign(grid.size(), {});
-  owner_.touched.clear();
   pressure_kicked_ = false;
   pose_at_states(floes);
   // The static problem couples every floe sharing a cell: it reads every

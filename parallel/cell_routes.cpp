@@ -56,13 +56,26 @@ CellRoutes::CellRoutes(std::vector<int> first_row, std::size_t columns)
     : first_row_(std::move(first_row)), columns_(columns) {
   FLOESIM_ASSERT(first_row_.size() >= 2 && columns_ > 0);
   row_owner_ = row_owners(first_row_);
-  slot_.assign(row_owner_.size() * columns_, 0);
+  rows_ = row_owner_.size();
+  ranks_ = static_cast<int>(first_row_.size()) - 1;
+  slot_.assign(rows_ * columns_, 0);
+}
+
+CellRoutes CellRoutes::replicated(int ranks, std::size_t columns, std::size_t rows) {
+  FLOESIM_ASSERT(ranks >= 1 && columns > 0 && rows > 0);
+  CellRoutes routes;
+  routes.replicated_ = true;
+  routes.ranks_ = ranks;
+  routes.columns_ = columns;
+  routes.rows_ = rows;
+  routes.slot_.assign(rows * columns, 0);
+  return routes;
 }
 
 std::vector<std::uint8_t> CellRoutes::interior_rows(int reach) const {
-  const int rows = static_cast<int>(row_owner_.size());
-  std::vector<std::uint8_t> interior(row_owner_.size(), 0);
-  if (reach >= rows) return interior;
+  const int rows = static_cast<int>(rows_);
+  std::vector<std::uint8_t> interior(rows_, 0);
+  if (replicated_ || reach >= rows) return interior;
   for (int y = 0; y < rows; ++y) {
     bool inside = true;
     for (int d = -reach; d <= reach && inside; ++d) inside = row_owner_[static_cast<std::size_t>(((y + d) % rows + rows) % rows)] == row_owner_[static_cast<std::size_t>(y)];
@@ -75,6 +88,7 @@ void CellRoutes::open(const Communicator& comm, std::span<const std::uint32_t> c
                       std::span<const std::uint32_t> keys, std::span<const double> parts, int width,
                       std::span<const std::uint32_t> alone) {
   // Each cell to its owner alone.
+  FLOESIM_ASSERT(!replicated_);
   owner_first_.resize(cells.size() + 1);
   owner_list_.resize(cells.size());
   for (std::size_t k = 0; k < cells.size(); ++k) {
@@ -100,11 +114,11 @@ void CellRoutes::send_pieces(const Communicator& comm, std::span<const std::uint
                              std::span<const double> parts, int width, std::span<const std::uint32_t> receivers_first,
                              std::span<const int> receivers, std::span<const std::uint32_t> alone) {
   const std::size_t ranks = static_cast<std::size_t>(comm.size()), w = static_cast<std::size_t>(width);
-  FLOESIM_ASSERT(ranks + 1 == first_row_.size() && first.size() == cells.size() + 1 && keys.size() == first.back() &&
+  FLOESIM_ASSERT(static_cast<int>(ranks) == ranks_ && first.size() == cells.size() + 1 && keys.size() == first.back() &&
                  parts.size() == keys.size() * w);
   // This rank's cells grouped by receiver (a cell in the group of each of
-  // its receivers) and its alone cells by owner, in their order within each
-  // group.
+  // its receivers) and its alone cells by owner (replicated: each in the
+  // group of every other rank), in their order within each group.
   sent_.assign(ranks, 0);
   sent_pieces_.assign(ranks, 0);
   sent_alone_.assign(ranks, 0);
@@ -114,18 +128,30 @@ void CellRoutes::send_pieces(const Communicator& comm, std::span<const std::uint
       ++sent_[r];
       sent_pieces_[r] += first[k + 1] - first[k];
     }
-  for (const std::uint32_t c : alone) ++sent_alone_[static_cast<std::size_t>(owner(c))];
+  const std::size_t me = static_cast<std::size_t>(comm.rank());
+  if (replicated_) {
+    for (std::size_t r = 0; r < ranks; ++r) sent_alone_[r] = r == me ? 0 : alone.size();
+  } else {
+    for (const std::uint32_t c : alone) ++sent_alone_[static_cast<std::size_t>(owner(c))];
+  }
   std::vector<std::size_t> next(ranks, 0);
   for (std::size_t r = 1; r < ranks; ++r) next[r] = next[r - 1] + sent_[r - 1];
   route_.resize(receivers.size());
   for (std::size_t k = 0; k < cells.size(); ++k)
     for (std::uint32_t q = receivers_first[k]; q < receivers_first[k + 1]; ++q)
       route_[next[static_cast<std::size_t>(receivers[q])]++] = static_cast<std::uint32_t>(k);
-  next.assign(ranks, 0);
-  for (std::size_t r = 1; r < ranks; ++r) next[r] = next[r - 1] + sent_alone_[r - 1];
-  alone_route_.resize(alone.size());
-  for (std::size_t k = 0; k < alone.size(); ++k)
-    alone_route_[next[static_cast<std::size_t>(owner(alone[k]))]++] = static_cast<std::uint32_t>(k);
+  alone_route_.clear();
+  alone_count_ = alone.size();
+  if (replicated_) {
+    for (std::size_t r = 0; r < ranks; ++r)
+      for (std::size_t k = 0; k < sent_alone_[r]; ++k) alone_route_.push_back(static_cast<std::uint32_t>(k));
+  } else {
+    next.assign(ranks, 0);
+    for (std::size_t r = 1; r < ranks; ++r) next[r] = next[r - 1] + sent_alone_[r - 1];
+    alone_route_.resize(alone.size());
+    for (std::size_t k = 0; k < alone.size(); ++k)
+      alone_route_[next[static_cast<std::size_t>(owner(alone[k]))]++] = static_cast<std::uint32_t>(k);
+  }
   first_.assign(first.begin(), first.end());
   // To each rank: the counts of the cells it receives and of its alone
   // cells, the cells, their pieces' counts, the alone cells, then the
@@ -266,7 +292,7 @@ void CellRoutes::reply(const Communicator& comm, int w, std::span<double> out) {
 double CellRoutes::add(const Communicator& comm, std::span<const double> parts, int width, double extra,
                        std::span<const double> alone_totals) {
   const std::size_t ranks = received_.size(), w = static_cast<std::size_t>(width);
-  FLOESIM_ASSERT(parts.size() == first_.back() * w && alone_totals.size() == alone_route_.size());
+  FLOESIM_ASSERT(parts.size() == first_.back() * w && alone_totals.size() == alone_count_);
   // To each owner: `extra`, the values of its cells' pieces in the order of
   // open(), then the totals of its alone cells.
   std::size_t send_total = 0, receive_total = 0;

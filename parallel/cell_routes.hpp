@@ -29,6 +29,13 @@
 // the same bits on every receiver. No totals go back (no reply()): one round
 // trip less, for the bytes of the pieces sent to more than one rank.
 //
+// On a grid that every rank holds whole (a sea not in slabs, replicated on
+// every rank: replicated()), every rank needs every cell's total: a cell's
+// receivers are then every rank (the caller names them), and an alone
+// cell goes to every other rank (4 bytes a cell, then its total with add(),
+// 8 bytes), where alone_owned() lists it. The sums are made by the same
+// code (sum_pieces), so a total is the serial sum to the bit there too.
+//
 // One round of sums (one contact evaluation), every call collective:
 //   open(cells, pieces, alone)  this rank's cells with their pieces' keys
 //                        and a first set of values, each cell to its
@@ -114,11 +121,19 @@ public:
   // first_row: ranks + 1 values, rank r's slab holds rows [first_row[r],
   // first_row[r + 1]); cell c lies in row c / columns.
   CellRoutes(std::vector<int> first_row, std::size_t columns);
-  bool empty() const { return first_row_.empty(); }
-  // The rank whose slab holds `cell`.
+  // Every one of `ranks` ranks holds every cell of a grid of `columns` x
+  // `rows` cells (no slabs): open_shared() only, no open() or reply().
+  static CellRoutes replicated(int ranks, std::size_t columns, std::size_t rows);
+  bool empty() const { return first_row_.empty() && !replicated_; }
+  bool replicated() const { return replicated_; }
+  // The rank whose slab holds `cell` (in slabs).
   int owner(std::uint32_t cell) const { return row_owner_[cell / columns_]; }
+  // Whether `rank` holds `cell`: the cell's owner does, in slabs; every
+  // rank does, replicated.
+  bool holds(int rank, std::uint32_t cell) const { return replicated_ || owner(cell) == rank; }
   // Per row: whether every row within `reach` rows of it (the grid's seam
-  // crossed) lies in its slab. When every rank's cells lie within `reach`
+  // crossed) lies in its slab (replicated: none, no rank's cells being its
+  // alone). When every rank's cells lie within `reach`
   // rows of its own slab, a cell in such a row gets parts from its owner
   // alone: its total is the owner's part, with nothing to route.
   std::vector<std::uint8_t> interior_rows(int reach) const;
@@ -130,7 +145,8 @@ public:
   // sender's pieces of a cell come in key order (the owner merges the
   // senders' runs). `alone`: cells (distinct, none of them in `cells` of
   // any rank) where this rank alone has pieces, summed by itself; their
-  // owners receive them now and their totals with the next add().
+  // owners (replicated: every other rank) receive them now and their
+  // totals with the next add().
   void open(const Communicator& comm, std::span<const std::uint32_t> cells, std::span<const std::uint32_t> first,
             std::span<const std::uint32_t> keys, std::span<const double> parts, int width,
             std::span<const std::uint32_t> alone = {});
@@ -173,14 +189,17 @@ public:
 
 private:
   std::vector<int> first_row_, row_owner_;
-  std::size_t columns_ = 1;
+  std::size_t columns_ = 1, rows_ = 0;
+  int ranks_ = 0;
+  bool replicated_ = false;
   // This rank's cells grouped by receiver (route_[k]: the index in open()'s
   // cells of the k-th sent; alone_route_ the same for its alone cells, by
-  // owner),
+  // owner, replicated by every other rank),
   // their pieces' offsets (first_), and the counts each way: cells (sent_,
   // received_), pieces (sent_pieces_, received_pieces_) and alone cells
   // (sent_alone_, received_alone_).
   std::vector<std::uint32_t> route_, alone_route_, first_;
+  std::size_t alone_count_ = 0;  // the last open's alone cells
   std::vector<std::size_t> sent_, received_, sent_pieces_, received_pieces_, sent_alone_, received_alone_;
   std::vector<std::uint32_t> from_;   // per received cell, in rank order: its index in owned_
   std::vector<std::uint32_t> count_;  // per received cell: its pieces' count

@@ -8,7 +8,8 @@
 // random distinct cells all over the grid (many shared by several ranks),
 // parts of random sign and size; slabs of uneven height, one empty on 3
 // ranks. Then pieces with order keys (pieces_in_key_order), and the same
-// summed by every rank named a receiver (pieces_summed_by_receivers). Run
+// summed by every rank named a receiver (pieces_summed_by_receivers), on
+// slabs and on routes where every rank holds every cell (replicated). Run
 // by ctest as mpi.cell_routes_ranks_N under `mpirun --oversubscribe -np N`
 // (N = 1, 2, 3), and serially without MPI.
 #include <algorithm>
@@ -205,9 +206,12 @@ bool pieces_in_key_order(const parallel::Communicator& comm, int nx, int ny, con
 // add()'s, must equal the sum from zero of every rank's pieces of the cell
 // in key order (equal keys in rank order, then the sender's) to the bit:
 // on the owner and on every other receiver alike. The alone cells' totals
-// reach their owners as with open().
+// reach their owners as with open(). `replicated` (a sea not in slabs,
+// CellRoutes::replicated, notslabs25): every rank holds every cell, so every
+// cell goes to every rank, and an alone cell's total to every other rank
+// (in rank order, then the sender's).
 bool pieces_summed_by_receivers(const parallel::Communicator& comm, int nx, int ny, const std::vector<int>& cut,
-                                unsigned seed) {
+                                unsigned seed, bool replicated) {
   const std::size_t n = static_cast<std::size_t>(nx) * static_cast<std::size_t>(ny);
   const int ranks = comm.size(), rank = comm.rank();
   std::mt19937_64 rng(seed * 13 + static_cast<unsigned>(rank));
@@ -241,6 +245,7 @@ bool pieces_summed_by_receivers(const parallel::Communicator& comm, int nx, int 
   // cells one more rank, drawn from the cell (the same on every rank).
   const std::vector<int> row_owner = parallel::row_owners(cut);
   auto receivers_of = [&](std::uint32_t c) {
+    if (replicated) return (std::uint64_t{1} << ranks) - 1;
     std::uint64_t to = has[c] | std::uint64_t{1} << row_owner[c / static_cast<std::uint32_t>(nx)];
     if (c % 3 == 0) to |= std::uint64_t{1} << ((c / 3) % static_cast<std::uint32_t>(ranks));
     return to;
@@ -262,25 +267,30 @@ bool pieces_summed_by_receivers(const parallel::Communicator& comm, int nx, int 
   for (double& x : alone_totals) x = u(rng) * std::exp(10.0 * u(rng));
   const std::vector<std::uint32_t> all_alone = comm.allgather<std::uint32_t>(alone);
   const std::vector<double> all_alone_totals = comm.allgather<double>(alone_totals);
+  const std::vector<std::uint64_t> alone_counts = comm.allgather<std::uint64_t>(std::vector<std::uint64_t>{alone.size()});
   std::vector<std::pair<std::uint32_t, double>> expected_alone;
-  for (std::size_t k = 0; k < all_alone.size(); ++k)
-    if (row_owner[all_alone[k] / static_cast<std::uint32_t>(nx)] == rank) expected_alone.push_back({all_alone[k], all_alone_totals[k]});
+  for (std::size_t r = 0, k = 0; r < alone_counts.size(); ++r)
+    for (std::uint64_t j = 0; j < alone_counts[r]; ++j, ++k)
+      if (replicated ? static_cast<int>(r) != rank : row_owner[all_alone[k] / static_cast<std::uint32_t>(nx)] == rank)
+        expected_alone.push_back({all_alone[k], all_alone_totals[k]});
   // The cells this rank must hold: those some rank with pieces names it for.
   std::vector<std::uint32_t> expected;
   for (std::uint32_t c = 0; c < n; ++c)
     if (has[c] != 0 && ((receivers_of(c) >> rank) & 1u)) expected.push_back(c);
 
-  parallel::CellRoutes routes(cut, static_cast<std::size_t>(nx));
+  parallel::CellRoutes routes = replicated ? parallel::CellRoutes::replicated(ranks, static_cast<std::size_t>(nx),
+                                                                             static_cast<std::size_t>(ny))
+                                           : parallel::CellRoutes(cut, static_cast<std::size_t>(nx));
   bool equal = true;
   routes.open_shared(comm, cells, first, keys, one, 1, receivers_first, receivers, alone);
   std::vector<std::uint32_t> held(routes.owned().begin(), routes.owned().end());
   std::sort(held.begin(), held.end());
   equal = equal && held == expected;
-  std::size_t others = 0;  // held cells another rank owns
+  std::size_t others = 0;  // held cells another rank owns (replicated: where this rank has no pieces)
   for (std::uint32_t c : expected) {
     const std::size_t j = routes.index(c);
     equal = equal && j != parallel::CellRoutes::kNotHeld && same_bits(routes.total(j, 0), ref1[c]);
-    others += row_owner[c / static_cast<std::uint32_t>(nx)] != rank ? 1 : 0;
+    others += (replicated ? ((has[c] >> rank) & 1u) == 0 : row_owner[c / static_cast<std::uint32_t>(nx)] != rank) ? 1 : 0;
   }
   const double extra = static_cast<double>(rank) + 0.25;
   double extras = 0.0;
@@ -291,10 +301,12 @@ bool pieces_summed_by_receivers(const parallel::Communicator& comm, int nx, int 
   equal = equal && routes.alone_owned().size() == expected_alone.size();
   for (std::size_t j = 0; j < expected_alone.size() && j < routes.alone_owned().size(); ++j)
     equal = equal && routes.alone_owned()[j] == expected_alone[j].first && same_bits(routes.alone_total(j), expected_alone[j].second);
-  std::printf("rank %d of %d, %d x %d, %zu cells, %zu held (%zu of other slabs), %zu alone owned: %s\n", rank, ranks, nx,
-              ny, cells.size(), held.size(), others, routes.alone_owned().size(),
+  std::printf("rank %d of %d, %d x %d%s, %zu cells, %zu held (%zu %s), %zu alone owned: %s\n", rank, ranks, nx, ny,
+              replicated ? " replicated" : "", cells.size(), held.size(), others,
+              replicated ? "without pieces here" : "of other slabs", routes.alone_owned().size(),
               equal ? "every receiver's totals the pieces summed in key order, bit for bit" : "DIFFERENT");
-  // The check could fail: on several ranks, cells of other slabs are held.
+  // The check could fail: on several ranks, cells of other slabs (or
+  // without this rank's pieces) are held.
   return equal && (ranks == 1 || others > 0);
 }
 
@@ -318,7 +330,8 @@ int main() {
     if (ranks >= 3) cut[2] = cut[1];
     if (!routes_equal_merge(comm, nx, ny, cut, static_cast<unsigned>(nx))) ++failed;
     if (!pieces_in_key_order(comm, nx, ny, cut, static_cast<unsigned>(ny))) ++failed;
-    if (!pieces_summed_by_receivers(comm, nx, ny, cut, static_cast<unsigned>(nx + ny))) ++failed;
+    if (!pieces_summed_by_receivers(comm, nx, ny, cut, static_cast<unsigned>(nx + ny), false)) ++failed;
+    if (!pieces_summed_by_receivers(comm, nx, ny, cut, static_cast<unsigned>(nx + ny + 1), true)) ++failed;
   }
   failed = comm.sum(failed);
   if (comm.writer()) std::printf("%s on %d ranks\n", failed == 0 ? "passed" : "FAILED", ranks);

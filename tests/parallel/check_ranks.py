@@ -14,9 +14,9 @@ for each R: every run file must equal the serial one (`floesim compare`,
 rtol 0 and atol 0 by default: bit for bit, which stage one's replicated state
 and ordered gathers promise); so must a run stopped half-way on 2 ranks and
 continued with --restart on 2 ranks. Each --also CONFIG (a run with a sea, say) is
-checked on 2 ranks with --also-rtol (0 by default; a sea with the explicit
-kicks sums the cells shared by ranks grouped by rank, docs/parallel.md stage
-three: issue 21's 1e-6). --fallback CONFIG: a run whose step-start collisions
+checked on 2 ranks with --also-rtol (0 by default: since stage eight and
+notslabs25 a sea with the explicit kicks sums every shared cell in the
+serial order, docs/parallel.md). --fallback CONFIG: a run whose step-start collisions
 fall back to the whole solve on 2 and 3 ranks must equal the serial run too,
 with fallbacks counted. Then the errors: bad input and a run file that
 rank 0 cannot create must end every rank with exit 2 and 1, and the message
