@@ -65,9 +65,9 @@ struct PoisonOptions {
 
 // Parses the test hook's value: "step" (NaN), "step-lure", "step-mutant",
 // each optionally followed by "-stale" (PoisonOptions::stale:
-// "step-lure-stale"), optionally followed by "@" and the windows to open, of "drift", "detect"
-// and "percussion" joined by '+' (e.g. "step-lure@drift+percussion"); all
-// three without. Returns false if `text` is not of this form.
+// "step-lure-stale"), then optionally by "@" and the windows to open, of
+// "drift", "detect" and "percussion" joined by '+' (e.g.
+// "step-lure@drift+percussion"); all three without. Returns false if `text` is not of this form.
 bool parse_poison_options(const std::string& text, PoisonOptions& options);
 
 class UnheldPoison {

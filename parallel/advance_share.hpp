@@ -254,9 +254,9 @@ void advance_by_owner(const Communicator& comm, std::span<const int> owner, Floe
 // reaches from their owners. `whole` gives the whole state and detection
 // for the back-off's whole steps and the fallback (state first), which is
 // taken also when a floe joins a share's cluster without being its
-// candidate (Conflict::missing_pairs). With options.impulse.record the shares record
-// and merge as in advance_by_owner. Equal to the serial advance bit for
-// bit, states, counts and record.
+// candidate (Conflict::missing_pairs). With options.impulse.record the
+// shares record and merge as in advance_by_owner. Equal to the serial
+// advance bit for bit, states, counts and record.
 void advance_on_part(const Communicator& comm, std::span<const int> owner, std::span<const std::uint32_t> mine,
                      Floes& floes, contact::CollisionShapes& shapes, const contact::Detection& part,
                      const WholeOnDemand& whole, double dt,
