@@ -44,6 +44,11 @@ bool parse_poison_options(const std::string& text, PoisonOptions& options) {
     kind = text.substr(0, at);
     window = text.substr(at + 1);
   }
+  const std::string stale = "-stale";
+  if (kind.size() > stale.size() && kind.ends_with(stale)) {
+    o.stale = true;
+    kind.resize(kind.size() - stale.size());
+  }
   if (kind == "step-lure") o.kind = PoisonOptions::Kind::lure;
   else if (kind == "step-mutant") o.mutant = true;
   else if (kind != "step") return false;
@@ -181,16 +186,28 @@ void Simulation::poison_step(const char* phase, StepContext& ctx) {
     for (const std::uint32_t i : owners_.mine()) held[i] = 1;
     p.poison(held, owners_.owner(), state, start, reach, detection_options_.domain);
   };
+  // A window leaves the unheld floes stale, as the halo exchange will: a
+  // step that reads every floe gathers them (whole_state). Set on every
+  // rank alike (open() may return without poisoning on none or all); not
+  // with the mutation `stale`.
+  const auto open_window = [&](std::vector<FloeState>* start) {
+    if (!p.options().stale) state_whole_ = false;
+    open(start);
+  };
+  const auto restore = [&](bool start_from_state) {
+    p.restore(comm_, state, &ctx.start, reach, start_from_state);
+    state_whole_ = true;
+  };
   // Opening: where an exchange of piece 8 gives the held floes their values.
-  if (at == "drift" && p.options().after_drift) open(&ctx.start);
-  if (at == "detect" && p.options().after_detect) open(&ctx.start);
+  if (at == "drift" && p.options().after_drift) open_window(&ctx.start);
+  if (at == "detect" && p.options().after_detect) open_window(&ctx.start);
   // After the percussion the step's start copy is not read again; the next
   // step's is taken from the (poisoned) state and put back at the restore.
-  if (at == "percussion" && p.options().after_percussion) open(nullptr);
+  if (at == "percussion" && p.options().after_percussion) open_window(nullptr);
   p.check(phase, state, &ctx.start, reach);
   // Closing: before the phases that read every floe's place for its owner.
-  if (at == "advance" || at == "record") p.restore(comm_, state, &ctx.start, reach);
-  if (at == "first half kick") p.restore(comm_, state, &ctx.start, reach, true);
+  if (at == "advance" || at == "record") restore(false);
+  if (at == "first half kick") restore(true);
 }
 
 }  // namespace floesim

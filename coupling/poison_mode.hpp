@@ -55,14 +55,19 @@ struct PoisonOptions {
   // The mutation of the tests: this rank's lowest held floe is poisoned too
   // (and never restored), so the first check must report it.
   bool mutant = false;
+  // The mutation of the whole state on demand's test: the windows do not
+  // say that the unheld floes are stale (Simulation::whole_state gathers
+  // nothing), so a step that reads every floe reads the poison.
+  bool stale = false;
   // Which windows are opened (above; all by default).
   bool after_drift = true, after_detect = true, after_percussion = true;
 };
 
 // Parses the test hook's value: "step" (NaN), "step-lure", "step-mutant",
-// optionally followed by "@" and the windows to open, of "drift", "detect"
-// and "percussion" joined by '+' (e.g. "step-lure@drift+percussion"); all
-// three without. Returns false if `text` is not of this form.
+// each optionally followed by "-stale" (PoisonOptions::stale:
+// "step-lure-stale"), then optionally by "@" and the windows to open, of
+// "drift", "detect" and "percussion" joined by '+' (e.g.
+// "step-lure@drift+percussion"); all three without. Returns false if `text` is not of this form.
 bool parse_poison_options(const std::string& text, PoisonOptions& options);
 
 class UnheldPoison {

@@ -1,6 +1,7 @@
 #include "coupling/simulation.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdlib>
 #include <limits>
@@ -283,6 +284,7 @@ void Simulation::drift(StepContext& ctx) {
     drift_velocities(scenario_.floes, quadrature_, drift_params_, current, wind, ctx.dt, owners_.mine(), water);
     owners_.charge(parallel::thread_seconds() - start);
     comm_.complete_owned(scenario_.floes.state, owners_.owner());
+    state_whole_ = true;
   }
   add_owned_momentum(std::span(ctx.momenta).subspan<StepContext::kAfterDrift, 2>());
 }
@@ -311,9 +313,11 @@ void Simulation::collide(StepContext& ctx) {
   // are keyed by pair, so record runs too).
   if (comm_.serial())
     contact::resolve_step_collisions(scenario_.floes, ctx.start, detection_, ctx.dt, impulse_options_, stats_);
-  else  // every detection on several ranks leaves this rank's part (the start's and a split's too)
+  else {  // every detection on several ranks leaves this rank's part (the start's and a split's too)
+    const parallel::WholeOnDemand whole = whole_on_demand(ctx);
     parallel::collide_on_part(comm_, owners_.owner(), scenario_.floes, ctx.start, *detection_part_, ctx.dt,
-                              impulse_options_, stats_, collide_share_);
+                              impulse_options_, stats_, collide_share_, {}, &whole);
+  }
   add_owned_momentum(std::span(ctx.momenta).subspan<StepContext::kAfterCollide, 2>());
 }
 
@@ -420,8 +424,8 @@ void Simulation::advance(StepContext& ctx) {
     contact::advance_with_collisions(scenario_.floes, shapes_, detection_, ctx.dt, o, stats_, substeps_);
   else if (detection_part_ && advance_share_options_.on_part)
     parallel::advance_on_part(comm_, owners_.owner(), owners_.mine(), scenario_.floes, shapes_, *detection_part_,
-                              [this]() -> const contact::Detection& { return whole_detection(); }, ctx.dt, o, stats_,
-                              substeps_, advance_share_, advance_share_options_);
+                              whole_on_demand(ctx), ctx.dt, o, stats_, substeps_, advance_share_,
+                              advance_share_options_);
   else
     parallel::advance_by_owner(comm_, owners_.owner(), scenario_.floes, shapes_, detection_, ctx.dt, o, stats_,
                                substeps_, advance_share_, advance_share_options_);
@@ -568,6 +572,36 @@ const contact::Detection& Simulation::whole_detection() {
     detection_whole_ = true;
   }
   return detection_;
+}
+
+void Simulation::whole_state(StepContext& ctx) {
+  // Collective, as whole_detection(): state_whole_ is the same on every
+  // rank. Each floe's state and step-start copy from its owner (the drift's,
+  // owners_: it drifted the floe and holds both current), in one message
+  // (192 B a floe the rank does not own). Only the floes this rank does not
+  // hold take them: a held floe's copy is current already (every holder
+  // updates it alike), and the poison mode's NaN in a held floe, a reader's
+  // trace, stays to be reported.
+  if (state_whole_) return;
+  std::vector<FloeState>& state = scenario_.floes.state;
+  const std::size_t n = state.size();
+  FLOESIM_ASSERT(ctx.start.size() == n && owners_.owner().size() == n);
+  std::vector<std::array<FloeState, 2>> both(n);
+  for (std::size_t i = 0; i < n; ++i) both[i] = {state[i], ctx.start[i]};
+  comm_.complete_owned(both, owners_.owner());
+  std::vector<std::uint8_t> held = held_.mask;
+  held.resize(n, 0);
+  for (const std::uint32_t i : owners_.mine()) held[i] = 1;
+  for (std::size_t i = 0; i < n; ++i)
+    if (!held[i]) {
+      state[i] = both[i][0];
+      ctx.start[i] = both[i][1];
+    }
+  state_whole_ = true;
+}
+
+parallel::WholeOnDemand Simulation::whole_on_demand(StepContext& ctx) {
+  return {[this]() -> const contact::Detection& { return whole_detection(); }, [this, &ctx]() { whole_state(ctx); }};
 }
 
 void Simulation::wrap_periodic() {

@@ -310,6 +310,17 @@ private:
   // detection()), every rank alike.
   bool detection_whole_ = true;
   const contact::Detection& whole_detection();
+  // Whether every floe's state and step-start copy (ctx.start) are current
+  // on this rank, every rank alike. True after the drift's complete_owned
+  // (today every rank holds every floe current); the halo exchange (piece
+  // 8) will leave only the held floes current (held_, and the own floes),
+  // and the poison mode of the run does so in its windows (false while one
+  // is open). whole_state() makes them current when a step reads every
+  // floe (the pair list's rebuild on a part, a fallback, a whole step of
+  // the back-off: parallel::WholeOnDemand), once in such a step.
+  bool state_whole_ = true;
+  void whole_state(StepContext& ctx);
+  parallel::WholeOnDemand whole_on_demand(StepContext& ctx);
   contact::CollisionStats stats_;
   std::unique_ptr<Percussion> percussion_;  // [fracture] enabled
   PercussionRanks percussion_ranks_;         // its analyses by owner (several ranks)

@@ -436,17 +436,19 @@ void move_not_held(Floes& floes, std::span<const std::uint32_t> held, double dt)
 
 void advance_on_part(const Communicator& comm, std::span<const int> owner, std::span<const std::uint32_t> mine,
                      Floes& floes, contact::CollisionShapes& shapes, const contact::Detection& part,
-                     const std::function<const contact::Detection&()>& whole, double dt,
+                     const WholeOnDemand& whole, double dt,
                      const contact::SubstepOptions& options, contact::CollisionStats& stats,
                      contact::SubstepReport& report, AdvanceShareCounts& counts,
                      const AdvanceShareOptions& share_options) {
   if (comm.serial())
-    return advance_by_owner(comm, owner, floes, shapes, whole(), dt, options, stats, report, counts, share_options);
+    return advance_by_owner(comm, owner, floes, shapes, whole.detection(), dt, options, stats, report, counts,
+                            share_options);
   if (counts.whole_now()) {
-    contact::advance_with_collisions(floes, shapes, whole(), dt, options, stats, report);
+    whole.state();
+    contact::advance_with_collisions(floes, shapes, whole.detection(), dt, options, stats, report);
     return;
   }
-  const std::vector<FloeState> start = floes.state;
+  std::vector<FloeState> start = floes.state;
   bool combined = false;
   {
     // A run that keeps the impulse record: as advance_by_owner (the events'
@@ -462,9 +464,14 @@ void advance_on_part(const Communicator& comm, std::span<const int> owner, std::
     // gathers the rooms again.
     if (any_outrun(rooms)) {
       ++counts.rebuilds;
-      // The rebuild detects over every floe: every floe's reach from its
-      // owner (a rank wrote only its band's at the detection, band18; 8
-      // bytes a floe, in such a step only).
+      // The rebuild detects over every floe (the serial set-up's, contact::
+      // Stepper::set_up_rebuilt): every floe's straight path and place from
+      // its state at the step's start, which the floes still are (rooms()
+      // moves none), made whole here; the fallback below starts again from
+      // it. And every floe's reach from its owner (a rank wrote only its
+      // band's at the detection, band18; 8 bytes a floe, in such a step only).
+      whole.state();
+      start = floes.state;
       std::vector<double> reach = part.reach;
       comm.complete_owned(reach, owner);
       rooms = comm.allgather_parts(pack(share.rooms_rebuilt(reach)), unpack_share_rooms);
@@ -522,7 +529,8 @@ void advance_on_part(const Communicator& comm, std::span<const int> owner, std::
   }
   counts.fell_back(share_options);
   floes.state = start;
-  contact::advance_with_collisions(floes, shapes, whole(), dt, options, stats, report);
+  whole.state();
+  contact::advance_with_collisions(floes, shapes, whole.detection(), dt, options, stats, report);
 }
 
 }  // namespace floesim::parallel

@@ -26,6 +26,22 @@
 
 namespace floesim::parallel {
 
+// What a step that reads every floe asks of its caller, on demand, in the
+// step that needs it (the halo plan's piece 3: the pair list's rebuild on a
+// part, a fallback, a step the back-off does whole). Both are collective:
+// every rank calls them at the same point of the same step, or none does.
+// `detection`: the whole detection's lists (gathered once a detection).
+// `state`: every floe's state, and the step's start copy, current on this
+// rank, from the floes' owners. Until the halo exchange (piece 8) every rank
+// holds every floe current after the drift and `state` does nothing; with
+// the exchange (and in the poison mode of the run, which leaves the floes a
+// rank does not hold stale as the exchange will) it gathers the floes the
+// rank does not hold, once in a step (Simulation::whole_state).
+struct WholeOnDemand {
+  std::function<const contact::Detection&()> detection;
+  std::function<void()> state;
+};
+
 // One rank's part of a step's advance: what its share did, the states of the
 // floes it moved (outcome.moved's order), its counts and, in a run that keeps
 // the impulse record, its record (events: outcome.events; none on a conflict).
@@ -233,16 +249,17 @@ void advance_by_owner(const Communicator& comm, std::span<const int> owner, Floe
 // move_not_held the others, until piece 8), the exchange of the parts. A
 // floe of any rank outrunning its reach (the flags gathered with the rooms)
 // makes every rank rebuild the pair list and gather the rooms again (one
-// more allgather_bytes in such a step). `whole` gives the whole
-// detection (collective: every rank calls it at the same point, or none
-// does) for the back-off's whole steps and the fallback, which is taken
-// also when a floe joins a share's cluster without being its candidate
-// (Conflict::missing_pairs). With options.impulse.record the shares record
-// and merge as in advance_by_owner. Equal to the serial advance bit for
-// bit, states, counts and record.
+// more allgather_bytes in such a step); the rebuild reads every floe's
+// state at the step's start and its reach: `whole.state` first, then the
+// reaches from their owners. `whole` gives the whole state and detection
+// for the back-off's whole steps and the fallback (state first), which is
+// taken also when a floe joins a share's cluster without being its
+// candidate (Conflict::missing_pairs). With options.impulse.record the
+// shares record and merge as in advance_by_owner. Equal to the serial
+// advance bit for bit, states, counts and record.
 void advance_on_part(const Communicator& comm, std::span<const int> owner, std::span<const std::uint32_t> mine,
                      Floes& floes, contact::CollisionShapes& shapes, const contact::Detection& part,
-                     const std::function<const contact::Detection&()>& whole, double dt,
+                     const WholeOnDemand& whole, double dt,
                      const contact::SubstepOptions& options, contact::CollisionStats& stats,
                      contact::SubstepReport& report, AdvanceShareCounts& counts,
                      const AdvanceShareOptions& share_options = {});

@@ -178,12 +178,21 @@ std::vector<contact::Detection> pairs_for_groups(const Floes& floes, const conta
 std::size_t collide_on_part(const Communicator& comm, std::span<const int> owner, Floes& floes,
                             std::span<const FloeState> start, const contact::Detection& part, double step,
                             const contact::ImpulseOptions& options, contact::CollisionStats& stats,
-                            AdvanceShareCounts& counts, const AdvanceShareOptions& share_options) {
+                            AdvanceShareCounts& counts, const AdvanceShareOptions& share_options,
+                            const WholeOnDemand* whole) {
   if (comm.serial())
     return collide_by_owner(comm, owner, floes, start, gather(comm, part), step, options, stats, counts,
                             share_options);
-  if (counts.whole_now())
-    return contact::resolve_step_collisions(floes, start, gather(comm, part), step, options, stats);
+  // The whole solve reads every floe's W^- and start (`start` views the
+  // caller's copy, which whole->state makes whole): the state first, then
+  // the lists.
+  contact::Detection gathered;
+  const auto solve_whole = [&]() {
+    if (whole) whole->state();
+    const contact::Detection& lists = whole ? whole->detection() : (gathered = gather(comm, part));
+    return contact::resolve_step_collisions(floes, start, lists, step, options, stats);
+  };
+  if (counts.whole_now()) return solve_whole();
   // Every rank's edges (20 bytes a pair with a flag: the floes' owners in
   // them), the same step groups and group owners on every rank.
   const std::vector<contact::GroupEdge> mine = contact::group_edges(floes, start, part, step, options, owner);
@@ -207,17 +216,21 @@ std::size_t collide_on_part(const Communicator& comm, std::span<const int> owner
   for (std::size_t s = 0; s < out.size(); ++s)
     if (!out[s].pairs.empty()) carried.outgoing[s] = {pack(routed_floes(floes, start, out[s]))};
   const contact::Detection local = exchange_pairs(comm, part, out, &carried);
+  // The share reads the routed floes' starts from a copy (the caller's
+  // `start` is left as it came, for the fallback's whole state).
   std::vector<FloeState> held_start;
+  std::span<const FloeState> share_start = start;
   if (!carried.received.empty()) {
     held_start.assign(start.begin(), start.end());
     for (const Pieces& r : carried.received) hold(unpack_routed_floes(r[0]), floes, held_start);
-    start = held_start;
+    share_start = held_start;
   }
   // The share on its pairs, then collide_by_owner's exchange (with the
   // share's record and its loads' places keyed by pair: the serial record
   // merged from the parts).
   const std::vector<FloeState> entry = floes.state;
-  const CollidePart share = run_collide_share(floes, start, local, step, options, owner, comm.rank(), &groups);
+  const CollidePart share =
+      run_collide_share(floes, share_start, local, step, options, owner, comm.rank(), &groups);
   const std::vector<CollidePart> shares = comm.allgather_parts(pack(share), unpack_collide_part);
   counts.clusters.resize(shares.size(), 0);
   std::size_t speculative = 0;
@@ -228,7 +241,7 @@ std::size_t collide_on_part(const Communicator& comm, std::span<const int> owner
   }
   counts.fell_back(share_options);
   floes.state = entry;
-  return contact::resolve_step_collisions(floes, start, gather(comm, part), step, options, stats);
+  return solve_whole();
 }
 
 }  // namespace floesim::parallel

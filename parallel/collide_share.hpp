@@ -94,11 +94,15 @@ std::vector<contact::Detection> pairs_for_groups(const Floes& floes, const conta
 // combination; with options.record each share records its loads with
 // their places keyed by pair (contact::ContactPlace) and every rank merges
 // the parts into options.record. A fallback and a step the back-off does
-// whole gather the whole detection first (parallel::gather). Equal to the
-// serial solve bit for bit, states, counts and record.
+// whole solve over every floe: `whole` gives them the whole state (W^- in
+// `floes`, the step's start in the caller's `start`, which the span views)
+// and then the whole detection; with no `whole`, the caller holds every
+// floe current and the detection is gathered here (parallel::gather).
+// Equal to the serial solve bit for bit, states, counts and record.
 std::size_t collide_on_part(const Communicator& comm, std::span<const int> owner, Floes& floes,
                             std::span<const FloeState> start, const contact::Detection& part, double step,
                             const contact::ImpulseOptions& options, contact::CollisionStats& stats,
-                            AdvanceShareCounts& counts, const AdvanceShareOptions& share_options = {});
+                            AdvanceShareCounts& counts, const AdvanceShareOptions& share_options = {},
+                            const WholeOnDemand* whole = nullptr);
 
 }  // namespace floesim::parallel

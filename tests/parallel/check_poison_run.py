@@ -23,6 +23,18 @@ On 2 ranks (`mpirun --oversubscribe`):
     clean check where the run failed) is one after the detection.
 (c) the mutation: each rank poisons one floe it holds too; the run fails,
     and each rank reports it after the drift, the first phase checked.
+(d) the whole state on demand (docs/parallel.md, "The whole state on demand
+    (ondemand25)"): the steps that read every floe gather it from the owners
+    first. The 10 000-floe pack of scripts/scenarios/moving_pack.py (seed 1,
+    to 320 s: one pair-list rebuild on a part) on 2 ranks with NaN after the
+    drift, and the wall-jam example (examples/pack_against_wall.toml to
+    1500 s: the collisions' and the advance's fallbacks and whole steps, a
+    rebuild) on 3 ranks with the lure (on 2 ranks every rank holds every
+    floe there), are bit for bit the serial run, each having rebuilt or
+    fallen back, with no phase reported; the mutation "-stale" (the windows
+    do not say the unheld floes are stale: nothing is gathered) fails or
+    differs on both (NaN on the pack; the lure on the wall jam, where a
+    sub-step on NaN makes no progress).
 Only what is stable is pinned: other readers are being removed.
 """
 import os
@@ -39,10 +51,10 @@ run = harness.run
 failures = []
 
 
-def mpirun(n, poison, config, out):
+def mpirun(n, poison, config, out, *extra):
     env = dict(ENV, FLOESIM_TEST_POISON_UNHELD=poison)
     return subprocess.run([args.mpiexec, "--oversubscribe", "-np", str(n), "-x", "FLOESIM_TEST_POISON_UNHELD",
-                           args.floesim, "run", config, "-o", out, "-q"],
+                           args.floesim, "run", config, "-o", out, "-q", *extra],
                           cwd=W, capture_output=True, text=True, timeout=600, env=env)
 
 
@@ -133,6 +145,44 @@ print(f"the mutation on 2 ranks: exit {p.returncode}, first reports {first}")
 if p.returncode == 0 or first != {0: "drift", 1: "drift"}:
     failures.append(f"the mutation (a held floe poisoned) must fail the run and be reported after the drift on "
                     f"both ranks: exit {p.returncode}, {first}\n{p.stderr}")
+
+# (d) The whole state on demand: a step that reads every floe (the pair
+# list's rebuild on a part, a fallback, a whole step of the back-off)
+# gathers the floes a rank does not hold from their owners first.
+import moving_pack  # (on the path since moving_pack_check)
+
+rebuild_dir = os.path.join(W, "rebuild")
+os.makedirs(rebuild_dir, exist_ok=True)
+rebuild = moving_pack.write(args.floesim, rebuild_dir, 10000, 320.0, seed=1, output_interval=320.0)
+wall = os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))), "examples",
+                    "pack_against_wall.toml")
+need(run([args.floesim, "run", rebuild, "-o", "rebuild_serial.h5", "-q"]), "the 10 000-floe pack, serial")
+need(run([args.floesim, "run", wall, "-o", "wall_serial.h5", "-q", "--until", "1500"]), "the wall jam, serial")
+# (what, config, ranks, poison, its mutation (nothing gathered), extra arguments, serial file, the counts that
+# say the whole steps happened)
+cases = [("the 10 000-floe pack (its pair list rebuilt on a part)", rebuild, 2, "step@drift", "step-stale@drift", [],
+          "rebuild_serial.h5", ["advance_rebuilds"]),
+         ("the wall jam (fallbacks and whole steps)", wall, 3, "step-lure", "step-lure-stale", ["--until", "1500"],
+          "wall_serial.h5", ["advance_fallbacks", "advance_whole", "collide_fallbacks"])]
+for what, config, n, poison, mutant, extra, serial, counted in cases:
+    name = f"{what} on {n} ranks, {poison}"
+    p = mpirun(n, poison, config, "on_demand.h5", *extra)
+    s, counts = summaries(p), {k: summary(p).get(f"parallel.{k}", "0") for k in counted}
+    same = p.returncode == 0 and equal("on_demand.h5", serial)
+    print(f"{name}: exit {p.returncode}, {'equal' if same else 'DIFFERENT'} to the serial run; {counts}; {s}")
+    if not same:
+        failures.append(f"{name}: a step that reads every floe read a floe its rank does not hold\n{p.stderr}")
+    if any(v == "0" for v in counts.values()):
+        failures.append(f"{name}: the case no longer reads every floe in a step ({counts}): it tests nothing")
+    if sorted(s) != list(range(n)) or sum(f for _, f, _, _ in s.values()) == 0 or any(r for _, _, r, _ in s.values()):
+        failures.append(f"{name}: the ranks must poison floes and report no phase: {s}\n{p.stderr}")
+    # The mutation: nothing gathered.
+    m = mpirun(n, mutant, config, "stale.h5", *extra)
+    found = m.returncode != 0 or not equal("stale.h5", serial)
+    print(f"{what} on {n} ranks, {mutant} (mutation): exit {m.returncode}, "
+          f"{'found (the run failed or differs)' if found else 'NOT FOUND'}")
+    if not found:
+        failures.append(f"{what}, {mutant}: with nothing gathered the run must fail or differ\n{m.stderr}")
 
 if failures:
     print("FAILED:\n" + "\n".join(failures))
