@@ -489,7 +489,7 @@ void Simulation::set_reach(std::span<ExactSum> along, std::span<long long> count
   // combines both (and `along`, `counts`). Each rank writes the reaches of
   // its own floes (at the detection, those it owned before the places
   // advanced: the floes that left its strip take theirs to their new
-  // owners, take_leaving); those of its band come from their owners
+  // owners, hold_band); those of its band come from their owners
   // (hold_band), and the others are not written.
   const Floes& f = scenario_.floes;
   const double dt_max = scenario_.config.run.dt_max;
@@ -534,12 +534,12 @@ void Simulation::read_try_budget(const StepContext& ctx) {
 bool Simulation::detect_and_check(StepContext& ctx) {
   // The owners at the advanced places, from the owners' own floes: each
   // rank tests its floes against the cuts (the cuts do not move here) and
-  // announces those that left its strip, with their reaches, which it
-  // computes (set_reach, over the floes it owned until now: a partition of
-  // the floes as good as the new one for the rms's exact sum). Each rank's
-  // count of notices rides on set_reach's call, so the notices take one
-  // call (none when no floe left a strip). The whole assignment only when
-  // the owners are not assigned for these floes.
+  // announces those that left its strip, with their places and reaches,
+  // which it computes (set_reach, over the floes it owned until now: a
+  // partition of the floes as good as the new one for the rms's exact
+  // sum). Each rank's count of notices rides on set_reach's call and the
+  // notices on the band's strips' gather (hold_band): no call added. The
+  // whole assignment only when the owners are not assigned for these floes.
   std::vector<parallel::LeaveNotice> leaving;
   std::vector<long long> leaving_counts;  // per rank
   const bool by_own = !comm_.serial() && owners_.assigned_for(scenario_.floes);
@@ -551,13 +551,17 @@ bool Simulation::detect_and_check(StepContext& ctx) {
     owners_.assign(scenario_.floes);
   }
   set_reach(std::span(ctx.momenta).first<StepContext::kTry>(), leaving_counts);  // combines the try's momenta too (one call)
-  if (by_own) take_leaving(leaving, leaving_counts);
+  // The notices carry the reaches their senders computed: a floe that
+  // comes to a rank takes its old owner's (the formula's bits).
+  for (parallel::LeaveNotice& k : leaving) k.reach = detection_options_.reach[k.floe];
   read_try_budget(ctx);
   // The held floes at the advanced places, their reaches from their owners:
   // the detection's subset reads only those. Kept when the step is
   // accepted (a rejected try's places are undone).
+  // The owners take the notices there (announce_held: they ride on the
+  // strips' gather).
   wrap_entering(owners_.mine());
-  parallel::HeldFloes held = hold_band();
+  parallel::HeldFloes held = hold_band(leaving, leaving_counts);
   wrap_entering(held.index);
   contact::Detection part;  // this rank's (serially: `next` itself)
   // The whole lists are gathered only for the advance from the whole
@@ -591,17 +595,6 @@ bool Simulation::detect_and_check(StepContext& ctx) {
     detection_own_ = owners_.mine();
   }
   return true;
-}
-
-void Simulation::take_leaving(std::vector<parallel::LeaveNotice>& leaving, std::span<const long long> counts) {
-  // The notices carry the reaches their senders computed; a floe that came
-  // to this rank takes its reach from its notice (its old owner's, the
-  // formula's bits), so that this rank holds the reach of every floe it owns.
-  for (parallel::LeaveNotice& k : leaving) k.reach = detection_options_.reach[k.floe];
-  const std::vector<parallel::LeaveNotice> all = parallel::gather_leaving(comm_, leaving, counts);
-  owners_.take_leaving(all);
-  for (const parallel::LeaveNotice& k : all)
-    if (k.owner == comm_.rank()) detection_options_.reach[k.floe] = k.reach;
 }
 
 void Simulation::start_owners() {
@@ -638,13 +631,14 @@ void Simulation::detect_in_place() {
   detection_own_ = owners_.mine();
 }
 
-parallel::HeldFloes Simulation::hold_band() {
+parallel::HeldFloes Simulation::hold_band(std::span<const parallel::LeaveNotice> leaving,
+                                          std::span<const long long> leaving_counts) {
   const std::size_t n = scenario_.floes.size();
   if (comm_.serial()) return held_.mask.size() == n ? std::move(held_) : parallel::every_floe(n);
   // Each owner tests its own floes against the ranks' strips and announces
   // them, with their reaches, to the ranks whose band holds them
   // (parallel::announce_held: the band's rule, H the ranks' largest h_j).
-  return parallel::announce_held(comm_, owners_, scenario_.floes, shapes_, detection_options_);
+  return parallel::announce_held(comm_, owners_, scenario_.floes, shapes_, detection_options_, leaving, leaving_counts);
 }
 
 const contact::Detection& Simulation::whole_detection() {

@@ -255,7 +255,11 @@ private:
   // own floes' reaches set): announced by their owners with their reaches,
   // which it writes (parallel::announce_held). Collective on several ranks;
   // one rank holds every floe.
-  parallel::HeldFloes hold_band();
+  // At a detection whose owners come from the own floes: `leaving`, this
+  // rank's notices of its floes that left its strip, and every rank's count
+  // of them, which the owners take there (announce_held).
+  parallel::HeldFloes hold_band(std::span<const parallel::LeaveNotice> leaving = {},
+                                std::span<const long long> leaving_counts = {});
   // Wraps the centroids of the floes this rank holds (held_now()) into a
   // periodic box, and notes which (wrapped_).
   void wrap_periodic();
@@ -284,11 +288,6 @@ private:
   // `counts` (integers of this rank's part) are summed over the ranks in
   // the same call.
   void set_reach(std::span<ExactSum> along = {}, std::span<long long> counts = {});
-  // The detection's owners from the own floes: this rank's notices of its
-  // floes that left its strip (FloeOwners::leaving), given their reaches,
-  // gathered (each rank's count in `counts`, known to all), applied on
-  // every rank, and the reaches of the floes that came to it written.
-  void take_leaving(std::vector<parallel::LeaveNotice>& leaving, std::span<const long long> counts);
   void read_try_budget(const StepContext& ctx);  // the try's momenta, combined, into step_budget_
   // The state check (the ranks agree on the first non-finite value) and the
   // step's momentum budget (the sea kick's momenta combined): one call.

@@ -124,7 +124,7 @@ std::vector<LeaveNotice> FloeOwners::leaving(int rank, const Floes& floes) const
   std::vector<LeaveNotice> out;
   const auto test = [&](std::size_t j) {
     const int now = owner_at(floes.state[j]);
-    if (now != rank) out.push_back({static_cast<std::uint32_t>(j), static_cast<std::int32_t>(now), 0.0});
+    if (now != rank) out.push_back({static_cast<std::uint32_t>(j), static_cast<std::int32_t>(now), place(floes.state[j]), 0.0});
   };
   if (rank == rank_) {
     for (const std::uint32_t j : mine_) test(j);
@@ -149,20 +149,6 @@ void FloeOwners::take_leaving(std::span<const LeaveNotice> notices) {
   std::vector<std::uint32_t> merged(mine_.size() + arrived.size());
   std::merge(mine_.begin(), mine_.end(), arrived.begin(), arrived.end(), merged.begin());
   mine_ = std::move(merged);
-}
-
-std::vector<LeaveNotice> gather_leaving(const Communicator& comm, std::span<const LeaveNotice> mine,
-                                        std::span<const long long> counts) {
-  static_assert(kSentAsBytes<LeaveNotice> && sizeof(LeaveNotice) == 16);
-  FLOESIM_ASSERT(counts.size() == static_cast<std::size_t>(comm.size()) &&
-                 counts[static_cast<std::size_t>(comm.rank())] == static_cast<long long>(mine.size()));
-  if (comm.serial()) return {mine.begin(), mine.end()};
-  std::vector<std::size_t> bytes(counts.size());
-  for (std::size_t r = 0; r < counts.size(); ++r) bytes[r] = static_cast<std::size_t>(counts[r]) * sizeof(LeaveNotice);
-  const std::vector<std::byte> all = comm.allgather_known(std::as_bytes(mine), bytes);
-  std::vector<LeaveNotice> out(all.size() / sizeof(LeaveNotice));
-  if (!all.empty()) std::memcpy(static_cast<void*>(out.data()), all.data(), all.size());
-  return out;
 }
 
 FloeOwners::WindowCharges FloeOwners::close_window(const Communicator& comm) {
@@ -275,10 +261,14 @@ namespace {
 // h_j at floe j's place y (the one formula of half_band, held_floes and detection_subset).
 double half_band_at(double y, const contact::CollisionShapes& shapes, const contact::DetectionOptions& options,
                     std::size_t j) {
-  const double h = shapes.radius[j] + options.reach_of(j) + 0.5 * options.collision_distance;
-  return h + 1e-9 * (1.0 + std::abs(y) + h);  // posing rounds; a floe held in excess costs only time
+  return half_band_for(y, shapes.radius[j], options.reach_of(j), options.collision_distance);
 }
 }  // namespace
+
+double half_band_for(double y, double radius, double reach, double collision_distance) {
+  const double h = radius + reach + 0.5 * collision_distance;
+  return h + 1e-9 * (1.0 + std::abs(y) + h);  // posing rounds; a floe held in excess costs only time
+}
 
 double half_band(const FloeOwners& owners, const Floes& floes, const contact::CollisionShapes& shapes,
                  const contact::DetectionOptions& options, std::size_t j) {

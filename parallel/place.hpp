@@ -89,11 +89,14 @@ std::vector<int> cut_rows_by_cost(std::span<const double> row_cost, int block, i
 // A floe that leaves its owner's strip, as its owner announces it at the
 // detection (FloeOwners::leaving; docs/parallel.md, "The hand-over at a
 // move of the cuts and the owners from their own floes (handover25)"): its
-// index, its owner at its present place, and its detection reach (m), which
-// only its old owner computed (Simulation::set_reach over the own floes).
+// index, its owner at its present place, its place (FloeOwners::place, m)
+// and its detection reach (m), which only its old owner computed
+// (Simulation::set_reach over the own floes): the new owner's strip is
+// widened by that place and half band (announce_held).
 struct LeaveNotice {
   std::uint32_t floe = 0;
   std::int32_t owner = 0;
+  double place = 0.0;
   double reach = 0.0;
 };
 
@@ -137,9 +140,10 @@ public:
   // The same owners from the owners' own floes (the cuts set, owners
   // assigned for these floes): each rank tests only the floes it owns
   // against the cuts, leaving() (its floes that now lie in another strip,
-  // ascending, their reaches left 0 for the caller), and every rank applies
-  // every rank's notices, take_leaving() (in any order: a floe has one
-  // owner, so one notice). A floe's owner is a function of its place alone
+  // ascending, with their places; their reaches left 0 for the caller), and
+  // every rank applies every rank's notices, take_leaving() (in any order,
+  // in parts: a floe has one owner, so one notice; announce_held carries
+  // them). A floe's owner is a function of its place alone
   // (owner_at), evaluated by its owner on the same doubles as assign()
   // evaluates it on every rank: the same owners, bit for bit, without
   // reading another rank's floes. `rank`: this object's rank, or a
@@ -235,13 +239,6 @@ private:
   std::vector<double> window_seconds_, total_seconds_, coupling_seconds_, fracture_seconds_;
 };
 
-// Collective: every rank's leaving notices (`mine`: this rank's, with their
-// reaches), in rank order, on every rank; `counts[r]`: rank r's number of
-// notices, known to all (Simulation::set_reach sums them in its call). One
-// call (allgather_known), none when no floe leaves its strip.
-std::vector<LeaveNotice> gather_leaving(const Communicator& comm, std::span<const LeaveNotice> mine,
-                                        std::span<const long long> counts);
-
 // ---- The halo band (docs/parallel.md, "The state held by owner with a
 // halo", "The band") ----
 //
@@ -270,6 +267,9 @@ std::vector<LeaveNotice> gather_leaving(const Communicator& comm, std::span<cons
 // h_j), the same bits in both.
 double half_band(const FloeOwners& owners, const Floes& floes, const contact::CollisionShapes& shapes,
                  const contact::DetectionOptions& options, std::size_t j);
+// h_j from its parts: place y (m), bounding radius R_j, reach_j and the
+// collision distance xi (the one formula of half_band and the band's passes).
+double half_band_for(double y, double radius, double reach, double collision_distance);
 // This rank's part of H: the largest h_j of the floes `rank` owns (owners
 // assigned for these floes), 0 if it owns none. H is its largest over the
 // ranks, one reduction (Communicator::max): every floe is owned by one rank,
