@@ -283,6 +283,7 @@ void Simulation::drift(StepContext& ctx) {
     drift_velocities(scenario_.floes, quadrature_, drift_params_, current, wind, ctx.dt, owners_.mine(), water);
     owners_.charge(parallel::thread_seconds() - start);
     comm_.complete_owned(scenario_.floes.state, owners_.owner());
+    wrapped_.clear();  // every copy is now its owner's (wrap_entering: nothing left to wrap)
   }
   add_owned_momentum(std::span(ctx.momenta).subspan<StepContext::kAfterDrift, 2>());
 }
@@ -602,6 +603,7 @@ void Simulation::start_owners() {
   // the floes' strips are its slabs, moved by whole blocks of the
   // transform's rows (drift()); otherwise the strips' cuts are free in y.
   owners_ = parallel::FloeOwners(comm_.rank(), comm_.size(), detection_options_.domain);
+  wrapped_.clear();  // the places are the start's or a checkpoint's, every copy as given: none to wrap late
   if (sea_ && !sea_->slab_rows().empty())
     owners_.set_slabs({sea_->slab_rows(), sea_->grid().dy(), fluid::RealFft2d::kRows});
 }

@@ -314,8 +314,10 @@ private:
   contact::DetectionOptions detection_options_;
   parallel::FloeOwners owners_;  // drift and detection by place (stage six)
   parallel::HeldFloes held_;     // own floes and band at the last detection (held_floes())
-  // Per floe, 1 if wrap_periodic (or wrap_entering since) wrapped this
-  // rank's copy; empty: every floe.
+  // Between the advance's wrap_periodic and the next drift's exchange: per
+  // floe, 1 if this rank's copy was wrapped (there or by wrap_entering
+  // since); empty after wrap_periodic: every floe was. Cleared when every
+  // copy is as given or its owner's (start_owners, the drift's exchange).
   std::vector<std::uint8_t> wrapped_;
   contact::ImpulseOptions impulse_options_;
   std::unique_ptr<contact::WarmStart> warm_ = std::make_unique<contact::WarmStart>();  // jam LCPs' last bases
