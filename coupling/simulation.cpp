@@ -655,10 +655,11 @@ const contact::Detection& Simulation::whole_detection() {
 void Simulation::wrap_periodic() {
   const contact::Domain& d = detection_options_.domain;
   if (!d.periodic) return;
-  // The floes this rank holds (every floe on one rank, or before the first
-  // detection). Every holder wraps a floe alike from the same bits; the
-  // other ranks' copies stay unwrapped until the drift's exchange brings
-  // the owner's (or hand_over_moved, to a new owner).
+  // The floes this rank holds (every floe on one rank, before the first
+  // detection, or with the implicit step: held_now()). Every holder wraps
+  // a floe alike from the same bits; the other ranks' copies stay
+  // unwrapped until the drift's exchange brings the owner's (or
+  // hand_over_moved to a new owner, or wrap_entering at the detection).
   wrapped_ = held_now();
   std::vector<FloeState>& state = scenario_.floes.state;
   for (std::size_t i = 0; i < state.size(); ++i)
@@ -672,8 +673,9 @@ void Simulation::wrap_floe(FloeState& s) const {
 }
 
 void Simulation::wrap_entering(std::span<const std::uint32_t> floes) {
-  // The wrap rounds (x - xmin + width is rounded to the box's binade), so
-  // it is not the identity on a place inside the box: a copy left unwrapped
+  // The wrap rounds ((x - xmin) + width is rounded to the spacing of the
+  // doubles between width and 2 width), so it is not the identity on a
+  // place inside the box: a copy left unwrapped
   // differs from its holders' in the last bits. A floe that enters this
   // rank's held set at the detection was not wrapped here at the advance;
   // its copy is the holders' before their wrap (the drift's exchange gave
