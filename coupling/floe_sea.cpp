@@ -497,10 +497,18 @@ void FloeSeaContact::kick_floes(Floes& floes, double h) {
   step_mean_pending_ = false;
 }
 
-void FloeSeaContact::advance_vertical(Floes& floes, std::span<const FloeState> start, fluid::Sea& sea, double h) {
+void FloeSeaContact::advance_vertical(Floes& floes, std::span<const FloeState> start, fluid::Sea& sea, double h,
+                                      std::span<const std::uint8_t> held) {
   if (implicit_) return implicit_step(floes, start, sea, h);
+  // Each floe's vertical drift is its own (three multiply-adds from its own
+  // rates), so every rank that holds a floe drifts it alike, to the same
+  // bits, and no exchange is needed. The other copies stay stale until the
+  // drift's exchange brings their owners'. (Simulation::held_now says which
+  // floes a rank holds: its band, its own floes and its own floes for the
+  // coupling, whose heave, pitch and roll the next evaluation's law reads.)
+  FLOESIM_ASSERT(held.empty() || held.size() == floes.size());
   for (std::size_t i = 0; i < floes.size(); ++i) {
-    if (floes.is_static[i]) continue;
+    if (floes.is_static[i] || (!held.empty() && !held[i])) continue;
     FloeState& st = floes.state[i];
     st.heave += h * st.heave_rate;
     st.pitch += h * st.pitch_rate;

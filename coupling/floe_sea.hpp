@@ -207,10 +207,15 @@ public:
   // (the floes' horizontal positions already at t + h, `start` the floes at
   // t, their vertical DOFs and the sea at t), on the footprint at the
   // midpoint of the horizontal motion. Explicit: the floes' vertical drift
-  // and the sea's free flow. Throws RunError if the Newton iteration does not
-  // converge.
-  void advance_vertical(Floes& floes, std::span<const FloeState> start, fluid::Sea& sea, double h);
+  // and the sea's free flow, of the floes `held` marks (per floe, 1: this
+  // rank holds it; empty: every floe; the other copies are left stale).
+  // Throws RunError if the Newton iteration does not converge.
+  void advance_vertical(Floes& floes, std::span<const FloeState> start, fluid::Sea& sea, double h,
+                        std::span<const std::uint8_t> held = {});
   bool implicit() const { return implicit_; }
+  // On several ranks: the floes this rank owns for the coupling (whose
+  // pieces it built at the footprints' last rebuild and moves), ascending.
+  std::span<const std::uint32_t> own_floes() const { return footprints_.mine(); }
   // Threads for the per-floe and per-piece work (results do not depend on it).
   void set_threads(int threads) { threads_ = std::max(threads, 1); }
   // Ranks that share the per-floe work (docs/parallel.md, stages two and

@@ -265,15 +265,15 @@ void Simulation::drift(StepContext& ctx) {
     // rows, like the drift's (FloeOwners::charge_coupling).
     if (owners_.has_slabs() && floe_sea_) owners_.charge_coupling(floe_sea_->take_owned_seconds());
     // Floes migrate; every few steps the strips move (with slabs, the sea's and the coupling's too).
-    // A floe that migrates across a cut was in its new owner's band (its
-    // reach held there); a move of the cuts can give a rank floes its band
-    // did not hold, whose reaches the advance reads (its own floes' outrun
-    // check): from their owners at the detection, who computed them.
+    // A floe that migrates across a cut was in its new owner's band; a move
+    // of the cuts can give a rank floes its band did not hold, which it
+    // then drifts and advances: they come from their owners at the last
+    // detection (hand_over_moved).
     std::vector<int> detected;  // the last detection's owners, when the cuts may move
     if (owners_.may_move(steps_)) detected.assign(owners_.owner().begin(), owners_.owner().end());
     const bool moved = owners_.update(comm_, scenario_.floes, steps_);
     if (moved && owners_.has_slabs()) follow_slabs();
-    if (moved && detection_part_) comm_.hand_over(detection_part_->reach, detected, owners_.owner());
+    if (moved) hand_over_moved(ctx, detected);
     // The moorings of the floes this rank drifts: each kick is its floe's
     // own, and the other floes' states come whole from their owners below.
     moorings_.kick(scenario_.floes, ctx.dt, owners_.mine());
@@ -285,8 +285,58 @@ void Simulation::drift(StepContext& ctx) {
     owners_.charge(parallel::thread_seconds() - start);
     comm_.complete_owned(scenario_.floes.state, owners_.owner());
     state_whole_ = true;
+    wrapped_.clear();  // every copy is now its owner's (wrap_entering: nothing left to wrap)
   }
   add_owned_momentum(std::span(ctx.momenta).subspan<StepContext::kAfterDrift, 2>());
+}
+
+void Simulation::hand_over_moved(StepContext& ctx, std::span<const int> detected) {
+  // Rank r's copies of the floes it holds (its own and its band at the
+  // last detection, held_now()) are current: every holder moves, wraps and
+  // drifts them alike. Its other copies are not (wrap_periodic and the
+  // vertical drift pass over the held floes only), and a move of the cuts
+  // can make r the owner of such a floe: r would drift it from its stale
+  // copy, and the drift's complete_owned would send that copy to every
+  // rank. So each floe whose owner changed goes from its owner at the last
+  // detection, which held it, to its new owner: what the new owner's
+  // drift and the phases after it read of it that the constants do not
+  // give (the collision shapes, the drift's quadrature, the moorings'
+  // anchors and the floes' masses are every rank's):
+  // - its state (96 B): the drift's start, and the advance's;
+  // - its step-start copy ctx.start (96 B): the collisions' and the
+  //   advance's start state of the floes it owns, and what a rejected try
+  //   restores the state from (the update at the redone try does not move
+  //   the cuts again);
+  // - its detection reach (8 B): the advance's outrun check over the own
+  //   floes (band18; the reaches of the floes a rank does not hold are not
+  //   written there).
+  // The water velocity goes from the coupling's owner to the drift's
+  // (hand_water_over, after this). One all-to-all of 200 B a floe that
+  // changes owner, in a step whose cuts moved (every 10 steps at most).
+  FLOESIM_ASSERT(detection_part_ && detected.size() == scenario_.floes.size());
+  comm_.hand_over_each(detected, owners_.owner(), scenario_.floes.state, ctx.start, detection_part_->reach);
+}
+
+std::vector<std::uint8_t> Simulation::held_now() const {
+  // The last detection's band and own floes (held_); the floes this rank
+  // owns now: after a move of the cuts some of those were in no band of
+  // it, and came to it by hand_over_moved; its own floes for the coupling:
+  // between a move of the slabs and the footprints' next rebuild (with a
+  // window) they need not be in its band, and it poses them (their x, y,
+  // yaw) and its law reads their heave, pitch and roll. Their copies are
+  // current: the drift's exchange brings every floe's state, and the
+  // collisions' and advance's moves reach every rank.
+  // Every floe with the implicit step, which poses every floe at the
+  // midpoint of its motion (whole on every rank).
+  const std::size_t n = scenario_.floes.size();
+  if (comm_.serial() || held_.mask.size() != n || owners_.owner().size() != n) return {};
+  if (floe_sea_ && floe_sea_->implicit()) return {};
+  std::vector<std::uint8_t> held = held_.mask;
+  for (const std::uint32_t i : owners_.mine()) held[i] = 1;
+  if (floe_sea_)
+    for (const std::uint32_t i : floe_sea_->own_floes())
+      if (i < n) held[i] = 1;
+  return held;
 }
 
 void Simulation::follow_slabs() {
@@ -433,7 +483,7 @@ void Simulation::advance(StepContext& ctx) {
   wrap_periodic();
 }
 
-void Simulation::set_reach(std::span<ExactSum> along) {
+void Simulation::set_reach(std::span<ExactSum> along, std::span<long long> counts) {
   // The pair list must hold every pair that can meet within the next step:
   // each floe's reach is what it may travel in dt_max at 1.5 times its
   // present speed (rotation included), plus half the pack's rms speed for
@@ -441,9 +491,11 @@ void Simulation::set_reach(std::span<ExactSum> along) {
   // still outrun its reach makes the sub-stepper rebuild the list.
   // The rms is the same bits on any number of ranks: each rank sums the
   // squares of the floes it owns exactly, and counts them; one call
-  // combines both (and `along`). Each rank writes the reaches of its own
-  // floes (the owners assigned at the present places); those of its band
-  // come from their owners (hold_band), and the others are not written.
+  // combines both (and `along`, `counts`). Each rank writes the reaches of
+  // its own floes (at the detection, those it owned before the places
+  // advanced: the floes that left its strip take theirs to their new
+  // owners, hold_band); those of its band come from their owners
+  // (hold_band), and the others are not written.
   const Floes& f = scenario_.floes;
   const double dt_max = scenario_.config.run.dt_max;
   FLOESIM_ASSERT(comm_.serial() || owners_.owner().size() == f.size());
@@ -452,7 +504,7 @@ void Simulation::set_reach(std::span<ExactSum> along) {
     return std::hypot(s.vx, s.vy) + std::abs(s.yaw_rate) * shapes_.radius[i];
   };
   std::vector<ExactSum> sums(1 + along.size());
-  std::array<long long, 1> dynamic{0};
+  std::vector<long long> dynamic(1 + counts.size(), 0);
   for_owned([&](std::size_t i) {
     if (f.is_static[i]) return;
     const double v = speed(i);
@@ -460,8 +512,10 @@ void Simulation::set_reach(std::span<ExactSum> along) {
     ++dynamic[0];
   });
   std::copy(along.begin(), along.end(), sums.begin() + 1);
+  std::copy(counts.begin(), counts.end(), dynamic.begin() + 1);
   comm_.sum(sums, dynamic);
   std::copy(sums.begin() + 1, sums.end(), along.begin());
+  std::copy(dynamic.begin() + 1, dynamic.end(), counts.begin());
   const double rms = dynamic[0] ? std::sqrt(sums[0].value() / static_cast<double>(dynamic[0])) : 0.0;
   detection_options_.reach.resize(f.size());
   for_owned([&](std::size_t i) {
@@ -483,13 +537,37 @@ void Simulation::read_try_budget(const StepContext& ctx) {
 }
 
 bool Simulation::detect_and_check(StepContext& ctx) {
-  if (!comm_.serial()) owners_.assign(scenario_.floes);  // the owners at the advanced places
-  set_reach(std::span(ctx.momenta).first<StepContext::kTry>());  // combines the try's momenta too (one call)
+  // The owners at the advanced places, from the owners' own floes: each
+  // rank tests its floes against the cuts (the cuts do not move here) and
+  // announces those that left its strip, with their places and reaches,
+  // which it computes (set_reach, over the floes it owned until now: a
+  // partition of the floes as good as the new one for the rms's exact
+  // sum). Each rank's count of notices rides on set_reach's call and the
+  // notices on the band's strips' gather (hold_band): no call added. The
+  // whole assignment only when the owners are not assigned for these floes.
+  std::vector<parallel::LeaveNotice> leaving;
+  std::vector<long long> leaving_counts;  // per rank
+  const bool by_own = !comm_.serial() && owners_.assigned_for(scenario_.floes);
+  if (by_own) {
+    leaving = owners_.leaving(comm_.rank(), scenario_.floes);
+    leaving_counts.assign(static_cast<std::size_t>(comm_.size()), 0);
+    leaving_counts[static_cast<std::size_t>(comm_.rank())] = static_cast<long long>(leaving.size());
+  } else if (!comm_.serial()) {
+    owners_.assign(scenario_.floes);
+  }
+  set_reach(std::span(ctx.momenta).first<StepContext::kTry>(), leaving_counts);  // combines the try's momenta too (one call)
+  // The notices carry the reaches their senders computed: a floe that
+  // comes to a rank takes its old owner's (the formula's bits).
+  for (parallel::LeaveNotice& k : leaving) k.reach = detection_options_.reach[k.floe];
   read_try_budget(ctx);
   // The held floes at the advanced places, their reaches from their owners:
   // the detection's subset reads only those. Kept when the step is
   // accepted (a rejected try's places are undone).
-  parallel::HeldFloes held = hold_band();
+  // The owners take the notices there (announce_held: they ride on the
+  // strips' gather).
+  wrap_entering(owners_.mine());
+  parallel::HeldFloes held = hold_band(leaving, leaving_counts);
+  wrap_entering(held.index);
   contact::Detection part;  // this rank's (serially: `next` itself)
   // The whole lists are gathered only for the advance from the whole
   // detection; else whole_detection() gathers them when a step needs them
@@ -529,6 +607,7 @@ void Simulation::start_owners() {
   // the floes' strips are its slabs, moved by whole blocks of the
   // transform's rows (drift()); otherwise the strips' cuts are free in y.
   owners_ = parallel::FloeOwners(comm_.rank(), comm_.size(), detection_options_.domain);
+  wrapped_.clear();  // the places are the start's or a checkpoint's, every copy as given: none to wrap late
   if (sea_ && !sea_->slab_rows().empty())
     owners_.set_slabs({sea_->slab_rows(), sea_->grid().dy(), fluid::RealFft2d::kRows});
 }
@@ -547,7 +626,9 @@ void Simulation::detect_in_place() {
   }
   owners_.assign(scenario_.floes);
   set_reach();
+  wrap_entering(owners_.mine());
   held_ = hold_band();
+  wrap_entering(held_.index);
   contact::Detection part;
   const bool whole = !advance_share_options_.on_part;
   detection_ = parallel::detect(comm_, owners_, scenario_.floes, shapes_, detection_options_, &part, whole, &held_);
@@ -556,13 +637,14 @@ void Simulation::detect_in_place() {
   detection_own_ = owners_.mine();
 }
 
-parallel::HeldFloes Simulation::hold_band() {
+parallel::HeldFloes Simulation::hold_band(std::span<const parallel::LeaveNotice> leaving,
+                                          std::span<const long long> leaving_counts) {
   const std::size_t n = scenario_.floes.size();
   if (comm_.serial()) return held_.mask.size() == n ? std::move(held_) : parallel::every_floe(n);
   // Each owner tests its own floes against the ranks' strips and announces
   // them, with their reaches, to the ranks whose band holds them
   // (parallel::announce_held: the band's rule, H the ranks' largest h_j).
-  return parallel::announce_held(comm_, owners_, scenario_.floes, shapes_, detection_options_);
+  return parallel::announce_held(comm_, owners_, scenario_.floes, shapes_, detection_options_, leaving, leaving_counts);
 }
 
 const contact::Detection& Simulation::whole_detection() {
@@ -607,9 +689,37 @@ parallel::WholeOnDemand Simulation::whole_on_demand(StepContext& ctx) {
 void Simulation::wrap_periodic() {
   const contact::Domain& d = detection_options_.domain;
   if (!d.periodic) return;
-  for (FloeState& s : scenario_.floes.state) {
-    s.x = d.xmin + std::fmod(std::fmod(s.x - d.xmin, d.width()) + d.width(), d.width());
-    s.y = d.ymin + std::fmod(std::fmod(s.y - d.ymin, d.height()) + d.height(), d.height());
+  // The floes this rank holds (every floe on one rank, before the first
+  // detection, or with the implicit step: held_now()). Every holder wraps
+  // a floe alike from the same bits; the other ranks' copies stay
+  // unwrapped until the drift's exchange brings the owner's (or
+  // hand_over_moved to a new owner, or wrap_entering at the detection).
+  wrapped_ = held_now();
+  std::vector<FloeState>& state = scenario_.floes.state;
+  for (std::size_t i = 0; i < state.size(); ++i)
+    if (wrapped_.empty() || wrapped_[i]) wrap_floe(state[i]);
+}
+
+void Simulation::wrap_floe(FloeState& s) const {
+  const contact::Domain& d = detection_options_.domain;
+  s.x = d.xmin + std::fmod(std::fmod(s.x - d.xmin, d.width()) + d.width(), d.width());
+  s.y = d.ymin + std::fmod(std::fmod(s.y - d.ymin, d.height()) + d.height(), d.height());
+}
+
+void Simulation::wrap_entering(std::span<const std::uint32_t> floes) {
+  // The wrap rounds ((x - xmin) + width is rounded to the spacing of the
+  // doubles between width and 2 width), so it is not the identity on a
+  // place inside the box: a copy left unwrapped
+  // differs from its holders' in the last bits. A floe that enters this
+  // rank's held set at the detection was not wrapped here at the advance;
+  // its copy is the holders' before their wrap (the drift's exchange gave
+  // the owner's state to every rank, and the collisions' and the advance's
+  // moves are every rank's alike), so one wrap now gives their bits.
+  if (!detection_options_.domain.periodic || wrapped_.empty()) return;
+  for (const std::uint32_t i : floes) {
+    if (i >= wrapped_.size() || wrapped_[i]) continue;  // a split's piece (i >= size) is its parent's copy
+    wrap_floe(scenario_.floes.state[i]);
+    wrapped_[i] = 1;
   }
 }
 
@@ -620,7 +730,7 @@ void Simulation::sea_flow(const StepContext& ctx) {
   if (!sea_) return;
   if (!floe_sea_) return sea_->flow(ctx.dt);
   floe_sea_->kick_sea(*sea_, 0.5 * ctx.dt);
-  floe_sea_->advance_vertical(scenario_.floes, ctx.start, *sea_, ctx.dt);
+  floe_sea_->advance_vertical(scenario_.floes, ctx.start, *sea_, ctx.dt, held_now());
 }
 
 void Simulation::sea_half_kick(StepContext& ctx) {

@@ -255,8 +255,26 @@ private:
   // own floes' reaches set): announced by their owners with their reaches,
   // which it writes (parallel::announce_held). Collective on several ranks;
   // one rank holds every floe.
-  parallel::HeldFloes hold_band();
+  // At a detection whose owners come from the own floes: `leaving`, this
+  // rank's notices of its floes that left its strip, and every rank's count
+  // of them, which the owners take there (announce_held).
+  parallel::HeldFloes hold_band(std::span<const parallel::LeaveNotice> leaving = {},
+                                std::span<const long long> leaving_counts = {});
+  // Wraps the centroids of the floes this rank holds (held_now()) into a
+  // periodic box, and notes which (wrapped_).
   void wrap_periodic();
+  void wrap_floe(FloeState& s) const;
+  // At a detection: wraps those of `floes` (the rank's own, then its held
+  // set) that the last wrap_periodic left unwrapped here.
+  void wrap_entering(std::span<const std::uint32_t> floes);
+  // On several ranks, in a step whose cuts moved: each floe whose owner
+  // changed goes from `detected` (the last detection's owners) to its new
+  // owner (its state, step-start copy and reach; one all-to-all).
+  void hand_over_moved(StepContext& ctx, std::span<const int> detected);
+  // Per floe, 1 if this rank holds it now: held_'s mask, its own floes
+  // (owners_.mine()) and its own floes for the coupling. Empty: every floe
+  // (one rank, no detection yet, or the implicit step).
+  std::vector<std::uint8_t> held_now() const;
   // The poison mode's hook after the phase `phase` (poison_mode.cpp): opens,
   // checks and closes its windows; nothing when the mode is off.
   void probe(const char* phase, StepContext& ctx) {
@@ -267,7 +285,9 @@ private:
   // assigned at the present places; one rank: every floe). Collective: the
   // pack's rms speed is summed by owner; `along` (exact sums of this rank's
   // part) are combined over the ranks in the same call.
-  void set_reach(std::span<ExactSum> along = {});
+  // `counts` (integers of this rank's part) are summed over the ranks in
+  // the same call.
+  void set_reach(std::span<ExactSum> along = {}, std::span<long long> counts = {});
   void read_try_budget(const StepContext& ctx);  // the try's momenta, combined, into step_budget_
   // The state check (the ranks agree on the first non-finite value) and the
   // step's momentum budget (the sea kick's momenta combined): one call.
@@ -294,6 +314,11 @@ private:
   contact::DetectionOptions detection_options_;
   parallel::FloeOwners owners_;  // drift and detection by place (stage six)
   parallel::HeldFloes held_;     // own floes and band at the last detection (held_floes())
+  // Between the advance's wrap_periodic and the next drift's exchange: per
+  // floe, 1 if this rank's copy was wrapped (there or by wrap_entering
+  // since); empty after wrap_periodic: every floe was. Cleared when every
+  // copy is as given or its owner's (start_owners, the drift's exchange).
+  std::vector<std::uint8_t> wrapped_;
   contact::ImpulseOptions impulse_options_;
   std::unique_ptr<contact::WarmStart> warm_ = std::make_unique<contact::WarmStart>();  // jam LCPs' last bases
   contact::Detection detection_;  // at the present positions

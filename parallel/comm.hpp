@@ -127,6 +127,11 @@ public:
   // changes rank (every rank sees that alike).
   template <class T>
   void hand_over(std::vector<T>& values, std::span<const int> held_by, std::span<const int> wanted_by) const;
+  // hand_over for several arrays indexed alike (item i is values[i] of
+  // each): each item that changes rank carries its values from every array
+  // together, in one all-to-all (none when no item changes rank).
+  template <class... T>
+  void hand_over_each(std::span<const int> held_by, std::span<const int> wanted_by, std::vector<T>&... values) const;
 
   // Bytes: every rank's `mine` concatenated in rank order; `counts` gets
   // each rank's byte count. Two collective calls (the counts, then the bytes).
@@ -270,6 +275,25 @@ void Communicator::hand_over(std::vector<T>& values, std::span<const int> held_b
   alltoall(std::as_bytes(std::span<const T>(out)), plan.send_bytes, std::as_writable_bytes(std::span<T>(in)),
            plan.receive_bytes);
   for (std::size_t k = 0; k < in.size(); ++k) values[plan.receive[k]] = in[k];
+}
+
+template <class... T>
+void Communicator::hand_over_each(std::span<const int> held_by, std::span<const int> wanted_by,
+                                  std::vector<T>&... values) const {
+  static_assert((kSentAsBytes<T> && ...));
+  if (serial()) return;
+  constexpr std::size_t item = (sizeof(T) + ... + std::size_t{0});
+  const HandOver plan = plan_hand_over(held_by, wanted_by, rank_, size_, item);
+  if (!plan.any) return;
+  // An item's record: its value from each array, in the arrays' order.
+  std::vector<std::byte> out(plan.send.size() * item), in(plan.receive.size() * item);
+  std::byte* to = out.data();
+  for (const std::uint32_t i : plan.send)
+    ((std::memcpy(to, static_cast<const void*>(&values[i]), sizeof(T)), to += sizeof(T)), ...);
+  alltoall(out, plan.send_bytes, in, plan.receive_bytes);
+  const std::byte* from = in.data();
+  for (const std::uint32_t i : plan.receive)
+    ((std::memcpy(static_cast<void*>(&values[i]), from, sizeof(T)), from += sizeof(T)), ...);
 }
 
 // The MPI environment of a process: MPI_Init when the process was started

@@ -1,14 +1,13 @@
 #include "parallel/held.hpp"
 
 #include <algorithm>
-#include <cstring>
 
 #include "core/error.hpp"
 #include "parallel/bytes.hpp"
 
 namespace floesim::parallel {
 
-static_assert(kSentAsBytes<BandStrip>);
+static_assert(kSentAsBytes<BandStrip> && kSentAsBytes<LeaveNotice>);
 
 std::vector<std::uint32_t> own_floes(const FloeOwners& owners, int rank) {
   if (rank == owners.rank()) return owners.mine();
@@ -56,24 +55,62 @@ HeldFloes held_from_notices(std::span<const std::uint32_t> own, std::size_t n, s
   return out;
 }
 
-HeldFloes announce_held(const Communicator& comm, const FloeOwners& owners, const Floes& floes,
-                        const contact::CollisionShapes& shapes, contact::DetectionOptions& options) {
+void widen_by_arrivals(std::span<BandStrip> strips, std::span<const LeaveNotice> notices,
+                       const contact::CollisionShapes& shapes, double collision_distance) {
+  for (const LeaveNotice& k : notices) {
+    BandStrip& s = strips[static_cast<std::size_t>(k.owner)];
+    s.lo = std::min(s.lo, k.place);
+    s.hi = std::max(s.hi, k.place);
+    s.largest = std::max(s.largest, half_band_for(k.place, shapes.radius[k.floe], k.reach, collision_distance));
+  }
+}
+
+HeldFloes announce_held(const Communicator& comm, FloeOwners& owners, const Floes& floes,
+                        const contact::CollisionShapes& shapes, contact::DetectionOptions& options,
+                        std::span<const LeaveNotice> leaving, std::span<const long long> leaving_counts) {
   const std::size_t n = floes.size();
   if (comm.serial()) return every_floe(n);
-  FLOESIM_ASSERT(owners.owner().size() == n && options.reach.size() == n && owners.rank() == comm.rank());
-  // Every rank's strip and part of H (one call); H their largest.
+  const auto ranks = static_cast<std::size_t>(comm.size());
+  FLOESIM_ASSERT(owners.owner().size() == n && options.reach.size() == n && owners.rank() == comm.rank() &&
+                 (leaving_counts.empty() || leaving_counts.size() == ranks));
+  // This rank's floes that left its strip are no longer its own (it knows
+  // their new owners); its strip and part of H from the floes it keeps.
+  owners.take_leaving(leaving);
   const BandStrip mine = band_strip(owners, comm.rank(), floes, shapes, options);
-  const std::vector<std::size_t> strip_bytes(static_cast<std::size_t>(comm.size()), sizeof(BandStrip));
-  const std::vector<std::byte> gathered = comm.allgather_known(std::as_bytes(std::span<const BandStrip>(&mine, 1)), strip_bytes);
-  std::vector<BandStrip> strips(strip_bytes.size());
-  std::memcpy(static_cast<void*>(strips.data()), gathered.data(), gathered.size());
+  // One call: every rank's strip and part of H, then its notices.
+  std::vector<std::byte> message;
+  append(message, std::span<const BandStrip>(&mine, 1));
+  append(message, leaving);
+  std::vector<std::size_t> message_bytes(ranks, sizeof(BandStrip));
+  for (std::size_t r = 0; r < leaving_counts.size(); ++r)
+    message_bytes[r] += static_cast<std::size_t>(leaving_counts[r]) * sizeof(LeaveNotice);
+  const std::vector<std::byte> gathered = comm.allgather_known(message, message_bytes);
+  std::vector<BandStrip> strips(ranks);
+  std::vector<LeaveNotice> notices;  // every rank's, in rank order
+  const std::byte* at = gathered.data();
+  for (std::size_t r = 0; r < ranks; ++r) {
+    strips[r] = take<BandStrip>(at, 1)[0];
+    const std::vector<LeaveNotice> part = take<LeaveNotice>(at, (message_bytes[r] - sizeof(BandStrip)) / sizeof(LeaveNotice));
+    // The others' notices change the owner array here (this rank's own did
+    // above); a floe that came to this rank takes its reach from its notice.
+    if (static_cast<int>(r) != comm.rank()) {
+      owners.take_leaving(part);
+      for (const LeaveNotice& k : part)
+        if (k.owner == comm.rank()) options.reach[k.floe] = k.reach;
+    }
+    notices.insert(notices.end(), part.begin(), part.end());
+  }
+  // Each strip widened by the places and half bands of the floes that came
+  // to its rank: band_strip over the rank's own floes now (min and max are
+  // exact in any order).
+  widen_by_arrivals(strips, notices, shapes, options.collision_distance);
   double largest = 0.0;
   for (const BandStrip& s : strips) largest = std::max(largest, s.largest);
   // The notices as one message a rank: the indices, then the reaches.
-  const std::vector<BandNotice> notices = band_notices(owners, comm.rank(), floes, shapes, options, strips, largest);
+  const std::vector<BandNotice> band = band_notices(owners, comm.rank(), floes, shapes, options, strips, largest);
   std::vector<std::byte> send;
   std::vector<std::size_t> send_counts;
-  for (const BandNotice& notice : notices) {
+  for (const BandNotice& notice : band) {
     append(send, std::span<const std::uint32_t>(notice.floe));
     append(send, std::span<const double>(notice.reach));
     send_counts.push_back(notice.floe.size() * (sizeof(std::uint32_t) + sizeof(double)));
@@ -82,7 +119,7 @@ HeldFloes announce_held(const Communicator& comm, const FloeOwners& owners, cons
   std::vector<std::size_t> got_counts;
   comm.alltoall_bytes(send, send_counts, got, got_counts);
   std::vector<BandNotice> received(got_counts.size());
-  const std::byte* at = got.data();
+  at = got.data();
   for (std::size_t s = 0; s < got_counts.size(); ++s) {
     const std::size_t k = got_counts[s] / (sizeof(std::uint32_t) + sizeof(double));
     received[s].floe = take<std::uint32_t>(at, k);

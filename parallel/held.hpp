@@ -75,13 +75,29 @@ std::vector<BandNotice> band_notices(const FloeOwners& owners, int rank, const F
 HeldFloes held_from_notices(std::span<const std::uint32_t> own, std::size_t n, std::span<const BandNotice> received,
                             double largest, std::span<double> reach);
 
+// The strips (band_strip of each rank's floes but those that left it)
+// widened by the floes that came to each rank: each notice's place and
+// half band (half_band_for with the notice's reach) into its new owner's
+// strip. The result is each rank's band_strip over its own floes now,
+// bit for bit (min and max are exact in any order).
+void widen_by_arrivals(std::span<BandStrip> strips, std::span<const LeaveNotice> notices,
+                       const contact::CollisionShapes& shapes, double collision_distance);
+
 // Collective (every rank, owners assigned for these floes, each rank's own
 // floes' reaches in options.reach, n values): every rank's held floes as
 // parallel::held_floes gives them with H the ranks' largest h_j, and the
 // reaches of its band's floes written into options.reach from their owners'.
-// Three calls: the strips' allgather, the notices' counts and records.
-// Serial: every floe held, nothing exchanged.
-HeldFloes announce_held(const Communicator& comm, const FloeOwners& owners, const Floes& floes,
-                        const contact::CollisionShapes& shapes, contact::DetectionOptions& options);
+// With the owners from the own floes (docs/parallel.md, handover25), the
+// owners still those before the places advanced: `leaving`, this rank's
+// notices of its floes that left its strip (FloeOwners::leaving, with their
+// reaches), and `leaving_counts`, every rank's number of them (known to
+// all; empty: none, the owners assigned already), ride on the strips'
+// gather; every rank applies them to `owners` and writes the reaches of
+// the floes that came to it. Three calls: the strips' and notices'
+// allgather, the band's notices' counts and records. Serial: every floe
+// held, nothing exchanged.
+HeldFloes announce_held(const Communicator& comm, FloeOwners& owners, const Floes& floes,
+                        const contact::CollisionShapes& shapes, contact::DetectionOptions& options,
+                        std::span<const LeaveNotice> leaving = {}, std::span<const long long> leaving_counts = {});
 
 }  // namespace floesim::parallel

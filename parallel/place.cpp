@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <numeric>
 
@@ -96,26 +97,58 @@ void FloeOwners::set_slabs(RowSlabs slabs) {
   set_cuts(std::move(cuts));
 }
 
+int FloeOwners::owner_at(const FloeState& s) const {
+  // With slabs: the slab of the centroid's grid row (parallel::grid_row,
+  // the coupling's rule); else the strip of the place between the cuts.
+  if (has_slabs()) return row_owner_[static_cast<std::size_t>(grid_row(s.y, slabs_.dy, slabs_.rows()))];
+  return static_cast<int>(std::upper_bound(cuts_.begin(), cuts_.end(), place(s)) - cuts_.begin());
+}
+
 void FloeOwners::assign(const Floes& floes) {
   const std::size_t n = floes.size();
-  if (has_slabs()) {
-    owner_.resize(n);
-    mine_.clear();
-    for (std::size_t i = 0; i < n; ++i) {
-      owner_[i] = row_owner_[static_cast<std::size_t>(grid_row(floes.state[i].y, slabs_.dy, slabs_.rows()))];
-      if (owner_[i] == rank_) mine_.push_back(static_cast<std::uint32_t>(i));
-    }
-    return;
+  if (!has_slabs() && !cut_) {
+    std::vector<double> y(n);
+    for (std::size_t i = 0; i < n; ++i) y[i] = place(floes.state[i]);
+    set_cuts(cut_by_cost(y, std::vector<double>(n, 1.0), ranks_));
   }
-  std::vector<double> y(n);
-  for (std::size_t i = 0; i < n; ++i) y[i] = place(floes.state[i]);
-  if (!cut_) set_cuts(cut_by_cost(y, std::vector<double>(n, 1.0), ranks_));
   owner_.resize(n);
   mine_.clear();
   for (std::size_t i = 0; i < n; ++i) {
-    owner_[i] = static_cast<int>(std::upper_bound(cuts_.begin(), cuts_.end(), y[i]) - cuts_.begin());
+    owner_[i] = owner_at(floes.state[i]);
     if (owner_[i] == rank_) mine_.push_back(static_cast<std::uint32_t>(i));
   }
+}
+
+std::vector<LeaveNotice> FloeOwners::leaving(int rank, const Floes& floes) const {
+  FLOESIM_ASSERT(assigned_for(floes) && rank >= 0 && rank < ranks_);
+  std::vector<LeaveNotice> out;
+  const auto test = [&](std::size_t j) {
+    const int now = owner_at(floes.state[j]);
+    if (now != rank) out.push_back({static_cast<std::uint32_t>(j), static_cast<std::int32_t>(now), place(floes.state[j]), 0.0});
+  };
+  if (rank == rank_) {
+    for (const std::uint32_t j : mine_) test(j);
+  } else {  // a simulated rank (tests): its floes from the owner array
+    for (std::size_t j = 0; j < owner_.size(); ++j)
+      if (owner_[j] == rank) test(j);
+  }
+  return out;
+}
+
+void FloeOwners::take_leaving(std::span<const LeaveNotice> notices) {
+  std::vector<std::uint32_t> arrived;
+  for (const LeaveNotice& k : notices) {
+    FLOESIM_ASSERT(k.floe < owner_.size() && k.owner >= 0 && k.owner < ranks_ && owner_[k.floe] != k.owner);
+    owner_[k.floe] = k.owner;
+    if (k.owner == rank_) arrived.push_back(k.floe);
+  }
+  // This rank's floes, ascending: its floes that left dropped, those that
+  // came to it merged in (a pass over its floes and the notices).
+  std::erase_if(mine_, [&](std::uint32_t i) { return owner_[i] != rank_; });
+  std::sort(arrived.begin(), arrived.end());
+  std::vector<std::uint32_t> merged(mine_.size() + arrived.size());
+  std::merge(mine_.begin(), mine_.end(), arrived.begin(), arrived.end(), merged.begin());
+  mine_ = std::move(merged);
 }
 
 FloeOwners::WindowCharges FloeOwners::close_window(const Communicator& comm) {
@@ -228,10 +261,14 @@ namespace {
 // h_j at floe j's place y (the one formula of half_band, held_floes and detection_subset).
 double half_band_at(double y, const contact::CollisionShapes& shapes, const contact::DetectionOptions& options,
                     std::size_t j) {
-  const double h = shapes.radius[j] + options.reach_of(j) + 0.5 * options.collision_distance;
-  return h + 1e-9 * (1.0 + std::abs(y) + h);  // posing rounds; a floe held in excess costs only time
+  return half_band_for(y, shapes.radius[j], options.reach_of(j), options.collision_distance);
 }
 }  // namespace
+
+double half_band_for(double y, double radius, double reach, double collision_distance) {
+  const double h = radius + reach + 0.5 * collision_distance;
+  return h + 1e-9 * (1.0 + std::abs(y) + h);  // posing rounds; a floe held in excess costs only time
+}
 
 double half_band(const FloeOwners& owners, const Floes& floes, const contact::CollisionShapes& shapes,
                  const contact::DetectionOptions& options, std::size_t j) {

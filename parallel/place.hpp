@@ -86,6 +86,20 @@ std::vector<double> cut_by_cost(std::span<const double> y, std::span<const doubl
 // holds at least one block (there must be at least `ranks` blocks).
 std::vector<int> cut_rows_by_cost(std::span<const double> row_cost, int block, int ranks);
 
+// A floe that leaves its owner's strip, as its owner announces it at the
+// detection (FloeOwners::leaving; docs/parallel.md, "The hand-over at a
+// move of the cuts and the owners from their own floes (handover25)"): its
+// index, its owner at its present place, its place (FloeOwners::place, m)
+// and its detection reach (m), which only its old owner computed
+// (Simulation::set_reach over the own floes): the new owner's strip is
+// widened by that place and half band (announce_held).
+struct LeaveNotice {
+  std::uint32_t floe = 0;
+  std::int32_t owner = 0;
+  double place = 0.0;
+  double reach = 0.0;
+};
+
 // The spectral sea's slabs as the floes' strips (issue 21 stage seven): the
 // slabs' first rows (ranks + 1 values), the grid's row height (its first row
 // at y = 0) and the transform's block of rows, the unit a cut moves by.
@@ -120,8 +134,27 @@ public:
   int ranks() const { return ranks_; }
 
   // The owners of the floes at their present places. Until cuts are set
-  // (set_cuts, update), the strips hold equal numbers of floes.
+  // (set_cuts, update), the strips hold equal numbers of floes. Reads every
+  // floe's place.
   void assign(const Floes& floes);
+  // The same owners from the owners' own floes (the cuts set, owners
+  // assigned for these floes): each rank tests only the floes it owns
+  // against the cuts, leaving() (its floes that now lie in another strip,
+  // ascending, with their places; their reaches left 0 for the caller), and
+  // every rank applies every rank's notices, take_leaving() (in any order,
+  // in parts: a floe has one owner, so one notice; announce_held carries
+  // them). A floe's owner is a function of its place alone
+  // (owner_at), evaluated by its owner on the same doubles as assign()
+  // evaluates it on every rank: the same owners, bit for bit, without
+  // reading another rank's floes. `rank`: this object's rank, or a
+  // simulated rank (tests: its floes from the owner array).
+  std::vector<LeaveNotice> leaving(int rank, const Floes& floes) const;
+  void take_leaving(std::span<const LeaveNotice> notices);
+  // Whether leaving() may replace assign() for `floes`: cuts set and an
+  // owner for each floe (not at the start, after a restore or a split).
+  bool assigned_for(const Floes& floes) const { return (cut_ || has_slabs()) && owner_.size() == floes.size(); }
+  // The rank whose strip holds a floe in state s (the one rule of assign and leaving).
+  int owner_at(const FloeState& s) const;
   // Collective (every rank at the same `step`): every options.rebalance_steps
   // steps, the cuts move by the ranks' charged times (above); then assign().
   // A step redone after an overlap calls it again with the same `step`: no
@@ -234,6 +267,9 @@ private:
 // h_j), the same bits in both.
 double half_band(const FloeOwners& owners, const Floes& floes, const contact::CollisionShapes& shapes,
                  const contact::DetectionOptions& options, std::size_t j);
+// h_j from its parts: place y (m), bounding radius R_j, reach_j and the
+// collision distance xi (the one formula of half_band and the band's passes).
+double half_band_for(double y, double radius, double reach, double collision_distance);
 // This rank's part of H: the largest h_j of the floes `rank` owns (owners
 // assigned for these floes), 0 if it owns none. H is its largest over the
 // ranks, one reduction (Communicator::max): every floe is owned by one rank,
