@@ -10,7 +10,6 @@
 
 #include "contact/substep.hpp"
 #include "core/error.hpp"
-#include "fluid/fft2d.hpp"
 #include "fluid/sea.hpp"
 #include "parallel/advance_share.hpp"
 #include "parallel/collide_share.hpp"
@@ -290,55 +289,6 @@ void Simulation::drift(StepContext& ctx) {
   add_owned_momentum(std::span(ctx.momenta).subspan<StepContext::kAfterDrift, 2>());
 }
 
-void Simulation::hand_over_moved(StepContext& ctx, std::span<const int> detected) {
-  // Rank r's copies of the floes it holds (its own and its band at the
-  // last detection, held_now()) are current: every holder moves, wraps and
-  // drifts them alike. Its other copies are not (wrap_periodic and the
-  // vertical drift pass over the held floes only), and a move of the cuts
-  // can make r the owner of such a floe: r would drift it from its stale
-  // copy, and the drift's complete_owned would send that copy to every
-  // rank. So each floe whose owner changed goes from its owner at the last
-  // detection, which held it, to its new owner: what the new owner's
-  // drift and the phases after it read of it that the constants do not
-  // give (the collision shapes, the drift's quadrature, the moorings'
-  // anchors and the floes' masses are every rank's):
-  // - its state (96 B): the drift's start, and the advance's;
-  // - its step-start copy ctx.start (96 B): the collisions' and the
-  //   advance's start state of the floes it owns, and what a rejected try
-  //   restores the state from (the update at the redone try does not move
-  //   the cuts again);
-  // - its detection reach (8 B): the advance's outrun check over the own
-  //   floes (band18; the reaches of the floes a rank does not hold are not
-  //   written there).
-  // The water velocity goes from the coupling's owner to the drift's
-  // (hand_water_over, after this). One all-to-all of 200 B a floe that
-  // changes owner, in a step whose cuts moved (every 10 steps at most).
-  FLOESIM_ASSERT(detection_part_ && detected.size() == scenario_.floes.size());
-  comm_.hand_over_each(detected, owners_.owner(), scenario_.floes.state, ctx.start, detection_part_->reach);
-}
-
-std::vector<std::uint8_t> Simulation::held_now() const {
-  // The last detection's band and own floes (held_); the floes this rank
-  // owns now: after a move of the cuts some of those were in no band of
-  // it, and came to it by hand_over_moved; its own floes for the coupling:
-  // between a move of the slabs and the footprints' next rebuild (with a
-  // window) they need not be in its band, and it poses them (their x, y,
-  // yaw) and its law reads their heave, pitch and roll. Their copies are
-  // current: the drift's exchange brings every floe's state, and the
-  // collisions' and advance's moves reach every rank.
-  // Every floe with the implicit step, which poses every floe at the
-  // midpoint of its motion (whole on every rank).
-  const std::size_t n = scenario_.floes.size();
-  if (comm_.serial() || held_.mask.size() != n || owners_.owner().size() != n) return {};
-  if (floe_sea_ && floe_sea_->implicit()) return {};
-  std::vector<std::uint8_t> held = held_.mask;
-  for (const std::uint32_t i : owners_.mine()) held[i] = 1;
-  if (floe_sea_)
-    for (const std::uint32_t i : floe_sea_->own_floes())
-      if (i < n) held[i] = 1;
-  return held;
-}
-
 void Simulation::follow_slabs() {
   // Every rank, at the same step (the cuts are computed from the same
   // gathered charges): the sea's row scratch and halo, the coupling's
@@ -600,127 +550,6 @@ bool Simulation::detect_and_check(StepContext& ctx) {
     detection_own_ = owners_.mine();
   }
   return true;
-}
-
-void Simulation::start_owners() {
-  // One decomposition (docs/parallel.md, stage seven): with a sea in slabs
-  // the floes' strips are its slabs, moved by whole blocks of the
-  // transform's rows (drift()); otherwise the strips' cuts are free in y.
-  owners_ = parallel::FloeOwners(comm_.rank(), comm_.size(), detection_options_.domain);
-  wrapped_.clear();  // the places are the start's or a checkpoint's, every copy as given: none to wrap late
-  if (sea_ && !sea_->slab_rows().empty())
-    owners_.set_slabs({sea_->slab_rows(), sea_->grid().dy(), fluid::RealFft2d::kRows});
-}
-
-void Simulation::detect_in_place() {
-  // Each rank its part, the pairs of the floes it owns at their present
-  // places (parallel::detect, as detect_and_check's); the whole lists
-  // gathered only for the advance from the whole detection, else by
-  // whole_detection() when a step needs them.
-  if (comm_.serial()) {
-    set_reach();
-    detection_ = contact::detect(scenario_.floes, shapes_, detection_options_);
-    detection_whole_ = true;
-    held_ = hold_band();
-    return;
-  }
-  owners_.assign(scenario_.floes);
-  set_reach();
-  wrap_entering(owners_.mine());
-  held_ = hold_band();
-  wrap_entering(held_.index);
-  contact::Detection part;
-  const bool whole = !advance_share_options_.on_part;
-  detection_ = parallel::detect(comm_, owners_, scenario_.floes, shapes_, detection_options_, &part, whole, &held_);
-  detection_whole_ = whole;
-  detection_part_ = std::move(part);
-  detection_own_ = owners_.mine();
-}
-
-parallel::HeldFloes Simulation::hold_band(std::span<const parallel::LeaveNotice> leaving,
-                                          std::span<const long long> leaving_counts) {
-  const std::size_t n = scenario_.floes.size();
-  if (comm_.serial()) return held_.mask.size() == n ? std::move(held_) : parallel::every_floe(n);
-  // Each owner tests its own floes against the ranks' strips and announces
-  // them, with their reaches, to the ranks whose band holds them
-  // (parallel::announce_held: the band's rule, H the ranks' largest h_j).
-  return parallel::announce_held(comm_, owners_, scenario_.floes, shapes_, detection_options_, leaving, leaving_counts);
-}
-
-const contact::Detection& Simulation::whole_detection() {
-  // Collective: every rank reaches it at the same point of the same step.
-  if (!detection_whole_) {
-    detection_ = parallel::gather(comm_, *detection_part_, detection_own_);
-    detection_whole_ = true;
-  }
-  return detection_;
-}
-
-void Simulation::whole_state(StepContext& ctx) {
-  // Collective, as whole_detection(): state_whole_ is the same on every
-  // rank. Each floe's state and step-start copy from its owner (the drift's,
-  // owners_: it drifted the floe and holds both current), in one message
-  // (192 B a floe the rank does not own). Only the floes this rank does not
-  // hold take them: a held floe's copy is current already (every holder
-  // updates it alike), and the poison mode's NaN in a held floe, a reader's
-  // trace, stays to be reported.
-  if (state_whole_) return;
-  std::vector<FloeState>& state = scenario_.floes.state;
-  const std::size_t n = state.size();
-  FLOESIM_ASSERT(ctx.start.size() == n && owners_.owner().size() == n);
-  std::vector<std::array<FloeState, 2>> both(n);
-  for (std::size_t i = 0; i < n; ++i) both[i] = {state[i], ctx.start[i]};
-  comm_.complete_owned(both, owners_.owner());
-  std::vector<std::uint8_t> held = held_.mask;
-  held.resize(n, 0);
-  for (const std::uint32_t i : owners_.mine()) held[i] = 1;
-  for (std::size_t i = 0; i < n; ++i)
-    if (!held[i]) {
-      state[i] = both[i][0];
-      ctx.start[i] = both[i][1];
-    }
-  state_whole_ = true;
-}
-
-parallel::WholeOnDemand Simulation::whole_on_demand(StepContext& ctx) {
-  return {[this]() -> const contact::Detection& { return whole_detection(); }, [this, &ctx]() { whole_state(ctx); }};
-}
-
-void Simulation::wrap_periodic() {
-  const contact::Domain& d = detection_options_.domain;
-  if (!d.periodic) return;
-  // The floes this rank holds (every floe on one rank, before the first
-  // detection, or with the implicit step: held_now()). Every holder wraps
-  // a floe alike from the same bits; the other ranks' copies stay
-  // unwrapped until the drift's exchange brings the owner's (or
-  // hand_over_moved to a new owner, or wrap_entering at the detection).
-  wrapped_ = held_now();
-  std::vector<FloeState>& state = scenario_.floes.state;
-  for (std::size_t i = 0; i < state.size(); ++i)
-    if (wrapped_.empty() || wrapped_[i]) wrap_floe(state[i]);
-}
-
-void Simulation::wrap_floe(FloeState& s) const {
-  const contact::Domain& d = detection_options_.domain;
-  s.x = d.xmin + std::fmod(std::fmod(s.x - d.xmin, d.width()) + d.width(), d.width());
-  s.y = d.ymin + std::fmod(std::fmod(s.y - d.ymin, d.height()) + d.height(), d.height());
-}
-
-void Simulation::wrap_entering(std::span<const std::uint32_t> floes) {
-  // The wrap rounds ((x - xmin) + width is rounded to the spacing of the
-  // doubles between width and 2 width), so it is not the identity on a
-  // place inside the box: a copy left unwrapped
-  // differs from its holders' in the last bits. A floe that enters this
-  // rank's held set at the detection was not wrapped here at the advance;
-  // its copy is the holders' before their wrap (the drift's exchange gave
-  // the owner's state to every rank, and the collisions' and the advance's
-  // moves are every rank's alike), so one wrap now gives their bits.
-  if (!detection_options_.domain.periodic || wrapped_.empty()) return;
-  for (const std::uint32_t i : floes) {
-    if (i >= wrapped_.size() || wrapped_[i]) continue;  // a split's piece (i >= size) is its parent's copy
-    wrap_floe(scenario_.floes.state[i]);
-    wrapped_[i] = 1;
-  }
 }
 
 void Simulation::sea_flow(const StepContext& ctx) {
