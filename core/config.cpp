@@ -60,6 +60,7 @@ void read_run(Section s, RunParams& r) {
                                    "an interval >= 0 (s; 0: a checkpoint only at the end)");
   r.record_collisions = s.boolean("record_collisions", r.record_collisions);
   r.advance_on_part = s.boolean("advance_on_part", r.advance_on_part);
+  r.crash_safe_output = s.boolean("crash_safe_output", r.crash_safe_output);
   s.finish();
 }
 

@@ -35,6 +35,13 @@ struct RunParams {
   // whole detection (advance_by_owner), the path of the runs that keep the
   // impulse record.
   bool advance_on_part = true;
+  // The run file written crash-safe (two copies, published whole at each
+  // flush: a kill at any instant leaves a whole file) or in place (half the
+  // disk and the writes; a kill during a flush may spoil the file);
+  // docs/formats.md, "A killed run's file". Like threads, an execution
+  // setting: the file's content is the same either way, and it is not
+  // written to run files.
+  bool crash_safe_output = true;
 };
 
 enum class SeaModel { none, spectral, bem };

@@ -112,6 +112,10 @@ void RunWriter::Impl::guarded(F&& write) {
 }
 
 namespace {
+h5::Writing h5_writing(RunFileWriting w) {
+  return w == RunFileWriting::crash_safe ? h5::Writing::published : h5::Writing::in_place;
+}
+
 std::uint32_t id_of(const Floes& floes, std::size_t i) {
   return i < floes.id.size() ? floes.id[i] : static_cast<std::uint32_t>(i);
 }
@@ -133,14 +137,14 @@ void RunWriter::Impl::write_tables() {
 
 RunWriter::RunWriter(const std::string& path, const Floes& floes, const std::string& config_toml,
                      std::vector<std::string> energy_columns, const SeaGridInfo& sea,
-                     std::size_t expected_records)
+                     std::size_t expected_records, RunFileWriting writing)
     : impl_(std::make_unique<Impl>()) {
   Impl& w = *impl_;
   w.path = path;
   w.energy_columns = std::move(energy_columns);
   w.sea = sea;
   const hsize_t rows = expected_records;
-  w.file = h5::create_file(path);
+  w.file = h5::create_file(path, h5_writing(writing));
   try {
     start(floes, config_toml, static_cast<unsigned long long>(rows));
   } catch (const RunError& e) {
@@ -339,13 +343,14 @@ void RunWriter::record_collisions(std::span<const CollisionEventRow> events) {
 }
 
 RunWriter::RunWriter(Resume, const std::string& path, const Checkpoint& c, const std::string& config_toml,
-                     const std::vector<std::string>& energy_columns, const SeaGridInfo& sea)
+                     const std::vector<std::string>& energy_columns, const SeaGridInfo& sea,
+                     RunFileWriting writing)
     : impl_(std::make_unique<Impl>()) {
   Impl& w = *impl_;
   w.path = path;
   w.energy_columns = energy_columns;
   w.sea = sea;
-  w.file = h5::open_file(path, true);
+  w.file = h5::open_file(path, true, h5_writing(writing));
   auto fail = [&](const std::string& what) { throw InputError(path + ": cannot continue the run: " + what); };
   w.floes_group = h5::open_group(w.file, "/floes", path);
   w.xdmf_group = h5::open_group(w.file, "/xdmf", path);

@@ -97,6 +97,17 @@ struct LcpCounters {
   std::array<double, kSubstepColumns> substeps{};  // /diagnostics/substeps, kSubstepColumnNames
 };
 
+// How a RunWriter writes its file ([run] crash_safe_output, docs/formats.md
+// "A killed run's file").
+//   crash_safe: two copies on disk, the file published whole at each flush
+//     (core/detail/h5_published.hpp): a run killed at any instant leaves a
+//     whole file; every byte is written twice and the disk holds the file
+//     twice while it is written.
+//   in_place: one copy, HDF5 writing in place: half the disk and the writes;
+//     a run killed during a flush may leave a file that no longer opens.
+// The file's content is the same either way.
+enum class RunFileWriting { crash_safe, in_place };
+
 class RunWriter {
 public:
   // Creates (truncates) the file and writes the static parts. Throws
@@ -113,7 +124,7 @@ public:
   // the failed write itself is reported (the file may then be damaged).
   RunWriter(const std::string& path, const Floes& floes, const std::string& config_toml,
             std::vector<std::string> energy_columns, const SeaGridInfo& sea = {},
-            std::size_t expected_records = 0);
+            std::size_t expected_records = 0, RunFileWriting writing = RunFileWriting::crash_safe);
   // Continues the run file `path` from its checkpoint `c` (read_checkpoint):
   // the records, fracture and collision events and floe numbers after it are dropped (a
   // run that went on past its last checkpoint), and record() appends after
@@ -122,7 +133,8 @@ public:
   // checkpoint counts, or its energy columns are not `energy_columns`.
   struct Resume {};
   RunWriter(Resume, const std::string& path, const Checkpoint& c, const std::string& config_toml,
-            const std::vector<std::string>& energy_columns, const SeaGridInfo& sea = {});
+            const std::vector<std::string>& energy_columns, const SeaGridInfo& sea = {},
+            RunFileWriting writing = RunFileWriting::crash_safe);
   ~RunWriter();  // closes; leaves status "running" unless finish() was called
   RunWriter(const RunWriter&) = delete;
   RunWriter& operator=(const RunWriter&) = delete;

@@ -28,12 +28,15 @@ RunSummary run_simulation(Simulation& sim, const RunOptions& options) {
   const auto expected_records = static_cast<std::size_t>(std::ceil(t_end / interval - 1e-9)) + 1;
   // One writer (rank 0): the other ranks hold the same state and have no file.
   std::unique_ptr<RunWriter> writer;
+  const RunFileWriting file_writing = cfg.run.crash_safe_output ? RunFileWriting::crash_safe : RunFileWriting::in_place;
   comm.together([&] {
     if (!comm.writer()) return;
     writer = options.resume ? std::make_unique<RunWriter>(RunWriter::Resume{}, options.output, *options.resume,
-                                                          resolved_toml(cfg), summary.energy_first.names, sim.sea_grid())
+                                                          resolved_toml(cfg), summary.energy_first.names, sim.sea_grid(),
+                                                          file_writing)
                             : std::make_unique<RunWriter>(options.output, sim.floes(), resolved_toml(cfg),
-                                                          summary.energy_first.names, sim.sea_grid(), expected_records);
+                                                          summary.energy_first.names, sim.sea_grid(), expected_records,
+                                                          file_writing);
     summary.xdmf = writer->xdmf_path();
   });
 

@@ -36,13 +36,31 @@ bool is_hdf5(const std::string& path) {
   return H5Fis_hdf5(path.c_str()) > 0;
 }
 
-Handle open_file(const std::string& path, bool write) {
+namespace {
+// The file access list for writing `path` as `how` says: the publishing
+// driver's, or the sec2 driver's (in place, also for a path that is not a
+// regular file). In place, the helper copies of an earlier published writer
+// go, so that no stale copy stays beside the file.
+Handle write_fapl(const std::string& path, Writing how) {
+  Handle fapl{how == Writing::published ? published_fapl(path) : hid_t{-1}, H5Pclose};
+  if (!fapl.valid()) {
+    fapl = Handle{H5Pcreate(H5P_FILE_ACCESS), H5Pclose};
+    H5Pset_fapl_sec2(fapl);
+  }
+  if (how == Writing::in_place) {
+    std::remove(working_path(path).c_str());
+    std::remove(previous_path(path).c_str());
+  }
+  H5Pset_file_locking(fapl, false, true);
+  return fapl;
+}
+}  // namespace
+
+Handle open_file(const std::string& path, bool write, Writing how) {
   silence_errors();
   if (!is_hdf5(path)) fail(path + ": not an HDF5 file (or it cannot be read)");
-  // A file continued (written) goes through the publishing driver, as one created.
-  Handle fapl{write ? published_fapl(path) : H5Pcreate(H5P_FILE_ACCESS), H5Pclose};
-  if (!fapl.valid()) fapl = Handle{H5Pcreate(H5P_FILE_ACCESS), H5Pclose};
-  if (write) H5Pset_file_locking(fapl, false, true);
+  // A file continued (written) is written as one created.
+  Handle fapl = write ? write_fapl(path, how) : Handle{H5Pcreate(H5P_FILE_ACCESS), H5Pclose};
   hid_t f = H5Fopen(path.c_str(), write ? H5F_ACC_RDWR : H5F_ACC_RDONLY, fapl);
   if (f < 0) fail(path + ": cannot open the HDF5 file" + (write ? " for writing" : ""));
   return {f, H5Fclose};
@@ -112,20 +130,15 @@ void check_global_heaps(const std::string& path) {
   for (std::uint64_t at : found) walk(at);
 }
 
-Handle create_file(const std::string& path) {
+Handle create_file(const std::string& path, Writing how) {
   silence_errors();
   // No file lock: a run file is written by one process and may be read by
-  // others (scripts, `floesim info`) while the run goes on. Written through
-  // the publishing driver (h5_published.hpp): the name `path` holds the file
-  // as of its last flush, whole, whatever instant the writer is stopped at.
-  // A path that is not a regular file (/dev/full) is written in place, on
-  // the sec2 driver. Both give reserve() a file descriptor.
-  Handle fapl{published_fapl(path), H5Pclose};
-  if (!fapl.valid()) {
-    fapl = Handle{H5Pcreate(H5P_FILE_ACCESS), H5Pclose};
-    H5Pset_fapl_sec2(fapl);
-  }
-  H5Pset_file_locking(fapl, false, true);
+  // others (scripts, `floesim info`) while the run goes on. Published
+  // (h5_published.hpp), the name `path` holds the file as of its last flush,
+  // whole, whatever instant the writer is stopped at; in place (by choice,
+  // or a path that is not a regular file such as /dev/full), on the sec2
+  // driver. Both give reserve() a file descriptor.
+  Handle fapl = write_fapl(path, how);
   errno = 0;
   hid_t f = H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, fapl);
   if (f < 0) {

@@ -38,13 +38,20 @@ private:
 void silence_errors();  // once per process: no HDF5 error-stack dumps on stderr
 
 bool is_hdf5(const std::string& path);
+// How a file opened to write, or created, is written.
+//   published: through the publishing driver (h5_published.hpp): `path`
+//     holds the file as of its last flush, whole, whatever instant the
+//     process is killed at; the disk holds it twice while it is written.
+//   in_place: on the sec2 (POSIX) driver, as HDF5 writes by itself: half the
+//     disk and the writes, but a process killed in a flush may leave a file
+//     that no longer opens. Helper copies an earlier published writer of
+//     `path` left (killed) are removed: they are copies of an older file.
+// A path that is not a regular file is written in place either way.
+enum class Writing { published, in_place };
 // A file opened to write, and a file created (an earlier one of that name is
-// removed), are written through the publishing driver (h5_published.hpp):
-// `path` holds the file as of its last flush, whole, whatever instant the
-// process is killed at. A path that is not a regular file is written in
-// place on the sec2 (POSIX) driver.
-Handle open_file(const std::string& path, bool write = false);
-Handle create_file(const std::string& path);
+// removed), are written as `how` says.
+Handle open_file(const std::string& path, bool write = false, Writing how = Writing::published);
+Handle create_file(const std::string& path, Writing how = Writing::published);
 // Writes every cached object of the file to disk (and publishes it); false
 // when a write failed.
 bool flush(hid_t file);

@@ -484,6 +484,41 @@ def case_kill_anywhere():
           f"{early} killed before their first one")
 
 
+def case_in_place():
+    # [run] crash_safe_output = false: the run file is written in place
+    # (docs/formats.md, "A killed run's file"). While the run writes, no
+    # helper copy lies beside it (the default run has its working copy
+    # there); its content equals the default run's, bit for bit; and such a
+    # run, interrupted and continued, equals the uninterrupted one.
+    text = WAVES.format(t_end=4.0, coupling='law = "strong"\nstiffness = 100.0')
+    cfgs = {"crash_safe": write("safe.toml", text),
+            "in_place": write("in_place.toml", text.replace("[run]\n", "[run]\ncrash_safe_output = false\n", 1))}
+    for how, cfg in cfgs.items():
+        out = os.path.join(WORK, how + "_stopped.h5")
+        helper = []
+
+        def ready(f):
+            if f["time"].shape[0] < 3:
+                return False
+            helper.append(os.path.exists(out + ".writing") or os.path.exists(out + ".previous"))
+            return True
+        code, stderr = stop_midway(cfg, out, signal.SIGINT, ready)
+        check(code == 130, f"{how}: interrupted, exit 130, got {code}\n{stderr}")
+        check(helper == [how == "crash_safe"],
+              f"{how}: a helper copy beside the file while it is written: {helper} (expected {how == 'crash_safe'})")
+        check(not os.path.exists(out + ".writing") and not os.path.exists(out + ".previous"),
+              f"{how}: no helper copy left after the run")
+        run("run", "-q", cfg, "-o", how + ".h5")
+    run("compare", "crash_safe.h5", "in_place.h5", "--rtol", "0", "--atol", "0")
+    compare_runs(os.path.join(WORK, "crash_safe.h5"), os.path.join(WORK, "in_place.h5"), "in place against crash-safe")
+    # Continued in place, written in place: equals the uninterrupted run.
+    t_end = checkpoint_time("in_place_stopped.h5") + 1.0
+    run("run", "-q", cfgs["crash_safe"], "-o", "full.h5", "--until", str(t_end))
+    run("run", "-q", cfgs["in_place"], "--restart", "in_place_stopped.h5", "--until", str(t_end), "-o", "cont.h5")
+    check(not os.path.exists(os.path.join(WORK, "cont.h5.writing")), "the continued run left no helper copy")
+    compare_runs(os.path.join(WORK, "full.h5"), os.path.join(WORK, "cont.h5"), "continued in place")
+
+
 def case_run_error():
     # A run that fails (exit 1: a wind of 1e200 m/s from t = 10.5 s overflows
     # the drag) keeps, as its checkpoint, the state at its last record: the

@@ -45,6 +45,17 @@ TEST_CASE("an empty configuration gives the documented defaults") {
   CHECK(c.floes.floes.empty());
 }
 
+TEST_CASE("[run] crash_safe_output chooses how the run file is written") {
+  CHECK(parse("").run.crash_safe_output);
+  CHECK(parse("[run]\ncrash_safe_output = true\n").run.crash_safe_output);
+  CHECK_FALSE(parse("[run]\ncrash_safe_output = false\n").run.crash_safe_output);
+  refused("[run]\ncrash_safe_output = \"yes\"\n", {"case.toml", "[run] crash_safe_output", "expected true or false", "a string"});
+  refused("[run]\ncrash_safe_output = 0\n", {"case.toml", "[run] crash_safe_output", "expected true or false"});
+  // An execution setting: not in the resolved configuration a run file keeps,
+  // so that a file written in place equals one written crash-safe.
+  CHECK(resolved_toml(parse("[run]\ncrash_safe_output = false\n")) == resolved_toml(parse("")));
+}
+
 TEST_CASE("a full configuration is read") {
   const Config c = parse(R"(
 [run]

@@ -90,6 +90,37 @@ TEST_CASE("a published run file changes only at a flush, and only to a whole fil
   fs::remove(path);
 }
 
+TEST_CASE("a file written in place by choice has no helper copy, and removes stale ones") {
+  const std::string path = (fs::temp_directory_path() / "floesim_in_place_test.h5").string();
+  fs::remove(path);
+  // Helper copies a killed published writer of `path` left: copies of an
+  // older file, removed by the writer in place.
+  for (const std::string& stale : {h5::working_path(path), h5::previous_path(path)}) std::ofstream(stale) << "old";
+  std::vector<double> a(5000, 1.5), b(3000, 2.5);
+  {
+    h5::Handle f = h5::create_file(path, h5::Writing::in_place);
+    REQUIRE(f.valid());
+    CHECK_FALSE(h5::is_published(f));
+    CHECK(fs::exists(path));  // written under its name from the start
+    CHECK_FALSE(fs::exists(h5::working_path(path)));
+    CHECK_FALSE(fs::exists(h5::previous_path(path)));
+    h5::write_doubles(f, "a", {a.size()}, a.data());
+    REQUIRE(h5::flush(f));
+    CHECK_FALSE(fs::exists(h5::working_path(path)));
+  }
+  CHECK(read_back(path, "a") == a);
+  {
+    h5::Handle f = h5::open_file(path, true, h5::Writing::in_place);
+    CHECK_FALSE(h5::is_published(f));
+    h5::write_doubles(f, "b", {b.size()}, b.data());
+    REQUIRE(h5::flush(f));
+    CHECK_FALSE(fs::exists(h5::working_path(path)));
+  }
+  CHECK(read_back(path, "a") == a);
+  CHECK(read_back(path, "b") == b);
+  fs::remove(path);
+}
+
 TEST_CASE("a path that is not a regular file is written in place") {
   CHECK(h5::published_fapl("/dev/null") < 0);
 }
