@@ -342,9 +342,10 @@ private:
   // and the poison mode of the run does so in its windows (false while one
   // is open). whole_state() makes them current when a step reads every
   // floe (the pair list's rebuild on a part, a fallback, a whole step of
-  // the back-off: parallel::WholeOnDemand), once in such a step.
+  // the back-off: parallel::WholeOnDemand), once in such a step; or the
+  // states alone (what the advance reads), which leave the flag false.
   bool state_whole_ = true;
-  void whole_state(StepContext& ctx);
+  void whole_state(StepContext& ctx, parallel::WholeState what);
   parallel::WholeOnDemand whole_on_demand(StepContext& ctx);
   contact::CollisionStats stats_;
   std::unique_ptr<Percussion> percussion_;  // [fracture] enabled

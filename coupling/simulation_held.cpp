@@ -118,24 +118,37 @@ const contact::Detection& Simulation::whole_detection() {
   return detection_;
 }
 
-void Simulation::whole_state(StepContext& ctx) {
-  // Collective, as whole_detection(): state_whole_ is the same on every
-  // rank. Each floe's state and step-start copy from its owner (the drift's,
-  // owners_: it drifted the floe and holds both current), in one message
-  // (192 B a floe the rank does not own). Only the floes this rank does not
-  // hold take them: a held floe's copy is current already (every holder
-  // updates it alike), and the poison mode's NaN in a held floe, a reader's
-  // trace, stays to be reported.
+void Simulation::whole_state(StepContext& ctx, parallel::WholeState what) {
+  // Collective, as whole_detection(): state_whole_ and `what` are the same
+  // on every rank. Each floe's state, and with WholeState::state_and_start
+  // its step-start copy, from its owner (the drift's, owners_: it drifted
+  // the floe and holds both current), in one message: 96 B a floe the rank
+  // does not own for the state alone, 192 B with the copy. Only the floes
+  // this rank does not hold take them: a held floe's copy is current
+  // already (every holder updates it alike), and the poison mode's NaN in a
+  // held floe, a reader's trace, stays to be reported.
+  //
+  // state_whole_ (one flag: both whole) is set only by the gather of both.
+  // The state alone leaves the step-start copies stale, so a later ask in
+  // the step gathers again; the advance, the one path that asks for the
+  // state alone, keeps what it gathered (its `start`) and asks once.
   if (state_whole_) return;
   std::vector<FloeState>& state = scenario_.floes.state;
   const std::size_t n = state.size();
   FLOESIM_ASSERT(ctx.start.size() == n && owners_.owner().size() == n);
-  std::vector<std::array<FloeState, 2>> both(n);
-  for (std::size_t i = 0; i < n; ++i) both[i] = {state[i], ctx.start[i]};
-  comm_.complete_owned(both, owners_.owner());
   std::vector<std::uint8_t> held = held_.mask;
   held.resize(n, 0);
   for (const std::uint32_t i : owners_.mine()) held[i] = 1;
+  if (what == parallel::WholeState::state) {
+    std::vector<FloeState> owned = state;
+    comm_.complete_owned(owned, owners_.owner());
+    for (std::size_t i = 0; i < n; ++i)
+      if (!held[i]) state[i] = owned[i];
+    return;
+  }
+  std::vector<std::array<FloeState, 2>> both(n);
+  for (std::size_t i = 0; i < n; ++i) both[i] = {state[i], ctx.start[i]};
+  comm_.complete_owned(both, owners_.owner());
   for (std::size_t i = 0; i < n; ++i)
     if (!held[i]) {
       state[i] = both[i][0];
@@ -145,7 +158,8 @@ void Simulation::whole_state(StepContext& ctx) {
 }
 
 parallel::WholeOnDemand Simulation::whole_on_demand(StepContext& ctx) {
-  return {[this]() -> const contact::Detection& { return whole_detection(); }, [this, &ctx]() { whole_state(ctx); }};
+  return {[this]() -> const contact::Detection& { return whole_detection(); },
+          [this, &ctx](parallel::WholeState what) { whole_state(ctx, what); }};
 }
 
 void Simulation::wrap_periodic() {

@@ -443,12 +443,16 @@ void advance_on_part(const Communicator& comm, std::span<const int> owner, std::
   if (comm.serial())
     return advance_by_owner(comm, owner, floes, shapes, whole.detection(), dt, options, stats, report, counts,
                             share_options);
+  // The advance reads the floes' states (W^+ of the collisions), never the
+  // step-start copy: it asks for the states alone (96 B a floe the rank does
+  // not hold, when they are not whole).
   if (counts.whole_now()) {
-    whole.state();
+    whole.state(WholeState::state);
     contact::advance_with_collisions(floes, shapes, whole.detection(), dt, options, stats, report);
     return;
   }
   std::vector<FloeState> start = floes.state;
+  bool start_whole = false;  // `start` holds every floe's current state (the rebuild gathered it)
   bool combined = false;
   {
     // A run that keeps the impulse record: as advance_by_owner (the events'
@@ -470,8 +474,9 @@ void advance_on_part(const Communicator& comm, std::span<const int> owner, std::
       // moves none), made whole here; the fallback below starts again from
       // it. And every floe's reach from its owner (a rank wrote only its
       // band's at the detection, band18; 8 bytes a floe, in such a step only).
-      whole.state();
+      whole.state(WholeState::state);
       start = floes.state;
+      start_whole = true;
       std::vector<double> reach = part.reach;
       comm.complete_owned(reach, owner);
       rooms = comm.allgather_parts(pack(share.rooms_rebuilt(reach)), unpack_share_rooms);
@@ -529,7 +534,8 @@ void advance_on_part(const Communicator& comm, std::span<const int> owner, std::
   }
   counts.fell_back(share_options);
   floes.state = start;
-  whole.state();
+  // After a rebuild `start` is whole already: the fallback gathers nothing more.
+  if (!start_whole) whole.state(WholeState::state);
   contact::advance_with_collisions(floes, shapes, whole.detection(), dt, options, stats, report);
 }
 

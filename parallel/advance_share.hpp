@@ -31,15 +31,22 @@ namespace floesim::parallel {
 // part, a fallback, a step the back-off does whole). Both are collective:
 // every rank calls them at the same point of the same step, or none does.
 // `detection`: the whole detection's lists (gathered once a detection).
-// `state`: every floe's state, and the step's start copy, current on this
-// rank, from the floes' owners. Until the halo exchange (piece 8) every rank
-// holds every floe current after the drift and `state` does nothing; with
-// the exchange (and in the poison mode of the run, which leaves the floes a
-// rank does not hold stale as the exchange will) it gathers the floes the
-// rank does not hold, once in a step (Simulation::whole_state).
+// `state(what)`: every floe's state (WholeState::state), or its state and
+// the step's start copy (WholeState::state_and_start), current on this
+// rank, from the floes' owners: each path names what it reads. Until the
+// halo exchange (piece 8) every rank holds every floe current after the
+// drift and `state` does nothing; with the exchange (and in the poison mode
+// of the run, which leaves the floes a rank does not hold stale as the
+// exchange will) it gathers the floes the rank does not hold
+// (Simulation::whole_state): the state and start once in a step, the state
+// alone (half the bytes) each time it is asked for.
+enum class WholeState {
+  state,            // the state: the advance's rebuild, fallback and whole step
+  state_and_start,  // and the step-start copy: the collide's fallback and whole step
+};
 struct WholeOnDemand {
   std::function<const contact::Detection&()> detection;
-  std::function<void()> state;
+  std::function<void(WholeState)> state;
 };
 
 // One rank's part of a step's advance: what its share did, the states of the
@@ -250,7 +257,8 @@ void advance_by_owner(const Communicator& comm, std::span<const int> owner, Floe
 // floe of any rank outrunning its reach (the flags gathered with the rooms)
 // makes every rank rebuild the pair list and gather the rooms again (one
 // more allgather_bytes in such a step); the rebuild reads every floe's
-// state at the step's start and its reach: `whole.state` first, then the
+// state at the step's start and its reach: `whole.state` (the state alone,
+// WholeState::state) first, then the
 // reaches from their owners. `whole` gives the whole state and detection
 // for the back-off's whole steps and the fallback (state first), which is
 // taken also when a floe joins a share's cluster without being its

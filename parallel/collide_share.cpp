@@ -188,7 +188,7 @@ std::size_t collide_on_part(const Communicator& comm, std::span<const int> owner
   // the lists.
   contact::Detection gathered;
   const auto solve_whole = [&]() {
-    if (whole) whole->state();
+    if (whole) whole->state(WholeState::state_and_start);
     const contact::Detection& lists = whole ? whole->detection() : (gathered = gather(comm, part));
     return contact::resolve_step_collisions(floes, start, lists, step, options, stats);
   };
