@@ -252,9 +252,22 @@ bool FloeOwners::update(const Communicator& comm, const Floes& floes, std::size_
   } else if (step >= next_move_) {
     next_move_ = step + static_cast<std::size_t>(options_.rebalance_steps);
     moved = has_slabs() ? move_slabs(comm, floes) : move_cuts(comm, floes);
+    assign(floes);
+    return moved;
   }
-  assign(floes);
+  if (!comm.serial() && assigned_for(floes)) migrate(comm, floes);
+  else assign(floes);  // the start, after a split, or one process standing for all ranks
   return moved;
+}
+
+void FloeOwners::migrate(const Communicator& comm, const Floes& floes) {
+  FLOESIM_ASSERT(comm.size() == ranks_ && comm.rank() == rank_);
+  // owner_at is a function of the place alone, evaluated by the floe's
+  // owner on its copy, the holders' bits: the owner assign() gives on any
+  // rank whose copy is current, without reading any other floe.
+  const std::vector<LeaveNotice> mine = leaving(rank_, floes);
+  const std::vector<LeaveNotice> all = comm.allgather<LeaveNotice>(mine);
+  take_leaving(all);
 }
 
 namespace {

@@ -156,12 +156,24 @@ public:
   // The rank whose strip holds a floe in state s (the one rule of assign and leaving).
   int owner_at(const FloeState& s) const;
   // Collective (every rank at the same `step`): every options.rebalance_steps
-  // steps, the cuts move by the ranks' charged times (above); then assign().
-  // A step redone after an overlap calls it again with the same `step`: no
-  // second move.
+  // steps, the cuts move by the ranks' charged times (above), then assign()
+  // (a move reads every floe's y or row: docs/parallel.md, update25); at
+  // the other steps, with the owners assigned for these floes on several
+  // ranks, migrate(): the same owners from the owners' own floes. A step
+  // redone after an overlap calls it again with the same `step`: no second
+  // move (the migration then gives the owners at the restored places).
   // Returns whether the cuts moved (with slabs: the slabs, which the sea and
   // the coupling must then be given, on every rank alike).
   bool update(const Communicator& comm, const Floes& floes, std::size_t step);
+  // Collective (assigned_for(floes), `comm` this object's ranks): the
+  // owners at the floes' present places, assign()'s entry for entry, read
+  // from the floes each rank owns only. Each rank announces its leaving()
+  // floes, the notices are gathered in rank order (an allgather of 24 B a
+  // notice: its counts' call, and the bytes' call only when some rank has
+  // one) and every rank applies all of them (take_leaving: one owner a
+  // floe, so any order). The other floes' copies are not read: they may be
+  // stale or unwrapped (the halo exchange of piece 8).
+  void migrate(const Communicator& comm, const Floes& floes);
   // Whether update(step) closes a window, and so may move the cuts (the
   // same on every rank).
   bool may_move(std::size_t step) const { return started_ && step >= next_move_; }
