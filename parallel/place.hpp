@@ -153,13 +153,21 @@ public:
   // Whether leaving() may replace assign() for `floes`: cuts set and an
   // owner for each floe (not at the start, after a restore or a split).
   bool assigned_for(const Floes& floes) const { return (cut_ || has_slabs()) && owner_.size() == floes.size(); }
-  // The rank whose strip holds a floe in state s (the one rule of assign and leaving).
-  int owner_at(const FloeState& s) const;
+  // The rank whose strip holds a floe in state s (the one rule of assign and
+  // leaving): the owner of its key (with slabs its centroid's grid row, a
+  // whole number held exactly in a double; else its place), which the cuts'
+  // move gathers from the owners (update).
+  int owner_at(const FloeState& s) const { return owner_of_key(key(s)); }
+  double key(const FloeState& s) const;
+  int owner_of_key(double key) const;
   // Collective (every rank at the same `step`): every options.rebalance_steps
-  // steps, the cuts move by the ranks' charged times (above), then assign()
-  // (a move reads every floe's y or row: docs/parallel.md, update25); at
-  // the other steps, with the owners assigned for these floes on several
-  // ranks, migrate(): the same owners from the owners' own floes. A step
+  // steps, the cuts move by the ranks' charged times (above). First the
+  // owners at the floes' present places: with the owners assigned for these
+  // floes on several ranks, migrate() (from the owners' own floes), else
+  // assign() (the start, after a split, serially). A move then gathers each
+  // floe's key (key(): its row or place, 8 B a floe) from its owner with
+  // the charges (one call), and every rank computes the new cuts and owners
+  // from the gathered keys: no floe's copy but the rank's own is read. A step
   // redone after an overlap calls it again with the same `step`: no second
   // move (the migration then gives the owners at the restored places).
   // Returns whether the cuts moved (with slabs: the slabs, which the sea and
@@ -241,7 +249,10 @@ private:
     std::vector<double> floe;
     double rows = 0.0;
   };
-  WindowCharges close_window(const Communicator& comm);
+  // The charges and every floe's key (n values, each from its owner; owners
+  // assigned for these floes).
+  WindowCharges close_window(const Communicator& comm, const Floes& floes, std::vector<double>& keys);
+  void assign_keys(std::span<const double> keys);  // the owners from every floe's key
   std::vector<double> floe_costs(std::span<const double> floe_seconds) const;  // per floe, after assign()
   bool move_slabs(const Communicator& comm, const Floes& floes);
   bool move_cuts(const Communicator& comm, const Floes& floes);

@@ -1,15 +1,19 @@
 // The drift's owners from their own floes (docs/parallel.md, "The drift's
 // owners from their own floes (update25)"): FloeOwners::update on the ranks
 // mpirun started, each rank given a copy of the floes in which every floe it
-// does not own is NaN (the stale copies the halo exchange will leave), but at
-// a step that moves the cuts (a move still reads every floe's y or row).
+// does not own is NaN (the stale copies the halo exchange will leave), at
+// every step (a move of the cuts gathers each floe's row or place from its
+// owner).
 // 2000 floes drift at random speeds along y (many cross a cut each step),
 // and every third step one floe in ten is put exactly on a cut (where
 // round-off would show); the ranks charge each floe's known cost (a floe
 // above the box's middle costs 20 times one below), so the cuts move every
 // 10 steps. After each update every rank's owner array and own floes must
 // equal FloeOwners::assign's over the whole, true floes with the same cuts,
-// entry for entry. Two layouts: free cuts in a periodic box from ymin = -250 m
+// entry for entry, and the cuts must be those of a twin FloeOwners updated
+// with the true floes on every rank (the reading of every floe it
+// replaces: FloeOwners::assign then the move over every floe's copy), to
+// the bit. Two layouts: free cuts in a periodic box from ymin = -250 m
 // (the wrap rounds there: the box from 0 is the easy case), and the sea's
 // slabs (rows of 1.25 m, blocks of 8) in a periodic box from 0.
 //
@@ -18,7 +22,10 @@
 // the update): it must give other owners than assign at some step on some
 // rank (a floe that came to a rank is then unknown to it). Run by ctest as
 // mpi.owners_update_ranks_N (N = 1, 2, 3).
+#include <algorithm>
+#include <bit>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <limits>
 #include <random>
@@ -68,19 +75,30 @@ void run_layout(const parallel::Communicator& comm, bool slabs, test::Failures& 
     owners.set_slabs({first, 1.25, 8});
   }
   owners.assign(truth);
+  parallel::FloeOwners reference = owners;  // updated with the true floes
   const double nan = std::numeric_limits<double>::quiet_NaN();
   for (std::size_t step = 1; step <= 60; ++step) {
     for (std::size_t i = 0; i < n; ++i) truth.state[i].y += speed[i];  // unwrapped: place() wraps
     if (step % 3 == 0 && !owners.cuts().empty())
       for (std::size_t i = step % 10; i < n; i += 10) truth.state[i].y = owners.cuts()[(i / 10) % owners.cuts().size()];
     const bool moving = owners.may_move(step);
-    // This rank's copy: the floes it does not own poisoned, but at a move.
+    // This rank's copy: every floe poisoned (at a move too) but those it
+    // owned and those that come to it at the present cuts (in a run, its
+    // band's: a floe that crosses a cut was in the band, docs/parallel.md,
+    // "Migration across cuts").
+    const parallel::FloeOwners arriving = twin();
     Floes copy = truth;
-    if (!moving)
-      for (std::size_t i = 0; i < n; ++i)
-        if (owners.owner()[i] != rank) copy.state[i].x = copy.state[i].y = nan;
+    for (std::size_t i = 0; i < n; ++i)
+      if (owners.owner()[i] != rank && arriving.owner()[i] != rank) copy.state[i].x = copy.state[i].y = nan;
     parallel::FloeOwners lossy = owners;
     owners.update(comm, copy, step);
+    reference.update(comm, truth, step);
+    const auto bits = [](double x) { return std::bit_cast<std::uint64_t>(x); };
+    if (!std::equal(owners.cuts().begin(), owners.cuts().end(), reference.cuts().begin(), reference.cuts().end(),
+                    [&](double a, double b) { return bits(a) == bits(b); }) ||
+        owners.slabs().first_row != reference.slabs().first_row)
+      failures.push_back(std::string(slabs ? "slabs" : "free cuts") + ": step " + std::to_string(step) +
+                         ": the cuts differ from those updated with the true floes");
     const parallel::FloeOwners whole = twin();
     const bool same = std::equal(owners.owner().begin(), owners.owner().end(), whole.owner().begin(),
                                  whole.owner().end()) &&
@@ -88,7 +106,7 @@ void run_layout(const parallel::Communicator& comm, bool slabs, test::Failures& 
     if (!same) failures.push_back(std::string(slabs ? "slabs" : "free cuts") + ": step " + std::to_string(step) +
                                   ": the owners differ from assign's over the true floes");
     ++counts.steps;
-    if (!moving) {
+    if (!moving) {  // the mutation where the cuts stay
       const std::vector<parallel::LeaveNotice> mine = lossy.leaving(rank, copy);
       counts.migrations += static_cast<long long>(mine.size());
       lossy.take_leaving(mine);
@@ -98,8 +116,13 @@ void run_layout(const parallel::Communicator& comm, bool slabs, test::Failures& 
     // Each rank charges its floes' known costs (the cuts move every 10 steps).
     double charged = 0.0;
     for (const std::uint32_t i : owners.mine()) charged += owners.place(truth.state[i]) >= ymin + 0.5 * height ? 20e-6 : 1e-6;
-    if (owners.has_slabs()) owners.charge_coupling(charged);
-    else owners.charge(charged);
+    if (owners.has_slabs()) {
+      owners.charge_coupling(charged);
+      reference.charge_coupling(charged);
+    } else {
+      owners.charge(charged);
+      reference.charge(charged);
+    }
   }
   counts.moves += owners.moves();
 }
