@@ -7,9 +7,9 @@
 // [cut[r-1], cut[r]) along y (cut[-1] = -inf, cut[ranks-1] = +inf), y wrapped
 // into a periodic box first. Strips run along y because the spectral sea's
 // slabs do (stage four), so that a floe's neighbours across a strip boundary
-// are few. The owners are recomputed from the replicated state (assign()) at
-// every step: a floe whose centroid crosses a cut "migrates", which costs
-// nothing since every rank holds every floe.
+// are few. The owners are recomputed at every step: a floe whose centroid
+// crosses a cut "migrates", its owner announcing it (migrate(), leaving();
+// docs/parallel.md, update25), so that no rank reads another's floes.
 //
 // Load balance by measured cost: each rank charges the CPU time of its
 // by-place work (its floes' drift, its part of detection: no waits, no
