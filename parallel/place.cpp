@@ -97,11 +97,25 @@ void FloeOwners::set_slabs(RowSlabs slabs) {
   set_cuts(std::move(cuts));
 }
 
-int FloeOwners::owner_at(const FloeState& s) const {
-  // With slabs: the slab of the centroid's grid row (parallel::grid_row,
-  // the coupling's rule); else the strip of the place between the cuts.
-  if (has_slabs()) return row_owner_[static_cast<std::size_t>(grid_row(s.y, slabs_.dy, slabs_.rows()))];
-  return static_cast<int>(std::upper_bound(cuts_.begin(), cuts_.end(), place(s)) - cuts_.begin());
+double FloeOwners::key(const FloeState& s) const {
+  // With slabs: the centroid's grid row (parallel::grid_row, the
+  // coupling's rule); else the place.
+  return has_slabs() ? static_cast<double>(grid_row(s.y, slabs_.dy, slabs_.rows())) : place(s);
+}
+
+int FloeOwners::owner_of_key(double key) const {
+  // With slabs: the slab of the row; else the strip of the place between the cuts.
+  if (has_slabs()) return row_owner_[static_cast<std::size_t>(key)];
+  return static_cast<int>(std::upper_bound(cuts_.begin(), cuts_.end(), key) - cuts_.begin());
+}
+
+void FloeOwners::assign_keys(std::span<const double> keys) {
+  owner_.resize(keys.size());
+  mine_.clear();
+  for (std::size_t i = 0; i < keys.size(); ++i) {
+    owner_[i] = owner_of_key(keys[i]);
+    if (owner_[i] == rank_) mine_.push_back(static_cast<std::uint32_t>(i));
+  }
 }
 
 void FloeOwners::assign(const Floes& floes) {
@@ -151,21 +165,35 @@ void FloeOwners::take_leaving(std::span<const LeaveNotice> notices) {
   mine_ = std::move(merged);
 }
 
-FloeOwners::WindowCharges FloeOwners::close_window(const Communicator& comm) {
-  // One call: each rank's by-place seconds, its row seconds (with slabs)
-  // and, for the summary, the coupling's and the fracture analyses' parts
-  // of the by-place seconds.
+FloeOwners::WindowCharges FloeOwners::close_window(const Communicator& comm, const Floes& floes,
+                                                   std::vector<double>& keys) {
+  // One call, of sizes known to all (each rank's floe count is in the
+  // owner array): each rank's by-place seconds, its row seconds (with
+  // slabs) and, for the summary, the coupling's and the fracture analyses'
+  // parts of the by-place seconds; then its own floes' keys, ascending.
+  FLOESIM_ASSERT(comm.size() == ranks_ && owner_.size() == floes.size());
   WindowCharges w;
   constexpr std::size_t kPerRank = 4;
-  const double mine[kPerRank] = {charged_, row_charged_, coupling_charged_, fracture_charged_};
-  const std::vector<double> all = comm.allgather<double>(std::span<const double>(mine, kPerRank));
+  std::vector<double> mine = {charged_, row_charged_, coupling_charged_, fracture_charged_};
+  for (const std::uint32_t i : mine_) mine.push_back(key(floes.state[i]));
+  std::vector<std::size_t> counts(static_cast<std::size_t>(ranks_), kPerRank * sizeof(double));
+  for (const int r : owner_) counts[static_cast<std::size_t>(r)] += sizeof(double);
+  const std::vector<std::byte> bytes = comm.allgather_known(std::as_bytes(std::span<const double>(mine)), counts);
+  std::vector<double> all(bytes.size() / sizeof(double));
+  if (!all.empty()) std::memcpy(all.data(), bytes.data(), bytes.size());
+  // Rank r's message starts at start[r]; its floes come in ascending order.
+  std::vector<std::size_t> start(counts.size(), 0), next(counts.size());
+  for (std::size_t r = 1; r < counts.size(); ++r) start[r] = start[r - 1] + counts[r - 1] / sizeof(double);
+  for (std::size_t r = 0; r < counts.size(); ++r) next[r] = start[r] + kPerRank;
+  keys.resize(owner_.size());
+  for (std::size_t i = 0; i < owner_.size(); ++i) keys[i] = all[next[static_cast<std::size_t>(owner_[i])]++];
   charged_ = row_charged_ = coupling_charged_ = fracture_charged_ = 0.0;
   coupling_seconds_.resize(static_cast<std::size_t>(ranks_), 0.0);
   fracture_seconds_.resize(static_cast<std::size_t>(ranks_), 0.0);
   window_seconds_.assign(static_cast<std::size_t>(ranks_), 0.0);
   w.floe.assign(static_cast<std::size_t>(ranks_), 0.0);
   for (std::size_t r = 0; r < static_cast<std::size_t>(ranks_); ++r) {
-    const std::size_t at = kPerRank * r;
+    const std::size_t at = start[r];
     const double row = all[at + 1];
     coupling_seconds_[r] += all[at + 2];
     fracture_seconds_[r] += all[at + 3];
@@ -195,17 +223,18 @@ std::vector<double> FloeOwners::floe_costs(std::span<const double> floe_seconds)
 }
 
 bool FloeOwners::move_slabs(const Communicator& comm, const Floes& floes) {
-  const WindowCharges w = close_window(comm);
+  // The owners are those at the floes' present places (update): the slabs
+  // the floes were charged in.
+  std::vector<double> row_of;  // each floe's row, from its owner
+  const WindowCharges w = close_window(comm, floes, row_of);
   const int rows = slabs_.rows();
   const int blocks = (rows + slabs_.block - 1) / slabs_.block;
-  assign(floes);  // the floes as the window left them, in the slabs they were charged in
   const double seconds = std::accumulate(window_seconds_.begin(), window_seconds_.end(), 0.0);
   if (!(seconds > 0.0) || blocks < ranks_) return false;
   // Per row: the sea's uniform row cost, plus its floes' costs (above).
   std::vector<double> row_cost(static_cast<std::size_t>(rows), w.rows / rows);
   const std::vector<double> cost = floe_costs(w.floe);
-  for (std::size_t i = 0; i < floes.size(); ++i)
-    row_cost[static_cast<std::size_t>(grid_row(floes.state[i].y, slabs_.dy, rows))] += cost[i];
+  for (std::size_t i = 0; i < floes.size(); ++i) row_cost[static_cast<std::size_t>(row_of[i])] += cost[i];
   const std::vector<int> target = cut_rows_by_cost(row_cost, slabs_.block, ranks_);
   // Part way, in whole blocks (half a block or more of the way rounds to a
   // block), each slab keeping at least one block.
@@ -221,19 +250,20 @@ bool FloeOwners::move_slabs(const Communicator& comm, const Floes& floes) {
   if (first == slabs_.first_row) return false;
   RowSlabs moved = slabs_;
   moved.first_row = std::move(first);
-  set_slabs(std::move(moved));
+  set_slabs(std::move(moved));  // the rows do not change: the keys stay the floes' rows
   ++moves_;
+  assign_keys(row_of);
   return true;
 }
 
 bool FloeOwners::move_cuts(const Communicator& comm, const Floes& floes) {
-  const WindowCharges w = close_window(comm);
-  assign(floes);  // the floes as the window left them, in the strips they were charged in
+  // The owners are those at the floes' present places (update): the strips
+  // the floes were charged in.
+  std::vector<double> y;  // each floe's place, from its owner
+  const WindowCharges w = close_window(comm, floes, y);
   const double seconds = std::accumulate(w.floe.begin(), w.floe.end(), 0.0);
   const std::size_t n = floes.size();
   if (!(seconds > 0.0) || n == 0) return false;
-  std::vector<double> y(n);
-  for (std::size_t i = 0; i < n; ++i) y[i] = place(floes.state[i]);
   std::vector<double> cuts = cut_by_cost(y, floe_costs(w.floe), ranks_);
   for (std::size_t k = 0; k < cuts.size(); ++k)  // part way (an infinite cut, an empty strip: all the way)
     if (std::isfinite(cuts[k]) && std::isfinite(cuts_[k])) cuts[k] = cuts_[k] + options_.relaxation * (cuts[k] - cuts_[k]);
@@ -241,20 +271,33 @@ bool FloeOwners::move_cuts(const Communicator& comm, const Floes& floes) {
   const bool moved = cuts != cuts_;
   set_cuts(std::move(cuts));
   ++moves_;
+  assign_keys(y);
   return moved;
 }
 
 bool FloeOwners::update(const Communicator& comm, const Floes& floes, std::size_t step) {
-  bool moved = false;
+  bool window = false;
   if (!started_) {
     started_ = true;
     next_move_ = step + static_cast<std::size_t>(options_.rebalance_steps);
   } else if (step >= next_move_) {
     next_move_ = step + static_cast<std::size_t>(options_.rebalance_steps);
-    moved = has_slabs() ? move_slabs(comm, floes) : move_cuts(comm, floes);
+    window = true;
   }
-  assign(floes);
-  return moved;
+  if (!comm.serial() && assigned_for(floes)) migrate(comm, floes);
+  else assign(floes);  // the start, after a split, or serially
+  if (!window) return false;
+  return has_slabs() ? move_slabs(comm, floes) : move_cuts(comm, floes);
+}
+
+void FloeOwners::migrate(const Communicator& comm, const Floes& floes) {
+  FLOESIM_ASSERT(comm.size() == ranks_ && comm.rank() == rank_);
+  // owner_at is a function of the place alone, evaluated by the floe's
+  // owner on its copy, the holders' bits: the owner assign() gives on any
+  // rank whose copy is current, without reading any other floe.
+  const std::vector<LeaveNotice> mine = leaving(rank_, floes);
+  const std::vector<LeaveNotice> all = comm.allgather<LeaveNotice>(mine);
+  take_leaving(all);
 }
 
 namespace {

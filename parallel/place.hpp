@@ -7,9 +7,9 @@
 // [cut[r-1], cut[r]) along y (cut[-1] = -inf, cut[ranks-1] = +inf), y wrapped
 // into a periodic box first. Strips run along y because the spectral sea's
 // slabs do (stage four), so that a floe's neighbours across a strip boundary
-// are few. The owners are recomputed from the replicated state (assign()) at
-// every step: a floe whose centroid crosses a cut "migrates", which costs
-// nothing since every rank holds every floe.
+// are few. The owners are recomputed at every step: a floe whose centroid
+// crosses a cut "migrates", its owner announcing it (migrate(), leaving();
+// docs/parallel.md, update25), so that no rank reads another's floes.
 //
 // Load balance by measured cost: each rank charges the CPU time of its
 // by-place work (its floes' drift, its part of detection: no waits, no
@@ -153,15 +153,35 @@ public:
   // Whether leaving() may replace assign() for `floes`: cuts set and an
   // owner for each floe (not at the start, after a restore or a split).
   bool assigned_for(const Floes& floes) const { return (cut_ || has_slabs()) && owner_.size() == floes.size(); }
-  // The rank whose strip holds a floe in state s (the one rule of assign and leaving).
-  int owner_at(const FloeState& s) const;
+  // The rank whose strip holds a floe in state s (the one rule of assign and
+  // leaving): the owner of its key (with slabs its centroid's grid row, a
+  // whole number held exactly in a double; else its place), which the cuts'
+  // move gathers from the owners (update).
+  int owner_at(const FloeState& s) const { return owner_of_key(key(s)); }
+  double key(const FloeState& s) const;
+  int owner_of_key(double key) const;
   // Collective (every rank at the same `step`): every options.rebalance_steps
-  // steps, the cuts move by the ranks' charged times (above); then assign().
-  // A step redone after an overlap calls it again with the same `step`: no
-  // second move.
+  // steps, the cuts move by the ranks' charged times (above). First the
+  // owners at the floes' present places: with the owners assigned for these
+  // floes on several ranks, migrate() (from the owners' own floes), else
+  // assign() (the start, after a split, serially). A move then gathers each
+  // floe's key (key(): its row or place, 8 B a floe) from its owner with
+  // the charges (one call), and every rank computes the new cuts and owners
+  // from the gathered keys: no floe's copy but the rank's own is read. A step
+  // redone after an overlap calls it again with the same `step`: no second
+  // move (the migration then gives the owners at the restored places).
   // Returns whether the cuts moved (with slabs: the slabs, which the sea and
   // the coupling must then be given, on every rank alike).
   bool update(const Communicator& comm, const Floes& floes, std::size_t step);
+  // Collective (assigned_for(floes), `comm` this object's ranks): the
+  // owners at the floes' present places, assign()'s entry for entry, read
+  // from the floes each rank owns only. Each rank announces its leaving()
+  // floes, the notices are gathered in rank order (an allgather of 24 B a
+  // notice: its counts' call, and the bytes' call only when some rank has
+  // one) and every rank applies all of them (take_leaving: one owner a
+  // floe, so any order). The other floes' copies are not read: they may be
+  // stale or unwrapped (the halo exchange of piece 8).
+  void migrate(const Communicator& comm, const Floes& floes);
   // Whether update(step) closes a window, and so may move the cuts (the
   // same on every rank).
   bool may_move(std::size_t step) const { return started_ && step >= next_move_; }
@@ -229,7 +249,10 @@ private:
     std::vector<double> floe;
     double rows = 0.0;
   };
-  WindowCharges close_window(const Communicator& comm);
+  // The charges and every floe's key (n values, each from its owner; owners
+  // assigned for these floes).
+  WindowCharges close_window(const Communicator& comm, const Floes& floes, std::vector<double>& keys);
+  void assign_keys(std::span<const double> keys);  // the owners from every floe's key
   std::vector<double> floe_costs(std::span<const double> floe_seconds) const;  // per floe, after assign()
   bool move_slabs(const Communicator& comm, const Floes& floes);
   bool move_cuts(const Communicator& comm, const Floes& floes);
