@@ -265,16 +265,7 @@ HandOver plan_hand_over(std::span<const int> held_by, std::span<const int> wante
 template <class T>
 void Communicator::hand_over(std::vector<T>& values, std::span<const int> held_by,
                              std::span<const int> wanted_by) const {
-  static_assert(kSentAsBytes<T>);
-  if (serial()) return;
-  const HandOver plan = plan_hand_over(held_by, wanted_by, rank_, size_, sizeof(T));
-  if (!plan.any) return;
-  std::vector<T> out, in(plan.receive.size());
-  out.reserve(plan.send.size());
-  for (const std::uint32_t i : plan.send) out.push_back(values[i]);
-  alltoall(std::as_bytes(std::span<const T>(out)), plan.send_bytes, std::as_writable_bytes(std::span<T>(in)),
-           plan.receive_bytes);
-  for (std::size_t k = 0; k < in.size(); ++k) values[plan.receive[k]] = in[k];
+  hand_over_each(held_by, wanted_by, values);
 }
 
 template <class... T>

@@ -119,18 +119,13 @@ void FloeOwners::assign_keys(std::span<const double> keys) {
 }
 
 void FloeOwners::assign(const Floes& floes) {
+  // Every floe's key (without slabs its place, which the first cuts split
+  // into equal counts), then the owners of the keys (owner_at's rule).
   const std::size_t n = floes.size();
-  if (!has_slabs() && !cut_) {
-    std::vector<double> y(n);
-    for (std::size_t i = 0; i < n; ++i) y[i] = place(floes.state[i]);
-    set_cuts(cut_by_cost(y, std::vector<double>(n, 1.0), ranks_));
-  }
-  owner_.resize(n);
-  mine_.clear();
-  for (std::size_t i = 0; i < n; ++i) {
-    owner_[i] = owner_at(floes.state[i]);
-    if (owner_[i] == rank_) mine_.push_back(static_cast<std::uint32_t>(i));
-  }
+  std::vector<double> keys(n);
+  for (std::size_t i = 0; i < n; ++i) keys[i] = key(floes.state[i]);
+  if (!has_slabs() && !cut_) set_cuts(cut_by_cost(keys, std::vector<double>(n, 1.0), ranks_));
+  assign_keys(keys);
 }
 
 std::vector<LeaveNotice> FloeOwners::leaving(int rank, const Floes& floes) const {
