@@ -214,8 +214,13 @@ public:
                         std::span<const std::uint8_t> held = {});
   bool implicit() const { return implicit_; }
   // On several ranks: the floes this rank owns for the coupling (whose
-  // pieces it built at the footprints' last rebuild and moves), ascending.
-  std::span<const std::uint32_t> own_floes() const { return footprints_.mine(); }
+  // pieces it built at the footprints' last rebuild and moves), ascending;
+  // on a sea not in slabs also those its strip holds at their last
+  // evaluated places (strips_.next), which it owns from the next rebuild on
+  // and so must hold (pose, and drift vertically) until then.
+  std::span<const std::uint32_t> own_floes() const {
+    return strips_.next.empty() ? footprints_.mine() : std::span<const std::uint32_t>(strips_.held);
+  }
   // Threads for the per-floe and per-piece work (results do not depend on it).
   void set_threads(int threads) { threads_ = std::max(threads, 1); }
   // Ranks that share the per-floe work (docs/parallel.md, stages two and
@@ -241,7 +246,8 @@ public:
   // run's to the bit, whichever rank owns which floe. pressure() then holds
   // this rank's slab's rows only, which is what its sea's kick reads. A sea
   // not in slabs (BEM seas, a tank, dims = 1) is whole on every rank, whose
-  // kick reads every cell's pressure: its floes are owned by index, and
+  // kick reads every cell's pressure: its floes are owned by place in
+  // strips across its longer side (strips_, below), and
   // the same routes make every cell's sums on every rank
   // (parallel::CellRoutes::replicated: a cell under another rank's floe's
   // box as pieces to every rank, any other cell's pressure as its total),
@@ -259,6 +265,7 @@ public:
                            : parallel::CellRoutes();
     footprints_.set_slabs(slabs ? slab_rows_ : std::vector<int>{});
     owner_.interior_reach = -1;  // the interior cells are those of the new routes
+    set_strips();
   }
   // The sea's slabs moved (issue 21 stage seven; first_row as
   // fluid::Sea::slab_rows gives it, the same on every rank, at the start of
@@ -400,8 +407,12 @@ private:
   double sum_cells_by_owner(double ks);
   // By owner: order_ <- this rank's floes in the serial order, and
   // owner_.position every floe's place in that order (one gather of the
-  // floes' first cells).
+  // floes' first cells, with their boxes; on a sea not in slabs, with the
+  // ranks of their strips: strips_.next).
   void order_by_owner(std::size_t floes);
+  // strips_ for the routes (their owners by place on replicated routes,
+  // else none); the floes' next owners forgotten.
+  void set_strips();
   // By owner: the penalty energy from every rank's terms
   // (owner_.energy_*), summed in the serial order (one gather).
   void settle_energy() const;
@@ -517,6 +528,42 @@ private:
     RoutedCells routed_counts;  // since the start, this rank's
   } owner_;
   static constexpr std::uint32_t kNoCell = parallel::CellBox::kNone;
+  // The coupling's owners by place on a sea not in slabs (routes_.
+  // replicated(); docs/parallel.md, "The seas not in slabs, their floes by
+  // place"). The sea's longer side, in cells (x when nx >= ny, and always
+  // in a long-crested sea, whose cells span its width), is cut in `ranks`
+  // equal shares of cells (parallel::share), and rank r owns the floes whose
+  // centroid's cell along that side (periodic: wrapped; walled: clamped)
+  // lies in its share: a cell then holds pieces of several ranks' floes only
+  // near a cut, where a strip of cells across the short side is shared,
+  // instead of wherever the floes are dense (by index). Each owner finds the
+  // strip of its own floes at every evaluation (from their poses, which it
+  // reads anyway) and sends it with the boxes' gather (order_by_owner: 4
+  // bytes a floe more); the next rebuild after a vertical drift
+  // (advance_vertical) takes those owners. Why after one: a new owner must
+  // hold the floe it builds (own_floes() names it from the gather on) and
+  // its copy must be current, which the drift's exchange and the vertical
+  // drift of the held floes make it (Simulation::drift, held_now); an
+  // evaluation before the next drift (a first half kick) keeps the owners.
+  // Until a gather (the start, a restart, a split), the owners are by index,
+  // which reads no floe's place.
+  struct PlaceStrips {
+    bool along_x = true;
+    std::vector<int> owner;   // per cell along that side: its share's rank (empty: not used)
+    std::vector<int> next;    // per floe: the rank of its place at the last evaluation (empty: none)
+    std::vector<std::uint32_t> next_mine;  // this rank's floes in `next`, ascending
+    std::vector<std::uint32_t> held;       // own_floes(): the footprints' mine() and next_mine
+    bool drifted = false;     // a vertical drift since `next` was gathered
+  } strips_;
+  // The rank of the strip that holds a floe at pose p (strips_.owner).
+  int strip_owner(const FloePose& p) const;
+  // The owners a rebuild of this evaluation takes, and this rank's floes
+  // among them (empty: none given, the footprints find them).
+  struct GivenOwners {
+    std::span<const int> owner;
+    std::span<const std::uint32_t> mine;
+  };
+  GivenOwners given_owners(std::size_t floes) const;
   // The sea's slabs (fluid::Sea::slab_rows; empty: whole on every rank), and
   // by owner on them, the routes of the cells' sums to the slabs' ranks;
   // the next evaluation clears pressure_ in routes_.owned() (the cells the

@@ -45,7 +45,10 @@
 // Sea not in slabs (BEM seas, a tank, dims = 1: every rank holds the whole
 // sea, whose kick reads every cell's pressure; CellRoutes::replicated). The
 // same two kinds of cells, every row being a boundary row: the floes are
-// owned by index, not by place, so no cell is deep in one rank's part. A
+// owned by place in strips across the sea's longer side (strips_, from the
+// footprints' first gather on; by index before it), so only the cells near
+// a cut are under several ranks' floes, but no row is deep in one rank's
+// part. A
 // cell no other rank's floe's box covers is summed here from zero in
 // order_, the serial sums, and its pressure's total goes to every other
 // rank (4 bytes a cell, then 8). Every other cell travels as its pieces to
@@ -90,6 +93,38 @@ void FloeSeaContact::set_slabs(std::vector<int> first_row) {
   owner_.interior_reach = -1;  // the interior cells are those of the new routes
 }
 
+void FloeSeaContact::set_strips() {
+  strips_ = {};
+  if (!routes_.replicated()) return;
+  // Cut the longer side: the cuts then cross the fewer cells.
+  strips_.along_x = grid_.dims == 1 || grid_.nx >= grid_.ny;
+  const int cells = strips_.along_x ? grid_.nx : grid_.ny;
+  std::vector<int> first(static_cast<std::size_t>(comm_.size()) + 1, cells);
+  for (int r = 0; r < comm_.size(); ++r)
+    first[static_cast<std::size_t>(r)] = static_cast<int>(parallel::share(static_cast<std::size_t>(cells), r, comm_.size()).begin);
+  strips_.owner = parallel::row_owners(first);
+}
+
+int FloeSeaContact::strip_owner(const FloePose& p) const {
+  const int cells = static_cast<int>(strips_.owner.size());
+  const double at = strips_.along_x ? p.x : p.y, width = strips_.along_x ? grid_.dx() : grid_.dy();
+  // Periodic: the cell that holds the place, the seam crossed (grid_row's
+  // rule); walled: a place beyond a wall is owned by the cell at that wall.
+  const int cell = grid_.edge == fluid::GridEdge::periodic
+                       ? parallel::grid_row(at, width, cells)
+                       : static_cast<int>(std::clamp(std::floor(at / width), 0.0, static_cast<double>(cells - 1)));
+  return strips_.owner[static_cast<std::size_t>(cell)];
+}
+
+FloeSeaContact::GivenOwners FloeSeaContact::given_owners(std::size_t floes) const {
+  // The drift's owners on the sea's slabs (take_place_owners)...
+  if (place_owner_.size() == floes && footprints_.takes_owners(place_rows_)) return {place_owner_, place_mine_};
+  // ...or the strips' of a sea not in slabs, once their new owners hold
+  // their floes' current states (strips_).
+  if (strips_.next.size() == floes && strips_.drifted) return {strips_.next, strips_.next_mine};
+  return {};
+}
+
 void FloeSeaContact::order_by_owner(std::size_t floes) {
   const Footprints& fp = footprints_.pieces();
   OwnerCells& o = owner_;
@@ -106,7 +141,33 @@ void FloeSeaContact::order_by_owner(std::size_t floes) {
         o.box[i].first_cell = fp.cell[fp.offsets[i]];
       }
     }
-  comm_.complete_owned(o.box, footprints_.owners());
+  if (strips_.owner.empty()) {
+    comm_.complete_owned(o.box, footprints_.owners());
+  } else {
+    // With each box, the rank of the strip of the floe's present place
+    // (poses_ holds this rank's floes' present poses: evaluate posed them).
+    struct Placed {
+      parallel::CellBox box;
+      std::int32_t strip;
+    };
+    std::vector<Placed> placed(floes, Placed{{}, 0});
+    for (std::uint32_t i : footprints_.mine()) placed[i] = {o.box[i], strip_owner(poses_[i])};
+    comm_.complete_owned(placed, footprints_.owners());
+    strips_.next.resize(floes);
+    strips_.next_mine.clear();
+    strips_.held.clear();
+    const std::span<const std::uint32_t> mine = footprints_.mine();
+    for (std::size_t i = 0, m = 0; i < floes; ++i) {
+      o.box[i] = placed[i].box;
+      strips_.next[i] = placed[i].strip;
+      const bool next_mine = placed[i].strip == comm_.rank();
+      const bool now_mine = m < mine.size() && mine[m] == i;
+      if (now_mine) ++m;
+      if (next_mine) strips_.next_mine.push_back(static_cast<std::uint32_t>(i));
+      if (next_mine || now_mine) strips_.held.push_back(static_cast<std::uint32_t>(i));
+    }
+    strips_.drifted = false;
+  }
   // place_footprints' serial sort, on the same floes in the same order.
   o.serial.clear();
   for (std::size_t i = 0; i < floes; ++i)
@@ -439,8 +500,9 @@ void FloeSeaContact::hand_water_over(std::span<const int> drift_owner) {
   // by place (parallel::FloeOwners); the coupling's owner of a floe is
   // mostly the same rank (both by place on the same slabs), but not always:
   // the coupling's owners are set at the footprints' last rebuild and follow
-  // a move of the slabs only at the next one, and without a sea in slabs (or
-  // with the implicit step) they are by index.
+  // a move of the slabs only at the next one; without a sea in slabs they
+  // are the strips' across its longer side (strips_), with the implicit
+  // step by index.
   if (comm_.serial() || !water_by_owner_) return;
   FLOESIM_ASSERT(drift_owner.size() == water_.size() && footprints_.owners().size() == water_.size());
   comm_.hand_over(water_, footprints_.owners(), drift_owner);

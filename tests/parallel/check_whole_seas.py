@@ -24,12 +24,32 @@ Checked, on 2 and 3 ranks:
     this) differed on every case here in the floes' states and the sea (by
     ~1e-14 relative), not only in the penalty energy;
   - rank 0 sent cells as pieces (parallel.coupling_cells: `shared` > 0), so
-    the pieces' path was taken (and, but in the flume, whose few cells are
-    nearly all shared, cells summed alone and sent as totals).
+    the pieces' path was taken, and cells summed alone and sent as totals;
+  - the floes are owned by place for the coupling (docs/parallel.md, "The
+    seas not in slabs, their floes by place"): strips of equal shares of
+    the cells along the longer side, so a cell rank 0 sends as pieces (under
+    another rank's floe's box) lies within d = ceil(R / dx) + 2 cells of a
+    cut (R the pack's largest floe radius; its pieces and the other floe's
+    box each lie within R / dx + 1 cells of their owners' strips, the
+    owners being those of the floes' places one evaluation earlier, less
+    than a cell away): at most 2 d cells along, times the cells across, a
+    cut, the cuts being ranks of them (the seam counted too). The first
+    evaluation, by index, may send every cell. Checked on the flume, where
+    d = 6 of its 96 cells: on 2 ranks at most 24 cells an evaluation; by
+    index (the mutation) its rank 0 sends about 95 an evaluation. (On the
+    bem and tank cases the bound exceeds their cells across a strip.)
+Then the flume's pack numbered along x (its floes sorted by x: there the
+owners by index would be strips along x too) on 2 ranks: bit for bit with
+its serial run, and rank 0's penalty phase receives at most 1.2 times the
+bytes of the pack numbered as made (in two rows along the flume: by index
+each rank's floes would lie along the whole flume and every cell travel as
+pieces, 3 times the bytes). By place the numbering does not choose the
+owners.
 Then the bem case stopped half-way on 2 ranks and continued from its
 checkpoint on 3 ranks must equal the serial run bit for bit.
 """
 import argparse
+import math
 import os
 import re
 import sys
@@ -66,6 +86,8 @@ pack = "{pack}"
 law = "strong"
 stiffness = 100.0
 """
+# Per case: the grid's cells along x and y, its cell size along x and y (m).
+GRIDS = {"bem": (24, 12, 0.5, 0.5), "tank": (96, 24, 0.25, 0.25), "flume": (96, 1, 0.25, 2.0)}
 SEAS = {
     "bem": ("""
 [sea]
@@ -116,6 +138,42 @@ wavelength = 6.0
 """, ["--floes", "40", "--box", "24", "2"]),
 }
 
+def largest_radius(pack):
+    """The largest distance of a floe's vertex from its centroid (m) in a pack file."""
+    import h5py  # (only with MPI: --no-mpi needs nothing of it)
+    with h5py.File(os.path.join(W, pack), "r") as f:
+        offsets, vertices = f["floes/offsets"][:], f["floes/vertices"][:]
+    return max(math.hypot(*v) for v in vertices) if len(offsets) > 1 else 0.0
+
+
+def numbered_along_x(pack, out):
+    """The floes of `pack` renumbered by their centroids' x, written to `out`."""
+    import h5py
+    import numpy as np
+    with h5py.File(os.path.join(W, pack), "r") as f, h5py.File(os.path.join(W, out), "w") as g:
+        for k, v in f.attrs.items():
+            g.attrs[k] = v
+        for k in f:
+            if k != "floes":
+                f.copy(k, g)
+        floes = f["floes"]
+        order = np.argsort(floes["pose"][:, 0], kind="stable")
+        offsets, vertices = floes["offsets"][:], floes["vertices"][:]
+        out_floes = g.create_group("floes")
+        for k in floes:
+            if k not in ("offsets", "vertices"):
+                out_floes[k] = floes[k][:][order]
+        out_floes["vertices"] = np.concatenate([vertices[offsets[i]:offsets[i + 1]] for i in order])
+        out_floes["offsets"] = np.concatenate([[0], np.cumsum([offsets[i + 1] - offsets[i] for i in order])]).astype(
+            offsets.dtype)
+
+
+def penalty_bytes(p):
+    """Rank 0's bytes received in the penalty phase (`parallel.phase.penalty: C calls, B bytes`)."""
+    return int(summary(p)["parallel.phase.penalty"].split()[2])
+
+
+penalty = {}  # (case, ranks) -> rank 0's penalty bytes
 for name, (sea, pack) in SEAS.items():
     need(run([args.floesim, "pack", *pack, "--concentration", "0.7", "--seed", "3", "--thickness", "0.2",
               "-o", f"{name}_pack.h5"]), f"{name}: floesim pack")
@@ -124,17 +182,48 @@ for name, (sea, pack) in SEAS.items():
         f.write(RUN + sea + COUPLING.format(pack=f"{name}_pack.h5"))
     s = summary(need(run([args.floesim, "run", config, "-o", f"{name}_serial.h5", "-q"]), f"{name}: serial run"))
     print(f"{name}: serial to 2 s, {s.get('steps')} steps")
+    nx, ny, dx, dy = GRIDS[name]
+    along_x = ny == 1 or nx >= ny  # the strips' rule (FloeSeaContact::set_strips)
+    d = math.ceil(largest_radius(f"{name}_pack.h5") / (dx if along_x else dy)) + 2
     for n in args.ranks:
         p = mpirun(n, "run", config, "-o", f"{name}_{n}.h5", "-q")
         if p.returncode != 0:
             failures.append(f"{name} on {n} ranks: exit {p.returncode}\n{p.stderr}")
             continue
         harness.same(f"{name}_{n}.h5", f"{name}_serial.h5", f"{name}: {n} ranks against the serial run", failures)
-        cells = summary(p).get("parallel.coupling_cells")
-        print(f"{name}: {n} ranks, rank 0's cells: {cells}")
+        s = summary(p)
+        penalty[name, n] = penalty_bytes(p)
+        cells = s.get("parallel.coupling_cells")
+        evaluations = int(s["footprints.placements"])
+        bound = nx * ny + (evaluations - 1) * n * 2 * d * (ny if along_x else nx)
+        print(f"{name}: {n} ranks, rank 0's cells: {cells} in {evaluations} evaluations (shared at most {bound}); "
+              f"penalty {s['parallel.phase.penalty']}")
         m = re.match(r"(\d+) shared \((\d+) pieces\), (\d+) alone owned, (\d+) alone sent", cells or "")
-        if not m or int(m.group(1)) == 0 or (name != "flume" and int(m.group(4)) == 0):
+        if not m or int(m.group(1)) == 0 or int(m.group(4)) == 0:
             failures.append(f"{name} on {n} ranks: no cell sent as pieces, or none as a total ({cells})")
+        elif name == "flume" and int(m.group(1)) > bound:
+            failures.append(f"{name} on {n} ranks: rank 0 sent {m.group(1)} cells as pieces, more than the {bound} "
+                            f"within {d} cells of the strips' cuts (the floes not owned by place?)")
+
+# The flume's floes numbered along x: the same owners by place, so the same
+# traffic within the runs' own drift (the two packs' serial runs differ in
+# their floes' order, so in round-off).
+numbered_along_x("flume_pack.h5", "flume_x_pack.h5")
+config = os.path.join(W, "flume_x.toml")
+with open(config, "w") as f:
+    f.write(RUN + SEAS["flume"][0] + COUPLING.format(pack="flume_x_pack.h5"))
+need(run([args.floesim, "run", config, "-o", "flume_x_serial.h5", "-q"]), "flume numbered along x: serial run")
+p = mpirun(2, "run", config, "-o", "flume_x_2.h5", "-q")
+if p.returncode != 0:
+    failures.append(f"flume numbered along x on 2 ranks: exit {p.returncode}\n{p.stderr}")
+elif ("flume", 2) in penalty:
+    harness.same("flume_x_2.h5", "flume_x_serial.h5", "flume numbered along x: 2 ranks against the serial run",
+                 failures)
+    along, made = penalty_bytes(p), penalty["flume", 2]
+    print(f"flume on 2 ranks, rank 0's penalty bytes: {made} (numbered as made), {along} (numbered along x)")
+    if not made <= 1.2 * along:
+        failures.append(f"flume on 2 ranks: rank 0's penalty phase received {made} bytes with the pack numbered as "
+                        f"made, more than 1.2 times the {along} with it numbered along x (owners by index?)")
 
 # A restart across rank counts: the bem case's first half on 2 ranks, the
 # rest from its checkpoint on 3 ranks.
