@@ -113,8 +113,8 @@ FloeSeaContact::FloeSeaContact(const CouplingParams& params, const SeaParams& se
 void FloeSeaContact::floes_changed(const Floes& floes) {
   loads_h_ = -1.0;  // the loads and the water velocity are the old floes'
   footprints_.forget();
-  strips_.next.clear();  // the next rebuild by index (reads no place), until a gather
-  strips_.drifted = false;
+  next_owners_.owner.clear();  // the next rebuild by index (reads no place), until owners by place are known
+  next_owners_.drifted = false;
   const std::size_t n = floes.size(), old = bottom0_.size();
   dynamic_.assign(n, 0);
   tilt_.assign(n, 0);
@@ -254,7 +254,7 @@ void FloeSeaContact::evaluate(const Floes& floes, fluid::Sea& sea, double h) {
   // it, this rank's floes' (MovingFootprints::mine, whose pieces it moves;
   // the verdict agreed over the ranks); a rebuild with owners given
   // (given_owners: the drift's by place on the slabs, take_place_owners, or
-  // the strips' of a sea not in slabs), this rank's floes' by them (the
+  // by place on a sea not in slabs), this rank's floes' by them (the
   // pieces it builds); any other rebuild, every floe's (set_owners finds
   // the owners by place from them).
   pose_at_states(floes, footprints_.mine());
@@ -509,7 +509,7 @@ void FloeSeaContact::advance_vertical(Floes& floes, std::span<const FloeState> s
   // floes a rank holds: its band, its own floes and its own floes for the
   // coupling, whose heave, pitch and roll the next evaluation's law reads.)
   FLOESIM_ASSERT(held.empty() || held.size() == floes.size());
-  strips_.drifted = true;  // the strips' next owners held their floes through it
+  next_owners_.drifted = true;  // the next owners held their floes through it
   for (std::size_t i = 0; i < floes.size(); ++i) {
     if (floes.is_static[i] || (!held.empty() && !held[i])) continue;
     FloeState& st = floes.state[i];

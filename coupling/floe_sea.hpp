@@ -186,7 +186,9 @@ public:
   // (MovingFootprints::owners) is not drift_owner[i] goes from the first to
   // the second (one all-to-all, none when the owners agree; collective).
   // After it water_velocity() holds the floes this rank drifts. The drift is
-  // its only reader (docs/parallel.md, "The coupling by owner").
+  // its only reader (docs/parallel.md, "The coupling by owner"). On a sea
+  // not in slabs with dims = 2, drift_owner also becomes the coupling's
+  // owners from the next rebuild on (next_owners_).
   void hand_water_over(std::span<const int> drift_owner);
   // On several ranks, for the next evaluation only: the drift's owners by
   // place (parallel::FloeOwners with the sea's slabs first_row), assigned
@@ -215,11 +217,11 @@ public:
   bool implicit() const { return implicit_; }
   // On several ranks: the floes this rank owns for the coupling (whose
   // pieces it built at the footprints' last rebuild and moves), ascending;
-  // on a sea not in slabs also those its strip holds at their last
-  // evaluated places (strips_.next), which it owns from the next rebuild on
-  // and so must hold (pose, and drift vertically) until then.
+  // on a sea not in slabs also those it owns from the next rebuild on
+  // (next_owners_), which it must hold (pose, and drift vertically) until
+  // then.
   std::span<const std::uint32_t> own_floes() const {
-    return strips_.next.empty() ? footprints_.mine() : std::span<const std::uint32_t>(strips_.held);
+    return next_owners_.owner.empty() ? footprints_.mine() : std::span<const std::uint32_t>(next_owners_.held);
   }
   // Threads for the per-floe and per-piece work (results do not depend on it).
   void set_threads(int threads) { threads_ = std::max(threads, 1); }
@@ -246,8 +248,8 @@ public:
   // run's to the bit, whichever rank owns which floe. pressure() then holds
   // this rank's slab's rows only, which is what its sea's kick reads. A sea
   // not in slabs (BEM seas, a tank, dims = 1) is whole on every rank, whose
-  // kick reads every cell's pressure: its floes are owned by place in
-  // strips across its longer side (strips_, below), and
+  // kick reads every cell's pressure: its floes are owned by place (the
+  // drift's owners; in a flume, shares of its columns: next_owners_), and
   // the same routes make every cell's sums on every rank
   // (parallel::CellRoutes::replicated: a cell under another rank's floe's
   // box as pieces to every rank, any other cell's pressure as its total),
@@ -265,7 +267,7 @@ public:
                            : parallel::CellRoutes();
     footprints_.set_slabs(slabs ? slab_rows_ : std::vector<int>{});
     owner_.interior_reach = -1;  // the interior cells are those of the new routes
-    set_strips();
+    set_place_owners();
   }
   // The sea's slabs moved (issue 21 stage seven; first_row as
   // fluid::Sea::slab_rows gives it, the same on every rank, at the start of
@@ -407,12 +409,12 @@ private:
   double sum_cells_by_owner(double ks);
   // By owner: order_ <- this rank's floes in the serial order, and
   // owner_.position every floe's place in that order (one gather of the
-  // floes' first cells, with their boxes; on a sea not in slabs, with the
-  // ranks of their strips: strips_.next).
+  // floes' first cells, with their boxes; in a flume not in slabs, with the
+  // ranks of their shares of columns: next_owners_).
   void order_by_owner(std::size_t floes);
-  // strips_ for the routes (their owners by place on replicated routes,
-  // else none); the floes' next owners forgotten.
-  void set_strips();
+  // next_owners_ for the routes (on replicated routes, in a flume, the
+  // columns' shares); the floes' next owners forgotten.
+  void set_place_owners();
   // By owner: the penalty energy from every rank's terms
   // (owner_.energy_*), summed in the serial order (one gather).
   void settle_energy() const;
@@ -530,33 +532,40 @@ private:
   static constexpr std::uint32_t kNoCell = parallel::CellBox::kNone;
   // The coupling's owners by place on a sea not in slabs (routes_.
   // replicated(); docs/parallel.md, "The seas not in slabs, their floes by
-  // place"). The sea's longer side, in cells (x when nx >= ny, and always
-  // in a long-crested sea, whose cells span its width), is cut in `ranks`
-  // equal shares of cells (parallel::share), and rank r owns the floes whose
-  // centroid's cell along that side (periodic: wrapped; walled: clamped)
-  // lies in its share: a cell then holds pieces of several ranks' floes only
-  // near a cut, where a strip of cells across the short side is shared,
-  // instead of wherever the floes are dense (by index). Each owner finds the
-  // strip of its own floes at every evaluation (from their poses, which it
-  // reads anyway) and sends it with the boxes' gather (order_by_owner: 4
-  // bytes a floe more); the next rebuild after a vertical drift
-  // (advance_vertical) takes those owners. Why after one: a new owner must
-  // hold the floe it builds (own_floes() names it from the gather on) and
-  // its copy must be current, which the drift's exchange and the vertical
-  // drift of the held floes make it (Simulation::drift, held_now); an
-  // evaluation before the next drift (a first half kick) keeps the owners.
-  // Until a gather (the start, a restart, a split), the owners are by index,
-  // which reads no floe's place.
-  struct PlaceStrips {
-    bool along_x = true;
-    std::vector<int> owner;   // per cell along that side: its share's rank (empty: not used)
-    std::vector<int> next;    // per floe: the rank of its place at the last evaluation (empty: none)
-    std::vector<std::uint32_t> next_mine;  // this rank's floes in `next`, ascending
-    std::vector<std::uint32_t> held;       // own_floes(): the footprints' mine() and next_mine
-    bool drifted = false;     // a vertical drift since `next` was gathered
-  } strips_;
-  // The rank of the strip that holds a floe at pose p (strips_.owner).
-  int strip_owner(const FloePose& p) const;
+  // place"), so that a cell holds pieces of several ranks' floes only near
+  // the parts' boundaries, not wherever the floes are dense (by index):
+  // - dims = 2 (a BEM sea, a tank): the drift's owners (parallel::
+  //   FloeOwners, strips in y), which Simulation gives every step
+  //   (hand_water_over). A new owner then holds the floe (its band or its
+  //   own: Simulation::held_now) and no water is left to hand over.
+  // - dims = 1 (a flume): the drift's strips in y would give each rank
+  //   floes along the whole sea, whose cells span its width; instead the
+  //   grid's columns are cut in `ranks` equal shares (parallel::share) and
+  //   rank r owns the floes whose centroid's column (periodic: wrapped;
+  //   walled: clamped) lies in its share. Each owner finds the share of its
+  //   own floes at every evaluation (from their poses, which it reads
+  //   anyway) and sends it with the boxes' gather (order_by_owner: 4 bytes
+  //   a floe more). A rank holds the floes of its share (own_floes(), in
+  //   held_now) from the gather on; it holds no band of its own for them:
+  //   where the drift's bands do not hold every floe of a flume (one wider
+  //   than the floes' reach), the halo exchange of the state would have to
+  //   bring them.
+  // The next rebuild after a vertical drift (advance_vertical) takes them:
+  // a new owner's copy of a floe is current after the drift's exchange and
+  // the vertical drift of the floes it holds; an evaluation before it (a
+  // first half kick) keeps the owners. Until the first (the start, a
+  // restart, a split), the owners are by index, which reads no floe's place.
+  struct NextOwners {
+    std::vector<int> column;  // dims = 1: per grid column, its share's rank (empty: the drift's owners)
+    std::vector<int> owner;   // per floe: the next rebuild's owner (empty: none yet)
+    std::vector<std::uint32_t> mine;  // this rank's floes in `owner`, ascending
+    std::vector<std::uint32_t> held;  // own_floes(): the footprints' mine() and `mine`
+    bool drifted = false;     // a vertical drift since `owner` was set
+  } next_owners_;
+  // next_owners_ from every floe's next owner.
+  void set_next_owners(std::span<const int> owner);
+  // dims = 1: the rank of the share of columns that holds a floe at pose p.
+  int column_owner(const FloePose& p) const;
   // The owners a rebuild of this evaluation takes, and this rank's floes
   // among them (empty: none given, the footprints find them).
   struct GivenOwners {

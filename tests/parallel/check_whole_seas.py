@@ -7,10 +7,12 @@ usage: check_whole_seas.py FLOESIM MPIEXEC WORKDIR [--ranks 2 3]
 
 A BEM sea, a spectral tank and a long-crested spectral sea (dims = 1) are
 whole on every rank (only a spectral sea with dims = 2 and no tank runs in
-slabs); their floes are owned by index. Each case is a dense pack (`floesim
-pack`, 70 % cover) whose floes are smaller than a few cells, so that many
-cells hold pieces of three or more floes of several ranks, with the explicit
-kicks (the law by owner) to 2 s:
+slabs); their floes are owned by place for the coupling (docs/parallel.md,
+"The seas not in slabs, their floes by place"): the drift's owners (strips
+in y) on the bem and tank, shares of the columns in the flume. Each case is
+a dense pack (`floesim pack`, 70 % cover) whose floes are smaller than a few
+cells, so that many cells hold pieces of three or more floes of several
+ranks, with the explicit kicks (the law by owner) to 2 s:
   - bem: 150 floes in a 12 m x 6 m basin with walls (BEM, 24 x 12 cells);
   - tank: 100 floes in a 24 m x 6 m tank (spectral, 96 x 24 cells, wave
     maker and absorber);
@@ -21,30 +23,34 @@ Checked, on 2 and 3 ranks:
     0 --atol 0`): each cell's coverage, sums and pressure are the serial
     sums, made from every rank's pieces in the serial order on every rank.
     Summing each rank's part and then the parts (stage three's merge, before
-    this) differed on every case here in the floes' states and the sea (by
-    ~1e-14 relative), not only in the penalty energy;
+    notslabs25) differed on every case here in the floes' states and the
+    sea (by ~1e-14 relative), not only in the penalty energy;
   - rank 0 sent cells as pieces (parallel.coupling_cells: `shared` > 0), so
     the pieces' path was taken, and cells summed alone and sent as totals;
-  - the floes are owned by place for the coupling (docs/parallel.md, "The
-    seas not in slabs, their floes by place"): strips of equal shares of
-    the cells along the longer side, so a cell rank 0 sends as pieces (under
-    another rank's floe's box) lies within d = ceil(R / dx) + 2 cells of a
-    cut (R the pack's largest floe radius; its pieces and the other floe's
-    box each lie within R / dx + 1 cells of their owners' strips, the
-    owners being those of the floes' places one evaluation earlier, less
-    than a cell away): at most 2 d cells along, times the cells across, a
-    cut, the cuts being ranks of them (the seam counted too). The first
-    evaluation, by index, may send every cell. Checked on the flume, where
-    d = 6 of its 96 cells: on 2 ranks at most 24 cells an evaluation; by
-    index (the mutation) its rank 0 sends about 95 an evaluation. (On the
-    bem and tank cases the bound exceeds their cells across a strip.)
+  - in the flume, a cell rank 0 sends as pieces (under another rank's
+    floe's box) lies within d = ceil(R / dx) + 2 columns of a cut between
+    two shares (R the pack's largest floe radius; its pieces and the other
+    floe's box each lie within R / dx + 1 columns of their owners' shares,
+    the owners being those of the floes' places one evaluation earlier,
+    less than a column away): at most 2 d cells a cut, the cuts being ranks
+    of them (the seam counted). The first evaluation, by index, may send
+    every cell. d = 6 of its 96 cells: on 2 ranks at most 24 cells an
+    evaluation; by index (the mutation) its rank 0 sends about 95.
 Then the flume's pack numbered along x (its floes sorted by x: there the
-owners by index would be strips along x too) on 2 ranks: bit for bit with
-its serial run, and rank 0's penalty phase receives at most 1.2 times the
-bytes of the pack numbered as made (in two rows along the flume: by index
-each rank's floes would lie along the whole flume and every cell travel as
-pieces, 3 times the bytes). By place the numbering does not choose the
-owners.
+owners by index would be shares of the columns too) on 2 ranks: bit for bit
+with its serial run, and rank 0's penalty phase receives at most 1.2 times
+the bytes of the pack numbered as made (in two rows along the flume: by
+index each rank's floes would lie along the whole flume and every cell
+travel as pieces, 3 times the bytes). By place the numbering does not
+choose the owners.
+Then the tank on 2 ranks in the poison mode (FLOESIM_TEST_POISON_UNHELD=step:
+each rank's copies of the floes it does not hold, neither in its band nor
+its own, are NaN in the windows; docs/parallel.md, "The poison mode of the
+run"): bit for bit with the serial run, floes poisoned, no phase reported.
+The coupling's owners are the drift's, so a rank builds and reads only
+floes it holds. With the columns' shares on the tank too (each rank's
+coupling floes along the whole width of the tank, outside its band in y)
+the run crashed (SIGSEGV on a NaN place).
 Then the bem case stopped half-way on 2 ranks and continued from its
 checkpoint on 3 ranks must equal the serial run bit for bit.
 """
@@ -203,7 +209,7 @@ for name, (sea, pack) in SEAS.items():
             failures.append(f"{name} on {n} ranks: no cell sent as pieces, or none as a total ({cells})")
         elif name == "flume" and int(m.group(1)) > bound:
             failures.append(f"{name} on {n} ranks: rank 0 sent {m.group(1)} cells as pieces, more than the {bound} "
-                            f"within {d} cells of the strips' cuts (the floes not owned by place?)")
+                            f"within {d} cells of the shares' cuts (the floes not owned by place?)")
 
 # The flume's floes numbered along x: the same owners by place, so the same
 # traffic within the runs' own drift (the two packs' serial runs differ in
@@ -224,6 +230,21 @@ elif ("flume", 2) in penalty:
     if not made <= 1.2 * along:
         failures.append(f"flume on 2 ranks: rank 0's penalty phase received {made} bytes with the pack numbered as "
                         f"made, more than 1.2 times the {along} with it numbered along x (owners by index?)")
+
+# The poison mode on the tank: the coupling reads only floes its rank holds.
+p = mpirun(2, "run", os.path.join(W, "tank.toml"), "-o", "tank_poison.h5", "-q",
+           hooks={"FLOESIM_TEST_POISON_UNHELD": "step"})
+poisoned = [int(m.group(1)) for m in re.finditer(r"windows, (\d+) floes poisoned", p.stderr)]
+reported = [int(m.group(1)) for m in re.finditer(r"(\d+) phases reported", p.stderr)]
+print(f"tank on 2 ranks, poison mode: exit {p.returncode}, floes poisoned {poisoned}, phases reported {reported}")
+if p.returncode != 0:
+    failures.append(f"tank on 2 ranks, poison mode: exit {p.returncode}\n{p.stderr[-2000:]}")
+else:
+    harness.same("tank_poison.h5", "tank_serial.h5", "tank: 2 ranks in the poison mode against the serial run",
+                 failures)
+    if len(poisoned) != 2 or min(poisoned) == 0 or any(reported):
+        failures.append(f"tank on 2 ranks, poison mode: floes poisoned {poisoned}, phases reported {reported} "
+                        f"(every rank must poison floes and report none)")
 
 # A restart across rank counts: the bem case's first half on 2 ranks, the
 # rest from its checkpoint on 3 ranks.
