@@ -54,28 +54,17 @@ the run crashed (SIGSEGV on a NaN place).
 Then the bem case stopped half-way on 2 ranks and continued from its
 checkpoint on 3 ranks must equal the serial run bit for bit.
 """
-import argparse
 import math
 import os
 import re
-import sys
 
-from ranks_harness import Ranks, finish, need, summary
+from ranks_harness import finish, need, ranks_check, summary
 
-if "--no-mpi" in sys.argv:
-    print("floesim was built without MPI (FLOESIM_MPI=OFF): the runs on the seas not in slabs are not checked")
-    sys.exit(77)
-
-ap = argparse.ArgumentParser()
-ap.add_argument("floesim")
-ap.add_argument("mpiexec")
-ap.add_argument("workdir")
-ap.add_argument("--ranks", type=int, nargs="+", default=[2, 3])
-args = ap.parse_args()
-
+args, harness = ranks_check(
+    "floesim was built without MPI (FLOESIM_MPI=OFF): the runs on the seas not in slabs are not checked",
+    lambda ap: ap.add_argument("--ranks", type=int, nargs="+", default=[2, 3]))
 W = args.workdir
 failures = []
-harness = Ranks(args.floesim, args.mpiexec, W)
 run, mpirun = harness.run, harness.mpirun
 
 RUN = """[run]
@@ -232,8 +221,7 @@ elif ("flume", 2) in penalty:
                         f"made, more than 1.2 times the {along} with it numbered along x (owners by index?)")
 
 # The poison mode on the tank: the coupling reads only floes its rank holds.
-p = mpirun(2, "run", os.path.join(W, "tank.toml"), "-o", "tank_poison.h5", "-q",
-           hooks={"FLOESIM_TEST_POISON_UNHELD": "step"})
+p = harness.poisoned(2, "step", "run", os.path.join(W, "tank.toml"), "-o", "tank_poison.h5", "-q")
 poisoned = [int(m.group(1)) for m in re.finditer(r"windows, (\d+) floes poisoned", p.stderr)]
 reported = [int(m.group(1)) for m in re.finditer(r"(\d+) phases reported", p.stderr)]
 print(f"tank on 2 ranks, poison mode: exit {p.returncode}, floes poisoned {poisoned}, phases reported {reported}")
