@@ -537,7 +537,8 @@ private:
   // - dims = 2 (a BEM sea, a tank): the drift's owners (parallel::
   //   FloeOwners, strips in y), which Simulation gives every step
   //   (hand_water_over). A new owner then holds the floe (its band or its
-  //   own: Simulation::held_now) and no water is left to hand over.
+  //   own: Simulation::held_now), and the water's hand-over has only the
+  //   floes that changed owner since to hand.
   // - dims = 1 (a flume): the drift's strips in y would give each rank
   //   floes along the whole sea, whose cells span its width; instead the
   //   grid's columns are cut in `ranks` equal shares (parallel::share) and
