@@ -113,6 +113,8 @@ FloeSeaContact::FloeSeaContact(const CouplingParams& params, const SeaParams& se
 void FloeSeaContact::floes_changed(const Floes& floes) {
   loads_h_ = -1.0;  // the loads and the water velocity are the old floes'
   footprints_.forget();
+  next_owners_.owner.clear();  // the next rebuild by index (reads no place), until owners by place are known
+  next_owners_.drifted = false;
   const std::size_t n = floes.size(), old = bottom0_.size();
   dynamic_.assign(n, 0);
   tilt_.assign(n, 0);
@@ -250,20 +252,20 @@ void FloeSeaContact::evaluate(const Floes& floes, fluid::Sea& sea, double h) {
   loads_h_ = h;
   // The poses a placement reads: a move and the window's test that allows
   // it, this rank's floes' (MovingFootprints::mine, whose pieces it moves;
-  // the verdict agreed over the ranks); a rebuild with the drift's owners
-  // by place (take_place_owners), this rank's floes' by them (the pieces it
-  // builds); any other rebuild, every floe's (set_owners finds the owners
-  // by place from them).
+  // the verdict agreed over the ranks); a rebuild with owners given
+  // (given_owners: the drift's by place on the slabs, take_place_owners, or
+  // by place on a sea not in slabs), this rank's floes' by them (the
+  // pieces it builds); any other rebuild, every floe's (set_owners finds
+  // the owners by place from them).
   pose_at_states(floes, footprints_.mine());
   const bool move = footprints_.movable(dynamic_, poses_);
-  std::span<const int> owners;
-  if (!move && place_owner_.size() == floes.size() && footprints_.takes_owners(place_rows_)) owners = place_owner_;
-  if (!move && !owners.empty()) pose_at_states(floes, place_mine_);
+  const GivenOwners given = move ? GivenOwners{} : given_owners(floes.size());
+  if (!move && !given.owner.empty()) pose_at_states(floes, given.mine);
   else if (!move) pose_at_states(floes);
   place_owner_ = {};
   place_rows_ = {};
   place_mine_ = {};
-  place_footprints(floes, move, owners);
+  place_footprints(floes, move, given.owner);
   const Footprints& fp = footprints_.pieces();
   const std::span<const double> area0 = footprints_.reference_area();
   // Routed with the floes owned by place, this rank's pieces lie within
@@ -507,6 +509,7 @@ void FloeSeaContact::advance_vertical(Floes& floes, std::span<const FloeState> s
   // floes a rank holds: its band, its own floes and its own floes for the
   // coupling, whose heave, pitch and roll the next evaluation's law reads.)
   FLOESIM_ASSERT(held.empty() || held.size() == floes.size());
+  next_owners_.drifted = true;  // the next owners held their floes through it
   for (std::size_t i = 0; i < floes.size(); ++i) {
     if (floes.is_static[i] || (!held.empty() && !held[i])) continue;
     FloeState& st = floes.state[i];

@@ -186,7 +186,9 @@ public:
   // (MovingFootprints::owners) is not drift_owner[i] goes from the first to
   // the second (one all-to-all, none when the owners agree; collective).
   // After it water_velocity() holds the floes this rank drifts. The drift is
-  // its only reader (docs/parallel.md, "The coupling by owner").
+  // its only reader (docs/parallel.md, "The coupling by owner"). On a sea
+  // not in slabs with dims = 2, drift_owner also becomes the coupling's
+  // owners from the next rebuild on (next_owners_).
   void hand_water_over(std::span<const int> drift_owner);
   // On several ranks, for the next evaluation only: the drift's owners by
   // place (parallel::FloeOwners with the sea's slabs first_row), assigned
@@ -214,8 +216,13 @@ public:
                         std::span<const std::uint8_t> held = {});
   bool implicit() const { return implicit_; }
   // On several ranks: the floes this rank owns for the coupling (whose
-  // pieces it built at the footprints' last rebuild and moves), ascending.
-  std::span<const std::uint32_t> own_floes() const { return footprints_.mine(); }
+  // pieces it built at the footprints' last rebuild and moves), ascending;
+  // on a sea not in slabs also those it owns from the next rebuild on
+  // (next_owners_), which it must hold (pose, and drift vertically) until
+  // then.
+  std::span<const std::uint32_t> own_floes() const {
+    return next_owners_.owner.empty() ? footprints_.mine() : std::span<const std::uint32_t>(next_owners_.held);
+  }
   // Threads for the per-floe and per-piece work (results do not depend on it).
   void set_threads(int threads) { threads_ = std::max(threads, 1); }
   // Ranks that share the per-floe work (docs/parallel.md, stages two and
@@ -241,7 +248,8 @@ public:
   // run's to the bit, whichever rank owns which floe. pressure() then holds
   // this rank's slab's rows only, which is what its sea's kick reads. A sea
   // not in slabs (BEM seas, a tank, dims = 1) is whole on every rank, whose
-  // kick reads every cell's pressure: its floes are owned by index, and
+  // kick reads every cell's pressure: its floes are owned by place (the
+  // drift's owners; in a flume, shares of its columns: next_owners_), and
   // the same routes make every cell's sums on every rank
   // (parallel::CellRoutes::replicated: a cell under another rank's floe's
   // box as pieces to every rank, any other cell's pressure as its total),
@@ -259,6 +267,7 @@ public:
                            : parallel::CellRoutes();
     footprints_.set_slabs(slabs ? slab_rows_ : std::vector<int>{});
     owner_.interior_reach = -1;  // the interior cells are those of the new routes
+    set_place_owners();
   }
   // The sea's slabs moved (issue 21 stage seven; first_row as
   // fluid::Sea::slab_rows gives it, the same on every rank, at the start of
@@ -400,8 +409,12 @@ private:
   double sum_cells_by_owner(double ks);
   // By owner: order_ <- this rank's floes in the serial order, and
   // owner_.position every floe's place in that order (one gather of the
-  // floes' first cells).
+  // floes' first cells, with their boxes; in a flume not in slabs, with the
+  // ranks of their shares of columns: next_owners_).
   void order_by_owner(std::size_t floes);
+  // next_owners_ for the routes (on replicated routes, in a flume, the
+  // columns' shares); the floes' next owners forgotten.
+  void set_place_owners();
   // By owner: the penalty energy from every rank's terms
   // (owner_.energy_*), summed in the serial order (one gather).
   void settle_energy() const;
@@ -517,6 +530,50 @@ private:
     RoutedCells routed_counts;  // since the start, this rank's
   } owner_;
   static constexpr std::uint32_t kNoCell = parallel::CellBox::kNone;
+  // The coupling's owners by place on a sea not in slabs (routes_.
+  // replicated(); docs/parallel.md, "The seas not in slabs, their floes by
+  // place"), so that a cell holds pieces of several ranks' floes only near
+  // the parts' boundaries, not wherever the floes are dense (by index):
+  // - dims = 2 (a BEM sea, a tank): the drift's owners (parallel::
+  //   FloeOwners, strips in y), which Simulation gives every step
+  //   (hand_water_over). A new owner then holds the floe (its band or its
+  //   own: Simulation::held_now), and the water's hand-over has only the
+  //   floes that changed owner since to hand.
+  // - dims = 1 (a flume): the drift's strips in y would give each rank
+  //   floes along the whole sea, whose cells span its width; instead the
+  //   grid's columns are cut in `ranks` equal shares (parallel::share) and
+  //   rank r owns the floes whose centroid's column (periodic: wrapped;
+  //   walled: clamped) lies in its share. Each owner finds the share of its
+  //   own floes at every evaluation (from their poses, which it reads
+  //   anyway) and sends it with the boxes' gather (order_by_owner: 4 bytes
+  //   a floe more). A rank holds the floes of its share (own_floes(), in
+  //   held_now) from the gather on; it holds no band of its own for them:
+  //   where the drift's bands do not hold every floe of a flume (one wider
+  //   than the floes' reach), the halo exchange of the state would have to
+  //   bring them.
+  // The next rebuild after a vertical drift (advance_vertical) takes them:
+  // a new owner's copy of a floe is current after the drift's exchange and
+  // the vertical drift of the floes it holds; an evaluation before it (a
+  // first half kick) keeps the owners. Until the first (the start, a
+  // restart, a split), the owners are by index, which reads no floe's place.
+  struct NextOwners {
+    std::vector<int> column;  // dims = 1: per grid column, its share's rank (empty: the drift's owners)
+    std::vector<int> owner;   // per floe: the next rebuild's owner (empty: none yet)
+    std::vector<std::uint32_t> mine;  // this rank's floes in `owner`, ascending
+    std::vector<std::uint32_t> held;  // own_floes(): the footprints' mine() and `mine`
+    bool drifted = false;     // a vertical drift since `owner` was set
+  } next_owners_;
+  // next_owners_ from every floe's next owner.
+  void set_next_owners(std::span<const int> owner);
+  // dims = 1: the rank of the share of columns that holds a floe at pose p.
+  int column_owner(const FloePose& p) const;
+  // The owners a rebuild of this evaluation takes, and this rank's floes
+  // among them (empty: none given, the footprints find them).
+  struct GivenOwners {
+    std::span<const int> owner;
+    std::span<const std::uint32_t> mine;
+  };
+  GivenOwners given_owners(std::size_t floes) const;
   // The sea's slabs (fluid::Sea::slab_rows; empty: whole on every rank), and
   // by owner on them, the routes of the cells' sums to the slabs' ranks;
   // the next evaluation clears pressure_ in routes_.owned() (the cells the

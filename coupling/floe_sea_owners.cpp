@@ -45,7 +45,10 @@
 // Sea not in slabs (BEM seas, a tank, dims = 1: every rank holds the whole
 // sea, whose kick reads every cell's pressure; CellRoutes::replicated). The
 // same two kinds of cells, every row being a boundary row: the floes are
-// owned by index, not by place, so no cell is deep in one rank's part. A
+// owned by place (next_owners_: the drift's owners, strips in y; in a
+// flume, shares of its columns; by index until they are known), so the
+// cells under several ranks' floes lie near the parts' boundaries, but no
+// row is deep in one rank's part. A
 // cell no other rank's floe's box covers is summed here from zero in
 // order_, the serial sums, and its pressure's total goes to every other
 // rank (4 bytes a cell, then 8). Every other cell travels as its pieces to
@@ -90,6 +93,52 @@ void FloeSeaContact::set_slabs(std::vector<int> first_row) {
   owner_.interior_reach = -1;  // the interior cells are those of the new routes
 }
 
+void FloeSeaContact::set_place_owners() {
+  next_owners_ = {};
+  if (!routes_.replicated() || grid_.dims != 1) return;
+  // A flume: its columns in equal shares (its cells span its width).
+  std::vector<int> first(static_cast<std::size_t>(comm_.size()) + 1, grid_.nx);
+  for (int r = 0; r < comm_.size(); ++r)
+    first[static_cast<std::size_t>(r)] =
+        static_cast<int>(parallel::share(static_cast<std::size_t>(grid_.nx), r, comm_.size()).begin);
+  next_owners_.column = parallel::row_owners(first);
+}
+
+void FloeSeaContact::set_next_owners(std::span<const int> owner) {
+  NextOwners& next = next_owners_;
+  next.owner.assign(owner.begin(), owner.end());
+  next.mine.clear();
+  next.held.clear();
+  const std::span<const std::uint32_t> mine = footprints_.mine();
+  for (std::size_t i = 0, m = 0; i < owner.size(); ++i) {
+    const bool now_mine = m < mine.size() && mine[m] == i;
+    if (now_mine) ++m;
+    if (owner[i] == comm_.rank()) next.mine.push_back(static_cast<std::uint32_t>(i));
+    if (owner[i] == comm_.rank() || now_mine) next.held.push_back(static_cast<std::uint32_t>(i));
+  }
+  next.drifted = false;
+}
+
+int FloeSeaContact::column_owner(const FloePose& p) const {
+  const int columns = static_cast<int>(next_owners_.column.size());
+  // Periodic: the column that holds x, the seam crossed (grid_row's rule);
+  // walled: a place beyond a wall is owned by the column at that wall.
+  const int column = grid_.edge == fluid::GridEdge::periodic
+                         ? parallel::grid_row(p.x, grid_.dx(), columns)
+                         : static_cast<int>(std::clamp(std::floor(p.x / grid_.dx()), 0.0, columns - 1.0));
+  return next_owners_.column[static_cast<std::size_t>(column)];
+}
+
+FloeSeaContact::GivenOwners FloeSeaContact::given_owners(std::size_t floes) const {
+  // The drift's owners on the sea's slabs (take_place_owners)...
+  if (place_owner_.size() == floes && footprints_.takes_owners(place_rows_)) return {place_owner_, place_mine_};
+  // ...or by place on a sea not in slabs, once their new owners hold
+  // their floes' current states (next_owners_).
+  const NextOwners& next = next_owners_;
+  if (next.owner.size() == floes && next.drifted) return {next.owner, next.mine};
+  return {};
+}
+
 void FloeSeaContact::order_by_owner(std::size_t floes) {
   const Footprints& fp = footprints_.pieces();
   OwnerCells& o = owner_;
@@ -106,7 +155,26 @@ void FloeSeaContact::order_by_owner(std::size_t floes) {
         o.box[i].first_cell = fp.cell[fp.offsets[i]];
       }
     }
-  comm_.complete_owned(o.box, footprints_.owners());
+  if (next_owners_.column.empty()) {
+    comm_.complete_owned(o.box, footprints_.owners());
+  } else {
+    // With each box, the rank of the share of columns of the floe's present
+    // place (poses_ holds this rank's floes' present poses: evaluate posed
+    // them).
+    struct Placed {
+      parallel::CellBox box;
+      std::int32_t owner;
+    };
+    std::vector<Placed> placed(floes, Placed{{}, 0});
+    for (std::uint32_t i : footprints_.mine()) placed[i] = {o.box[i], column_owner(poses_[i])};
+    comm_.complete_owned(placed, footprints_.owners());
+    std::vector<int> owner(floes);
+    for (std::size_t i = 0; i < floes; ++i) {
+      o.box[i] = placed[i].box;
+      owner[i] = placed[i].owner;
+    }
+    set_next_owners(owner);
+  }
   // place_footprints' serial sort, on the same floes in the same order.
   o.serial.clear();
   for (std::size_t i = 0; i < floes; ++i)
@@ -439,8 +507,11 @@ void FloeSeaContact::hand_water_over(std::span<const int> drift_owner) {
   // by place (parallel::FloeOwners); the coupling's owner of a floe is
   // mostly the same rank (both by place on the same slabs), but not always:
   // the coupling's owners are set at the footprints' last rebuild and follow
-  // a move of the slabs only at the next one, and without a sea in slabs (or
-  // with the implicit step) they are by index.
+  // a move of the slabs only at the next one; without a sea in slabs they
+  // are these owners from the next rebuild on (next_owners_), but in a
+  // flume (shares of its columns) and with the implicit step (by index).
+  if (routes_.replicated() && next_owners_.column.empty() && drift_owner.size() == dynamic_.size())
+    set_next_owners(drift_owner);
   if (comm_.serial() || !water_by_owner_) return;
   FLOESIM_ASSERT(drift_owner.size() == water_.size() && footprints_.owners().size() == water_.size());
   comm_.hand_over(water_, footprints_.owners(), drift_owner);

@@ -109,9 +109,10 @@ void MovingFootprints::set_owners(std::span<const FloePose> poses, std::span<con
     next_owner_rows_.clear();
   }
   reference_whole_ = true;
-  if (by_place_ && !owners.empty()) {
-    // Given by place on these slabs (takes_owners): the rule below, applied
-    // by their maker at the same poses.
+  if (!comm_.serial() && !owners.empty()) {
+    // Given: by place on these slabs (takes_owners: the rule below, applied
+    // by their maker at the same poses), or without slabs by their maker's
+    // rule (a sea not in slabs: FloeSeaContact's strips).
     FLOESIM_ASSERT(owners.size() == n);
     std::copy(owners.begin(), owners.end(), owner_.begin());
     reference_whole_ = false;

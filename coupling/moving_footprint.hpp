@@ -99,9 +99,11 @@ public:
   // the placement with that verdict (moved: poses of mine() read; rebuilt:
   // every floe's, which set_owners reads).
   bool movable(std::span<const std::uint8_t> include, std::span<const FloePose> poses) const;
-  // With `owners` (by place: takes_owners), a rebuild takes its owners from
-  // them instead of from the poses, and reads the poses of its own floes
-  // (owners[i] == rank) only.
+  // With `owners` (by place: takes_owners; or any rule of the caller's
+  // when no slabs are set, e.g. FloeSeaContact's strips of a sea not in
+  // slabs), a rebuild takes its owners from them instead of from the poses,
+  // and reads the poses of its own floes (owners[i] == rank) only. On
+  // several ranks only; the same on every rank.
   bool place(const Floes& floes, std::span<const std::uint8_t> include, std::span<const FloePose> poses, int threads,
              bool move, std::span<const int> owners = {});
   // Whether the next rebuild may take its owners given: the owners by place

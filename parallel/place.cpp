@@ -2,13 +2,13 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstring>
 #include <limits>
 #include <numeric>
 
 #include <time.h>
 
 #include "core/error.hpp"
+#include "parallel/bytes.hpp"
 #include "parallel/cell_routes.hpp"
 
 namespace floesim::parallel {
@@ -174,27 +174,29 @@ FloeOwners::WindowCharges FloeOwners::close_window(const Communicator& comm, con
   std::vector<std::size_t> counts(static_cast<std::size_t>(ranks_), kPerRank * sizeof(double));
   for (const int r : owner_) counts[static_cast<std::size_t>(r)] += sizeof(double);
   const std::vector<std::byte> bytes = comm.allgather_known(std::as_bytes(std::span<const double>(mine)), counts);
-  std::vector<double> all(bytes.size() / sizeof(double));
-  if (!all.empty()) std::memcpy(all.data(), bytes.data(), bytes.size());
-  // Rank r's message starts at start[r]; its floes come in ascending order.
-  std::vector<std::size_t> start(counts.size(), 0), next(counts.size());
-  for (std::size_t r = 1; r < counts.size(); ++r) start[r] = start[r - 1] + counts[r - 1] / sizeof(double);
-  for (std::size_t r = 0; r < counts.size(); ++r) next[r] = start[r] + kPerRank;
-  keys.resize(owner_.size());
-  for (std::size_t i = 0; i < owner_.size(); ++i) keys[i] = all[next[static_cast<std::size_t>(owner_[i])]++];
+  // Rank r's message, in rank order: its charges, then its floes' keys.
   charged_ = row_charged_ = coupling_charged_ = fracture_charged_ = 0.0;
   coupling_seconds_.resize(static_cast<std::size_t>(ranks_), 0.0);
   fracture_seconds_.resize(static_cast<std::size_t>(ranks_), 0.0);
   window_seconds_.assign(static_cast<std::size_t>(ranks_), 0.0);
   w.floe.assign(static_cast<std::size_t>(ranks_), 0.0);
+  std::vector<std::vector<double>> rank_keys(static_cast<std::size_t>(ranks_));
+  const std::byte* in = bytes.data();
   for (std::size_t r = 0; r < static_cast<std::size_t>(ranks_); ++r) {
-    const std::size_t at = start[r];
-    const double row = all[at + 1];
-    coupling_seconds_[r] += all[at + 2];
-    fracture_seconds_[r] += all[at + 3];
-    w.floe[r] = all[at];
-    w.rows += row;
-    window_seconds_[r] = w.floe[r] + row;
+    const std::vector<double> charges = take<double>(in, kPerRank);
+    rank_keys[r] = take<double>(in, counts[r] / sizeof(double) - kPerRank);
+    w.floe[r] = charges[0];
+    coupling_seconds_[r] += charges[2];
+    fracture_seconds_[r] += charges[3];
+    w.rows += charges[1];
+    window_seconds_[r] = w.floe[r] + charges[1];
+  }
+  // Each floe's key from its owner, whose floes came in ascending order.
+  keys.resize(owner_.size());
+  std::vector<std::size_t> next(static_cast<std::size_t>(ranks_), 0);
+  for (std::size_t i = 0; i < owner_.size(); ++i) {
+    const auto r = static_cast<std::size_t>(owner_[i]);
+    keys[i] = rank_keys[r][next[r]++];
   }
   total_seconds_.resize(window_seconds_.size(), 0.0);
   for (std::size_t r = 0; r < window_seconds_.size(); ++r) total_seconds_[r] += window_seconds_[r];

@@ -39,10 +39,9 @@ Only what is stable is pinned: other readers are being removed.
 """
 import os
 import re
-import subprocess
 import sys
 
-from ranks_harness import ENV, half_pack, moving_pack_check, need, ocean_toml, summary
+from ranks_harness import half_pack, moving_pack_check, need, ocean_toml, summary
 
 args, harness, base = moving_pack_check(
     "floesim was built without MPI (FLOESIM_MPI=OFF): the poison mode is not checked", 400, 250.0, [2])
@@ -52,10 +51,7 @@ failures = []
 
 
 def mpirun(n, poison, config, out, *extra):
-    env = dict(ENV, FLOESIM_TEST_POISON_UNHELD=poison)
-    return subprocess.run([args.mpiexec, "--oversubscribe", "-np", str(n), "-x", "FLOESIM_TEST_POISON_UNHELD",
-                           args.floesim, "run", config, "-o", out, "-q", *extra],
-                          cwd=W, capture_output=True, text=True, timeout=600, env=env)
+    return harness.poisoned(n, poison, "run", config, "-o", out, "-q", *extra)
 
 
 def equal(a, b):

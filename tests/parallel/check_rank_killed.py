@@ -21,7 +21,6 @@ Then:
   bit (`floesim compare --rtol 0 --atol 0`): nothing the killed run wrote
   after its checkpoint leaks into the continuation.
 """
-import argparse
 import os
 import re
 import signal
@@ -29,21 +28,13 @@ import subprocess
 import sys
 import time
 
-from ranks_harness import ENV, Ranks, need
+from ranks_harness import ENV, Ranks, need, ranks_check
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))),
                                 "scripts", "scenarios"))
 import moving_pack  # noqa: E402
 
-if "--no-mpi" in sys.argv:
-    print("floesim was built without MPI (FLOESIM_MPI=OFF): the killed rank is not checked")
-    sys.exit(77)
-
-ap = argparse.ArgumentParser()
-ap.add_argument("floesim")
-ap.add_argument("mpiexec")
-ap.add_argument("workdir")
-args = ap.parse_args()
+args, _ = ranks_check("floesim was built without MPI (FLOESIM_MPI=OFF): the killed rank is not checked")
 W = os.path.abspath(args.workdir)
 args.floesim = os.path.abspath(args.floesim)
 harness = Ranks(args.floesim, args.mpiexec, W)

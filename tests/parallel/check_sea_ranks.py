@@ -42,28 +42,22 @@ energy, picked the other one on 2 and 3 ranks). Last, a restart across rank
 counts: the first half on 2 ranks, the rest from its checkpoint on 3 ranks
 and serially, both bit for bit with the serial run.
 """
-import argparse
 import os
 import re
 import sys
 
-from ranks_harness import Ranks, need, ocean_toml, summary
+from ranks_harness import need, ocean_toml, ranks_check, summary
 
-if "--no-mpi" in sys.argv:
-    print("floesim was built without MPI (FLOESIM_MPI=OFF): the distributed sea runs are not checked")
-    sys.exit(77)
 
-ap = argparse.ArgumentParser()
-ap.add_argument("floesim")
-ap.add_argument("mpiexec")
-ap.add_argument("workdir")
-ap.add_argument("--ranks", type=int, nargs="+", default=[1, 2, 3])
-ap.add_argument("--t-end", type=float, default=2.0)
-args = ap.parse_args()
+def options(ap):
+    ap.add_argument("--ranks", type=int, nargs="+", default=[1, 2, 3])
+    ap.add_argument("--t-end", type=float, default=2.0)
 
+
+args, harness = ranks_check(
+    "floesim was built without MPI (FLOESIM_MPI=OFF): the distributed sea runs are not checked", options)
 W = args.workdir
 failures = []
-harness = Ranks(args.floesim, args.mpiexec, W)
 run, mpirun = harness.run, harness.mpirun
 
 

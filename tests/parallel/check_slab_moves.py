@@ -34,14 +34,10 @@ cuts move from the equal shares toward the floes (parallel.slab_rows, every
 import os
 import sys
 
-from ranks_harness import Ranks, half_pack, need, ocean_toml, summary
+from ranks_harness import half_pack, need, ocean_toml, ranks_check, summary
 
-if "--no-mpi" in sys.argv:
-    print("floesim was built without MPI (FLOESIM_MPI=OFF): the moving slabs are not checked")
-    sys.exit(77)
-
-floesim, mpiexec, W = sys.argv[1:4]
-harness = Ranks(floesim, mpiexec, W)
+args, harness = ranks_check("floesim was built without MPI (FLOESIM_MPI=OFF): the moving slabs are not checked")
+floesim, W = args.floesim, args.workdir
 run, mpirun = harness.run, harness.mpirun
 failures = []
 

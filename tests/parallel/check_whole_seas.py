@@ -7,10 +7,12 @@ usage: check_whole_seas.py FLOESIM MPIEXEC WORKDIR [--ranks 2 3]
 
 A BEM sea, a spectral tank and a long-crested spectral sea (dims = 1) are
 whole on every rank (only a spectral sea with dims = 2 and no tank runs in
-slabs); their floes are owned by index. Each case is a dense pack (`floesim
-pack`, 70 % cover) whose floes are smaller than a few cells, so that many
-cells hold pieces of three or more floes of several ranks, with the explicit
-kicks (the law by owner) to 2 s:
+slabs); their floes are owned by place for the coupling (docs/parallel.md,
+"The seas not in slabs, their floes by place"): the drift's owners (strips
+in y) on the bem and tank, shares of the columns in the flume. Each case is
+a dense pack (`floesim pack`, 70 % cover) whose floes are smaller than a few
+cells, so that many cells hold pieces of three or more floes of several
+ranks, with the explicit kicks (the law by owner) to 2 s:
   - bem: 150 floes in a 12 m x 6 m basin with walls (BEM, 24 x 12 cells);
   - tank: 100 floes in a 24 m x 6 m tank (spectral, 96 x 24 cells, wave
     maker and absorber);
@@ -21,35 +23,48 @@ Checked, on 2 and 3 ranks:
     0 --atol 0`): each cell's coverage, sums and pressure are the serial
     sums, made from every rank's pieces in the serial order on every rank.
     Summing each rank's part and then the parts (stage three's merge, before
-    this) differed on every case here in the floes' states and the sea (by
-    ~1e-14 relative), not only in the penalty energy;
+    notslabs25) differed on every case here in the floes' states and the
+    sea (by ~1e-14 relative), not only in the penalty energy;
   - rank 0 sent cells as pieces (parallel.coupling_cells: `shared` > 0), so
-    the pieces' path was taken (and, but in the flume, whose few cells are
-    nearly all shared, cells summed alone and sent as totals).
+    the pieces' path was taken, and cells summed alone and sent as totals;
+  - in the flume, a cell rank 0 sends as pieces (under another rank's
+    floe's box) lies within d = ceil(R / dx) + 2 columns of a cut between
+    two shares (R the pack's largest floe radius; its pieces and the other
+    floe's box each lie within R / dx + 1 columns of their owners' shares,
+    the owners being those of the floes' places one evaluation earlier,
+    less than a column away): at most 2 d cells a cut, the cuts being ranks
+    of them (the seam counted). The first evaluation, by index, may send
+    every cell. d = 6 of its 96 cells: on 2 ranks at most 24 cells an
+    evaluation; by index (the mutation) its rank 0 sends about 95.
+Then the flume's pack numbered along x (its floes sorted by x: there the
+owners by index would be shares of the columns too) on 2 ranks: bit for bit
+with its serial run, and rank 0's penalty phase receives at most 1.2 times
+the bytes of the pack numbered as made (in two rows along the flume: by
+index each rank's floes would lie along the whole flume and every cell
+travel as pieces, 3 times the bytes). By place the numbering does not
+choose the owners.
+Then the tank on 2 ranks in the poison mode (FLOESIM_TEST_POISON_UNHELD=step:
+each rank's copies of the floes it does not hold, neither in its band nor
+its own, are NaN in the windows; docs/parallel.md, "The poison mode of the
+run"): bit for bit with the serial run, floes poisoned, no phase reported.
+The coupling's owners are the drift's, so a rank builds and reads only
+floes it holds. With the columns' shares on the tank too (each rank's
+coupling floes along the whole width of the tank, outside its band in y)
+the run crashed (SIGSEGV on a NaN place).
 Then the bem case stopped half-way on 2 ranks and continued from its
 checkpoint on 3 ranks must equal the serial run bit for bit.
 """
-import argparse
+import math
 import os
 import re
-import sys
 
-from ranks_harness import Ranks, finish, need, summary
+from ranks_harness import finish, need, ranks_check, summary
 
-if "--no-mpi" in sys.argv:
-    print("floesim was built without MPI (FLOESIM_MPI=OFF): the runs on the seas not in slabs are not checked")
-    sys.exit(77)
-
-ap = argparse.ArgumentParser()
-ap.add_argument("floesim")
-ap.add_argument("mpiexec")
-ap.add_argument("workdir")
-ap.add_argument("--ranks", type=int, nargs="+", default=[2, 3])
-args = ap.parse_args()
-
+args, harness = ranks_check(
+    "floesim was built without MPI (FLOESIM_MPI=OFF): the runs on the seas not in slabs are not checked",
+    lambda ap: ap.add_argument("--ranks", type=int, nargs="+", default=[2, 3]))
 W = args.workdir
 failures = []
-harness = Ranks(args.floesim, args.mpiexec, W)
 run, mpirun = harness.run, harness.mpirun
 
 RUN = """[run]
@@ -66,6 +81,8 @@ pack = "{pack}"
 law = "strong"
 stiffness = 100.0
 """
+# Per case: the grid's cells along x and y, its cell size along x and y (m).
+GRIDS = {"bem": (24, 12, 0.5, 0.5), "tank": (96, 24, 0.25, 0.25), "flume": (96, 1, 0.25, 2.0)}
 SEAS = {
     "bem": ("""
 [sea]
@@ -116,6 +133,42 @@ wavelength = 6.0
 """, ["--floes", "40", "--box", "24", "2"]),
 }
 
+def largest_radius(pack):
+    """The largest distance of a floe's vertex from its centroid (m) in a pack file."""
+    import h5py  # (only with MPI: --no-mpi needs nothing of it)
+    with h5py.File(os.path.join(W, pack), "r") as f:
+        offsets, vertices = f["floes/offsets"][:], f["floes/vertices"][:]
+    return max(math.hypot(*v) for v in vertices) if len(offsets) > 1 else 0.0
+
+
+def numbered_along_x(pack, out):
+    """The floes of `pack` renumbered by their centroids' x, written to `out`."""
+    import h5py
+    import numpy as np
+    with h5py.File(os.path.join(W, pack), "r") as f, h5py.File(os.path.join(W, out), "w") as g:
+        for k, v in f.attrs.items():
+            g.attrs[k] = v
+        for k in f:
+            if k != "floes":
+                f.copy(k, g)
+        floes = f["floes"]
+        order = np.argsort(floes["pose"][:, 0], kind="stable")
+        offsets, vertices = floes["offsets"][:], floes["vertices"][:]
+        out_floes = g.create_group("floes")
+        for k in floes:
+            if k not in ("offsets", "vertices"):
+                out_floes[k] = floes[k][:][order]
+        out_floes["vertices"] = np.concatenate([vertices[offsets[i]:offsets[i + 1]] for i in order])
+        out_floes["offsets"] = np.concatenate([[0], np.cumsum([offsets[i + 1] - offsets[i] for i in order])]).astype(
+            offsets.dtype)
+
+
+def penalty_bytes(p):
+    """Rank 0's bytes received in the penalty phase (`parallel.phase.penalty: C calls, B bytes`)."""
+    return int(summary(p)["parallel.phase.penalty"].split()[2])
+
+
+penalty = {}  # (case, ranks) -> rank 0's penalty bytes
 for name, (sea, pack) in SEAS.items():
     need(run([args.floesim, "pack", *pack, "--concentration", "0.7", "--seed", "3", "--thickness", "0.2",
               "-o", f"{name}_pack.h5"]), f"{name}: floesim pack")
@@ -124,17 +177,62 @@ for name, (sea, pack) in SEAS.items():
         f.write(RUN + sea + COUPLING.format(pack=f"{name}_pack.h5"))
     s = summary(need(run([args.floesim, "run", config, "-o", f"{name}_serial.h5", "-q"]), f"{name}: serial run"))
     print(f"{name}: serial to 2 s, {s.get('steps')} steps")
+    nx, ny, dx, dy = GRIDS[name]
+    along_x = ny == 1 or nx >= ny  # the strips' rule (FloeSeaContact::set_strips)
+    d = math.ceil(largest_radius(f"{name}_pack.h5") / (dx if along_x else dy)) + 2
     for n in args.ranks:
         p = mpirun(n, "run", config, "-o", f"{name}_{n}.h5", "-q")
         if p.returncode != 0:
             failures.append(f"{name} on {n} ranks: exit {p.returncode}\n{p.stderr}")
             continue
         harness.same(f"{name}_{n}.h5", f"{name}_serial.h5", f"{name}: {n} ranks against the serial run", failures)
-        cells = summary(p).get("parallel.coupling_cells")
-        print(f"{name}: {n} ranks, rank 0's cells: {cells}")
+        s = summary(p)
+        penalty[name, n] = penalty_bytes(p)
+        cells = s.get("parallel.coupling_cells")
+        evaluations = int(s["footprints.placements"])
+        bound = nx * ny + (evaluations - 1) * n * 2 * d * (ny if along_x else nx)
+        print(f"{name}: {n} ranks, rank 0's cells: {cells} in {evaluations} evaluations (shared at most {bound}); "
+              f"penalty {s['parallel.phase.penalty']}")
         m = re.match(r"(\d+) shared \((\d+) pieces\), (\d+) alone owned, (\d+) alone sent", cells or "")
-        if not m or int(m.group(1)) == 0 or (name != "flume" and int(m.group(4)) == 0):
+        if not m or int(m.group(1)) == 0 or int(m.group(4)) == 0:
             failures.append(f"{name} on {n} ranks: no cell sent as pieces, or none as a total ({cells})")
+        elif name == "flume" and int(m.group(1)) > bound:
+            failures.append(f"{name} on {n} ranks: rank 0 sent {m.group(1)} cells as pieces, more than the {bound} "
+                            f"within {d} cells of the shares' cuts (the floes not owned by place?)")
+
+# The flume's floes numbered along x: the same owners by place, so the same
+# traffic within the runs' own drift (the two packs' serial runs differ in
+# their floes' order, so in round-off).
+numbered_along_x("flume_pack.h5", "flume_x_pack.h5")
+config = os.path.join(W, "flume_x.toml")
+with open(config, "w") as f:
+    f.write(RUN + SEAS["flume"][0] + COUPLING.format(pack="flume_x_pack.h5"))
+need(run([args.floesim, "run", config, "-o", "flume_x_serial.h5", "-q"]), "flume numbered along x: serial run")
+p = mpirun(2, "run", config, "-o", "flume_x_2.h5", "-q")
+if p.returncode != 0:
+    failures.append(f"flume numbered along x on 2 ranks: exit {p.returncode}\n{p.stderr}")
+elif ("flume", 2) in penalty:
+    harness.same("flume_x_2.h5", "flume_x_serial.h5", "flume numbered along x: 2 ranks against the serial run",
+                 failures)
+    along, made = penalty_bytes(p), penalty["flume", 2]
+    print(f"flume on 2 ranks, rank 0's penalty bytes: {made} (numbered as made), {along} (numbered along x)")
+    if not made <= 1.2 * along:
+        failures.append(f"flume on 2 ranks: rank 0's penalty phase received {made} bytes with the pack numbered as "
+                        f"made, more than 1.2 times the {along} with it numbered along x (owners by index?)")
+
+# The poison mode on the tank: the coupling reads only floes its rank holds.
+p = harness.poisoned(2, "step", "run", os.path.join(W, "tank.toml"), "-o", "tank_poison.h5", "-q")
+poisoned = [int(m.group(1)) for m in re.finditer(r"windows, (\d+) floes poisoned", p.stderr)]
+reported = [int(m.group(1)) for m in re.finditer(r"(\d+) phases reported", p.stderr)]
+print(f"tank on 2 ranks, poison mode: exit {p.returncode}, floes poisoned {poisoned}, phases reported {reported}")
+if p.returncode != 0:
+    failures.append(f"tank on 2 ranks, poison mode: exit {p.returncode}\n{p.stderr[-2000:]}")
+else:
+    harness.same("tank_poison.h5", "tank_serial.h5", "tank: 2 ranks in the poison mode against the serial run",
+                 failures)
+    if len(poisoned) != 2 or min(poisoned) == 0 or any(reported):
+        failures.append(f"tank on 2 ranks, poison mode: floes poisoned {poisoned}, phases reported {reported} "
+                        f"(every rank must poison floes and report none)")
 
 # A restart across rank counts: the bem case's first half on 2 ranks, the
 # rest from its checkpoint on 3 ranks.

@@ -37,9 +37,7 @@ run = harness.run
 failures = []
 
 
-def mpirun(n, poison, *floesim_args):
-    """floesim on n ranks with the test hook set to `poison` (None: unset)."""
-    return harness.mpirun(n, *floesim_args, hooks={"FLOESIM_TEST_POISON_UNHELD": poison} if poison else None)
+mpirun = harness.poisoned  # (n, the test hook's value or None, floesim's arguments...)
 
 
 def same(a, b, what):

@@ -1,8 +1,10 @@
 """What the distributed-run checks share (check_ranks.py, check_record_ranks.py,
 check_sea_ranks.py, check_slab_moves.py, check_rank_killed.py,
-check_writer_ranks.py, check_advance_part.py): commands run in the work
+check_writer_ranks.py, check_advance_part.py, check_poison_run.py,
+check_whole_seas.py): their arguments (ranks_check), commands run in the work
 folder with MPI allowed as root (CI containers) and one thread per rank,
-`mpirun --oversubscribe` (with test hooks' variables passed to every rank),
+`mpirun --oversubscribe` (with test hooks' variables passed to every rank;
+the poison mode's),
 `floesim compare`, the run summary as a dict, the small ocean the sea checks
 run on, the moving pack's checks' set-up, a stop with the command's output
 when a step that must work fails, and the failures' list a check collects:
@@ -34,6 +36,12 @@ class Ranks:
         return subprocess.run([self.mpiexec, "--oversubscribe", "-np", str(n), *passed, self.floesim, *floesim_args],
                               cwd=self.workdir, capture_output=True, text=True, timeout=600,
                               env=dict(ENV, **hooks))
+
+    def poisoned(self, n, poison, *floesim_args):
+        """floesim on n ranks in the poison mode: the test hook
+        FLOESIM_TEST_POISON_UNHELD set to `poison` (None: unset; docs/parallel.md,
+        "The poison mode of the run")."""
+        return self.mpirun(n, *floesim_args, hooks={"FLOESIM_TEST_POISON_UNHELD": poison} if poison else None)
 
     def compare(self, a, b, rtol):
         """`floesim compare` of two run files within the relative `rtol` (no absolute slack)."""
@@ -138,6 +146,24 @@ def half_pack(run, floesim, out="half_pack.h5"):
     return out
 
 
+def ranks_check(no_mpi, options=None):
+    """The set-up every distributed-run check shares. With --no-mpi (MPI not
+    built): says `no_mpi` and exits 77 (ctest's skip code). Else the
+    arguments FLOESIM MPIEXEC WORKDIR and those `options(parser)` adds.
+    Returns the arguments and a Ranks for WORKDIR."""
+    if "--no-mpi" in sys.argv:
+        print(no_mpi)
+        sys.exit(77)
+    ap = argparse.ArgumentParser()
+    ap.add_argument("floesim")
+    ap.add_argument("mpiexec")
+    ap.add_argument("workdir")
+    if options:
+        options(ap)
+    args = ap.parse_args()
+    return args, Ranks(args.floesim, args.mpiexec, args.workdir)
+
+
 def moving_pack_check(no_mpi, floes, t_end, ranks, options=None):
     """The set-up of the checks on the moving pack (check_ranks.py,
     check_record_ranks.py). With --no-mpi (MPI not built): says `no_mpi` and
@@ -147,20 +173,14 @@ def moving_pack_check(no_mpi, floes, t_end, ranks, options=None):
     scripts/scenarios/moving_pack.py (seed 5, wind (10, 3) m/s, records every
     quarter of the run) written to WORKDIR. Returns the arguments, a Ranks
     for WORKDIR and the configuration's path."""
-    if "--no-mpi" in sys.argv:
-        print(no_mpi)
-        sys.exit(77)
-    ap = argparse.ArgumentParser()
-    ap.add_argument("floesim")
-    ap.add_argument("mpiexec")
-    ap.add_argument("workdir")
-    ap.add_argument("--floes", type=int, default=floes)
-    ap.add_argument("--t-end", type=float, default=t_end)
-    ap.add_argument("--ranks", type=int, nargs="+", default=ranks)
-    if options:
-        options(ap)
-    args = ap.parse_args()
-    harness = Ranks(args.floesim, args.mpiexec, args.workdir)
+    def pack_options(ap):
+        ap.add_argument("--floes", type=int, default=floes)
+        ap.add_argument("--t-end", type=float, default=t_end)
+        ap.add_argument("--ranks", type=int, nargs="+", default=ranks)
+        if options:
+            options(ap)
+
+    args, harness = ranks_check(no_mpi, pack_options)
     sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))),
                                     "scripts", "scenarios"))
     import moving_pack  # (the pack shared with bench/mpi_pack.py; it needs h5py, which --no-mpi does not)
