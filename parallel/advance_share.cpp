@@ -217,6 +217,48 @@ AdvancePart share_part(const contact::ShareAdvance& share, contact::ShareOutcome
   return part;
 }
 
+const char* conflict_name(contact::ShareOutcome::Conflict conflict) {
+  using C = contact::ShareOutcome::Conflict;
+  switch (conflict) {
+    case C::none: return "none";
+    case C::foreign_cluster: return "foreign_cluster";
+    case C::warm_start: return "warm_start";
+    case C::failed_lcp: return "failed_lcp";
+    case C::error: return "error";
+    case C::missing_pairs: return "missing_pairs";
+    case C::missing_floe: return "missing_floe";
+  }
+  return "unknown";
+}
+
+void count_conflicts(std::span<const AdvancePart> parts, AdvanceShareCounts& counts) {
+  std::vector<std::string> kinds;
+  std::vector<std::uint8_t> taken;
+  bool twice = false;
+  for (const AdvancePart& p : parts) {
+    if (p.outcome.conflict != ShareOutcome::Conflict::none) {
+      kinds.push_back(conflict_name(p.outcome.conflict));
+      continue;
+    }
+    for (const std::uint32_t i : p.outcome.moved) {
+      if (i >= taken.size()) taken.resize(i + 1, 0);
+      twice = twice || taken[i];
+      taken[i] = 1;
+    }
+  }
+  if (kinds.empty() && twice) kinds.push_back("taken_twice");
+  std::sort(kinds.begin(), kinds.end());
+  kinds.erase(std::unique(kinds.begin(), kinds.end()), kinds.end());
+  for (const std::string& k : kinds) ++counts.conflicts[k];
+}
+
+// A set-up's conflicts (the gathered rooms' flags), each kind once.
+static void count_set_up(std::span<const contact::ShareRooms> rooms, AdvanceShareCounts& counts) {
+  std::vector<AdvancePart> parts(rooms.size());
+  for (std::size_t r = 0; r < rooms.size(); ++r) parts[r].outcome.conflict = rooms[r].conflict;
+  count_conflicts(parts, counts);
+}
+
 bool combine_parts(std::span<const AdvancePart> parts, Floes& floes, CollisionStats& stats, SubstepReport& report,
                    contact::ImpulseRecord* record) {
   std::vector<std::uint8_t> taken(floes.size(), 0);
@@ -293,7 +335,11 @@ void advance_by_owner(const Communicator& comm, std::span<const int> owner, Floe
           counts.rooms[r] += parts[r].outcome.rooms;
         }
         counts.pairs += parts.front().outcome.pairs;
+      } else {
+        count_conflicts(parts, counts);
       }
+    } else {
+      count_set_up(rooms, counts);
     }
   }
   if (combined) {
@@ -520,12 +566,18 @@ void advance_on_part(const Communicator& comm, std::span<const int> owner, std::
             counts.rooms[r] += parts[r].outcome.rooms;
             counts.pairs += parts[r].outcome.pairs;
           }
-        } else if (std::any_of(parts.begin(), parts.end(), [](const AdvancePart& p) {
-                     return p.outcome.conflict == contact::ShareOutcome::Conflict::missing_pairs;
-                   })) {
-          ++counts.missing;
+        } else {
+          count_conflicts(parts, counts);
+          if (std::any_of(parts.begin(), parts.end(), [](const AdvancePart& p) {
+                return p.outcome.conflict == contact::ShareOutcome::Conflict::missing_pairs;
+              }))
+            ++counts.missing;
         }
+      } else {
+        ++counts.conflicts[conflict_name(routes.conflict)];
       }
+    } else {
+      count_set_up(rooms, counts);
     }
   }
   if (combined) {

@@ -16,8 +16,10 @@
 
 #include <algorithm>
 #include <cstddef>
+#include <map>
 #include <span>
 #include <functional>
+#include <string>
 #include <vector>
 
 #include "contact/substep.hpp"
@@ -200,6 +202,14 @@ struct AdvanceShareCounts {
   // From the rank's part: the bytes of the collision shapes and reaches
   // this rank sent with its routed pairs' floes (RoutedShapes).
   long shape_bytes = 0;
+  // The tries that fell back, by what made them (the run's summary, one
+  // line a kind): each try counts once under each kind that some part of
+  // it (or its set-up) said, so the kinds may sum to more than the tries.
+  // The advance's kinds: the names of contact::ShareOutcome::Conflict
+  // (conflict_name) and `taken_twice` (a free floe two ranks' clusters
+  // took, which no part can see: combine_parts finds it); the
+  // collisions': those of contact::StepCollisionShare::Conflict.
+  std::map<std::string, long> conflicts;
   long wait = 0;                // advances still to do whole
   long next_wait = 1;           // the wait after the next fallback
 
@@ -223,6 +233,15 @@ struct AdvanceShareCounts {
     next_wait = std::min(2 * next_wait, o.max_wait);
   }
 };
+
+// The name of a share's conflict as the summary prints it
+// (parallel.advance_conflicts.NAME): the enumerator's.
+const char* conflict_name(contact::ShareOutcome::Conflict conflict);
+// The kinds of conflict a tried step's parts (rank order) say, each once,
+// counted into `counts.conflicts`: each part's conflict, and `taken_twice`
+// when no part has one but two parts moved one floe. A step whose parts
+// combine counts nothing.
+void count_conflicts(std::span<const AdvancePart> parts, AdvanceShareCounts& counts);
 
 // The step's advance on every rank of `comm` (or whole, while the back-off
 // above waits): this rank's share's set-up (its pairs' rooms), the exchange
