@@ -17,6 +17,7 @@
 #include <algorithm>
 #include <cstddef>
 #include <map>
+#include <set>
 #include <span>
 #include <functional>
 #include <string>
@@ -67,6 +68,16 @@ struct AdvancePart {
 // past it.
 void append_record(std::vector<std::byte>& out, const contact::ImpulseRecord& record);
 contact::ImpulseRecord take_record(const std::byte*& in);
+
+// A share's warm-store writes in a message (contact::ShareOutcome::warm
+// and the uses: the pairs' count, the uses, then per pair its key, clock,
+// entries' count and entries, 37 bytes each), appended to `out`; read back
+// by take_warm, which moves `in` past them. Written into a store by
+// hold_warm (each pair replaced, the uses added).
+using WarmPairs = std::vector<std::pair<std::uint64_t, contact::WarmStart::Pair>>;
+void append_warm(std::vector<std::byte>& out, const WarmPairs& pairs, long uses);
+WarmPairs take_warm(const std::byte*& in, long& uses);
+void hold_warm(const WarmPairs& pairs, long uses, contact::WarmStart& store);
 
 std::vector<std::byte> pack(const AdvancePart& part);
 AdvancePart unpack_advance_part(std::span<const std::byte> bytes);
@@ -154,12 +165,15 @@ void check_routed_floes(std::span<const AdvancePart> parts);
 
 // Combines every rank's part (rank order) into `floes` (each rank's moved
 // floes get its states; the free floes are already at the end of the step on
-// every rank), `stats`, `report` and `record` (if not null: the parts'
-// records merged in the serial order, contact::merge_advance_record), and
-// returns true; or returns false, changing nothing, when a part has a
-// conflict or two parts moved one floe.
+// every rank), `stats`, `report`, `record` (if not null: the parts'
+// records merged in the serial order, contact::merge_advance_record) and
+// `warm` (if not null: the run's warm store, every part's stored pairs
+// written into it, hold_warm), and returns true; or returns false,
+// changing nothing, when a part has a conflict, two parts moved one floe
+// or stored one warm pair.
 bool combine_parts(std::span<const AdvancePart> parts, Floes& floes, contact::CollisionStats& stats,
-                   contact::SubstepReport& report, contact::ImpulseRecord* record = nullptr);
+                   contact::SubstepReport& report, contact::ImpulseRecord* record = nullptr,
+                   contact::WarmStart* warm = nullptr);
 
 // A step redone whole costs the share's work and the whole advance; packs
 // where ranks' clusters keep meeting (a jam across strips, a jam whose LCP
@@ -177,6 +191,12 @@ struct AdvanceShareOptions {
   // combines as often as from the whole (docs/parallel.md, "The advance from
   // the rank's part").
   bool on_part = true;
+  // From the rank's part: the tries of a step, the first included, before
+  // the whole advance, where a try's conflicts are clusters of two runners
+  // meeting (JoinedClusters). Each try joins more clusters; on the wall jam
+  // of examples/pack_against_wall.toml every such step combined by its
+  // second or third (docs/parallel.md, "The conflicting clusters on one rank").
+  int max_rounds = 8;
 };
 
 // How the advances by cluster owner went (the run's summary), and the
@@ -202,6 +222,11 @@ struct AdvanceShareCounts {
   // From the rank's part: the bytes of the collision shapes and reaches
   // this rank sent with its routed pairs' floes (RoutedShapes).
   long shape_bytes = 0;
+  // From the rank's part: the tries that fell back and combined in a later
+  // try with the conflicting clusters joined on one rank (not counted in
+  // `fallbacks`), and the tries made again for it (JoinedClusters).
+  long joined = 0;
+  long rounds = 0;
   // The tries that fell back, by what made them (the run's summary, one
   // line a kind): each try counts once under each kind that some part of
   // it (or its set-up) said, so the kinds may sum to more than the tries.
@@ -232,6 +257,30 @@ struct AdvanceShareCounts {
     wait = next_wait;
     next_wait = std::min(2 * next_wait, o.max_wait);
   }
+};
+
+// The conflicting clusters on one rank (docs/parallel.md, "The conflicting
+// clusters on one rank (onerank26)"). After a try whose parts refused to
+// combine only because clusters of different runners would have merged
+// (foreign_cluster: ShareOutcome::met) or taken one free floe (a floe two
+// parts moved), add() joins those clusters, with the clusters each share
+// had merged into them (ShareOutcome::merged), into groups, each run by the
+// runner of its lowest cluster as `share` (that try's) ran it: runners()
+// (ClusterShare::runners) for the next try. The groups only grow from try
+// to try. Every rank reads the same parts and the same runners: the same
+// groups. False, changing nothing, when a part had another conflict (or no
+// clusters to join): the whole advance.
+class JoinedClusters {
+public:
+  bool add(std::span<const AdvancePart> parts, const contact::ShareAdvance& share);
+  std::span<const std::pair<std::int32_t, std::int32_t>> runners() const { return runners_; }
+
+private:
+  std::int32_t find(std::int32_t k);
+  void unite(std::int32_t a, std::int32_t b);
+  std::map<std::int32_t, std::int32_t> parent_;  // union-find over the clusters named so far
+  std::set<std::int32_t> joined_;                // clusters of a conflict
+  std::vector<std::pair<std::int32_t, std::int32_t>> runners_;  // (cluster, rank), ascending
 };
 
 // The name of a share's conflict as the summary prints it
