@@ -718,18 +718,20 @@ void advance_on_part(const Communicator& comm, std::span<const int> owner, std::
       if (round > 0) ++counts.joined;
       break;
     }
-    if (round == 0) {
-      count_conflicts(parts, counts);
-      if (std::any_of(parts.begin(), parts.end(), [](const AdvancePart& p) {
-            return p.outcome.conflict == contact::ShareOutcome::Conflict::missing_pairs;
-          }))
-        ++counts.missing;
-    }
     // Joined on one rank when every conflict is clusters of two runners
     // meeting; a step whose pair list was rebuilt whole is left to the
-    // whole advance (its set-up is not the part's).
-    if (start_whole || round + 1 >= share_options.max_rounds || !joined.add(parts, share)) break;
-    ++counts.rounds;
+    // whole advance (its set-up is not the part's), and so is the last
+    // try's conflict, counted by kind.
+    if (!start_whole && round + 1 < share_options.max_rounds && joined.add(parts, share)) {
+      ++counts.rounds;
+      continue;
+    }
+    count_conflicts(parts, counts);
+    if (std::any_of(parts.begin(), parts.end(), [](const AdvancePart& p) {
+          return p.outcome.conflict == contact::ShareOutcome::Conflict::missing_pairs;
+        }))
+      ++counts.missing;
+    break;
   }
   if (combined) {
     counts.combined();

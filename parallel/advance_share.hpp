@@ -229,7 +229,9 @@ struct AdvanceShareCounts {
   long rounds = 0;
   // The tries that fell back, by what made them (the run's summary, one
   // line a kind): each try counts once under each kind that some part of
-  // it (or its set-up) said, so the kinds may sum to more than the tries.
+  // its last try (or its set-up) said, so the kinds may sum to more than
+  // the fallbacks. A try whose meeting clusters were joined and then
+  // combined counts in `joined` only.
   // The advance's kinds: the names of contact::ShareOutcome::Conflict
   // (conflict_name) and `taken_twice` (a free floe two ranks' clusters
   // took, which no part can see: combine_parts finds it); the
