@@ -256,6 +256,7 @@ void Stepper::bring_in(int k) {
     c.members.push_back(j);
     floes_.state[j] = linear(j, c.tau);
     ++report_.joined;
+    if (share_) taken_.emplace_back(static_cast<std::int32_t>(j), k);
   }
   std::sort(merging_.begin(), merging_.end());
   merging_.erase(std::unique(merging_.begin(), merging_.end()), merging_.end());

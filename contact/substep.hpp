@@ -240,11 +240,10 @@ struct ShareOutcome {
   // caller to join them on one rank (ClusterShare::runners): on
   // foreign_cluster, (the share's cluster, each cluster of another runner
   // it would merge with); `merged`, (cluster, the share's cluster it
-  // merged into) for each merge the share made; `moved_cluster`, per floe
-  // of `moved`, its cluster at the end (a free floe two shares took is in
-  // two shares' clusters).
-  std::vector<std::pair<std::int32_t, std::int32_t>> met, merged;
-  std::vector<std::int32_t> moved_cluster;
+  // merged into) for each merge the share made; `taken`, (free floe,
+  // cluster) for each free floe a cluster of the share took in (a free floe
+  // two shares took is in both shares' `taken`).
+  std::vector<std::pair<std::int32_t, std::int32_t>> met, merged, taken;
 };
 
 // The first half's answer: the share's tight pairs (room below xi) and

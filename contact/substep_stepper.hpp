@@ -113,18 +113,13 @@ public:
     o.events = events_;
     o.met = met_;
     o.merged = merged_;
-    std::vector<std::pair<std::uint32_t, std::int32_t>> moved;
+    o.taken = taken_;
     for (std::size_t k = 0; k < clusters_.size(); ++k) {
       if (!own_[k]) continue;
       ++o.clusters;
-      if (clusters_[k].alive)
-        for (const std::uint32_t i : clusters_[k].members) moved.emplace_back(i, static_cast<std::int32_t>(k));
+      if (clusters_[k].alive) o.moved.insert(o.moved.end(), clusters_[k].members.begin(), clusters_[k].members.end());
     }
-    std::sort(moved.begin(), moved.end());
-    for (const auto& [i, k] : moved) {
-      o.moved.push_back(i);
-      o.moved_cluster.push_back(k);
-    }
+    std::sort(o.moved.begin(), o.moved.end());
     return o;
   }
 
@@ -392,7 +387,7 @@ private:
   std::vector<std::uint8_t> own_;      // per cluster: run by this call
   ShareOutcome::Conflict conflict_ = ShareOutcome::Conflict::none;
   std::vector<EventPlace> events_;     // a share's: per event it recorded, its pop's key
-  std::vector<std::pair<std::int32_t, std::int32_t>> met_, merged_;  // ShareOutcome::met, merged
+  std::vector<std::pair<std::int32_t, std::int32_t>> met_, merged_, taken_;  // ShareOutcome::met, merged, taken
   double floor_tau_ = -1.0;            // the last floor step's key (tau, cluster)
   long floor_cluster_ = -1;
 

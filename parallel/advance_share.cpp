@@ -149,17 +149,16 @@ std::vector<std::byte> pack(const AdvancePart& p) {
   }
   append_record(out, p.record);
   append_warm(out, p.outcome.warm, p.outcome.warm_uses);
-  // The clusters to join (ShareOutcome::met, merged, moved_cluster).
+  // The clusters to join (ShareOutcome::met, merged, taken: 8 bytes each).
   const std::array<std::int64_t, 3> joins{static_cast<std::int64_t>(p.outcome.met.size()),
                                           static_cast<std::int64_t>(p.outcome.merged.size()),
-                                          static_cast<std::int64_t>(p.outcome.moved_cluster.size())};
+                                          static_cast<std::int64_t>(p.outcome.taken.size())};
   append(out, std::span<const std::int64_t>(joins));
-  for (const auto* list : {&p.outcome.met, &p.outcome.merged})
+  for (const auto* list : {&p.outcome.met, &p.outcome.merged, &p.outcome.taken})
     for (const auto& [a, b] : *list) {
       const std::array<std::int32_t, 2> ab{a, b};
       append(out, std::span<const std::int32_t>(ab));
     }
-  append(out, std::span<const std::int32_t>(p.outcome.moved_cluster));
   return out;
 }
 
@@ -194,11 +193,11 @@ AdvancePart unpack_advance_part(std::span<const std::byte> bytes) {
   p.record = take_record(in);
   p.outcome.warm = take_warm(in, p.outcome.warm_uses);
   const std::vector<std::int64_t> joins = take<std::int64_t>(in, 3);
-  for (auto [list, n] : {std::pair{&p.outcome.met, joins[0]}, std::pair{&p.outcome.merged, joins[1]}}) {
+  for (auto [list, n] : {std::pair{&p.outcome.met, joins[0]}, std::pair{&p.outcome.merged, joins[1]},
+                         std::pair{&p.outcome.taken, joins[2]}}) {
     const std::vector<std::int32_t> ab = take<std::int32_t>(in, 2 * static_cast<std::size_t>(n));
     for (std::size_t j = 0; j < ab.size(); j += 2) list->emplace_back(ab[j], ab[j + 1]);
   }
-  p.outcome.moved_cluster = take<std::int32_t>(in, static_cast<std::size_t>(joins[2]));
   FLOESIM_ASSERT(in == bytes.data() + bytes.size());
   return p;
 }
@@ -564,10 +563,12 @@ bool JoinedClusters::add(std::span<const AdvancePart> parts, const contact::Shar
       any = true;
     }
     if (c != ShareOutcome::Conflict::none) continue;
-    for (std::size_t j = 0; j < p.outcome.moved.size(); ++j) {
-      const auto [it, fresh] = taker.emplace(p.outcome.moved[j], p.outcome.moved_cluster[j]);
+    // A floe two parts moved was free at the step's start (the clusters are
+    // the same on every rank) and taken in by a cluster of each.
+    for (const auto& [floe, k] : p.outcome.taken) {
+      const auto [it, fresh] = taker.emplace(static_cast<std::uint32_t>(floe), k);
       if (fresh) continue;
-      unite(it->second, p.outcome.moved_cluster[j]);
+      unite(it->second, k);
       joined_.insert(it->second);
       any = true;
     }
