@@ -138,7 +138,7 @@ struct WarmStart {
   double match_distance = 0.05;  // m
   long clock = 0;
   long max_age = 256;
-  long uses = 0;  // solves that started from the store (a share's probe: ShareAdvance, resolve_step_collisions_share)
+  long uses = 0;  // solves that started from the store (a share's copy, ShareAdvance, or probe, resolve_step_collisions_share)
   // A share's copy of the run's store (ShareAdvance) logs the keys of the
   // pairs it stores, in order (repeats kept), so that its caller can send
   // those pairs to every rank (docs/parallel.md, "The conflicting

@@ -210,9 +210,8 @@ struct ShareOutcome {
   // pairs routed to the share came without its state, mass, collision shape
   // or reach (not finite where the share holds it: ShareAdvance::hold); not
   // a fallback but a fault of the routing, which the caller reports.
-  // (warm_start, a share's solve that would start from the warm store, was
-  // a conflict until onerank26: the share now runs on a copy of the store
-  // and reports what it stored, `warm`.)
+  // A solve from the warm store is not a conflict: the share runs on a
+  // copy of the store and reports what it stored (`warm`).
   enum class Conflict { none, foreign_cluster, failed_lcp, error, missing_pairs, missing_floe };
   Conflict conflict = Conflict::none;
   // Ascending: the floes of the share's clusters (joined free floes

@@ -8,11 +8,12 @@
 // clusters and every free floe (linear motion), and the ranks then exchange
 // the states of the floes their clusters moved (index + state) and their
 // collision counts.
-// A step where a rank's cluster met another rank's cluster, where two ranks
-// took the same free floe, or where a share could not run alone
-// (ShareOutcome::Conflict) is advanced again whole on every rank from the
-// step's states: the serial advance, so the answer is the serial one bit for
-// bit either way.
+// A step where a rank's cluster met another rank's cluster or two ranks
+// took the same free floe is tried again (from the rank's part) with those
+// clusters joined on one rank (JoinedClusters); one where a share could not
+// run alone (ShareOutcome::Conflict, the others) is advanced again whole on
+// every rank from the step's states: the serial advance, so the answer is
+// the serial one bit for bit either way.
 
 #include <algorithm>
 #include <cstddef>
@@ -222,9 +223,10 @@ struct AdvanceShareCounts {
   // From the rank's part: the bytes of the collision shapes and reaches
   // this rank sent with its routed pairs' floes (RoutedShapes).
   long shape_bytes = 0;
-  // From the rank's part: the tries that fell back and combined in a later
-  // try with the conflicting clusters joined on one rank (not counted in
-  // `fallbacks`), and the tries made again for it (JoinedClusters).
+  // From the rank's part: the steps whose first try met clusters of two
+  // runners and which combined in a later try with those clusters joined on
+  // one rank (not counted in `fallbacks`), and the tries made again for
+  // them (JoinedClusters).
   long joined = 0;
   long rounds = 0;
   // The tries that fell back, by what made them (the run's summary, one
@@ -332,9 +334,14 @@ void advance_by_owner(const Communicator& comm, std::span<const int> owner, Floe
 // reaches from their owners. `whole` gives the whole state and detection
 // for the back-off's whole steps and the fallback (state first), which is
 // taken also when a floe joins a share's cluster without being its
-// candidate (Conflict::missing_pairs). With options.impulse.record the
-// shares record and merge as in advance_by_owner. Equal to the serial
-// advance bit for bit, states, counts and record.
+// candidate (Conflict::missing_pairs). A try whose only conflicts are
+// clusters of two runners meeting is made again from the step's start with
+// those clusters joined on one rank (JoinedClusters; the rooms and edges
+// of the first try; up to share_options.max_rounds tries, each its
+// candidates, routed pairs and parts exchanged again). With
+// options.impulse.record the shares record and merge as in
+// advance_by_owner. Equal to the serial advance bit for bit, states,
+// counts, record and warm store.
 void advance_on_part(const Communicator& comm, std::span<const int> owner, std::span<const std::uint32_t> mine,
                      Floes& floes, contact::CollisionShapes& shapes, const contact::Detection& part,
                      const WholeOnDemand& whole, double dt,
