@@ -899,6 +899,51 @@ TEST_CASE("clusters of two ranks that meet, joined on one rank and run there fro
   CHECK(single + cured == splits);  // no split left to the whole advance on these packs
 }
 
+TEST_CASE("two ranks' clusters that take the same free floe, from the parts: joined on one rank, the serial advance") {
+  // The row of "two ranks' clusters that take the same free floe" above (a's
+  // cluster on rank 0, b's on rank 1, both take j), played from each rank's
+  // part: the first try's parts both move j (no conflict, taken twice), so
+  // the two clusters are joined on rank 0 (the runner of the lower) and the
+  // second try combines, equal to the serial advance.
+  auto box = [](double x0, double vx) {
+    FloeInput f;
+    f.vertices = {{x0, 0.0}, {x0 + 10.0, 0.0}, {x0 + 10.0, 10.0}, {x0, 10.0}};
+    f.velocity = {vx, 0.0};
+    return f;
+  };
+  Case c;
+  for (const FloeInput& in : {box(0.0, 1.0), box(10.5, 0.0), box(55.0, -1.0), box(44.5, 0.0), box(27.5, 0.0)})
+    c.floes.add(make_floe_shape(in), in);
+  c.shapes = contact::build_collision_shapes(c.floes);
+  contact::DetectionOptions d;
+  d.horizon = c.dt;
+  d.reach.assign(c.floes.size(), 6.0);
+  c.detection = contact::detect(c.floes, c.shapes, d);
+  c.detect_options = d;
+  c.options.floor = 1e-3 * c.dt;
+  const Serial serial = serial_advance(c);
+  REQUIRE(serial.report.merges == 1);
+  parallel::FloeOwners strips(0, 2, c.domain);
+  strips.assign(c.floes);
+  const std::vector<int> owner{0, 0, 1, 1, 0};
+  parallel::JoinedClusters joined;
+  int tries = 0;
+  PartsPlay p;
+  for (bool again = true; again; ++tries) {
+    again = false;
+    long sent = 0, stopped = 0, pads = 0;
+    p = PartsPlay{};
+    p.ok = play_parts(c, strips, owner, 2, p.f, p.stats, p.report, sent, stopped, pads, true, nullptr, nullptr,
+                      nullptr, nullptr, &joined, &again);
+    REQUIRE(tries < 8);
+  }
+  MESSAGE(tries << " tries, " << joined.runners().size() << " clusters given another runner");
+  CHECK(tries == 2);
+  CHECK(p.ok);
+  CHECK(joined.runners().size() == 2);
+  check_serial(p, serial);
+}
+
 TEST_CASE("the advance's share given a routed floe without its collision shape fails at once, naming the floe and the rank") {
   // The poisoned play of the case above (each share's copy NaN beyond its
   // strip and part), with the first routed floe a share did not hold left
