@@ -419,7 +419,8 @@ int run(const Args& args, const parallel::Session& session) {
     // From the rank's part: the tries that combined once the clusters of
     // two runners that met were joined on one rank, and the tries made
     // again for it.
-    o << "\nparallel.advance_joined: " << share.joined << "\nparallel.advance_rounds: " << share.rounds;
+    o << "\nparallel.advance_joined: " << share.joined << "\nparallel.advance_rounds: " << share.rounds
+      << "\nparallel.advance_kept: " << share.kept;
     // The tries that fell back by what made them, one line a kind (a try
     // counts under each kind its parts said; none: no line).
     for (const auto& [kind, n] : share.conflicts) o << "\nparallel.advance_conflicts." << kind << ": " << n;

@@ -4,6 +4,7 @@
 #include <array>
 #include <cstring>
 #include <map>
+#include <optional>
 #include <set>
 #include <string>
 #include <tuple>
@@ -632,6 +633,13 @@ void advance_on_part(const Communicator& comm, std::span<const int> owner, std::
   JoinedClusters joined;
   contact::ShareRooms all;
   std::vector<contact::ContactEdge> pad_edges;
+  // A rank whose part had no conflict and none of whose clusters a try
+  // again joins elsewhere or takes in keeps that part and its floes' states
+  // (`kept`, `kept_state`): its share would run the same clusters on the
+  // same pairs again. It still makes the try's set-up and routing (its
+  // part's pairs may go to a joined group's runner).
+  std::optional<AdvancePart> kept;
+  std::vector<FloeState> kept_state;
   for (int round = 0;; ++round) {
     if (round > 0) floes.state = start;
     // A run that keeps the impulse record: as advance_by_owner (the events'
@@ -703,8 +711,16 @@ void advance_on_part(const Communicator& comm, std::span<const int> owner, std::
       share.hold(exchange_advance_pairs(comm, part, routed_pairs(part, to, comm.size()), floes, shapes,
                                         &counts.shape_bytes));
     }
-    const AdvancePart done = share_part(share, share.advance(), floes, record ? &own : nullptr);
-    move_not_held(floes, share.held(), dt);
+    AdvancePart done;
+    if (kept) {
+      done = std::move(*kept);
+      floes.state = std::move(kept_state);
+      ++counts.kept;
+    } else {
+      done = share_part(share, share.advance(), floes, record ? &own : nullptr);
+      move_not_held(floes, share.held(), dt);
+    }
+    kept.reset();
     const std::vector<AdvancePart> parts = comm.allgather_parts(pack(done), unpack_advance_part);
     check_routed_floes(parts);
     counts.clusters.resize(parts.size(), 0);
@@ -725,6 +741,13 @@ void advance_on_part(const Communicator& comm, std::span<const int> owner, std::
     // try's conflict, counted by kind.
     if (!start_whole && round + 1 < share_options.max_rounds && joined.add(parts, share)) {
       ++counts.rounds;
+      const bool touched = std::any_of(joined.runners().begin(), joined.runners().end(), [&](const auto& kr) {
+        return kr.second == comm.rank() || share.runner_of_cluster(kr.first) == comm.rank();
+      });
+      if (done.outcome.conflict == contact::ShareOutcome::Conflict::none && !touched) {
+        kept = std::move(done);
+        kept_state = floes.state;
+      }
       continue;
     }
     count_conflicts(parts, counts);

@@ -229,6 +229,7 @@ struct AdvanceShareCounts {
   // them (JoinedClusters).
   long joined = 0;
   long rounds = 0;
+  long kept = 0;  // of those tries again, the ones where this rank kept its part (no share run)
   // The tries that fell back, by what made them (the run's summary, one
   // line a kind): each try counts once under each kind that some part of
   // its last try (or its set-up) said, so the kinds may sum to more than
