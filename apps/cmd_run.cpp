@@ -416,12 +416,21 @@ int run(const Args& args, const parallel::Session& session) {
     o << "\nparallel.advance_missing: " << share.missing << "\nparallel.advance_pads: " << share.pads
       << "\nparallel.advance_candidates: " << share.candidates << "\nparallel.advance_rebuilds: " << share.rebuilds
       << "\nparallel.advance_shape_bytes: " << share.shape_bytes;
+    // From the rank's part: the tries that combined once the clusters of
+    // two runners that met were joined on one rank, and the tries made
+    // again for it.
+    o << "\nparallel.advance_joined: " << share.joined << "\nparallel.advance_rounds: " << share.rounds
+      << "\nparallel.advance_kept: " << share.kept;
+    // The tries that fell back by what made them, one line a kind (a try
+    // counts under each kind its parts said; none: no line).
+    for (const auto& [kind, n] : share.conflicts) o << "\nparallel.advance_conflicts." << kind << ": " << n;
     // The collisions at the step's start by owner, the same way: tried,
     // redone whole, done whole by the back-off, each rank's step groups.
     const parallel::AdvanceShareCounts& collide = sim.collide_share();
     o << "\nparallel.collide_steps: " << collide.steps << "\nparallel.collide_fallbacks: " << collide.fallbacks
       << "\nparallel.collide_whole: " << collide.whole << "\nparallel.collide_groups:";
     for (const long k : collide.clusters) o << " " << k;
+    for (const auto& [kind, n] : collide.conflicts) o << "\nparallel.collide_conflicts." << kind << ": " << n;
     // The fracture analyses by owner: the steps that exchanged them, each
     // rank's checks (they sum to fracture.checks) and its wall time in them.
     if (sim.percussion_stats()) {

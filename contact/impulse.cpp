@@ -127,6 +127,7 @@ void warm_store(WarmStart& warm, const Floes& floes, const std::vector<ContactPo
     WarmStart::Pair& pair = warm.pairs[pair_key(c.a, c.b)];
     pair.entries.clear();
     pair.stored = warm.clock;
+    if (warm.log) warm.written.push_back(pair_key(c.a, c.b));
   }
   auto on = [&](std::size_t i) -> std::uint8_t { return z_basic[i]; };
   for (std::size_t k = 0; k < m; ++k) {

@@ -138,7 +138,13 @@ struct WarmStart {
   double match_distance = 0.05;  // m
   long clock = 0;
   long max_age = 256;
-  long uses = 0;  // solves that started from the store (a share's probe: ShareAdvance, resolve_step_collisions_share)
+  long uses = 0;  // solves that started from the store (a share's copy, ShareAdvance, or probe, resolve_step_collisions_share)
+  // A share's copy of the run's store (ShareAdvance) logs the keys of the
+  // pairs it stores, in order (repeats kept), so that its caller can send
+  // those pairs to every rank (docs/parallel.md, "The conflicting
+  // clusters on one rank"). Off in the run's store.
+  bool log = false;
+  std::vector<std::uint64_t> written;
 
   void tick() {
     if (++clock % max_age == 0) std::erase_if(pairs, [&](const auto& p) { return clock - p.second.stored > max_age; });
@@ -404,6 +410,11 @@ std::size_t resolve_step_collisions(Floes& floes, std::span<const FloeState> sta
 struct ClusterShare {
   std::span<const int> owner;  // per floe: its rank, one of the sharing ranks' (each pair's room on one share)
   int rank = 0;
+  // The advance (ShareAdvance) only: clusters given another runner than
+  // their lowest floe's owner, (cluster, rank), the clusters numbered as
+  // every share numbers them: the conflicting clusters joined on one rank
+  // (docs/parallel.md, "The conflicting clusters on one rank").
+  std::span<const std::pair<std::int32_t, std::int32_t>> runners = {};
 };
 
 // One share of resolve_step_collisions: the LCPs of the step groups whose

@@ -246,8 +246,9 @@ void Stepper::bring_in(int k) {
   for (int l : merging_)
     if (!own_[static_cast<std::size_t>(l)]) {
       conflict_ = ShareOutcome::Conflict::foreign_cluster;
-      return;
+      met_.emplace_back(k, l);
     }
+  if (conflict_ != ShareOutcome::Conflict::none) return;
   std::sort(joining_.begin(), joining_.end());
   joining_.erase(std::unique(joining_.begin(), joining_.end()), joining_.end());
   for (std::uint32_t j : joining_) {
@@ -255,6 +256,7 @@ void Stepper::bring_in(int k) {
     c.members.push_back(j);
     floes_.state[j] = linear(j, c.tau);
     ++report_.joined;
+    if (share_) taken_.emplace_back(static_cast<std::int32_t>(j), k);
   }
   std::sort(merging_.begin(), merging_.end());
   merging_.erase(std::unique(merging_.begin(), merging_.end()), merging_.end());
@@ -269,6 +271,7 @@ void Stepper::bring_in(int k) {
     o.members.clear();
     o.alive = false;
     ++report_.merges;
+    if (share_) merged_.emplace_back(l, k);
   }
   compute_budgets(k);
   collect_internal(k);

@@ -127,10 +127,19 @@ void advance_with_collisions(Floes& floes, const CollisionShapes& shapes, const 
 // So are the impulse record's events: the serial advance numbers its solves
 // in pop order, and a share's solves of one pop get that pop's key, which
 // no other share's pop has (merge_advance_record, impulse.hpp).
-// The warm store (ImpulseOptions::warm) is shared across steps by pair, so
-// a share that would use it is a conflict too (the stores of the ranks
-// would part); so is a failed LCP (its dump is numbered in the run) and a
-// RunError (the serial advance throws it, or a different one, in its order).
+// The warm store (ImpulseOptions::warm) is kept across steps by pair: a
+// solve reads and then replaces the entries of its contacts' pairs
+// (warm_guess, warm_store), and a contact's pair has both floes in the
+// cluster (or one and an obstacle), so the pairs one cluster's solves read
+// and write are no other cluster's. A share therefore runs on a copy of the
+// store as it was at the step's start (the same on every rank): each of its
+// solves reads what the serial advance's would (the step's start, or what
+// the share's own earlier solves stored), and the pairs it stored
+// (ShareOutcome::warm), written into every rank's store with the other
+// shares', leave it as the serial advance leaves it (each pair written by
+// one share, its last write the serial one's). A failed LCP is a conflict
+// (its dump is numbered in the run) and so is a RunError (the serial
+// advance throws it, or a different one, in its order).
 //
 // The set-up by share. A pair's room (step 1) is a function of the pair and
 // of its floes' states at the step's start: the same bits on whichever share
@@ -201,7 +210,9 @@ struct ShareOutcome {
   // pairs routed to the share came without its state, mass, collision shape
   // or reach (not finite where the share holds it: ShareAdvance::hold); not
   // a fallback but a fault of the routing, which the caller reports.
-  enum class Conflict { none, foreign_cluster, warm_start, failed_lcp, error, missing_pairs, missing_floe };
+  // A solve from the warm store is not a conflict: the share runs on a
+  // copy of the store and reports what it stored (`warm`).
+  enum class Conflict { none, foreign_cluster, failed_lcp, error, missing_pairs, missing_floe };
   Conflict conflict = Conflict::none;
   // Ascending: the floes of the share's clusters (joined free floes
   // included); on missing_floe, the floe that came incomplete.
@@ -216,6 +227,22 @@ struct ShareOutcome {
   // Per event the share recorded (options.impulse.record), the key (tau,
   // cluster) of the queue's pop it was solved in (RecordPart, impulse.hpp).
   std::vector<EventPlace> events;
+  // With a warm store (options.impulse.warm): the pairs the share's solves
+  // stored, by key ascending, each as the share's copy holds it at the end
+  // (WarmStart::Pair), and the share's solves that started from the store
+  // (WarmStart::uses). Written into every rank's store, they make it the
+  // serial advance's (ShareAdvance, "Why a share gives the serial bits").
+  std::vector<std::pair<std::uint64_t, WarmStart::Pair>> warm;
+  long warm_uses = 0;
+  // Which clusters (numbered as every share numbers them) the serial
+  // advance would run together where the shares ran them apart, for the
+  // caller to join them on one rank (ClusterShare::runners): on
+  // foreign_cluster, (the share's cluster, each cluster of another runner
+  // it would merge with); `merged`, (cluster, the share's cluster it
+  // merged into) for each merge the share made; `taken`, (free floe,
+  // cluster) for each free floe a cluster of the share took in (a free floe
+  // two shares took is in both shares' `taken`).
+  std::vector<std::pair<std::int32_t, std::int32_t>> met, merged, taken;
 };
 
 // The first half's answer: the share's tight pairs (room below xi) and
@@ -316,10 +343,13 @@ public:
 
   const CollisionStats& stats() const { return stats_; }
   const SubstepReport& report() const { return report_; }
+  // After clusters() (and pads()): the share that runs cluster k (its
+  // lowest floe's owner as the edges carried it, or ClusterShare::runners').
+  int runner_of_cluster(std::int32_t k) const;
 
 private:
-  SubstepOptions options_;  // the caller's, with the warm store replaced by probe_
-  WarmStart probe_;         // counts the solves that would have used the warm store
+  SubstepOptions options_;  // the caller's, with the warm store replaced by warm_
+  WarmStart warm_;          // a copy of the caller's warm store, logging what the share stores
   CollisionStats stats_;
   SubstepReport report_;
   ClusterShare share_;

@@ -224,6 +224,13 @@ void Stepper::form_clusters() {
   // it is one floe hot through a tight pair: its lowest floe is an end of
   // an edge, whose owner the edge carried (runner, run_share).
   for ([[maybe_unused]] const Cluster& c : clusters_) FLOESIM_ASSERT(!share_ || edge_owner_[c.members.front()] >= 0);
+  // The clusters the caller gave another runner (ClusterShare::runners):
+  // runner() and run_share read the lowest floe's entry.
+  if (share_)
+    for (const auto& [k, r] : share_->runners) {
+      FLOESIM_ASSERT(k >= 0 && static_cast<std::size_t>(k) < clusters_.size());
+      edge_owner_[clusters_[static_cast<std::size_t>(k)].members.front()] = r;
+    }
 }
 
 void Stepper::find_jams() {

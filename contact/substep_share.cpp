@@ -192,12 +192,19 @@ ShareAdvance::ShareAdvance(Floes& floes, const CollisionShapes& shapes, const De
                            const SubstepOptions& options, const ClusterShare& share, bool on_part,
                            std::span<const std::uint32_t> mine)
     : options_(options), share_(share) {
-  // The warm store is replaced by an empty probe that only says whether a
-  // solve of the share would have used it (ClusterShare above). A failure's
+  // The warm store: a copy of the caller's (the step's start, the same on
+  // every rank), logging the pairs the share stores (substep.hpp: the
+  // pairs of one cluster's solves are no other cluster's). A failure's
   // dump is left to the whole advance that follows it, which numbers it in
   // the run's count (the share's count starts at zero and would overwrite
   // the run's first dumps).
-  if (options.impulse.warm) options_.impulse.warm = &probe_;
+  if (options.impulse.warm) {
+    warm_ = *options.impulse.warm;
+    warm_.uses = 0;
+    warm_.log = true;
+    warm_.written.clear();
+    options_.impulse.warm = &warm_;
+  }
   options_.impulse.dump_failed_lcps.clear();
   stepper_ =
       std::make_unique<detail::Stepper>(floes, shapes, detection, dt, options_, stats_, report_, &share_, on_part, mine);
@@ -260,6 +267,8 @@ ShareAdvance::Routes ShareAdvance::clusters(const ShareRooms& all) {
   return out;
 }
 
+int ShareAdvance::runner_of_cluster(std::int32_t k) const { return stepper_->cluster_runner(static_cast<std::size_t>(k)); }
+
 std::vector<ContactEdge> ShareAdvance::pad_edges() {
   if (set_up_ != ShareOutcome::Conflict::none) return {};
   return stepper_->pad_edges();
@@ -299,10 +308,15 @@ ShareOutcome ShareAdvance::advance() {
   } catch (const RunError&) {
     outcome.conflict = ShareOutcome::Conflict::error;
   }
-  if (outcome.conflict == ShareOutcome::Conflict::none && probe_.uses > 0)
-    outcome.conflict = ShareOutcome::Conflict::warm_start;
   if (outcome.conflict == ShareOutcome::Conflict::none && stats_.failures > 0)
     outcome.conflict = ShareOutcome::Conflict::failed_lcp;
+  if (outcome.conflict == ShareOutcome::Conflict::none && options_.impulse.warm) {
+    std::vector<std::uint64_t> keys = warm_.written;
+    std::sort(keys.begin(), keys.end());
+    keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
+    for (const std::uint64_t k : keys) outcome.warm.emplace_back(k, warm_.pairs.at(k));
+    outcome.warm_uses = warm_.uses;
+  }
   return outcome;
 }
 

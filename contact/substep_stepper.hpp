@@ -100,6 +100,8 @@ public:
         share_(share), part_(part), mine_(mine) {}
 
   ShareOutcome::Conflict conflict() const { return conflict_; }
+  // The share that runs cluster k (after clusters()).
+  int cluster_runner(std::size_t k) const { return edge_owner_[clusters_[k].members.front()]; }
   // A share's run (ShareAdvance): what it did.
   ShareOutcome outcome() const {
     ShareOutcome o;
@@ -109,6 +111,9 @@ public:
     o.rooms = rooms_;
     o.pairs = pairs_;
     o.events = events_;
+    o.met = met_;
+    o.merged = merged_;
+    o.taken = taken_;
     for (std::size_t k = 0; k < clusters_.size(); ++k) {
       if (!own_[k]) continue;
       ++o.clusters;
@@ -382,6 +387,7 @@ private:
   std::vector<std::uint8_t> own_;      // per cluster: run by this call
   ShareOutcome::Conflict conflict_ = ShareOutcome::Conflict::none;
   std::vector<EventPlace> events_;     // a share's: per event it recorded, its pop's key
+  std::vector<std::pair<std::int32_t, std::int32_t>> met_, merged_, taken_;  // ShareOutcome::met, merged, taken
   double floor_tau_ = -1.0;            // the last floor step's key (tau, cluster)
   long floor_cluster_ = -1;
 

@@ -3,6 +3,9 @@
 #include <algorithm>
 #include <array>
 #include <cstring>
+#include <map>
+#include <optional>
+#include <set>
 #include <string>
 #include <tuple>
 #include <utility>
@@ -77,6 +80,49 @@ contact::ImpulseRecord take_record(const std::byte*& in) {
   return record;
 }
 
+void append_warm(std::vector<std::byte>& out, const WarmPairs& pairs, long uses) {
+  const std::array<std::int64_t, 2> head{static_cast<std::int64_t>(pairs.size()), uses};
+  append(out, std::span<const std::int64_t>(head));
+  for (const auto& [key, pair] : pairs) {
+    const std::array<std::int64_t, 3> h{static_cast<std::int64_t>(key), pair.stored,
+                                        static_cast<std::int64_t>(pair.entries.size())};
+    append(out, std::span<const std::int64_t>(h));
+    for (const contact::WarmStart::Entry& e : pair.entries) {
+      const std::array<double, 4> d{e.body_point.x(), e.body_point.y(), e.body_normal.x(), e.body_normal.y()};
+      const std::array<std::uint8_t, 5> b{e.basic[0], e.basic[1], e.basic[2], e.basic[3],
+                                          static_cast<std::uint8_t>(e.vertex_of_b ? 1 : 0)};
+      append(out, std::span<const double>(d));
+      append(out, std::span<const std::uint8_t>(b));
+    }
+  }
+}
+
+WarmPairs take_warm(const std::byte*& in, long& uses) {
+  const std::vector<std::int64_t> head = take<std::int64_t>(in, 2);
+  uses = head[1];
+  WarmPairs pairs(static_cast<std::size_t>(head[0]));
+  for (auto& [key, pair] : pairs) {
+    const std::vector<std::int64_t> h = take<std::int64_t>(in, 3);
+    key = static_cast<std::uint64_t>(h[0]);
+    pair.stored = h[1];
+    pair.entries.resize(static_cast<std::size_t>(h[2]));
+    for (contact::WarmStart::Entry& e : pair.entries) {
+      const std::vector<double> d = take<double>(in, 4);
+      const std::vector<std::uint8_t> b = take<std::uint8_t>(in, 5);
+      e.body_point = {d[0], d[1]};
+      e.body_normal = {d[2], d[3]};
+      e.basic = {b[0], b[1], b[2], b[3]};
+      e.vertex_of_b = b[4] != 0;
+    }
+  }
+  return pairs;
+}
+
+void hold_warm(const WarmPairs& pairs, long uses, contact::WarmStart& store) {
+  for (const auto& [key, pair] : pairs) store.pairs[key] = pair;
+  store.uses += uses;
+}
+
 std::vector<std::byte> pack(const AdvancePart& p) {
   std::array<long, kHeader> head{};
   head[0] = static_cast<long>(p.outcome.conflict);
@@ -103,6 +149,17 @@ std::vector<std::byte> pack(const AdvancePart& p) {
     append(out, std::span<const std::int64_t>(&e.cluster, 1));
   }
   append_record(out, p.record);
+  append_warm(out, p.outcome.warm, p.outcome.warm_uses);
+  // The clusters to join (ShareOutcome::met, merged, taken: 8 bytes each).
+  const std::array<std::int64_t, 3> joins{static_cast<std::int64_t>(p.outcome.met.size()),
+                                          static_cast<std::int64_t>(p.outcome.merged.size()),
+                                          static_cast<std::int64_t>(p.outcome.taken.size())};
+  append(out, std::span<const std::int64_t>(joins));
+  for (const auto* list : {&p.outcome.met, &p.outcome.merged, &p.outcome.taken})
+    for (const auto& [a, b] : *list) {
+      const std::array<std::int32_t, 2> ab{a, b};
+      append(out, std::span<const std::int32_t>(ab));
+    }
   return out;
 }
 
@@ -135,6 +192,13 @@ AdvancePart unpack_advance_part(std::span<const std::byte> bytes) {
     e.cluster = take<std::int64_t>(in, 1).front();
   }
   p.record = take_record(in);
+  p.outcome.warm = take_warm(in, p.outcome.warm_uses);
+  const std::vector<std::int64_t> joins = take<std::int64_t>(in, 3);
+  for (auto [list, n] : {std::pair{&p.outcome.met, joins[0]}, std::pair{&p.outcome.merged, joins[1]},
+                         std::pair{&p.outcome.taken, joins[2]}}) {
+    const std::vector<std::int32_t> ab = take<std::int32_t>(in, 2 * static_cast<std::size_t>(n));
+    for (std::size_t j = 0; j < ab.size(); j += 2) list->emplace_back(ab[j], ab[j + 1]);
+  }
   FLOESIM_ASSERT(in == bytes.data() + bytes.size());
   return p;
 }
@@ -213,20 +277,69 @@ AdvancePart share_part(const contact::ShareAdvance& share, contact::ShareOutcome
     if (record) part.record = std::move(*record);
   } else {
     part.outcome.events.clear();
+    part.outcome.warm.clear();
+    part.outcome.warm_uses = 0;
   }
   return part;
 }
 
+const char* conflict_name(contact::ShareOutcome::Conflict conflict) {
+  using C = contact::ShareOutcome::Conflict;
+  switch (conflict) {
+    case C::none: return "none";
+    case C::foreign_cluster: return "foreign_cluster";
+    case C::failed_lcp: return "failed_lcp";
+    case C::error: return "error";
+    case C::missing_pairs: return "missing_pairs";
+    case C::missing_floe: return "missing_floe";
+  }
+  return "unknown";
+}
+
+void count_conflicts(std::span<const AdvancePart> parts, AdvanceShareCounts& counts) {
+  std::vector<std::string> kinds;
+  std::vector<std::uint8_t> taken;
+  bool twice = false;
+  for (const AdvancePart& p : parts) {
+    if (p.outcome.conflict != ShareOutcome::Conflict::none) {
+      kinds.push_back(conflict_name(p.outcome.conflict));
+      continue;
+    }
+    for (const std::uint32_t i : p.outcome.moved) {
+      if (i >= taken.size()) taken.resize(i + 1, 0);
+      twice = twice || taken[i];
+      taken[i] = 1;
+    }
+  }
+  if (kinds.empty() && twice) kinds.push_back("taken_twice");
+  std::sort(kinds.begin(), kinds.end());
+  kinds.erase(std::unique(kinds.begin(), kinds.end()), kinds.end());
+  for (const std::string& k : kinds) ++counts.conflicts[k];
+}
+
+// A set-up's conflicts (the gathered rooms' flags), each kind once.
+static void count_set_up(std::span<const contact::ShareRooms> rooms, AdvanceShareCounts& counts) {
+  std::vector<AdvancePart> parts(rooms.size());
+  for (std::size_t r = 0; r < rooms.size(); ++r) parts[r].outcome.conflict = rooms[r].conflict;
+  count_conflicts(parts, counts);
+}
+
 bool combine_parts(std::span<const AdvancePart> parts, Floes& floes, CollisionStats& stats, SubstepReport& report,
-                   contact::ImpulseRecord* record) {
+                   contact::ImpulseRecord* record, contact::WarmStart* warm) {
   std::vector<std::uint8_t> taken(floes.size(), 0);
+  std::vector<std::uint64_t> stored;  // the warm pairs of every part: each pair one cluster's, so one part's
   for (const AdvancePart& p : parts) {
     if (p.outcome.conflict != ShareOutcome::Conflict::none) return false;
     for (const std::uint32_t i : p.outcome.moved) {
       if (taken[i]) return false;  // a free floe two ranks' clusters took: the serial advance merges them
       taken[i] = 1;
     }
+    for (const auto& w : p.outcome.warm) stored.push_back(w.first);
   }
+  std::sort(stored.begin(), stored.end());
+  if (std::adjacent_find(stored.begin(), stored.end()) != stored.end()) return false;
+  if (warm)
+    for (const AdvancePart& p : parts) hold_warm(p.outcome.warm, p.outcome.warm_uses, *warm);
   for (const AdvancePart& p : parts)
     for (std::size_t j = 0; j < p.states.size(); ++j) floes.state[p.outcome.moved[j]] = p.states[j];
   // Counts: sums, but the largest LCP and cluster (maxima) and the pair
@@ -286,14 +399,18 @@ void advance_by_owner(const Communicator& comm, std::span<const int> owner, Floe
       const std::vector<AdvancePart> parts = comm.allgather_parts(pack(mine), unpack_advance_part);
       counts.clusters.resize(parts.size(), 0);
       counts.rooms.resize(parts.size(), 0);
-      combined = combine_parts(parts, floes, stats, report, record);
+      combined = combine_parts(parts, floes, stats, report, record, options.impulse.warm);
       if (combined) {
         for (std::size_t r = 0; r < parts.size(); ++r) {
           counts.clusters[r] += parts[r].outcome.clusters;
           counts.rooms[r] += parts[r].outcome.rooms;
         }
         counts.pairs += parts.front().outcome.pairs;
+      } else {
+        count_conflicts(parts, counts);
       }
+    } else {
+      count_set_up(rooms, counts);
     }
   }
   if (combined) {
@@ -434,6 +551,61 @@ void move_not_held(Floes& floes, std::span<const std::uint32_t> held, double dt)
   }
 }
 
+bool JoinedClusters::add(std::span<const AdvancePart> parts, const contact::ShareAdvance& share) {
+  bool any = false;
+  std::map<std::uint32_t, std::int32_t> taker;  // a moved floe's cluster, over the parts without a conflict
+  for (const AdvancePart& p : parts) {
+    const ShareOutcome::Conflict c = p.outcome.conflict;
+    if (c != ShareOutcome::Conflict::none && c != ShareOutcome::Conflict::foreign_cluster) return false;
+    for (const auto& [a, b] : p.outcome.merged) unite(a, b);
+    for (const auto& [a, b] : p.outcome.met) {
+      unite(a, b);
+      joined_.insert(a);
+      any = true;
+    }
+    if (c != ShareOutcome::Conflict::none) continue;
+    // A floe two parts moved was free at the step's start (the clusters are
+    // the same on every rank) and taken in by a cluster of each.
+    for (const auto& [floe, k] : p.outcome.taken) {
+      const auto [it, fresh] = taker.emplace(static_cast<std::uint32_t>(floe), k);
+      if (fresh) continue;
+      unite(it->second, k);
+      joined_.insert(it->second);
+      any = true;
+    }
+  }
+  if (!any) return false;
+  // Each group with a joined cluster: all its clusters to the runner of
+  // its lowest (as this try ran it: every rank the same).
+  std::map<std::int32_t, std::int32_t> lowest;  // group (root) -> its lowest cluster
+  for (const auto& [k, up] : parent_) {
+    const std::int32_t r = find(k);
+    const auto [it, fresh] = lowest.emplace(r, k);
+    if (!fresh) it->second = std::min(it->second, k);
+  }
+  std::set<std::int32_t> groups;
+  for (const std::int32_t k : joined_) groups.insert(find(k));
+  runners_.clear();
+  for (const auto& [k, up] : parent_)
+    if (const std::int32_t r = find(k); groups.contains(r)) runners_.emplace_back(k, share.runner_of_cluster(lowest[r]));
+  return true;
+}
+
+std::int32_t JoinedClusters::find(std::int32_t k) {
+  auto it = parent_.emplace(k, k).first;
+  while (it->second != it->first) {
+    const auto up = parent_.find(it->second);
+    it->second = up->second;  // halving
+    it = up;
+  }
+  return it->first;
+}
+
+void JoinedClusters::unite(std::int32_t a, std::int32_t b) {
+  const std::int32_t ra = find(a), rb = find(b);
+  if (ra != rb) parent_[std::max(ra, rb)] = std::min(ra, rb);
+}
+
 void advance_on_part(const Communicator& comm, std::span<const int> owner, std::span<const std::uint32_t> mine,
                      Floes& floes, contact::CollisionShapes& shapes, const contact::Detection& part,
                      const WholeOnDemand& whole, double dt,
@@ -454,79 +626,136 @@ void advance_on_part(const Communicator& comm, std::span<const int> owner, std::
   std::vector<FloeState> start = floes.state;
   bool start_whole = false;  // `start` holds every floe's current state (the rebuild gathered it)
   bool combined = false;
-  {
+  // A try whose parts refuse only because clusters of two runners meet is
+  // tried again with those clusters joined on one rank (JoinedClusters),
+  // from the step's start, on the rooms, contact edges and pad edges
+  // gathered in the first try (functions of the step's start: the same).
+  JoinedClusters joined;
+  contact::ShareRooms all;
+  std::vector<contact::ContactEdge> pad_edges;
+  // A rank whose part had no conflict and none of whose clusters a try
+  // again joins elsewhere or takes in keeps that part and its floes' states
+  // (`kept`, `kept_state`): its share would run the same clusters on the
+  // same pairs again. It still makes the try's set-up and routing (its
+  // part's pairs may go to a joined group's runner).
+  std::optional<AdvancePart> kept;
+  std::vector<FloeState> kept_state;
+  for (int round = 0;; ++round) {
+    if (round > 0) floes.state = start;
     // A run that keeps the impulse record: as advance_by_owner (the events'
     // places are the queue's keys, which read no list of the detection).
     contact::ImpulseRecord* const record = options.impulse.record;
     contact::ImpulseRecord own;
     contact::SubstepOptions own_options = options;
     if (record) own_options.impulse.record = &own;
-    contact::ShareAdvance share(floes, shapes, part, dt, own_options, {owner, comm.rank()}, true, mine);
-    std::vector<contact::ShareRooms> rooms = comm.allgather_parts(pack(share.rooms()), unpack_share_rooms);
-    // A floe outrunning its reach on some rank (the flags gathered with the
-    // rooms: the same on every rank): every rank rebuilds the pair list and
-    // gathers the rooms again.
-    if (any_outrun(rooms)) {
-      ++counts.rebuilds;
-      // The rebuild detects over every floe (the serial set-up's, contact::
-      // Stepper::set_up_rebuilt): every floe's straight path and place from
-      // its state at the step's start, which the floes still are (rooms()
-      // moves none), made whole here; the fallback below starts again from
-      // it. And every floe's reach from its owner (a rank wrote only its
-      // band's at the detection, band18; 8 bytes a floe, in such a step only).
-      whole.state(WholeState::state);
-      start = floes.state;
-      start_whole = true;
-      std::vector<double> reach = part.reach;
-      comm.complete_owned(reach, owner);
-      rooms = comm.allgather_parts(pack(share.rooms_rebuilt(reach)), unpack_share_rooms);
+    contact::ShareAdvance share(floes, shapes, part, dt, own_options, {owner, comm.rank(), joined.runners()}, true,
+                                mine);
+    if (round == 0) {
+      std::vector<contact::ShareRooms> rooms = comm.allgather_parts(pack(share.rooms()), unpack_share_rooms);
+      // A floe outrunning its reach on some rank (the flags gathered with the
+      // rooms: the same on every rank): every rank rebuilds the pair list and
+      // gathers the rooms again.
+      if (any_outrun(rooms)) {
+        ++counts.rebuilds;
+        // The rebuild detects over every floe (the serial set-up's, contact::
+        // Stepper::set_up_rebuilt): every floe's straight path and place from
+        // its state at the step's start, which the floes still are (rooms()
+        // moves none), made whole here; the fallback below starts again from
+        // it. And every floe's reach from its owner (a rank wrote only its
+        // band's at the detection, band18; 8 bytes a floe, in such a step only).
+        whole.state(WholeState::state);
+        start = floes.state;
+        start_whole = true;
+        std::vector<double> reach = part.reach;
+        comm.complete_owned(reach, owner);
+        rooms = comm.allgather_parts(pack(share.rooms_rebuilt(reach)), unpack_share_rooms);
+      }
+      // The gathered conflicts are the same on every rank: all skip the
+      // next exchanges alike.
+      if (!combine_rooms(rooms, all)) {
+        count_set_up(rooms, counts);
+        break;
+      }
+    } else {
+      // The set-up of the same pairs from the same start: the same rooms
+      // as the first try's, whose gathered `all` the clusters read.
+      const contact::ShareRooms again = share.rooms();
+      FLOESIM_ASSERT(again.conflict == contact::ShareOutcome::Conflict::none && !again.outrun);
     }
-    contact::ShareRooms all;
-    // The gathered conflicts and the clusters are the same on every rank:
-    // all skip the next exchanges alike.
-    if (combine_rooms(rooms, all)) {
-      contact::ShareAdvance::Routes routes = share.clusters(all);
-      // A jam-sized cluster (the same on every rank): every rank's pad edges first.
-      if (routes.conflict == contact::ShareOutcome::Conflict::none && routes.pads) {
+    // The clusters are the same on every rank, and so are their runners.
+    contact::ShareAdvance::Routes routes = share.clusters(all);
+    // A jam-sized cluster (the same on every rank): every rank's pad edges first.
+    if (routes.conflict == contact::ShareOutcome::Conflict::none && routes.pads) {
+      if (round == 0) {
         ++counts.pads;
-        routes = share.pads(comm.allgather<contact::ContactEdge>(share.pad_edges()));
+        pad_edges = comm.allgather<contact::ContactEdge>(share.pad_edges());
       }
-      if (routes.conflict == contact::ShareOutcome::Conflict::none) {
-        // Every rank's join candidates (8 bytes each), then the pairs
-        // touching a cluster's members or candidates to its runner; with no
-        // cluster anywhere (the same on every rank) nothing to route.
-        if (routes.any_cluster) {
-          const std::vector<contact::JoinCandidate> candidates =
-              comm.allgather<contact::JoinCandidate>(routes.candidates);
-          counts.candidates += static_cast<long>(candidates.size());
-          const std::vector<std::pair<int, std::uint32_t>> to = share.routes(candidates);
-          // The pairs with their floes (state at the start, mass, inertia,
-          // collision shape, reach), which the share then reads from the
-          // message (ShareAdvance::hold takes their start states into its
-          // straight paths).
-          share.hold(exchange_advance_pairs(comm, part, routed_pairs(part, to, comm.size()), floes, shapes,
-                                            &counts.shape_bytes));
-        }
-        const AdvancePart done = share_part(share, share.advance(), floes, record ? &own : nullptr);
-        move_not_held(floes, share.held(), dt);
-        const std::vector<AdvancePart> parts = comm.allgather_parts(pack(done), unpack_advance_part);
-        check_routed_floes(parts);
-        counts.clusters.resize(parts.size(), 0);
-        counts.rooms.resize(parts.size(), 0);
-        combined = combine_parts(parts, floes, stats, report, record);
-        if (combined) {
-          for (std::size_t r = 0; r < parts.size(); ++r) {
-            counts.clusters[r] += parts[r].outcome.clusters;
-            counts.rooms[r] += parts[r].outcome.rooms;
-            counts.pairs += parts[r].outcome.pairs;
-          }
-        } else if (std::any_of(parts.begin(), parts.end(), [](const AdvancePart& p) {
-                     return p.outcome.conflict == contact::ShareOutcome::Conflict::missing_pairs;
-                   })) {
-          ++counts.missing;
-        }
-      }
+      routes = share.pads(pad_edges);
     }
+    if (routes.conflict != contact::ShareOutcome::Conflict::none) {
+      ++counts.conflicts[conflict_name(routes.conflict)];
+      break;
+    }
+    // Every rank's join candidates (8 bytes each), then the pairs touching a
+    // cluster's members or candidates to its runner; with no cluster
+    // anywhere (the same on every rank) nothing to route.
+    if (routes.any_cluster) {
+      const std::vector<contact::JoinCandidate> candidates =
+          comm.allgather<contact::JoinCandidate>(routes.candidates);
+      counts.candidates += static_cast<long>(candidates.size());
+      const std::vector<std::pair<int, std::uint32_t>> to = share.routes(candidates);
+      // The pairs with their floes (state at the start, mass, inertia,
+      // collision shape, reach), which the share then reads from the
+      // message (ShareAdvance::hold takes their start states into its
+      // straight paths).
+      share.hold(exchange_advance_pairs(comm, part, routed_pairs(part, to, comm.size()), floes, shapes,
+                                        &counts.shape_bytes));
+    }
+    AdvancePart done;
+    if (kept) {
+      done = std::move(*kept);
+      floes.state = std::move(kept_state);
+      ++counts.kept;
+    } else {
+      done = share_part(share, share.advance(), floes, record ? &own : nullptr);
+      move_not_held(floes, share.held(), dt);
+    }
+    kept.reset();
+    const std::vector<AdvancePart> parts = comm.allgather_parts(pack(done), unpack_advance_part);
+    check_routed_floes(parts);
+    counts.clusters.resize(parts.size(), 0);
+    counts.rooms.resize(parts.size(), 0);
+    combined = combine_parts(parts, floes, stats, report, record, options.impulse.warm);
+    if (combined) {
+      for (std::size_t r = 0; r < parts.size(); ++r) {
+        counts.clusters[r] += parts[r].outcome.clusters;
+        counts.rooms[r] += parts[r].outcome.rooms;
+        counts.pairs += parts[r].outcome.pairs;
+      }
+      if (round > 0) ++counts.joined;
+      break;
+    }
+    // Joined on one rank when every conflict is clusters of two runners
+    // meeting; a step whose pair list was rebuilt whole is left to the
+    // whole advance (its set-up is not the part's), and so is the last
+    // try's conflict, counted by kind.
+    if (!start_whole && round + 1 < share_options.max_rounds && joined.add(parts, share)) {
+      ++counts.rounds;
+      const bool touched = std::any_of(joined.runners().begin(), joined.runners().end(), [&](const auto& kr) {
+        return kr.second == comm.rank() || share.runner_of_cluster(kr.first) == comm.rank();
+      });
+      if (done.outcome.conflict == contact::ShareOutcome::Conflict::none && !touched) {
+        kept = std::move(done);
+        kept_state = floes.state;
+      }
+      continue;
+    }
+    count_conflicts(parts, counts);
+    if (std::any_of(parts.begin(), parts.end(), [](const AdvancePart& p) {
+          return p.outcome.conflict == contact::ShareOutcome::Conflict::missing_pairs;
+        }))
+      ++counts.missing;
+    break;
   }
   if (combined) {
     counts.combined();

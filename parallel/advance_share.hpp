@@ -8,16 +8,20 @@
 // clusters and every free floe (linear motion), and the ranks then exchange
 // the states of the floes their clusters moved (index + state) and their
 // collision counts.
-// A step where a rank's cluster met another rank's cluster, where two ranks
-// took the same free floe, or where a share could not run alone
-// (ShareOutcome::Conflict) is advanced again whole on every rank from the
-// step's states: the serial advance, so the answer is the serial one bit for
-// bit either way.
+// A step where a rank's cluster met another rank's cluster or two ranks
+// took the same free floe is tried again (from the rank's part) with those
+// clusters joined on one rank (JoinedClusters); one where a share could not
+// run alone (ShareOutcome::Conflict, the others) is advanced again whole on
+// every rank from the step's states: the serial advance, so the answer is
+// the serial one bit for bit either way.
 
 #include <algorithm>
 #include <cstddef>
+#include <map>
+#include <set>
 #include <span>
 #include <functional>
+#include <string>
 #include <vector>
 
 #include "contact/substep.hpp"
@@ -65,6 +69,16 @@ struct AdvancePart {
 // past it.
 void append_record(std::vector<std::byte>& out, const contact::ImpulseRecord& record);
 contact::ImpulseRecord take_record(const std::byte*& in);
+
+// A share's warm-store writes in a message (contact::ShareOutcome::warm
+// and the uses: the pairs' count, the uses, then per pair its key, clock,
+// entries' count and entries, 37 bytes each), appended to `out`; read back
+// by take_warm, which moves `in` past them. Written into a store by
+// hold_warm (each pair replaced, the uses added).
+using WarmPairs = std::vector<std::pair<std::uint64_t, contact::WarmStart::Pair>>;
+void append_warm(std::vector<std::byte>& out, const WarmPairs& pairs, long uses);
+WarmPairs take_warm(const std::byte*& in, long& uses);
+void hold_warm(const WarmPairs& pairs, long uses, contact::WarmStart& store);
 
 std::vector<std::byte> pack(const AdvancePart& part);
 AdvancePart unpack_advance_part(std::span<const std::byte> bytes);
@@ -152,12 +166,15 @@ void check_routed_floes(std::span<const AdvancePart> parts);
 
 // Combines every rank's part (rank order) into `floes` (each rank's moved
 // floes get its states; the free floes are already at the end of the step on
-// every rank), `stats`, `report` and `record` (if not null: the parts'
-// records merged in the serial order, contact::merge_advance_record), and
-// returns true; or returns false, changing nothing, when a part has a
-// conflict or two parts moved one floe.
+// every rank), `stats`, `report`, `record` (if not null: the parts'
+// records merged in the serial order, contact::merge_advance_record) and
+// `warm` (if not null: the run's warm store, every part's stored pairs
+// written into it, hold_warm), and returns true; or returns false,
+// changing nothing, when a part has a conflict, two parts moved one floe
+// or stored one warm pair.
 bool combine_parts(std::span<const AdvancePart> parts, Floes& floes, contact::CollisionStats& stats,
-                   contact::SubstepReport& report, contact::ImpulseRecord* record = nullptr);
+                   contact::SubstepReport& report, contact::ImpulseRecord* record = nullptr,
+                   contact::WarmStart* warm = nullptr);
 
 // A step redone whole costs the share's work and the whole advance; packs
 // where ranks' clusters keep meeting (a jam across strips, a jam whose LCP
@@ -175,6 +192,12 @@ struct AdvanceShareOptions {
   // combines as often as from the whole (docs/parallel.md, "The advance from
   // the rank's part").
   bool on_part = true;
+  // From the rank's part: the tries of a step, the first included, before
+  // the whole advance, where a try's conflicts are clusters of two runners
+  // meeting (JoinedClusters). Each try joins more clusters; on the wall jam
+  // of examples/pack_against_wall.toml every such step combined by its
+  // second or third (docs/parallel.md, "The conflicting clusters on one rank").
+  int max_rounds = 8;
 };
 
 // How the advances by cluster owner went (the run's summary), and the
@@ -200,6 +223,23 @@ struct AdvanceShareCounts {
   // From the rank's part: the bytes of the collision shapes and reaches
   // this rank sent with its routed pairs' floes (RoutedShapes).
   long shape_bytes = 0;
+  // From the rank's part: the steps whose first try met clusters of two
+  // runners and which combined in a later try with those clusters joined on
+  // one rank (not counted in `fallbacks`), and the tries made again for
+  // them (JoinedClusters).
+  long joined = 0;
+  long rounds = 0;
+  long kept = 0;  // of those tries again, the ones where this rank kept its part (no share run)
+  // The tries that fell back, by what made them (the run's summary, one
+  // line a kind): each try counts once under each kind that some part of
+  // its last try (or its set-up) said, so the kinds may sum to more than
+  // the fallbacks. A try whose meeting clusters were joined and then
+  // combined counts in `joined` only.
+  // The advance's kinds: the names of contact::ShareOutcome::Conflict
+  // (conflict_name) and `taken_twice` (a free floe two ranks' clusters
+  // took, which no part can see: combine_parts finds it); the
+  // collisions': those of contact::StepCollisionShare::Conflict.
+  std::map<std::string, long> conflicts;
   long wait = 0;                // advances still to do whole
   long next_wait = 1;           // the wait after the next fallback
 
@@ -223,6 +263,39 @@ struct AdvanceShareCounts {
     next_wait = std::min(2 * next_wait, o.max_wait);
   }
 };
+
+// The conflicting clusters on one rank (docs/parallel.md, "The conflicting
+// clusters on one rank (onerank26)"). After a try whose parts refused to
+// combine only because clusters of different runners would have merged
+// (foreign_cluster: ShareOutcome::met) or taken one free floe (a floe two
+// parts moved), add() joins those clusters, with the clusters each share
+// had merged into them (ShareOutcome::merged), into groups, each run by the
+// runner of its lowest cluster as `share` (that try's) ran it: runners()
+// (ClusterShare::runners) for the next try. The groups only grow from try
+// to try. Every rank reads the same parts and the same runners: the same
+// groups. False, changing nothing, when a part had another conflict (or no
+// clusters to join): the whole advance.
+class JoinedClusters {
+public:
+  bool add(std::span<const AdvancePart> parts, const contact::ShareAdvance& share);
+  std::span<const std::pair<std::int32_t, std::int32_t>> runners() const { return runners_; }
+
+private:
+  std::int32_t find(std::int32_t k);
+  void unite(std::int32_t a, std::int32_t b);
+  std::map<std::int32_t, std::int32_t> parent_;  // union-find over the clusters named so far
+  std::set<std::int32_t> joined_;                // clusters of a conflict
+  std::vector<std::pair<std::int32_t, std::int32_t>> runners_;  // (cluster, rank), ascending
+};
+
+// The name of a share's conflict as the summary prints it
+// (parallel.advance_conflicts.NAME): the enumerator's.
+const char* conflict_name(contact::ShareOutcome::Conflict conflict);
+// The kinds of conflict a tried step's parts (rank order) say, each once,
+// counted into `counts.conflicts`: each part's conflict, and `taken_twice`
+// when no part has one but two parts moved one floe. A step whose parts
+// combine counts nothing.
+void count_conflicts(std::span<const AdvancePart> parts, AdvanceShareCounts& counts);
 
 // The step's advance on every rank of `comm` (or whole, while the back-off
 // above waits): this rank's share's set-up (its pairs' rooms), the exchange
@@ -262,9 +335,14 @@ void advance_by_owner(const Communicator& comm, std::span<const int> owner, Floe
 // reaches from their owners. `whole` gives the whole state and detection
 // for the back-off's whole steps and the fallback (state first), which is
 // taken also when a floe joins a share's cluster without being its
-// candidate (Conflict::missing_pairs). With options.impulse.record the
-// shares record and merge as in advance_by_owner. Equal to the serial
-// advance bit for bit, states, counts and record.
+// candidate (Conflict::missing_pairs). A try whose only conflicts are
+// clusters of two runners meeting is made again from the step's start with
+// those clusters joined on one rank (JoinedClusters; the rooms and edges
+// of the first try; up to share_options.max_rounds tries, each its
+// candidates, routed pairs and parts exchanged again). With
+// options.impulse.record the shares record and merge as in
+// advance_by_owner. Equal to the serial advance bit for bit, states,
+// counts, record and warm store.
 void advance_on_part(const Communicator& comm, std::span<const int> owner, std::span<const std::uint32_t> mine,
                      Floes& floes, contact::CollisionShapes& shapes, const contact::Detection& part,
                      const WholeOnDemand& whole, double dt,

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <string>
 #include <tuple>
 #include <utility>
 
@@ -97,6 +98,36 @@ CollidePart run_collide_share(Floes& floes, std::span<const FloeState> start, co
   return part;
 }
 
+namespace {
+// The kinds of conflict of a try's parts, each once, into counts.conflicts
+// (AdvanceShareCounts): the names of StepCollisionShare::Conflict, and
+// `taken_twice` when no part has one but two parts changed one floe (the
+// groups are disjoint: never expected).
+void count_conflicts(std::span<const CollidePart> parts, AdvanceShareCounts& counts) {
+  std::vector<std::string> kinds;
+  std::vector<std::uint8_t> taken;
+  bool twice = false;
+  for (const CollidePart& p : parts) {
+    switch (p.outcome.conflict) {
+      case StepCollisionShare::Conflict::none:
+        for (const std::uint32_t i : p.outcome.moved) {
+          if (i >= taken.size()) taken.resize(i + 1, 0);
+          twice = twice || taken[i];
+          taken[i] = 1;
+        }
+        break;
+      case StepCollisionShare::Conflict::warm_start: kinds.push_back("warm_start"); break;
+      case StepCollisionShare::Conflict::failed_lcp: kinds.push_back("failed_lcp"); break;
+      case StepCollisionShare::Conflict::error: kinds.push_back("error"); break;
+    }
+  }
+  if (kinds.empty() && twice) kinds.push_back("taken_twice");
+  std::sort(kinds.begin(), kinds.end());
+  kinds.erase(std::unique(kinds.begin(), kinds.end()), kinds.end());
+  for (const std::string& k : kinds) ++counts.conflicts[k];
+}
+}  // namespace
+
 bool combine_collide_parts(std::span<const CollidePart> parts, Floes& floes, CollisionStats& stats,
                            std::size_t& speculative, contact::ImpulseRecord* record) {
   std::vector<std::uint8_t> taken(floes.size(), 0);
@@ -138,6 +169,7 @@ std::size_t collide_by_owner(const Communicator& comm, std::span<const int> owne
     return speculative;
   }
   // A conflict: the whole solve from the states on entry, as the serial run.
+  count_conflicts(parts, counts);
   counts.fell_back(share_options);
   floes.state = entry;
   return contact::resolve_step_collisions(floes, start, detection, step, options, stats);
@@ -239,6 +271,7 @@ std::size_t collide_on_part(const Communicator& comm, std::span<const int> owner
     counts.combined();
     return speculative;
   }
+  count_conflicts(shares, counts);
   counts.fell_back(share_options);
   floes.state = entry;
   return solve_whole();

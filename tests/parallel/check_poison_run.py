@@ -158,8 +158,12 @@ need(run([args.floesim, "run", wall, "-o", "wall_serial.h5", "-q", "--until", "1
 # say the whole steps happened)
 cases = [("the 10 000-floe pack (its pair list rebuilt on a part)", rebuild, 2, "step@drift", "step-stale@drift", [],
           "rebuild_serial.h5", ["advance_rebuilds"]),
-         ("the wall jam (fallbacks and whole steps)", wall, 3, "step-lure", "step-lure-stale", ["--until", "1500"],
-          "wall_serial.h5", ["advance_fallbacks", "advance_whole", "collide_fallbacks"])]
+         # Since onerank26 the wall jam's advances no longer fall back (its
+         # conflicts are joined on one rank: advance_joined, tries that read
+         # only the held and routed floes); its step-start collisions do.
+         ("the wall jam (fallbacks, whole steps, clusters joined on one rank)", wall, 3, "step-lure",
+          "step-lure-stale", ["--until", "1500"], "wall_serial.h5",
+          ["advance_joined", "collide_fallbacks", "collide_whole"])]
 for what, config, n, poison, mutant, extra, serial, counted in cases:
     name = f"{what} on {n} ranks, {poison}"
     p = mpirun(n, poison, config, "on_demand.h5", *extra)

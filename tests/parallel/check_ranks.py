@@ -144,6 +144,33 @@ if args.fallback:
             failures.append(f"fallback run on {n} ranks: exit {p.returncode}\n{p.stderr}\n{c.stdout}")
         elif not (tried and fell and int(fell[0]) > 0 and int(tried[0]) > int(fell[0])):
             failures.append(f"fallback run on {n} ranks: expected fallbacks and kept tries ({tried}, {fell})")
+        # The fallbacks by kind (onerank26): the step-start collisions' are the
+        # warm store's (counted), while the advance's shares run on copies of
+        # the store and no longer fall back for it; the advance's fallbacks
+        # left are clusters of two ranks that meet.
+        kinds = {l.split(":", 1)[0]: int(l.split(":", 1)[1]) for l in p.stdout.splitlines()
+                 if l.startswith(("parallel.advance_conflicts.", "parallel.collide_conflicts."))}
+        afell = key("parallel.advance_fallbacks")
+        print(f"fallback run on {n} ranks: advance {key('parallel.advance_steps')} tried, {afell} redone, "
+              f"{key('parallel.advance_whole')} whole; by kind {kinds}")
+        if equal and kinds.get("parallel.collide_conflicts.warm_start", 0) != int(fell[0]):
+            failures.append(f"fallback run on {n} ranks: the collisions' fallbacks by kind {kinds} do not sum to {fell}")
+        # Cured (onerank26): neither the warm store nor clusters of two ranks
+        # that meet send an advance to the whole fallback any more; the
+        # meeting clusters are joined on one rank (which this run needs).
+        cured = [k for k in ("parallel.advance_conflicts.warm_start", "parallel.advance_conflicts.foreign_cluster",
+                             "parallel.advance_conflicts.taken_twice") if k in kinds]
+        joined = key("parallel.advance_joined")
+        print(f"fallback run on {n} ranks: {joined} advances combined with meeting clusters joined on one rank")
+        if equal and cured:
+            failures.append(f"fallback run on {n} ranks: an advance fell back for a cured kind: {kinds}")
+        if equal and not (joined and int(joined[0]) > 0):
+            failures.append(f"fallback run on {n} ranks: no advance joined meeting clusters ({joined}): "
+                            "the case no longer tests it")
+        if equal and not (afell and sum(v for k, v in kinds.items() if k.startswith("parallel.advance_"))
+                          >= int(afell[0])):
+            failures.append(f"fallback run on {n} ranks: the advance's fallbacks {afell} are not all counted by kind "
+                            f"{kinds}")
 
 if args.errors:
     # Bad input: every rank reads it, every rank stops, exit 2, said once.

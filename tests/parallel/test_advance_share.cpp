@@ -328,43 +328,6 @@ TEST_CASE("two ranks' clusters that take the same free floe fall back to the ser
   CHECK(same_report(report, serial.report));
 }
 
-TEST_CASE("a share that would use the warm store falls back, and the next advances are whole for a while") {
-  // One rank (the serial communicator) owning every floe; every LCP starts
-  // from the warm store (warm_min = 0), which a share must not use: each
-  // advance by owner falls back, then waits 1, 2, 4 advances (the back-off,
-  // AdvanceShareOptions), every one equal to the serial advance with its own
-  // warm store (the stores stay alike through the fallbacks).
-  Case c = dense_pack(2.0, 3, 0.5);
-  contact::WarmStart serial_warm, shared_warm;
-  c.options.impulse.warm_min = 0;
-  const parallel::Communicator comm;
-  const std::vector<int> owner(c.floes.size(), 0);
-  parallel::AdvanceShareCounts counts;
-  parallel::AdvanceShareOptions share;
-  share.max_wait = 4;
-  std::vector<long> fallbacks;
-  for (int step = 0; step < 10; ++step) {
-    CAPTURE(step);
-    Floes s = c.floes, f = c.floes;
-    contact::SubstepOptions so = c.options, fo = c.options;
-    so.impulse.warm = &serial_warm;
-    fo.impulse.warm = &shared_warm;
-    contact::CollisionStats ss, fs;
-    contact::SubstepReport sr, fr;
-    contact::advance_with_collisions(s, c.shapes, c.detection, c.dt, so, ss, sr);
-    parallel::advance_by_owner(comm, owner, f, c.shapes, c.detection, c.dt, fo, fs, fr, counts, share);
-    CHECK(std::memcmp(f.state.data(), s.state.data(), f.state.size() * sizeof(FloeState)) == 0);
-    CHECK(same_stats(fs, ss));
-    CHECK(same_report(fr, sr));
-    fallbacks.push_back(counts.fallbacks);
-  }
-  // Tried at advances 0, 2 and 5 (then waits of 1, 2 and 4, the cap).
-  CHECK(counts.steps == 3);
-  CHECK(counts.fallbacks == 3);
-  CHECK(counts.whole == 7);
-  CHECK(serial_warm.uses > 0);
-}
-
 TEST_CASE("the advance's impulse records by cluster owner merge into the serial record") {
   // The packs above (events of many clusters at many sub-step times), and
   // with jams of two floes (time steps, whose solves again drop their loads
@@ -512,7 +475,8 @@ void poison_floe(Floes& f, std::size_t i) {
 bool play_parts(const Case& c, const parallel::FloeOwners& strips, std::span<const int> owner, int ranks, Floes& f,
                 contact::CollisionStats& stats, contact::SubstepReport& report, long& sent, long& missing,
                 long& pads, bool candidates = true, contact::ImpulseRecord* merged = nullptr,
-                std::vector<std::uint32_t>* events = nullptr, Poisoned* poisoned = nullptr, long* rebuilds = nullptr) {
+                std::vector<std::uint32_t>* events = nullptr, Poisoned* poisoned = nullptr, long* rebuilds = nullptr,
+                parallel::JoinedClusters* joined = nullptr, bool* again = nullptr) {
   const auto n = static_cast<std::size_t>(ranks);
   std::vector<Floes> copies(n, c.floes);
   std::vector<std::vector<std::uint8_t>> held(n, std::vector<std::uint8_t>(c.floes.size(), 0));
@@ -550,12 +514,16 @@ bool play_parts(const Case& c, const parallel::FloeOwners& strips, std::span<con
       for (std::size_t i = 0; i < c.floes.size(); ++i)
         if (!known[i]) parts[k].reach[i] = std::numeric_limits<double>::quiet_NaN();
     }
+  // With `joined`: the clusters it joined on one rank run there.
+  const std::span<const std::pair<std::int32_t, std::int32_t>> runners =
+      joined ? joined->runners() : std::span<const std::pair<std::int32_t, std::int32_t>>{};
   for (int r = 0; r < ranks; ++r) {
     const std::size_t k = static_cast<std::size_t>(r);
     contact::SubstepOptions o = c.options;
     if (merged) o.impulse.record = &own[k];
     shares.push_back(std::make_unique<contact::ShareAdvance>(copies[k], shapes[k], parts[k], c.dt, o,
-                                                             contact::ClusterShare{owners[k], r}, true, strip_floes[k]));
+                                                             contact::ClusterShare{owners[k], r, runners}, true,
+                                                             strip_floes[k]));
     rooms.push_back(parallel::unpack_share_rooms(parallel::pack(shares.back()->rooms())));
   }
   if (parallel::any_outrun(rooms)) {
@@ -664,6 +632,12 @@ bool play_parts(const Case& c, const parallel::FloeOwners& strips, std::span<con
     }
     f = std::move(copies.front());
     ok = parallel::combine_parts(advanced, f, stats, report, merged);
+    // With `joined`: clusters of two runners that met are joined on one
+    // rank and the caller plays the step again (advance_on_part's next try).
+    if (!ok && joined && joined->add(advanced, *shares.front())) {
+      *again = true;
+      return false;
+    }
   }
   if (ok) return true;
   f = c.floes;
@@ -687,7 +661,8 @@ struct PartsPlay {
   std::vector<std::uint32_t> events;    // with `record`: each share's event count
 };
 PartsPlay play_shifted(const Case& c, int ranks, int shift, bool candidates = true, bool record = false,
-                       Poisoned* poisoned = nullptr) {
+                       Poisoned* poisoned = nullptr, parallel::JoinedClusters* joined = nullptr,
+                       bool* again = nullptr) {
   parallel::FloeOwners strips(0, ranks, c.domain);
   strips.assign(c.floes);
   std::vector<int> owner(strips.owner().begin(), strips.owner().end());
@@ -695,8 +670,28 @@ PartsPlay play_shifted(const Case& c, int ranks, int shift, bool candidates = tr
   PartsPlay p;
   p.record.events = 1;  // the step-start collisions' event
   p.ok = play_parts(c, strips, owner, ranks, p.f, p.stats, p.report, p.sent, p.stopped, p.pads, candidates,
-                    record ? &p.record : nullptr, &p.events, poisoned, &p.rebuilds);
+                    record ? &p.record : nullptr, &p.events, poisoned, &p.rebuilds, joined, again);
   return p;
+}
+
+// play_shifted with the tries of advance_on_part: while a try's parts
+// refuse only because clusters of two runners meet, they are joined on one
+// rank (JoinedClusters) and the step is played again from its start.
+// `rounds` counts the tries made again; with `poisoned`, each try poisons
+// afresh and `poisoned` is left with the last try's.
+PartsPlay play_joined(const Case& c, int ranks, int shift, int& rounds, Poisoned* poisoned = nullptr) {
+  parallel::JoinedClusters joined;
+  rounds = 0;
+  for (;;) {
+    bool again = false;
+    Poisoned fresh;
+    if (poisoned) fresh.poison = poisoned->poison;
+    PartsPlay p = play_shifted(c, ranks, shift, true, false, poisoned ? &fresh : nullptr, &joined, &again);
+    if (poisoned) *poisoned = std::move(fresh);
+    if (!again) return p;
+    ++rounds;
+    REQUIRE(rounds < 8);  // advance_on_part's max_rounds
+  }
 }
 // The played advance is the serial one: states to the bit, counts, report.
 void check_serial(const PartsPlay& p, const Serial& serial) {
@@ -849,6 +844,104 @@ TEST_CASE("the advance's share reads its strip, its part's floes and the floes t
   CHECK(compared >= 6);
   CHECK(fetched > 0);
   CHECK(reach_checked > 0);
+}
+
+TEST_CASE("clusters of two ranks that meet, joined on one rank and run there from their members only, are the "
+          "serial advance") {
+  // The tries of advance_on_part (docs/parallel.md, "The conflicting
+  // clusters on one rank"): a try whose shares met another runner's
+  // cluster or took one free floe is played again with those clusters
+  // joined on the runner of their lowest, until the parts combine. Over 2,
+  // 3 and 7 strips, the clusters' owners the strips and shifted by one
+  // rank: the answer is the serial advance bit for bit, and every split
+  // the single try left to the whole advance for meeting clusters now
+  // combines. Played again with each share's copy poisoned beyond its
+  // strip and part (the joined clusters' members and candidates reach
+  // their runner only with the routed pairs), the last try's parts are the
+  // clean play's byte for byte.
+  int splits = 0, single = 0, cured = 0, poisoned_compared = 0;
+  long rounds_total = 0;
+  const std::pair<unsigned, double> packs[] = {{3u, 2.0}, {11u, 2.0}, {5u, 1.5}, {7u, 1.2}, {9u, 1.8}};
+  for (const auto& [seed, speed] : packs) {
+    CAPTURE(seed);
+    const Case c = dense_pack(speed, seed, 0.5);
+    const Serial serial = serial_advance(c);
+    for (const int ranks : {2, 3, 7})
+      for (const int shift : {0, 1}) {
+        CAPTURE(ranks);
+        CAPTURE(shift);
+        ++splits;
+        single += play_shifted(c, ranks, shift).ok ? 1 : 0;
+        int rounds = 0;
+        const PartsPlay p = play_joined(c, ranks, shift, rounds);
+        check_serial(p, serial);
+        rounds_total += rounds;
+        if (p.ok && rounds > 0) ++cured;
+        MESSAGE(ranks << " ranks, shift " << shift << ": " << std::string(p.ok ? "combined" : "fell back")
+                      << " after " << rounds << " tries joining clusters");
+        // The clean and the poisoned plays of the same tries.
+        Poisoned clean, poisoned;
+        clean.poison = false;
+        int clean_rounds = 0, poisoned_rounds = 0;
+        const PartsPlay whole = play_joined(c, ranks, shift, clean_rounds, &clean);
+        const PartsPlay q = play_joined(c, ranks, shift, poisoned_rounds, &poisoned);
+        CHECK(poisoned_rounds == clean_rounds);
+        CHECK(q.ok == whole.ok);
+        CHECK(poisoned.packed == clean.packed);
+        if (rounds > 0 && q.ok) ++poisoned_compared;
+      }
+  }
+  MESSAGE(single << " of " << splits << " splits combined in one try, " << cured << " more once their meeting clusters "
+                 << "were joined (" << rounds_total << " tries again); " << poisoned_compared
+                 << " of those compared poisoned");
+  CHECK(cured > 0);
+  CHECK(poisoned_compared > 0);
+  CHECK(single + cured == splits);  // no split left to the whole advance on these packs
+}
+
+TEST_CASE("two ranks' clusters that take the same free floe, from the parts: joined on one rank, the serial advance") {
+  // The row of "two ranks' clusters that take the same free floe" above (a's
+  // cluster on rank 0, b's on rank 1, both take j), played from each rank's
+  // part: the first try's parts both move j (no conflict, taken twice), so
+  // the two clusters are joined on rank 0 (the runner of the lower) and the
+  // second try combines, equal to the serial advance.
+  auto box = [](double x0, double vx) {
+    FloeInput f;
+    f.vertices = {{x0, 0.0}, {x0 + 10.0, 0.0}, {x0 + 10.0, 10.0}, {x0, 10.0}};
+    f.velocity = {vx, 0.0};
+    return f;
+  };
+  Case c;
+  for (const FloeInput& in : {box(0.0, 1.0), box(10.5, 0.0), box(55.0, -1.0), box(44.5, 0.0), box(27.5, 0.0)})
+    c.floes.add(make_floe_shape(in), in);
+  c.shapes = contact::build_collision_shapes(c.floes);
+  contact::DetectionOptions d;
+  d.horizon = c.dt;
+  d.reach.assign(c.floes.size(), 6.0);
+  c.detection = contact::detect(c.floes, c.shapes, d);
+  c.detect_options = d;
+  c.options.floor = 1e-3 * c.dt;
+  const Serial serial = serial_advance(c);
+  REQUIRE(serial.report.merges == 1);
+  parallel::FloeOwners strips(0, 2, c.domain);
+  strips.assign(c.floes);
+  const std::vector<int> owner{0, 0, 1, 1, 0};
+  parallel::JoinedClusters joined;
+  int tries = 0;
+  PartsPlay p;
+  for (bool again = true; again; ++tries) {
+    again = false;
+    long sent = 0, stopped = 0, pads = 0;
+    p = PartsPlay{};
+    p.ok = play_parts(c, strips, owner, 2, p.f, p.stats, p.report, sent, stopped, pads, true, nullptr, nullptr,
+                      nullptr, nullptr, &joined, &again);
+    REQUIRE(tries < 8);
+  }
+  MESSAGE(tries << " tries, " << joined.runners().size() << " clusters given another runner");
+  CHECK(tries == 2);
+  CHECK(p.ok);
+  CHECK(joined.runners().size() == 2);
+  check_serial(p, serial);
 }
 
 TEST_CASE("the advance's share given a routed floe without its collision shape fails at once, naming the floe and the rank") {

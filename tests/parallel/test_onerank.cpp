@@ -1,0 +1,237 @@
+// The advance's shares with the run's warm store (docs/parallel.md, "The
+// conflicting clusters on one rank (onerank26)"): each share runs on a copy
+// of the store as it was at the step's start and sends the pairs it stored;
+// every rank writes every part's pairs into its store. Played over 1, 2, 3
+// and 7 strips (each share on its own copy of the floes, the parts through
+// their bytes), step after step, the states, counts and the store itself
+// must be the serial advance's bit for bit; and the fallbacks are counted
+// by kind (AdvanceShareCounts::conflicts), with no warm_start left.
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <cstring>
+#include <memory>
+#include <numeric>
+#include <string>
+#include <vector>
+
+#include "contact/detection.hpp"
+#include "contact/shapes.hpp"
+#include "contact/substep.hpp"
+#include "parallel/advance_share.hpp"
+#include "parallel/place.hpp"
+#include "tests/parallel/collide_case.hpp"
+
+TEST_SUITE_BEGIN("mpi");
+
+using namespace floesim;
+
+namespace {
+
+struct Case {
+  Floes floes;
+  contact::CollisionShapes shapes;
+  contact::Detection detection;
+  contact::SubstepOptions options;
+  contact::Domain domain;
+  double dt = 10.0;
+};
+
+// A dense periodic pack of 400 floes moving at up to `speed` (the pack of
+// test_advance_share.cpp): many small clusters, some merging.
+Case dense_pack(double speed, unsigned seed, double concentration) {
+  GeneratedPack g = test::moving_generated_pack(seed, speed, concentration);
+  Case c;
+  c.floes = std::move(g.floes);
+  c.shapes = contact::build_collision_shapes(c.floes);
+  c.domain = {true, g.window[0], g.window[1], g.window[2], g.window[3]};
+  contact::DetectionOptions d;
+  d.domain = c.domain;
+  d.horizon = c.dt;
+  d.reach.assign(c.floes.size(), 0.0);
+  for (std::size_t i = 0; i < c.floes.size(); ++i) {
+    const FloeState& s = c.floes.state[i];
+    d.reach[i] = c.dt * (1.5 * (std::hypot(s.vx, s.vy) + std::abs(s.yaw_rate) * c.shapes.radius[i]) + 0.5 * speed) +
+                 d.collision_distance;
+  }
+  c.detection = contact::detect(c.floes, c.shapes, d);
+  c.options.collision_distance = d.collision_distance;
+  c.options.floor = 1e-3 * c.dt;
+  c.options.domain = c.domain;
+  c.options.impulse.collision_distance = d.collision_distance;
+  c.options.impulse.min_gap = 0.1 * d.collision_distance;
+  // Every LCP starts from the warm store and stores its basis.
+  c.options.impulse.warm_min = 0;
+  return c;
+}
+
+// Two stores hold the same pairs, each with the same clock and the same
+// entries to the bit, and the same uses.
+bool same_store(const contact::WarmStart& a, const contact::WarmStart& b) {
+  if (a.pairs.size() != b.pairs.size() || a.uses != b.uses || a.clock != b.clock) return false;
+  for (const auto& [key, p] : a.pairs) {
+    const auto it = b.pairs.find(key);
+    if (it == b.pairs.end() || it->second.stored != p.stored || it->second.entries.size() != p.entries.size())
+      return false;
+    for (std::size_t k = 0; k < p.entries.size(); ++k) {
+      const contact::WarmStart::Entry &x = p.entries[k], &y = it->second.entries[k];
+      if (std::memcmp(x.body_point.data(), y.body_point.data(), 2 * sizeof(double)) != 0 ||
+          std::memcmp(x.body_normal.data(), y.body_normal.data(), 2 * sizeof(double)) != 0 || x.basic != y.basic ||
+          x.vertex_of_b != y.vertex_of_b)
+        return false;
+    }
+  }
+  return true;
+}
+
+// One step over `ranks` ranks, as parallel::advance_by_owner makes it: the
+// shares set up on copies of the floes, the rooms and parts through their
+// bytes, combined into `f` and `warm`, or, on a conflict (counted by kind
+// in `counts`), the whole advance from the step's start with `warm`.
+// Returns whether the parts combined; `stored` adds the pairs the parts
+// stored.
+bool play(const Case& c, std::span<const int> owner, int ranks, contact::WarmStart& warm, Floes& f,
+          contact::CollisionStats& stats, contact::SubstepReport& report, parallel::AdvanceShareCounts& counts,
+          long& stored) {
+  contact::SubstepOptions o = c.options;
+  o.impulse.warm = &warm;
+  std::vector<Floes> copies(static_cast<std::size_t>(ranks), c.floes);
+  std::vector<std::unique_ptr<contact::ShareAdvance>> shares;
+  std::vector<contact::ShareRooms> rooms;
+  for (int r = 0; r < ranks; ++r) {
+    shares.push_back(std::make_unique<contact::ShareAdvance>(copies[static_cast<std::size_t>(r)], c.shapes,
+                                                             c.detection, c.dt, o, contact::ClusterShare{owner, r}));
+    rooms.push_back(parallel::unpack_share_rooms(parallel::pack(shares.back()->rooms())));
+  }
+  contact::ShareRooms all;
+  REQUIRE(parallel::combine_rooms(rooms, all));
+  std::vector<parallel::AdvancePart> parts;
+  for (int r = 0; r < ranks; ++r) {
+    const std::size_t k = static_cast<std::size_t>(r);
+    parts.push_back(parallel::unpack_advance_part(parallel::pack(parallel::finish_share(*shares[k], all, copies[k]))));
+  }
+  f = std::move(copies.front());
+  if (parallel::combine_parts(parts, f, stats, report, nullptr, &warm)) {
+    for (const parallel::AdvancePart& p : parts) stored += static_cast<long>(p.outcome.warm.size());
+    return true;
+  }
+  parallel::count_conflicts(parts, counts);
+  f = c.floes;
+  stats = {};
+  report = {};
+  contact::advance_with_collisions(f, c.shapes, c.detection, c.dt, o, stats, report);
+  return false;
+}
+
+bool same_stats(const contact::CollisionStats& a, const contact::CollisionStats& b) {
+  return a.contacts == b.contacts && a.lcps == b.lcps && a.pivots == b.pivots && a.failures == b.failures &&
+         a.warm == b.warm && a.warm_missed == b.warm_missed && a.largest == b.largest;
+}
+
+}  // namespace
+
+TEST_CASE("the advance's shares on copies of the warm store, their stored pairs written on every rank, keep the "
+          "serial store and answer") {
+  // Four steps from the same start, the store carried from each to the next
+  // (its entries are those of the step before: warm starts that hit); the
+  // serial advance and each split keep a store of their own.
+  long combined = 0, stored = 0, tries = 0;
+  for (const unsigned seed : {3u, 11u}) {
+    CAPTURE(seed);
+    const Case c = dense_pack(2.0, seed, 0.5);
+    for (const int ranks : {1, 2, 3, 7}) {
+      CAPTURE(ranks);
+      parallel::FloeOwners owners(0, ranks, c.domain);
+      owners.assign(c.floes);
+      contact::WarmStart serial_warm, shared_warm;
+      parallel::AdvanceShareCounts counts;
+      for (int step = 0; step < 4; ++step) {
+        CAPTURE(step);
+        Floes s = c.floes, f;
+        contact::SubstepOptions so = c.options;
+        so.impulse.warm = &serial_warm;
+        contact::CollisionStats ss, fs;
+        contact::SubstepReport sr, fr;
+        contact::advance_with_collisions(s, c.shapes, c.detection, c.dt, so, ss, sr);
+        long kept = 0;
+        const bool ok = play(c, owners.owner(), ranks, shared_warm, f, fs, fr, counts, kept);
+        if (ranks == 1) CHECK(ok);
+        if (ranks > 1) {  // the splits: one rank's share is the serial advance itself
+          ++tries;
+          combined += ok ? 1 : 0;
+          stored += kept;
+        }
+        CHECK(std::memcmp(f.state.data(), s.state.data(), f.state.size() * sizeof(FloeState)) == 0);
+        CHECK(same_stats(fs, ss));
+        CHECK(ss.lcps > 0);
+        CHECK(same_store(shared_warm, serial_warm));
+        serial_warm.tick();
+        shared_warm.tick();
+      }
+      CHECK(serial_warm.uses > 0);
+      // No share's fallback is for the warm store any more.
+      CHECK_FALSE(counts.conflicts.contains("warm_start"));
+    }
+  }
+  MESSAGE(combined << " of " << tries << " tries over several ranks combined, " << stored
+                   << " warm pairs stored by their shares");
+  // Until onerank26 each of these tries fell back (warm_start).
+  CHECK(combined >= tries / 3);
+  CHECK(stored > 0);
+}
+
+TEST_CASE("the advance's fallbacks are counted by kind: a cluster meeting another rank's, a floe two ranks took") {
+  // Every floe its own rank: every merge of the serial advance is between
+  // ranks (foreign_cluster).
+  {
+    const Case c = dense_pack(2.0, 3, 0.5);
+    std::vector<int> owner(c.floes.size());
+    std::iota(owner.begin(), owner.end(), 0);
+    contact::WarmStart warm;
+    Floes f;
+    contact::CollisionStats stats;
+    contact::SubstepReport report;
+    parallel::AdvanceShareCounts counts;
+    long stored = 0;
+    CHECK_FALSE(play(c, owner, static_cast<int>(owner.size()), warm, f, stats, report, counts, stored));
+    CHECK(counts.conflicts.size() == 1);
+    CHECK(counts.conflicts["foreign_cluster"] == 1);
+  }
+  // Two parts that moved one floe and have no conflict: taken_twice.
+  {
+    std::vector<parallel::AdvancePart> parts(2);
+    parts[0].outcome.moved = {1, 4};
+    parts[1].outcome.moved = {2, 4};
+    parallel::AdvanceShareCounts counts;
+    parallel::count_conflicts(parts, counts);
+    CHECK(counts.conflicts.size() == 1);
+    CHECK(counts.conflicts["taken_twice"] == 1);
+    // A part with a conflict names it, each kind once per try.
+    parts[0].outcome.conflict = contact::ShareOutcome::Conflict::missing_pairs;
+    parts[1].outcome.conflict = contact::ShareOutcome::Conflict::missing_pairs;
+    parallel::count_conflicts(parts, counts);
+    CHECK(counts.conflicts["missing_pairs"] == 1);
+    CHECK(counts.conflicts["taken_twice"] == 1);
+  }
+}
+
+TEST_CASE("the back-off of the advance by owner: after fallbacks in a row, waits of 1, 2, 4 up to max_wait") {
+  // Ten advances whose every try falls back: tried at advances 0, 2 and 5
+  // (then waits of 1, 2 and 4, the cap), the rest whole.
+  parallel::AdvanceShareCounts counts;
+  parallel::AdvanceShareOptions o;
+  o.max_wait = 4;
+  std::vector<int> tried;
+  for (int step = 0; step < 10; ++step)
+    if (!counts.whole_now()) {
+      tried.push_back(step);
+      counts.fell_back(o);
+    }
+  CHECK(tried == std::vector<int>{0, 2, 5});
+  CHECK(counts.steps == 3);
+  CHECK(counts.fallbacks == 3);
+  CHECK(counts.whole == 7);
+  // A try that combines resets the next wait to 1.
+  counts.combined();
+  CHECK(counts.next_wait == 1);
+}
