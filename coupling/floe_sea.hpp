@@ -216,6 +216,9 @@ public:
   // On several ranks: the floes this rank owns for the coupling (whose
   // pieces it built at the footprints' last rebuild and moves), ascending.
   std::span<const std::uint32_t> own_floes() const { return footprints_.mine(); }
+  // On several ranks: every floe's coupling owner (the same on every rank;
+  // empty before the first placement).
+  std::span<const int> floe_owners() const { return footprints_.owners(); }
   // Threads for the per-floe and per-piece work (results do not depend on it).
   void set_threads(int threads) { threads_ = std::max(threads, 1); }
   // Ranks that share the per-floe work (docs/parallel.md, stages two and
