@@ -117,10 +117,11 @@ struct Energies {
 class Simulation {
 public:
   // `comm`: the ranks of a distributed run (parallel/comm.hpp; default: serial).
-  // Every rank holds the whole state and steps it the same way; the ranks
-  // share the drift and detection by place (each its floes, stage six of
-  // docs/parallel.md) and gather their results, so every rank ends each
-  // step with the serial run's state, bit for bit. step() is then collective.
+  // The ranks share the step by place (each its floes, docs/parallel.md);
+  // each rank keeps current the floes it holds (its own and its halo band:
+  // the halo exchange, or every floe where the run reads every floe), so
+  // its held floes and the writer's gather (writer_states()) are the
+  // serial run's, bit for bit. step() is then collective.
   explicit Simulation(Scenario scenario, parallel::Communicator comm = {});
   ~Simulation();
   Simulation(Simulation&&) noexcept;
@@ -368,11 +369,10 @@ private:
   bool detection_whole_ = true;
   const contact::Detection& whole_detection();
   // Whether every floe's state and step-start copy (ctx.start) are current
-  // on this rank, every rank alike. True after the drift's complete_owned
-  // (today every rank holds every floe current); the halo exchange (piece
-  // 8) will leave only the held floes current (held_, and the own floes),
-  // and the poison mode of the run does so in its windows (false while one
-  // is open). whole_state() makes them current when a step reads every
+  // on this rank, every rank alike. True where the drift sends every
+  // state to every rank (halo_exchange() false); with the halo exchange
+  // false from the drift on (only the held floes are current: held_now()).
+  // whole_state() makes them current when a step reads every
   // floe (the pair list's rebuild on a part, a fallback, a whole step of
   // the back-off: parallel::WholeOnDemand), once in such a step; or the
   // states alone (what the advance reads), which leave the flag false.

@@ -22,8 +22,8 @@ void Simulation::hand_over_moved(StepContext& ctx, std::span<const int> detected
   // drifts them alike. Its other copies are not (wrap_periodic and the
   // vertical drift pass over the held floes only), and a move of the cuts
   // can make r the owner of such a floe: r would drift it from its stale
-  // copy, and the drift's complete_owned would send that copy to every
-  // rank. So each floe whose owner changed goes from its owner at the last
+  // copy, and the drift's exchange would send that copy to its holders.
+  // So each floe whose owner changed goes from its owner at the last
   // detection, which held it, to its new owner: what the new owner's
   // drift and the phases after it read of it that the constants do not
   // give (the collision shapes, the drift's quadrature, the moorings'
@@ -50,7 +50,8 @@ std::vector<std::uint8_t> Simulation::held_now() const {
   // between a move of the slabs and the footprints' next rebuild (with a
   // window) they need not be in its band, and it poses them (their x, y,
   // yaw) and its law reads their heave, pitch and roll. Their copies are
-  // current: the drift's exchange brings every floe's state, and the
+  // current: the drift's exchange sends each to its holders (the coupling's
+  // owner among them), the detection's the floes entering a band, and the
   // collisions' and advance's moves reach every rank.
   // Every floe with the implicit step, which poses every floe at the
   // midpoint of its motion (whole on every rank).
@@ -202,14 +203,15 @@ void Simulation::whole_state(StepContext& ctx, parallel::WholeState what) {
   // its step-start copy, from its owner (the drift's, owners_: it drifted
   // the floe and holds both current), in one message: 96 B a floe the rank
   // does not own for the state alone, 192 B with the copy. Only the floes
-  // this rank does not hold take them: a held floe's copy is current
+  // this rank does not hold (held_now()) take them: a held floe's copy is current
   // already (every holder updates it alike), and the poison mode's NaN in a
   // held floe, a reader's trace, stays to be reported.
   //
   // state_whole_ (one flag: both whole) is set only by the gather of both.
   // The state alone leaves the step-start copies stale, so a later ask in
-  // the step gathers again; the advance, the one path that asks for the
-  // state alone, keeps what it gathered (its `start`) and asks once.
+  // the step gathers again; the advance, which asks for the state alone,
+  // keeps what it gathered (its `start`) and asks once; a split asks for
+  // the state alone after the step (nothing reads the step-start copy then).
   //
   // The poison mode's mutation `stale` (coupling/poison_mode.hpp) gathers
   // nothing: a step that reads every floe then reads the poison.
