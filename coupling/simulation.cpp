@@ -237,8 +237,11 @@ void Simulation::floes_half_kick(StepContext& ctx) {
   // the explicit damper): a rebuild of the footprints then takes the drift's
   // owners (assigned at the last detection, at the present places: the sea's
   // flow and the kicks move no floe) and poses this rank's floes only, as in
-  // sea_half_kick.
-  offer_place_owners();
+  // sea_half_kick. After a rejected try the owners are those of its places,
+  // not of the step's start the floes are back at: a rebuild then poses
+  // every floe, so every floe's state comes from its owner first (rare).
+  if (owners_off_places_) whole_state(ctx, parallel::WholeState::state);
+  else offer_place_owners();
   floe_sea_->ready_loads(scenario_.floes, *sea_, incident_.get(), 0.5 * ctx.dt);
   floe_sea_->kick_floes(scenario_.floes, 0.5 * ctx.dt);
 }
@@ -282,6 +285,7 @@ void Simulation::drift(StepContext& ctx) {
     std::vector<int> detected;  // the last detection's owners, when the cuts may move
     if (owners_.may_move(steps_)) detected.assign(owners_.owner().begin(), owners_.owner().end());
     const bool moved = owners_.update(comm_, scenario_.floes, steps_);
+    owners_off_places_ = false;
     if (moved && owners_.has_slabs()) follow_slabs();
     if (moved) hand_over_moved(ctx, detected);
     // The moorings of the floes this rank drifts: each kick is its floe's
@@ -568,6 +572,7 @@ bool Simulation::detect_and_check(StepContext& ctx) {
     // Redo the step with half the time.
     ++rejected_steps_;
     scenario_.floes.state = ctx.start;
+    owners_off_places_ = !comm_.serial();  // the owners took the try's notices
     ctx.dt *= 0.5;
     if (ctx.dt < kFloorFraction * scenario_.config.run.dt_max * std::pow(0.5, kMaxHalvings / 2)) {
       std::ostringstream m;

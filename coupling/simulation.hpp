@@ -290,6 +290,9 @@ private:
   // The ranks this rank announced its floes to at the last detection kept
   // (the floes it owned then; empty before the first, or without the exchange).
   parallel::Announced announced_;
+  // From a rejected try to the redone try's drift: the owners are those of
+  // the try's places, not of the places the floes are back at.
+  bool owners_off_places_ = false;
   // Wraps the centroids of the floes this rank holds (held_now()) into a
   // periodic box, and notes which (wrapped_).
   void wrap_periodic();
