@@ -162,7 +162,14 @@ void Simulation::poison_step(const char* phase, StepContext& ctx) {
   // set there do not get theirs, so it is checked until then only.
   const bool start_read = at != "detect" && at != "sea" && at != "second half kick" && at != "record" &&
                           at != "percussion" && at != "check";
-  p.check(phase, state, start_read ? &ctx.start : nullptr, detection_options_.reach);
+  // The detection's reaches (detection_options_) are set at the detection
+  // and read from it to the next drift; from the drift to the detection the
+  // phases read the part's (the advance's outrun check and rebuild), which
+  // a move of the cuts hands over (hand_over_moved): a floe that came to
+  // the rank there has no detection reach here until set_reach writes it.
+  const bool reach_read = at != "drift" && at != "collide" && at != "advance";
+  p.check(phase, state, start_read ? &ctx.start : nullptr,
+          reach_read ? std::span<const double>(detection_options_.reach) : std::span<const double>{});
 }
 
 }  // namespace floesim

@@ -369,8 +369,9 @@ void Simulation::percussion(StepContext& ctx) {
   // are), and every rank concludes on all of them in floe order: the serial
   // events and splits.
   const double start = parallel::thread_seconds();
+  const std::vector<std::uint8_t> held = held_now();  // a split's neighbours: among the held floes
   const PercussionAnalyses mine = percussion_->analyse(scenario_.floes, *impulse_record_, t_, ctx.dt,
-                                                       PercussionShare{owners_.owner(), comm_.rank()});
+                                                       PercussionShare{owners_.owner(), comm_.rank(), held});
   owners_.charge_fracture(parallel::thread_seconds() - start);
   if (!mine.loaded) return;
   PercussionAnalyses all = combine(comm_.allgather_parts(pack(mine), unpack_percussion), percussion_ranks_);

@@ -38,6 +38,9 @@ On 2 ranks (`mpirun --oversubscribe`):
     the wall jam, where a sub-step on NaN makes no progress).
 (e) the halo exchange's bytes: in (d)'s pack run, rank 0's drift phase
     receives less than a tenth of every floe's state each step.
+(f) a split's neighbours among the held floes: check_writer_ranks.py's
+    fracture pack (to 500 s, floes split) on 3 ranks with the lure is bit
+    for bit the serial run.
 Only what is stable is pinned: other readers are being removed.
 """
 import os
@@ -199,6 +202,34 @@ for what, config, n, poison, mutant, extra, serial, counted, floes in cases:
           f"{'found (the run failed or differs)' if found else 'NOT FOUND'}")
     if not found:
         failures.append(f"{what}, {mutant}: with nothing gathered the run must fail or differ\n{m.stderr}")
+
+# (f) A split's neighbours (Percussion::decide_split, on the owner) are
+# looked for among the held floes: the lure, which can put an unheld floe
+# beside a cracked one, must not change a split. check_writer_ranks.py's
+# fracture pack (the pack to 500 s, floes split) on 3 ranks.
+FRACTURE = """
+[fracture]
+enabled = true
+criterion = "stress"
+strength = 0.2e6
+split = true
+mesh_size = 20.0
+min_fragment_area = 400.0
+"""
+splits = os.path.join(W, "splits.toml")
+with open(base) as f:
+    text = f.read()
+with open(splits, "w") as f:
+    f.write(re.sub(r"t_end = [^\n]*", "t_end = 500.0", text, count=1) + FRACTURE)
+s = summary(need(run([args.floesim, "run", splits, "-o", "splits_serial.h5", "-q"]), "the fracture pack, serial"))
+p = mpirun(3, "step-lure", splits, "splits3.h5")
+same = p.returncode == 0 and equal("splits3.h5", "splits_serial.h5")
+print(f"the fracture pack on 3 ranks, step-lure ({s.get('fracture.splits')} splits): exit {p.returncode}, "
+      f"{'equal' if same else 'DIFFERENT'} to the serial run; {summaries(p)}")
+if s.get("fracture.splits", "0") == "0":
+    failures.append("the fracture pack made no split: (f) tests nothing")
+if not same:
+    failures.append(f"the fracture pack on 3 ranks with the lure differs: a split read an unheld floe\n{p.stderr}")
 
 if failures:
     print("FAILED:\n" + "\n".join(failures))
