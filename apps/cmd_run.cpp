@@ -273,7 +273,7 @@ int run(const Args& args, const parallel::Session& session) {
   // (Simulation::set_writer_test). Read here, by the command, so that the
   // library reads no environment.
   // "step", "step-lure", "step-mutant" (optionally "-stale", then optionally
-  // "@drift", "@detect", "@percussion": the grammar is parse_poison_options'):
+  // "@drift", "@detect": the grammar is parse_poison_options'):
   // the poison mode of the run (Simulation::set_poison_test,
   // tests/parallel/check_poison_run.py), the writer's gathers as in a plain run.
   if (const char* test = std::getenv("FLOESIM_TEST_POISON_UNHELD")) {

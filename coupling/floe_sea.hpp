@@ -223,6 +223,9 @@ public:
   std::span<const std::uint32_t> own_floes() const {
     return next_owners_.owner.empty() ? footprints_.mine() : std::span<const std::uint32_t>(next_owners_.held);
   }
+  // On several ranks: every floe's coupling owner (the same on every rank;
+  // empty before the first placement).
+  std::span<const int> floe_owners() const { return footprints_.owners(); }
   // Threads for the per-floe and per-piece work (results do not depend on it).
   void set_threads(int threads) { threads_ = std::max(threads, 1); }
   // Ranks that share the per-floe work (docs/parallel.md, stages two and

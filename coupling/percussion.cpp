@@ -250,7 +250,7 @@ PercussionAnalyses Percussion::analyse(const Floes& floes, const contact::Impuls
   if (params_.split) {
     const auto cut = std::chrono::steady_clock::now();
     for (FloeInitiation& fi : out.initiations)
-      if (fi.through) fi.split = decide_split(floes, fi.floe, fi);
+      if (fi.through) fi.split = decide_split(floes, fi.floe, fi, share.held);
     stats_.split_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - cut).count();
   }
   return out;
@@ -357,7 +357,8 @@ double Percussion::min_fragment_area() const {
   return params_.min_fragment_area > 0.0 ? params_.min_fragment_area : params_.mesh_size * params_.mesh_size;
 }
 
-SplitDecision Percussion::decide_split(const Floes& floes, std::size_t i, const FloeInitiation& fi) const {
+SplitDecision Percussion::decide_split(const Floes& floes, std::size_t i, const FloeInitiation& fi,
+                                       std::span<const std::uint8_t> held) const {
   const fracture::Chord chord = fracture::chord_through(
       floes.vertices(i), Vec2{fi.point_x, fi.point_y}, Vec2{std::cos(fi.direction), std::sin(fi.direction)});
   // No piece below the minimum fragment area (a sliver): the floe is not split.
@@ -373,7 +374,7 @@ SplitDecision Percussion::decide_split(const Floes& floes, std::size_t i, const 
       near.push_back(i);
       const double ri = radius_of(floes, i);
       for (std::size_t j = 0; j < floes.size(); ++j) {
-        if (j == i) continue;
+        if (j == i || (!held.empty() && !held[j])) continue;
         const double d = std::hypot(floes.state[j].x - floes.state[i].x, floes.state[j].y - floes.state[i].y);
         if (d <= ri + radius_of(floes, j) + gap_) near.push_back(j);
       }

@@ -150,6 +150,11 @@ struct PercussionStats {
 struct PercussionShare {
   std::span<const int> owner;
   int rank = 0;
+  // Per floe, 1 if this rank holds it (its own floes and its halo band;
+  // empty: every floe): the splits' neighbours are looked for among those
+  // only. With the state held by owner (the halo exchange) the other
+  // copies are stale, and a stale floe's place must not make a neighbour.
+  std::span<const std::uint8_t> held;
   bool mine(std::size_t i) const { return (i < owner.size() ? owner[i] : 0) == rank; }
 };
 
@@ -250,7 +255,10 @@ public:
   // within R_i + R_j + gap of its centroid (R the radius about the
   // centroid), no other: within the halo band of floe i's owner
   // (docs/parallel.md, "Splits"; tests/parallel/test_halo_split.cpp).
-  SplitDecision decide_split(const Floes& floes, std::size_t i, const FloeInitiation& fi) const;
+  // `held` (per floe, 1: held; empty: every floe): the floes it may read,
+  // which must hold those (the owner's band does): the same decision.
+  SplitDecision decide_split(const Floes& floes, std::size_t i, const FloeInitiation& fi,
+                             std::span<const std::uint8_t> held = {}) const;
 
   // The initiations since the last call.
   std::vector<FractureEventRow> take_events();

@@ -52,14 +52,13 @@ bool parse_poison_options(const std::string& text, PoisonOptions& options) {
   if (kind == "step-lure") o.kind = PoisonOptions::Kind::lure;
   else if (kind == "step-mutant") o.mutant = true;
   else if (kind != "step") return false;
-  if (!window.empty()) {  // one or more windows, joined by '+'
-    o.after_drift = o.after_detect = o.after_percussion = false;
+  if (!window.empty()) {  // one or both exchanges, joined by '+'
+    o.after_drift = o.after_detect = false;
     for (std::size_t at = 0; at <= window.size();) {
       const std::size_t end = std::min(window.find('+', at), window.size());
       const std::string w = window.substr(at, end - at);
       if (w == "drift") o.after_drift = true;
       else if (w == "detect") o.after_detect = true;
-      else if (w == "percussion") o.after_percussion = true;
       else return false;
       at = end + 1;
     }
@@ -68,31 +67,19 @@ bool parse_poison_options(const std::string& text, PoisonOptions& options) {
   return true;
 }
 
-void UnheldPoison::poison(std::span<const std::uint8_t> held, std::span<const int> owner,
-                          std::vector<FloeState>& state, std::vector<FloeState>* start, std::vector<double>& reach,
-                          const contact::Domain& domain) {
+void UnheldPoison::poison(std::span<const std::uint8_t> held, std::vector<FloeState>& state,
+                          std::vector<FloeState>* start, std::vector<double>& reach, const contact::Domain& domain) {
   const std::size_t n = state.size();
   held_.assign(held.begin(), held.end());
   held_.resize(n, 0);
-  owner_.assign(owner.begin(), owner.end());
-  unheld_.clear();
-  kept_state_.clear();
-  kept_start_.clear();
-  kept_reach_.clear();
   const bool lure = options_.kind == PoisonOptions::Kind::lure;
+  long long count = 0;
   for (std::size_t i = 0; i < n; ++i) {
     if (held_[i]) continue;
-    unheld_.push_back(static_cast<std::uint32_t>(i));
-    kept_state_.push_back(state[i]);
+    ++count;
     state[i] = lure ? lured(state[i], domain) : nan_state();
-    if (start) {
-      kept_start_.push_back((*start)[i]);
-      (*start)[i] = lure ? lured((*start)[i], domain) : nan_state();
-    }
-    if (i < reach.size()) {
-      kept_reach_.push_back(reach[i]);
-      reach[i] = lure ? reach[i] + 10.0 : kNan;
-    }
+    if (start && i < start->size()) (*start)[i] = lure ? lured((*start)[i], domain) : nan_state();
+    if (i < reach.size()) reach[i] = lure ? reach[i] + 10.0 : kNan;
   }
   if (options_.mutant) {
     const auto first = std::find(held_.begin(), held_.end(), std::uint8_t{1});
@@ -100,24 +87,7 @@ void UnheldPoison::poison(std::span<const std::uint8_t> held, std::span<const in
   }
   open_ = true;
   ++windows_;
-  poisoned_ += static_cast<long long>(unheld_.size());
-}
-
-void UnheldPoison::restore(const parallel::Communicator& comm, std::vector<FloeState>& state,
-                           std::vector<FloeState>* start, std::vector<double>& reach, bool start_from_state) {
-  if (!open_) return;
-  open_ = false;
-  // Every floe from its owner; only the unheld floes' values are taken, so
-  // a poison that reached a held floe stays (in the run file: the lure).
-  std::vector<FloeState> owners = state;
-  comm.complete_owned(owners, owner_);
-  for (std::size_t k = 0; k < unheld_.size(); ++k) {
-    const std::size_t i = unheld_[k];
-    state[i] = owners[i];
-    if (start && start_from_state) (*start)[i] = kept_state_[k];
-    else if (start && k < kept_start_.size()) (*start)[i] = kept_start_[k];
-    if (k < kept_reach_.size() && i < reach.size()) reach[i] = kept_reach_[k];
-  }
+  poisoned_ += count;
 }
 
 void UnheldPoison::check(const char* phase, const std::vector<FloeState>& state,
@@ -174,40 +144,32 @@ std::string Simulation::poison_summary() const {
 void Simulation::poison_step(const char* phase, StepContext& ctx) {
   UnheldPoison& p = *poison_;
   std::vector<FloeState>& state = scenario_.floes.state;
-  std::vector<double>& reach = detection_options_.reach;
   const std::string at = phase;
-  // The held set of a window: the band at the last detection (held_) and
-  // the floes this rank owns now (after the drift's update a floe may have
-  // come to it from a strip whose cut moved: piece 8 sends it then).
-  const auto open = [&](std::vector<FloeState>* start) {
-    const std::size_t n = state.size();
-    if (held_.mask.size() != n || owners_.owner().size() != n) return;
-    std::vector<std::uint8_t> held = held_.mask;
-    for (const std::uint32_t i : owners_.mine()) held[i] = 1;
-    p.poison(held, owners_.owner(), state, start, reach, detection_options_.domain);
-  };
-  // A window leaves the unheld floes stale, as the halo exchange will: a
-  // step that reads every floe gathers them (whole_state). Set on every
-  // rank alike (open() may return without poisoning on none or all); not
-  // with the mutation `stale`.
-  const auto open_window = [&](std::vector<FloeState>* start) {
-    if (!p.options().stale) state_whole_ = false;
-    open(start);
-  };
-  const auto restore = [&](bool start_from_state) {
-    p.restore(comm_, state, &ctx.start, reach, start_from_state);
-    state_whole_ = true;
-  };
-  // Opening: where an exchange of piece 8 gives the held floes their values.
-  if (at == "drift" && p.options().after_drift) open_window(&ctx.start);
-  if (at == "detect" && p.options().after_detect) open_window(&ctx.start);
-  // After the percussion the step's start copy is not read again; the next
-  // step's is taken from the (poisoned) state and put back at the restore.
-  if (at == "percussion" && p.options().after_percussion) open_window(nullptr);
-  p.check(phase, state, &ctx.start, reach);
-  // Closing: before the phases that read every floe's place for its owner.
-  if (at == "advance" || at == "record") restore(false);
-  if (at == "first half kick") restore(true);
+  // Right after the exchanges (the drift's part (a); the detection's part
+  // (b)), the floes this rank does not hold now (held_by_band(): the
+  // derivation of held_now(), which the exchanges and whole_state use, but
+  // for the implicit step, which reads every floe: a known reader). Every
+  // rank holds every floe before the first detection.
+  const bool exchanged = (at == "drift" && p.options().after_drift) || (at == "detect" && p.options().after_detect);
+  if (exchanged) {
+    const std::vector<std::uint8_t> held = held_by_band();
+    if (held.size() == state.size())
+      p.poison(held, state, &ctx.start, detection_options_.reach, detection_options_.domain);
+  }
+  // The step-start copy is read until the detection (the collisions, the
+  // advance, a rejected try's restore) and not after it (the explicit
+  // kicks; the next step takes a new one): the floes that enter the held
+  // set there do not get theirs, so it is checked until then only.
+  const bool start_read = at != "detect" && at != "sea" && at != "second half kick" && at != "record" &&
+                          at != "percussion" && at != "check";
+  // The detection's reaches (detection_options_) are set at the detection
+  // and read from it to the next drift; from the drift to the detection the
+  // phases read the part's (the advance's outrun check and rebuild), which
+  // a move of the cuts hands over (hand_over_moved): a floe that came to
+  // the rank there has no detection reach here until set_reach writes it.
+  const bool reach_read = at != "drift" && at != "collide" && at != "advance";
+  p.check(phase, state, start_read ? &ctx.start : nullptr,
+          reach_read ? std::span<const double>(detection_options_.reach) : std::span<const double>{});
 }
 
 }  // namespace floesim

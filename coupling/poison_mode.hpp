@@ -2,34 +2,31 @@
 // The poison mode of the run (a test option of Simulation, not a user key;
 // docs/parallel.md, "The poison mode of the run (piece 7; poison18)").
 //
-// The halo exchange that is to replace the drift's complete_owned (piece 8)
-// leaves each rank with current values for the floes it holds only (its own
-// floes and its band B_r); everything else is stale. This mode makes that
-// visible on a real run: at the points where the exchanges will be, each
-// rank overwrites its copies of the floes it does not hold with poison, and
+// With the state held by owner (the halo exchange, docs/parallel.md "The
+// halo exchange (halo26)") each rank's copies of the floes it does not hold
+// (its own floes, its band B_r, its coupling's own floes: held_now()) are
+// stale between the exchanges. This mode makes them visibly wrong: right
+// after each exchange (a, after the drift; b, at the detection) each rank
+// overwrites its copies of the floes it does not hold with poison, and
 // after each phase it looks for the poison in the floes it holds. A phase
-// that reads a floe outside the held set then either carries NaN into a held
-// floe (reported: phase, floe, field, rank) or, with the finite lure, gives
-// another run file than the plain run.
+// that reads a floe outside the held set then either carries NaN into a
+// held floe (reported: phase, floe, field, rank) or, with the finite lure,
+// gives another run file than the plain run.
 //
-// A window is opened (poison) where an exchange will send the held floes
-// their values and closed (restore) before the next phase that is known to
-// read every floe's place to decide owners (which would make the ranks
-// disagree on the owners and stop the collectives instead of reporting):
+// Nothing is restored: what takes the poison away is the run's own
+// traffic, the exchanges (which write the held floes) and the gathers of
+// the whole state where a step reads every floe (Simulation::whole_state:
+// the pair list's rebuild, the fallbacks, a split). So a run in the mode
+// equals the plain run exactly when no phase reads an unheld floe. Where
+// the run keeps the whole state (the implicit step, the seas not in slabs,
+// the advance from the whole detection: Simulation::halo_exchange() false)
+// the drift still sends every state to every rank and the poison after it
+// is read: those runs fail or differ, by design (their readers are known).
 //
-//   after the drift's complete_owned  .. before the detection
-//   after the detection               .. before the percussion
-//   after the percussion              .. before the next drift
-//
-// A restore sends every floe's state from its owner (one complete_owned, by
-// the owners of the window's start) and puts back the kept step-start copy
-// and reaches; so what the run reads outside the windows is today's whole
-// state, and each window tests the phases inside it only.
-//
-// What is poisoned, for the floes outside the window's held set: the state
-// (12 columns), the step-start copy (StepContext::start: piece 8 leaves it
-// stale too, it is taken from the state at the step's start) and the
-// detection reach (set from the state by set_reach at the detection).
+// What is poisoned, for the floes outside the held set: the state (12
+// columns), the step-start copy (StepContext::start, taken from the state at
+// the step's start: as stale) and the detection reach (the band's come with
+// the notices; the others are not written).
 //
 // Two poisons. NaN: a read that reaches a held floe shows up as NaN there
 // (the check); but a NaN place that reaches an index computation (grid_row,
@@ -45,29 +42,27 @@
 
 #include "contact/detection.hpp"
 #include "core/floes.hpp"
-#include "parallel/comm.hpp"
 
 namespace floesim {
 
 struct PoisonOptions {
   enum class Kind { nan, lure };
   Kind kind = Kind::nan;
-  // The mutation of the tests: this rank's lowest held floe is poisoned too
-  // (and never restored), so the first check must report it.
+  // The mutation of the tests: this rank's lowest held floe is poisoned too,
+  // so the first check must report it.
   bool mutant = false;
-  // The mutation of the whole state on demand's test: the windows do not
-  // say that the unheld floes are stale (Simulation::whole_state gathers
-  // nothing), so a step that reads every floe reads the poison.
+  // The mutation of the whole state on demand's test: Simulation::whole_state
+  // gathers nothing, so a step that reads every floe reads the poison.
   bool stale = false;
-  // Which windows are opened (above; all by default).
-  bool after_drift = true, after_detect = true, after_percussion = true;
+  // After which exchange the unheld floes are poisoned (both by default).
+  bool after_drift = true, after_detect = true;
 };
 
 // Parses the test hook's value: "step" (NaN), "step-lure", "step-mutant",
 // each optionally followed by "-stale" (PoisonOptions::stale:
-// "step-lure-stale"), then optionally by "@" and the windows to open, of
-// "drift", "detect" and "percussion" joined by '+' (e.g.
-// "step-lure@drift+percussion"); all three without. Returns false if `text` is not of this form.
+// "step-lure-stale"), then optionally by "@" and the exchanges after which
+// to poison, "drift" and "detect" joined by '+' (e.g. "step-lure@drift");
+// both without. Returns false if `text` is not of this form.
 bool parse_poison_options(const std::string& text, PoisonOptions& options);
 
 class UnheldPoison {
@@ -75,26 +70,18 @@ public:
   UnheldPoison(PoisonOptions options, int rank) : options_(options), rank_(rank) {}
   const PoisonOptions& options() const { return options_; }
 
-  // Opens a window: every floe i with !held[i] gets the poison in `state`,
-  // in `start` (if given) and in `reach`; their values are kept for the
-  // restore, with `owner` (every floe's owner on every rank, alike).
-  void poison(std::span<const std::uint8_t> held, std::span<const int> owner, std::vector<FloeState>& state,
-              std::vector<FloeState>* start, std::vector<double>& reach, const contact::Domain& domain);
-  // Closes the window (nothing if none is open): the unheld floes' states
-  // from their owners (collective), the kept reaches, and in `start` (if
-  // given) the kept step-start copy, or, with `start_from_state`, the state
-  // kept at the window's opening (a window opened before the step's start
-  // copy was taken, the state unchanged between).
-  void restore(const parallel::Communicator& comm, std::vector<FloeState>& state, std::vector<FloeState>* start,
-               std::vector<double>& reach, bool start_from_state = false);
+  // Poisons every floe i with !held[i] in `state`, in `start` (if given)
+  // and in `reach` (where it has a value), and keeps `held` for the checks.
+  void poison(std::span<const std::uint8_t> held, std::vector<FloeState>& state, std::vector<FloeState>* start,
+              std::vector<double>& reach, const contact::Domain& domain);
   // Looks for NaN in the held floes' state, `start` (if given) and reach;
   // the first found after a phase is reported once a phase (stderr, and
-  // reports()). Nothing when no window is open.
+  // reports()). Nothing before the first poison.
   void check(const char* phase, const std::vector<FloeState>& state, const std::vector<FloeState>* start,
              std::span<const double> reach);
 
   bool open() const { return open_; }
-  // Windows opened and floes poisoned in them (summed over the windows).
+  // Times the unheld floes were poisoned (windows) and floes poisoned (summed over them).
   long long windows() const { return windows_; }
   long long poisoned() const { return poisoned_; }
   // The phase after which the last check was made (a run that fails or
@@ -109,10 +96,6 @@ private:
   long long windows_ = 0, poisoned_ = 0;
   std::string last_checked_;
   std::vector<std::uint8_t> held_;
-  std::vector<int> owner_;
-  std::vector<std::uint32_t> unheld_;
-  std::vector<FloeState> kept_state_, kept_start_;
-  std::vector<double> kept_reach_;
   std::vector<std::string> reported_phases_, reports_;
 };
 

@@ -233,8 +233,22 @@ void Simulation::floes_half_kick(StepContext& ctx) {
   ctx.momenta = {};
   add_owned_momentum(std::span(ctx.momenta).subspan<StepContext::kAtStart, 2>());
   if (!floe_sea_) return;
+  // The loads are evaluated here when they went stale (a split, a restore,
+  // the explicit damper): a rebuild of the footprints then takes the drift's
+  // owners (assigned at the last detection, at the present places: the sea's
+  // flow and the kicks move no floe) and poses this rank's floes only, as in
+  // sea_half_kick. After a rejected try the owners are those of its places,
+  // not of the step's start the floes are back at: a rebuild then poses
+  // every floe, so every floe's state comes from its owner first (rare).
+  if (owners_off_places_) whole_state(ctx, parallel::WholeState::state);
+  else offer_place_owners();
   floe_sea_->ready_loads(scenario_.floes, *sea_, incident_.get(), 0.5 * ctx.dt);
   floe_sea_->kick_floes(scenario_.floes, 0.5 * ctx.dt);
+}
+
+void Simulation::offer_place_owners() {
+  if (!comm_.serial() && owners_.has_slabs() && owners_.owner().size() == scenario_.floes.size())
+    floe_sea_->take_place_owners(owners_.owner(), owners_.mine(), owners_.slabs().first_row);
 }
 
 void Simulation::drift(StepContext& ctx) {
@@ -271,6 +285,7 @@ void Simulation::drift(StepContext& ctx) {
     std::vector<int> detected;  // the last detection's owners, when the cuts may move
     if (owners_.may_move(steps_)) detected.assign(owners_.owner().begin(), owners_.owner().end());
     const bool moved = owners_.update(comm_, scenario_.floes, steps_);
+    owners_off_places_ = false;
     if (moved && owners_.has_slabs()) follow_slabs();
     if (moved) hand_over_moved(ctx, detected);
     // The moorings of the floes this rank drifts: each kick is its floe's
@@ -282,9 +297,17 @@ void Simulation::drift(StepContext& ctx) {
     const double start = parallel::thread_seconds();
     drift_velocities(scenario_.floes, quadrature_, drift_params_, current, wind, ctx.dt, owners_.mine(), water);
     owners_.charge(parallel::thread_seconds() - start);
-    comm_.complete_owned(scenario_.floes.state, owners_.owner());
-    state_whole_ = true;
-    wrapped_.clear();  // every copy is now its owner's (wrap_entering: nothing left to wrap)
+    // The drifted states to the ranks that read them: with the state held
+    // by owner, to the ranks that hold each floe (the halo exchange, part
+    // (a)); else to every rank.
+    if (halo_exchange()) {
+      send_to_holders();
+      state_whole_ = false;
+    } else {
+      comm_.complete_owned(scenario_.floes.state, owners_.owner());
+      state_whole_ = true;
+    }
+    wrapped_.clear();  // every copy a rank holds is now its owner's (wrap_entering: nothing left to wrap)
   }
   add_owned_momentum(std::span(ctx.momenta).subspan<StepContext::kAfterDrift, 2>());
 }
@@ -330,7 +353,7 @@ void Simulation::note_collisions() {
   collision_events_.insert(collision_events_.end(), rows.begin(), rows.end());
 }
 
-void Simulation::percussion(const StepContext& ctx) {
+void Simulation::percussion(StepContext& ctx) {
   // The step is done (the floes at t_ = ctx.t + dt): its collisions' loads
   // are judged; pieces of a split start the next step.
   if (!percussion_) return;
@@ -346,11 +369,23 @@ void Simulation::percussion(const StepContext& ctx) {
   // are), and every rank concludes on all of them in floe order: the serial
   // events and splits.
   const double start = parallel::thread_seconds();
+  const std::vector<std::uint8_t> held = held_now();  // a split's neighbours: among the held floes
   const PercussionAnalyses mine = percussion_->analyse(scenario_.floes, *impulse_record_, t_, ctx.dt,
-                                                       PercussionShare{owners_.owner(), comm_.rank()});
+                                                       PercussionShare{owners_.owner(), comm_.rank(), held});
   owners_.charge_fracture(parallel::thread_seconds() - start);
   if (!mine.loaded) return;
   PercussionAnalyses all = combine(comm_.allgather_parts(pack(mine), unpack_percussion), percussion_ranks_);
+  // Every rank applies every split, deciding it again from the parent's
+  // neighbours where an earlier split came near, and the pieces take their
+  // parent's state; then the owners are assigned from every floe's place
+  // (detect_in_place). With the state held by owner a rank's copies of the
+  // floes it does not hold are stale, so when a split may be made (an
+  // initiation through the floe, the same on every rank) every floe's
+  // state comes from its owner first: one gather, in such a step only.
+  const bool may_split = scenario_.config.fracture.split &&
+                         std::any_of(all.initiations.begin(), all.initiations.end(),
+                                     [](const FloeInitiation& fi) { return fi.through != 0; });
+  if (may_split) whole_state(ctx, parallel::WholeState::state);
   if (percussion_->conclude(scenario_.floes, std::move(all))) on_floes_changed();
 }
 
@@ -515,8 +550,13 @@ bool Simulation::detect_and_check(StepContext& ctx) {
   // accepted (a rejected try's places are undone).
   // The owners take the notices there (announce_held: they ride on the
   // strips' gather).
+  // With the state held by owner the floes entering this rank's held set
+  // (and those come to it) get their states here (the halo exchange's part
+  // (b), on the same calls; kept only if the step is accepted).
   wrap_entering(owners_.mine());
-  parallel::HeldFloes held = hold_band(leaving, leaving_counts);
+  std::optional<parallel::HaloPart> halo = halo_part(&announced_, &ctx.start);
+  parallel::HeldFloes held = hold_band(leaving, leaving_counts, halo ? &*halo : nullptr);
+  note_arrived(halo);
   wrap_entering(held.index);
   contact::Detection part;  // this rank's (serially: `next` itself)
   // The whole lists are gathered only for the advance from the whole
@@ -533,6 +573,7 @@ bool Simulation::detect_and_check(StepContext& ctx) {
     // Redo the step with half the time.
     ++rejected_steps_;
     scenario_.floes.state = ctx.start;
+    owners_off_places_ = !comm_.serial();  // the owners took the try's notices
     ctx.dt *= 0.5;
     if (ctx.dt < kFloorFraction * scenario_.config.run.dt_max * std::pow(0.5, kMaxHalvings / 2)) {
       std::ostringstream m;
@@ -544,6 +585,13 @@ bool Simulation::detect_and_check(StepContext& ctx) {
   }
   detection_ = std::move(next);
   held_ = std::move(held);
+  // With the state held by owner the copies of the floes this rank does
+  // not hold are stale from here on (the vertical drift that follows is
+  // over the held floes; they were since the drift unless gathered).
+  if (halo) {
+    announced_ = std::move(halo->announced);
+    state_whole_ = false;
+  }
   detection_whole_ = comm_.serial() || whole;
   if (!comm_.serial()) {
     detection_part_ = std::move(part);
@@ -571,8 +619,7 @@ void Simulation::sea_half_kick(StepContext& ctx) {
   // places the loads are evaluated at (the sea's flow moves no floe
   // across): a rebuild of the footprints takes them, and poses this rank's
   // floes only.
-  if (!comm_.serial() && owners_.has_slabs() && owners_.owner().size() == scenario_.floes.size())
-    floe_sea_->take_place_owners(owners_.owner(), owners_.mine(), owners_.slabs().first_row);
+  offer_place_owners();
   floe_sea_->evaluate_loads(scenario_.floes, *sea_, incident_.get(), 0.5 * ctx.dt);
   add_owned_momentum(std::span(ctx.momenta).subspan<StepContext::kBeforeSeaKick, 2>());
   floe_sea_->kick_floes(scenario_.floes, 0.5 * ctx.dt);

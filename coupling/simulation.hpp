@@ -64,6 +64,7 @@
 #include "coupling/scenario.hpp"
 #include "parallel/comm.hpp"
 #include "parallel/advance_share.hpp"
+#include "parallel/held.hpp"
 #include "parallel/place.hpp"
 
 namespace floesim {
@@ -116,10 +117,11 @@ struct Energies {
 class Simulation {
 public:
   // `comm`: the ranks of a distributed run (parallel/comm.hpp; default: serial).
-  // Every rank holds the whole state and steps it the same way; the ranks
-  // share the drift and detection by place (each its floes, stage six of
-  // docs/parallel.md) and gather their results, so every rank ends each
-  // step with the serial run's state, bit for bit. step() is then collective.
+  // The ranks share the step by place (each its floes, docs/parallel.md);
+  // each rank keeps current the floes it holds (its own and its halo band:
+  // the halo exchange, or every floe where the run reads every floe), so
+  // its held floes and the writer's gather (writer_states()) are the
+  // serial run's, bit for bit. step() is then collective.
   explicit Simulation(Scenario scenario, parallel::Communicator comm = {});
   ~Simulation();
   Simulation(Simulation&&) noexcept;
@@ -232,12 +234,15 @@ private:
   void sample_forcing(StepContext& ctx) const;
   void sea_flow(const StepContext& ctx);
   void floes_half_kick(StepContext& ctx);
+  // The drift's owners by place to the coupling for its next evaluation
+  // (FloeSeaContact::take_place_owners), when they follow the sea's slabs.
+  void offer_place_owners();
   void sea_half_kick(StepContext& ctx);
   void drift(StepContext& ctx);
   void follow_slabs();  // the sea and the coupling take the owners' moved slabs
   void collide(StepContext& ctx);
   void note_collisions();
-  void percussion(const StepContext& ctx);
+  void percussion(StepContext& ctx);
   void on_floes_changed();  // rebuilds every per-floe structure (after a split)
   void advance(StepContext& ctx);
   bool detect_and_check(StepContext& ctx);  // false: the step overlapped, dt halved
@@ -258,8 +263,36 @@ private:
   // At a detection whose owners come from the own floes: `leaving`, this
   // rank's notices of its floes that left its strip, and every rank's count
   // of them, which the owners take there (announce_held).
+  // With the halo exchange (`halo`: halo_part()), the part (b) rides on it.
   parallel::HeldFloes hold_band(std::span<const parallel::LeaveNotice> leaving = {},
-                                std::span<const long long> leaving_counts = {});
+                                std::span<const long long> leaving_counts = {}, parallel::HaloPart* halo = nullptr);
+  // The state held by owner with a halo (docs/parallel.md, "The halo
+  // exchange (halo26)"): on several ranks, with the advance from the parts,
+  // no sea or the sea in slabs with the explicit kicks (the implicit step,
+  // the seas not in slabs and the advance from the whole detection read
+  // every floe at every step: the drift sends every state to every rank
+  // there). The same on every rank, for the whole run.
+  bool halo_exchange() const;
+  // The halo exchange's part (a), after the drift: each floe this rank owns
+  // to the ranks that hold it (held_now() on each: those its owner at the
+  // last detection announced it to, its coupling's owner; a floe whose
+  // owner changed since, to every rank), one all-to-all.
+  void send_to_holders();
+  // Part (b) at a detection: the HaloPart for announce_held (none without
+  // the exchange), with `last` the announced sets of the last detection
+  // (null: none known, every entering state sent) and `start` the
+  // step-start copies (null outside a step: no floe leaves its strip
+  // there). The detection keeps its announced sets (announced_) if kept.
+  std::optional<parallel::HaloPart> halo_part(const parallel::Announced* last, std::vector<FloeState>* start);
+  // The floes whose states arrived there are their owners' copies, which
+  // the owners wrapped: noted as wrapped (wrap_entering leaves them).
+  void note_arrived(const std::optional<parallel::HaloPart>& halo);
+  // The ranks this rank announced its floes to at the last detection kept
+  // (the floes it owned then; empty before the first, or without the exchange).
+  parallel::Announced announced_;
+  // From a rejected try to the redone try's drift: the owners are those of
+  // the try's places, not of the places the floes are back at.
+  bool owners_off_places_ = false;
   // Wraps the centroids of the floes this rank holds (held_now()) into a
   // periodic box, and notes which (wrapped_).
   void wrap_periodic();
@@ -275,6 +308,9 @@ private:
   // (owners_.mine()) and its own floes for the coupling. Empty: every floe
   // (one rank, no detection yet, or the implicit step).
   std::vector<std::uint8_t> held_now() const;
+  // held_now() but for the implicit step's every floe (the poison mode's
+  // held set: the implicit step is a reader of the others).
+  std::vector<std::uint8_t> held_by_band() const;
   // The poison mode's hook after the phase `phase` (poison_mode.cpp): opens,
   // checks and closes its windows; nothing when the mode is off.
   void probe(const char* phase, StepContext& ctx) {
@@ -336,11 +372,10 @@ private:
   bool detection_whole_ = true;
   const contact::Detection& whole_detection();
   // Whether every floe's state and step-start copy (ctx.start) are current
-  // on this rank, every rank alike. True after the drift's complete_owned
-  // (today every rank holds every floe current); the halo exchange (piece
-  // 8) will leave only the held floes current (held_, and the own floes),
-  // and the poison mode of the run does so in its windows (false while one
-  // is open). whole_state() makes them current when a step reads every
+  // on this rank, every rank alike. True where the drift sends every
+  // state to every rank (halo_exchange() false); with the halo exchange
+  // false from the drift on (only the held floes are current: held_now()).
+  // whole_state() makes them current when a step reads every
   // floe (the pair list's rebuild on a part, a fallback, a whole step of
   // the back-off: parallel::WholeOnDemand), once in such a step; or the
   // states alone (what the advance reads), which leave the flag false.

@@ -4,6 +4,7 @@
 // a move of the cuts, the whole lists and the whole state on demand, and
 // the periodic wrap of the held floes. The step's phases are in
 // simulation.cpp.
+#include <algorithm>
 #include <cmath>
 
 #include "core/error.hpp"
@@ -21,8 +22,8 @@ void Simulation::hand_over_moved(StepContext& ctx, std::span<const int> detected
   // drifts them alike. Its other copies are not (wrap_periodic and the
   // vertical drift pass over the held floes only), and a move of the cuts
   // can make r the owner of such a floe: r would drift it from its stale
-  // copy, and the drift's complete_owned would send that copy to every
-  // rank. So each floe whose owner changed goes from its owner at the last
+  // copy, and the drift's exchange would send that copy to its holders.
+  // So each floe whose owner changed goes from its owner at the last
   // detection, which held it, to its new owner: what the new owner's
   // drift and the phases after it read of it that the constants do not
   // give (the collision shapes, the drift's quadrature, the moorings'
@@ -49,13 +50,18 @@ std::vector<std::uint8_t> Simulation::held_now() const {
   // between a move of the slabs and the footprints' next rebuild (with a
   // window) they need not be in its band, and it poses them (their x, y,
   // yaw) and its law reads their heave, pitch and roll. Their copies are
-  // current: the drift's exchange brings every floe's state, and the
+  // current: the drift's exchange sends each to its holders (the coupling's
+  // owner among them), the detection's the floes entering a band, and the
   // collisions' and advance's moves reach every rank.
   // Every floe with the implicit step, which poses every floe at the
   // midpoint of its motion (whole on every rank).
+  if (floe_sea_ && floe_sea_->implicit()) return {};
+  return held_by_band();
+}
+
+std::vector<std::uint8_t> Simulation::held_by_band() const {
   const std::size_t n = scenario_.floes.size();
   if (comm_.serial() || held_.mask.size() != n || owners_.owner().size() != n) return {};
-  if (floe_sea_ && floe_sea_->implicit()) return {};
   std::vector<std::uint8_t> held = held_.mask;
   for (const std::uint32_t i : owners_.mine()) held[i] = 1;
   if (floe_sea_)
@@ -89,7 +95,13 @@ void Simulation::detect_in_place() {
   owners_.assign(scenario_.floes);
   set_reach();
   wrap_entering(owners_.mine());
-  held_ = hold_band();
+  // Outside a step nothing is known of who held what (the start, a
+  // restore: every copy is the file's; a split: gathered first): every
+  // entering floe's state goes with its notice.
+  std::optional<parallel::HaloPart> halo = halo_part(nullptr, nullptr);
+  held_ = hold_band({}, {}, halo ? &*halo : nullptr);
+  note_arrived(halo);
+  if (halo) announced_ = std::move(halo->announced);
   wrap_entering(held_.index);
   contact::Detection part;
   const bool whole = !advance_share_options_.on_part;
@@ -100,13 +112,80 @@ void Simulation::detect_in_place() {
 }
 
 parallel::HeldFloes Simulation::hold_band(std::span<const parallel::LeaveNotice> leaving,
-                                          std::span<const long long> leaving_counts) {
+                                          std::span<const long long> leaving_counts, parallel::HaloPart* halo) {
   const std::size_t n = scenario_.floes.size();
   if (comm_.serial()) return held_.mask.size() == n ? std::move(held_) : parallel::every_floe(n);
   // Each owner tests its own floes against the ranks' strips and announces
   // them, with their reaches, to the ranks whose band holds them
   // (parallel::announce_held: the band's rule, H the ranks' largest h_j).
-  return parallel::announce_held(comm_, owners_, scenario_.floes, shapes_, detection_options_, leaving, leaving_counts);
+  return parallel::announce_held(comm_, owners_, scenario_.floes, shapes_, detection_options_, leaving, leaving_counts,
+                                 halo);
+}
+
+bool Simulation::halo_exchange() const {
+  // The readers of every floe that stay (docs/parallel.md, "The halo
+  // exchange (halo26)"): the implicit step poses and moves every floe at
+  // the midpoint of its motion, on every rank; a sea not in slabs
+  // rebuilds the footprints from every floe's pose (its owners by index);
+  // the advance from the whole detection sets up every floe's pairs.
+  if (comm_.serial() || !advance_share_options_.on_part) return false;
+  return !floe_sea_ || (!floe_sea_->implicit() && owners_.has_slabs());
+}
+
+void Simulation::send_to_holders() {
+  // Rank s reads, until the next drift, the floes it holds (held_now() on
+  // s): its band and own floes at the last detection, the floes it owns
+  // now, its coupling's own floes. Their copies there are current but for
+  // the drift, which only the owner made; so the owner sends each floe's
+  // drifted state (96 B and its index) to
+  // - the ranks it announced the floe to at the last detection, if it
+  //   owned the floe then (announced_): their bands held it;
+  // - every other rank, if it did not (the floe came to it since, by the
+  //   drift's migration or a move of the cuts: the ranks that hold it,
+  //   its old owner and that owner's band, are known to that owner only);
+  //   the floes that change owner are few, and each new owner then
+  //   announces them at the next detection;
+  // - its coupling's owner (FloeSeaContact::floe_owners), if not among
+  //   those: between a move of the slabs and the footprints' next rebuild
+  //   the coupling's floes need not be in its band.
+  // The floes this rank owns now are its own already.
+  const auto ranks = static_cast<std::size_t>(comm_.size());
+  const int me = comm_.rank();
+  const std::size_t n = scenario_.floes.size();
+  std::span<const int> coupling;
+  if (floe_sea_ && floe_sea_->floe_owners().size() == n) coupling = floe_sea_->floe_owners();
+  std::vector<std::vector<std::uint32_t>> to(ranks);
+  for (const std::uint32_t j : owners_.mine()) {
+    std::span<const int> holders;
+    const bool known = announced_.find(j, holders);
+    if (known) {
+      for (const int s : holders) to[static_cast<std::size_t>(s)].push_back(j);
+    } else {
+      for (std::size_t s = 0; s < ranks; ++s)
+        if (static_cast<int>(s) != me) to[s].push_back(j);
+    }
+    if (!coupling.empty() && known) {
+      const int c = coupling[j];
+      if (c != me && !std::binary_search(holders.begin(), holders.end(), c)) to[static_cast<std::size_t>(c)].push_back(j);
+    }
+  }
+  comm_.send_items(scenario_.floes.state, to);
+}
+
+std::optional<parallel::HaloPart> Simulation::halo_part(const parallel::Announced* last,
+                                                        std::vector<FloeState>* start) {
+  if (!halo_exchange()) return std::nullopt;
+  parallel::HaloPart halo;
+  halo.last = last;
+  halo.state = &scenario_.floes.state;
+  halo.start = start;
+  return halo;
+}
+
+void Simulation::note_arrived(const std::optional<parallel::HaloPart>& halo) {
+  if (!halo || wrapped_.empty()) return;
+  for (const std::uint32_t j : halo->written)
+    if (j < wrapped_.size()) wrapped_[j] = 1;
 }
 
 const contact::Detection& Simulation::whole_detection() {
@@ -124,33 +203,36 @@ void Simulation::whole_state(StepContext& ctx, parallel::WholeState what) {
   // its step-start copy, from its owner (the drift's, owners_: it drifted
   // the floe and holds both current), in one message: 96 B a floe the rank
   // does not own for the state alone, 192 B with the copy. Only the floes
-  // this rank does not hold take them: a held floe's copy is current
+  // this rank does not hold (held_now()) take them: a held floe's copy is current
   // already (every holder updates it alike), and the poison mode's NaN in a
   // held floe, a reader's trace, stays to be reported.
   //
   // state_whole_ (one flag: both whole) is set only by the gather of both.
   // The state alone leaves the step-start copies stale, so a later ask in
-  // the step gathers again; the advance, the one path that asks for the
-  // state alone, keeps what it gathered (its `start`) and asks once.
-  if (state_whole_) return;
+  // the step gathers again; the advance, which asks for the state alone,
+  // keeps what it gathered (its `start`) and asks once; a split asks for
+  // the state alone after the step (nothing reads the step-start copy then).
+  //
+  // The poison mode's mutation `stale` (coupling/poison_mode.hpp) gathers
+  // nothing: a step that reads every floe then reads the poison.
+  if (state_whole_ || (poison_ && poison_->options().stale)) return;
   std::vector<FloeState>& state = scenario_.floes.state;
   const std::size_t n = state.size();
   FLOESIM_ASSERT(ctx.start.size() == n && owners_.owner().size() == n);
-  std::vector<std::uint8_t> held = held_.mask;
-  held.resize(n, 0);
-  for (const std::uint32_t i : owners_.mine()) held[i] = 1;
+  const std::vector<std::uint8_t> held_mask = held_now();  // empty: every floe held
+  const auto held = [&](std::size_t i) { return held_mask.empty() || held_mask[i] != 0; };
   if (what == parallel::WholeState::state) {
     std::vector<FloeState> owned = state;
     comm_.complete_owned(owned, owners_.owner());
     for (std::size_t i = 0; i < n; ++i)
-      if (!held[i]) state[i] = owned[i];
+      if (!held(i)) state[i] = owned[i];
     return;
   }
   std::vector<std::array<FloeState, 2>> both(n);
   for (std::size_t i = 0; i < n; ++i) both[i] = {state[i], ctx.start[i]};
   comm_.complete_owned(both, owners_.owner());
   for (std::size_t i = 0; i < n; ++i)
-    if (!held[i]) {
+    if (!held(i)) {
       state[i] = both[i][0];
       ctx.start[i] = both[i][1];
     }

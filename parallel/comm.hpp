@@ -133,6 +133,17 @@ public:
   template <class... T>
   void hand_over_each(std::span<const int> held_by, std::span<const int> wanted_by, std::vector<T>&... values) const;
 
+  // Items sent to the ranks that want them, when only the sender knows who
+  // does: to[s] lists the items (indices into `values`) this rank sends
+  // rank s, which it holds current; each rank writes every item it
+  // receives into its `values`. Records of the index (4 B) and the value,
+  // one alltoall_bytes (two calls: the sizes, then the records). Returns
+  // the items this rank received, by sender in rank order and in each
+  // sender's order within.
+  template <class T>
+  std::vector<std::uint32_t> send_items(std::vector<T>& values,
+                                        const std::vector<std::vector<std::uint32_t>>& to) const;
+
   // Bytes: every rank's `mine` concatenated in rank order; `counts` gets
   // each rank's byte count. Two collective calls (the counts, then the bytes).
   std::vector<std::byte> allgather_bytes(std::span<const std::byte> mine, std::vector<std::size_t>& counts) const;
@@ -285,6 +296,37 @@ void Communicator::hand_over_each(std::span<const int> held_by, std::span<const 
   const std::byte* from = in.data();
   for (const std::uint32_t i : plan.receive)
     ((std::memcpy(static_cast<void*>(&values[i]), from, sizeof(T)), from += sizeof(T)), ...);
+}
+
+template <class T>
+std::vector<std::uint32_t> Communicator::send_items(std::vector<T>& values,
+                                                    const std::vector<std::vector<std::uint32_t>>& to) const {
+  static_assert(kSentAsBytes<T>);
+  if (serial()) return {};
+  constexpr std::size_t record = sizeof(std::uint32_t) + sizeof(T);
+  std::vector<std::size_t> send_bytes(static_cast<std::size_t>(size_), 0);
+  std::size_t total = 0;
+  for (std::size_t s = 0; s < to.size(); ++s) total += to[s].size();
+  std::vector<std::byte> out(total * record);
+  std::byte* at = out.data();
+  for (std::size_t s = 0; s < to.size(); ++s) {
+    send_bytes[s] = to[s].size() * record;
+    for (const std::uint32_t i : to[s]) {
+      std::memcpy(at, &i, sizeof(i));
+      std::memcpy(at + sizeof(i), static_cast<const void*>(&values[i]), sizeof(T));
+      at += record;
+    }
+  }
+  std::vector<std::byte> in;
+  std::vector<std::size_t> receive_bytes;
+  alltoall_bytes(out, send_bytes, in, receive_bytes);
+  std::vector<std::uint32_t> received(in.size() / record);
+  for (std::size_t k = 0; k < received.size(); ++k) {
+    const std::byte* from = in.data() + k * record;
+    std::memcpy(&received[k], from, sizeof(std::uint32_t));
+    std::memcpy(static_cast<void*>(&values[received[k]]), from + sizeof(std::uint32_t), sizeof(T));
+  }
+  return received;
 }
 
 // The MPI environment of a process: MPI_Init when the process was started

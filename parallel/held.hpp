@@ -83,6 +83,46 @@ HeldFloes held_from_notices(std::span<const std::uint32_t> own, std::size_t n, s
 void widen_by_arrivals(std::span<BandStrip> strips, std::span<const LeaveNotice> notices,
                        const contact::CollisionShapes& shapes, double collision_distance);
 
+// The ranks an owner announced its floes to at a detection (band_notices):
+// for each floe it owned then, ascending, the ranks whose band held it.
+// The halo exchange (docs/parallel.md, "The halo exchange (halo26)") sends
+// an owned floe's state to those ranks after the drift, and at the next
+// detection knows which of the ranks its band notices go to held the floe
+// already (those it announced it to, if it owned the floe then).
+struct Announced {
+  std::vector<std::uint32_t> floe;  // ascending
+  std::vector<std::size_t> offset;  // floe[k]'s ranks: rank[offset[k], offset[k + 1])
+  std::vector<int> rank;            // ascending within a floe
+  // Whether floe j was announced by this rank (owned at that detection),
+  // and if so its ranks in `ranks`.
+  bool find(std::uint32_t j, std::span<const int>& ranks) const;
+};
+// The announced sets of `own` (ascending) from the notices a rank sends
+// (band_notices' result, one per rank).
+Announced announced_of(std::span<const std::uint32_t> own, std::span<const BandNotice> sent);
+
+// The halo exchange's part at a detection (piece 8 (b)), given to
+// announce_held: the floes that enter a rank's held set there get their
+// state from their owner with their band notice, and a floe that leaves
+// its owner's strip takes its state and step-start copy to its new owner
+// with its leave notice (the new owner need not have held it). Every rank
+// alike gives one or none.
+struct HaloPart {
+  // In: this rank's announced sets at the last accepted detection (the
+  // floes it owned then); a floe not among them, or one that came to this
+  // rank here, has its state sent with every band notice of it.
+  const Announced* last = nullptr;
+  // In and out: the floes' states (the receiver writes the floes whose
+  // state arrives) and step-start copies (the new owner writes the
+  // leaving floes' own). Must be the states announce_held reads.
+  std::vector<FloeState>* state = nullptr;
+  std::vector<FloeState>* start = nullptr;
+  // Out: this detection's announced sets, and the floes whose state this
+  // rank received (entering its held set, or come to it).
+  Announced announced;
+  std::vector<std::uint32_t> written;
+};
+
 // Collective (every rank, owners assigned for these floes, each rank's own
 // floes' reaches in options.reach, n values): every rank's held floes as
 // parallel::held_floes gives them with H the ranks' largest h_j, and the
@@ -96,8 +136,14 @@ void widen_by_arrivals(std::span<BandStrip> strips, std::span<const LeaveNotice>
 // the floes that came to it. Three calls: the strips' and notices'
 // allgather, the band's notices' counts and records. Serial: every floe
 // held, nothing exchanged.
+// With `halo` (the state held by owner), the part (b) of the halo
+// exchange rides on the same calls: the leave notices carry the leaving
+// floes' states and step-start copies (192 B more a notice), the band
+// notices the states of the floes that enter the receiver's held set
+// (HaloPart; 96 B a floe and receiver, and 1 B and a header of 8 B).
 HeldFloes announce_held(const Communicator& comm, FloeOwners& owners, const Floes& floes,
                         const contact::CollisionShapes& shapes, contact::DetectionOptions& options,
-                        std::span<const LeaveNotice> leaving = {}, std::span<const long long> leaving_counts = {});
+                        std::span<const LeaveNotice> leaving = {}, std::span<const long long> leaving_counts = {},
+                        HaloPart* halo = nullptr);
 
 }  // namespace floesim::parallel

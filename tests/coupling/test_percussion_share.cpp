@@ -125,7 +125,7 @@ long check_ranks(int ranks, const Floes& start, const std::vector<contact::Impul
     for (int r = 0; r < ranks; ++r) {
       const auto ru = static_cast<std::size_t>(r);
       parts.push_back(
-          unpack_percussion(pack(rank[ru].analyse(floes[ru], records[step], t, dt, PercussionShare{owner, r}))));
+          unpack_percussion(pack(rank[ru].analyse(floes[ru], records[step], t, dt, PercussionShare{owner, r, {}}))));
     }
     // In rank order, not floe order: conclude sorts them.
     const PercussionAnalyses all = combine(parts, by_rank);

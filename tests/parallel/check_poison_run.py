@@ -1,10 +1,11 @@
 #!/usr/bin/env python3
 """The poison mode of the run (docs/parallel.md, "The poison mode of the run
-(piece 7; poison18)"): with the test hook FLOESIM_TEST_POISON_UNHELD=step
-(NaN), step-lure (finite, wrong values) or step-mutant, each rank poisons
-its copies of the floes it does not hold (its own floes and its halo band)
-where the halo exchange of piece 8 will be, and reports the first NaN it
-finds in a held floe after each phase.
+(piece 7; poison18)" and "The halo exchange (halo26)"): with the test hook
+FLOESIM_TEST_POISON_UNHELD=step (NaN), step-lure (finite, wrong values) or
+step-mutant, each rank poisons its copies of the floes it does not hold (its
+own floes, its halo band, its coupling's own floes) right after each part of
+the halo exchange (after the drift, at the detection) and restores nothing,
+and reports the first NaN it finds in a held floe after each phase.
 
 usage: check_poison_run.py FLOESIM MPIEXEC WORKDIR
        check_poison_run.py --no-mpi    (MPI not built: exits 77, ctest's skip code)
@@ -13,14 +14,15 @@ On 2 ranks (`mpirun --oversubscribe`):
 (a) no reader left: the collisions-only periodic pack of
     scripts/scenarios/moving_pack.py (400 floes to 250 s), NaN and lure, is
     bit for bit the serial run, every rank poisoning floes and reporting no
-    phase (unless a step fell back to the whole solve, a known reader: then
-    said, not failed); on 1 rank the mode poisons nothing and the run is the serial one.
+    phase (unless a step fell back to the whole solve: then said, not
+    failed); on 1 rank the mode poisons nothing and the run is the serial one.
 (b) known readers are found: the same pack with the advance from the whole
     detection (`advance_on_part = false`, whose set-up and clusters read
-    every floe by design) with the lure does not give the serial run; a small
-    ocean with the implicit floe-sea step (whole on every rank) with NaN does
-    not either, and the phase it names (a report, or the phase after the last
-    clean check where the run failed) is one after the detection.
+    every floe by design; the drift sends every state there) with the lure
+    does not give the serial run; a small ocean with the implicit floe-sea
+    step (whole on every rank) with NaN does not either, and the phase it
+    names (a report, or the phase after the last clean check where the run
+    failed) is the detection or one after it.
 (c) the mutation: each rank poisons one floe it holds too; the run fails,
     and each rank reports it after the drift, the first phase checked.
 (d) the whole state on demand (docs/parallel.md, "The whole state on demand
@@ -31,10 +33,14 @@ On 2 ranks (`mpirun --oversubscribe`):
     1500 s: the collisions' and the advance's fallbacks and whole steps, a
     rebuild) on 3 ranks with the lure (on 2 ranks every rank holds every
     floe there), are bit for bit the serial run, each having rebuilt or
-    fallen back, with no phase reported; the mutation "-stale" (the windows
-    do not say the unheld floes are stale: nothing is gathered) fails or
-    differs on both (NaN on the pack; the lure on the wall jam, where a
-    sub-step on NaN makes no progress).
+    fallen back, with no phase reported; the mutation "-stale" (whole_state
+    gathers nothing) fails or differs on both (NaN on the pack; the lure on
+    the wall jam, where a sub-step on NaN makes no progress).
+(e) the halo exchange's bytes: in (d)'s pack run, rank 0's drift phase
+    receives less than a tenth of every floe's state each step.
+(f) a split's neighbours among the held floes: check_writer_ranks.py's
+    fracture pack (to 500 s, floes split) on 3 ranks with the lure is bit
+    for bit the serial run.
 Only what is stable is pinned: other readers are being removed.
 """
 import os
@@ -155,21 +161,34 @@ wall = os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(os.path.absp
 need(run([args.floesim, "run", rebuild, "-o", "rebuild_serial.h5", "-q"]), "the 10 000-floe pack, serial")
 need(run([args.floesim, "run", wall, "-o", "wall_serial.h5", "-q", "--until", "1500"]), "the wall jam, serial")
 # (what, config, ranks, poison, its mutation (nothing gathered), extra arguments, serial file, the counts that
-# say the whole steps happened)
+# say the whole steps happened, the floes whose drift phase's bytes are checked or None)
 cases = [("the 10 000-floe pack (its pair list rebuilt on a part)", rebuild, 2, "step@drift", "step-stale@drift", [],
-          "rebuild_serial.h5", ["advance_rebuilds"]),
+          "rebuild_serial.h5", ["advance_rebuilds"], 10000),
          # Since onerank26 the wall jam's advances no longer fall back (its
          # conflicts are joined on one rank: advance_joined, tries that read
          # only the held and routed floes); its step-start collisions do.
          ("the wall jam (fallbacks, whole steps, clusters joined on one rank)", wall, 3, "step-lure",
           "step-lure-stale", ["--until", "1500"], "wall_serial.h5",
-          ["advance_joined", "collide_fallbacks", "collide_whole"])]
-for what, config, n, poison, mutant, extra, serial, counted in cases:
+          ["advance_joined", "collide_fallbacks", "collide_whole"], None)]
+for what, config, n, poison, mutant, extra, serial, counted, floes in cases:
     name = f"{what} on {n} ranks, {poison}"
     p = mpirun(n, poison, config, "on_demand.h5", *extra)
     s, counts = summaries(p), {k: summary(p).get(f"parallel.{k}", "0") for k in counted}
     same = p.returncode == 0 and equal("on_demand.h5", serial)
     print(f"{name}: exit {p.returncode}, {'equal' if same else 'DIFFERENT'} to the serial run; {counts}; {s}")
+    if floes and p.returncode == 0:
+        # (e) The halo exchange: rank 0's drift phase receives the states of
+        # the floes it holds and does not own (its band: some hundreds of
+        # 10 000), not every floe's (96 B x floes x steps with the drift's
+        # complete_owned). The poison mode adds no call (it restores nothing).
+        steps = int(summary(p)["steps"])
+        drift = int(summary(p)["parallel.phase.drift"].split()[2])
+        whole = 96 * floes * steps
+        print(f"{name}: rank 0's drift phase received {drift} B in {steps} steps "
+              f"({drift / whole:.3f} of every floe's state each step, {whole} B)")
+        if not drift < whole // 10:
+            failures.append(f"{name}: the drift phase received {drift} B, not less than a tenth of every floe's "
+                            f"state each step ({whole} B): the halo exchange sends more than the held floes")
     if not same:
         failures.append(f"{name}: a step that reads every floe read a floe its rank does not hold\n{p.stderr}")
     if any(v == "0" for v in counts.values()):
@@ -183,6 +202,34 @@ for what, config, n, poison, mutant, extra, serial, counted in cases:
           f"{'found (the run failed or differs)' if found else 'NOT FOUND'}")
     if not found:
         failures.append(f"{what}, {mutant}: with nothing gathered the run must fail or differ\n{m.stderr}")
+
+# (f) A split's neighbours (Percussion::decide_split, on the owner) are
+# looked for among the held floes: the lure, which can put an unheld floe
+# beside a cracked one, must not change a split. check_writer_ranks.py's
+# fracture pack (the pack to 500 s, floes split) on 3 ranks.
+FRACTURE = """
+[fracture]
+enabled = true
+criterion = "stress"
+strength = 0.2e6
+split = true
+mesh_size = 20.0
+min_fragment_area = 400.0
+"""
+splits = os.path.join(W, "splits.toml")
+with open(base) as f:
+    text = f.read()
+with open(splits, "w") as f:
+    f.write(re.sub(r"t_end = [^\n]*", "t_end = 500.0", text, count=1) + FRACTURE)
+s = summary(need(run([args.floesim, "run", splits, "-o", "splits_serial.h5", "-q"]), "the fracture pack, serial"))
+p = mpirun(3, "step-lure", splits, "splits3.h5")
+same = p.returncode == 0 and equal("splits3.h5", "splits_serial.h5")
+print(f"the fracture pack on 3 ranks, step-lure ({s.get('fracture.splits')} splits): exit {p.returncode}, "
+      f"{'equal' if same else 'DIFFERENT'} to the serial run; {summaries(p)}")
+if s.get("fracture.splits", "0") == "0":
+    failures.append("the fracture pack made no split: (f) tests nothing")
+if not same:
+    failures.append(f"the fracture pack on 3 ranks with the lure differs: a split read an unheld floe\n{p.stderr}")
 
 if failures:
     print("FAILED:\n" + "\n".join(failures))
