@@ -279,7 +279,7 @@ private:
   // owner changed since, to every rank), one all-to-all.
   void send_to_holders();
   // Part (b) at a detection: the HaloPart for announce_held (none without
-  // the exchange), with `last` the announced sets of the last detection
+  // the exchange but in the poison mode), with `last` the announced sets of the last detection
   // (null: none known, every entering state sent) and `start` the
   // step-start copies (null outside a step: no floe leaves its strip
   // there). The detection keeps its announced sets (announced_) if kept.
