@@ -47,7 +47,7 @@ import os
 import re
 import sys
 
-from ranks_harness import half_pack, moving_pack_check, need, ocean_toml, summary
+from ranks_harness import FRACTURE, half_pack, moving_pack_check, need, ocean_toml, summary
 
 args, harness, base = moving_pack_check(
     "floesim was built without MPI (FLOESIM_MPI=OFF): the poison mode is not checked", 400, 250.0, [2])
@@ -207,15 +207,6 @@ for what, config, n, poison, mutant, extra, serial, counted, floes in cases:
 # looked for among the held floes: the lure, which can put an unheld floe
 # beside a cracked one, must not change a split. check_writer_ranks.py's
 # fracture pack (the pack to 500 s, floes split) on 3 ranks.
-FRACTURE = """
-[fracture]
-enabled = true
-criterion = "stress"
-strength = 0.2e6
-split = true
-mesh_size = 20.0
-min_fragment_area = 400.0
-"""
 splits = os.path.join(W, "splits.toml")
 with open(base) as f:
     text = f.read()

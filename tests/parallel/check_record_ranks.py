@@ -37,7 +37,7 @@ import os
 import shutil
 import sys
 
-from ranks_harness import moving_pack_check, need, summary
+from ranks_harness import FRACTURE, moving_pack_check, need, summary
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
@@ -46,16 +46,6 @@ args, harness, base = moving_pack_check(
 W = args.workdir
 run, mpirun = harness.run, harness.mpirun
 failures = []
-
-FRACTURE = """
-[fracture]
-enabled = true
-criterion = "stress"
-strength = 0.2e6
-split = true
-mesh_size = 20.0
-min_fragment_area = 400.0
-"""
 
 config = os.path.join(W, "record.toml")
 with open(base) as f:

@@ -28,7 +28,7 @@ usage: check_writer_ranks.py FLOESIM MPIEXEC WORKDIR
 """
 import os
 
-from ranks_harness import finish, half_pack, moving_pack_check, need, ocean_toml, ran, summary
+from ranks_harness import FRACTURE, finish, half_pack, moving_pack_check, need, ocean_toml, ran, summary
 
 args, harness, base = moving_pack_check(
     "floesim was built without MPI (FLOESIM_MPI=OFF): the writer's gather is not checked", 400, 500.0, [2, 3])
@@ -44,15 +44,6 @@ def same(a, b, what):
     harness.same(a, b, what, failures)
 
 
-FRACTURE = """
-[fracture]
-enabled = true
-criterion = "stress"
-strength = 0.2e6
-split = true
-mesh_size = 20.0
-min_fragment_area = 400.0
-"""
 config = os.path.join(W, "writer.toml")
 with open(base) as f:
     text = f.read()

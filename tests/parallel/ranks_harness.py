@@ -6,7 +6,7 @@ folder with MPI allowed as root (CI containers) and one thread per rank,
 `mpirun --oversubscribe` (with test hooks' variables passed to every rank;
 the poison mode's),
 `floesim compare`, the run summary as a dict, the small ocean the sea checks
-run on, the moving pack's checks' set-up, a stop with the command's output
+run on, the moving pack's checks' set-up and fracture, a stop with the command's output
 when a step that must work fails, and the failures' list a check collects:
 a run that must exit 0, a file that must equal another bit for bit (or
 must not: a mutation), and the check's end."""
@@ -14,6 +14,19 @@ import argparse
 import os
 import subprocess
 import sys
+
+# The fracture the moving pack's checks add (check_writer_ranks.py,
+# check_record_ranks.py, check_poison_run.py): a strength its collisions
+# exceed, so floes crack and split within a few hundred seconds.
+FRACTURE = """
+[fracture]
+enabled = true
+criterion = "stress"
+strength = 0.2e6
+split = true
+mesh_size = 20.0
+min_fragment_area = 400.0
+"""
 
 ENV = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1", OMP_NUM_THREADS="1")
 
