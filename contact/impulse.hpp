@@ -138,16 +138,38 @@ struct WarmStart {
   double match_distance = 0.05;  // m
   long clock = 0;
   long max_age = 256;
-  long uses = 0;  // solves that started from the store (a share's copy, ShareAdvance, or probe, resolve_step_collisions_share)
-  // A share's copy of the run's store (ShareAdvance) logs the keys of the
-  // pairs it stores, in order (repeats kept), so that its caller can send
-  // those pairs to every rank (docs/parallel.md, "The conflicting
-  // clusters on one rank"). Off in the run's store.
+  long uses = 0;  // solves that started from the store (a share's copy counts its own: ShareAdvance, resolve_step_collisions_share)
+  // A share's copy of the run's store (ShareAdvance, resolve_step_collisions_share)
+  // logs the keys of the pairs it stores, in order (repeats kept), so that
+  // its caller can send those pairs to every rank (docs/parallel.md, "The
+  // conflicting clusters on one rank"). Off in the run's store.
   bool log = false;
   std::vector<std::uint64_t> written;
+  // The pairs a share stored, by key ascending, each with its entries as
+  // the share's copy holds them at the end.
+  using Written = std::vector<std::pair<std::uint64_t, Pair>>;
 
   void tick() {
     if (++clock % max_age == 0) std::erase_if(pairs, [&](const auto& p) { return clock - p.second.stored > max_age; });
+  }
+  // A share's copy of this store: the same pairs and clock, no uses, its
+  // writes logged.
+  WarmStart share_copy() const {
+    WarmStart copy = *this;
+    copy.uses = 0;
+    copy.log = true;
+    copy.written.clear();
+    return copy;
+  }
+  // What a share's copy stored (`written`, each pair once).
+  Written written_pairs() const {
+    std::vector<std::uint64_t> keys = written;
+    std::sort(keys.begin(), keys.end());
+    keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
+    Written out;
+    out.reserve(keys.size());
+    for (const std::uint64_t k : keys) out.emplace_back(k, pairs.at(k));
+    return out;
   }
 };
 
@@ -441,13 +463,28 @@ struct ClusterShare {
 // call's over its groups (sums; `largest` a maximum), and the groups of the
 // shares are disjoint.
 //
+// The warm store (options.warm) is kept across steps by pair: a solve reads
+// and then replaces the entries of its contacts' pairs (warm_guess,
+// warm_store), and a contact's pair has both floes in one step group (or
+// one and an obstacle): its component lies in one group. So the pairs one
+// group's solves read and write are no other group's, and the share runs on
+// a copy of the store as it was at the step's start (WarmStart::share_copy,
+// the same on every rank): each of its solves reads what the whole call's
+// solve of that component reads (the start's entry, or what an earlier
+// solve of the same group stored: the share keeps its groups' solves in the
+// whole call's order), and the share returns the pairs it stored (`warm`)
+// and its uses. Written into every rank's store with the other shares'
+// (each pair by one share, its last write the whole call's), they leave the
+// store as the whole call leaves it. options.warm itself is not changed.
+//
 // A conflict (the caller then solves the whole step from the states on
-// entry): a solve that would have used the warm store (options.warm: kept
-// across steps by pair, the shares' stores would part; the share is given an
-// empty store that counts uses), a failed LCP (its dump, not written by a
-// share, is numbered by the run's failures), a RunError. options.record (if
-// any) receives the share's loads as one event, and `places` their places
-// in the whole call's record (RecordPart, merge_step_record).
+// entry): a failed LCP (its dump, not written by a share, is numbered by the
+// run's failures), a RunError. `warm_start` is no share's own conflict any
+// more: the caller may make a share's use of the store one (a test hook,
+// parallel::CollideShareOptions::warm_conflict, which keeps the whole path
+// reachable). options.record (if any) receives the share's loads as one
+// event, and `places` their places in the whole call's record (RecordPart,
+// merge_step_record).
 struct StepCollisionShare {
   enum class Conflict { none, warm_start, failed_lcp, error };
   Conflict conflict = Conflict::none;
@@ -455,6 +492,10 @@ struct StepCollisionShare {
   long groups = 0;                   // step groups of the share
   std::size_t speculative = 0;       // speculative contacts that took part (resolve_step_collisions' count)
   std::vector<ContactPlace> places;  // per load the share recorded (options.record): its contact's place
+  // With a warm store (options.warm; none on a conflict): the pairs the
+  // share's solves stored and its solves that started from the store.
+  WarmStart::Written warm;
+  long warm_uses = 0;
 };
 //
 // `groups` (optional): the step groups, found from every pair's edge

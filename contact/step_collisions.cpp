@@ -280,11 +280,15 @@ StepCollisionShare resolve_step_collisions_share(Floes& floes, std::span<const F
                                                  const Detection& detection, double step,
                                                  const ImpulseOptions& options, const ClusterShare& share,
                                                  CollisionStats& stats, const StepGroups* groups) {
-  // The warm store is replaced by an empty probe that only says whether a
-  // solve would have used it; a failure's dump is left to the whole solve.
+  // The share's solves read and write a copy of the warm store (impulse.hpp:
+  // a pair's reads and writes are its group's alone); a failure's dump is
+  // left to the whole solve, which numbers it in the run's count.
   ImpulseOptions o = options;
-  WarmStart probe;
-  if (options.warm) o.warm = &probe;
+  WarmStart copy;
+  if (options.warm) {
+    copy = options.warm->share_copy();
+    o.warm = &copy;
+  }
   o.dump_failed_lcps.clear();
   const long failures = stats.failures;
   StepCollisionShare outcome;
@@ -297,10 +301,12 @@ StepCollisionShare resolve_step_collisions_share(Floes& floes, std::span<const F
   } catch (const RunError&) {
     outcome.conflict = StepCollisionShare::Conflict::error;
   }
-  if (outcome.conflict == StepCollisionShare::Conflict::none && probe.uses > 0)
-    outcome.conflict = StepCollisionShare::Conflict::warm_start;
   if (outcome.conflict == StepCollisionShare::Conflict::none && stats.failures != failures)
     outcome.conflict = StepCollisionShare::Conflict::failed_lcp;
+  if (outcome.conflict == StepCollisionShare::Conflict::none && options.warm) {
+    outcome.warm = copy.written_pairs();
+    outcome.warm_uses = copy.uses;
+  }
   return outcome;
 }
 

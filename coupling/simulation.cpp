@@ -338,8 +338,10 @@ void Simulation::collide(StepContext& ctx) {
     contact::resolve_step_collisions(scenario_.floes, ctx.start, detection_, ctx.dt, impulse_options_, stats_);
   else {  // every detection on several ranks leaves this rank's part (the start's and a split's too)
     const parallel::WholeOnDemand whole = whole_on_demand(ctx);
+    parallel::CollideShareOptions share;
+    share.warm_conflict = collide_warm_conflict_;
     parallel::collide_on_part(comm_, owners_.owner(), scenario_.floes, ctx.start, *detection_part_, ctx.dt,
-                              impulse_options_, stats_, collide_share_, {}, &whole);
+                              impulse_options_, stats_, collide_share_, share, &whole);
   }
   add_owned_momentum(std::span(ctx.momenta).subspan<StepContext::kAfterCollide, 2>());
 }

@@ -164,6 +164,10 @@ public:
   // and reports the first NaN it finds in a held floe after each phase.
   // Nothing changes on one rank. Its reports (also said on stderr):
   void set_poison_test(PoisonOptions options);
+  // Test option (not a user key): on several ranks, a step-start share that
+  // used the warm store falls back to the whole solve
+  // (parallel::CollideShareOptions::warm_conflict), so that tests reach it.
+  void set_collide_test(bool warm_conflict) { collide_warm_conflict_ = warm_conflict; }
   std::vector<std::string> poison_reports() const;
   std::string poison_summary() const;  // windows, floes poisoned, phases reported (empty when off)
 
@@ -398,6 +402,7 @@ private:
   long rejected_steps_ = 0;       // steps redone after an overlap
   WriterTest writer_test_ = WriterTest::off;  // set_writer_test
   std::unique_ptr<UnheldPoison> poison_;      // set_poison_test
+  bool collide_warm_conflict_ = false;        // set_collide_test
   Profile profile_;
   double t_ = 0.0;
   std::size_t steps_ = 0;

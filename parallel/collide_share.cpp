@@ -23,7 +23,8 @@ constexpr std::size_t kStats = std::tuple_size_v<decltype(contact::collision_cou
 // count (the moved floes' when the share had no conflict, else none), the
 // load places' count, the stats; then the moved floes, their states, the
 // places (segment, a, b, index as uint32, then the shift's x and y: 32
-// bytes each) and the record (append_record).
+// bytes each), the record (append_record) and the warm pairs stored
+// (append_warm: 16 bytes, and 37 an entry).
 constexpr std::size_t kHeader = 6 + kStats;
 
 }  // namespace
@@ -50,6 +51,7 @@ std::vector<std::byte> pack(const CollidePart& p) {
     append(out, std::span<const double>(shift));
   }
   append_record(out, p.record);
+  append_warm(out, p.outcome.warm, p.outcome.warm_uses);
   return out;
 }
 
@@ -77,23 +79,32 @@ CollidePart unpack_collide_part(std::span<const std::byte> bytes) {
     c = {ints[0], ints[1], ints[2], shift[0], shift[1], ints[3]};
   }
   p.record = take_record(in);
+  p.outcome.warm = take_warm(in, p.outcome.warm_uses);
   FLOESIM_ASSERT(in == bytes.data() + bytes.size());
   return p;
 }
 
 CollidePart run_collide_share(Floes& floes, std::span<const FloeState> start, const contact::Detection& detection,
                               double step, const contact::ImpulseOptions& options, std::span<const int> owner,
-                              int rank, const contact::StepGroups* groups) {
+                              int rank, const contact::StepGroups* groups,
+                              const CollideShareOptions& share_options) {
   CollidePart part;
   contact::ImpulseOptions o = options;
   if (options.record) o.record = &part.record;
   part.outcome =
       contact::resolve_step_collisions_share(floes, start, detection, step, o, {owner, rank}, part.stats, groups);
+  // The test hook: a share's use of the warm store made a conflict, as
+  // before the shares ran on copies of it (CollideShareOptions).
+  if (share_options.warm_conflict && part.outcome.conflict == StepCollisionShare::Conflict::none &&
+      part.outcome.warm_uses > 0)
+    part.outcome.conflict = StepCollisionShare::Conflict::warm_start;
   if (part.outcome.conflict == StepCollisionShare::Conflict::none) {
     for (const std::uint32_t i : part.outcome.moved) part.states.push_back(floes.state[i]);
   } else {
     part.record.clear();
     part.outcome.places.clear();
+    part.outcome.warm.clear();
+    part.outcome.warm_uses = 0;
   }
   return part;
 }
@@ -101,11 +112,13 @@ CollidePart run_collide_share(Floes& floes, std::span<const FloeState> start, co
 namespace {
 // The kinds of conflict of a try's parts, each once, into counts.conflicts
 // (AdvanceShareCounts): the names of StepCollisionShare::Conflict, and
-// `taken_twice` when no part has one but two parts changed one floe (the
-// groups are disjoint: never expected).
+// `taken_twice` (`stored_twice`) when no part has one but two parts changed
+// one floe (stored one warm pair; the groups and their pairs are disjoint:
+// never expected).
 void count_conflicts(std::span<const CollidePart> parts, AdvanceShareCounts& counts) {
   std::vector<std::string> kinds;
   std::vector<std::uint8_t> taken;
+  std::vector<std::uint64_t> stored;
   bool twice = false;
   for (const CollidePart& p : parts) {
     switch (p.outcome.conflict) {
@@ -115,13 +128,17 @@ void count_conflicts(std::span<const CollidePart> parts, AdvanceShareCounts& cou
           twice = twice || taken[i];
           taken[i] = 1;
         }
+        for (const auto& w : p.outcome.warm) stored.push_back(w.first);
         break;
       case StepCollisionShare::Conflict::warm_start: kinds.push_back("warm_start"); break;
       case StepCollisionShare::Conflict::failed_lcp: kinds.push_back("failed_lcp"); break;
       case StepCollisionShare::Conflict::error: kinds.push_back("error"); break;
     }
   }
+  std::sort(stored.begin(), stored.end());
   if (kinds.empty() && twice) kinds.push_back("taken_twice");
+  if (kinds.empty() && std::adjacent_find(stored.begin(), stored.end()) != stored.end())
+    kinds.push_back("stored_twice");
   std::sort(kinds.begin(), kinds.end());
   kinds.erase(std::unique(kinds.begin(), kinds.end()), kinds.end());
   for (const std::string& k : kinds) ++counts.conflicts[k];
@@ -129,15 +146,23 @@ void count_conflicts(std::span<const CollidePart> parts, AdvanceShareCounts& cou
 }  // namespace
 
 bool combine_collide_parts(std::span<const CollidePart> parts, Floes& floes, CollisionStats& stats,
-                           std::size_t& speculative, contact::ImpulseRecord* record) {
+                           std::size_t& speculative, contact::ImpulseRecord* record, contact::WarmStart* warm) {
   std::vector<std::uint8_t> taken(floes.size(), 0);
+  std::vector<std::uint64_t> stored;  // each pair one group's (impulse.hpp), so one part's
   for (const CollidePart& p : parts) {
     if (p.outcome.conflict != StepCollisionShare::Conflict::none) return false;
     for (const std::uint32_t i : p.outcome.moved) {
       if (taken[i]) return false;
       taken[i] = 1;
     }
+    for (const auto& w : p.outcome.warm) stored.push_back(w.first);
   }
+  std::sort(stored.begin(), stored.end());
+  if (std::adjacent_find(stored.begin(), stored.end()) != stored.end()) return false;
+  // The store: every part's pairs as its share left them, the whole call's
+  // last writes (impulse.hpp, StepCollisionShare), on every rank alike.
+  if (warm)
+    for (const CollidePart& p : parts) hold_warm(p.outcome.warm, p.outcome.warm_uses, *warm);
   speculative = 0;
   for (const CollidePart& p : parts) {
     for (std::size_t j = 0; j < p.states.size(); ++j) floes.state[p.outcome.moved[j]] = p.states[j];
@@ -155,22 +180,23 @@ bool combine_collide_parts(std::span<const CollidePart> parts, Floes& floes, Col
 std::size_t collide_by_owner(const Communicator& comm, std::span<const int> owner, Floes& floes,
                              std::span<const FloeState> start, const contact::Detection& detection, double step,
                              const contact::ImpulseOptions& options, contact::CollisionStats& stats,
-                             AdvanceShareCounts& counts, const AdvanceShareOptions& share_options) {
+                             AdvanceShareCounts& counts, const CollideShareOptions& share_options) {
   if (counts.whole_now()) return contact::resolve_step_collisions(floes, start, detection, step, options, stats);
   // W^-: a fallback starts again from it. Only the velocities change here.
   const std::vector<FloeState> entry = floes.state;
-  const CollidePart mine = run_collide_share(floes, start, detection, step, options, owner, comm.rank());
+  const CollidePart mine =
+      run_collide_share(floes, start, detection, step, options, owner, comm.rank(), nullptr, share_options);
   const std::vector<CollidePart> parts = comm.allgather_parts(pack(mine), unpack_collide_part);
   counts.clusters.resize(parts.size(), 0);
   std::size_t speculative = 0;
-  if (combine_collide_parts(parts, floes, stats, speculative, options.record)) {
+  if (combine_collide_parts(parts, floes, stats, speculative, options.record, options.warm)) {
     for (std::size_t r = 0; r < parts.size(); ++r) counts.clusters[r] += parts[r].outcome.groups;
     counts.combined();
     return speculative;
   }
   // A conflict: the whole solve from the states on entry, as the serial run.
   count_conflicts(parts, counts);
-  counts.fell_back(share_options);
+  counts.fell_back(share_options.back_off);
   floes.state = entry;
   return contact::resolve_step_collisions(floes, start, detection, step, options, stats);
 }
@@ -210,7 +236,7 @@ std::vector<contact::Detection> pairs_for_groups(const Floes& floes, const conta
 std::size_t collide_on_part(const Communicator& comm, std::span<const int> owner, Floes& floes,
                             std::span<const FloeState> start, const contact::Detection& part, double step,
                             const contact::ImpulseOptions& options, contact::CollisionStats& stats,
-                            AdvanceShareCounts& counts, const AdvanceShareOptions& share_options,
+                            AdvanceShareCounts& counts, const CollideShareOptions& share_options,
                             const WholeOnDemand* whole) {
   if (comm.serial())
     return collide_by_owner(comm, owner, floes, start, gather(comm, part), step, options, stats, counts,
@@ -262,17 +288,17 @@ std::size_t collide_on_part(const Communicator& comm, std::span<const int> owner
   // merged from the parts).
   const std::vector<FloeState> entry = floes.state;
   const CollidePart share =
-      run_collide_share(floes, share_start, local, step, options, owner, comm.rank(), &groups);
+      run_collide_share(floes, share_start, local, step, options, owner, comm.rank(), &groups, share_options);
   const std::vector<CollidePart> shares = comm.allgather_parts(pack(share), unpack_collide_part);
   counts.clusters.resize(shares.size(), 0);
   std::size_t speculative = 0;
-  if (combine_collide_parts(shares, floes, stats, speculative, options.record)) {
+  if (combine_collide_parts(shares, floes, stats, speculative, options.record, options.warm)) {
     for (std::size_t r = 0; r < shares.size(); ++r) counts.clusters[r] += shares[r].outcome.groups;
     counts.combined();
     return speculative;
   }
   count_conflicts(shares, counts);
-  counts.fell_back(share_options);
+  counts.fell_back(share_options.back_off);
   floes.state = entry;
   return solve_whole();
 }

@@ -6,10 +6,11 @@
 // speculative contacts they may gain); each group belongs to the owner by
 // place (FloeOwners) of its lowest floe; each rank solves its own groups,
 // and the ranks then exchange the velocities their solves changed (index +
-// state) and their collision counts. A step where a share could not run
-// alone (StepCollisionShare::Conflict: the warm store, a failed LCP, an
-// error) is solved again whole on every rank from the states on entry: the
-// serial solve, so the answer is the serial one bit for bit either way.
+// state), the warm-store pairs they stored and their collision counts. A
+// step where a share could not run alone (StepCollisionShare::Conflict: a
+// failed LCP, an error) is solved again whole on every rank from the states
+// on entry: the serial solve, so the answer is the serial one bit for bit
+// either way.
 
 #include <cstddef>
 #include <span>
@@ -21,8 +22,25 @@
 
 namespace floesim::parallel {
 
+// The options of the collisions at the step's start by owner.
+struct CollideShareOptions {
+  // The back-off after a fallback (AdvanceShareOptions::max_wait; the
+  // advance's rule, its own counts).
+  AdvanceShareOptions back_off;
+  // Test hook, not a user key (`floesim run` reads it from the environment,
+  // FLOESIM_TEST_COLLIDE_FALLBACK=warm): a share whose solves started from
+  // the warm store is a conflict (StepCollisionShare::Conflict::warm_start),
+  // the rule before the shares ran on copies of the store (docs/parallel.md,
+  // "The step-start collisions' conflicts (collide27)"). The tries that fell
+  // back for it then fall back again, so the tests reach the whole path and
+  // the whole state gathered on demand on a real run (the wall jam of
+  // examples/pack_against_wall.toml) with the shares otherwise unchanged.
+  bool warm_conflict = false;
+};
+
 // One rank's part of a step's collisions: what its share did, the states of
-// the floes it changed (outcome.moved's order; none on a conflict), its
+// the floes it changed (outcome.moved's order; none on a conflict), the
+// warm-store pairs it stored (outcome.warm; none on a conflict), its
 // counts and, in a run that keeps the impulse record, its record (its loads'
 // places: outcome.places; none on a conflict).
 struct CollidePart {
@@ -38,22 +56,29 @@ CollidePart unpack_collide_part(std::span<const std::byte> bytes);
 // Runs rank `rank`'s share (contact::resolve_step_collisions_share) on
 // `floes` (the states on entry, W^-) and returns its part; `floes` is left
 // with the share's states. With options.record, the share records into the
-// part's own record (options.record itself is left alone).
+// part's own record (options.record itself is left alone); with
+// options.warm, the share runs on a copy of the store (options.warm is left
+// alone) and its part carries the pairs it stored.
 // With `groups` (contact::resolve_step_collisions_share), `detection` may be
-// the rank's part of the step's (collide_on_part).
+// the rank's part of the step's (collide_on_part). `share_options`: its
+// test hook (warm_conflict).
 CollidePart run_collide_share(Floes& floes, std::span<const FloeState> start, const contact::Detection& detection,
                               double step, const contact::ImpulseOptions& options, std::span<const int> owner,
-                              int rank, const contact::StepGroups* groups = nullptr);
+                              int rank, const contact::StepGroups* groups = nullptr,
+                              const CollideShareOptions& share_options = {});
 
 // Combines every rank's part (rank order) into `floes` (each part's moved
-// floes take its states), `stats` (contact::add_collision_counts) and
-// `record` (if not null: the parts' records merged as the whole call's one
-// event, contact::merge_step_record), sets `speculative` to the parts' sum
-// and returns true; or returns false, changing nothing, when a part has a
-// conflict or two parts moved one floe (the groups are disjoint: this would
-// be a bug, refused all the same).
+// floes take its states), `stats` (contact::add_collision_counts), `record`
+// (if not null: the parts' records merged as the whole call's one event,
+// contact::merge_step_record) and `warm` (if not null: the run's warm
+// store, every part's stored pairs and uses written into it, hold_warm), sets
+// `speculative` to the parts' sum and returns true; or returns false,
+// changing nothing, when a part has a conflict, two parts moved one floe or
+// two parts stored one warm pair (the groups are disjoint, and so are their
+// pairs: this would be a bug, refused all the same).
 bool combine_collide_parts(std::span<const CollidePart> parts, Floes& floes, contact::CollisionStats& stats,
-                           std::size_t& speculative, contact::ImpulseRecord* record = nullptr);
+                           std::size_t& speculative, contact::ImpulseRecord* record = nullptr,
+                           contact::WarmStart* warm = nullptr);
 
 // The collisions at the step's start on every rank of `comm`, as
 // contact::resolve_step_collisions (whose arguments these are; no impulses
@@ -63,12 +88,14 @@ bool combine_collide_parts(std::span<const CollidePart> parts, Floes& floes, con
 // solve from the states on entry (which records into options.record).
 // `counts` and the back-off are those of the advance's (AdvanceShareCounts,
 // AdvanceShareOptions), kept apart; `counts.clusters` counts each rank's step
-// groups in the steps not redone. Returns the speculative contacts' count.
-// Equal to the serial solve bit for bit, states, counts and record.
+// groups in the steps not redone. With options.warm, the parts' stored
+// pairs are written into it on every rank. Returns the speculative contacts'
+// count. Equal to the serial solve bit for bit, states, counts, record and
+// warm store.
 std::size_t collide_by_owner(const Communicator& comm, std::span<const int> owner, Floes& floes,
                              std::span<const FloeState> start, const contact::Detection& detection, double step,
                              const contact::ImpulseOptions& options, contact::CollisionStats& stats,
-                             AdvanceShareCounts& counts, const AdvanceShareOptions& share_options = {});
+                             AdvanceShareCounts& counts, const CollideShareOptions& share_options = {});
 
 // The detection's lists by owner (docs/parallel.md, "The detection's lists
 // by owner"). `part`: the pairs a rank detected (parallel::detect_part, in
@@ -98,11 +125,12 @@ std::vector<contact::Detection> pairs_for_groups(const Floes& floes, const conta
 // `floes`, the step's start in the caller's `start`, which the span views)
 // and then the whole detection; with no `whole`, the caller holds every
 // floe current and the detection is gathered here (parallel::gather).
-// Equal to the serial solve bit for bit, states, counts and record.
+// Equal to the serial solve bit for bit, states, counts, record and warm
+// store.
 std::size_t collide_on_part(const Communicator& comm, std::span<const int> owner, Floes& floes,
                             std::span<const FloeState> start, const contact::Detection& part, double step,
                             const contact::ImpulseOptions& options, contact::CollisionStats& stats,
-                            AdvanceShareCounts& counts, const AdvanceShareOptions& share_options = {},
+                            AdvanceShareCounts& counts, const CollideShareOptions& share_options = {},
                             const WholeOnDemand* whole = nullptr);
 
 }  // namespace floesim::parallel

@@ -82,6 +82,25 @@ inline bool same_stats(const contact::CollisionStats& a, const contact::Collisio
   return true;
 }
 
+// Two warm stores hold the same pairs, each with the same clock and the
+// same entries to the bit, and the same uses.
+inline bool same_store(const contact::WarmStart& a, const contact::WarmStart& b) {
+  if (a.pairs.size() != b.pairs.size() || a.uses != b.uses || a.clock != b.clock) return false;
+  for (const auto& [key, p] : a.pairs) {
+    const auto it = b.pairs.find(key);
+    if (it == b.pairs.end() || it->second.stored != p.stored || it->second.entries.size() != p.entries.size())
+      return false;
+    for (std::size_t k = 0; k < p.entries.size(); ++k) {
+      const contact::WarmStart::Entry &x = p.entries[k], &y = it->second.entries[k];
+      if (std::memcmp(x.body_point.data(), y.body_point.data(), 2 * sizeof(double)) != 0 ||
+          std::memcmp(x.body_normal.data(), y.body_normal.data(), 2 * sizeof(double)) != 0 || x.basic != y.basic ||
+          x.vertex_of_b != y.vertex_of_b)
+        return false;
+    }
+  }
+  return true;
+}
+
 // The same record: the same loads in the same order, field for field (the
 // doubles bit for bit), the same event numbers and count.
 inline bool same_record(const contact::ImpulseRecord& a, const contact::ImpulseRecord& b) {

@@ -6,7 +6,10 @@
 // equal the serial solve (resolve_step_collisions on every rank's own copy)
 // bit for bit: first kept (on several ranks: tried once, no fallback, groups
 // solved on every rank), then with every LCP on the warm store (warm_min =
-// 0), which falls back on every rank alike and is the serial solve again.
+// 0): kept too, each share on a copy of the store and every rank's store
+// left as the serial solve leaves its own, entry by entry; then the same
+// under the test hook (CollideShareOptions::warm_conflict), which falls back
+// on every rank alike and is the serial solve and store again.
 // Both from the whole detection (collide_by_owner) and from each rank's
 // part of it, the pairs whose floe a it owns (parallel::collide_on_part:
 // the edges gathered, the groups' pairs sent to their owners, the whole
@@ -17,6 +20,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <cstring>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -40,12 +44,17 @@ int main() {
   owners.assign(c.floes);
   const contact::Detection part = parallel::select_pairs(
       c.detection, [&](const contact::NearPair& p) { return owners.owner()[p.a] == comm.rank(); });
+  enum class Mode { cold, warm, hooked };  // no store use; the store; the store under the test hook
   for (const bool on_part : {false, true})
-  for (const bool warm : {false, true}) {
-    const std::string name = std::string(on_part ? "on the rank's part: " : "") + (warm ? "warm store: " : "");
+  for (const Mode mode : {Mode::cold, Mode::warm, Mode::hooked}) {
+    const bool warm = mode != Mode::cold, falls = mode == Mode::hooked;
+    const std::string name = std::string(on_part ? "on the rank's part: " : "") +
+                             (warm ? (falls ? "warm store, the hook: " : "warm store: ") : "");
     contact::ImpulseOptions o = c.options;
     contact::WarmStart serial_warm, shared_warm;
     if (warm) o.warm_min = 0;
+    parallel::CollideShareOptions share;
+    share.warm_conflict = falls;
     Floes s = c.floes, f = c.floes;
     contact::CollisionStats ss, fs;
     contact::ImpulseOptions so = o, fo = o;
@@ -54,19 +63,25 @@ int main() {
     const std::size_t a = contact::resolve_step_collisions(s, c.start, c.detection, c.dt, so, ss);
     parallel::AdvanceShareCounts counts;
     const std::size_t b =
-        on_part ? parallel::collide_on_part(comm, owners.owner(), f, c.start, part, c.dt, fo, fs, counts)
-                : parallel::collide_by_owner(comm, owners.owner(), f, c.start, c.detection, c.dt, fo, fs, counts);
+        on_part ? parallel::collide_on_part(comm, owners.owner(), f, c.start, part, c.dt, fo, fs, counts, share)
+                : parallel::collide_by_owner(comm, owners.owner(), f, c.start, c.detection, c.dt, fo, fs, counts,
+                                             share);
     if (std::memcmp(f.state.data(), s.state.data(), f.state.size() * sizeof(FloeState)) != 0)
       failures.push_back(name + "the floes differ from the serial solve");
     if (!test::same_stats(fs, ss)) failures.push_back(name + "the collision counts differ from the serial solve");
     if (a != b) failures.push_back(name + "the speculative contacts' count differs");
     if (ss.lcps < 64 || a == 0) failures.push_back(name + "too few LCPs or no speculative contact: no test");
-    if (counts.steps != 1 || counts.fallbacks != (warm ? 1 : 0))
-      failures.push_back(name + "expected 1 try and " + std::to_string(warm ? 1 : 0) + " fallback, got " +
+    if (counts.steps != 1 || counts.fallbacks != (falls ? 1 : 0))
+      failures.push_back(name + "expected 1 try and " + std::to_string(falls ? 1 : 0) + " fallback, got " +
                          std::to_string(counts.steps) + " and " + std::to_string(counts.fallbacks));
+    if (falls && counts.conflicts != std::map<std::string, long>{{"warm_start", 1}})
+      failures.push_back(name + "the fallback was not counted as the hook's warm_start");
+    if (!test::same_store(shared_warm, serial_warm))
+      failures.push_back(name + "the warm store differs from the serial solve's");
+    if (warm && serial_warm.pairs.empty()) failures.push_back(name + "no warm pair stored: no test");
     long busy = 0;  // ranks that solved groups
     for (const long g : counts.clusters) busy += g > 0 ? 1 : 0;
-    if (!warm && busy != ranks) failures.push_back("not every rank solved step groups");
+    if (!falls && busy != ranks) failures.push_back(name + "not every rank solved step groups");
     if (comm.writer()) {
       std::printf("%s%d ranks: %ld LCPs, %zu speculative contacts, fallbacks %ld, groups by rank:", name.c_str(),
                   ranks, ss.lcps, a, counts.fallbacks);

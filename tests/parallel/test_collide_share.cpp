@@ -6,15 +6,19 @@
 // solve (contact::resolve_step_collisions) bit for bit: the floes' states
 // (memcmp), the collision counts and the speculative contacts' count. A
 // speculative contact that joins two ranks' contact components puts both in
-// one step group, on one rank. A share that would use the warm store falls
-// back to the serial solve, with the advance's back-off. In a run that keeps
-// the impulse record, the shares' records merged are the serial record.
+// one step group, on one rank. Shares that use the warm store run on copies
+// of it and their stored pairs, written into every rank's store, keep it the
+// serial store over several steps (collide27); under the test hook
+// (CollideShareOptions::warm_conflict) they fall back to the serial solve,
+// with the advance's back-off. In a run that keeps the impulse record, the
+// shares' records merged are the serial record.
 #include <doctest/doctest.h>
 
 #include <algorithm>
 #include <cstring>
 #include <random>
 #include <numeric>
+#include <map>
 #include <string>
 
 #include "core/pack_generator.hpp"
@@ -221,19 +225,21 @@ TEST_CASE("a speculative contact between two ranks' contact components puts both
   CHECK(speculative == serial.speculative);
 }
 
-TEST_CASE("step-start collisions that would use the warm store fall back, with the advance's back-off") {
+TEST_CASE("under the test hook, step-start shares that use the warm store fall back, with the advance's back-off") {
   // One rank (the serial communicator) owning every floe; every LCP starts
-  // from the warm store (warm_min = 0), which a share must not use: each try
-  // falls back, then waits 1, 2, 4 steps (AdvanceShareOptions), every step
-  // equal to the serial solve with its own warm store.
+  // from the warm store (warm_min = 0), which the hook
+  // (CollideShareOptions::warm_conflict) makes a conflict: each try falls
+  // back, then waits 1, 2, 4 steps (AdvanceShareOptions), every step equal
+  // to the serial solve with its own warm store.
   CollideCase c = test::rows_of_four(3);
   c.options.warm_min = 0;
   contact::WarmStart serial_warm, shared_warm;
   const parallel::Communicator comm;
   const std::vector<int> owner(c.floes.size(), 0);
   parallel::AdvanceShareCounts counts;
-  parallel::AdvanceShareOptions share;
-  share.max_wait = 4;
+  parallel::CollideShareOptions share;
+  share.back_off.max_wait = 4;
+  share.warm_conflict = true;
   for (int step = 0; step < 10; ++step) {
     CAPTURE(step);
     Floes s = c.floes, f = c.floes;
@@ -246,11 +252,131 @@ TEST_CASE("step-start collisions that would use the warm store fall back, with t
     CHECK(same_states(f.state, s.state));
     CHECK(same_stats(fs, ss));
     CHECK(a == b);
+    CHECK(test::same_store(shared_warm, serial_warm));
   }
   CHECK(counts.steps == 3);  // tried at steps 0, 2 and 5
   CHECK(counts.fallbacks == 3);
   CHECK(counts.whole == 7);
+  CHECK(counts.conflicts == std::map<std::string, long>{{"warm_start", 3}});
   CHECK(serial_warm.uses > 0);
+}
+
+namespace {
+
+// The rows of four with W^- and the step's start scaled by `scale`: the same
+// contacts and witnesses (positions), other velocities, so that the store
+// one step leaves is matched and read by the next (warm starts that hit).
+CollideCase scaled(const CollideCase& c, double scale) {
+  CollideCase out = c;
+  for (std::vector<FloeState>* v : {&out.floes.state, &out.start})
+    for (FloeState& x : *v) {
+      x.vx *= scale;
+      x.vy *= scale;
+      x.yaw_rate *= scale;
+    }
+  return out;
+}
+
+// Plays `ranks` ranks with the run's warm store `warm` (each share on its
+// copy of it, as each rank's share runs), the parts through their bytes,
+// combined into `f`, `stats` and, with `write`, `warm`. Returns whether they
+// combined; `uses` gets each part's solves from the store and `stored` adds
+// the pairs the parts stored.
+bool play_warm(const CollideCase& c, std::span<const int> owner, int ranks, contact::WarmStart& warm, bool write,
+               const parallel::CollideShareOptions& share, Floes& f, contact::CollisionStats& stats,
+               std::size_t& speculative, std::vector<long>& uses, long& stored) {
+  contact::ImpulseOptions o = c.options;
+  o.warm = &warm;
+  const contact::WarmStart before = warm;
+  std::vector<parallel::CollidePart> parts;
+  for (int r = 0; r < ranks; ++r) {
+    Floes mine = c.floes;
+    parts.push_back(parallel::unpack_collide_part(
+        parallel::pack(parallel::run_collide_share(mine, c.start, c.detection, c.dt, o, owner, r, nullptr, share))));
+    uses.push_back(parts.back().outcome.warm_uses);
+    stored += static_cast<long>(parts.back().outcome.warm.size());
+    if (r == 0) f = std::move(mine);
+  }
+  CHECK(test::same_store(warm, before));  // the shares ran on copies
+  return parallel::combine_collide_parts(parts, f, stats, speculative, nullptr, write ? &warm : nullptr);
+}
+
+}  // namespace
+
+TEST_CASE("step-start shares on copies of the warm store, their stored pairs written on every rank, keep the serial "
+          "store and answer over several steps") {
+  // Four steps over 1, 2, 3 and 7 strips, every LCP from the warm store
+  // (warm_min = 0), the store carried from each step to the next (its
+  // entries are those of the step before: warm starts that hit). The serial
+  // solve and each split keep a store of their own. Until collide27 each
+  // multi-rank try fell back (warm_start): under the test hook it still does.
+  long tries = 0, combined = 0, stored = 0;
+  for (const unsigned seed : {3u, 11u}) {
+    CAPTURE(seed);
+    CollideCase base = test::rows_of_four(seed);
+    base.options.warm_min = 0;
+    for (const int ranks : {1, 2, 3, 7}) {
+      CAPTURE(ranks);
+      int n = ranks;
+      const std::vector<int> owner = owners_of(base, ranks, n);
+      contact::WarmStart serial_warm, shared_warm, unwritten;
+      for (int step = 0; step < 4; ++step) {
+        CAPTURE(step);
+        const CollideCase c = scaled(base, 1.0 + 0.25 * step);
+        Floes s = c.floes;
+        contact::ImpulseOptions so = c.options;
+        so.warm = &serial_warm;
+        contact::CollisionStats ss;
+        const std::size_t a = contact::resolve_step_collisions(s, c.start, c.detection, c.dt, so, ss);
+        if (step > 0) CHECK(ss.warm > 0);  // the last step's entries were read
+        Floes f;
+        contact::CollisionStats fs;
+        std::size_t b = 0;
+        std::vector<long> uses;
+        const bool ok = play_warm(c, owner, n, shared_warm, true, {}, f, fs, b, uses, stored);
+        CHECK(ok);
+        CHECK(same_states(f.state, s.state));
+        CHECK(same_stats(fs, ss));
+        CHECK(a == b);
+        CHECK(test::same_store(shared_warm, serial_warm));
+        if (n > 1) {
+          ++tries;
+          combined += ok ? 1 : 0;
+          // Several parts solved from the store: each a warm_start conflict before.
+          CHECK(std::count_if(uses.begin(), uses.end(), [](long u) { return u > 0; }) >= 2);
+          Floes g;
+          contact::CollisionStats gs;
+          std::size_t gb = 0;
+          std::vector<long> hook_uses;
+          long hook_stored = 0;
+          contact::WarmStart hooked = serial_warm;
+          parallel::CollideShareOptions hook;
+          hook.warm_conflict = true;
+          CHECK_FALSE(play_warm(c, owner, n, hooked, true, hook, g, gs, gb, hook_uses, hook_stored));
+          CHECK(hook_stored == 0);
+        }
+        // Without the parts' pairs written (the store stays empty) the
+        // next steps' solves start cold: their counts part from the serial
+        // ones (what the store's equality above guards).
+        Floes h;
+        contact::CollisionStats hs;
+        std::size_t hb = 0;
+        std::vector<long> unused_uses;
+        long unused_stored = 0;
+        CHECK(play_warm(c, owner, n, unwritten, false, {}, h, hs, hb, unused_uses, unused_stored));
+        if (step > 0) CHECK_FALSE(same_stats(hs, ss));
+        serial_warm.tick();
+        shared_warm.tick();
+        unwritten.tick();
+      }
+      CHECK(serial_warm.uses > 0);
+      CHECK_FALSE(test::same_store(unwritten, serial_warm));
+    }
+  }
+  MESSAGE(combined << " of " << tries << " tries over several ranks combined, " << stored
+                   << " warm pairs stored by their shares");
+  CHECK(tries == 2 * 3 * 4);
+  CHECK(stored > 0);
 }
 
 namespace {

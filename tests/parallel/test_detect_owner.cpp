@@ -7,7 +7,8 @@
 // those received. Over 1, 2, 3 and 7 strips, with the groups' owners not the
 // detection's, the shares combined are the serial solve bit for bit (states
 // by memcmp, counts, speculative contacts), the pairs sent are a small part
-// of the lists, and a share that needs the warm store falls back. In a run
+// of the lists, and shares that use the warm store (each on its copy)
+// leave the serial store. In a run
 // that keeps the impulse record, the shares on their parts record their
 // loads keyed by pair (contact::ContactPlace), and the parts merged are the
 // serial record.
@@ -56,7 +57,8 @@ struct Played {
 // the step groups belong to the owners `owner` (of the step, after the
 // drift). Each rank's share runs on its own copy of W^-. With `merged`, the
 // shares record (each into its part's own record) and the parts' records
-// are merged into `merged`.
+// are merged into `merged`. With c.options.warm, the parts' stored pairs
+// are written into it.
 Played play(const CollideCase& c, const std::vector<int>& detected, const std::vector<int>& owner, int ranks,
             contact::ImpulseRecord* merged = nullptr) {
   Played out;
@@ -111,7 +113,8 @@ Played play(const CollideCase& c, const std::vector<int>& detected, const std::v
   }
   CHECK(unused.loads.empty());
   CHECK(unused.events == 0);
-  out.combined = parallel::combine_collide_parts(parts, out.floes, out.stats, out.speculative, merged);
+  out.combined =
+      parallel::combine_collide_parts(parts, out.floes, out.stats, out.speculative, merged, c.options.warm);
   return out;
 }
 
@@ -217,18 +220,29 @@ TEST_CASE("the step groups from the edges are those of the whole detection, jams
   }
 }
 
-TEST_CASE("a share on its pairs that would use the warm store is a conflict: the whole solve") {
-  // warm_min = 0: every LCP would start from the warm store; each share
-  // reports the conflict, so the parts do not combine (collide_on_part then
-  // gathers the whole detection and solves it whole).
+TEST_CASE("shares on their pairs that use the warm store combine into the serial answer and store") {
+  // warm_min = 0: every LCP starts from the warm store. Each share runs on
+  // a copy of it (the store the shares see is left alone) and the parts'
+  // stored pairs, written into it, make it the serial store (until
+  // collide27 each share reported a conflict: the whole solve).
   CollideCase c = test::rows_of_four(3);
   c.options.warm_min = 0;
-  contact::WarmStart warm;
+  contact::WarmStart serial_warm, warm;
+  Floes serial = c.floes;
+  contact::CollisionStats serial_stats;
+  contact::ImpulseOptions so = c.options;
+  so.warm = &serial_warm;
+  const std::size_t serial_speculative =
+      contact::resolve_step_collisions(serial, c.start, c.detection, c.dt, so, serial_stats);
   c.options.warm = &warm;
   const std::vector<int> detected = strips(c, 3);
   const Played p = play(c, detected, detected, 3);
-  CHECK_FALSE(p.combined);
-  CHECK(warm.uses == 0);  // the shares probed an empty store of their own
+  CHECK(p.combined);
+  CHECK(same_states(p.floes.state, serial.state));
+  CHECK(same_stats(p.stats, serial_stats));
+  CHECK(p.speculative == serial_speculative);
+  CHECK(serial_warm.uses > 0);
+  CHECK(test::same_store(warm, serial_warm));
 }
 
 TEST_CASE("the first overlapping pair and its distance at t from the ranks' parts are the serial scan's") {
