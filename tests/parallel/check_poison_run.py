@@ -30,7 +30,8 @@ On 2 ranks (`mpirun --oversubscribe`):
     first. The 10 000-floe pack of scripts/scenarios/moving_pack.py (seed 1,
     to 320 s: one pair-list rebuild on a part) on 2 ranks with NaN after the
     drift, and the wall-jam example (examples/pack_against_wall.toml to
-    1500 s: the collisions' and the advance's fallbacks and whole steps, a
+    1500 s: the collisions' fallbacks and whole steps, made by the test hook
+    FLOESIM_TEST_COLLIDE_FALLBACK=warm since collide27 cured them, and a
     rebuild) on 3 ranks with the lure (on 2 ranks every rank holds every
     floe there), are bit for bit the serial run, each having rebuilt or
     fallen back, with no phase reported; the mutation "-stale" (whole_state
@@ -56,8 +57,10 @@ run = harness.run
 failures = []
 
 
-def mpirun(n, poison, config, out, *extra):
-    return harness.poisoned(n, poison, "run", config, "-o", out, "-q", *extra)
+def mpirun(n, poison, config, out, *extra, hooks=None):
+    """floesim on n ranks in the poison mode `poison`, with other test hooks (name -> value)."""
+    return harness.mpirun(n, "run", config, "-o", out, "-q", *extra,
+                          hooks=dict(hooks or {}, FLOESIM_TEST_POISON_UNHELD=poison))
 
 
 def equal(a, b):
@@ -160,19 +163,21 @@ wall = os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(os.path.absp
                     "pack_against_wall.toml")
 need(run([args.floesim, "run", rebuild, "-o", "rebuild_serial.h5", "-q"]), "the 10 000-floe pack, serial")
 need(run([args.floesim, "run", wall, "-o", "wall_serial.h5", "-q", "--until", "1500"]), "the wall jam, serial")
-# (what, config, ranks, poison, its mutation (nothing gathered), extra arguments, serial file, the counts that
-# say the whole steps happened, the floes whose drift phase's bytes are checked or None)
+# (what, config, ranks, poison, its mutation (nothing gathered), extra arguments, other test hooks, serial file,
+# the counts that say the whole steps happened, the floes whose drift phase's bytes are checked or None)
 cases = [("the 10 000-floe pack (its pair list rebuilt on a part)", rebuild, 2, "step@drift", "step-stale@drift", [],
-          "rebuild_serial.h5", ["advance_rebuilds"], 10000),
+          {}, "rebuild_serial.h5", ["advance_rebuilds"], 10000),
          # Since onerank26 the wall jam's advances no longer fall back (its
          # conflicts are joined on one rank: advance_joined, tries that read
-         # only the held and routed floes); its step-start collisions do.
-         ("the wall jam (fallbacks, whole steps, clusters joined on one rank)", wall, 3, "step-lure",
-          "step-lure-stale", ["--until", "1500"], "wall_serial.h5",
+         # only the held and routed floes), and since collide27 neither do
+         # its step-start collisions: the test hook makes those fall back
+         # where their shares use the warm store (4 tries), as they did.
+         ("the wall jam (fallbacks by the hook, whole steps, clusters joined on one rank)", wall, 3, "step-lure",
+          "step-lure-stale", ["--until", "1500"], {"FLOESIM_TEST_COLLIDE_FALLBACK": "warm"}, "wall_serial.h5",
           ["advance_joined", "collide_fallbacks", "collide_whole"], None)]
-for what, config, n, poison, mutant, extra, serial, counted, floes in cases:
+for what, config, n, poison, mutant, extra, hooks, serial, counted, floes in cases:
     name = f"{what} on {n} ranks, {poison}"
-    p = mpirun(n, poison, config, "on_demand.h5", *extra)
+    p = mpirun(n, poison, config, "on_demand.h5", *extra, hooks=hooks)
     s, counts = summaries(p), {k: summary(p).get(f"parallel.{k}", "0") for k in counted}
     same = p.returncode == 0 and equal("on_demand.h5", serial)
     print(f"{name}: exit {p.returncode}, {'equal' if same else 'DIFFERENT'} to the serial run; {counts}; {s}")
@@ -196,7 +201,7 @@ for what, config, n, poison, mutant, extra, serial, counted, floes in cases:
     if sorted(s) != list(range(n)) or sum(f for _, f, _, _ in s.values()) == 0 or any(r for _, _, r, _ in s.values()):
         failures.append(f"{name}: the ranks must poison floes and report no phase: {s}\n{p.stderr}")
     # The mutation: nothing gathered.
-    m = mpirun(n, mutant, config, "stale.h5", *extra)
+    m = mpirun(n, mutant, config, "stale.h5", *extra, hooks=hooks)
     found = m.returncode != 0 or not equal("stale.h5", serial)
     print(f"{what} on {n} ranks, {mutant} (mutation): exit {m.returncode}, "
           f"{'found (the run failed or differs)' if found else 'NOT FOUND'}")

@@ -17,8 +17,10 @@ continued with --restart on 2 ranks. Each --also CONFIG (a run with a sea, say) 
 checked on 2 ranks with --also-rtol (0 by default: since stage eight and
 notslabs25 a sea with the explicit kicks sums every shared cell in the
 serial order, docs/parallel.md). --fallback CONFIG: a run whose step-start collisions
-fall back to the whole solve on 2 and 3 ranks must equal the serial run too,
-with fallbacks counted. Then the errors: bad input and a run file that
+take the warm store (the wall jam) must equal the serial run on 2 and 3 ranks
+with no try fallen back for it, and so must it under the test hook
+FLOESIM_TEST_COLLIDE_FALLBACK=warm, whose tries fall back (counted) to the
+whole solve. Then the errors: bad input and a run file that
 rank 0 cannot create must end every rank with exit 2 and 1, and the message
 said once.
 """
@@ -34,8 +36,8 @@ def options(ap):
     ap.add_argument("--errors", action=argparse.BooleanOptionalAction, default=True)
     ap.add_argument("--also", nargs="*", default=[], help="other configurations to check on 2 ranks (e.g. with a sea)")
     ap.add_argument("--also-rtol", type=float, default=0.0, help="relative tolerance of the --also runs")
-    ap.add_argument("--fallback", help="a run whose step-start collisions fall back on several ranks (a jam forming "
-                    "against a wall, whose LCPs take the warm store): on 2 and 3 ranks, bit for bit")
+    ap.add_argument("--fallback", help="a run whose step-start collisions take the warm store (a jam forming "
+                    "against a wall): on 2 and 3 ranks, plain and with the fallback's test hook, bit for bit")
     ap.add_argument("--fallback-until", type=float, help="the --fallback runs stop at this time")
 
 
@@ -126,51 +128,64 @@ for other in args.also:
     if p.returncode != 0 or c.returncode != 0:
         failures.append(f"{other} on 2 ranks: exit {p.returncode}\n{p.stderr}\n{c.stdout}")
 
-# Step-start collisions that fall back to the whole solve on every rank (a
-# share's LCP would use the warm store, kept alike on every rank): still the
-# serial run bit for bit, and some tries kept.
+# The wall jam (--fallback): a forming jam's step-start LCPs take the warm
+# store. Since collide27 each share runs on a copy of the store and sends the
+# pairs it stored: no try falls back for it (plain runs). The test hook
+# FLOESIM_TEST_COLLIDE_FALLBACK=warm makes a share's use of the store a
+# conflict again (the rule before), so the same tries fall back to the whole
+# solve on every rank (the state gathered on demand): still the serial run
+# bit for bit, with fallbacks counted by kind and some tries kept.
 if args.fallback:
     until = ["--until", str(args.fallback_until)] if args.fallback_until else []
     need(run([args.floesim, "run", args.fallback, "-o", "fallback_serial.h5", "-q", *until]), "fallback: serial run")
-    for n in (2, 3):
-        p = mpirun(n, "run", args.fallback, "-o", f"fallback_{n}.h5", "-q", *until)
+    for n, hook in ((2, None), (3, None), (2, "warm"), (3, "warm")):
+        what = f"fallback run on {n} ranks" + (f" (FLOESIM_TEST_COLLIDE_FALLBACK={hook})" if hook else "")
+        p = harness.mpirun(n, "run", args.fallback, "-o", f"fallback_{n}.h5", "-q", *until,
+                           hooks={"FLOESIM_TEST_COLLIDE_FALLBACK": hook} if hook else None)
         c = run([args.floesim, "compare", f"fallback_{n}.h5", "fallback_serial.h5", "--rtol", "0", "--atol", "0"])
         key = lambda k: next((l.split(":", 1)[1].split() for l in p.stdout.splitlines() if l.startswith(k + ":")), [])
         tried, fell = key("parallel.collide_steps"), key("parallel.collide_fallbacks")
         equal = p.returncode == 0 and c.returncode == 0
-        print(f"fallback run on {n} ranks: {'equal' if equal else 'DIFFERENT'} to the serial run; "
+        print(f"{what}: {'equal' if equal else 'DIFFERENT'} to the serial run; "
               f"{tried} step-start collisions by owner, {fell} redone whole")
         if not equal:
-            failures.append(f"fallback run on {n} ranks: exit {p.returncode}\n{p.stderr}\n{c.stdout}")
-        elif not (tried and fell and int(fell[0]) > 0 and int(tried[0]) > int(fell[0])):
-            failures.append(f"fallback run on {n} ranks: expected fallbacks and kept tries ({tried}, {fell})")
-        # The fallbacks by kind (onerank26): the step-start collisions' are the
-        # warm store's (counted), while the advance's shares run on copies of
-        # the store and no longer fall back for it; the advance's fallbacks
-        # left are clusters of two ranks that meet.
+            failures.append(f"{what}: exit {p.returncode}\n{p.stderr}\n{c.stdout}")
+            continue
         kinds = {l.split(":", 1)[0]: int(l.split(":", 1)[1]) for l in p.stdout.splitlines()
                  if l.startswith(("parallel.advance_conflicts.", "parallel.collide_conflicts."))}
+        warm = kinds.get("parallel.collide_conflicts.warm_start", 0)
+        if hook:
+            # The hook's fallbacks: the whole path, some tries still kept,
+            # every fallback the hook's kind.
+            if not (tried and fell and int(fell[0]) > 0 and int(tried[0]) > int(fell[0])):
+                failures.append(f"{what}: expected fallbacks and kept tries ({tried}, {fell})")
+            elif warm != int(fell[0]):
+                failures.append(f"{what}: the collisions' fallbacks by kind {kinds} do not sum to {fell}")
+        else:
+            # Cured (collide27): no try falls back for the warm store.
+            if not (tried and fell and int(tried[0]) > 0):
+                failures.append(f"{what}: no step-start collisions by owner ({tried}, {fell})")
+            elif warm:
+                failures.append(f"{what}: a step-start try fell back for the warm store (cured): {kinds}")
+            elif sum(v for k, v in kinds.items() if k.startswith("parallel.collide_")) < int(fell[0]):
+                failures.append(f"{what}: the collisions' fallbacks {fell} are not all counted by kind {kinds}")
+        # The advance's fallbacks by kind (onerank26): neither the warm store
+        # nor clusters of two ranks that meet send an advance to the whole
+        # fallback any more; the meeting clusters are joined on one rank
+        # (which this run needs).
         afell = key("parallel.advance_fallbacks")
-        print(f"fallback run on {n} ranks: advance {key('parallel.advance_steps')} tried, {afell} redone, "
+        print(f"{what}: advance {key('parallel.advance_steps')} tried, {afell} redone, "
               f"{key('parallel.advance_whole')} whole; by kind {kinds}")
-        if equal and kinds.get("parallel.collide_conflicts.warm_start", 0) != int(fell[0]):
-            failures.append(f"fallback run on {n} ranks: the collisions' fallbacks by kind {kinds} do not sum to {fell}")
-        # Cured (onerank26): neither the warm store nor clusters of two ranks
-        # that meet send an advance to the whole fallback any more; the
-        # meeting clusters are joined on one rank (which this run needs).
         cured = [k for k in ("parallel.advance_conflicts.warm_start", "parallel.advance_conflicts.foreign_cluster",
                              "parallel.advance_conflicts.taken_twice") if k in kinds]
         joined = key("parallel.advance_joined")
-        print(f"fallback run on {n} ranks: {joined} advances combined with meeting clusters joined on one rank")
-        if equal and cured:
-            failures.append(f"fallback run on {n} ranks: an advance fell back for a cured kind: {kinds}")
-        if equal and not (joined and int(joined[0]) > 0):
-            failures.append(f"fallback run on {n} ranks: no advance joined meeting clusters ({joined}): "
-                            "the case no longer tests it")
-        if equal and not (afell and sum(v for k, v in kinds.items() if k.startswith("parallel.advance_"))
-                          >= int(afell[0])):
-            failures.append(f"fallback run on {n} ranks: the advance's fallbacks {afell} are not all counted by kind "
-                            f"{kinds}")
+        print(f"{what}: {joined} advances combined with meeting clusters joined on one rank")
+        if cured:
+            failures.append(f"{what}: an advance fell back for a cured kind: {kinds}")
+        if not (joined and int(joined[0]) > 0):
+            failures.append(f"{what}: no advance joined meeting clusters ({joined}): the case no longer tests it")
+        if not (afell and sum(v for k, v in kinds.items() if k.startswith("parallel.advance_")) >= int(afell[0])):
+            failures.append(f"{what}: the advance's fallbacks {afell} are not all counted by kind {kinds}")
 
 if args.errors:
     # Bad input: every rank reads it, every rank stops, exit 2, said once.
