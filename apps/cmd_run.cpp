@@ -293,6 +293,7 @@ int run(const Args& args, const parallel::Session& session) {
                        std::string(test) + "\"");
     sim.set_collide_test(true);
   }
+  for (const std::string& note : sim.notes()) std::cerr << "floesim: note: " << note << "\n";
 
   ProgressLine progress(!args.quiet && comm.writer(), isatty(STDERR_FILENO) != 0, args.log_every);
   g_interrupted = false;
