@@ -379,6 +379,32 @@ TEST_CASE("step-start shares on copies of the warm store, their stored pairs wri
   CHECK(stored > 0);
 }
 
+TEST_CASE("two parts that stored one warm pair do not combine, and the store is left alone") {
+  // Never expected (a pair's solves are one group's, so one share's), and
+  // refused all the same: the whole solve then writes the store.
+  CollideCase c = test::rows_of_four(3);
+  c.options.warm_min = 0;
+  contact::WarmStart warm;
+  contact::ImpulseOptions o = c.options;
+  o.warm = &warm;
+  const std::vector<int> owner(c.floes.size(), 0);
+  Floes mine = c.floes;
+  const parallel::CollidePart part = parallel::run_collide_share(mine, c.start, c.detection, c.dt, o, owner, 0);
+  REQUIRE_FALSE(part.outcome.warm.empty());
+  parallel::CollidePart other;  // another part that stored the first part's first pair and moved nothing
+  other.outcome.warm = {part.outcome.warm.front()};
+  Floes f = c.floes;
+  contact::CollisionStats stats;
+  std::size_t speculative = 0;
+  const std::vector<parallel::CollidePart> parts{part, other};
+  CHECK_FALSE(parallel::combine_collide_parts(parts, f, stats, speculative, nullptr, &warm));
+  CHECK(warm.pairs.empty());
+  CHECK(same_states(f.state, c.floes.state));
+  // Each part alone combines and writes its pairs.
+  CHECK(parallel::combine_collide_parts(std::span(parts).first(1), f, stats, speculative, nullptr, &warm));
+  CHECK(warm.pairs.size() == part.outcome.warm.size());
+}
+
 namespace {
 
 contact::ImpulseRecord begun() {
