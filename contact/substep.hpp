@@ -232,7 +232,7 @@ struct ShareOutcome {
   // (WarmStart::Pair), and the share's solves that started from the store
   // (WarmStart::uses). Written into every rank's store, they make it the
   // serial advance's (ShareAdvance, "Why a share gives the serial bits").
-  std::vector<std::pair<std::uint64_t, WarmStart::Pair>> warm;
+  WarmStart::Written warm;
   long warm_uses = 0;
   // Which clusters (numbered as every share numbers them) the serial
   // advance would run together where the shares ran them apart, for the

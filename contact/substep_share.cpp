@@ -199,10 +199,7 @@ ShareAdvance::ShareAdvance(Floes& floes, const CollisionShapes& shapes, const De
   // the run's count (the share's count starts at zero and would overwrite
   // the run's first dumps).
   if (options.impulse.warm) {
-    warm_ = *options.impulse.warm;
-    warm_.uses = 0;
-    warm_.log = true;
-    warm_.written.clear();
+    warm_ = options.impulse.warm->share_copy();
     options_.impulse.warm = &warm_;
   }
   options_.impulse.dump_failed_lcps.clear();
@@ -311,10 +308,7 @@ ShareOutcome ShareAdvance::advance() {
   if (outcome.conflict == ShareOutcome::Conflict::none && stats_.failures > 0)
     outcome.conflict = ShareOutcome::Conflict::failed_lcp;
   if (outcome.conflict == ShareOutcome::Conflict::none && options_.impulse.warm) {
-    std::vector<std::uint64_t> keys = warm_.written;
-    std::sort(keys.begin(), keys.end());
-    keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
-    for (const std::uint64_t k : keys) outcome.warm.emplace_back(k, warm_.pairs.at(k));
+    outcome.warm = warm_.written_pairs();
     outcome.warm_uses = warm_.uses;
   }
   return outcome;
