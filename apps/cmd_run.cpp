@@ -334,6 +334,7 @@ int run(const Args& args, const parallel::Session& session) {
   if (restart) o << "\nrestarted_from: " << args.restart << " at t = " << checkpoint.time << " s";
   o << "\ncheckpoint: " << (s.checkpoint_time >= 0.0 ? std::to_string(s.checkpoint_time) + " s" : "none") << "\noutput: " << fs::absolute(s.output).string()
     << "\nparaview: " << fs::absolute(s.xdmf).string() << "\nfloes: " << sim.floes().size() << "\nsteps: " << s.steps
+    << "\nsteps_redone: " << sim.rejected_steps()  // tries redone with half the dt after an overlap (this process)
     << "\nrecords: " << s.records << "\nsimulated: " << s.t_end << " s\nwall_time: " << std::setprecision(4)
     << s.wall_seconds << " s\nsetup_time: " << setup_seconds << " s\nsteps_per_second: " << (s.wall_seconds > 0 ? static_cast<double>(run_steps) / s.wall_seconds : 0.0)
     << "\n";

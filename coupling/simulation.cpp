@@ -243,6 +243,12 @@ void Simulation::floes_half_kick(StepContext& ctx) {
   if (owners_off_places_) whole_state(ctx, parallel::WholeState::state);
   else offer_place_owners();
   floe_sea_->ready_loads(scenario_.floes, *sea_, incident_.get(), 0.5 * ctx.dt);
+  // The offer holds for this evaluation only: the drift's update moves the
+  // owners and may reallocate their arrays. Withdrawn here (an evaluation
+  // has cleared it already), so that a try redone after an overlap finds
+  // no offer, rather than spans into the rejected try's arrays, and its
+  // rebuild poses every floe.
+  floe_sea_->take_place_owners({}, {}, {});
   floe_sea_->kick_floes(scenario_.floes, 0.5 * ctx.dt);
 }
 

@@ -370,6 +370,46 @@ bool combine_parts(std::span<const AdvancePart> parts, Floes& floes, CollisionSt
   return true;
 }
 
+namespace {
+
+// Which lists the parts' `outcome.pairs` count (each share's set-up
+// counts the pairs of the list it saw): one list every share saw whole
+// (the whole detection, or the list every rank rebuilt over every floe
+// when a floe outran its reach), which every part counts alike, so the
+// step's pairs are one part's; or each rank's own part of the detection,
+// disjoint parts of the list, so the step's pairs are their sum.
+enum class PairLists { whole_on_every_rank, one_part_a_rank };
+
+struct Gathered {
+  std::vector<AdvancePart> parts;  // every rank's, rank order
+  bool combined = false;           // combine_parts took them
+};
+
+// Every rank's part (one allgather_bytes), then, a routed floe that came
+// incomplete being a fault (check_routed_floes), their combination
+// (combine_parts); when they combine, each rank's clusters and rooms and
+// the step's pairs (by `lists`) are counted. On a conflict nothing is
+// counted: the caller counts it, or tries again.
+Gathered gather_and_combine(const Communicator& comm, const AdvancePart& mine, PairLists lists, Floes& floes,
+                            CollisionStats& stats, SubstepReport& report, contact::ImpulseRecord* record,
+                            contact::WarmStart* warm, AdvanceShareCounts& counts) {
+  Gathered g;
+  g.parts = comm.allgather_parts(pack(mine), unpack_advance_part);
+  check_routed_floes(g.parts);
+  counts.clusters.resize(g.parts.size(), 0);
+  counts.rooms.resize(g.parts.size(), 0);
+  g.combined = combine_parts(g.parts, floes, stats, report, record, warm);
+  if (!g.combined) return g;
+  for (std::size_t r = 0; r < g.parts.size(); ++r) {
+    counts.clusters[r] += g.parts[r].outcome.clusters;
+    counts.rooms[r] += g.parts[r].outcome.rooms;
+    if (lists == PairLists::one_part_a_rank || r == 0) counts.pairs += g.parts[r].outcome.pairs;
+  }
+  return g;
+}
+
+}  // namespace
+
 void advance_by_owner(const Communicator& comm, std::span<const int> owner, Floes& floes,
                       const contact::CollisionShapes& shapes, const contact::Detection& detection, double dt,
                       const contact::SubstepOptions& options, contact::CollisionStats& stats,
@@ -396,19 +436,10 @@ void advance_by_owner(const Communicator& comm, std::span<const int> owner, Floe
     // exchange alike.
     if (combine_rooms(rooms, all)) {
       const AdvancePart mine = finish_share(share, all, floes, record ? &own : nullptr);
-      const std::vector<AdvancePart> parts = comm.allgather_parts(pack(mine), unpack_advance_part);
-      counts.clusters.resize(parts.size(), 0);
-      counts.rooms.resize(parts.size(), 0);
-      combined = combine_parts(parts, floes, stats, report, record, options.impulse.warm);
-      if (combined) {
-        for (std::size_t r = 0; r < parts.size(); ++r) {
-          counts.clusters[r] += parts[r].outcome.clusters;
-          counts.rooms[r] += parts[r].outcome.rooms;
-        }
-        counts.pairs += parts.front().outcome.pairs;
-      } else {
-        count_conflicts(parts, counts);
-      }
+      const Gathered g = gather_and_combine(comm, mine, PairLists::whole_on_every_rank, floes, stats, report,
+                                            record, options.impulse.warm, counts);
+      combined = g.combined;
+      if (!combined) count_conflicts(g.parts, counts);
     } else {
       count_set_up(rooms, counts);
     }
@@ -721,17 +752,14 @@ void advance_on_part(const Communicator& comm, std::span<const int> owner, std::
       move_not_held(floes, share.held(), dt);
     }
     kept.reset();
-    const std::vector<AdvancePart> parts = comm.allgather_parts(pack(done), unpack_advance_part);
-    check_routed_floes(parts);
-    counts.clusters.resize(parts.size(), 0);
-    counts.rooms.resize(parts.size(), 0);
-    combined = combine_parts(parts, floes, stats, report, record, options.impulse.warm);
+    // The parts' lists: each rank's part, or after a rebuild the whole
+    // rebuilt list on every rank.
+    const Gathered g = gather_and_combine(
+        comm, done, start_whole ? PairLists::whole_on_every_rank : PairLists::one_part_a_rank, floes, stats,
+        report, record, options.impulse.warm, counts);
+    const std::vector<AdvancePart>& parts = g.parts;
+    combined = g.combined;
     if (combined) {
-      for (std::size_t r = 0; r < parts.size(); ++r) {
-        counts.clusters[r] += parts[r].outcome.clusters;
-        counts.rooms[r] += parts[r].outcome.rooms;
-        counts.pairs += parts[r].outcome.pairs;
-      }
       if (round > 0) ++counts.joined;
       break;
     }

@@ -138,6 +138,7 @@ for other in args.also:
 if args.fallback:
     until = ["--until", str(args.fallback_until)] if args.fallback_until else []
     need(run([args.floesim, "run", args.fallback, "-o", "fallback_serial.h5", "-q", *until]), "fallback: serial run")
+    kept_pairs = {}  # ranks -> (parallel.advance_pairs, parallel.advance_rebuilds) when no advance was redone
     for n, hook in ((2, None), (3, None), (2, "warm"), (3, "warm")):
         what = f"fallback run on {n} ranks" + (f" (FLOESIM_TEST_COLLIDE_FALLBACK={hook})" if hook else "")
         p = harness.mpirun(n, "run", args.fallback, "-o", f"fallback_{n}.h5", "-q", *until,
@@ -186,6 +187,16 @@ if args.fallback:
             failures.append(f"{what}: no advance joined meeting clusters ({joined}): the case no longer tests it")
         if not (afell and sum(v for k, v in kinds.items() if k.startswith("parallel.advance_")) >= int(afell[0])):
             failures.append(f"{what}: the advance's fallbacks {afell} are not all counted by kind {kinds}")
+        # The pairs of the advances kept: with none redone, every step's
+        # list counted once whatever the ranks (the parts' lists add up, a
+        # list every rank rebuilt counts once: this run rebuilds one).
+        if not hook and afell == ["0"]:
+            kept_pairs[n] = (key("parallel.advance_pairs"), key("parallel.advance_rebuilds"))
+    if len(kept_pairs) == 2:
+        (p2, r2), (p3, r3) = kept_pairs[2], kept_pairs[3]
+        print(f"fallback runs, every advance kept: {p2} and {p3} pairs on 2 and 3 ranks ({r2} and {r3} rebuilds)")
+        if p2 != p3:
+            failures.append(f"fallback runs: the advances' pairs differ on 2 and 3 ranks ({p2}, {p3})")
 
 if args.errors:
     # Bad input: every rank reads it, every rank stops, exit 2, said once.

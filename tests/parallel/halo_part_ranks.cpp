@@ -63,17 +63,17 @@ void check(const parallel::Communicator& comm, test::Failures& failures, Counts&
   }
   const std::vector<FloeState>& start_true = p.floes.state;
   // This rank's copies: the floes it held true, the others NaN; the reaches
-  // of its own floes (set_reach's), the others NaN.
-  copy = after;
-  std::vector<FloeState> start = start_true;
-  options.reach = p.detect.reach;
+  // of its own floes (set_reach's), the others NaN (the poison tool,
+  // halo_case.hpp).
+  test::Held held(n), own(n);
   for (std::size_t j = 0; j < n; ++j) {
-    if (held0.holds(j)) continue;
-    test::poison(copy.state[j]);
-    test::poison(start[j]);
+    held[j] = held0.holds(j) ? 1 : 0;
+    own[j] = owners.owner()[j] == rank ? 1 : 0;
   }
-  for (std::size_t j = 0; j < n; ++j)
-    if (owners.owner()[j] != rank) options.reach[j] = test::kNaN;
+  copy = after;
+  copy.state = test::poisoned(after.state, held);
+  std::vector<FloeState> start = test::poisoned(start_true, held);
+  options.reach = test::poisoned(p.detect.reach, own);
   std::vector<parallel::LeaveNotice> leaving = owners.leaving(rank, copy);
   for (parallel::LeaveNotice& k : leaving) k.reach = options.reach[k.floe];
   const long long mine = static_cast<long long>(leaving.size());

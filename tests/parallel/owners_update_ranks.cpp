@@ -34,6 +34,7 @@
 
 #include "parallel/comm.hpp"
 #include "parallel/place.hpp"
+#include "tests/parallel/halo_case.hpp"
 #include "tests/parallel/ranks_main.hpp"
 
 using namespace floesim;
@@ -76,7 +77,6 @@ void run_layout(const parallel::Communicator& comm, bool slabs, test::Failures& 
   }
   owners.assign(truth);
   parallel::FloeOwners reference = owners;  // updated with the true floes
-  const double nan = std::numeric_limits<double>::quiet_NaN();
   for (std::size_t step = 1; step <= 60; ++step) {
     for (std::size_t i = 0; i < n; ++i) truth.state[i].y += speed[i];  // unwrapped: place() wraps
     if (step % 3 == 0 && !owners.cuts().empty())
@@ -87,9 +87,10 @@ void run_layout(const parallel::Communicator& comm, bool slabs, test::Failures& 
     // band's: a floe that crosses a cut was in the band, docs/parallel.md,
     // "Migration across cuts").
     const parallel::FloeOwners arriving = twin();
+    test::Held kept(n);
+    for (std::size_t i = 0; i < n; ++i) kept[i] = owners.owner()[i] == rank || arriving.owner()[i] == rank ? 1 : 0;
     Floes copy = truth;
-    for (std::size_t i = 0; i < n; ++i)
-      if (owners.owner()[i] != rank && arriving.owner()[i] != rank) copy.state[i].x = copy.state[i].y = nan;
+    copy.state = test::poisoned(truth.state, kept);  // the poison tool (halo_case.hpp): every column NaN
     parallel::FloeOwners lossy = owners;
     owners.update(comm, copy, step);
     reference.update(comm, truth, step);

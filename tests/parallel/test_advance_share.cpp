@@ -26,6 +26,7 @@
 #include "parallel/advance_share.hpp"
 #include "parallel/detect.hpp"
 #include "parallel/place.hpp"
+#include "tests/parallel/advance_case.hpp"
 #include "tests/parallel/collide_case.hpp"
 #include "tests/parallel/halo_case.hpp"
 
@@ -35,41 +36,10 @@ using namespace floesim;
 
 namespace {
 
-struct Case {
-  Floes floes;
-  contact::CollisionShapes shapes;
-  contact::Detection detection;
-  contact::DetectionOptions detect_options;  // the detection's (detect_part)
-  contact::SubstepOptions options;
-  contact::Domain domain;
-  double dt = 10.0;
-};
-
-// A dense periodic pack whose floes move at up to `speed` towards random
-// neighbours: many small clusters, some merging, some floes joining.
+// The cases (tests/parallel/advance_case.hpp).
+using Case = test::AdvanceCase;
 Case dense_pack(double speed, unsigned seed, double concentration = 0.75) {
-  GeneratedPack g = test::moving_generated_pack(seed, speed, concentration);
-  Case c;
-  c.floes = std::move(g.floes);
-  c.shapes = contact::build_collision_shapes(c.floes);
-  c.domain = {true, g.window[0], g.window[1], g.window[2], g.window[3]};
-  contact::DetectionOptions d;
-  d.domain = c.domain;
-  d.horizon = c.dt;
-  d.reach.assign(c.floes.size(), 0.0);
-  for (std::size_t i = 0; i < c.floes.size(); ++i) {  // as Simulation::set_reach
-    const FloeState& s = c.floes.state[i];
-    d.reach[i] = c.dt * (1.5 * (std::hypot(s.vx, s.vy) + std::abs(s.yaw_rate) * c.shapes.radius[i]) + 0.5 * speed) +
-                 d.collision_distance;
-  }
-  c.detection = contact::detect(c.floes, c.shapes, d);
-  c.detect_options = d;
-  c.options.collision_distance = d.collision_distance;
-  c.options.floor = 1e-3 * c.dt;
-  c.options.domain = c.domain;
-  c.options.impulse.collision_distance = d.collision_distance;
-  c.options.impulse.min_gap = 0.1 * d.collision_distance;
-  return c;
+  return test::dense_advance_pack(speed, seed, concentration);
 }
 
 bool same_stats(const contact::CollisionStats& a, const contact::CollisionStats& b) {
@@ -284,31 +254,12 @@ TEST_CASE("clusters of different ranks that merge, or share a free floe, fall ba
 }
 
 TEST_CASE("two ranks' clusters that take the same free floe fall back to the serial advance") {
-  // In a row along x, 10 m squares: a1 (floe 0, 1 m/s) hits a2 (floe 1, at
-  // rest) 0.5 m ahead of it, and b1 (floe 2, -1 m/s) hits b2 (floe 3) the
-  // same way from the other side; j (floe 4, at rest) lies 7 m from a2 and
-  // from b2: free at the step's start (no hot pair), taken by both clusters
-  // once a2 and b2 rebound towards it (at 0.7 m/s: half the room, 3.5 m, at
-  // about 5.5 s; they would reach j after the 10 s step, so j never moves
-  // towards the other cluster). Serially the first cluster takes j
-  // and the second merges with it; as shares on two ranks, neither sees the
-  // other (no foreign cluster), both take j: only the floe moved twice says
-  // so, and the combination must refuse.
-  auto box = [](double x0, double vx) {
-    FloeInput f;
-    f.vertices = {{x0, 0.0}, {x0 + 10.0, 0.0}, {x0 + 10.0, 10.0}, {x0, 10.0}};
-    f.velocity = {vx, 0.0};
-    return f;
-  };
-  Case c;
-  for (const FloeInput& in : {box(0.0, 1.0), box(10.5, 0.0), box(55.0, -1.0), box(44.5, 0.0), box(27.5, 0.0)})
-    c.floes.add(make_floe_shape(in), in);
-  c.shapes = contact::build_collision_shapes(c.floes);
-  contact::DetectionOptions d;
-  d.horizon = c.dt;
-  d.reach.assign(c.floes.size(), 6.0);  // m: pairs within 12 m (a2-j and b2-j, not a2-b2)
-  c.detection = contact::detect(c.floes, c.shapes, d);
-  c.options.floor = 1e-3 * c.dt;
+  // The row of test::row_taking_one_free_floe (a's cluster and b's both
+  // take the free floe j; serially the first takes j and the second merges
+  // with it): as shares on two ranks, neither sees the other (no foreign
+  // cluster), both take j: only the floe moved twice says so, and the
+  // combination must refuse.
+  const Case c = test::row_taking_one_free_floe();
   const Serial serial = serial_advance(c);
   MESSAGE("serial: " << serial.report.clusters << " clusters, " << serial.report.joined << " joined, "
                      << serial.report.merges << " merges");
@@ -905,22 +856,7 @@ TEST_CASE("two ranks' clusters that take the same free floe, from the parts: joi
   // part: the first try's parts both move j (no conflict, taken twice), so
   // the two clusters are joined on rank 0 (the runner of the lower) and the
   // second try combines, equal to the serial advance.
-  auto box = [](double x0, double vx) {
-    FloeInput f;
-    f.vertices = {{x0, 0.0}, {x0 + 10.0, 0.0}, {x0 + 10.0, 10.0}, {x0, 10.0}};
-    f.velocity = {vx, 0.0};
-    return f;
-  };
-  Case c;
-  for (const FloeInput& in : {box(0.0, 1.0), box(10.5, 0.0), box(55.0, -1.0), box(44.5, 0.0), box(27.5, 0.0)})
-    c.floes.add(make_floe_shape(in), in);
-  c.shapes = contact::build_collision_shapes(c.floes);
-  contact::DetectionOptions d;
-  d.horizon = c.dt;
-  d.reach.assign(c.floes.size(), 6.0);
-  c.detection = contact::detect(c.floes, c.shapes, d);
-  c.detect_options = d;
-  c.options.floor = 1e-3 * c.dt;
+  const Case c = test::row_taking_one_free_floe();
   const Serial serial = serial_advance(c);
   REQUIRE(serial.report.merges == 1);
   parallel::FloeOwners strips(0, 2, c.domain);

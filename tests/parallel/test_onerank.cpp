@@ -20,6 +20,7 @@
 #include "contact/substep.hpp"
 #include "parallel/advance_share.hpp"
 #include "parallel/place.hpp"
+#include "tests/parallel/advance_case.hpp"
 #include "tests/parallel/collide_case.hpp"
 
 TEST_SUITE_BEGIN("mpi");
@@ -28,39 +29,12 @@ using namespace floesim;
 
 namespace {
 
-struct Case {
-  Floes floes;
-  contact::CollisionShapes shapes;
-  contact::Detection detection;
-  contact::SubstepOptions options;
-  contact::Domain domain;
-  double dt = 10.0;
-};
-
-// A dense periodic pack of 400 floes moving at up to `speed` (the pack of
-// test_advance_share.cpp): many small clusters, some merging.
+// The dense periodic pack of test_advance_share.cpp (tests/parallel/
+// advance_case.hpp): many small clusters, some merging; every LCP starts
+// from the warm store and stores its basis.
+using Case = test::AdvanceCase;
 Case dense_pack(double speed, unsigned seed, double concentration) {
-  GeneratedPack g = test::moving_generated_pack(seed, speed, concentration);
-  Case c;
-  c.floes = std::move(g.floes);
-  c.shapes = contact::build_collision_shapes(c.floes);
-  c.domain = {true, g.window[0], g.window[1], g.window[2], g.window[3]};
-  contact::DetectionOptions d;
-  d.domain = c.domain;
-  d.horizon = c.dt;
-  d.reach.assign(c.floes.size(), 0.0);
-  for (std::size_t i = 0; i < c.floes.size(); ++i) {
-    const FloeState& s = c.floes.state[i];
-    d.reach[i] = c.dt * (1.5 * (std::hypot(s.vx, s.vy) + std::abs(s.yaw_rate) * c.shapes.radius[i]) + 0.5 * speed) +
-                 d.collision_distance;
-  }
-  c.detection = contact::detect(c.floes, c.shapes, d);
-  c.options.collision_distance = d.collision_distance;
-  c.options.floor = 1e-3 * c.dt;
-  c.options.domain = c.domain;
-  c.options.impulse.collision_distance = d.collision_distance;
-  c.options.impulse.min_gap = 0.1 * d.collision_distance;
-  // Every LCP starts from the warm store and stores its basis.
+  Case c = test::dense_advance_pack(speed, seed, concentration);
   c.options.impulse.warm_min = 0;
   return c;
 }
