@@ -49,6 +49,11 @@ struct FootprintQuadrature {
   std::span<const Vec2> points(std::size_t i) const {
     return {point.data() + offsets[i], offsets[i + 1] - offsets[i]};
   }
+  // What these arrays allocate, against the held floes' entries
+  // (core/floe_bytes.hpp; `held` empty: every floe).
+  FloeBytes memory(std::span<const std::uint8_t> held) const {
+    return csr_bytes(offsets, capacity_bytes(point) + capacity_bytes(weight), sizeof(Vec2) + sizeof(double), held);
+  }
 };
 FootprintQuadrature build_footprint_quadrature(const Floes& floes, int level = 0);
 

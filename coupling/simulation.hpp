@@ -201,6 +201,18 @@ public:
   // The floes this rank holds (its own and its halo band, parallel::held_floes)
   // at the places and reaches of the last detection; one rank: every floe.
   const parallel::HeldFloes& held_floes() const { return held_; }
+  // What the per-floe structures allocate on this rank, against the entries
+  // of the floes it holds (core/floe_bytes.hpp; docs/parallel.md, "The
+  // arrays held by band: measured (mem27)"): one entry a structure, named
+  // as the run's summary prints it (memory.floes.NAME), and the held
+  // floes' count (its own and its band, held_by_band(); one rank: every
+  // floe). Not counted: the per-step scratch (the step-start copies, the
+  // posed shapes), the per-cell arrays (the sea's), the contact store.
+  struct FloeMemory {
+    std::size_t floes = 0, held = 0;
+    std::vector<std::pair<std::string, FloeBytes>> parts;
+  };
+  FloeMemory floe_memory() const;
   const contact::SubstepReport& substep_report() const { return substeps_; }
   const parallel::AdvanceShareCounts& advance_share() const { return advance_share_; }  // stage seven
   const parallel::AdvanceShareCounts& collide_share() const { return collide_share_; }  // the step-start collisions
