@@ -1,10 +1,18 @@
-// Simulation::floe_memory: the per-floe structures' bytes on this rank
-// against the held floes' entries (docs/parallel.md, "The arrays held by
-// band: measured (mem27)").
+// The per-floe structures held by band and their memory on this rank
+// (docs/parallel.md, "The arrays held by band: measured (mem27)"):
+// Simulation::hold_quadrature, Simulation::floe_memory.
 
 #include "coupling/simulation.hpp"
 
 namespace floesim {
+
+void Simulation::hold_quadrature() {
+  // Only the drift reads the quadrature, each rank its own floes' (which it
+  // holds), in every case of several ranks (the halo exchange or not): the
+  // floes of its band are kept too, so that a floe migrating to it across
+  // a cut has its points already.
+  if (!comm_.serial()) quadrature_.hold(scenario_.floes, held_by_band());
+}
 
 Simulation::FloeMemory Simulation::floe_memory() const {
   const std::vector<std::uint8_t> held = held_by_band();  // empty: every floe
