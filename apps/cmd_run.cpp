@@ -323,6 +323,21 @@ int run(const Args& args, const parallel::Session& session) {
   restore_signals();
   say_poison(sim);
   const int status = s.status == "complete" ? 0 : kInterruptedExit;
+  // The run's collectives, read before the memory's gather below (the
+  // summary's parallel.* figures are the run's alone).
+  const parallel::Communicator::Traffic traffic = comm.traffic();
+  // Each rank's per-floe structures (Simulation::floe_memory: every rank
+  // names the same structures in the same order), gathered to every rank:
+  // per rank its held floes, then per structure its bytes and its held
+  // floes' entries' bytes.
+  const Simulation::FloeMemory memory = sim.floe_memory();
+  std::vector<std::uint64_t> memory_mine{memory.held};
+  for (const auto& part : memory.parts) {
+    memory_mine.push_back(part.second.whole);
+    memory_mine.push_back(part.second.held);
+  }
+  const std::vector<std::uint64_t> memory_all =
+      comm.serial() ? memory_mine : comm.allgather<std::uint64_t>(memory_mine);
   if (!comm.writer()) return status;  // rank 0 reports the run
 
   // steps counts the run's steps from its start; the rate, this process's
@@ -376,9 +391,25 @@ int run(const Args& args, const parallel::Session& session) {
       << "\nimplicit.cg_per_step: " << static_cast<double>(st.cg) / steps
       << "\nimplicit.sea_responses_per_step: " << static_cast<double>(st.g_products) / steps << "\n";
   }
+  {
+    // The per-floe structures' bytes (capacity) on each rank, in rank order,
+    // and the bytes their held floes' entries would take (core/floe_bytes.hpp;
+    // docs/parallel.md, "The arrays held by band: measured (mem27)").
+    const std::size_t stride = memory_mine.size(), ranks = memory_all.size() / stride;
+    o << "memory.floes.held:";
+    for (std::size_t r = 0; r < ranks; ++r) o << " " << memory_all[r * stride];
+    o << " of " << memory.floes << "\n";
+    for (std::size_t k = 0; k < memory.parts.size(); ++k) {
+      o << "memory.floes." << memory.parts[k].first << ":";
+      for (std::size_t r = 0; r < ranks; ++r) o << " " << memory_all[r * stride + 1 + 2 * k];
+      o << " bytes; held";
+      for (std::size_t r = 0; r < ranks; ++r) o << " " << memory_all[r * stride + 2 + 2 * k];
+      o << "\n";
+    }
+  }
   if (!comm.serial()) {
     // Rank 0's collectives: bytes it received and the time in them, waits for the other ranks included.
-    const parallel::Communicator::Traffic t = comm.traffic();
+    const parallel::Communicator::Traffic& t = traffic;
     o << "parallel.ranks: " << comm.size() << "\nparallel.collectives: " << t.calls << "\nparallel.bytes_received: " << t.bytes
       << "\nparallel.collective_seconds: " << t.seconds << "\n";
     // The same by phase (Profile): the calls and bytes of each phase that

@@ -25,6 +25,20 @@ void extend_collision_shapes(CollisionShapes& s, const Floes& floes, std::size_t
   }
 }
 
+FloeBytes CollisionShapes::memory(std::span<const std::uint8_t> held) const {
+  const std::size_t n = radius.size();
+  std::size_t floes = 0, parts = 0, points = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!held.empty() && (i >= held.size() || !held[i])) continue;
+    ++floes;
+    parts += parts_of(i);
+    points += vertex_offsets[part_offsets[i + 1]] - vertex_offsets[part_offsets[i]];
+  }
+  return {capacity_bytes(part_offsets) + capacity_bytes(vertex_offsets) + capacity_bytes(vertices) +
+              capacity_bytes(radius),
+          (floes + 1 + parts) * sizeof(std::size_t) + points * sizeof(Vec2) + floes * sizeof(double)};
+}
+
 CollisionShapes build_collision_shapes(const Floes& floes) {
   CollisionShapes s;
   extend_collision_shapes(s, floes, 0);

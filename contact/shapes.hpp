@@ -20,6 +20,11 @@ struct CollisionShapes {
     return {vertices.data() + vertex_offsets[p], vertex_offsets[p + 1] - vertex_offsets[p]};
   }
   std::size_t parts_of(std::size_t floe) const { return part_offsets[floe + 1] - part_offsets[floe]; }
+
+  // What these arrays allocate, against the entries of the floes `held`
+  // marks (core/floe_bytes.hpp; empty: every floe): their part offsets and
+  // radii, their parts' vertex offsets and vertices.
+  FloeBytes memory(std::span<const std::uint8_t> held) const;
 };
 
 CollisionShapes build_collision_shapes(const Floes& floes);

@@ -86,4 +86,16 @@ Floes Floes::select(std::span<const std::size_t> which) const {
   return out;
 }
 
+Floes::Memory Floes::memory(std::span<const std::uint8_t> held) const {
+  const std::size_t k = held_count(held, size());
+  Memory m;
+  for (const auto* v : {&thickness, &density, &area, &mass, &inertia_z, &inertia_x, &inertia_y, &ocean_drag})
+    m.constants += per_floe_bytes(*v, k);
+  m.constants += per_floe_bytes(is_static, k);
+  m.constants += per_floe_bytes(id, k);
+  m.vertices = csr_bytes(offsets, capacity_bytes(body), sizeof(Vec2), held);
+  m.state = per_floe_bytes(state, k);
+  return m;
+}
+
 }  // namespace floesim

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "core/floe.hpp"
+#include "core/floe_bytes.hpp"
 
 namespace floesim {
 
@@ -98,6 +99,14 @@ struct Floes {
   // A copy of the listed floes, in that order, with their ids.
   Floes select(std::span<const std::size_t> which) const;
   // Every per-floe array above must be handled by add, replace and select.
+
+  // What these arrays allocate (core/floe_bytes.hpp), against the entries of
+  // the floes `held` marks (empty: every floe): the constants (thickness to
+  // is_static, and id), the body vertices (CSR), the states.
+  struct Memory {
+    FloeBytes constants, vertices, state;
+  };
+  Memory memory(std::span<const std::uint8_t> held) const;
 };
 
 }  // namespace floesim

@@ -4,6 +4,8 @@
 #include <array>
 #include <cmath>
 
+#include "core/error.hpp"
+
 namespace floesim {
 
 namespace {
@@ -34,17 +36,115 @@ void add_triangle(FootprintQuadrature& q, const Vec2& a, const Vec2& b, const Ve
     q.weight.push_back(r.w * area);
   }
 }
+
+// The points floe i's range takes: 6 a fan triangle, 4^level of them a vertex.
+std::size_t points_of(const Floes& floes, std::size_t i, int level) {
+  return kRule.size() * (std::size_t{1} << (2 * level)) * (floes.offsets[i + 1] - floes.offsets[i]);
+}
+
+// Appends floe i's points (the fan triangles (G, v_k, v_{k+1})) as its range.
+void append_floe(FootprintQuadrature& q, const Floes& floes, std::size_t i) {
+  const auto v = floes.vertices(i);
+  q.first[i] = q.point.size();
+  for (std::size_t k = 0; k < v.size(); ++k) add_triangle(q, Vec2::Zero(), v[k], v[(k + 1) % v.size()], q.level);
+  q.count[i] = static_cast<std::uint32_t>(q.point.size() - q.first[i]);
+}
+
+// The live ranges copied in floe order into arrays of `capacity` points.
+void compact(FootprintQuadrature& q, std::size_t capacity) {
+  std::vector<Vec2> point;
+  std::vector<double> weight;
+  point.reserve(capacity);
+  weight.reserve(capacity);
+  for (std::size_t i = 0; i < q.count.size(); ++i) {
+    if (q.count[i] == 0) continue;
+    const std::size_t from = q.first[i];
+    q.first[i] = point.size();
+    point.insert(point.end(), q.point.begin() + static_cast<std::ptrdiff_t>(from),
+                 q.point.begin() + static_cast<std::ptrdiff_t>(from + q.count[i]));
+    weight.insert(weight.end(), q.weight.begin() + static_cast<std::ptrdiff_t>(from),
+                  q.weight.begin() + static_cast<std::ptrdiff_t>(from + q.count[i]));
+  }
+  q.point = std::move(point);
+  q.weight = std::move(weight);
+  q.dead = 0;
+}
 }  // namespace
 
 FootprintQuadrature build_footprint_quadrature(const Floes& floes, int level) {
   FootprintQuadrature q;
-  for (std::size_t i = 0; i < floes.size(); ++i) {
-    const auto v = floes.vertices(i);
-    for (std::size_t k = 0; k < v.size(); ++k)
-      add_triangle(q, Vec2::Zero(), v[k], v[(k + 1) % v.size()], level);
-    q.offsets.push_back(q.point.size());
-  }
+  q.level = level;
+  q.first.assign(floes.size(), 0);
+  q.count.assign(floes.size(), 0);
+  std::size_t total = 0;
+  for (std::size_t i = 0; i < floes.size(); ++i) total += points_of(floes, i, level);
+  q.point.reserve(total);
+  q.weight.reserve(total);
+  for (std::size_t i = 0; i < floes.size(); ++i) append_floe(q, floes, i);
   return q;
+}
+
+void FootprintQuadrature::forget() {
+  const int kept = level;
+  *this = FootprintQuadrature();
+  level = kept;
+}
+
+namespace {
+// Room for `needed` more points: compacted when the dead points exceed half
+// the live ones (a compaction copies the live points, at most twice the
+// dead ones it frees: two copies a dropped point) or when the appends would
+// reallocate (the vector's doubling would hold up to twice the points),
+// into room for a quarter more than the live and needed points.
+void make_room(FootprintQuadrature& q, std::size_t needed) {
+  const std::size_t live = q.point.size() - q.dead;
+  if (2 * q.dead > live || q.point.size() + needed > q.point.capacity())
+    compact(q, live + needed + (live + needed) / 4);
+}
+}  // namespace
+
+void FootprintQuadrature::hold(const Floes& floes, std::span<const std::uint8_t> held) {
+  const std::size_t n = floes.size();
+  FLOESIM_ASSERT(held.empty() || held.size() == n);
+  first.resize(n, 0);
+  count.resize(n, 0);
+  std::size_t needed = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const bool keep = held.empty() || held[i] != 0;
+    if (!keep && count[i] > 0) {
+      dead += count[i];
+      count[i] = 0;
+    } else if (keep && count[i] == 0) {
+      needed += points_of(floes, i, level);
+    }
+  }
+  make_room(*this, needed);
+  if (needed == 0) return;
+  for (std::size_t i = 0; i < n; ++i)
+    if ((held.empty() || held[i] != 0) && count[i] == 0) append_floe(*this, floes, i);
+}
+
+void FootprintQuadrature::ensure(const Floes& floes, std::span<const std::uint32_t> which) {
+  FLOESIM_ASSERT(count.size() == floes.size());
+  std::size_t needed = 0;
+  for (const std::uint32_t i : which)
+    if (count[i] == 0) needed += points_of(floes, i, level);
+  if (needed == 0) return;
+  make_room(*this, needed);
+  for (const std::uint32_t i : which)
+    if (count[i] == 0) append_floe(*this, floes, i);
+}
+
+FloeBytes FootprintQuadrature::memory(std::span<const std::uint8_t> held) const {
+  std::size_t floes = 0, points = 0;
+  for (std::size_t i = 0; i < count.size(); ++i)
+    if (held.empty() || (i < held.size() && held[i])) {
+      ++floes;
+      points += count[i];
+    }
+  // A layout of the held floes alone: their offsets (one more) and points.
+  return {capacity_bytes(first) + capacity_bytes(count) + capacity_bytes(point) + capacity_bytes(weight),
+          (floes + 1) * sizeof(std::size_t) + points * (sizeof(Vec2) + sizeof(double))};
 }
 
 DragLoad drag_load(const Floes& floes, const FootprintQuadrature& q, std::size_t i,
@@ -55,7 +155,8 @@ DragLoad drag_load(const Floes& floes, const FootprintQuadrature& q, std::size_t
   const double cw = floes.ocean_drag[i] >= 0.0 ? floes.ocean_drag[i] : p.ocean_drag;
   const double k = p.rho_water * cw;
   const double c = std::cos(s.yaw), sn = std::sin(s.yaw);
-  const std::size_t begin = q.offsets[i], end = q.offsets[i + 1];
+  FLOESIM_ASSERT(q.has(i));  // a floe drifted is held (FootprintQuadrature::hold)
+  const std::size_t begin = q.first[i], end = begin + q.count[i];
   // Force, torque and the six entries of the symmetric Jacobian, accumulated as
   // scalars: with B = [I | kr], B^T (|u| I + u u^T/|u|) B = |u| B^T B + (B^T u)(B^T u)^T / |u|,
   // B^T B = [[1, 0, kr_x], [0, 1, kr_y], [kr_x, kr_y, |r|^2]], B^T u = (u_x, u_y, kr . u).

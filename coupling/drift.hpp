@@ -41,15 +41,52 @@ struct DriftParams {
   double coriolis = 0.0;      // f, 1/s
 };
 
-// Quadrature points of every floe, body frame, contiguous with offsets.
+// Quadrature points of the floes, body frame: floe i's are
+// [first[i], first[i] + count[i]) of `point` and `weight` (a function of its
+// body vertices and the level alone).
+//
+// Held by band (docs/parallel.md, "The arrays held by band: measured
+// (mem27)"): on several ranks a rank drifts only the floes it owns, so it
+// keeps the points of the floes it holds (its own and its band) and none of
+// the others' (count 0; hold()). The floes' ranges then are not in floe
+// order: a floe entering the held set gets its range appended at the end
+// (its own points, built from its vertices, which every rank keeps), a floe
+// leaving it leaves a dead range behind, and the arrays are compacted (the
+// live ranges copied in floe order) when the dead points exceed half the
+// live ones or an append would outgrow the capacity. With CSR offsets
+// instead, an entering floe would shift every later floe's points; here the
+// per-floe cost of the layout is one more array (12 B a floe: the offset
+// and a count). A floe's points are the same values wherever they lie, so
+// the drag reads the same bits.
 struct FootprintQuadrature {
-  std::vector<std::size_t> offsets{0};
-  std::vector<Vec2> point;    // m, body frame (relative to the centroid)
-  std::vector<double> weight; // m^2 (signed); they sum to the floe's area
-  std::span<const Vec2> points(std::size_t i) const {
-    return {point.data() + offsets[i], offsets[i + 1] - offsets[i]};
-  }
+  int level = 0;                     // each fan triangle split into 4^level (build_footprint_quadrature)
+  std::vector<std::size_t> first;    // per floe: its first point
+  std::vector<std::uint32_t> count;  // per floe: its points (0: not held, or not built yet)
+  std::vector<Vec2> point;           // m, body frame (relative to the centroid)
+  std::vector<double> weight;        // m^2 (signed); a floe's sum to its area
+  std::size_t dead = 0;              // points in no floe's range (left by floes no longer held)
+
+  std::span<const Vec2> points(std::size_t i) const { return {point.data() + first[i], count[i]}; }
+  std::span<const double> weights(std::size_t i) const { return {weight.data() + first[i], count[i]}; }
+  bool has(std::size_t i) const { return i < count.size() && count[i] > 0; }
+  // Keeps the points of the floes `held` marks (empty: every floe) and of
+  // no other: drops the others' ranges, builds the held floes' that have
+  // none (a floe entering the held set; the floes added since the last
+  // call, e.g. a split's pieces, start with none), compacts when due.
+  // Floes whose vertices changed (Floes::replace) must be forgotten first
+  // (forget()).
+  void hold(const Floes& floes, std::span<const std::uint8_t> held);
+  // Builds the ranges of the listed floes that have none (those come to
+  // this rank since the last hold(), by a move of the cuts), for these
+  // floes (hold() called for them).
+  void ensure(const Floes& floes, std::span<const std::uint32_t> which);
+  // Every range dropped and the arrays freed (the floes changed).
+  void forget();
+  // What these arrays allocate, against the held floes' entries
+  // (core/floe_bytes.hpp; `held` empty: every floe).
+  FloeBytes memory(std::span<const std::uint8_t> held) const;
 };
+// Every floe's points, in floe order.
 FootprintQuadrature build_footprint_quadrature(const Floes& floes, int level = 0);
 
 // Force and Jacobian of ocean + air drag on floe i (world frame, about G).

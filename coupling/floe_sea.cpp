@@ -531,4 +531,28 @@ double FloeSeaContact::weight_energy(const Floes& floes, std::size_t i) const {
   return dynamic_[i] ? floes.mass[i] * g_ * floes.state[i].heave : 0.0;
 }
 
+FloeSeaContact::Memory FloeSeaContact::memory(std::span<const std::uint8_t> held) const {
+  const std::size_t k = held_count(held, dynamic_.size());
+  Memory m;
+  FloeBytes& f = m.per_floe;
+  f += per_floe_bytes(dynamic_, k);
+  f += per_floe_bytes(tilt_, k);
+  f += per_floe_bytes(bottom0_, k);
+  f += per_floe_bytes(body_moments_, k);
+  f += per_floe_bytes(poses_, k);
+  f += per_floe_bytes(loads_, k);
+  f += per_floe_bytes(water_, k);
+  f += per_floe_bytes(slope_, k);
+  f += per_floe_bytes(step_horizontal_, k);
+  f += per_floe_bytes(first_half_, k);
+  f += per_floe_bytes(inertia_, k);
+  f += per_floe_bytes(free_bottom_, k);
+  f += per_floe_bytes(eval_.wetted, k);
+  f += per_floe_bytes(owner_.box, k);
+  f += per_floe_bytes(owner_.position, k);
+  f += per_floe_bytes(next_owners_.owner, k);
+  m.footprints = footprints_.memory(held);
+  return m;
+}
+
 }  // namespace floesim

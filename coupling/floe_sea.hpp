@@ -351,6 +351,19 @@ public:
   // Floes whose contact rebuilt data must be redone (after a split).
   void floes_changed(const Floes& floes);
 
+  // What the coupling allocates per floe on this rank, against the held
+  // floes' entries (core/floe_bytes.hpp; `held` empty: every floe): its
+  // arrays of one entry a floe (the constants it derives, the poses, loads,
+  // water velocities and slopes, the implicit step's, the owners' boxes
+  // and places in the serial order, the next owners), and the footprints'
+  // (MovingFootprints::memory). Not counted: the per-cell arrays (the sea's
+  // grid, not the floes) and the per-piece scratch of one evaluation.
+  struct Memory {
+    FloeBytes per_floe;
+    MovingFootprints::Memory footprints;
+  };
+  Memory memory(std::span<const std::uint8_t> held) const;
+
   // Restart (core/checkpoint.hpp): what this class carries from one step to
   // the next beyond the floes and the sea. restore() takes the floes and the
   // sea (and incident waves) already restored, and evaluates the loads cache

@@ -312,4 +312,27 @@ void MovingFootprints::gather_moved() {
   }
 }
 
+MovingFootprints::Memory MovingFootprints::memory(std::span<const std::uint8_t> held) const {
+  const std::size_t k = held_count(held, pieces_.floes());
+  const Footprints& f = pieces_;
+  Memory m;
+  m.per_floe = per_floe_bytes(reference_, k);
+  m.per_floe += per_floe_bytes(include_, k);
+  m.per_floe += per_floe_bytes(radius_, k);
+  m.per_floe += per_floe_bytes(owner_, k);
+  m.per_floe += {capacity_bytes(mine_), capacity_bytes(mine_)};  // this rank's own floes: held already
+  m.area_pieces = csr_bytes(f.offsets,
+                            capacity_bytes(f.cell) + capacity_bytes(f.area) + capacity_bytes(f.centroid) +
+                                capacity_bytes(area0_) + capacity_bytes(moment0_),
+                            sizeof(std::uint32_t) + sizeof(double) + sizeof(Vec2) + sizeof(double) + sizeof(Vec2), held);
+  m.edge_pieces = csr_bytes(f.edge_offsets,
+                            capacity_bytes(f.edge_cell) + capacity_bytes(f.edge_piece) + capacity_bytes(f.edge_length) +
+                                capacity_bytes(f.edge_normal) + capacity_bytes(f.edge_twist) +
+                                capacity_bytes(f.edge_first) + capacity_bytes(f.edge_swept),
+                            sizeof(std::uint32_t) + sizeof(std::ptrdiff_t) + sizeof(double) + sizeof(Vec2) +
+                                sizeof(double) + sizeof(Eigen::Matrix2d) + sizeof(Vec2),
+                            held);
+  return m;
+}
+
 }  // namespace floesim

@@ -190,6 +190,16 @@ public:
   long placements() const { return placements_; }
   long rebuilds() const { return rebuilds_; }
 
+  // What this object allocates, against the held floes' entries
+  // (core/floe_bytes.hpp; `held` empty: every floe): per floe (reference
+  // poses, include, radius, owner; this rank's floes' list), the area
+  // pieces (the CSR of Footprints with each piece's reference area and
+  // moment) and the edge pieces (their CSR).
+  struct Memory {
+    FloeBytes per_floe, area_pieces, edge_pieces;
+  };
+  Memory memory(std::span<const std::uint8_t> held) const;
+
 private:
   void move(std::span<const FloePose> poses, int threads);
   // owner_ and mine_ for floes at `poses` (the rebuild's), or `owners`

@@ -193,7 +193,11 @@ void Simulation::restore(const Checkpoint& c) {
   equal_dt_ = c.equal_dt;
   // What the floes determine: collision shapes, drag quadrature, the pair
   // list and contacts as detect_and_check left them at the end of the step.
-  quadrature_ = build_footprint_quadrature(scenario_.floes);
+  // (the quadrature on several ranks: the held floes' only, at the detection below)
+  if (comm_.serial())
+    quadrature_ = build_footprint_quadrature(scenario_.floes);
+  else
+    quadrature_.forget();
   shapes_ = contact::build_collision_shapes(scenario_.floes);
   // The owners by place start again from the restored places, as at a
   // run's start (the strips by equal counts, or the sea's slabs), and the

@@ -82,7 +82,9 @@ Simulation::Simulation(Scenario scenario, parallel::Communicator comm)
   const Config& c = scenario_.config;
   drift_params_ = DriftParams{c.sea.rho, c.forcing.ocean_drag, c.forcing.air_density, c.forcing.air_drag,
                               c.forcing.coriolis};
-  quadrature_ = build_footprint_quadrature(scenario_.floes);
+  // Serially every floe's drift quadrature; on several ranks none until the
+  // start's detection, which holds the rank's floes' (hold_quadrature).
+  if (comm_.serial()) quadrature_ = build_footprint_quadrature(scenario_.floes);
   moorings_ = Moorings(scenario_.floes, c.floes.floes);  // anchored where the floes start (also on a restart)
   shapes_ = contact::build_collision_shapes(scenario_.floes);
   detection_options_.collision_distance = c.contact.collision_distance;
@@ -301,6 +303,10 @@ void Simulation::drift(StepContext& ctx) {
     if (floe_sea_) floe_sea_->hand_water_over(owners_.owner());
     water_at();
     const double start = parallel::thread_seconds();
+    // The floes come to this rank by a move of the cuts since the detection
+    // (hand_over_moved), or taken by the owners at a rejected try's, need
+    // not be in its held set there: their quadratures built here.
+    quadrature_.ensure(scenario_.floes, owners_.mine());
     drift_velocities(scenario_.floes, quadrature_, drift_params_, current, wind, ctx.dt, owners_.mine(), water);
     owners_.charge(parallel::thread_seconds() - start);
     // The drifted states to the ranks that read them: with the state held
@@ -398,7 +404,12 @@ void Simulation::percussion(StepContext& ctx) {
 }
 
 void Simulation::on_floes_changed() {
-  quadrature_ = build_footprint_quadrature(scenario_.floes);
+  // A split replaces its parent's vertices: every quadrature made again
+  // (on several ranks the held floes' at the detection below).
+  if (comm_.serial())
+    quadrature_ = build_footprint_quadrature(scenario_.floes);
+  else
+    quadrature_.forget();
   shapes_ = contact::build_collision_shapes(scenario_.floes);
   // The reaches (new pieces included) are set and the pieces are placed (appended at the same indices with the same ids
   // on every rank: Percussion::conclude on the same initiations in floe
@@ -593,6 +604,7 @@ bool Simulation::detect_and_check(StepContext& ctx) {
   }
   detection_ = std::move(next);
   held_ = std::move(held);
+  hold_quadrature();
   // With the state held by owner the copies of the floes this rank does
   // not hold are stale from here on (the vertical drift that follows is
   // over the held floes; they were since the drift unless gathered).

@@ -205,7 +205,22 @@ public:
   // The floes this rank holds (its own and its halo band, parallel::held_floes)
   // at the places and reaches of the last detection; one rank: every floe.
   const parallel::HeldFloes& held_floes() const { return held_; }
+  // What the per-floe structures allocate on this rank, against the entries
+  // of the floes it holds (core/floe_bytes.hpp; docs/parallel.md, "The
+  // arrays held by band: measured (mem27)"): one entry a structure, named
+  // as the run's summary prints it (memory.floes.NAME), and the held
+  // floes' count (its own and its band, held_by_band(); one rank: every
+  // floe). Not counted: the per-step scratch (the step-start copies, the
+  // posed shapes), the per-cell arrays (the sea's), the contact store.
+  struct FloeMemory {
+    std::size_t floes = 0, held = 0;
+    std::vector<std::pair<std::string, FloeBytes>> parts;
+  };
+  FloeMemory floe_memory() const;
   const contact::SubstepReport& substep_report() const { return substeps_; }
+  // The drift's quadrature: serially every floe's; on several ranks the
+  // points of the floes this rank holds only (hold_quadrature).
+  const FootprintQuadrature& quadrature() const { return quadrature_; }
   const parallel::AdvanceShareCounts& advance_share() const { return advance_share_; }  // stage seven
   const parallel::AdvanceShareCounts& collide_share() const { return collide_share_; }  // the step-start collisions
   long rejected_steps() const { return rejected_steps_; }
@@ -312,6 +327,13 @@ private:
   // (owners_.mine()) and its own floes for the coupling. Empty: every floe
   // (one rank, no detection yet, or the implicit step).
   std::vector<std::uint8_t> held_now() const;
+  // The drift's quadrature held by band (docs/parallel.md, "The arrays held
+  // by band: measured (mem27)"): on several ranks, at each detection that
+  // sets held_, the points of the floes this rank holds (held_by_band()) and
+  // none of the others' (FootprintQuadrature::hold). Only the drift reads
+  // them, each rank its own floes', which it holds (a floe come to it
+  // since: ensure() at the drift). Serially nothing (every floe's, built).
+  void hold_quadrature();
   // held_now() but for the implicit step's every floe (the poison mode's
   // held set: the implicit step is a reader of the others).
   std::vector<std::uint8_t> held_by_band() const;

@@ -100,6 +100,7 @@ void Simulation::detect_in_place() {
   // entering floe's state goes with its notice.
   std::optional<parallel::HaloPart> halo = halo_part(nullptr, nullptr);
   held_ = hold_band({}, {}, halo ? &*halo : nullptr);
+  hold_quadrature();
   note_arrived(halo);
   if (halo) announced_ = std::move(halo->announced);
   wrap_entering(held_.index);

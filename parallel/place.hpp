@@ -213,6 +213,13 @@ public:
   }
 
   std::span<const int> owner() const { return owner_; }  // per floe, after assign()
+  // The owner array's and this rank's list's bytes (core/floe_bytes.hpp),
+  // against `held` floes' entries of the owner array (the list is held).
+  FloeBytes memory(std::size_t held) const {
+    FloeBytes m = per_floe_bytes(owner_, held);
+    m += {capacity_bytes(mine_), capacity_bytes(mine_)};
+    return m;
+  }
   const std::vector<std::uint32_t>& mine() const { return mine_; }  // this rank's floes, ascending
   // A floe's place: its centroid's y, wrapped into the box when periodic.
   double place(const FloeState& s) const;

@@ -44,7 +44,7 @@ TEST_CASE("footprint quadrature integrates area and second moments exactly") {
   const Floes& f = s.floes();
   const FootprintQuadrature q = build_footprint_quadrature(f, 1);
   double area = 0, jxx = 0;
-  for (std::size_t j = q.offsets[0]; j < q.offsets[1]; ++j) {
+  for (std::size_t j = q.first[0]; j < q.first[0] + q.count[0]; ++j) {
     area += q.weight[j];
     jxx += q.weight[j] * q.point[j].x() * q.point[j].x();
   }
@@ -146,7 +146,7 @@ TEST_CASE("a spinning floe in still water slows down at the rate the drag integr
   Simulation probe = square_floe("", 1.0, side, h);
   const FootprintQuadrature q = build_footprint_quadrature(probe.floes());
   double r3q = 0.0;
-  for (std::size_t j = q.offsets[0]; j < q.offsets[1]; ++j) r3q += q.weight[j] * std::pow(q.point[j].norm(), 3);
+  for (std::size_t j = q.first[0]; j < q.first[0] + q.count[0]; ++j) r3q += q.weight[j] * std::pow(q.point[j].norm(), 3);
   MESSAGE("quadrature of |r|^3: " << r3q << ", closed form " << r3 << ", relative error " << r3q / r3 - 1);
   CHECK(r3q == doctest::Approx(r3).epsilon(2e-3));
   const double c = kRhoW * kCw * r3q / Iz;

@@ -75,7 +75,7 @@ inline contact::CollisionShapes poisoned(contact::CollisionShapes shapes, const 
 inline FootprintQuadrature poisoned(FootprintQuadrature q, const Held& held) {
   for (std::size_t i = 0; i < held.size(); ++i) {
     if (held[i]) continue;
-    for (std::size_t k = q.offsets[i]; k < q.offsets[i + 1]; ++k) {
+    for (std::size_t k = q.first[i]; k < q.first[i] + q.count[i]; ++k) {
       q.point[k] = Vec2::Constant(kNaN);
       q.weight[k] = kNaN;
     }
