@@ -555,15 +555,14 @@ private:
   //   own floes at every evaluation (from their poses, which it reads
   //   anyway) and sends it with the boxes' gather (order_by_owner: 4 bytes
   //   a floe more). A rank holds the floes of its share (own_floes(), in
-  //   held_now) from the gather on; it holds no band of its own for them:
-  //   where the drift's bands do not hold every floe of a flume (one wider
-  //   than the floes' reach), the halo exchange of the state would have to
-  //   bring them.
+  //   held_now) from the next drift's exchange on, which sends each floe's
+  //   state to its next owner (next_floe_owners: its band need not hold
+  //   them in a flume wider than the floes' reach).
   // The next rebuild after a vertical drift (advance_vertical) takes them:
   // a new owner's copy of a floe is current after the drift's exchange and
   // the vertical drift of the floes it holds; an evaluation before it (a
-  // first half kick) keeps the owners. Until the first (the start, a
-  // restart, a split), the owners are by index, which reads no floe's place.
+  // first half kick) keeps the last rebuild's owners (given_owners). Until
+  // the first (the start, a restart, a split), the owners are by index.
   struct NextOwners {
     std::vector<int> column;  // dims = 1: per grid column, its share's rank (empty: the drift's owners)
     std::vector<int> owner;   // per floe: the next rebuild's owner (empty: none yet)

@@ -18,7 +18,7 @@
 // the whole state where a step reads every floe (Simulation::whole_state:
 // the pair list's rebuild, the fallbacks, a split). So a run in the mode
 // equals the plain run exactly when no phase reads an unheld floe. Where
-// the run keeps the whole state (the implicit step, the seas not in slabs,
+// the run keeps the whole state (the implicit step,
 // the advance from the whole detection: Simulation::halo_exchange() false)
 // the drift still sends every state to every rank and the poison after it
 // is read: those runs fail or differ, by design (their readers are known).

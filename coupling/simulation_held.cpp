@@ -185,7 +185,8 @@ std::optional<parallel::HaloPart> Simulation::halo_part(const parallel::Announce
                                                         std::vector<FloeState>* start) {
   // The poison mode (a test) poisons the unheld floes after the drift
   // whatever the exchange, so its runs take part (b) even where the drift
-  // sends every state (the implicit step, the seas not in slabs): the
+  // sends every state (the implicit step, the advance from the whole
+  // detection): the
   // floes entering a band then come from their owners as with the exchange,
   // and what the mode finds is a phase's read beyond the held floes, not
   // the entering floes that part (b) would have brought.
