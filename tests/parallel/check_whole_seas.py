@@ -73,6 +73,12 @@ the drift's exchange the wide flume differs from the serial run, plain and
 with the lure, and crashes with NaN.
 Then the bem case stopped half-way on 2 ranks and continued from its
 checkpoint on 3 ranks must equal the serial run bit for bit.
+Then the wide flume with fracture (286 floes at 2 s from 160) on 2 ranks,
+from the parts and from the whole detection (advance_on_part = false), bit
+for bit with the serial run: a split reads its parent's state on every
+rank, whose vertical drift only its holders made (main's build at 555f1e4
+made 284 floes on 2 ranks, the split's gather skipped after the drift's
+whole exchange).
 """
 import math
 import os
@@ -302,4 +308,35 @@ if p.returncode != 0:
 else:
     harness.same("bem_rest3.h5", "bem_serial.h5", "bem: half on 2 ranks, continued on 3, against the serial run",
                  failures)
+# Splits on a sea not in slabs: the wide flume with fracture (its floes
+# crack and split within the 2 s), on 2 ranks from the parts (the default,
+# the halo exchange) and from the whole detection (`advance_on_part =
+# false`: the drift sends every state). A split reads its parent's state on
+# every rank; the vertical drift before it moves only the floes each rank
+# holds, so the other copies' heave, pitch and roll are stale whatever the
+# drift's exchange, and whole_state must gather them.
+FRACTURE = """
+[fracture]
+enabled = true
+criterion = "stress"
+strength = 2.0e3
+split = true
+mesh_size = 0.2
+min_fragment_area = 0.05
+"""
+for label, run_table in (("from the parts", RUN), ("from the whole detection", RUN + "advance_on_part = false\n")):
+    config = os.path.join(W, "wide_split.toml" if run_table == RUN else "wide_split_whole.toml")
+    with open(config, "w") as f:
+        f.write(run_table + SEAS["wide"][0] + coupling("wide", "wide_pack.h5") + FRACTURE)
+    serial = config.replace(".toml", "_serial.h5")
+    s = summary(need(run([args.floesim, "run", config, "-o", serial, "-q"]), f"wide with splits {label}: serial run"))
+    print(f"wide with splits {label}: serial to 2 s, {s.get('floes')} floes from 160")
+    if int(s.get("floes", 0)) <= 160:
+        failures.append(f"wide with splits {label}: no floe split in the serial run ({s.get('floes')} floes)")
+    p = mpirun(2, "run", config, "-o", config.replace(".toml", "_2.h5"), "-q")
+    if p.returncode != 0:
+        failures.append(f"wide with splits {label} on 2 ranks: exit {p.returncode}\n{p.stderr}")
+    else:
+        harness.same(config.replace(".toml", "_2.h5"), serial, f"wide with splits {label}: 2 ranks against the "
+                     f"serial run", failures)
 finish(failures)
