@@ -219,10 +219,15 @@ public:
   // pieces it built at the footprints' last rebuild and moves), ascending;
   // on a sea not in slabs also those it owns from the next rebuild on
   // (next_owners_), which it must hold (pose, and drift vertically) until
-  // then.
+  // then, from the drift's exchange that sends them their states on.
   std::span<const std::uint32_t> own_floes() const {
-    return next_owners_.owner.empty() ? footprints_.mine() : std::span<const std::uint32_t>(next_owners_.held);
+    const NextOwners& next = next_owners_;
+    return next.owner.empty() || !next.current ? footprints_.mine() : std::span<const std::uint32_t>(next.held);
   }
+  // On a sea not in slabs, on several ranks: every floe's coupling owner
+  // from the next rebuild on (next_owners_; the same on every rank), to
+  // which the drift's exchange sends its state (empty: none known yet).
+  std::span<const int> next_floe_owners() const { return next_owners_.owner; }
   // On several ranks: every floe's coupling owner (the same on every rank;
   // empty before the first placement).
   std::span<const int> floe_owners() const { return footprints_.owners(); }
@@ -563,21 +568,27 @@ private:
   //   own floes at every evaluation (from their poses, which it reads
   //   anyway) and sends it with the boxes' gather (order_by_owner: 4 bytes
   //   a floe more). A rank holds the floes of its share (own_floes(), in
-  //   held_now) from the gather on; it holds no band of its own for them:
-  //   where the drift's bands do not hold every floe of a flume (one wider
-  //   than the floes' reach), the halo exchange of the state would have to
-  //   bring them.
+  //   held_now) from the next drift's exchange on, which sends each floe's
+  //   state to its next owner (next_floe_owners: its band need not hold
+  //   them in a flume wider than the floes' reach).
   // The next rebuild after a vertical drift (advance_vertical) takes them:
   // a new owner's copy of a floe is current after the drift's exchange and
   // the vertical drift of the floes it holds; an evaluation before it (a
-  // first half kick) keeps the owners. Until the first (the start, a
-  // restart, a split), the owners are by index, which reads no floe's place.
+  // first half kick) keeps the last rebuild's owners (given_owners). Until
+  // the first (the start, a restart, a split), the owners are by index.
   struct NextOwners {
     std::vector<int> column;  // dims = 1: per grid column, its share's rank (empty: the drift's owners)
     std::vector<int> owner;   // per floe: the next rebuild's owner (empty: none yet)
     std::vector<std::uint32_t> mine;  // this rank's floes in `owner`, ascending
-    std::vector<std::uint32_t> held;  // own_floes(): the footprints' mine() and `mine`
+    std::vector<std::uint32_t> held;  // own_floes() once `current`: the footprints' mine() and `mine`
+    // A drift's exchange since `owner` was set, which sent each floe's state
+    // to its next owner (hand_water_over, before it): until then a new
+    // owner's copy is stale and own_floes() is the footprints' mine() alone.
+    bool current = false;
     bool drifted = false;     // a vertical drift since `owner` was set
+    // given_owners' copy of the last rebuild's owners, when it keeps them.
+    std::vector<int> kept;
+    std::vector<std::uint32_t> kept_mine;
   } next_owners_;
   // next_owners_ from every floe's next owner.
   void set_next_owners(std::span<const int> owner);
@@ -589,7 +600,7 @@ private:
     std::span<const int> owner;
     std::span<const std::uint32_t> mine;
   };
-  GivenOwners given_owners(std::size_t floes) const;
+  GivenOwners given_owners(std::size_t floes);
   // The sea's slabs (fluid::Sea::slab_rows; empty: whole on every rank), and
   // by owner on them, the routes of the cells' sums to the slabs' ranks;
   // the next evaluation clears pressure_ in routes_.owned() (the cells the

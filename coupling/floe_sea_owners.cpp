@@ -116,6 +116,7 @@ void FloeSeaContact::set_next_owners(std::span<const int> owner) {
     if (owner[i] == comm_.rank()) next.mine.push_back(static_cast<std::uint32_t>(i));
     if (owner[i] == comm_.rank() || now_mine) next.held.push_back(static_cast<std::uint32_t>(i));
   }
+  next.current = false;
   next.drifted = false;
 }
 
@@ -129,13 +130,24 @@ int FloeSeaContact::column_owner(const FloePose& p) const {
   return next_owners_.column[static_cast<std::size_t>(column)];
 }
 
-FloeSeaContact::GivenOwners FloeSeaContact::given_owners(std::size_t floes) const {
+FloeSeaContact::GivenOwners FloeSeaContact::given_owners(std::size_t floes) {
   // The drift's owners on the sea's slabs (take_place_owners)...
   if (place_owner_.size() == floes && footprints_.takes_owners(place_rows_)) return {place_owner_, place_mine_};
   // ...or by place on a sea not in slabs, once their new owners hold
-  // their floes' current states (next_owners_).
-  const NextOwners& next = next_owners_;
+  // their floes' current states (next_owners_)...
+  NextOwners& next = next_owners_;
   if (next.owner.size() == floes && next.drifted) return {next.owner, next.mine};
+  // ...or, not in slabs, the last rebuild's owners kept: each holds its
+  // floes current (own_floes()), so a rebuild before the new owners hold
+  // theirs (a first half kick with stale loads, a redone try) poses only
+  // floes its rank holds. (Copies: the rebuild rewrites the footprints'.)
+  // None given (by index, every floe posed) only when no rebuild owns these
+  // floes yet: the start, a restore, a split, where every copy is current.
+  if (routes_.replicated() && footprints_.owners().size() == floes) {
+    next.kept.assign(footprints_.owners().begin(), footprints_.owners().end());
+    next.kept_mine.assign(footprints_.mine().begin(), footprints_.mine().end());
+    return {next.kept, next.kept_mine};
+  }
   return {};
 }
 
@@ -512,6 +524,9 @@ void FloeSeaContact::hand_water_over(std::span<const int> drift_owner) {
   // flume (shares of its columns) and with the implicit step (by index).
   if (routes_.replicated() && next_owners_.column.empty() && drift_owner.size() == dynamic_.size())
     set_next_owners(drift_owner);
+  // The drift's exchange that follows sends each floe's state to its next
+  // owner too (Simulation::send_to_holders): from here on they hold them.
+  next_owners_.current = true;
   if (comm_.serial() || !water_by_owner_) return;
   FLOESIM_ASSERT(drift_owner.size() == water_.size() && footprints_.owners().size() == water_.size());
   comm_.hand_over(water_, footprints_.owners(), drift_owner);

@@ -67,11 +67,14 @@ bool parse_poison_options(const std::string& text, PoisonOptions& options) {
   return true;
 }
 
-void UnheldPoison::poison(std::span<const std::uint8_t> held, std::vector<FloeState>& state,
-                          std::vector<FloeState>* start, std::vector<double>& reach, const contact::Domain& domain) {
+void UnheldPoison::poison(std::span<const std::uint8_t> held, std::span<const std::uint8_t> kept,
+                          std::vector<FloeState>& state, std::vector<FloeState>* start, std::vector<double>& reach,
+                          const contact::Domain& domain) {
   const std::size_t n = state.size();
   held_.assign(held.begin(), held.end());
   held_.resize(n, 0);
+  kept_.assign(kept.begin(), kept.end());
+  kept_.resize(n, 0);
   const bool lure = options_.kind == PoisonOptions::Kind::lure;
   long long count = 0;
   for (std::size_t i = 0; i < n; ++i) {
@@ -100,9 +103,9 @@ void UnheldPoison::check(const char* phase, const std::vector<FloeState>& state,
     if (!held_[i]) continue;
     std::string field;
     if (const int k = first_nan(state[i]); k >= 0) field = kStateColumnNames[k];
-    else if (start && i < start->size() && first_nan((*start)[i]) >= 0)
+    else if (kept_[i] && start && i < start->size() && first_nan((*start)[i]) >= 0)
       field = std::string("step-start ") + kStateColumnNames[first_nan((*start)[i])];
-    else if (i < reach.size() && std::isnan(reach[i])) field = "reach";
+    else if (kept_[i] && i < reach.size() && std::isnan(reach[i])) field = "reach";
     else continue;
     std::ostringstream m;
     m << "poison: rank " << rank_ << ": after " << phase << ": held floe " << i << "'s " << field << " is NaN";
@@ -151,10 +154,19 @@ void Simulation::poison_step(const char* phase, StepContext& ctx) {
   // for the implicit step, which reads every floe: a known reader). Every
   // rank holds every floe before the first detection.
   const bool exchanged = (at == "drift" && p.options().after_drift) || (at == "detect" && p.options().after_detect);
+  // The step-start copies and reaches are checked in the detection's held
+  // floes (its band and own floes, and the floes the rank owns now) only:
+  // the coupling's own floes beyond them are held for their state alone
+  // (UnheldPoison::poison).
   if (exchanged) {
     const std::vector<std::uint8_t> held = held_by_band();
-    if (held.size() == state.size())
-      p.poison(held, state, &ctx.start, detection_options_.reach, detection_options_.domain);
+    if (held.size() == state.size()) {
+      std::vector<std::uint8_t> kept = held_.mask;
+      kept.resize(held.size(), 0);
+      for (const std::uint32_t i : owners_.mine())
+        if (i < kept.size()) kept[i] = 1;
+      p.poison(held, kept, state, &ctx.start, detection_options_.reach, detection_options_.domain);
+    }
   }
   // The step-start copy is read until the detection (the collisions, the
   // advance, a rejected try's restore) and not after it (the explicit

@@ -18,7 +18,7 @@
 // the whole state where a step reads every floe (Simulation::whole_state:
 // the pair list's rebuild, the fallbacks, a split). So a run in the mode
 // equals the plain run exactly when no phase reads an unheld floe. Where
-// the run keeps the whole state (the implicit step, the seas not in slabs,
+// the run keeps the whole state (the implicit step,
 // the advance from the whole detection: Simulation::halo_exchange() false)
 // the drift still sends every state to every rank and the poison after it
 // is read: those runs fail or differ, by design (their readers are known).
@@ -71,12 +71,18 @@ public:
   const PoisonOptions& options() const { return options_; }
 
   // Poisons every floe i with !held[i] in `state`, in `start` (if given)
-  // and in `reach` (where it has a value), and keeps `held` for the checks.
-  void poison(std::span<const std::uint8_t> held, std::vector<FloeState>& state, std::vector<FloeState>* start,
-              std::vector<double>& reach, const contact::Domain& domain);
-  // Looks for NaN in the held floes' state, `start` (if given) and reach;
-  // the first found after a phase is reported once a phase (stderr, and
-  // reports()). Nothing before the first poison.
+  // and in `reach` (where it has a value), and keeps `held` for the checks,
+  // with `kept` (a subset of `held`, the same size): the held floes whose
+  // step-start copy and reach the run keeps current too; the others are
+  // held for their state alone (a flume's floes of its rank's share of the
+  // columns outside its band: the coupling reads their state only, and
+  // the drift's exchange that brings it to a new holder carries no
+  // step-start copy and no reach).
+  void poison(std::span<const std::uint8_t> held, std::span<const std::uint8_t> kept, std::vector<FloeState>& state,
+              std::vector<FloeState>* start, std::vector<double>& reach, const contact::Domain& domain);
+  // Looks for NaN in the held floes' state and the kept floes' `start` (if
+  // given) and reach; the first found after a phase is reported once a
+  // phase (stderr, and reports()). Nothing before the first poison.
   void check(const char* phase, const std::vector<FloeState>& state, const std::vector<FloeState>* start,
              std::span<const double> reach);
 
@@ -95,7 +101,7 @@ private:
   bool open_ = false;
   long long windows_ = 0, poisoned_ = 0;
   std::string last_checked_;
-  std::vector<std::uint8_t> held_;
+  std::vector<std::uint8_t> held_, kept_;
   std::vector<std::string> reported_phases_, reports_;
 };
 

@@ -605,13 +605,13 @@ bool Simulation::detect_and_check(StepContext& ctx) {
   detection_ = std::move(next);
   held_ = std::move(held);
   hold_quadrature();
-  // With the state held by owner the copies of the floes this rank does
-  // not hold are stale from here on (the vertical drift that follows is
-  // over the held floes; they were since the drift unless gathered).
-  if (halo) {
-    announced_ = std::move(halo->announced);
-    state_whole_ = false;
-  }
+  // The copies of the floes this rank does not hold (held_now(); the
+  // implicit step holds every floe) are stale from here on, whatever the
+  // drift's exchange (the vertical drift that follows is over the held
+  // floes; with the state held by owner they were since the drift unless
+  // gathered): a split's whole_state gathers them.
+  if (halo) announced_ = std::move(halo->announced);
+  if (!held_now().empty()) state_whole_ = false;
   detection_whole_ = comm_.serial() || whole;
   if (!comm_.serial()) {
     detection_part_ = std::move(part);

@@ -286,15 +286,15 @@ private:
   parallel::HeldFloes hold_band(std::span<const parallel::LeaveNotice> leaving = {},
                                 std::span<const long long> leaving_counts = {}, parallel::HaloPart* halo = nullptr);
   // The state held by owner with a halo (docs/parallel.md, "The halo
-  // exchange (halo26)"): on several ranks, with the advance from the parts,
-  // no sea or the sea in slabs with the explicit kicks (the implicit step,
-  // the seas not in slabs and the advance from the whole detection read
-  // every floe at every step: the drift sends every state to every rank
-  // there). The same on every rank, for the whole run.
+  // exchange (halo26)", "... on the seas not in slabs (halo27)"): on
+  // several ranks, with the advance from the parts, no sea or any sea with
+  // the explicit kicks (the implicit step and the advance from the whole
+  // detection read every floe at every step: the drift sends every state
+  // to every rank there). The same on every rank, for the whole run.
   bool halo_exchange() const;
   // The halo exchange's part (a), after the drift: each floe this rank owns
   // to the ranks that hold it (held_now() on each: those its owner at the
-  // last detection announced it to, its coupling's owner; a floe whose
+  // last detection announced it to, its coupling's owners; a floe whose
   // owner changed since, to every rank), one all-to-all.
   void send_to_holders();
   // Part (b) at a detection: the HaloPart for announce_held (none without

@@ -125,12 +125,13 @@ parallel::HeldFloes Simulation::hold_band(std::span<const parallel::LeaveNotice>
 
 bool Simulation::halo_exchange() const {
   // The readers of every floe that stay (docs/parallel.md, "The halo
-  // exchange (halo26)"): the implicit step poses and moves every floe at
-  // the midpoint of its motion, on every rank; a sea not in slabs
-  // rebuilds the footprints from every floe's pose (its owners by index);
-  // the advance from the whole detection sets up every floe's pairs.
+  // exchange (halo26)", "... on the seas not in slabs (halo27)"): the
+  // implicit step poses and moves every floe at the midpoint of its motion
+  // and solves every floe's pieces, on every rank; the advance from the
+  // whole detection sets up every floe's pairs. Every sea with the explicit
+  // kicks, in slabs or not, reads only the floes its ranks hold.
   if (comm_.serial() || !advance_share_options_.on_part) return false;
-  return !floe_sea_ || (!floe_sea_->implicit() && owners_.has_slabs());
+  return !floe_sea_ || !floe_sea_->implicit();
 }
 
 void Simulation::send_to_holders() {
@@ -146,15 +147,19 @@ void Simulation::send_to_holders() {
   //   its old owner and that owner's band, are known to that owner only);
   //   the floes that change owner are few, and each new owner then
   //   announces them at the next detection;
-  // - its coupling's owner (FloeSeaContact::floe_owners), if not among
-  //   those: between a move of the slabs and the footprints' next rebuild
-  //   the coupling's floes need not be in its band.
+  // - its coupling's owners (FloeSeaContact::floe_owners, the last
+  //   rebuild's, and next_floe_owners, the next rebuild's on a sea not in
+  //   slabs), if not among those: between a move of the slabs and the
+  //   footprints' next rebuild the coupling's floes need not be in its
+  //   band, nor a flume's floes in its rank's share of the columns
+  //   (FloeSeaContact::own_floes holds them from this exchange on).
   // The floes this rank owns now are its own already.
   const auto ranks = static_cast<std::size_t>(comm_.size());
   const int me = comm_.rank();
   const std::size_t n = scenario_.floes.size();
-  std::span<const int> coupling;
+  std::span<const int> coupling, next;
   if (floe_sea_ && floe_sea_->floe_owners().size() == n) coupling = floe_sea_->floe_owners();
+  if (floe_sea_ && floe_sea_->next_floe_owners().size() == n) next = floe_sea_->next_floe_owners();
   std::vector<std::vector<std::uint32_t>> to(ranks);
   for (const std::uint32_t j : owners_.mine()) {
     std::span<const int> holders;
@@ -164,11 +169,15 @@ void Simulation::send_to_holders() {
     } else {
       for (std::size_t s = 0; s < ranks; ++s)
         if (static_cast<int>(s) != me) to[s].push_back(j);
+      continue;
     }
-    if (!coupling.empty() && known) {
-      const int c = coupling[j];
-      if (c != me && !std::binary_search(holders.begin(), holders.end(), c)) to[static_cast<std::size_t>(c)].push_back(j);
-    }
+    const auto add = [&](int c) {
+      std::vector<std::uint32_t>& list = to[static_cast<std::size_t>(c)];
+      if (c != me && !std::binary_search(holders.begin(), holders.end(), c) && (list.empty() || list.back() != j))
+        list.push_back(j);
+    };
+    if (!coupling.empty()) add(coupling[j]);
+    if (!next.empty()) add(next[j]);
   }
   comm_.send_items(scenario_.floes.state, to);
 }
@@ -177,7 +186,8 @@ std::optional<parallel::HaloPart> Simulation::halo_part(const parallel::Announce
                                                         std::vector<FloeState>* start) {
   // The poison mode (a test) poisons the unheld floes after the drift
   // whatever the exchange, so its runs take part (b) even where the drift
-  // sends every state (the implicit step, the seas not in slabs): the
+  // sends every state (the implicit step, the advance from the whole
+  // detection): the
   // floes entering a band then come from their owners as with the exchange,
   // and what the mode finds is a phase's read beyond the held floes, not
   // the entering floes that part (b) would have brought.

@@ -17,7 +17,13 @@ ranks, with the explicit kicks (the law by owner) to 2 s:
   - tank: 100 floes in a 24 m x 6 m tank (spectral, 96 x 24 cells, wave
     maker and absorber);
   - flume: 40 floes in a 24 m x 2 m flume (spectral, dims = 1, 96 x 1
-    cells: every cell spans the flume).
+    cells: every cell spans the flume);
+  - wide: 160 floes in a flume 8 m wide (the same grid's cells 8 m across),
+    with the blend law (its explicit damper: the loads go stale at each
+    kick, so each first half kick evaluates them again). The drift's bands
+    (strips in y) do not hold every floe of a rank's share of the columns:
+    those come to it by the drift's exchange (docs/parallel.md, "The halo
+    exchange on the seas not in slabs (halo27)").
 Checked, on 2 and 3 ranks:
   - the run file equals the serial one bit for bit (`floesim compare --rtol
     0 --atol 0`): each cell's coverage, sums and pressure are the serial
@@ -35,7 +41,16 @@ Checked, on 2 and 3 ranks:
     less than a column away): at most 2 d cells a cut, the cuts being ranks
     of them (the seam counted). The first evaluation, by index, may send
     every cell. d = 6 of its 96 cells: on 2 ranks at most 24 cells an
-    evaluation; by index (the mutation) its rank 0 sends about 95.
+    evaluation; by index (the mutation) its rank 0 sends about 95. The same
+    bound in the wide flume, whose first half kicks rebuild the footprints
+    with the last rebuild's owners (by index there, every floe posed: 2.2
+    times the bound on 2 ranks, 1.4 on 3);
+  - with the halo exchange (every sea with the explicit kicks), rank 0's
+    drift phase (parallel.phase.drift) receives less than 0.6 of every
+    floe's state (96 B) each step on the bem, tank and wide cases, whose
+    bands do not hold every floe (the flume's every rank holds every floe;
+    every state to every rank, before halo27, is above 1.0 with the water's
+    hand-over).
 Then the flume's pack numbered along x (its floes sorted by x: there the
 owners by index would be shares of the columns too) on 2 ranks: bit for bit
 with its serial run, and rank 0's penalty phase receives at most 1.2 times
@@ -43,16 +58,27 @@ the bytes of the pack numbered as made (in two rows along the flume: by
 index each rank's floes would lie along the whole flume and every cell
 travel as pieces, 3 times the bytes). By place the numbering does not
 choose the owners.
-Then the tank on 2 ranks in the poison mode (FLOESIM_TEST_POISON_UNHELD=step:
-each rank's copies of the floes it does not hold, neither in its band nor
-its own, are NaN in the windows; docs/parallel.md, "The poison mode of the
-run"): bit for bit with the serial run, floes poisoned, no phase reported.
-The coupling's owners are the drift's, so a rank builds and reads only
-floes it holds. With the columns' shares on the tank too (each rank's
-coupling floes along the whole width of the tank, outside its band in y)
-the run crashed (SIGSEGV on a NaN place).
+Then bem, tank, flume and wide on 2 ranks in the poison mode
+(FLOESIM_TEST_POISON_UNHELD=step and step-lure: each rank's copies of the
+floes it does not hold, neither in its band nor its own nor its coupling's,
+are NaN, or wrong but finite, in the windows; docs/parallel.md, "The poison
+mode of the run"): bit for bit with the serial run, no phase reported, floes
+poisoned (none in the flume, whose every rank holds every floe). The
+coupling's owners are the drift's, or a flume's column shares sent their
+floes by the drift's exchange, so a rank builds and reads only floes it
+holds. With the columns' shares on the tank too (each rank's coupling
+floes along the whole width of the tank, outside its band in y) the run
+crashed (SIGSEGV on a NaN place); with the next coupling owner left out of
+the drift's exchange the wide flume differs from the serial run, plain and
+with the lure, and crashes with NaN.
 Then the bem case stopped half-way on 2 ranks and continued from its
 checkpoint on 3 ranks must equal the serial run bit for bit.
+Then the wide flume with fracture (286 floes at 2 s from 160) on 2 ranks,
+from the parts and from the whole detection (advance_on_part = false), bit
+for bit with the serial run: a split reads its parent's state on every
+rank, whose vertical drift only its holders made (main's build at 555f1e4
+made 284 floes on 2 ranks, the split's gather skipped after the drift's
+whole exchange).
 """
 import math
 import os
@@ -78,11 +104,15 @@ COUPLING = """
 pack = "{pack}"
 
 [coupling]
-law = "strong"
 stiffness = 100.0
-"""
+{law}"""
 # Per case: the grid's cells along x and y, its cell size along x and y (m).
-GRIDS = {"bem": (24, 12, 0.5, 0.5), "tank": (96, 24, 0.25, 0.25), "flume": (96, 1, 0.25, 2.0)}
+GRIDS = {"bem": (24, 12, 0.5, 0.5), "tank": (96, 24, 0.25, 0.25), "flume": (96, 1, 0.25, 2.0),
+         "wide": (96, 1, 0.25, 8.0)}
+# Per case: the penalty law's lines ([coupling]).
+LAWS = {"wide": 'law = "blend"\nblend = 0.5\n'}
+FLUMES = ("flume", "wide")  # dims = 1: the coupling's owners are shares of the columns
+SOME_HELD = ("bem", "tank", "wide")  # the bands do not hold every floe on 2 ranks
 SEAS = {
     "bem": ("""
 [sea]
@@ -131,7 +161,25 @@ kind = "regular"
 amplitude = 0.05
 wavelength = 6.0
 """, ["--floes", "40", "--box", "24", "2"]),
+    "wide": ("""
+[sea]
+model = "spectral"
+dims = 1
+size = [24.0, 8.0]
+cells = [96, 1]
+depth = 1.0
+rho = 1000.0
+
+[sea.waves]
+kind = "regular"
+amplitude = 0.05
+wavelength = 6.0
+""", ["--floes", "160", "--box", "24", "8"]),
 }
+
+
+def coupling(name, pack):
+    return COUPLING.format(pack=pack, law=LAWS.get(name, 'law = "strong"\n'))
 
 def largest_radius(pack):
     """The largest distance of a floe's vertex from its centroid (m) in a pack file."""
@@ -163,9 +211,13 @@ def numbered_along_x(pack, out):
             offsets.dtype)
 
 
+def phase_bytes(p, phase):
+    """Rank 0's bytes received in a phase (`parallel.phase.PHASE: C calls, B bytes`)."""
+    return int(summary(p)[f"parallel.phase.{phase}"].split()[2])
+
+
 def penalty_bytes(p):
-    """Rank 0's bytes received in the penalty phase (`parallel.phase.penalty: C calls, B bytes`)."""
-    return int(summary(p)["parallel.phase.penalty"].split()[2])
+    return phase_bytes(p, "penalty")
 
 
 penalty = {}  # (case, ranks) -> rank 0's penalty bytes
@@ -174,9 +226,10 @@ for name, (sea, pack) in SEAS.items():
               "-o", f"{name}_pack.h5"]), f"{name}: floesim pack")
     config = os.path.join(W, f"{name}.toml")
     with open(config, "w") as f:
-        f.write(RUN + sea + COUPLING.format(pack=f"{name}_pack.h5"))
+        f.write(RUN + sea + coupling(name, f"{name}_pack.h5"))
     s = summary(need(run([args.floesim, "run", config, "-o", f"{name}_serial.h5", "-q"]), f"{name}: serial run"))
     print(f"{name}: serial to 2 s, {s.get('steps')} steps")
+    steps = int(s["steps"])
     nx, ny, dx, dy = GRIDS[name]
     along_x = ny == 1 or nx >= ny  # the strips' rule (FloeSeaContact::set_strips)
     d = math.ceil(largest_radius(f"{name}_pack.h5") / (dx if along_x else dy)) + 2
@@ -196,9 +249,17 @@ for name, (sea, pack) in SEAS.items():
         m = re.match(r"(\d+) shared \((\d+) pieces\), (\d+) alone owned, (\d+) alone sent", cells or "")
         if not m or int(m.group(1)) == 0 or int(m.group(4)) == 0:
             failures.append(f"{name} on {n} ranks: no cell sent as pieces, or none as a total ({cells})")
-        elif name == "flume" and int(m.group(1)) > bound:
+        elif name in FLUMES and int(m.group(1)) > bound:
             failures.append(f"{name} on {n} ranks: rank 0 sent {m.group(1)} cells as pieces, more than the {bound} "
                             f"within {d} cells of the shares' cuts (the floes not owned by place?)")
+        # The halo exchange: the drift's states to their holders only.
+        drift = phase_bytes(p, "drift")
+        whole = 96 * int(pack[1]) * steps  # every floe's state, every step
+        print(f"{name}: {n} ranks, rank 0's drift phase {s['parallel.phase.drift']}: {drift / whole:.3f} of every "
+              f"floe's state each step")
+        if name in SOME_HELD and not drift < 0.6 * whole:
+            failures.append(f"{name} on {n} ranks: rank 0's drift phase received {drift} bytes, not under 0.6 x "
+                            f"96 B x {pack[1]} floes x {steps} steps = {0.6 * whole:.0f} (every state to every rank?)")
 
 # The flume's floes numbered along x: the same owners by place, so the same
 # traffic within the runs' own drift (the two packs' serial runs differ in
@@ -206,7 +267,7 @@ for name, (sea, pack) in SEAS.items():
 numbered_along_x("flume_pack.h5", "flume_x_pack.h5")
 config = os.path.join(W, "flume_x.toml")
 with open(config, "w") as f:
-    f.write(RUN + SEAS["flume"][0] + COUPLING.format(pack="flume_x_pack.h5"))
+    f.write(RUN + SEAS["flume"][0] + coupling("flume", "flume_x_pack.h5"))
 need(run([args.floesim, "run", config, "-o", "flume_x_serial.h5", "-q"]), "flume numbered along x: serial run")
 p = mpirun(2, "run", config, "-o", "flume_x_2.h5", "-q")
 if p.returncode != 0:
@@ -220,19 +281,22 @@ elif ("flume", 2) in penalty:
         failures.append(f"flume on 2 ranks: rank 0's penalty phase received {made} bytes with the pack numbered as "
                         f"made, more than 1.2 times the {along} with it numbered along x (owners by index?)")
 
-# The poison mode on the tank: the coupling reads only floes its rank holds.
-p = harness.poisoned(2, "step", "run", os.path.join(W, "tank.toml"), "-o", "tank_poison.h5", "-q")
-poisoned = [int(m.group(1)) for m in re.finditer(r"windows, (\d+) floes poisoned", p.stderr)]
-reported = [int(m.group(1)) for m in re.finditer(r"(\d+) phases reported", p.stderr)]
-print(f"tank on 2 ranks, poison mode: exit {p.returncode}, floes poisoned {poisoned}, phases reported {reported}")
-if p.returncode != 0:
-    failures.append(f"tank on 2 ranks, poison mode: exit {p.returncode}\n{p.stderr[-2000:]}")
-else:
-    harness.same("tank_poison.h5", "tank_serial.h5", "tank: 2 ranks in the poison mode against the serial run",
-                 failures)
-    if len(poisoned) != 2 or min(poisoned) == 0 or any(reported):
-        failures.append(f"tank on 2 ranks, poison mode: floes poisoned {poisoned}, phases reported {reported} "
-                        f"(every rank must poison floes and report none)")
+# The poison mode: the coupling, the seas and the step read only floes
+# their rank holds.
+for name in SEAS:
+    for poison in ("step", "step-lure"):
+        p = harness.poisoned(2, poison, "run", os.path.join(W, f"{name}.toml"), "-o", f"{name}_{poison}.h5", "-q")
+        poisoned = [int(m.group(1)) for m in re.finditer(r"windows, (\d+) floes poisoned", p.stderr)]
+        reported = [int(m.group(1)) for m in re.finditer(r"(\d+) phases reported", p.stderr)]
+        what = f"{name} on 2 ranks, poison mode {poison}"
+        print(f"{what}: exit {p.returncode}, floes poisoned {poisoned}, phases reported {reported}")
+        if p.returncode != 0:
+            failures.append(f"{what}: exit {p.returncode}\n{p.stderr[-2000:]}")
+            continue
+        harness.same(f"{name}_{poison}.h5", f"{name}_serial.h5", f"{what}, against the serial run", failures)
+        if len(poisoned) != 2 or any(reported) or (name != "flume" and min(poisoned) == 0):
+            failures.append(f"{what}: floes poisoned {poisoned}, phases reported {reported} (every rank must "
+                            f"report none{'' if name == 'flume' else ' and poison floes'})")
 
 # A restart across rank counts: the bem case's first half on 2 ranks, the
 # rest from its checkpoint on 3 ranks.
@@ -244,4 +308,35 @@ if p.returncode != 0:
 else:
     harness.same("bem_rest3.h5", "bem_serial.h5", "bem: half on 2 ranks, continued on 3, against the serial run",
                  failures)
+# Splits on a sea not in slabs: the wide flume with fracture (its floes
+# crack and split within the 2 s), on 2 ranks from the parts (the default,
+# the halo exchange) and from the whole detection (`advance_on_part =
+# false`: the drift sends every state). A split reads its parent's state on
+# every rank; the vertical drift before it moves only the floes each rank
+# holds, so the other copies' heave, pitch and roll are stale whatever the
+# drift's exchange, and whole_state must gather them.
+FRACTURE = """
+[fracture]
+enabled = true
+criterion = "stress"
+strength = 2.0e3
+split = true
+mesh_size = 0.2
+min_fragment_area = 0.05
+"""
+for label, run_table in (("from the parts", RUN), ("from the whole detection", RUN + "advance_on_part = false\n")):
+    config = os.path.join(W, "wide_split.toml" if run_table == RUN else "wide_split_whole.toml")
+    with open(config, "w") as f:
+        f.write(run_table + SEAS["wide"][0] + coupling("wide", "wide_pack.h5") + FRACTURE)
+    serial = config.replace(".toml", "_serial.h5")
+    s = summary(need(run([args.floesim, "run", config, "-o", serial, "-q"]), f"wide with splits {label}: serial run"))
+    print(f"wide with splits {label}: serial to 2 s, {s.get('floes')} floes from 160")
+    if int(s.get("floes", 0)) <= 160:
+        failures.append(f"wide with splits {label}: no floe split in the serial run ({s.get('floes')} floes)")
+    p = mpirun(2, "run", config, "-o", config.replace(".toml", "_2.h5"), "-q")
+    if p.returncode != 0:
+        failures.append(f"wide with splits {label} on 2 ranks: exit {p.returncode}\n{p.stderr}")
+    else:
+        harness.same(config.replace(".toml", "_2.h5"), serial, f"wide with splits {label}: 2 ranks against the "
+                     f"serial run", failures)
 finish(failures)
