@@ -472,6 +472,10 @@ int run(const Args& args, const parallel::Session& session) {
       << "\nparallel.collide_whole: " << collide.whole << "\nparallel.collide_groups:";
     for (const long k : collide.clusters) o << " " << k;
     for (const auto& [kind, n] : collide.conflicts) o << "\nparallel.collide_conflicts." << kind << ": " << n;
+    // Every floe's state gathered from the owners (Simulation::whole_state),
+    // for any reader, and rank 0's bytes received in those gathers.
+    const Simulation::WholeStateCounts& whole = sim.whole_state_counts();
+    o << "\nparallel.whole_state_gathers: " << whole.gathers << " (" << whole.bytes << " bytes)";
     // The fracture analyses by owner: the steps that exchanged them, each
     // rank's checks (they sum to fracture.checks) and its wall time in them.
     if (sim.percussion_stats()) {
@@ -484,6 +488,8 @@ int run(const Args& args, const parallel::Session& session) {
       // of strip_seconds_total), over every window.
       o << "\nparallel.fracture_charged:";
       for (const double x : owners.fracture_seconds()) o << " " << x;
+      // Of those gathers, the ones before a split (a crack through a floe).
+      o << "\nparallel.fracture_whole_state: " << fr.whole_gathers << " steps, " << fr.whole_bytes << " bytes";
     }
     o << "\n";
     // Stage eight: the slabs the coupling's floe owners followed at the

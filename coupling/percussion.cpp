@@ -314,6 +314,16 @@ bool Percussion::conclude(Floes& floes, PercussionAnalyses all) {
   return changed;
 }
 
+bool Percussion::may_split(const PercussionAnalyses& all) const {
+  // A refused_overlap stays refused unless an earlier split made near it:
+  // with none of the verdicts below, none is made (by induction in floe
+  // order). refused_small and refused_chord stand whatever the others.
+  return params_.split && std::any_of(all.initiations.begin(), all.initiations.end(), [](const FloeInitiation& fi) {
+           return fi.through != 0 &&
+                  (fi.split.verdict == SplitVerdict::split || fi.split.verdict == SplitVerdict::undecided);
+         });
+}
+
 std::vector<std::byte> pack(const PercussionAnalyses& analyses) {
   std::vector<std::byte> out(sizeof(PercussionCounts) + sizeof(double) + sizeof(std::uint64_t) +
                              analyses.initiations.size() * sizeof(FloeInitiation));

@@ -207,6 +207,13 @@ struct PercussionRanks {
   long steps = 0;
   std::vector<long> checks;
   std::vector<double> seconds;
+  // The steps with a crack through a floe (a split may be made), which
+  // gather every floe's state first (Simulation::whole_state), and the
+  // bytes this rank received in those gathers (the summary's
+  // parallel.fracture_whole_state; docs/parallel.md, "A split step by its
+  // holders").
+  long whole_gathers = 0;
+  long long whole_bytes = 0;
 };
 
 // One share's analyses as bytes for parallel::Communicator::allgather_parts,
@@ -247,6 +254,14 @@ public:
   // here, against the floes as they then are). Returns true if the set of
   // floes changed.
   bool conclude(Floes& floes, PercussionAnalyses all);
+  // Whether conclude(all) may split a floe, and so read floes' states (the
+  // parents', their neighbours'): conclude splits only a floe whose decision
+  // is a split, or undecided, and takes a decision again only near a split
+  // it made before in floe order. Without such an initiation (no through
+  // crack, split = false, or every one refused for a sliver, a chord or the
+  // neighbours) it splits nothing and reads no state (on several ranks no
+  // floe is gathered for it).
+  bool may_split(const PercussionAnalyses& all) const;
 
   // Floe i's split along the crack of `fi` (mesh frame), worked out against
   // `floes`: the pieces at the widest opening (from gap, quartered down to

@@ -394,12 +394,15 @@ void Simulation::percussion(StepContext& ctx) {
   // parent's state; then the owners are assigned from every floe's place
   // (detect_in_place). With the state held by owner a rank's copies of the
   // floes it does not hold are stale, so when a split may be made (an
-  // initiation through the floe, the same on every rank) every floe's
-  // state comes from its owner first: one gather, in such a step only.
-  const bool may_split = scenario_.config.fracture.split &&
-                         std::any_of(all.initiations.begin(), all.initiations.end(),
-                                     [](const FloeInitiation& fi) { return fi.through != 0; });
-  if (may_split) whole_state(ctx, parallel::WholeState::state);
+  // initiation through a floe whose share decided a split: the same on every
+  // rank, Percussion::may_split) every floe's state comes from its owner
+  // first: one gather, in such a step only.
+  if (percussion_->may_split(all)) {
+    const WholeStateCounts before = whole_state_counts_;  // none gathered if every state is current already
+    whole_state(ctx, parallel::WholeState::state);
+    percussion_ranks_.whole_gathers += whole_state_counts_.gathers - before.gathers;
+    percussion_ranks_.whole_bytes += whole_state_counts_.bytes - before.bytes;
+  }
   if (percussion_->conclude(scenario_.floes, std::move(all))) on_floes_changed();
 }
 

@@ -236,6 +236,15 @@ public:
   const PercussionStats* percussion_stats() const { return percussion_ ? &percussion_->stats() : nullptr; }
   // The fracture analyses by owner on several ranks, per rank (empty when serial).
   const PercussionRanks& percussion_ranks() const { return percussion_ranks_; }
+  // The gathers of every floe's state from the owners on several ranks
+  // (whole_state: a split, the pair list's rebuild, a fallback, a redone
+  // try's footprints) and the bytes this rank received in them (the
+  // summary's parallel.whole_state_gathers).
+  struct WholeStateCounts {
+    long gathers = 0;
+    long long bytes = 0;
+  };
+  const WholeStateCounts& whole_state_counts() const { return whole_state_counts_; }
 
   // The sea surface, if the run has one ([sea] model != "none").
   bool has_sea() const { return sea_ != nullptr; }
@@ -406,6 +415,7 @@ private:
   // the back-off: parallel::WholeOnDemand), once in such a step; or the
   // states alone (what the advance reads), which leave the flag false.
   bool state_whole_ = true;
+  WholeStateCounts whole_state_counts_;
   void whole_state(StepContext& ctx, parallel::WholeState what);
   parallel::WholeOnDemand whole_on_demand(StepContext& ctx);
   contact::CollisionStats stats_;

@@ -238,9 +238,12 @@ void Simulation::whole_state(StepContext& ctx, parallel::WholeState what) {
   FLOESIM_ASSERT(ctx.start.size() == n && owners_.owner().size() == n);
   const std::vector<std::uint8_t> held_mask = held_now();  // empty: every floe held
   const auto held = [&](std::size_t i) { return held_mask.empty() || held_mask[i] != 0; };
+  ++whole_state_counts_.gathers;
+  const long long before = comm_.traffic().bytes;
   if (what == parallel::WholeState::state) {
     std::vector<FloeState> owned = state;
     comm_.complete_owned(owned, owners_.owner());
+    whole_state_counts_.bytes += comm_.traffic().bytes - before;
     for (std::size_t i = 0; i < n; ++i)
       if (!held(i)) state[i] = owned[i];
     return;
@@ -248,6 +251,7 @@ void Simulation::whole_state(StepContext& ctx, parallel::WholeState what) {
   std::vector<std::array<FloeState, 2>> both(n);
   for (std::size_t i = 0; i < n; ++i) both[i] = {state[i], ctx.start[i]};
   comm_.complete_owned(both, owners_.owner());
+  whole_state_counts_.bytes += comm_.traffic().bytes - before;
   for (std::size_t i = 0; i < n; ++i)
     if (!held(i)) {
       state[i] = both[i][0];

@@ -32,6 +32,12 @@ usage: check_record_ranks.py FLOESIM MPIEXEC WORKDIR [--floes N] [--t-end T] [--
    and tried again with the meeting clusters joined on one rank (each try
    recording afresh; since onerank26 these steps no longer fall back whole:
    `parallel.advance_joined`), or redone whole.
+3. In both: every floe's state is gathered before the splits
+   (`parallel.fracture_whole_state`) in exactly the steps where a floe split
+   (the serial run's /events/fracture rows with a piece): a step whose
+   cracks are all refused (a sliver, a chord, the neighbours) gathers
+   nothing (Percussion::may_split; docs/parallel.md, "A split step by its
+   holders").
 """
 import os
 import shutil
@@ -72,6 +78,34 @@ def kept_mostly(p, n, what):
     return steps, fell, whole
 
 
+def split_steps(path):
+    """The steps of a run file in which a floe split: the distinct times of
+    its /events/fracture rows with a piece (piece_a >= 0)."""
+    import h5py
+    with h5py.File(os.path.join(W, path), "r") as f:
+        if "events/fracture" not in f:
+            return 0
+        d = f["events/fracture"]
+        columns = [c.decode() if isinstance(c, bytes) else str(c) for c in d.attrs["columns"]]
+        rows = d[...]
+    if rows.size == 0:
+        return 0
+    times = {float(r[columns.index("time")]) for r in rows if r[columns.index("piece_a")] >= 0}
+    return len(times)
+
+
+def check_split_gathers(p, serial, what):
+    """Item 3: the steps that gathered every floe's state before a split are
+    the steps in which a floe split."""
+    gathered = int(summary(p).get("parallel.fracture_whole_state", "-1 steps").split()[0])
+    steps = split_steps(serial)
+    print(f"{what}: every floe's state gathered before the splits in {gathered} steps, "
+          f"{steps} steps with a split (serial)")
+    if steps == 0 or gathered != steps:
+        failures.append(f"{what}: the states gathered for the splits in {gathered} steps, not the {steps} "
+                        "steps with a split")
+
+
 def detect_bytes(p):
     """The bytes the detect phase received (summary: `N calls, B bytes`)."""
     return int(summary(p)["parallel.phase.detect"].split()[2])
@@ -107,6 +141,7 @@ for n in args.ranks:
     if n == 2 and whole_bytes is not None and not detect_bytes(p) < whole_bytes:
         failures.append(f"2 ranks: the record run's detect phase received {detect_bytes(p)} bytes, not fewer than "
                         f"{whole_bytes} with the whole lists gathered")
+    check_split_gathers(p, "serial.h5", f"{n} ranks")
     k = summary(p)
     by_rank = [int(x) for x in k.get("parallel.fracture_checks", "").split()]
     print(f"{n} ranks: fracture checks by rank {by_rank} (serial {s.get('fracture.checks')}), "
@@ -147,6 +182,7 @@ print(f"pack_fracture to 900 s ({s.get('fracture.splits')} splits): 2 ranks {'eq
 if not equal:
     failures.append(f"pack_fracture on 2 ranks: exit {p.returncode}\n{p.stderr}\n{c.stdout}")
 else:
+    check_split_gathers(p, "jam_serial.h5", "pack_fracture on 2 ranks")
     steps, fell, whole = kept_mostly(p, 2, "advance")
     joined = int(summary(p).get("parallel.advance_joined", "0"))
     print(f"2 ranks: advance: {joined} tries combined with meeting clusters joined on one rank")
