@@ -294,7 +294,7 @@ void Simulation::drift(StepContext& ctx) {
     if (owners_.may_move(steps_)) detected.assign(owners_.owner().begin(), owners_.owner().end());
     const bool moved = owners_.update(comm_, scenario_.floes, steps_);
     owners_off_places_ = false;
-    if (moved && owners_.has_slabs()) follow_slabs();
+    if (moved && owners_.has_slabs()) slabs_to_follow_ = true;  // after the sea's first kick (sea_flow)
     if (moved) hand_over_moved(ctx, detected);
     // The moorings of the floes this rank drifts: each kick is its floe's
     // own, and the other floes' states come whole from their owners below.
@@ -328,6 +328,19 @@ void Simulation::follow_slabs() {
   // Every rank, at the same step (the cuts are computed from the same
   // gathered charges): the sea's row scratch and halo, the coupling's
   // routes and owners are remade for the new slabs.
+  // Not at the drift that moved the cuts, but after the sea's first kick of
+  // the step (sea_flow): that kick may carry a pressure evaluated at this
+  // step's first half kick (the explicit damper's loads are evaluated there),
+  // whose cells each rank summed on the routes of the slabs it was evaluated
+  // on; the sea's kick reads the rows of its slab, and the coupling's
+  // set_slabs clears the old routes' sums. Followed before that kick, a rank
+  // kicks its new rows with the sums of its old ones (zeros where a row came
+  // to it), and the sea leaves the serial run. Between the drift and that
+  // kick nothing reads the sea's slabs or the coupling's routes: the
+  // collisions, the advance and the detection go by the owners' strips,
+  // which are the new ones already. The sea's pending kicks are spectra of
+  // its columns, which a move of the rows keeps.
+  slabs_to_follow_ = false;
   const std::vector<int>& first_row = owners_.slabs().first_row;
   sea_->set_slab_rows(first_row);
   if (floe_sea_) floe_sea_->set_slabs(first_row);
@@ -628,8 +641,12 @@ void Simulation::sea_flow(const StepContext& ctx) {
   // the sea over dt: their free flows (explicit kicks), or the implicit step
   // of the penalty spring (coupling/floe_sea.hpp).
   if (!sea_) return;
-  if (!floe_sea_) return sea_->flow(ctx.dt);
+  if (!floe_sea_) {
+    if (slabs_to_follow_) follow_slabs();
+    return sea_->flow(ctx.dt);
+  }
   floe_sea_->kick_sea(*sea_, 0.5 * ctx.dt);
+  if (slabs_to_follow_) follow_slabs();  // the kick above took the pressure on the slabs it was summed on
   floe_sea_->advance_vertical(scenario_.floes, ctx.start, *sea_, ctx.dt, held_now());
 }
 

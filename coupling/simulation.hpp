@@ -268,6 +268,10 @@ private:
   void sea_half_kick(StepContext& ctx);
   void drift(StepContext& ctx);
   void follow_slabs();  // the sea and the coupling take the owners' moved slabs
+  // The owners' slabs moved at a drift and the sea and the coupling have
+  // not followed yet: they follow in sea_flow, after the sea's first kick
+  // (follow_slabs' comment says why).
+  bool slabs_to_follow_ = false;
   void collide(StepContext& ctx);
   void note_collisions();
   void percussion(StepContext& ctx);
