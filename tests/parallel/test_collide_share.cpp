@@ -31,6 +31,7 @@ TEST_SUITE_BEGIN("mpi");
 using namespace floesim;
 using test::CollideCase;
 using test::same_record;
+using test::same_states;
 using test::same_stats;
 
 namespace {
@@ -102,10 +103,6 @@ std::vector<int> owners_of(const CollideCase& c, int ranks, int& n) {
   std::iota(owner.begin(), owner.end(), 0);
   n = static_cast<int>(owner.size());
   return owner;
-}
-
-bool same_states(const std::vector<FloeState>& a, const std::vector<FloeState>& b) {
-  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(FloeState)) == 0;
 }
 
 }  // namespace

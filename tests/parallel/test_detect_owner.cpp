@@ -29,13 +29,10 @@ TEST_SUITE_BEGIN("mpi");
 
 using namespace floesim;
 using test::CollideCase;
+using test::same_states;
 using test::same_stats;
 
 namespace {
-
-bool same_states(const std::vector<FloeState>& a, const std::vector<FloeState>& b) {
-  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(FloeState)) == 0;
-}
 
 std::vector<int> strips(const CollideCase& c, int ranks) {
   parallel::FloeOwners owners(0, ranks, c.domain);
