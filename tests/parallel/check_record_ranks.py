@@ -30,7 +30,7 @@ usage: check_record_ranks.py FLOESIM MPIEXEC WORKDIR [--floes N] [--t-end T] [--
    LCPs take the warm store, and clusters of the two ranks meet): bit for
    bit on 2 ranks, with both kinds of step present: kept at the first try,
    and tried again with the meeting clusters joined on one rank (each try
-   recording afresh; since onerank26 these steps no longer fall back whole:
+   recording afresh; these steps do not fall back whole:
    `parallel.advance_joined`), or redone whole.
 3. In both: every floe's state is gathered before the splits
    (`parallel.fracture_whole_state`) in exactly the steps where a floe split

@@ -49,8 +49,8 @@ Checked, on 2 and 3 ranks:
     drift phase (parallel.phase.drift) receives less than 0.6 of every
     floe's state (96 B) each step on the bem, tank and wide cases, whose
     bands do not hold every floe (the flume's every rank holds every floe;
-    every state to every rank, before halo27, is above 1.0 with the water's
-    hand-over).
+    every state to every rank, without the halo exchange, is above 1.0 with
+    the water's hand-over).
 Then the flume's pack numbered along x (its floes sorted by x: there the
 owners by index would be shares of the columns too) on 2 ranks: bit for bit
 with its serial run, and rank 0's penalty phase receives at most 1.2 times
@@ -76,9 +76,8 @@ checkpoint on 3 ranks must equal the serial run bit for bit.
 Then the wide flume with fracture (286 floes at 2 s from 160) on 2 ranks,
 from the parts and from the whole detection (advance_on_part = false), bit
 for bit with the serial run: a split reads its parent's state on every
-rank, whose vertical drift only its holders made (main's build at 555f1e4
-made 284 floes on 2 ranks, the split's gather skipped after the drift's
-whole exchange).
+rank, whose vertical drift only its holders made (with the split's gather
+skipped after the drift's whole exchange, 284 floes on 2 ranks).
 """
 import math
 import os

@@ -220,8 +220,7 @@ TEST_CASE("the step groups from the edges are those of the whole detection, jams
 TEST_CASE("shares on their pairs that use the warm store combine into the serial answer and store") {
   // warm_min = 0: every LCP starts from the warm store. Each share runs on
   // a copy of it (the store the shares see is left alone) and the parts'
-  // stored pairs, written into it, make it the serial store (until
-  // collide27 each share reported a conflict: the whole solve).
+  // stored pairs, written into it, make it the serial store.
   CollideCase c = test::rows_of_four(3);
   c.options.warm_min = 0;
   contact::WarmStart serial_warm, warm;
