@@ -43,7 +43,7 @@ import os
 import shutil
 import sys
 
-from ranks_harness import FRACTURE, moving_pack_check, need, summary
+from ranks_harness import FRACTURE, moving_pack_check, need, phase_bytes, summary
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
@@ -107,8 +107,8 @@ def check_split_gathers(p, serial, what):
 
 
 def detect_bytes(p):
-    """The bytes the detect phase received (summary: `N calls, B bytes`)."""
-    return int(summary(p)["parallel.phase.detect"].split()[2])
+    """The bytes the detect phase received (rank 0's)."""
+    return phase_bytes(p, "detect")
 
 
 # The whole lists gathered at every detection (advance_on_part = false), on

@@ -83,7 +83,7 @@ import math
 import os
 import re
 
-from ranks_harness import finish, need, ranks_check, summary
+from ranks_harness import finish, need, phase_bytes, ranks_check, summary
 
 args, harness = ranks_check(
     "floesim was built without MPI (FLOESIM_MPI=OFF): the runs on the seas not in slabs are not checked",
@@ -208,11 +208,6 @@ def numbered_along_x(pack, out):
         out_floes["vertices"] = np.concatenate([vertices[offsets[i]:offsets[i + 1]] for i in order])
         out_floes["offsets"] = np.concatenate([[0], np.cumsum([offsets[i + 1] - offsets[i] for i in order])]).astype(
             offsets.dtype)
-
-
-def phase_bytes(p, phase):
-    """Rank 0's bytes received in a phase (`parallel.phase.PHASE: C calls, B bytes`)."""
-    return int(summary(p)[f"parallel.phase.{phase}"].split()[2])
 
 
 def penalty_bytes(p):
