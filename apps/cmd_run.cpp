@@ -284,9 +284,9 @@ int run(const Args& args, const parallel::Session& session) {
       sim.set_writer_test(std::string(test) == "unread" ? Simulation::WriterTest::poison_unread
                                                         : Simulation::WriterTest::poison);
   }
-  // "warm": a step-start share that used the warm store falls back whole,
-  // the rule before collide27 (Simulation::set_collide_test,
-  // tests/parallel/check_ranks.py --fallback, check_poison_run.py (d)).
+  // "warm": a step-start share that used the warm store falls back whole
+  // (Simulation::set_collide_test, tests/parallel/check_ranks.py --fallback,
+  // check_poison_run.py (d)).
   if (const char* test = std::getenv("FLOESIM_TEST_COLLIDE_FALLBACK")) {
     if (std::string(test) != "warm")
       throw InputError("FLOESIM_TEST_COLLIDE_FALLBACK (a test hook): expected \"warm\", got \"" +

@@ -479,8 +479,8 @@ struct ClusterShare {
 //
 // A conflict (the caller then solves the whole step from the states on
 // entry): a failed LCP (its dump, not written by a share, is numbered by the
-// run's failures), a RunError. `warm_start` is no share's own conflict any
-// more: the caller may make a share's use of the store one (a test hook,
+// run's failures), a RunError. The share never sets `warm_start` itself:
+// its caller may make a share's use of the store one (a test hook,
 // parallel::CollideShareOptions::warm_conflict, which keeps the whole path
 // reachable). options.record (if any) receives the share's loads as one
 // event, and `places` their places in the whole call's record (RecordPart,

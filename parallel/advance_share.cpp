@@ -80,7 +80,7 @@ contact::ImpulseRecord take_record(const std::byte*& in) {
   return record;
 }
 
-void append_warm(std::vector<std::byte>& out, const WarmPairs& pairs, long uses) {
+void append_warm(std::vector<std::byte>& out, const contact::WarmStart::Written& pairs, long uses) {
   const std::array<std::int64_t, 2> head{static_cast<std::int64_t>(pairs.size()), uses};
   append(out, std::span<const std::int64_t>(head));
   for (const auto& [key, pair] : pairs) {
@@ -97,10 +97,10 @@ void append_warm(std::vector<std::byte>& out, const WarmPairs& pairs, long uses)
   }
 }
 
-WarmPairs take_warm(const std::byte*& in, long& uses) {
+contact::WarmStart::Written take_warm(const std::byte*& in, long& uses) {
   const std::vector<std::int64_t> head = take<std::int64_t>(in, 2);
   uses = head[1];
-  WarmPairs pairs(static_cast<std::size_t>(head[0]));
+  contact::WarmStart::Written pairs(static_cast<std::size_t>(head[0]));
   for (auto& [key, pair] : pairs) {
     const std::vector<std::int64_t> h = take<std::int64_t>(in, 3);
     key = static_cast<std::uint64_t>(h[0]);
@@ -118,7 +118,7 @@ WarmPairs take_warm(const std::byte*& in, long& uses) {
   return pairs;
 }
 
-void hold_warm(const WarmPairs& pairs, long uses, contact::WarmStart& store) {
+void hold_warm(const contact::WarmStart::Written& pairs, long uses, contact::WarmStart& store) {
   for (const auto& [key, pair] : pairs) store.pairs[key] = pair;
   store.uses += uses;
 }

@@ -70,15 +70,15 @@ struct AdvancePart {
 void append_record(std::vector<std::byte>& out, const contact::ImpulseRecord& record);
 contact::ImpulseRecord take_record(const std::byte*& in);
 
-// A share's warm-store writes in a message (contact::ShareOutcome::warm
-// and the uses: the pairs' count, the uses, then per pair its key, clock,
-// entries' count and entries, 37 bytes each), appended to `out`; read back
-// by take_warm, which moves `in` past them. Written into a store by
-// hold_warm (each pair replaced, the uses added).
-using WarmPairs = std::vector<std::pair<std::uint64_t, contact::WarmStart::Pair>>;
-void append_warm(std::vector<std::byte>& out, const WarmPairs& pairs, long uses);
-WarmPairs take_warm(const std::byte*& in, long& uses);
-void hold_warm(const WarmPairs& pairs, long uses, contact::WarmStart& store);
+// A share's warm-store writes in a message (contact::WarmStart::Written:
+// ShareOutcome::warm, StepCollisionShare::warm; and the uses: the pairs'
+// count, the uses, then per pair its key, clock, entries' count and
+// entries, 37 bytes each), appended to `out`; read back by take_warm, which
+// moves `in` past them. Written into a store by hold_warm (each pair
+// replaced, the uses added).
+void append_warm(std::vector<std::byte>& out, const contact::WarmStart::Written& pairs, long uses);
+contact::WarmStart::Written take_warm(const std::byte*& in, long& uses);
+void hold_warm(const contact::WarmStart::Written& pairs, long uses, contact::WarmStart& store);
 
 std::vector<std::byte> pack(const AdvancePart& part);
 AdvancePart unpack_advance_part(std::span<const std::byte> bytes);

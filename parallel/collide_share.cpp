@@ -93,8 +93,8 @@ CollidePart run_collide_share(Floes& floes, std::span<const FloeState> start, co
   if (options.record) o.record = &part.record;
   part.outcome =
       contact::resolve_step_collisions_share(floes, start, detection, step, o, {owner, rank}, part.stats, groups);
-  // The test hook: a share's use of the warm store made a conflict, as
-  // before the shares ran on copies of it (CollideShareOptions).
+  // The test hook: a share's use of the warm store made a conflict
+  // (CollideShareOptions::warm_conflict).
   if (share_options.warm_conflict && part.outcome.conflict == StepCollisionShare::Conflict::none &&
       part.outcome.warm_uses > 0)
     part.outcome.conflict = StepCollisionShare::Conflict::warm_start;

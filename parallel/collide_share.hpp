@@ -29,12 +29,12 @@ struct CollideShareOptions {
   AdvanceShareOptions back_off;
   // Test hook, not a user key (`floesim run` reads it from the environment,
   // FLOESIM_TEST_COLLIDE_FALLBACK=warm): a share whose solves started from
-  // the warm store is a conflict (StepCollisionShare::Conflict::warm_start),
-  // the rule before the shares ran on copies of the store (docs/parallel.md,
-  // "The step-start collisions' conflicts (collide27)"). The tries that fell
-  // back for it then fall back again, so the tests reach the whole path and
-  // the whole state gathered on demand on a real run (the wall jam of
-  // examples/pack_against_wall.toml) with the shares otherwise unchanged.
+  // the warm store is a conflict (StepCollisionShare::Conflict::warm_start;
+  // docs/parallel.md, "The step-start collisions' conflicts (collide27)"):
+  // the tries whose shares use the store fall back, so the tests reach the
+  // whole path and the whole state gathered on demand on a real run (the
+  // wall jam of examples/pack_against_wall.toml) with the shares otherwise
+  // unchanged.
   bool warm_conflict = false;
 };
 

@@ -17,7 +17,7 @@ the parts): serially and on 2 ranks, bit for bit (/events/collisions
 included), and its detect phase too receives less than a tenth of the bytes
 of the run with it off (the same detections: the record changes no state).
 """
-from ranks_harness import finish, moving_pack_check, need, ran, summary
+from ranks_harness import finish, moving_pack_check, need, phase_bytes, ran, summary
 
 args, harness, config = moving_pack_check(
     "floesim was built without MPI (FLOESIM_MPI=OFF): the advance from the parts is not checked", 1500, 1000.0, [2, 3])
@@ -50,7 +50,7 @@ for n in args.ranks:
         combined[on] = steps - fallbacks
         if on:
             on_missing[n] = missing
-        detect[on] = int(s["parallel.phase.detect"].split()[2])
+        detect[on] = phase_bytes(p, "detect")
         print(f"{n} ranks, advance_on_part {on}: {steps} advances tried, {fallbacks} redone ({missing} for a floe "
               f"not held), {s['parallel.advance_whole']} whole, {candidates} join candidates; "
               f"advance {s['parallel.phase.advance']}; detect {s['parallel.phase.detect']}")
@@ -85,7 +85,7 @@ p = ran(mpirun(2, "run", record, "-o", "ranks2_record.h5", "-q"), "2 ranks, reco
 if p:
     harness.same("ranks2_record.h5", "serial_record.h5", "2 ranks, record_collisions, against the serial run", failures)
     s = summary(p)
-    detect_record = int(s["parallel.phase.detect"].split()[2])
+    detect_record = phase_bytes(p, "detect")
     print(f"2 ranks, record_collisions: collide {s['parallel.collide_steps']} tried, "
           f"{s['parallel.collide_fallbacks']} redone; advance {s['parallel.advance_steps']} tried, "
           f"{s['parallel.advance_fallbacks']} redone; detect {s['parallel.phase.detect']}")

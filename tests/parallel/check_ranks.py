@@ -129,12 +129,12 @@ for other in args.also:
         failures.append(f"{other} on 2 ranks: exit {p.returncode}\n{p.stderr}\n{c.stdout}")
 
 # The wall jam (--fallback): a forming jam's step-start LCPs take the warm
-# store. Since collide27 each share runs on a copy of the store and sends the
-# pairs it stored: no try falls back for it (plain runs). The test hook
+# store. Each share runs on a copy of the store and sends the pairs it
+# stored: no try falls back for it (plain runs). The test hook
 # FLOESIM_TEST_COLLIDE_FALLBACK=warm makes a share's use of the store a
-# conflict again (the rule before), so the same tries fall back to the whole
-# solve on every rank (the state gathered on demand): still the serial run
-# bit for bit, with fallbacks counted by kind and some tries kept.
+# conflict, so those tries fall back to the whole solve on every rank (the
+# state gathered on demand): still the serial run bit for bit, with
+# fallbacks counted by kind and some tries kept.
 if args.fallback:
     until = ["--until", str(args.fallback_until)] if args.fallback_until else []
     need(run([args.floesim, "run", args.fallback, "-o", "fallback_serial.h5", "-q", *until]), "fallback: serial run")
@@ -163,17 +163,16 @@ if args.fallback:
             elif warm != int(fell[0]):
                 failures.append(f"{what}: the collisions' fallbacks by kind {kinds} do not sum to {fell}")
         else:
-            # Cured (collide27): no try falls back for the warm store.
+            # Without the hook no try falls back for the warm store.
             if not (tried and fell and int(tried[0]) > 0):
                 failures.append(f"{what}: no step-start collisions by owner ({tried}, {fell})")
             elif warm:
                 failures.append(f"{what}: a step-start try fell back for the warm store (cured): {kinds}")
             elif sum(v for k, v in kinds.items() if k.startswith("parallel.collide_")) < int(fell[0]):
                 failures.append(f"{what}: the collisions' fallbacks {fell} are not all counted by kind {kinds}")
-        # The advance's fallbacks by kind (onerank26): neither the warm store
-        # nor clusters of two ranks that meet send an advance to the whole
-        # fallback any more; the meeting clusters are joined on one rank
-        # (which this run needs).
+        # The advance's fallbacks by kind: neither the warm store nor clusters
+        # of two ranks that meet send an advance to the whole fallback; the
+        # meeting clusters are joined on one rank (which this run needs).
         afell = key("parallel.advance_fallbacks")
         print(f"{what}: advance {key('parallel.advance_steps')} tried, {afell} redone, "
               f"{key('parallel.advance_whole')} whole; by kind {kinds}")

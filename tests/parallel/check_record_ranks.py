@@ -30,7 +30,7 @@ usage: check_record_ranks.py FLOESIM MPIEXEC WORKDIR [--floes N] [--t-end T] [--
    LCPs take the warm store, and clusters of the two ranks meet): bit for
    bit on 2 ranks, with both kinds of step present: kept at the first try,
    and tried again with the meeting clusters joined on one rank (each try
-   recording afresh; since onerank26 these steps no longer fall back whole:
+   recording afresh; these steps do not fall back whole:
    `parallel.advance_joined`), or redone whole.
 3. In both: every floe's state is gathered before the splits
    (`parallel.fracture_whole_state`) in exactly the steps where a floe split
@@ -43,7 +43,7 @@ import os
 import shutil
 import sys
 
-from ranks_harness import FRACTURE, moving_pack_check, need, summary
+from ranks_harness import FRACTURE, moving_pack_check, need, phase_bytes, summary
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
@@ -107,8 +107,8 @@ def check_split_gathers(p, serial, what):
 
 
 def detect_bytes(p):
-    """The bytes the detect phase received (summary: `N calls, B bytes`)."""
-    return int(summary(p)["parallel.phase.detect"].split()[2])
+    """The bytes the detect phase received (rank 0's)."""
+    return phase_bytes(p, "detect")
 
 
 # The whole lists gathered at every detection (advance_on_part = false), on

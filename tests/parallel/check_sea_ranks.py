@@ -206,9 +206,9 @@ if os.path.exists(os.path.join(W, "moved_2.h5")):
 # A row of 2 m squares along y across the cut of 2 ranks: A (4 m/s) hits B
 # 5 cm ahead early in the first step, and B, whose reach was set at rest
 # (about 0.1 m: the pack's rms speed is low), overlaps C 0.5 m ahead; 30
-# floes at rest elsewhere. (Where the overlap came in the third step
-# instead, main at 555f1e4 read the rejected try's offer and still gave the
-# serial run: that read is undefined, and here it crashed.)
+# floes at rest elsewhere. (The overlap comes in the first step: a read of
+# the rejected try's offer is undefined, and with the overlap in the third
+# step such a read still gave the serial run; here it crashes.)
 # Serially and on 2 and 3 ranks, in the poison mode too (the unheld copies
 # NaN: a rebuild posing a floe not gathered reads NaN), bit for bit, each
 # run having redone a step (`steps_redone`).

@@ -99,9 +99,10 @@ for n in (2, 3):
 # first half kick, and the sea's kick of that pressure comes after the drift,
 # where the cuts move. The sea and the coupling follow the moved slabs only
 # after that kick (Simulation::follow_slabs): followed at the drift, the
-# rows a rank took over were kicked with its old routes' sums, and the sea
-# left the serial run from the first move on (every cell's eta, every floe's
-# vertical rates; floes_on_waves on 2 and 3 ranks, scripts/validate_ranks).
+# rows a rank takes over would be kicked with its old routes' sums, and the
+# sea would leave the serial run from the first move on (every cell's eta,
+# every floe's vertical rates; floes_on_waves on 2 and 3 ranks,
+# scripts/validate_ranks).
 damper = os.path.join(W, "half_damper.toml")
 with open(damper, "w") as f:
     f.write(ocean_toml("half_pack.h5", 1.0, 0.5, contact="box = [0.0, 200.0, 0.0, 200.0]\n",

@@ -49,8 +49,8 @@ Checked, on 2 and 3 ranks:
     drift phase (parallel.phase.drift) receives less than 0.6 of every
     floe's state (96 B) each step on the bem, tank and wide cases, whose
     bands do not hold every floe (the flume's every rank holds every floe;
-    every state to every rank, before halo27, is above 1.0 with the water's
-    hand-over).
+    every state to every rank, without the halo exchange, is above 1.0 with
+    the water's hand-over).
 Then the flume's pack numbered along x (its floes sorted by x: there the
 owners by index would be shares of the columns too) on 2 ranks: bit for bit
 with its serial run, and rank 0's penalty phase receives at most 1.2 times
@@ -76,15 +76,14 @@ checkpoint on 3 ranks must equal the serial run bit for bit.
 Then the wide flume with fracture (286 floes at 2 s from 160) on 2 ranks,
 from the parts and from the whole detection (advance_on_part = false), bit
 for bit with the serial run: a split reads its parent's state on every
-rank, whose vertical drift only its holders made (main's build at 555f1e4
-made 284 floes on 2 ranks, the split's gather skipped after the drift's
-whole exchange).
+rank, whose vertical drift only its holders made (with the split's gather
+skipped after the drift's whole exchange, 284 floes on 2 ranks).
 """
 import math
 import os
 import re
 
-from ranks_harness import finish, need, ranks_check, summary
+from ranks_harness import finish, need, phase_bytes, ranks_check, summary
 
 args, harness = ranks_check(
     "floesim was built without MPI (FLOESIM_MPI=OFF): the runs on the seas not in slabs are not checked",
@@ -209,11 +208,6 @@ def numbered_along_x(pack, out):
         out_floes["vertices"] = np.concatenate([vertices[offsets[i]:offsets[i + 1]] for i in order])
         out_floes["offsets"] = np.concatenate([[0], np.cumsum([offsets[i + 1] - offsets[i] for i in order])]).astype(
             offsets.dtype)
-
-
-def phase_bytes(p, phase):
-    """Rank 0's bytes received in a phase (`parallel.phase.PHASE: C calls, B bytes`)."""
-    return int(summary(p)[f"parallel.phase.{phase}"].split()[2])
 
 
 def penalty_bytes(p):

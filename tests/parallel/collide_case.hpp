@@ -1,7 +1,8 @@
 #pragma once
 // The step-start collisions' test case, shared by test_collide_share.cpp
 // (shares played on one process) and collide_share_ranks.cpp (over the
-// ranks mpirun starts).
+// ranks mpirun starts), and the comparisons bit for bit the parallel tests
+// share (states, collision counts, warm store, impulse record).
 #include <algorithm>
 #include <cstring>
 #include <numeric>
@@ -74,6 +75,12 @@ inline CollideCase rows_of_four(unsigned seed, int side = 8) {
   return c;
 }
 
+// The same states, bit for bit.
+inline bool same_states(const std::vector<FloeState>& a, const std::vector<FloeState>& b) {
+  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(FloeState)) == 0;
+}
+
+// The same collision counts: every one contact::collision_counts names.
 inline bool same_stats(const contact::CollisionStats& a, const contact::CollisionStats& b) {
   const auto x = contact::collision_counts(a);
   const auto y = contact::collision_counts(b);

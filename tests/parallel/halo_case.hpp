@@ -155,12 +155,6 @@ inline Held halo_band(const parallel::FloeOwners& owners, int rank, const Floes&
   return parallel::held_floes(owners, rank, floes, shapes, d, largest_by_ranks(owners, floes, shapes, d)).mask;
 }
 
-// ---- Comparisons, bit for bit -------------------------------------------
-
-inline bool same_states(const std::vector<FloeState>& a, const std::vector<FloeState>& b) {
-  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(FloeState)) == 0;
-}
-
 // ---- The cases -----------------------------------------------------------
 
 // A dense pack whose floes move at up to `speed` (m/s) and turn, with the

@@ -104,6 +104,11 @@ def summary(p):
     return dict(l.split(": ", 1) for l in p.stdout.splitlines() if ": " in l)
 
 
+def phase_bytes(p, phase):
+    """Rank 0's bytes received in a phase (`parallel.phase.PHASE: C calls, B bytes`)."""
+    return int(summary(p)[f"parallel.phase.{phase}"].split()[2])
+
+
 def ocean_toml(pack, t_end, output_interval, contact="", coupling=""):
     """A small ocean like bench/ocean/ocean.toml: the floes of `pack` in a
     200 m x 200 m periodic box on a 128^2 spectral sea (JONSWAP, Hs = 1 m,

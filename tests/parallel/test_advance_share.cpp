@@ -38,16 +38,11 @@ namespace {
 
 // The cases (tests/parallel/advance_case.hpp).
 using Case = test::AdvanceCase;
+using test::same_stats;
 Case dense_pack(double speed, unsigned seed, double concentration = 0.75) {
   return test::dense_advance_pack(speed, seed, concentration);
 }
 
-bool same_stats(const contact::CollisionStats& a, const contact::CollisionStats& b) {
-  return a.contacts == b.contacts && a.lcps == b.lcps && a.pivots == b.pivots && a.failures == b.failures &&
-         a.fallbacks == b.fallbacks && a.flagged == b.flagged && a.gauss_seidel == b.gauss_seidel &&
-         a.tolerated == b.tolerated && a.largest == b.largest && a.total_size == b.total_size && a.warm == b.warm &&
-         a.warm_missed == b.warm_missed;
-}
 bool same_report(const contact::SubstepReport& a, const contact::SubstepReport& b) {
   return a.clusters == b.clusters && a.substeps == b.substeps && a.time_steps == b.time_steps &&
          a.largest_cluster == b.largest_cluster && a.joined == b.joined && a.merges == b.merges &&

@@ -8,7 +8,7 @@
 // speculative contact that joins two ranks' contact components puts both in
 // one step group, on one rank. Shares that use the warm store run on copies
 // of it and their stored pairs, written into every rank's store, keep it the
-// serial store over several steps (collide27); under the test hook
+// serial store over several steps; under the test hook
 // (CollideShareOptions::warm_conflict) they fall back to the serial solve,
 // with the advance's back-off. In a run that keeps the impulse record, the
 // shares' records merged are the serial record.
@@ -31,6 +31,7 @@ TEST_SUITE_BEGIN("mpi");
 using namespace floesim;
 using test::CollideCase;
 using test::same_record;
+using test::same_states;
 using test::same_stats;
 
 namespace {
@@ -102,10 +103,6 @@ std::vector<int> owners_of(const CollideCase& c, int ranks, int& n) {
   std::iota(owner.begin(), owner.end(), 0);
   n = static_cast<int>(owner.size());
   return owner;
-}
-
-bool same_states(const std::vector<FloeState>& a, const std::vector<FloeState>& b) {
-  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(FloeState)) == 0;
 }
 
 }  // namespace
@@ -308,8 +305,8 @@ TEST_CASE("step-start shares on copies of the warm store, their stored pairs wri
   // Four steps over 1, 2, 3 and 7 strips, every LCP from the warm store
   // (warm_min = 0), the store carried from each step to the next (its
   // entries are those of the step before: warm starts that hit). The serial
-  // solve and each split keep a store of their own. Until collide27 each
-  // multi-rank try fell back (warm_start): under the test hook it still does.
+  // solve and each split keep a store of their own. Under the test hook
+  // each multi-rank try falls back (warm_start).
   long tries = 0, combined = 0, stored = 0;
   for (const unsigned seed : {3u, 11u}) {
     CAPTURE(seed);
@@ -342,7 +339,7 @@ TEST_CASE("step-start shares on copies of the warm store, their stored pairs wri
         if (n > 1) {
           ++tries;
           combined += ok ? 1 : 0;
-          // Several parts solved from the store: each a warm_start conflict before.
+          // Several parts solved from the store: each a warm_start conflict under the hook.
           CHECK(std::count_if(uses.begin(), uses.end(), [](long u) { return u > 0; }) >= 2);
           Floes g;
           contact::CollisionStats gs;

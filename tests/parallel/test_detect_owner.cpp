@@ -29,13 +29,10 @@ TEST_SUITE_BEGIN("mpi");
 
 using namespace floesim;
 using test::CollideCase;
+using test::same_states;
 using test::same_stats;
 
 namespace {
-
-bool same_states(const std::vector<FloeState>& a, const std::vector<FloeState>& b) {
-  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(FloeState)) == 0;
-}
 
 std::vector<int> strips(const CollideCase& c, int ranks) {
   parallel::FloeOwners owners(0, ranks, c.domain);
@@ -223,8 +220,7 @@ TEST_CASE("the step groups from the edges are those of the whole detection, jams
 TEST_CASE("shares on their pairs that use the warm store combine into the serial answer and store") {
   // warm_min = 0: every LCP starts from the warm store. Each share runs on
   // a copy of it (the store the shares see is left alone) and the parts'
-  // stored pairs, written into it, make it the serial store (until
-  // collide27 each share reported a conflict: the whole solve).
+  // stored pairs, written into it, make it the serial store.
   CollideCase c = test::rows_of_four(3);
   c.options.warm_min = 0;
   contact::WarmStart serial_warm, warm;
