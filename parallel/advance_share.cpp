@@ -13,6 +13,7 @@
 #include "core/error.hpp"
 #include "parallel/bytes.hpp"
 #include "parallel/detect.hpp"
+#include "parallel/refusals.hpp"
 
 namespace floesim::parallel {
 
@@ -296,25 +297,14 @@ const char* conflict_name(contact::ShareOutcome::Conflict conflict) {
   return "unknown";
 }
 
+namespace {
+const char* refused_name(contact::ShareOutcome::Conflict conflict) {
+  return conflict == ShareOutcome::Conflict::none ? nullptr : conflict_name(conflict);
+}
+}  // namespace
+
 void count_conflicts(std::span<const AdvancePart> parts, AdvanceShareCounts& counts) {
-  std::vector<std::string> kinds;
-  std::vector<std::uint8_t> taken;
-  bool twice = false;
-  for (const AdvancePart& p : parts) {
-    if (p.outcome.conflict != ShareOutcome::Conflict::none) {
-      kinds.push_back(conflict_name(p.outcome.conflict));
-      continue;
-    }
-    for (const std::uint32_t i : p.outcome.moved) {
-      if (i >= taken.size()) taken.resize(i + 1, 0);
-      twice = twice || taken[i];
-      taken[i] = 1;
-    }
-  }
-  if (kinds.empty() && twice) kinds.push_back("taken_twice");
-  std::sort(kinds.begin(), kinds.end());
-  kinds.erase(std::unique(kinds.begin(), kinds.end()), kinds.end());
-  for (const std::string& k : kinds) ++counts.conflicts[k];
+  for (const std::string& k : refusals(parts, refused_name)) ++counts.conflicts[k];
 }
 
 // A set-up's conflicts (the gathered rooms' flags), each kind once.
@@ -326,18 +316,7 @@ static void count_set_up(std::span<const contact::ShareRooms> rooms, AdvanceShar
 
 bool combine_parts(std::span<const AdvancePart> parts, Floes& floes, CollisionStats& stats, SubstepReport& report,
                    contact::ImpulseRecord* record, contact::WarmStart* warm) {
-  std::vector<std::uint8_t> taken(floes.size(), 0);
-  std::vector<std::uint64_t> stored;  // the warm pairs of every part: each pair one cluster's, so one part's
-  for (const AdvancePart& p : parts) {
-    if (p.outcome.conflict != ShareOutcome::Conflict::none) return false;
-    for (const std::uint32_t i : p.outcome.moved) {
-      if (taken[i]) return false;  // a free floe two ranks' clusters took: the serial advance merges them
-      taken[i] = 1;
-    }
-    for (const auto& w : p.outcome.warm) stored.push_back(w.first);
-  }
-  std::sort(stored.begin(), stored.end());
-  if (std::adjacent_find(stored.begin(), stored.end()) != stored.end()) return false;
+  if (!refusals(parts, refused_name).empty()) return false;
   if (warm)
     for (const AdvancePart& p : parts) hold_warm(p.outcome.warm, p.outcome.warm_uses, *warm);
   for (const AdvancePart& p : parts)

@@ -236,9 +236,9 @@ struct AdvanceShareCounts {
   // the fallbacks. A try whose meeting clusters were joined and then
   // combined counts in `joined` only.
   // The advance's kinds: the names of contact::ShareOutcome::Conflict
-  // (conflict_name) and `taken_twice` (a free floe two ranks' clusters
-  // took, which no part can see: combine_parts finds it); the
-  // collisions': those of contact::StepCollisionShare::Conflict.
+  // (conflict_name), the collisions' those of
+  // contact::StepCollisionShare::Conflict, and for both `taken_twice` and
+  // `stored_twice`, which no part can see (parallel/refusals.hpp).
   std::map<std::string, long> conflicts;
   long wait = 0;                // advances still to do whole
   long next_wait = 1;           // the wait after the next fallback
@@ -292,9 +292,8 @@ private:
 // (parallel.advance_conflicts.NAME): the enumerator's.
 const char* conflict_name(contact::ShareOutcome::Conflict conflict);
 // The kinds of conflict a tried step's parts (rank order) say, each once,
-// counted into `counts.conflicts`: each part's conflict, and `taken_twice`
-// when no part has one but two parts moved one floe. A step whose parts
-// combine counts nothing.
+// counted into `counts.conflicts` (parallel/refusals.hpp: the rule that
+// combine_parts refuses by). A step whose parts combine counts nothing.
 void count_conflicts(std::span<const AdvancePart> parts, AdvanceShareCounts& counts);
 
 // The step's advance on every rank of `comm` (or whole, while the back-off

@@ -9,6 +9,7 @@
 #include "core/error.hpp"
 #include "parallel/bytes.hpp"
 #include "parallel/detect.hpp"
+#include "parallel/refusals.hpp"
 
 namespace floesim::parallel {
 
@@ -110,55 +111,27 @@ CollidePart run_collide_share(Floes& floes, std::span<const FloeState> start, co
 }
 
 namespace {
-// The kinds of conflict of a try's parts, each once, into counts.conflicts
-// (AdvanceShareCounts): the names of StepCollisionShare::Conflict, and
-// `taken_twice` (`stored_twice`) when no part has one but two parts changed
-// one floe (stored one warm pair; the groups and their pairs are disjoint:
-// never expected).
-void count_conflicts(std::span<const CollidePart> parts, AdvanceShareCounts& counts) {
-  std::vector<std::string> kinds;
-  std::vector<std::uint8_t> taken;
-  std::vector<std::uint64_t> stored;
-  bool twice = false;
-  for (const CollidePart& p : parts) {
-    switch (p.outcome.conflict) {
-      case StepCollisionShare::Conflict::none:
-        for (const std::uint32_t i : p.outcome.moved) {
-          if (i >= taken.size()) taken.resize(i + 1, 0);
-          twice = twice || taken[i];
-          taken[i] = 1;
-        }
-        for (const auto& w : p.outcome.warm) stored.push_back(w.first);
-        break;
-      case StepCollisionShare::Conflict::warm_start: kinds.push_back("warm_start"); break;
-      case StepCollisionShare::Conflict::failed_lcp: kinds.push_back("failed_lcp"); break;
-      case StepCollisionShare::Conflict::error: kinds.push_back("error"); break;
-    }
+const char* refused_name(StepCollisionShare::Conflict conflict) {
+  switch (conflict) {
+    case StepCollisionShare::Conflict::none: return nullptr;
+    case StepCollisionShare::Conflict::warm_start: return "warm_start";
+    case StepCollisionShare::Conflict::failed_lcp: return "failed_lcp";
+    case StepCollisionShare::Conflict::error: return "error";
   }
-  std::sort(stored.begin(), stored.end());
-  if (kinds.empty() && twice) kinds.push_back("taken_twice");
-  if (kinds.empty() && std::adjacent_find(stored.begin(), stored.end()) != stored.end())
-    kinds.push_back("stored_twice");
-  std::sort(kinds.begin(), kinds.end());
-  kinds.erase(std::unique(kinds.begin(), kinds.end()), kinds.end());
-  for (const std::string& k : kinds) ++counts.conflicts[k];
+  return "unknown";
+}
+
+// The kinds of conflict of a try's parts, each once, into counts.conflicts
+// (AdvanceShareCounts): refusals.hpp.
+void count_conflicts(std::span<const CollidePart> parts, AdvanceShareCounts& counts) {
+  for (const std::string& k : refusals(parts, refused_name)) ++counts.conflicts[k];
 }
 }  // namespace
 
 bool combine_collide_parts(std::span<const CollidePart> parts, Floes& floes, CollisionStats& stats,
                            std::size_t& speculative, contact::ImpulseRecord* record, contact::WarmStart* warm) {
-  std::vector<std::uint8_t> taken(floes.size(), 0);
-  std::vector<std::uint64_t> stored;  // each pair one group's (impulse.hpp), so one part's
-  for (const CollidePart& p : parts) {
-    if (p.outcome.conflict != StepCollisionShare::Conflict::none) return false;
-    for (const std::uint32_t i : p.outcome.moved) {
-      if (taken[i]) return false;
-      taken[i] = 1;
-    }
-    for (const auto& w : p.outcome.warm) stored.push_back(w.first);
-  }
-  std::sort(stored.begin(), stored.end());
-  if (std::adjacent_find(stored.begin(), stored.end()) != stored.end()) return false;
+  // Each warm pair is one group's (impulse.hpp), so one part's.
+  if (!refusals(parts, refused_name).empty()) return false;
   // The store: every part's pairs as its share left them, the whole call's
   // last writes (impulse.hpp, StepCollisionShare), on every rank alike.
   if (warm)

@@ -132,7 +132,7 @@ TEST_CASE("the advance's shares on copies of the warm store, their stored pairs 
   CHECK(stored > 0);
 }
 
-TEST_CASE("the advance's fallbacks are counted by kind: a cluster meeting another rank's, a floe two ranks took") {
+TEST_CASE("the advance's fallbacks are counted by kind: a cluster meeting another rank's, a floe two ranks took, a warm pair two parts stored") {
   // Every floe its own rank: every merge of the serial advance is between
   // ranks (foreign_cluster).
   {
@@ -164,6 +164,42 @@ TEST_CASE("the advance's fallbacks are counted by kind: a cluster meeting anothe
     parallel::count_conflicts(parts, counts);
     CHECK(counts.conflicts["missing_pairs"] == 1);
     CHECK(counts.conflicts["taken_twice"] == 1);
+  }
+  // Two parts that stored one warm pair (and moved different floes): they
+  // do not combine, the store and the states are left alone, and the try
+  // counts as `stored_twice` (the rule combine_parts refuses by is the one
+  // the count names: parallel/refusals.hpp).
+  {
+    std::vector<parallel::AdvancePart> parts(2);
+    parts[0].outcome.moved = {0};
+    parts[1].outcome.moved = {1};
+    parts[0].states = {FloeState{}};
+    parts[1].states = {FloeState{}};
+    parts[0].states[0].x = 5.0;
+    parts[1].states[0].x = 6.0;
+    const std::uint64_t key = 7;
+    parts[0].outcome.warm.emplace_back(key, contact::WarmStart::Pair{});
+    parts[1].outcome.warm.emplace_back(key, contact::WarmStart::Pair{});
+    Floes f;
+    f.state.resize(2);
+    f.thickness.resize(2, 1.0);
+    contact::WarmStart warm;
+    contact::CollisionStats stats;
+    contact::SubstepReport report;
+    CHECK_FALSE(parallel::combine_parts(parts, f, stats, report, nullptr, &warm));
+    CHECK(warm.pairs.empty());
+    CHECK(f.state[0].x == 0.0);
+    CHECK(f.state[1].x == 0.0);
+    parallel::AdvanceShareCounts counts;
+    parallel::count_conflicts(parts, counts);
+    CHECK(counts.conflicts.size() == 1);
+    CHECK(counts.conflicts["stored_twice"] == 1);
+    // One pair each: they combine, both states written, both pairs stored.
+    parts[1].outcome.warm.front().first = key + 1;
+    CHECK(parallel::combine_parts(parts, f, stats, report, nullptr, &warm));
+    CHECK(f.state[0].x == 5.0);
+    CHECK(f.state[1].x == 6.0);
+    CHECK(warm.pairs.size() == 2);
   }
 }
 
