@@ -51,6 +51,7 @@ bool parse_poison_options(const std::string& text, PoisonOptions& options) {
   }
   if (kind == "step-lure") o.kind = PoisonOptions::Kind::lure;
   else if (kind == "step-mutant") o.mutant = true;
+  else if (kind == "step-mutant-sea") o.mutant_sea = true;
   else if (kind != "step") return false;
   if (!window.empty()) {  // one or both exchanges, joined by '+'
     o.after_drift = o.after_detect = false;
@@ -84,9 +85,13 @@ void UnheldPoison::poison(std::span<const std::uint8_t> held, std::span<const st
     if (start && i < start->size()) (*start)[i] = lure ? lured((*start)[i], domain) : nan_state();
     if (i < reach.size()) reach[i] = lure ? reach[i] + 10.0 : kNan;
   }
-  if (options_.mutant) {
+  if (options_.mutant || options_.mutant_sea) {
     const auto first = std::find(held_.begin(), held_.end(), std::uint8_t{1});
-    if (first != held_.end()) state[static_cast<std::size_t>(first - held_.begin())] = nan_state();
+    if (first != held_.end()) {
+      FloeState& s = state[static_cast<std::size_t>(first - held_.begin())];
+      if (options_.mutant) s = nan_state();
+      else s.heave = kNan;
+    }
   }
   open_ = true;
   ++windows_;
@@ -119,11 +124,24 @@ void UnheldPoison::check(const char* phase, const std::vector<FloeState>& state,
   }
 }
 
+void UnheldPoison::check_sea(const char* phase, bool sea_finite) {
+  if (!open_ || sea_finite) return;
+  if (std::find(reported_sea_phases_.begin(), reported_sea_phases_.end(), phase) != reported_sea_phases_.end())
+    return;
+  std::ostringstream m;
+  m << "poison: rank " << rank_ << ": after " << phase << ": the sea's modal state is NaN";
+  reports_.push_back(m.str());
+  reported_sea_phases_.emplace_back(phase);
+  std::fprintf(stderr, "floesim: %s\n", m.str().c_str());
+  std::fflush(stderr);
+}
+
 }  // namespace floesim
 
 // ---- Simulation's side: where the windows open and close in a step ----
 
 #include "coupling/simulation.hpp"
+#include "fluid/sea.hpp"
 
 namespace floesim {
 
@@ -182,6 +200,9 @@ void Simulation::poison_step(const char* phase, StepContext& ctx) {
   const bool reach_read = at != "drift" && at != "collide" && at != "advance";
   p.check(phase, state, start_read ? &ctx.start : nullptr,
           reach_read ? std::span<const double>(detection_options_.reach) : std::span<const double>{});
+  // The sea this rank steps (its slab's modes, or the whole sea on a sea
+  // not in slabs, which every rank steps alike).
+  if (sea_) p.check_sea(phase, sea_->finite_state());
 }
 
 }  // namespace floesim

@@ -51,6 +51,11 @@ struct PoisonOptions {
   // The mutation of the tests: this rank's lowest held floe is poisoned too,
   // so the first check must report it.
   bool mutant = false;
+  // The mutation of the sea's check ("step-mutant-sea"): this rank's lowest
+  // held floe's heave is NaN too, its place left finite, so that the
+  // coupling poses it where it is and its penalty pressure, NaN, reaches
+  // the sea at the next kick (check_sea must report it).
+  bool mutant_sea = false;
   // The mutation of the whole state on demand's test: Simulation::whole_state
   // gathers nothing, so a step that reads every floe reads the poison.
   bool stale = false;
@@ -59,6 +64,7 @@ struct PoisonOptions {
 };
 
 // Parses the test hook's value: "step" (NaN), "step-lure", "step-mutant",
+// "step-mutant-sea",
 // each optionally followed by "-stale" (PoisonOptions::stale:
 // "step-lure-stale"), then optionally by "@" and the exchanges after which
 // to poison, "drift" and "detect" joined by '+' (e.g. "step-lure@drift");
@@ -86,6 +92,16 @@ public:
   void check(const char* phase, const std::vector<FloeState>& state, const std::vector<FloeState>* start,
              std::span<const double> reach);
 
+  // The sea's check after a phase: `sea_finite` is the sea's
+  // fluid::Sea::finite_state() on this rank (its slab's modes, or the whole
+  // sea on a sea not in slabs). A NaN there came from a floe a phase read
+  // (the pressures are made from the floes): reported once a phase as for
+  // a floe, "sea's modal state is NaN". Nothing before the first poison.
+  // A NaN a rank carries into its sea may reach no held floe and no file
+  // (on a rank that does not write it), so the floes' check alone would
+  // not see it.
+  void check_sea(const char* phase, bool sea_finite);
+
   bool open() const { return open_; }
   // Times the unheld floes were poisoned (windows) and floes poisoned (summed over them).
   long long windows() const { return windows_; }
@@ -102,7 +118,7 @@ private:
   long long windows_ = 0, poisoned_ = 0;
   std::string last_checked_;
   std::vector<std::uint8_t> held_, kept_;
-  std::vector<std::string> reported_phases_, reports_;
+  std::vector<std::string> reported_phases_, reported_sea_phases_, reports_;
 };
 
 }  // namespace floesim

@@ -60,6 +60,16 @@ void Sea::hold_pressure(std::span<const double> p) {
   invalidate();
 }
 
+namespace {
+bool all_finite(std::span<const double> values) {
+  return std::all_of(values.begin(), values.end(), [](double x) { return std::isfinite(x); });
+}
+}  // namespace
+
+bool Sea::finite_state() const {
+  return all_finite(bank_.q()) && all_finite(bank_.v()) && all_finite(held_pressure());
+}
+
 void Sea::gather_modal_state(std::vector<double>& q, std::vector<double>& v) {
   settle();
   q.assign(bank_.q().begin(), bank_.q().end());

@@ -254,6 +254,14 @@ public:
     invalidate();
     return bank_;
   }
+  // Whether this rank's part of the sea's state is finite: the modes'
+  // amplitudes and rates it steps (in slabs its columns only; else every
+  // mode), the loads of the kicks a backend deferred, and the pressure
+  // held. Reads no field and settles nothing (the state and its bits are
+  // left as they are); no communication. For the poison mode of the run
+  // (coupling/poison_mode.hpp): a NaN that a phase carried into the sea
+  // stays in these values (the fields are made from them).
+  virtual bool finite_state() const;
   // The whole modal state in the whole bank's layout, for checkpoints:
   // modal_size() amplitudes q and as many rates v (settled). In slabs,
   // collective: every rank's modes are gathered to rank 0, which alone

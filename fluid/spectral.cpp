@@ -2,6 +2,7 @@
 
 #include <fftw3.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstring>
@@ -218,6 +219,18 @@ void SpectralSea::repeat_kick(double h) {
   ++m.pending;
   m.staged_vy = false;
   invalidate_rates();
+}
+
+bool SpectralSea::finite_state() const {
+  if (!Sea::finite_state()) return false;
+  // A deferred kick's load (the pressure's spectrum) is applied at the
+  // next flow: a NaN pressure waits there until then.
+  const Impl& m = *impl_;
+  for (int i = 0; i < m.pending; ++i) {
+    const double* s = m.kick_data(i);
+    if (!std::all_of(s, s + 2 * m.modes, [](double x) { return std::isfinite(x); })) return false;
+  }
+  return true;
 }
 
 void SpectralSea::settle() {

@@ -86,6 +86,8 @@ public:
 
   // omega of the Fourier mode with wave vector 2 pi (mx / lx, my / ly).
   double omega(int mx, int my = 0) const;
+  // Sea::finite_state() and the deferred kicks' loads.
+  bool finite_state() const override;
   // The tank's relaxation zones, or nullptr.
   const TankZones* tank() const;
 
