@@ -296,9 +296,7 @@ bool Percussion::conclude(Floes& floes, PercussionAnalyses all) {
       SplitDecision decision = fi.split;
       // Decisions made without the neighbours (a piece too small, no two
       // polygons) stand whatever the other splits.
-      const bool neighbours =
-          decision.verdict == SplitVerdict::split || decision.verdict == SplitVerdict::refused_overlap;
-      const bool again = neighbours && changed_near(i);
+      const bool again = decided_against_neighbours(decision.verdict) && changed_near(i);
       if (again) ++stats_.splits_redone;
       if (again || decision.verdict == SplitVerdict::undecided) decision = decide_split(floes, i, fi);
       const Made before{floes.state[i].x, floes.state[i].y, radius_of(floes, i), i, floes.size()};
@@ -315,12 +313,10 @@ bool Percussion::conclude(Floes& floes, PercussionAnalyses all) {
 }
 
 bool Percussion::may_split(const PercussionAnalyses& all) const {
-  // A refused_overlap stays refused unless an earlier split made near it:
-  // with none of the verdicts below, none is made (by induction in floe
-  // order). refused_small and refused_chord stand whatever the others.
+  // conclude splits nothing unless some through crack may split on its own
+  // (may_split_alone, percussion.hpp: the rule and why).
   return params_.split && std::any_of(all.initiations.begin(), all.initiations.end(), [](const FloeInitiation& fi) {
-           return fi.through != 0 &&
-                  (fi.split.verdict == SplitVerdict::split || fi.split.verdict == SplitVerdict::undecided);
+           return fi.through != 0 && may_split_alone(fi.split.verdict);
          });
 }
 

@@ -167,6 +167,19 @@ enum class SplitVerdict : std::uint64_t {
   refused_overlap,  // two valid pieces, but at every opening a piece would overlap a neighbour
   refused_chord,    // the chord does not cut two valid polygons
 };
+// The verdicts Percussion::conclude takes again, and those it applies on
+// their own; one place, as Percussion::may_split reasons from them:
+//   - a verdict taken against the floe's neighbours (split, refused_overlap)
+//     is taken again when a split made earlier in the step reached them;
+//     the others (refused_small, refused_chord) stand whatever the others;
+//   - so a floe splits without an earlier split near it only on a split
+//     verdict or none yet (undecided: decided in conclude), and a step with
+//     neither among its through cracks splits nothing (by induction in floe
+//     order: a refused_overlap is taken again only near a split made).
+inline bool decided_against_neighbours(SplitVerdict v) {
+  return v == SplitVerdict::split || v == SplitVerdict::refused_overlap;
+}
+inline bool may_split_alone(SplitVerdict v) { return v == SplitVerdict::split || v == SplitVerdict::undecided; }
 
 // A split worked out against given floes (Percussion::decide_split): the
 // verdict and, for a split, the opening (m). A split is the same when its
