@@ -98,7 +98,8 @@ struct Floes {
   void replace(std::size_t i, const FloeShape& shape, const FloeInput& input);
   // A copy of the listed floes, in that order, with their ids.
   Floes select(std::span<const std::size_t> which) const;
-  // Every per-floe array above must be handled by add, replace and select.
+  // Every per-floe array above must be handled by add, replace and select,
+  // and counted by memory() (below).
 
   // What these arrays allocate (core/floe_bytes.hpp), against the entries of
   // the floes `held` marks (empty: every floe): the constants (thickness to
