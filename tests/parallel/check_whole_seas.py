@@ -112,6 +112,35 @@ GRIDS = {"bem": (24, 12, 0.5, 0.5), "tank": (96, 24, 0.25, 0.25), "flume": (96, 
 LAWS = {"wide": 'law = "blend"\nblend = 0.5\n'}
 FLUMES = ("flume", "wide")  # dims = 1: the coupling's owners are shares of the columns
 SOME_HELD = ("bem", "tank", "wide")  # the bands do not hold every floe on 2 ranks
+
+
+def spectral(dims, width, ny, floes, tank=False):
+    """A spectral sea's [sea] 24 m long and `width` m wide on 96 x `ny` cells
+    (dims = 1: a flume, every cell spans it), 1 m deep, regular waves (with
+    `tank`, a wave maker and an absorber 6 m long each), and its pack's
+    `floesim pack` arguments: `floes` floes over the sea."""
+    return (f"""
+[sea]
+model = "spectral"
+dims = {dims}
+size = [24.0, {width:.1f}]
+cells = [96, {ny}]
+depth = 1.0
+rho = 1000.0
+
+[sea.waves]
+kind = "regular"
+amplitude = 0.05
+wavelength = 6.0
+""" + ("""
+[sea.tank]
+enabled = true
+generation_length = 6.0
+absorption_length = 6.0
+""" if tank else ""), ["--floes", str(floes), "--box", "24", f"{width:g}"])
+
+
+# Per case: its [sea] and its pack's `floesim pack` arguments.
 SEAS = {
     "bem": ("""
 [sea]
@@ -127,53 +156,9 @@ kind = "standing"
 amplitude = 0.05
 wavelength = 24.0
 """, ["--floes", "150", "--box", "12", "6"]),
-    "tank": ("""
-[sea]
-model = "spectral"
-dims = 2
-size = [24.0, 6.0]
-cells = [96, 24]
-depth = 1.0
-rho = 1000.0
-
-[sea.waves]
-kind = "regular"
-amplitude = 0.05
-wavelength = 6.0
-
-[sea.tank]
-enabled = true
-generation_length = 6.0
-absorption_length = 6.0
-""", ["--floes", "100", "--box", "24", "6"]),
-    "flume": ("""
-[sea]
-model = "spectral"
-dims = 1
-size = [24.0, 2.0]
-cells = [96, 1]
-depth = 1.0
-rho = 1000.0
-
-[sea.waves]
-kind = "regular"
-amplitude = 0.05
-wavelength = 6.0
-""", ["--floes", "40", "--box", "24", "2"]),
-    "wide": ("""
-[sea]
-model = "spectral"
-dims = 1
-size = [24.0, 8.0]
-cells = [96, 1]
-depth = 1.0
-rho = 1000.0
-
-[sea.waves]
-kind = "regular"
-amplitude = 0.05
-wavelength = 6.0
-""", ["--floes", "160", "--box", "24", "8"]),
+    "tank": spectral(2, 6.0, 24, 100, tank=True),
+    "flume": spectral(1, 2.0, 1, 40),
+    "wide": spectral(1, 8.0, 1, 160),
 }
 
 
