@@ -82,8 +82,13 @@ skipped after the drift's whole exchange, 284 floes on 2 ranks).
 import math
 import os
 import re
+import sys
 
 from ranks_harness import finish, need, phase_bytes, ranks_check, summary
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))), "scripts",
+                                "scenarios"))
+from whole_seas import SEAS, pack_command  # per case: its [sea] and its pack's arguments
 
 args, harness = ranks_check(
     "floesim was built without MPI (FLOESIM_MPI=OFF): the runs on the seas not in slabs are not checked",
@@ -112,54 +117,6 @@ GRIDS = {"bem": (24, 12, 0.5, 0.5), "tank": (96, 24, 0.25, 0.25), "flume": (96, 
 LAWS = {"wide": 'law = "blend"\nblend = 0.5\n'}
 FLUMES = ("flume", "wide")  # dims = 1: the coupling's owners are shares of the columns
 SOME_HELD = ("bem", "tank", "wide")  # the bands do not hold every floe on 2 ranks
-
-
-def spectral(dims, width, ny, floes, tank=False):
-    """A spectral sea's [sea] 24 m long and `width` m wide on 96 x `ny` cells
-    (dims = 1: a flume, every cell spans it), 1 m deep, regular waves (with
-    `tank`, a wave maker and an absorber 6 m long each), and its pack's
-    `floesim pack` arguments: `floes` floes over the sea."""
-    return (f"""
-[sea]
-model = "spectral"
-dims = {dims}
-size = [24.0, {width:.1f}]
-cells = [96, {ny}]
-depth = 1.0
-rho = 1000.0
-
-[sea.waves]
-kind = "regular"
-amplitude = 0.05
-wavelength = 6.0
-""" + ("""
-[sea.tank]
-enabled = true
-generation_length = 6.0
-absorption_length = 6.0
-""" if tank else ""), ["--floes", str(floes), "--box", "24", f"{width:g}"])
-
-
-# Per case: its [sea] and its pack's `floesim pack` arguments.
-SEAS = {
-    "bem": ("""
-[sea]
-model = "bem"
-dims = 2
-size = [12.0, 6.0]
-cells = [24, 12]
-depth = 2.0
-rho = 1000.0
-
-[sea.waves]
-kind = "standing"
-amplitude = 0.05
-wavelength = 24.0
-""", ["--floes", "150", "--box", "12", "6"]),
-    "tank": spectral(2, 6.0, 24, 100, tank=True),
-    "flume": spectral(1, 2.0, 1, 40),
-    "wide": spectral(1, 8.0, 1, 160),
-}
 
 
 def coupling(name, pack):
@@ -201,8 +158,7 @@ def penalty_bytes(p):
 
 penalty = {}  # (case, ranks) -> rank 0's penalty bytes
 for name, (sea, pack) in SEAS.items():
-    need(run([args.floesim, "pack", *pack, "--concentration", "0.7", "--seed", "3", "--thickness", "0.2",
-              "-o", f"{name}_pack.h5"]), f"{name}: floesim pack")
+    need(run(pack_command(args.floesim, name, f"{name}_pack.h5")), f"{name}: floesim pack")
     config = os.path.join(W, f"{name}.toml")
     with open(config, "w") as f:
         f.write(RUN + sea + coupling(name, f"{name}_pack.h5"))
