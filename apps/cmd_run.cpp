@@ -239,7 +239,6 @@ void set_test_hooks(const TestHooks& hooks, Simulation& sim) {
 // checkpoint for a restart).
 struct SetUp {
   std::string config_path, output;
-  Config config;
   Checkpoint checkpoint;  // a restart's (its restored state released)
   std::unique_ptr<Simulation> simulation;
   double setup_seconds = 0.0;  // s, the run's set-up on this rank (shapes, the start's detection, the sea)
@@ -252,6 +251,7 @@ struct SetUp {
 void set_up(const Args& args, const parallel::Session& session, SetUp& u) {
   const parallel::Communicator& comm = session.world();
   const bool restart = !args.restart.empty();
+  Config config;
   u.config_path = args.config.empty() && !restart ? default_config() : args.config;
   if (!u.config_path.empty() && !path_exists(u.config_path))
     throw InputError(u.config_path + ": configuration file not found");
@@ -272,8 +272,8 @@ void set_up(const Args& args, const parallel::Session& session, SetUp& u) {
     if (!path_exists(args.restart)) throw InputError(args.restart + ": run file not found (--restart)");
     const RunInfo info = read_run_info(args.restart);
     u.checkpoint = read_checkpoint(args.restart);
-    u.config = restart_config(args.restart, u.config_path, info);
-    const double t_end = args.until >= 0.0 ? args.until : u.config.run.t_end;
+    config = restart_config(args.restart, u.config_path, info);
+    const double t_end = args.until >= 0.0 ? args.until : config.run.t_end;
     if (t_end < u.checkpoint.time) {
       std::ostringstream m;
       m << args.restart << ": the checkpoint is at t = " << u.checkpoint.time << " s, after the end asked for ("
@@ -282,21 +282,21 @@ void set_up(const Args& args, const parallel::Session& session, SetUp& u) {
       throw InputError(m.str());
     }
   } else {
-    u.config = load_config(u.config_path);
+    config = load_config(u.config_path);
   }
-  if (args.threads >= 0) u.config.run.threads = args.threads;
+  if (args.threads >= 0) config.run.threads = args.threads;
   // --until replaces t_end: the bounds on the records and steps of [run] t_end hold for it too.
   if (args.until >= 0.0)
-    for (auto [problem, key] : {std::pair{record_count_problem(args.until, u.config.run.output_interval), "output_interval"},
-                                std::pair{step_count_problem(args.until, u.config.run.dt_max), "dt_max"}})
+    for (auto [problem, key] : {std::pair{record_count_problem(args.until, config.run.output_interval), "output_interval"},
+                                std::pair{step_count_problem(args.until, config.run.dt_max), "dt_max"}})
       if (!problem.empty()) {
         std::ostringstream m;
         m << "--until " << args.until << ": " << problem << " ("
           << (u.config_path.empty() ? args.restart : u.config_path) << ": [run] " << key << ")";
         throw InputError(m.str());
       }
-  share_cores(u.config, session);
-  Scenario scenario = build_scenario(u.config);
+  share_cores(config, session);
+  Scenario scenario = build_scenario(config);
   const auto setup_begin = std::chrono::steady_clock::now();
   u.simulation = std::make_unique<Simulation>(std::move(scenario), comm);
   if (restart) u.simulation->restore(u.checkpoint);
