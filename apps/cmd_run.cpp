@@ -16,10 +16,12 @@
 #include <filesystem>
 #include <iomanip>
 #include <iostream>
+#include <optional>
 #include <sstream>
 #include <thread>
 
 #include "apps/commands.hpp"
+#include "apps/run_summary.hpp"
 #include "core/checkpoint.hpp"
 #include "core/config.hpp"
 #include "core/run_file.hpp"
@@ -181,10 +183,167 @@ void add_run_command(CLI::App& app, Registry& registry) {
 
 namespace {
 
-// The poison mode's summary (a test option: Simulation::set_poison_test),
-// every rank's: stdio, as the other ranks' streams are silenced by run().
+// The test hooks: environment variables the tests set (and pass to every
+// rank with `mpirun -x`), not user keys; read here, by the command, in this
+// one place, so that the library reads no environment.
+struct TestHooks {
+  // FLOESIM_TEST_POISON_UNHELD (tests/parallel/check_writer_ranks.py): "1":
+  // each rank's copy of the floes it does not hold is poisoned before the
+  // writer's gathers, so the run file is right only if they read every
+  // floe from its holder; "unread": the writer writes its poisoned copy
+  // (Simulation::set_writer_test).
+  Simulation::WriterTest writer = Simulation::WriterTest::off;
+  // The same variable, "step", "step-lure", "step-mutant" (optionally
+  // "-stale", then optionally "@drift", "@detect": the grammar is
+  // parse_poison_options'): the poison mode of the run
+  // (Simulation::set_poison_test, tests/parallel/check_poison_run.py), the
+  // writer's gathers as in a plain run.
+  std::optional<PoisonOptions> poison;
+  // FLOESIM_TEST_COLLIDE_FALLBACK = "warm": a step-start share that used the
+  // warm store falls back whole (Simulation::set_collide_test,
+  // tests/parallel/check_ranks.py --fallback, check_poison_run.py (d)).
+  bool collide_fallback = false;
+};
+
+// InputError for a value a hook does not take.
+TestHooks read_test_hooks() {
+  TestHooks hooks;
+  if (const char* text = std::getenv("FLOESIM_TEST_POISON_UNHELD")) {
+    const std::string value = text;
+    PoisonOptions poison;
+    if (parse_poison_options(value, poison))
+      hooks.poison = poison;
+    else if (value == "1" || value == "unread")
+      hooks.writer = value == "1" ? Simulation::WriterTest::poison : Simulation::WriterTest::poison_unread;
+    else
+      throw InputError("FLOESIM_TEST_POISON_UNHELD (a test hook): expected \"1\", \"unread\" or a poison mode "
+                       "(\"step\", \"step-lure\", ...), got \"" + value + "\"");
+  }
+  if (const char* text = std::getenv("FLOESIM_TEST_COLLIDE_FALLBACK")) {
+    if (std::string(text) != "warm")
+      throw InputError("FLOESIM_TEST_COLLIDE_FALLBACK (a test hook): expected \"warm\", got \"" + std::string(text) +
+                       "\"");
+    hooks.collide_fallback = true;
+  }
+  return hooks;
+}
+
+void set_test_hooks(const TestHooks& hooks, Simulation& sim) {
+  if (hooks.poison) sim.set_poison_test(*hooks.poison);
+  if (hooks.writer != Simulation::WriterTest::off) sim.set_writer_test(hooks.writer);
+  if (hooks.collide_fallback) sim.set_collide_test(true);
+}
+
+// What the set-up makes of the arguments: the configuration read and
+// checked, the scenario built into a simulation (restored from the
+// checkpoint for a restart).
+struct SetUp {
+  std::string config_path, output;
+  Checkpoint checkpoint;  // a restart's (its restored state released)
+  std::unique_ptr<Simulation> simulation;
+  double setup_seconds = 0.0;  // s, the run's set-up on this rank (shapes, the start's detection, the sea)
+};
+
+// Every rank reads and checks the input and builds the scenario before any
+// work is shared: bad input on any rank stops every rank with its message
+// (the same on each, as they read the same files). Called by every rank
+// within comm.together.
+void set_up(const Args& args, const parallel::Session& session, SetUp& u) {
+  const parallel::Communicator& comm = session.world();
+  const bool restart = !args.restart.empty();
+  Config config;
+  u.config_path = args.config.empty() && !restart ? default_config() : args.config;
+  if (!u.config_path.empty() && !path_exists(u.config_path))
+    throw InputError(u.config_path + ": configuration file not found");
+  u.output = args.output;
+  if (u.output.empty()) u.output = restart ? args.restart : fs::path(u.config_path).stem().string() + ".h5";
+  if (!u.config_path.empty() && path_exists(u.output) && fs::equivalent(u.output, u.config_path))
+    throw InputError(u.output + ": the output would overwrite the configuration");
+  {
+    // An output that cannot be written is found before the scenario is built
+    // (which may take long); the writer reports what this cannot foresee.
+    const fs::path dir = fs::absolute(u.output).parent_path();
+    if (access(dir.c_str(), W_OK) != 0) {
+      const int err = errno;
+      throw RunError(u.output + ": cannot write the run file in " + dir.string() + " (" + std::strerror(err) + ")");
+    }
+  }
+  if (restart) {
+    if (!path_exists(args.restart)) throw InputError(args.restart + ": run file not found (--restart)");
+    const RunInfo info = read_run_info(args.restart);
+    u.checkpoint = read_checkpoint(args.restart);
+    config = restart_config(args.restart, u.config_path, info);
+    const double t_end = args.until >= 0.0 ? args.until : config.run.t_end;
+    if (t_end < u.checkpoint.time) {
+      std::ostringstream m;
+      m << args.restart << ": the checkpoint is at t = " << u.checkpoint.time << " s, after the end asked for ("
+        << (args.until >= 0.0 ? "--until " : "[run] t_end = ") << t_end << " s): expected an end >= "
+        << u.checkpoint.time << " s";
+      throw InputError(m.str());
+    }
+  } else {
+    config = load_config(u.config_path);
+  }
+  if (args.threads >= 0) config.run.threads = args.threads;
+  // --until replaces t_end: the bounds on the records and steps of [run] t_end hold for it too.
+  if (args.until >= 0.0)
+    for (auto [problem, key] : {std::pair{record_count_problem(args.until, config.run.output_interval), "output_interval"},
+                                std::pair{step_count_problem(args.until, config.run.dt_max), "dt_max"}})
+      if (!problem.empty()) {
+        std::ostringstream m;
+        m << "--until " << args.until << ": " << problem << " ("
+          << (u.config_path.empty() ? args.restart : u.config_path) << ": [run] " << key << ")";
+        throw InputError(m.str());
+      }
+  share_cores(config, session);
+  Scenario scenario = build_scenario(config);
+  const auto setup_begin = std::chrono::steady_clock::now();
+  u.simulation = std::make_unique<Simulation>(std::move(scenario), comm);
+  if (restart) u.simulation->restore(u.checkpoint);
+  u.setup_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - setup_begin).count();
+  if (restart) {
+    release_restored(u.checkpoint);  // the simulation holds that state now; the run keeps the marks
+    // A new output starts as a copy of the run; the records after the checkpoint are dropped from it.
+    if (comm.writer() && !(path_exists(u.output) && fs::equivalent(u.output, args.restart))) {
+      std::error_code ec;
+      fs::copy_file(args.restart, u.output, fs::copy_options::overwrite_existing, ec);
+      if (ec) throw InputError(u.output + ": cannot copy the run file " + args.restart + " to it: " + ec.message());
+    }
+  }
+}
+
+// The poison mode's summary (a test hook), every rank's: stdio, as the
+// other ranks' streams are silenced by run().
 void say_poison(const Simulation& sim) {
   if (const std::string poison = sim.poison_summary(); !poison.empty()) std::fprintf(stderr, "floesim: %s\n", poison.c_str());
+}
+
+// Runs the simulation to its end with the progress line, SIGINT and SIGTERM
+// stopping it after the step in progress; however it ends, the progress line
+// is closed, the signals' handlers put back and the poison mode's summary said.
+RunSummary run_with_progress(const Args& args, SetUp& u, const parallel::Communicator& comm) {
+  Simulation& sim = *u.simulation;
+  ProgressLine progress(!args.quiet && comm.writer(), isatty(STDERR_FILENO) != 0, args.log_every);
+  g_interrupted = false;
+  auto previous = std::signal(SIGINT, on_signal);
+  auto previous_term = std::signal(SIGTERM, on_signal);
+  const auto end = [&] {
+    progress.done();
+    std::signal(SIGINT, previous);
+    std::signal(SIGTERM, previous_term);
+    say_poison(sim);
+  };
+  const RunOptions options{u.output, args.until, [&](const RunProgress& p) { progress(p); },
+                           [] { return g_interrupted.load(); }, args.restart.empty() ? nullptr : &u.checkpoint};
+  RunSummary s;
+  try {
+    s = run_simulation(sim, options);
+  } catch (...) {
+    end();
+    throw;
+  }
+  end();
+  return s;
 }
 
 int run(const Args& args, const parallel::Session& session) {
@@ -194,345 +353,30 @@ int run(const Args& args, const parallel::Session& session) {
     std::cout.rdbuf(nullptr);
     std::cerr.rdbuf(nullptr);
   }
-  const bool restart = !args.restart.empty();
-  std::string config_path, output;
-  Config config;
-  Checkpoint checkpoint;
-  std::unique_ptr<Simulation> simulation;
-  double setup_seconds = 0.0;  // s
-  // Every rank reads and checks the input and builds the scenario before
-  // any work is shared: bad input on any rank stops every rank with its
-  // message (the same on each, as they read the same files).
+  SetUp u;
+  TestHooks hooks;
   comm.together([&] {
-    config_path = args.config.empty() && !restart ? default_config() : args.config;
-    if (!config_path.empty() && !path_exists(config_path)) throw InputError(config_path + ": configuration file not found");
-    output = args.output;
-    if (output.empty()) output = restart ? args.restart : fs::path(config_path).stem().string() + ".h5";
-    if (!config_path.empty() && path_exists(output) && fs::equivalent(output, config_path))
-      throw InputError(output + ": the output would overwrite the configuration");
-
-    {
-      // An output that cannot be written is found before the scenario is built
-      // (which may take long); the writer reports what this cannot foresee.
-      const fs::path dir = fs::absolute(output).parent_path();
-      if (access(dir.c_str(), W_OK) != 0) {
-        const int err = errno;
-        throw RunError(output + ": cannot write the run file in " + dir.string() + " (" + std::strerror(err) + ")");
-      }
-    }
-    if (restart) {
-      if (!path_exists(args.restart)) throw InputError(args.restart + ": run file not found (--restart)");
-      const RunInfo info = read_run_info(args.restart);
-      checkpoint = read_checkpoint(args.restart);
-      config = restart_config(args.restart, config_path, info);
-      const double t_end = args.until >= 0.0 ? args.until : config.run.t_end;
-      if (t_end < checkpoint.time) {
-        std::ostringstream m;
-        m << args.restart << ": the checkpoint is at t = " << checkpoint.time << " s, after the end asked for ("
-          << (args.until >= 0.0 ? "--until " : "[run] t_end = ") << t_end << " s): expected an end >= "
-          << checkpoint.time << " s";
-        throw InputError(m.str());
-      }
-    } else {
-      config = load_config(config_path);
-    }
-    if (args.threads >= 0) config.run.threads = args.threads;
-    // --until replaces t_end: the bounds on the records and steps of [run] t_end hold for it too.
-    if (args.until >= 0.0)
-      for (auto [problem, key] : {std::pair{record_count_problem(args.until, config.run.output_interval), "output_interval"},
-                                  std::pair{step_count_problem(args.until, config.run.dt_max), "dt_max"}})
-        if (!problem.empty()) {
-          std::ostringstream m;
-          m << "--until " << args.until << ": " << problem << " ("
-            << (config_path.empty() ? args.restart : config_path) << ": [run] " << key << ")";
-          throw InputError(m.str());
-        }
-    share_cores(config, session);
-    Scenario scenario = build_scenario(config);
-    const auto setup_begin = std::chrono::steady_clock::now();
-    simulation = std::make_unique<Simulation>(std::move(scenario), comm);
-    if (restart) simulation->restore(checkpoint);
-    // The summary's setup_time: the run's set-up on this rank (shapes, the
-    // start's detection, the sea), not the reading of the input.
-    setup_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - setup_begin).count();
-    if (restart) {
-      release_restored(checkpoint);  // the simulation holds that state now; the run keeps the marks
-      // A new output starts as a copy of the run; the records after the checkpoint are dropped from it.
-      if (comm.writer() && !(path_exists(output) && fs::equivalent(output, args.restart))) {
-        std::error_code ec;
-        fs::copy_file(args.restart, output, fs::copy_options::overwrite_existing, ec);
-        if (ec) throw InputError(output + ": cannot copy the run file " + args.restart + " to it: " + ec.message());
-      }
-    }
+    hooks = read_test_hooks();
+    set_up(args, session, u);
   });
-  Simulation& sim = *simulation;
-  // Test hook, not a user key (tests/parallel/check_writer_ranks.py): "1":
-  // each rank's copy of the floes it does not hold is poisoned before the
-  // writer's gathers, so the run file is right only if they read every
-  // floe from its holder; "unread": the writer writes its poisoned copy
-  // (Simulation::set_writer_test). Read here, by the command, so that the
-  // library reads no environment.
-  // "step", "step-lure", "step-mutant" (optionally "-stale", then optionally
-  // "@drift", "@detect": the grammar is parse_poison_options'):
-  // the poison mode of the run (Simulation::set_poison_test,
-  // tests/parallel/check_poison_run.py), the writer's gathers as in a plain run.
-  if (const char* test = std::getenv("FLOESIM_TEST_POISON_UNHELD")) {
-    PoisonOptions poison;
-    if (parse_poison_options(test, poison))
-      sim.set_poison_test(poison);
-    else
-      sim.set_writer_test(std::string(test) == "unread" ? Simulation::WriterTest::poison_unread
-                                                        : Simulation::WriterTest::poison);
-  }
-  // "warm": a step-start share that used the warm store falls back whole
-  // (Simulation::set_collide_test, tests/parallel/check_ranks.py --fallback,
-  // check_poison_run.py (d)).
-  if (const char* test = std::getenv("FLOESIM_TEST_COLLIDE_FALLBACK")) {
-    if (std::string(test) != "warm")
-      throw InputError("FLOESIM_TEST_COLLIDE_FALLBACK (a test hook): expected \"warm\", got \"" +
-                       std::string(test) + "\"");
-    sim.set_collide_test(true);
-  }
+  Simulation& sim = *u.simulation;
+  set_test_hooks(hooks, sim);
   for (const std::string& note : sim.notes()) std::cerr << "floesim: note: " << note << "\n";
 
-  ProgressLine progress(!args.quiet && comm.writer(), isatty(STDERR_FILENO) != 0, args.log_every);
-  g_interrupted = false;
-  auto previous = std::signal(SIGINT, on_signal);
-  auto previous_term = std::signal(SIGTERM, on_signal);
-  auto restore_signals = [&] {
-    std::signal(SIGINT, previous);
-    std::signal(SIGTERM, previous_term);
-  };
-  RunOptions options{output, args.until, [&](const RunProgress& p) { progress(p); },
-                     [] { return g_interrupted.load(); }, restart ? &checkpoint : nullptr};
-  RunSummary s;
-  try {
-    s = run_simulation(sim, options);
-  } catch (const RunError&) {
-    progress.done();
-    restore_signals();
-    say_poison(sim);
-    throw;
-  } catch (...) {
-    progress.done();
-    restore_signals();
-    say_poison(sim);
-    throw;
-  }
-  progress.done();
-  restore_signals();
-  say_poison(sim);
+  const RunSummary s = run_with_progress(args, u, comm);
   const int status = s.status == "complete" ? 0 : kInterruptedExit;
-  // The run's collectives, read before the memory's gather below (the
-  // summary's parallel.* figures are the run's alone).
+  // The run's collectives, read before the memory's gather (the summary's
+  // parallel.* figures are the run's alone); the gather, on every rank.
   const parallel::Communicator::Traffic traffic = comm.traffic();
-  // Each rank's per-floe structures (Simulation::floe_memory: every rank
-  // names the same structures in the same order), gathered to every rank:
-  // per rank its held floes, then per structure its bytes and its held
-  // floes' entries' bytes.
-  const Simulation::FloeMemory memory = sim.floe_memory();
-  std::vector<std::uint64_t> memory_mine{memory.held};
-  for (const auto& part : memory.parts) {
-    memory_mine.push_back(part.second.whole);
-    memory_mine.push_back(part.second.held);
-  }
-  const std::vector<std::uint64_t> memory_all =
-      comm.serial() ? memory_mine : comm.allgather<std::uint64_t>(memory_mine);
+  FloeMemoryAll memory = gather_floe_memory(sim, comm);
   if (!comm.writer()) return status;  // rank 0 reports the run
 
-  // steps counts the run's steps from its start; the rate, this process's
-  // (a restart's steps before its checkpoint took none of its wall time).
-  const std::size_t before = restart ? static_cast<std::size_t>(checkpoint.steps) : 0;
-  const std::size_t run_steps = s.steps >= before ? s.steps - before : 0;
-  std::ostream& o = std::cout;
-  o << "status: " << s.status << "\nconfig: " << (config_path.empty() ? args.restart + " (its config)" : config_path);
-  if (restart) o << "\nrestarted_from: " << args.restart << " at t = " << checkpoint.time << " s";
-  o << "\ncheckpoint: " << (s.checkpoint_time >= 0.0 ? std::to_string(s.checkpoint_time) + " s" : "none") << "\noutput: " << fs::absolute(s.output).string()
-    << "\nparaview: " << fs::absolute(s.xdmf).string() << "\nfloes: " << sim.floes().size() << "\nsteps: " << s.steps
-    << "\nsteps_redone: " << sim.rejected_steps()  // tries redone with half the dt after an overlap (this process)
-    << "\nrecords: " << s.records << "\nsimulated: " << s.t_end << " s\nwall_time: " << std::setprecision(4)
-    << s.wall_seconds << " s\nsetup_time: " << setup_seconds << " s\nsteps_per_second: " << (s.wall_seconds > 0 ? static_cast<double>(run_steps) / s.wall_seconds : 0.0)
-    << "\n";
-  o << std::setprecision(8);
-  for (std::size_t k = 0; k < s.energy_last.names.size(); ++k)
-    o << "energy." << s.energy_last.names[k] << ": " << s.energy_first.values[k] << " -> "
-      << s.energy_last.values[k] << " J\n";
-  const contact::CollisionStats& c = s.collisions;
-  o << "collisions.lcps: " << c.lcps << "\ncollisions.contacts: " << c.contacts << "\ncollisions.pivots: " << c.pivots
-    << "\ncollisions.largest_lcp: " << c.largest << "\ncollisions.failures: " << c.failures
-    << "\ncollisions.fallbacks: " << c.fallbacks << "\ncollisions.gauss_seidel: " << c.gauss_seidel
-    << "\ncollisions.tolerated: " << c.tolerated << "\n";
-  {
-    const LcpCounters counters = sim.lcp_counters();  // the sub-stepper's counts, as in /diagnostics/substeps
-    for (int k = 0; k < kSubstepColumns; ++k)
-      o << "substeps." << kSubstepColumnNames[k] << ": " << counters.substeps[static_cast<std::size_t>(k)] << "\n";
-  }
-  if (const PercussionStats* f = sim.percussion_stats())
-    o << "fracture.checks: " << f->counts.checks << "\nfracture.screened: " << f->counts.screened
-      << "\nfracture.bounded: " << f->counts.bounded << "\nfracture.cut_short: " << f->counts.cut_short
-      << "\nfracture.loop_steps: " << f->counts.loop_steps
-      << "\nfracture.sustained: " << f->counts.sustained << "\nfracture.initiations: " << f->initiations
-      << "\nfracture.splits: " << f->splits << "\nfracture.failed_splits: " << f->failed_splits
-      << "\nfracture.refused_small: " << f->refused_small << "\nfracture.refused_overlap: " << f->refused_overlap
-      << "\nfracture.splits_redone: " << f->splits_redone
-      << "\nfracture.seconds: " << f->seconds << "\nfracture.models: " << f->models
-      << "\nfracture.model_seconds: " << f->model_seconds
-      << "\nfracture.split_seconds: " << f->split_seconds << "\nfracture.phase_seconds: " << f->phase_seconds
-      << "\nfracture.mesh_seconds: " << f->mesh_seconds << "\nfracture.bound_seconds: " << f->bound_seconds
-      << "\nfracture.factor_seconds: " << f->factor_seconds << "\nfracture.lattice_meshes: " << f->lattice_meshes
-      << "\n";
-  if (const FloeSeaContact* fs = sim.floe_sea())
-    o << "footprints.placements: " << fs->footprint_placements() << "\nfootprints.rebuilds: " << fs->footprint_rebuilds()
-      << "\n";
-  if (const FloeSeaContact* fs = sim.floe_sea(); fs && fs->implicit()) {
-    const FloeSeaContact::ImplicitStats& st = fs->implicit_stats();
-    const double steps = std::max<double>(1.0, static_cast<double>(st.steps));
-    o << "implicit.newton_per_step: " << static_cast<double>(st.newton) / steps
-      << "\nimplicit.cg_per_step: " << static_cast<double>(st.cg) / steps
-      << "\nimplicit.sea_responses_per_step: " << static_cast<double>(st.g_products) / steps << "\n";
-  }
-  {
-    // The per-floe structures' bytes (capacity) on each rank, in rank order,
-    // and the bytes their held floes' entries would take (core/floe_bytes.hpp;
-    // docs/parallel.md, "The arrays held by band: measured (mem27)").
-    const std::size_t stride = memory_mine.size(), ranks = memory_all.size() / stride;
-    o << "memory.floes.held:";
-    for (std::size_t r = 0; r < ranks; ++r) o << " " << memory_all[r * stride];
-    o << " of " << memory.floes << "\n";
-    for (std::size_t k = 0; k < memory.parts.size(); ++k) {
-      o << "memory.floes." << memory.parts[k].first << ":";
-      for (std::size_t r = 0; r < ranks; ++r) o << " " << memory_all[r * stride + 1 + 2 * k];
-      o << " bytes; held";
-      for (std::size_t r = 0; r < ranks; ++r) o << " " << memory_all[r * stride + 2 + 2 * k];
-      o << "\n";
-    }
-  }
-  if (!comm.serial()) {
-    // Rank 0's collectives: bytes it received and the time in them, waits for the other ranks included.
-    const parallel::Communicator::Traffic& t = traffic;
-    o << "parallel.ranks: " << comm.size() << "\nparallel.collectives: " << t.calls << "\nparallel.bytes_received: " << t.bytes
-      << "\nparallel.collective_seconds: " << t.seconds << "\n";
-    // The same by phase (Profile): the calls and bytes of each phase that
-    // made any, then the rest (the run loop's agreements, the set-up, the summary).
-    long long calls = t.calls, bytes = t.bytes;
-    for (std::size_t k = 0; k < kPhaseNames.size(); ++k) {
-      calls -= s.profile.calls[k];
-      bytes -= s.profile.bytes[k];
-      if (s.profile.calls[k] > 0)
-        o << "parallel.phase." << kPhaseNames[k] << ": " << s.profile.calls[k] << " calls, " << s.profile.bytes[k]
-          << " bytes\n";
-    }
-    o << "parallel.phase.other: " << calls << " calls, " << bytes << " bytes\n";
-    // The floes' strips (stage six): the cuts in y, the floes in each strip
-    // now, the cuts' moves by measured cost and each rank's by-place seconds
-    // (CPU) over the window before the last move and over all windows.
-    const parallel::FloeOwners& owners = sim.floe_owners();
-    std::vector<std::size_t> in_strip(static_cast<std::size_t>(comm.size()), 0);
-    for (const int r : owners.owner()) ++in_strip[static_cast<std::size_t>(r)];
-    o << "parallel.strip_cuts:";
-    for (const double cut : owners.cuts()) o << " " << cut;
-    o << "\nparallel.strip_floes:";
-    for (const std::size_t k : in_strip) o << " " << k;
-    o << "\nparallel.strip_moves: " << owners.moves() << "\nparallel.strip_seconds:";
-    for (const double x : owners.window_seconds()) o << " " << x;
-    o << "\nparallel.strip_seconds_total:";
-    for (const double x : owners.charged_seconds()) o << " " << x;
-    // The advances by cluster owner (stage seven): tried, redone whole after
-    // a conflict, done whole at once after fallbacks (the back-off), and the
-    // clusters each rank ran and the pair rooms it computed in the steps not
-    // redone, against the pairs of those steps (a replicated set-up computes
-    // every one).
-    const parallel::AdvanceShareCounts& share = sim.advance_share();
-    o << "\nparallel.advance_steps: " << share.steps << "\nparallel.advance_fallbacks: " << share.fallbacks
-      << "\nparallel.advance_whole: " << share.whole << "\nparallel.advance_clusters:";
-    for (const long k : share.clusters) o << " " << k;
-    o << "\nparallel.advance_rooms:";
-    for (const long k : share.rooms) o << " " << k;
-    o << "\nparallel.advance_pairs: " << share.pairs;
-    // From the rank's part ([run] advance_on_part): the tries redone for a
-    // join the share did not hold, the tries with a jam-sized cluster's pads
-    // gathered, the join candidates gathered, the tries where a floe
-    // would outrun its reach (the pair list rebuilt on every rank), and the
-    // bytes of the shapes this rank sent with the routed floes.
-    o << "\nparallel.advance_missing: " << share.missing << "\nparallel.advance_pads: " << share.pads
-      << "\nparallel.advance_candidates: " << share.candidates << "\nparallel.advance_rebuilds: " << share.rebuilds
-      << "\nparallel.advance_shape_bytes: " << share.shape_bytes;
-    // From the rank's part: the tries that combined once the clusters of
-    // two runners that met were joined on one rank, and the tries made
-    // again for it.
-    o << "\nparallel.advance_joined: " << share.joined << "\nparallel.advance_rounds: " << share.rounds
-      << "\nparallel.advance_kept: " << share.kept;
-    // The tries that fell back by what made them, one line a kind (a try
-    // counts under each kind its parts said; none: no line).
-    for (const auto& [kind, n] : share.conflicts) o << "\nparallel.advance_conflicts." << kind << ": " << n;
-    // The collisions at the step's start by owner, the same way: tried,
-    // redone whole, done whole by the back-off, each rank's step groups.
-    const parallel::AdvanceShareCounts& collide = sim.collide_share();
-    o << "\nparallel.collide_steps: " << collide.steps << "\nparallel.collide_fallbacks: " << collide.fallbacks
-      << "\nparallel.collide_whole: " << collide.whole << "\nparallel.collide_groups:";
-    for (const long k : collide.clusters) o << " " << k;
-    for (const auto& [kind, n] : collide.conflicts) o << "\nparallel.collide_conflicts." << kind << ": " << n;
-    // Every floe's state gathered from the owners (Simulation::whole_state),
-    // for any reader, and rank 0's bytes received in those gathers.
-    const Simulation::WholeStateCounts& whole = sim.whole_state_counts();
-    o << "\nparallel.whole_state_gathers: " << whole.gathers << " (" << whole.bytes << " bytes)";
-    // The fracture analyses by owner: the steps that exchanged them, each
-    // rank's checks (they sum to fracture.checks) and its wall time in them.
-    if (sim.percussion_stats()) {
-      const PercussionRanks& fr = sim.percussion_ranks();
-      o << "\nparallel.fracture_steps: " << fr.steps << "\nparallel.fracture_checks:";
-      for (const long k : fr.checks) o << " " << k;
-      o << "\nparallel.fracture_seconds:";
-      for (const double x : fr.seconds) o << " " << x;
-      // The CPU seconds of those analyses charged to the strips' moves (part
-      // of strip_seconds_total), over every window.
-      o << "\nparallel.fracture_charged:";
-      for (const double x : owners.fracture_seconds()) o << " " << x;
-      // Of those gathers, the ones before a split (a crack through a floe).
-      o << "\nparallel.fracture_whole_state: " << fr.whole_gathers << " steps, " << fr.whole_bytes << " bytes";
-    }
-    o << "\n";
-    // Stage eight: the slabs the coupling's floe owners followed at the
-    // footprints' last rebuild.
-    if (const FloeSeaContact* fs = sim.floe_sea(); fs && !fs->owner_slabs().empty()) {
-      o << "parallel.coupling_slab_rows:";
-      for (const int r : fs->owner_slabs()) o << " " << r;
-      o << "\n";
-    }
-    // Rank 0's cells outside its slab's interior (every cell of its pieces
-    // on a sea not in slabs), summed over the evaluations: sent as pieces
-    // (their pieces), summed alone here (owned here, or sent as totals).
-    if (const FloeSeaContact* fs = sim.floe_sea(); fs) {
-      const FloeSeaContact::RoutedCells& cells = fs->routed_cells();
-      if (cells.shared + cells.alone_here + cells.alone_sent > 0)
-        o << "parallel.coupling_cells: " << cells.shared << " shared (" << cells.pieces << " pieces), "
-          << cells.alone_here << " alone owned, " << cells.alone_sent << " alone sent\n";
-    }
-    // Stage seven: with a sea in slabs the strips are its slabs, their first
-    // rows (then the row count) now.
-    if (owners.has_slabs()) {
-      o << "parallel.slab_rows:";
-      for (const int row : owners.slabs().first_row) o << " " << row;
-      // Each rank's CPU seconds in the coupling's per-floe work charged to
-      // the slabs' moves (part of strip_seconds_total), over every window.
-      o << "\nparallel.coupling_seconds:";
-      for (const double x : owners.coupling_seconds()) o << " " << x;
-      o << "\n";
-    }
-  }
-  o << "notes: " << s.notes.size() << "\n";
-  for (const auto& n : s.notes) o << "  " << n << "\n";
-  o << "warnings: " << s.warnings.size() << "\n";
-  for (const auto& w : s.warnings) o << "  " << w << "\n";
-  if (args.profile) {
-    double total = 0;
-    for (double x : s.profile.seconds) total += x;
-    for (std::size_t k = 0; k < s.profile.seconds.size(); ++k)
-      o << "profile." << kPhaseNames[k] << ": " << std::setprecision(4) << s.profile.seconds[k] << " s ("
-        << std::setprecision(3) << (total > 0 ? 100 * s.profile.seconds[k] / total : 0.0) << "%)\n";
-  }
+  const bool restart = !args.restart.empty();
+  print_summary(std::cout, {s, sim, comm, traffic, std::move(memory),
+                            u.config_path.empty() ? args.restart + " (its config)" : u.config_path, args.restart,
+                            restart ? &u.checkpoint : nullptr, u.setup_seconds, args.profile});
   if (s.status != "complete")
-    std::cerr << "floesim: interrupted; continue with: floesim run --restart " << output << "\n";
+    std::cerr << "floesim: interrupted; continue with: floesim run --restart " << u.output << "\n";
   return status;
 }
 

@@ -5,7 +5,8 @@ FLOESIM_TEST_POISON_UNHELD=step (NaN), step-lure (finite, wrong values) or
 step-mutant, each rank poisons its copies of the floes it does not hold (its
 own floes, its halo band, its coupling's own floes) right after each part of
 the halo exchange (after the drift, at the detection) and restores nothing,
-and reports the first NaN it finds in a held floe after each phase.
+and reports the first NaN it finds in a held floe, and in its sea, after
+each phase.
 
 usage: check_poison_run.py FLOESIM MPIEXEC WORKDIR
        check_poison_run.py --no-mpi    (MPI not built: exits 77, ctest's skip code)
@@ -21,8 +22,9 @@ On 2 ranks (`mpirun --oversubscribe`):
     every floe by design; the drift sends every state there) with the lure
     does not give the serial run; a small ocean with the implicit floe-sea
     step (whole on every rank) with NaN does not either, and the phase it
-    names (a report, or the phase after the last clean check where the run
-    failed) is the detection or one after it.
+    names (a report of a held floe or of the rank's sea, or the phase after
+    the last clean check where the run failed) is the detection or one
+    after it.
 (c) the mutation: each rank poisons one floe it holds too; the run fails,
     and each rank reports it after the drift, the first phase checked.
 (d) the whole state on demand (docs/parallel.md, "The whole state on demand
@@ -31,8 +33,7 @@ On 2 ranks (`mpirun --oversubscribe`):
     to 320 s: one pair-list rebuild on a part) on 2 ranks with NaN after the
     drift, and the wall-jam example (examples/pack_against_wall.toml to
     1500 s: the collisions' fallbacks and whole steps, made by the test hook
-    FLOESIM_TEST_COLLIDE_FALLBACK=warm since collide27 cured them, and a
-    rebuild) on 3 ranks with the lure (on 2 ranks every rank holds every
+    FLOESIM_TEST_COLLIDE_FALLBACK=warm, and a rebuild) on 3 ranks with the lure (on 2 ranks every rank holds every
     floe there), are bit for bit the serial run, each having rebuilt or
     fallen back, with no phase reported; the mutation "-stale" (whole_state
     gathers nothing) fails or differs on both (NaN on the pack; the lure on
@@ -42,13 +43,13 @@ On 2 ranks (`mpirun --oversubscribe`):
 (f) a split's neighbours among the held floes: check_writer_ranks.py's
     fracture pack (to 500 s, floes split) on 3 ranks with the lure is bit
     for bit the serial run.
-Only what is stable is pinned: other readers are being removed.
+Only what is stable is pinned.
 """
 import os
 import re
 import sys
 
-from ranks_harness import FRACTURE, half_pack, moving_pack_check, need, ocean_toml, summary
+from ranks_harness import FRACTURE, half_pack, moving_pack_check, need, ocean_toml, phase_bytes, summary
 
 args, harness, base = moving_pack_check(
     "floesim was built without MPI (FLOESIM_MPI=OFF): the poison mode is not checked", 400, 250.0, [2])
@@ -77,9 +78,10 @@ def summaries(p):
 
 
 def reports(p):
-    """Each report: (rank, phase, floe, field)."""
-    return [(int(m.group(1)), m.group(2), int(m.group(3)), m.group(4))
-            for m in re.finditer(r"poison: rank (\d+): after (.+?): held floe (\d+)'s (.+) is NaN", p.stderr)]
+    """Each report, of a held floe or of the rank's sea (UnheldPoison::check,
+    check_sea): (rank, phase, what: "held floe N's FIELD" or "the sea's modal state")."""
+    return [(int(m.group(1)), m.group(2), m.group(3)) for m in
+            re.finditer(r"poison: rank (\d+): after (.+?): (held floe \d+'s .+|the sea's modal state) is NaN", p.stderr)]
 
 
 need(run([args.floesim, "run", base, "-o", "serial.h5", "-q"]), "the pack, serial")
@@ -123,7 +125,8 @@ print(f"the pack from the whole detection on 2 ranks, step-lure: exit {p.returnc
       f"{'found (the run failed or differs)' if found else 'NOT FOUND'}")
 if not found:
     failures.append(f"the lure did not reach the advance from the whole detection (it reads every floe)\n{p.stderr}")
-# The implicit floe-sea step (whole on every rank), with NaN.
+# The implicit floe-sea step (whole on every rank), with NaN: the NaN it
+# reads shows in a held floe or in a rank's sea, reported either way.
 half_pack(run, args.floesim)
 implicit = os.path.join(W, "implicit.toml")
 with open(implicit, "w") as f:
@@ -132,11 +135,13 @@ with open(implicit, "w") as f:
 need(run([args.floesim, "run", implicit, "-o", "implicit_serial.h5", "-q"]), "the implicit ocean, serial")
 p = mpirun(2, "step", implicit, "implicit2.h5")
 s, r = summaries(p), reports(p)
-named = {phase for _, phase, _, _ in r} | ({"(failed after) " + last for _, _, _, last in s.values()}
+named = {phase for _, phase, _ in r} | ({"(failed after) " + last for _, _, _, last in s.values()}
                                           if p.returncode != 0 else set())
 after_detection = {"sea", "second half kick", "record", "(failed after) detect", "(failed after) sea",
                    "(failed after) second half kick"}
-print(f"the implicit ocean on 2 ranks, step: exit {p.returncode}, named {sorted(named)}")
+sea_reports = sum(what == "the sea's modal state" for _, _, what in r)
+print(f"the implicit ocean on 2 ranks, step: exit {p.returncode}, named {sorted(named)} "
+      f"({len(r) - sea_reports} floe reports, {sea_reports} sea reports)")
 if p.returncode == 0 and equal("implicit2.h5", "implicit_serial.h5"):
     failures.append(f"the NaN did not reach the implicit step (whole on every rank)\n{p.stderr}")
 elif not named & after_detection:
@@ -145,7 +150,7 @@ elif not named & after_detection:
 # (c) The mutation: a held floe poisoned too is reported at the first check.
 p = mpirun(2, "step-mutant", base, "mutant2.h5")
 r = reports(p)
-first = {rank: phase for rank, phase, _, _ in reversed(r)}
+first = {rank: phase for rank, phase, _ in reversed(r)}
 print(f"the mutation on 2 ranks: exit {p.returncode}, first reports {first}")
 if p.returncode == 0 or first != {0: "drift", 1: "drift"}:
     failures.append(f"the mutation (a held floe poisoned) must fail the run and be reported after the drift on "
@@ -167,11 +172,10 @@ need(run([args.floesim, "run", wall, "-o", "wall_serial.h5", "-q", "--until", "1
 # the counts that say the whole steps happened, the floes whose drift phase's bytes are checked or None)
 cases = [("the 10 000-floe pack (its pair list rebuilt on a part)", rebuild, 2, "step@drift", "step-stale@drift", [],
           {}, "rebuild_serial.h5", ["advance_rebuilds"], 10000),
-         # Since onerank26 the wall jam's advances no longer fall back (its
-         # conflicts are joined on one rank: advance_joined, tries that read
-         # only the held and routed floes), and since collide27 neither do
-         # its step-start collisions: the test hook makes those fall back
-         # where their shares use the warm store (4 tries), as they did.
+         # The wall jam's advances join their conflicts on one rank
+         # (advance_joined: tries that read only the held and routed floes)
+         # and its step-start collisions do not fall back on their own: the
+         # test hook makes those whose shares use the warm store fall back.
          ("the wall jam (fallbacks by the hook, whole steps, clusters joined on one rank)", wall, 3, "step-lure",
           "step-lure-stale", ["--until", "1500"], {"FLOESIM_TEST_COLLIDE_FALLBACK": "warm"}, "wall_serial.h5",
           ["advance_joined", "collide_fallbacks", "collide_whole"], None)]
@@ -187,7 +191,7 @@ for what, config, n, poison, mutant, extra, hooks, serial, counted, floes in cas
         # 10 000), not every floe's (96 B x floes x steps with the drift's
         # complete_owned). The poison mode adds no call (it restores nothing).
         steps = int(summary(p)["steps"])
-        drift = int(summary(p)["parallel.phase.drift"].split()[2])
+        drift = phase_bytes(p, "drift")
         whole = 96 * floes * steps
         print(f"{name}: rank 0's drift phase received {drift} B in {steps} steps "
               f"({drift / whole:.3f} of every floe's state each step, {whole} B)")

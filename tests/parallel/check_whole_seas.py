@@ -82,8 +82,13 @@ skipped after the drift's whole exchange, 284 floes on 2 ranks).
 import math
 import os
 import re
+import sys
 
 from ranks_harness import finish, need, phase_bytes, ranks_check, summary
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))), "scripts",
+                                "scenarios"))
+from whole_seas import SEAS, pack_command  # per case: its [sea] and its pack's arguments
 
 args, harness = ranks_check(
     "floesim was built without MPI (FLOESIM_MPI=OFF): the runs on the seas not in slabs are not checked",
@@ -112,69 +117,6 @@ GRIDS = {"bem": (24, 12, 0.5, 0.5), "tank": (96, 24, 0.25, 0.25), "flume": (96, 
 LAWS = {"wide": 'law = "blend"\nblend = 0.5\n'}
 FLUMES = ("flume", "wide")  # dims = 1: the coupling's owners are shares of the columns
 SOME_HELD = ("bem", "tank", "wide")  # the bands do not hold every floe on 2 ranks
-SEAS = {
-    "bem": ("""
-[sea]
-model = "bem"
-dims = 2
-size = [12.0, 6.0]
-cells = [24, 12]
-depth = 2.0
-rho = 1000.0
-
-[sea.waves]
-kind = "standing"
-amplitude = 0.05
-wavelength = 24.0
-""", ["--floes", "150", "--box", "12", "6"]),
-    "tank": ("""
-[sea]
-model = "spectral"
-dims = 2
-size = [24.0, 6.0]
-cells = [96, 24]
-depth = 1.0
-rho = 1000.0
-
-[sea.waves]
-kind = "regular"
-amplitude = 0.05
-wavelength = 6.0
-
-[sea.tank]
-enabled = true
-generation_length = 6.0
-absorption_length = 6.0
-""", ["--floes", "100", "--box", "24", "6"]),
-    "flume": ("""
-[sea]
-model = "spectral"
-dims = 1
-size = [24.0, 2.0]
-cells = [96, 1]
-depth = 1.0
-rho = 1000.0
-
-[sea.waves]
-kind = "regular"
-amplitude = 0.05
-wavelength = 6.0
-""", ["--floes", "40", "--box", "24", "2"]),
-    "wide": ("""
-[sea]
-model = "spectral"
-dims = 1
-size = [24.0, 8.0]
-cells = [96, 1]
-depth = 1.0
-rho = 1000.0
-
-[sea.waves]
-kind = "regular"
-amplitude = 0.05
-wavelength = 6.0
-""", ["--floes", "160", "--box", "24", "8"]),
-}
 
 
 def coupling(name, pack):
@@ -216,8 +158,7 @@ def penalty_bytes(p):
 
 penalty = {}  # (case, ranks) -> rank 0's penalty bytes
 for name, (sea, pack) in SEAS.items():
-    need(run([args.floesim, "pack", *pack, "--concentration", "0.7", "--seed", "3", "--thickness", "0.2",
-              "-o", f"{name}_pack.h5"]), f"{name}: floesim pack")
+    need(run(pack_command(args.floesim, name, f"{name}_pack.h5")), f"{name}: floesim pack")
     config = os.path.join(W, f"{name}.toml")
     with open(config, "w") as f:
         f.write(RUN + sea + coupling(name, f"{name}_pack.h5"))

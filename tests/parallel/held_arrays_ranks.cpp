@@ -19,7 +19,6 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
-#include <random>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -30,35 +29,29 @@
 #include "parallel/comm.hpp"
 #include "parallel/place.hpp"
 #include "tests/parallel/ranks_main.hpp"
+#include "tests/parallel/rows_pack.hpp"
 
 using namespace floesim;
 
 namespace {
 
+// Squares, pentagons and L shapes in turn, 40 m across.
 std::string moving_pack() {
-  std::mt19937_64 rng(7);
-  std::uniform_real_distribution<double> jitter(0.0, 8.0), speed(-0.4, 0.4);
-  std::ostringstream t;
-  t << "[run]\ndt_max = 10\nt_end = 900\nthreads = 1\n"
-    << "[contact]\nrestitution = 0.4\nfriction = 0.5\n"
-    << "[forcing]\nwind = [8.0, -6.0]\ncurrent = [0.02, 0.05]\nlatitude = 75.0\n";
-  int k = 0;
-  for (int row = 0; row < 20; ++row)
-    for (int col = 0; col < 6; ++col, ++k) {
-      const double x = 60.0 * col + jitter(rng), y = 60.0 * row + jitter(rng);
-      t << "[[floes.floe]]\nvertices = [";
-      if (k % 3 == 0)
-        t << "[" << x << ", " << y << "], [" << x + 40 << ", " << y << "], [" << x + 40 << ", " << y + 40 << "], ["
-          << x << ", " << y + 40 << "]";
-      else if (k % 3 == 1)
-        t << "[" << x + 4 << ", " << y << "], [" << x + 34 << ", " << y << "], [" << x + 40 << ", " << y + 24
-          << "], [" << x + 19 << ", " << y + 40 << "], [" << x << ", " << y + 24 << "]";
-      else
-        t << "[" << x << ", " << y << "], [" << x + 40 << ", " << y << "], [" << x + 40 << ", " << y + 14 << "], ["
-          << x + 14 << ", " << y + 14 << "], [" << x + 14 << ", " << y + 40 << "], [" << x << ", " << y + 40 << "]";
-      t << "]\nvelocity = [" << speed(rng) << ", " << speed(rng) << "]\n";
-    }
-  return t.str();
+  return test::rows_pack(
+      {.seed = 7, .rows = 20, .speed = 0.4, .t_end = 900.0, .wind = "[8.0, -6.0]", .current = "[0.02, 0.05]"},
+      [](int k, double x, double y) {
+        std::ostringstream v;
+        if (k % 3 == 0)
+          v << "[" << x << ", " << y << "], [" << x + 40 << ", " << y << "], [" << x + 40 << ", " << y + 40 << "], ["
+            << x << ", " << y + 40 << "]";
+        else if (k % 3 == 1)
+          v << "[" << x + 4 << ", " << y << "], [" << x + 34 << ", " << y << "], [" << x + 40 << ", " << y + 24
+            << "], [" << x + 19 << ", " << y + 40 << "], [" << x << ", " << y + 24 << "]";
+        else
+          v << "[" << x << ", " << y << "], [" << x + 40 << ", " << y << "], [" << x + 40 << ", " << y + 14 << "], ["
+            << x + 14 << ", " << y + 14 << "], [" << x + 14 << ", " << y + 40 << "], [" << x << ", " << y + 40 << "]";
+        return test::RowFloe{v.str(), ""};
+      });
 }
 
 void check_quadrature(const parallel::Communicator& comm, std::vector<std::string>& failures) {

@@ -23,7 +23,6 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
-#include <random>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -35,29 +34,23 @@
 #include "parallel/comm.hpp"
 #include "parallel/place.hpp"
 #include "tests/parallel/ranks_main.hpp"
+#include "tests/parallel/rows_pack.hpp"
 
 using namespace floesim;
 
 namespace {
 
+// 60 square floes 40 m across, every second one on a soft mooring.
 std::string moored_pack() {
-  std::mt19937_64 rng(3);
-  std::uniform_real_distribution<double> jitter(0.0, 8.0), speed(-0.3, 0.3);
-  std::ostringstream t;
-  t << "[run]\ndt_max = 10\nt_end = 600\nthreads = 1\n"
-    << "[contact]\nrestitution = 0.4\nfriction = 0.5\n"
-    << "[forcing]\nwind = [12.0, 4.0]\ncurrent = [0.05, 0.1]\nlatitude = 75.0\n";
-  int k = 0;
-  for (int row = 0; row < 10; ++row)
-    for (int col = 0; col < 6; ++col, ++k) {
-      const double x = 60.0 * col + jitter(rng), y = 60.0 * row + jitter(rng), w = 40.0;
-      t << "[[floes.floe]]\nvertices = [[" << x << ", " << y << "], [" << x + w << ", " << y << "], [" << x + w
-        << ", " << y + w << "], [" << x << ", " << y + w << "]]\n";
-      const double vx = speed(rng), vy = speed(rng);
-      t << "velocity = [" << vx << ", " << vy << "]\n";
-      if (k % 2 == 0) t << "mooring_period = 200.0\nmooring_damping = 0.1\n";
-    }
-  return t.str();
+  return test::rows_pack({.seed = 3, .rows = 10, .speed = 0.3, .t_end = 600.0, .wind = "[12.0, 4.0]",
+                          .current = "[0.05, 0.1]"},
+                         [](int k, double x, double y) {
+                           const double w = 40.0;
+                           std::ostringstream v;
+                           v << "[" << x << ", " << y << "], [" << x + w << ", " << y << "], [" << x + w << ", "
+                             << y + w << "], [" << x << ", " << y + w << "]";
+                           return test::RowFloe{v.str(), k % 2 == 0 ? "mooring_period = 200.0\nmooring_damping = 0.1\n" : ""};
+                         });
 }
 
 void check_moored(const parallel::Communicator& comm, std::vector<std::string>& failures) {
