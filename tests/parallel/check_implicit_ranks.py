@@ -10,8 +10,8 @@ pieces on every rank; what it reads of each floe is its vertical DOFs, which
 every rank holds (the solve alone writes them), and its yaw, gathered from
 its owner. The floes' whole states go to the ranks that hold them only (the
 drift's exchange), and the drift's owners pose and build their floes'
-pieces at the step's midpoint. Three cases, each whose bands do not hold
-every floe on 2 ranks but the tank's:
+pieces at the step's midpoint. Three cases, in each of which a rank does
+not hold some floes on 2 ranks:
   - bem: check_whole_seas.py's BEM basin (150 floes, 12 m x 6 m, walls) with
     the implicit step, to 2 s (100 steps);
   - ocean: ranks_harness's small ocean (120 floes in the lower half of a
@@ -32,9 +32,14 @@ Checked:
     bit, no phase reported, floes poisoned on bem and ocean;
   - the bem case stopped half-way on 2 ranks and continued from its
     checkpoint on 3 ranks equals the serial run bit for bit.
-The mutation that fails it: the tilt inertia from the rank's own copy of the
-yaw, not the gathered one (FloeSeaContact::gather_tilted_yaw skipped): the
-poisoned runs of bem and ocean report NaN and fail.
+The mutations that fail it (builds not committed): the tilt inertia from
+the rank's own copy of the yaw (FloeSeaContact::gather_tilted_yaw skipped):
+the ocean differs on 2 and 3 ranks, the ocean's and the tank's `step` runs
+report NaN (bem's floes resist no slope); the midpoint posed by index (every
+floe, the drift's owners not given): bem, ocean and tank differ on 3 ranks,
+and the restart; the implicit step's zero vertical kick kept (kick_floes,
+whose tilt term reads the yaw): the ocean's `step` run fails, the tank's
+reports NaN.
 """
 import os
 import re
