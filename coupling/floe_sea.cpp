@@ -189,8 +189,8 @@ double FloeSeaContact::weak_coefficient(const Floes& floes, std::size_t i) const
   return K_ * rho_ * std::sqrt(g_ * floes.draft(i, rho_));
 }
 
-Eigen::Matrix2d FloeSeaContact::tilt_inertia(const Floes& floes, std::size_t i) const {
-  const double c = std::cos(floes.state[i].yaw), s = std::sin(floes.state[i].yaw);
+Eigen::Matrix2d FloeSeaContact::tilt_inertia(const Floes& floes, std::size_t i, double yaw) const {
+  const double c = std::cos(yaw), s = std::sin(yaw);
   Eigen::Matrix2d R;
   R << c, -s, s, c;
   const double h = floes.thickness[i];
@@ -476,13 +476,19 @@ void FloeSeaContact::kick_floes(Floes& floes, double h) {
     if (!dynamic_[i]) continue;
     FloeState& st = floes.state[i];
     const FloeSeaLoad& load = loads_[i];
-    st.heave_rate += h * load.vertical[0] / floes.mass[i];
-    if (tilt_[i] == 2) {
-      const Eigen::Vector2d da = tilt_inertia(floes, i).ldlt().solve(load.vertical.tail<2>());
-      st.pitch_rate += h * da[0];
-      st.roll_rate += h * da[1];
-    } else if (tilt_[i] == 1) {
-      st.pitch_rate += h * load.vertical[1] / tilt_inertia(floes, i)(0, 0);
+    // The implicit step applies the vertical law and the weight itself (the
+    // loads' vertical part is zero): no vertical kick. Every rank's copy of
+    // every floe's vertical DOFs is then the implicit step's alone, which
+    // it reads; the kick would turn a stale copy's yaw into them.
+    if (!implicit_) {
+      st.heave_rate += h * load.vertical[0] / floes.mass[i];
+      if (tilt_[i] == 2) {
+        const Eigen::Vector2d da = tilt_inertia(floes, i).ldlt().solve(load.vertical.tail<2>());
+        st.pitch_rate += h * da[0];
+        st.roll_rate += h * da[1];
+      } else if (tilt_[i] == 1) {
+        st.pitch_rate += h * load.vertical[1] / tilt_inertia(floes, i)(0, 0);
+      }
     }
     // Implicit: the first half kick of a step applies the last step's mean
     // load (the drift's predictor), the second completes the step's impulse
@@ -546,6 +552,7 @@ FloeSeaContact::Memory FloeSeaContact::memory(std::span<const std::uint8_t> held
   f += per_floe_bytes(step_horizontal_, k);
   f += per_floe_bytes(first_half_, k);
   f += per_floe_bytes(inertia_, k);
+  f += per_floe_bytes(yaw_, k);
   f += per_floe_bytes(free_bottom_, k);
   f += per_floe_bytes(eval_.wetted, k);
   f += per_floe_bytes(owner_.box, k);

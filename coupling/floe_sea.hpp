@@ -262,7 +262,8 @@ public:
   // (parallel::CellRoutes::replicated: a cell under another rank's floe's
   // box as pieces to every rank, any other cell's pressure as its total),
   // the serial sums to the bit too. The implicit step
-  // stays replicated on every floe's pieces (gathered), to the bit. Every
+  // stays replicated on every floe's pieces (gathered), to the bit, its
+  // floes posed and built by the drift's owners (next_owners_). Every
   // rank calls every method in the same order (they may exchange data).
   void set_communicator(const parallel::Communicator& comm) {
     comm_ = comm;
@@ -383,7 +384,12 @@ private:
   // psi(Phi) = 1 / (1 + K (1 - Phi)): the sub-cell weight of a cell covered
   // to the share Phi (the header's "Partly covered cells").
   double subcell_weight(double coverage) const;
-  Eigen::Matrix2d tilt_inertia(const Floes& floes, std::size_t i) const;
+  // Floe i's tilt inertia in the world frame, the floe turned by `yaw`
+  // (its present yaw when not given).
+  Eigen::Matrix2d tilt_inertia(const Floes& floes, std::size_t i) const {
+    return tilt_inertia(floes, i, floes.state[i].yaw);
+  }
+  Eigen::Matrix2d tilt_inertia(const Floes& floes, std::size_t i, double yaw) const;
   // Clears the cells of the present footprints, places them with floe i at
   // poses_[i] (moved if `move`, MovingFootprints::movable's verdict, else
   // rebuilt: coupling/moving_footprint.hpp) and sums the cells' coverage
@@ -465,8 +471,20 @@ private:
   // truncated BEM sea's correction): p = rho g (W - eta), W the waves.
   void hold_static_pressure(fluid::Sea& sea, std::span<const double> waves, std::span<const double> eta);
   // Footprints (and coverage) at the midpoint of each floe's horizontal
-  // motion from `start` to its present position.
+  // motion from `start` to its present position. The floes posed are those
+  // the placement reads (evaluate()'s rule): the footprints' own floes for
+  // a move, the given owners' for a rebuild with owners (given_owners),
+  // every floe only for a rebuild by index.
   void place_midpoint_footprints(const Floes& floes, std::span<const FloeState> start);
+  // poses_[i] <- floe i's pose at the midpoint from start[i] to its present
+  // place, for i in `which` (a static floe's: its present place).
+  void pose_at_midpoint(const Floes& floes, std::span<const FloeState> start, std::span<const std::uint32_t> which);
+  // On several ranks: the present yaw of each floe of order_ that resists a
+  // slope (tilt_ > 0; its tilt inertia turns with it), from its coupling
+  // owner, which holds it (the other ranks' copies of its horizontal state
+  // may be stale: the halo exchange), into yaw_ (per floe; the others'
+  // entries are not read). One gather, 8 B a tilted floe.
+  void gather_tilted_yaw(const Floes& floes);
   // The sea's part of the implicit step's operator: out = G_sea u on the
   // pieces (coupling/penalty_step.hpp).
   void sea_response(fluid::Sea& sea, double h, std::span<const double> u, std::span<double> out);
@@ -571,9 +589,16 @@ private:
   //   held_now) from the next drift's exchange on, which sends each floe's
   //   state to its next owner (next_floe_owners: its band need not hold
   //   them in a flume wider than the floes' reach).
+  // - the implicit step (every sea: it is whole on every rank): the
+  //   drift's owners too, whatever the sea's dims. Its footprints are
+  //   gathered to every rank and its solve replicated, so the owners
+  //   choose only who poses and builds each floe's pieces: a rank that
+  //   holds the floe.
   // The next rebuild after a vertical drift (advance_vertical) takes them:
   // a new owner's copy of a floe is current after the drift's exchange and
-  // the vertical drift of the floes it holds; an evaluation before it (a
+  // the vertical drift of the floes it holds (with the implicit step after
+  // the drift's exchange: every rank's copy of every floe's vertical DOFs
+  // is current, kick_floes); an evaluation before it (a
   // first half kick) keeps the last rebuild's owners (given_owners). Until
   // the first (the start, a restart, a split), the owners are by index.
   struct NextOwners {
@@ -632,6 +657,7 @@ private:
   double self_response_h_ = -1.0, self_response_ = 0.0;  // sea's node response to its own pressure over h
   std::vector<double> grid_work_, grid_eta_;  // grid-sized scratch of the implicit step
   std::vector<VerticalInertia> inertia_;      // per floe, the implicit step's
+  std::vector<double> yaw_;                   // per floe: gather_tilted_yaw's (the tilted floes of order_)
   std::vector<Eigen::Vector3d> free_bottom_;  // per floe: (z, a) at t + h with no penalty
   struct ImplicitPieces {                     // per piece, the implicit step's problem
     std::vector<double> spring, damper, start, free_end;

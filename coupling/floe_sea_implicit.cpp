@@ -43,14 +43,17 @@ void FloeSeaContact::sea_response(fluid::Sea& sea, double h, std::span<const dou
   for (std::uint32_t c : fp.cell) grid_work_[c] = 0.0;
 }
 
-void FloeSeaContact::place_midpoint_footprints(const Floes& floes, std::span<const FloeState> start) {
+void FloeSeaContact::pose_at_midpoint(const Floes& floes, std::span<const FloeState> start,
+                                      std::span<const std::uint32_t> which) {
   // At the step's end the vertical forces would lag the drift by h / 2: a
   // first-order error. A periodic grid's seam is crossed by the shorter way.
-  pose_at_states(floes);
   const bool periodic = grid_.edge == fluid::GridEdge::periodic;
-  for (std::size_t i = 0; i < floes.size() && i < start.size(); ++i) {
-    if (!dynamic_[i]) continue;
+  poses_.resize(floes.size());
+  for (const std::uint32_t i : which) {
+    const FloeState& s = floes.state[i];
     FloePose& p = poses_[i];
+    p = {s.x, s.y, s.yaw};
+    if (!dynamic_[i] || i >= start.size()) continue;
     double dx = p.x - start[i].x, dy = p.y - start[i].y;
     if (periodic) {
       dx -= grid_.lx * std::round(dx / grid_.lx);
@@ -60,7 +63,46 @@ void FloeSeaContact::place_midpoint_footprints(const Floes& floes, std::span<con
     p.y -= 0.5 * dy;
     p.yaw = 0.5 * (p.yaw + start[i].yaw);
   }
-  place_footprints(floes, footprints_.movable(dynamic_, poses_));
+}
+
+void FloeSeaContact::place_midpoint_footprints(const Floes& floes, std::span<const FloeState> start) {
+  // The floes a placement reads, as evaluate() poses them: on several ranks
+  // with the halo exchange a rank's copies of the floes it does not hold
+  // are stale, and the owners that build or move a floe's pieces hold it
+  // (its present state and step-start copy: Simulation::held_now).
+  pose_at_midpoint(floes, start, footprints_.mine());
+  const bool move = footprints_.movable(dynamic_, poses_);
+  const GivenOwners given = move ? GivenOwners{} : given_owners(floes.size());
+  if (!move && !given.owner.empty()) {
+    pose_at_midpoint(floes, start, given.mine);
+  } else if (!move) {  // by index (the start, a restore, a split: every copy current)
+    std::vector<std::uint32_t> every(floes.size());
+    for (std::size_t i = 0; i < every.size(); ++i) every[i] = static_cast<std::uint32_t>(i);
+    pose_at_midpoint(floes, start, every);
+  }
+  place_footprints(floes, move, given.owner);
+}
+
+void FloeSeaContact::gather_tilted_yaw(const Floes& floes) {
+  yaw_.resize(floes.size());
+  if (comm_.serial()) {
+    for (const std::uint32_t i : order_) yaw_[i] = floes.state[i].yaw;
+    return;
+  }
+  // order_ and tilt_ are the same on every rank (every floe's pieces are
+  // gathered), and so are the owners: the entries line up.
+  const std::span<const int> owner = footprints_.owners();
+  std::vector<double> yaw;
+  std::vector<int> by;
+  for (const std::uint32_t i : order_) {
+    if (tilt_[i] == 0) continue;
+    yaw.push_back(owner[i] == comm_.rank() ? floes.state[i].yaw : 0.0);
+    by.push_back(owner[i]);
+  }
+  comm_.complete_owned(yaw, by);
+  std::size_t j = 0;
+  for (const std::uint32_t i : order_)
+    if (tilt_[i] != 0) yaw_[i] = yaw[j++];
 }
 
 void FloeSeaContact::implicit_step(Floes& floes, std::span<const FloeState> start, fluid::Sea& sea, double h) {
@@ -68,7 +110,12 @@ void FloeSeaContact::implicit_step(Floes& floes, std::span<const FloeState> star
   place_midpoint_footprints(floes, start);
   const Footprints& fp = footprints_.pieces();
   const std::size_t n = fp.cell.size();
-  // Each floe's vertical inertia on the DOFs it has.
+  // Each floe's vertical inertia on the DOFs it has, at its present yaw.
+  // The solve is every rank's, over every floe's pieces; what it reads of
+  // each floe is its vertical DOFs, which every rank holds current (the
+  // solve alone writes them, alike on every rank, and the explicit kicks do
+  // not: kick_floes), its constants, and its yaw, from its owner.
+  gather_tilted_yaw(floes);
   inertia_.assign(floes.size(), {});
   for (std::uint32_t i : order_) {
     VerticalInertia& in = inertia_[i];
@@ -76,11 +123,11 @@ void FloeSeaContact::implicit_step(Floes& floes, std::span<const FloeState> star
     in.mass(0, 0) = floes.mass[i];
     in.inverse_mass(0, 0) = 1.0 / floes.mass[i];
     if (tilt_[i] == 2) {
-      const Eigen::Matrix2d J = tilt_inertia(floes, i);
+      const Eigen::Matrix2d J = tilt_inertia(floes, i, yaw_[i]);
       in.mass.bottomRightCorner<2, 2>() = J;
       in.inverse_mass.bottomRightCorner<2, 2>() = J.inverse();
     } else if (tilt_[i] == 1) {
-      in.mass(1, 1) = tilt_inertia(floes, i)(0, 0);
+      in.mass(1, 1) = tilt_inertia(floes, i, yaw_[i])(0, 0);
       in.inverse_mass(1, 1) = 1.0 / in.mass(1, 1);
     }
   }
@@ -204,8 +251,12 @@ void FloeSeaContact::step_mean_horizontal(const Floes& floes, std::span<const Fl
   eval_.wetted.assign(floes.size(), 0.0);
   slope_.resize(floes.size());
   for_each_floe(order_, threads_, [&](std::uint32_t i) {
-    const FloeState& st = floes.state[i];
-    slope_[i] = 0.5 * Vec2{st.pitch + start[i].pitch, st.roll + start[i].roll};
+    // The midpoint slopes, read by the owner's horizontal loads only (its
+    // step-start copy is current; another rank's may be stale).
+    if (footprints_.owns(i)) {
+      const FloeState& st = floes.state[i];
+      slope_[i] = 0.5 * Vec2{st.pitch + start[i].pitch, st.roll + start[i].roll};
+    }
     double wet = 0.0;
     for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k) {
       psi[k] = subcell_weight(cells_[fp.cell[k]].coverage);

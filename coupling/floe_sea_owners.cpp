@@ -134,9 +134,11 @@ FloeSeaContact::GivenOwners FloeSeaContact::given_owners(std::size_t floes) {
   // The drift's owners on the sea's slabs (take_place_owners)...
   if (place_owner_.size() == floes && footprints_.takes_owners(place_rows_)) return {place_owner_, place_mine_};
   // ...or by place on a sea not in slabs, once their new owners hold
-  // their floes' current states (next_owners_)...
+  // their floes' current states (next_owners_): after the vertical drift
+  // of the floes they hold; with the implicit step (whose vertical DOFs
+  // every rank holds, next_owners_) from the drift's exchange on...
   NextOwners& next = next_owners_;
-  if (next.owner.size() == floes && next.drifted) return {next.owner, next.mine};
+  if (next.owner.size() == floes && (next.drifted || (implicit_ && next.current))) return {next.owner, next.mine};
   // ...or, not in slabs, the last rebuild's owners kept: each holds its
   // floes current (own_floes()), so a rebuild before the new owners hold
   // theirs (a first half kick with stale loads, a redone try) poses only
@@ -519,10 +521,11 @@ void FloeSeaContact::hand_water_over(std::span<const int> drift_owner) {
   // by place (parallel::FloeOwners); the coupling's owner of a floe is
   // mostly the same rank (both by place on the same slabs), but not always:
   // the coupling's owners are set at the footprints' last rebuild and follow
-  // a move of the slabs only at the next one; without a sea in slabs they
-  // are these owners from the next rebuild on (next_owners_), but in a
-  // flume (shares of its columns) and with the implicit step (by index).
-  if (routes_.replicated() && next_owners_.column.empty() && drift_owner.size() == dynamic_.size())
+  // a move of the slabs only at the next one; without a sea in slabs (the
+  // implicit step's sea too) they are these owners from the next rebuild on
+  // (next_owners_), but in a flume with the explicit kicks (shares of its
+  // columns).
+  if ((routes_.replicated() || implicit_) && next_owners_.column.empty() && drift_owner.size() == dynamic_.size())
     set_next_owners(drift_owner);
   // The drift's exchange that follows sends each floe's state to its next
   // owner too (Simulation::send_to_holders): from here on they hold them.

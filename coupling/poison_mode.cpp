@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <cstdio>
 #include <limits>
 #include <sstream>
@@ -29,11 +30,27 @@ FloeState lured(FloeState s, const contact::Domain& d) {
   return s;
 }
 
-int first_nan(const FloeState& s) {
+// The state's columns from x to yaw_rate are its horizontal state; from
+// heave on, its vertical DOFs (core/floes.hpp's order).
+constexpr int kFirstVertical = 6;
+static_assert(offsetof(FloeState, heave) == kFirstVertical * sizeof(double));
+
+int first_nan(const FloeState& s, int from = 0) {
   const double* v = reinterpret_cast<const double*>(&s);
-  for (int k = 0; k < kStateColumns; ++k)
+  for (int k = from; k < kStateColumns; ++k)
     if (std::isnan(v[k])) return k;
   return -1;
+}
+
+// `poisoned`'s horizontal state with `s`'s vertical DOFs.
+FloeState keep_vertical(FloeState poisoned, const FloeState& s) {
+  poisoned.heave = s.heave;
+  poisoned.pitch = s.pitch;
+  poisoned.roll = s.roll;
+  poisoned.heave_rate = s.heave_rate;
+  poisoned.pitch_rate = s.pitch_rate;
+  poisoned.roll_rate = s.roll_rate;
+  return poisoned;
 }
 }  // namespace
 
@@ -78,11 +95,15 @@ void UnheldPoison::poison(std::span<const std::uint8_t> held, std::span<const st
   kept_.resize(n, 0);
   const bool lure = options_.kind == PoisonOptions::Kind::lure;
   long long count = 0;
+  const auto poisoned = [&](const FloeState& s) {
+    const FloeState p = lure ? lured(s, domain) : nan_state();
+    return vertical_held_ ? keep_vertical(p, s) : p;
+  };
   for (std::size_t i = 0; i < n; ++i) {
     if (held_[i]) continue;
     ++count;
-    state[i] = lure ? lured(state[i], domain) : nan_state();
-    if (start && i < start->size()) (*start)[i] = lure ? lured((*start)[i], domain) : nan_state();
+    state[i] = poisoned(state[i]);
+    if (start && i < start->size()) (*start)[i] = poisoned((*start)[i]);
     if (i < reach.size()) reach[i] = lure ? reach[i] + 10.0 : kNan;
   }
   if (options_.mutant || options_.mutant_sea) {
@@ -105,9 +126,10 @@ void UnheldPoison::check(const char* phase, const std::vector<FloeState>& state,
   if (std::find(reported_phases_.begin(), reported_phases_.end(), phase) != reported_phases_.end()) return;
   const std::size_t n = std::min(held_.size(), state.size());
   for (std::size_t i = 0; i < n; ++i) {
-    if (!held_[i]) continue;
+    if (!held_[i] && !vertical_held_) continue;
     std::string field;
-    if (const int k = first_nan(state[i]); k >= 0) field = kStateColumnNames[k];
+    if (const int k = first_nan(state[i], held_[i] ? 0 : kFirstVertical); k >= 0) field = kStateColumnNames[k];
+    else if (!held_[i]) continue;
     else if (kept_[i] && start && i < start->size() && first_nan((*start)[i]) >= 0)
       field = std::string("step-start ") + kStateColumnNames[first_nan((*start)[i])];
     else if (kept_[i] && i < reach.size() && std::isnan(reach[i])) field = "reach";
@@ -167,18 +189,19 @@ void Simulation::poison_step(const char* phase, StepContext& ctx) {
   std::vector<FloeState>& state = scenario_.floes.state;
   const std::string at = phase;
   // Right after the exchanges (the drift's part (a); the detection's part
-  // (b)), the floes this rank does not hold now (held_by_band(): the
-  // derivation of held_now(), which the exchanges and whole_state use, but
-  // for the implicit step, which reads every floe: a known reader). Every
-  // rank holds every floe before the first detection.
+  // (b)), the floes this rank does not hold now (held_now(), which the
+  // exchanges and whole_state use; with the implicit step every floe's
+  // vertical DOFs besides). Every rank holds every floe before the first
+  // detection.
   const bool exchanged = (at == "drift" && p.options().after_drift) || (at == "detect" && p.options().after_detect);
   // The step-start copies and reaches are checked in the detection's held
   // floes (its band and own floes, and the floes the rank owns now) only:
   // the coupling's own floes beyond them are held for their state alone
   // (UnheldPoison::poison).
   if (exchanged) {
-    const std::vector<std::uint8_t> held = held_by_band();
+    const std::vector<std::uint8_t> held = held_now();
     if (held.size() == state.size()) {
+      p.hold_vertical(floe_sea_ && floe_sea_->implicit());
       std::vector<std::uint8_t> kept = held_.mask;
       kept.resize(held.size(), 0);
       for (const std::uint32_t i : owners_.mine())

@@ -22,6 +22,12 @@
 // the advance from the whole detection: Simulation::halo_exchange() false)
 // the drift still sends every state to every rank and the poison after it
 // is read: those runs fail or differ, by design (their readers are known).
+// With the implicit step every rank holds every floe's vertical DOFs
+// (heave, pitch, roll and their rates: the replicated solve writes them
+// alike on every rank, Simulation::held_now) besides its held floes' whole
+// state: there the mode poisons the other columns only (the horizontal
+// state: place, yaw and their rates, in the state and the step-start copy)
+// and checks every floe's vertical DOFs too.
 //
 // What is poisoned, for the floes outside the held set: the state (12
 // columns), the step-start copy (StepContext::start, taken from the state at
@@ -76,6 +82,11 @@ public:
   UnheldPoison(PoisonOptions options, int rank) : options_(options), rank_(rank) {}
   const PoisonOptions& options() const { return options_; }
 
+  // With the implicit step (set before the first poison): every floe's
+  // vertical DOFs are held, the unheld floes' horizontal state only is
+  // poisoned.
+  void hold_vertical(bool every_floe) { vertical_held_ = every_floe; }
+
   // Poisons every floe i with !held[i] in `state`, in `start` (if given)
   // and in `reach` (where it has a value), and keeps `held` for the checks,
   // with `kept` (a subset of `held`, the same size): the held floes whose
@@ -87,7 +98,8 @@ public:
   void poison(std::span<const std::uint8_t> held, std::span<const std::uint8_t> kept, std::vector<FloeState>& state,
               std::vector<FloeState>* start, std::vector<double>& reach, const contact::Domain& domain);
   // Looks for NaN in the held floes' state and the kept floes' `start` (if
-  // given) and reach; the first found after a phase is reported once a
+  // given) and reach (and with hold_vertical, in every floe's vertical
+  // DOFs); the first found after a phase is reported once a
   // phase (stderr, and reports()). Nothing before the first poison.
   void check(const char* phase, const std::vector<FloeState>& state, const std::vector<FloeState>* start,
              std::span<const double> reach);
@@ -115,6 +127,7 @@ private:
   PoisonOptions options_;
   int rank_ = 0;
   bool open_ = false;
+  bool vertical_held_ = false;  // hold_vertical
   long long windows_ = 0, poisoned_ = 0;
   std::string last_checked_;
   std::vector<std::uint8_t> held_, kept_;

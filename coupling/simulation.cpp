@@ -621,8 +621,8 @@ bool Simulation::detect_and_check(StepContext& ctx) {
   detection_ = std::move(next);
   held_ = std::move(held);
   hold_quadrature();
-  // The copies of the floes this rank does not hold (held_now(); the
-  // implicit step holds every floe) are stale from here on, whatever the
+  // The copies of the floes this rank does not hold (held_now()) are stale
+  // from here on, whatever the
   // drift's exchange (the vertical drift that follows is over the held
   // floes; with the state held by owner they were since the drift unless
   // gathered): a split's whole_state gathers them.

@@ -209,7 +209,7 @@ public:
   // of the floes it holds (core/floe_bytes.hpp; docs/parallel.md, "The
   // arrays held by band: measured (mem27)"): one entry a structure, named
   // as the run's summary prints it (memory.floes.NAME), and the held
-  // floes' count (its own and its band, held_by_band(); one rank: every
+  // floes' count (its own and its band, held_now(); one rank: every
   // floe). Not counted: the per-step scratch (the step-start copies, the
   // posed shapes), the per-cell arrays (the sea's), the contact store.
   struct FloeMemory {
@@ -300,10 +300,11 @@ private:
                                 std::span<const long long> leaving_counts = {}, parallel::HaloPart* halo = nullptr);
   // The state held by owner with a halo (docs/parallel.md, "The halo
   // exchange (halo26)", "... on the seas not in slabs (halo27)"): on
-  // several ranks, with the advance from the parts, no sea or any sea with
-  // the explicit kicks (the implicit step and the advance from the whole
-  // detection read every floe at every step: the drift sends every state
-  // to every rank there). The same on every rank, for the whole run.
+  // several ranks, with the advance from the parts, with or without a sea,
+  // the explicit kicks or the implicit step ("... for the implicit step
+  // (implicit28)"; the advance from the whole detection reads every floe
+  // at every step: the drift sends every state to every rank there). The
+  // same on every rank, for the whole run.
   bool halo_exchange() const;
   // The halo exchange's part (a), after the drift: each floe this rank owns
   // to the ranks that hold it (held_now() on each: those its owner at the
@@ -338,18 +339,16 @@ private:
   void hand_over_moved(StepContext& ctx, std::span<const int> detected);
   // Per floe, 1 if this rank holds it now: held_'s mask, its own floes
   // (owners_.mine()) and its own floes for the coupling. Empty: every floe
-  // (one rank, no detection yet, or the implicit step).
+  // (one rank, no detection yet). With the implicit step every rank holds
+  // every floe's vertical DOFs besides (not marked).
   std::vector<std::uint8_t> held_now() const;
   // The drift's quadrature held by band (docs/parallel.md, "The arrays held
   // by band: measured (mem27)"): on several ranks, at each detection that
-  // sets held_, the points of the floes this rank holds (held_by_band()) and
+  // sets held_, the points of the floes this rank holds (held_now()) and
   // none of the others' (FootprintQuadrature::hold). Only the drift reads
   // them, each rank its own floes', which it holds (a floe come to it
   // since: ensure() at the drift). Serially nothing (every floe's, built).
   void hold_quadrature();
-  // held_now() but for the implicit step's every floe (the poison mode's
-  // held set: the implicit step is a reader of the others).
-  std::vector<std::uint8_t> held_by_band() const;
   // The poison mode's hook after the phase `phase` (poison_mode.cpp): opens,
   // checks and closes its windows; nothing when the mode is off.
   void probe(const char* phase, StepContext& ctx) {

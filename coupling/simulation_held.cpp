@@ -53,13 +53,10 @@ std::vector<std::uint8_t> Simulation::held_now() const {
   // current: the drift's exchange sends each to its holders (the coupling's
   // owner among them), the detection's the floes entering a band, and the
   // collisions' and advance's moves reach every rank.
-  // Every floe with the implicit step, which poses every floe at the
-  // midpoint of its motion (whole on every rank).
-  if (floe_sea_ && floe_sea_->implicit()) return {};
-  return held_by_band();
-}
-
-std::vector<std::uint8_t> Simulation::held_by_band() const {
+  // With the implicit step every rank also holds every floe's vertical
+  // DOFs (heave, pitch, roll and their rates), which the replicated solve
+  // alone writes, alike on every rank (FloeSeaContact::implicit_step): not
+  // marked here, this is the held set of the whole state.
   const std::size_t n = scenario_.floes.size();
   if (comm_.serial() || held_.mask.size() != n || owners_.owner().size() != n) return {};
   std::vector<std::uint8_t> held = held_.mask;
@@ -124,14 +121,14 @@ parallel::HeldFloes Simulation::hold_band(std::span<const parallel::LeaveNotice>
 }
 
 bool Simulation::halo_exchange() const {
-  // The readers of every floe that stay (docs/parallel.md, "The halo
-  // exchange (halo26)", "... on the seas not in slabs (halo27)"): the
-  // implicit step poses and moves every floe at the midpoint of its motion
-  // and solves every floe's pieces, on every rank; the advance from the
-  // whole detection sets up every floe's pairs. Every sea with the explicit
-  // kicks, in slabs or not, reads only the floes its ranks hold.
-  if (comm_.serial() || !advance_share_options_.on_part) return false;
-  return !floe_sea_ || !floe_sea_->implicit();
+  // The reader of every floe that stays (docs/parallel.md, "The halo
+  // exchange (halo26)", "... on the seas not in slabs (halo27)", "... for
+  // the implicit step (implicit28)"): the advance from the whole detection
+  // sets up every floe's pairs. Every sea, in slabs or not, with the
+  // explicit kicks or the implicit step (whose solve on every rank reads
+  // every floe's vertical DOFs, which every rank holds, and its yaw,
+  // gathered from its owner), reads only the floes its ranks hold.
+  return !comm_.serial() && advance_share_options_.on_part;
 }
 
 void Simulation::send_to_holders() {
@@ -186,8 +183,7 @@ std::optional<parallel::HaloPart> Simulation::halo_part(const parallel::Announce
                                                         std::vector<FloeState>* start) {
   // The poison mode (a test) poisons the unheld floes after the drift
   // whatever the exchange, so its runs take part (b) even where the drift
-  // sends every state (the implicit step, the advance from the whole
-  // detection): the
+  // sends every state (the advance from the whole detection): the
   // floes entering a band then come from their owners as with the exchange,
   // and what the mode finds is a phase's read beyond the held floes, not
   // the entering floes that part (b) would have brought.
@@ -269,7 +265,7 @@ void Simulation::wrap_periodic() {
   const contact::Domain& d = detection_options_.domain;
   if (!d.periodic) return;
   // The floes this rank holds (every floe on one rank, before the first
-  // detection, or with the implicit step: held_now()). Every holder wraps
+  // detection: held_now()). Every holder wraps
   // a floe alike from the same bits; the other ranks' copies stay
   // unwrapped until the drift's exchange brings the owner's (or
   // hand_over_moved to a new owner, or wrap_entering at the detection).

@@ -11,11 +11,11 @@ void Simulation::hold_quadrature() {
   // holds), in every case of several ranks (the halo exchange or not): the
   // floes of its band are kept too, so that a floe migrating to it across
   // a cut has its points already.
-  if (!comm_.serial()) quadrature_.hold(scenario_.floes, held_by_band());
+  if (!comm_.serial()) quadrature_.hold(scenario_.floes, held_now());
 }
 
 Simulation::FloeMemory Simulation::floe_memory() const {
-  const std::vector<std::uint8_t> held = held_by_band();  // empty: every floe
+  const std::vector<std::uint8_t> held = held_now();  // empty: every floe
   FloeMemory m;
   m.floes = scenario_.floes.size();
   m.held = held_count(held, m.floes);

@@ -20,11 +20,9 @@ On 2 ranks (`mpirun --oversubscribe`):
 (b) known readers are found: the same pack with the advance from the whole
     detection (`advance_on_part = false`, whose set-up and clusters read
     every floe by design; the drift sends every state there) with the lure
-    does not give the serial run; a small ocean with the implicit floe-sea
-    step (whole on every rank) with NaN does not either, and the phase it
-    names (a report of a held floe or of the rank's sea, or the phase after
-    the last clean check where the run failed) is the detection or one
-    after it.
+    does not give the serial run. (The implicit floe-sea step, a known
+    reader here until implicit28, reads only held floes since: its poisoned
+    runs are check_implicit_ranks.py's, bit for bit.)
 (c) the mutation: each rank poisons one floe it holds too; the run fails,
     and each rank reports it after the drift, the first phase checked.
 (d) the whole state on demand (docs/parallel.md, "The whole state on demand
@@ -49,7 +47,7 @@ import os
 import re
 import sys
 
-from ranks_harness import FRACTURE, half_pack, moving_pack_check, need, ocean_toml, phase_bytes, summary
+from ranks_harness import FRACTURE, moving_pack_check, need, phase_bytes, summary
 
 args, harness, base = moving_pack_check(
     "floesim was built without MPI (FLOESIM_MPI=OFF): the poison mode is not checked", 400, 250.0, [2])
@@ -125,27 +123,6 @@ print(f"the pack from the whole detection on 2 ranks, step-lure: exit {p.returnc
       f"{'found (the run failed or differs)' if found else 'NOT FOUND'}")
 if not found:
     failures.append(f"the lure did not reach the advance from the whole detection (it reads every floe)\n{p.stderr}")
-# The implicit floe-sea step (whole on every rank), with NaN: the NaN it
-# reads shows in a held floe or in a rank's sea, reported either way.
-half_pack(run, args.floesim)
-implicit = os.path.join(W, "implicit.toml")
-with open(implicit, "w") as f:
-    f.write(ocean_toml("half_pack.h5", 0.5, 0.25, contact="box = [0.0, 200.0, 0.0, 200.0]\n",
-                       coupling='integrator = "implicit"\n'))
-need(run([args.floesim, "run", implicit, "-o", "implicit_serial.h5", "-q"]), "the implicit ocean, serial")
-p = mpirun(2, "step", implicit, "implicit2.h5")
-s, r = summaries(p), reports(p)
-named = {phase for _, phase, _ in r} | ({"(failed after) " + last for _, _, _, last in s.values()}
-                                          if p.returncode != 0 else set())
-after_detection = {"sea", "second half kick", "record", "(failed after) detect", "(failed after) sea",
-                   "(failed after) second half kick"}
-sea_reports = sum(what == "the sea's modal state" for _, _, what in r)
-print(f"the implicit ocean on 2 ranks, step: exit {p.returncode}, named {sorted(named)} "
-      f"({len(r) - sea_reports} floe reports, {sea_reports} sea reports)")
-if p.returncode == 0 and equal("implicit2.h5", "implicit_serial.h5"):
-    failures.append(f"the NaN did not reach the implicit step (whole on every rank)\n{p.stderr}")
-elif not named & after_detection:
-    failures.append(f"the implicit ocean's reader is named {sorted(named)}, not a phase after the detection\n{p.stderr}")
 
 # (c) The mutation: a held floe poisoned too is reported at the first check.
 p = mpirun(2, "step-mutant", base, "mutant2.h5")

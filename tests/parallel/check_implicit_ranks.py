@@ -1,0 +1,138 @@
+#!/usr/bin/env python3
+"""The implicit floe-sea step on several ranks with the halo exchange
+(docs/parallel.md, "The halo exchange for the implicit step (implicit28)").
+
+usage: check_implicit_ranks.py FLOESIM MPIEXEC WORKDIR [--ranks 2 3]
+       check_implicit_ranks.py --no-mpi    (MPI not built: exits 77, ctest's skip code)
+
+The implicit step ([coupling] integrator = "implicit") solves every floe's
+pieces on every rank; what it reads of each floe is its vertical DOFs, which
+every rank holds (the solve alone writes them), and its yaw, gathered from
+its owner. The floes' whole states go to the ranks that hold them only (the
+drift's exchange), and the drift's owners pose and build their floes'
+pieces at the step's midpoint. Three cases, in each of which a rank does
+not hold some floes on 2 ranks:
+  - bem: check_whole_seas.py's BEM basin (150 floes, 12 m x 6 m, walls) with
+    the implicit step, to 2 s (100 steps);
+  - ocean: ranks_harness's small ocean (120 floes in the lower half of a
+    periodic 200 m box, spectral 128^2, whole on every rank with the
+    implicit step), to 5 s;
+  - tank: examples/wave_tank_disc.toml (one disc in a tank) to 2 s.
+Checked:
+  - on 2 and 3 ranks the run file equals the serial one bit for bit
+    (`floesim compare --rtol 0 --atol 0`);
+  - rank 0's drift phase (parallel.phase.drift) receives less than 0.6 of
+    every floe's state (96 B) each step on bem and ocean: with every state
+    sent to every rank (the drift's complete_owned, before implicit28) it
+    is 1.01 of it on 2 ranks;
+  - on 2 ranks in the poison mode (FLOESIM_TEST_POISON_UNHELD=step and
+    step-lure: each rank's copies of the horizontal state of the floes it
+    does not hold NaN, or wrong but finite, after each exchange; the
+    vertical DOFs, which every rank holds, checked in every floe): bit for
+    bit, no phase reported, floes poisoned on bem and ocean;
+  - the bem case stopped half-way on 2 ranks and continued from its
+    checkpoint on 3 ranks equals the serial run bit for bit.
+The mutations that fail it (builds not committed): the tilt inertia from
+the rank's own copy of the yaw (FloeSeaContact::gather_tilted_yaw skipped):
+the ocean differs on 2 and 3 ranks, the ocean's and the tank's `step` runs
+report NaN (bem's floes resist no slope); the midpoint posed by index (every
+floe, the drift's owners not given): bem, ocean and tank differ on 3 ranks,
+and the restart; the implicit step's zero vertical kick kept (kick_floes,
+whose tilt term reads the yaw): the ocean's `step` run fails, the tank's
+reports NaN.
+"""
+import os
+import re
+from pathlib import Path
+
+from ranks_harness import finish, half_pack, need, ocean_toml, phase_bytes, ranks_check, summary
+
+args, harness = ranks_check(
+    "floesim was built without MPI (FLOESIM_MPI=OFF): the implicit step on several ranks is not checked",
+    lambda ap: ap.add_argument("--ranks", type=int, nargs="+", default=[2, 3]))
+W = args.workdir
+failures = []
+run, mpirun = harness.run, harness.mpirun
+EXAMPLES = Path(__file__).resolve().parent.parent.parent / "examples"
+
+BEM = """[run]
+t_end = 2.0
+dt_max = 0.02
+output_interval = 0.5
+threads = 1
+
+[sea]
+model = "bem"
+dims = 2
+size = [12.0, 6.0]
+cells = [24, 12]
+depth = 2.0
+rho = 1000.0
+
+[sea.waves]
+kind = "standing"
+amplitude = 0.05
+wavelength = 24.0
+
+[floes]
+pack = "bem_pack.h5"
+
+[coupling]
+stiffness = 100.0
+law = "strong"
+integrator = "implicit"
+"""
+need(run([args.floesim, "pack", "--floes", "150", "--box", "12", "6", "--concentration", "0.7", "--seed", "3",
+          "--thickness", "0.2", "-o", "bem_pack.h5"]), "bem: floesim pack")
+half_pack(run, args.floesim)
+CASES = {  # name: (configuration, --until, floes whose drift bytes are bounded or None)
+    "bem": (BEM, [], 150),
+    "ocean": (ocean_toml("half_pack.h5", 5.0, 2.5, coupling='integrator = "implicit"\n'), [], 120),
+    "tank": ((EXAMPLES / "wave_tank_disc.toml").read_text(), ["--until", "2"], None),
+}
+for name, (text, until, floes) in CASES.items():
+    config = os.path.join(W, f"{name}.toml")
+    with open(config, "w") as f:
+        f.write(text)
+    s = summary(need(run([args.floesim, "run", config, "-o", f"{name}_serial.h5", "-q", *until]), f"{name}: serial"))
+    steps = int(s["steps"])
+    print(f"{name}: serial, {steps} steps")
+    for n in args.ranks:
+        p = mpirun(n, "run", config, "-o", f"{name}_{n}.h5", "-q", *until)
+        if p.returncode != 0:
+            failures.append(f"{name} on {n} ranks: exit {p.returncode}\n{p.stderr}")
+            continue
+        harness.same(f"{name}_{n}.h5", f"{name}_serial.h5", f"{name}: {n} ranks against the serial run", failures)
+        if floes:
+            drift, whole = phase_bytes(p, "drift"), 96 * floes * steps
+            print(f"{name}: {n} ranks, rank 0's drift phase {summary(p)['parallel.phase.drift']}: "
+                  f"{drift / whole:.3f} of every floe's state each step")
+            if not drift < 0.6 * whole:
+                failures.append(f"{name} on {n} ranks: rank 0's drift phase received {drift} B, not under 0.6 x 96 B "
+                                f"x {floes} floes x {steps} steps = {0.6 * whole:.0f} (every state to every rank?)")
+    for poison in ("step", "step-lure"):
+        p = harness.poisoned(2, poison, "run", config, "-o", f"{name}_{poison}.h5", "-q", *until)
+        poisoned = [int(m.group(1)) for m in re.finditer(r"windows, (\d+) floes poisoned", p.stderr)]
+        reported = [int(m.group(1)) for m in re.finditer(r"(\d+) phases reported", p.stderr)]
+        what = f"{name} on 2 ranks, poison mode {poison}"
+        print(f"{what}: exit {p.returncode}, floes poisoned {poisoned}, phases reported {reported}")
+        if p.returncode != 0:
+            failures.append(f"{what}: exit {p.returncode}\n{p.stderr[-3000:]}")
+            continue
+        harness.same(f"{name}_{poison}.h5", f"{name}_serial.h5", f"{what}, against the serial run", failures)
+        if len(poisoned) != 2 or any(reported) or (floes and min(poisoned) == 0):
+            failures.append(f"{what}: floes poisoned {poisoned}, phases reported {reported} (every rank must report "
+                            f"none{' and poison floes' if floes else ''})\n{p.stderr[-3000:]}")
+
+# A restart across rank counts: the checkpoint holds the step's mean
+# horizontal loads and the footprints' reference poses, gathered from the
+# owners that posed them.
+need(mpirun(2, "run", os.path.join(W, "bem.toml"), "-o", "bem_half.h5", "-q", "--until", "1"),
+     "bem: the first half on 2 ranks")
+p = mpirun(3, "run", "--restart", "bem_half.h5", "-o", "bem_rest3.h5", "-q")
+if p.returncode != 0:
+    failures.append(f"bem: restart on 3 ranks: exit {p.returncode}\n{p.stderr}")
+else:
+    harness.same("bem_rest3.h5", "bem_serial.h5", "bem: half on 2 ranks, continued on 3, against the serial run",
+                 failures)
+finish(failures)
