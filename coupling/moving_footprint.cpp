@@ -138,10 +138,10 @@ namespace {
 
 // A build appends its pieces, each array growing by doubling, and a clear
 // keeps the capacity from one build to the next: the arrays would keep up to
-// twice the most pieces any build had (and, after the static start gathered
-// every floe's, every floe's). An array whose spare capacity exceeds a
-// quarter of its size is copied into one with an eighth spare: a copy at
-// the builds whose count grew or fell by about a tenth, not at every build.
+// twice the most pieces any build had. An array whose spare capacity
+// exceeds a quarter of its size is copied into one with an eighth spare: a
+// copy at the builds whose count grew or fell by about a tenth, not at
+// every build.
 template <class T>
 void fit(std::vector<T>& v) {
   if (v.capacity() - v.size() <= v.size() / 4) return;
