@@ -13,7 +13,9 @@
 //   pieces, the serial run's bytes; every other floe has none; the area
 //   pieces' bytes (memory().footprints.area_pieces.whole, capacity) are
 //   below what every floe's pieces take (the whole gather's: the serial
-//   count of pieces times a piece's 52 bytes and one offset a floe);
+//   count of pieces times a piece's 52 bytes and one offset a floe); the
+//   same with the floes' heave given (start = "given": no static problem,
+//   nothing gathered at the start);
 // - the implicit step (replicated on every floe's pieces): every floe's area
 //   pieces on every rank, the serial run's bytes;
 // - the held floes' states are the serial run's (the static start, which
@@ -156,6 +158,9 @@ int main() {
       [](const parallel::Communicator& comm, test::Failures& f) { check_variant(comm, "rebuilt", "", true, f); },
       [](const parallel::Communicator& comm, test::Failures& f) {
         check_variant(comm, "moved", "footprint_reach = 0.3\n", true, f);
+      },
+      [](const parallel::Communicator& comm, test::Failures& f) {
+        check_variant(comm, "given", "start = \"given\"\n", true, f);
       },
       [](const parallel::Communicator& comm, test::Failures& f) {
         check_variant(comm, "implicit", "integrator = \"implicit\"\n", false, f);
