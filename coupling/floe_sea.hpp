@@ -611,21 +611,19 @@ private:
     // owner's copy is stale and own_floes() is the footprints' mine() alone.
     bool current = false;
     bool drifted = false;     // a vertical drift since `owner` was set
-    // given_owners' copy of the last rebuild's owners, when it keeps them.
-    std::vector<int> kept;
-    std::vector<std::uint32_t> kept_mine;
   } next_owners_;
   // next_owners_ from every floe's next owner.
   void set_next_owners(std::span<const int> owner);
   // dims = 1: the rank of the share of columns that holds a floe at pose p.
   int column_owner(const FloePose& p) const;
   // The owners a rebuild of this evaluation takes, and this rank's floes
-  // among them (empty: none given, the footprints find them).
+  // among them (empty: none given, the footprints find them). The spans
+  // stay valid until the rebuild (they may be the footprints' own).
   struct GivenOwners {
     std::span<const int> owner;
     std::span<const std::uint32_t> mine;
   };
-  GivenOwners given_owners(std::size_t floes);
+  GivenOwners given_owners(std::size_t floes) const;
   // The sea's slabs (fluid::Sea::slab_rows; empty: whole on every rank), and
   // by owner on them, the routes of the cells' sums to the slabs' ranks;
   // the next evaluation clears pressure_ in routes_.owned() (the cells the

@@ -130,26 +130,23 @@ int FloeSeaContact::column_owner(const FloePose& p) const {
   return next_owners_.column[static_cast<std::size_t>(column)];
 }
 
-FloeSeaContact::GivenOwners FloeSeaContact::given_owners(std::size_t floes) {
+FloeSeaContact::GivenOwners FloeSeaContact::given_owners(std::size_t floes) const {
   // The drift's owners on the sea's slabs (take_place_owners)...
   if (place_owner_.size() == floes && footprints_.takes_owners(place_rows_)) return {place_owner_, place_mine_};
   // ...or by place on a sea not in slabs, once their new owners hold
   // their floes' current states (next_owners_): after the vertical drift
   // of the floes they hold; with the implicit step (whose vertical DOFs
   // every rank holds, next_owners_) from the drift's exchange on...
-  NextOwners& next = next_owners_;
+  const NextOwners& next = next_owners_;
   if (next.owner.size() == floes && (next.drifted || (implicit_ && next.current))) return {next.owner, next.mine};
   // ...or, not in slabs, the last rebuild's owners kept: each holds its
   // floes current (own_floes()), so a rebuild before the new owners hold
   // theirs (a first half kick with stale loads, a redone try) poses only
-  // floes its rank holds. (Copies: the rebuild rewrites the footprints'.)
+  // floes its rank holds. The footprints' own arrays, given back to them
+  // (MovingFootprints::set_owners keeps its owners when given them).
   // None given (by index, every floe posed) only when no rebuild owns these
   // floes yet: the start, a restore, a split, where every copy is current.
-  if (routes_.replicated() && footprints_.owners().size() == floes) {
-    next.kept.assign(footprints_.owners().begin(), footprints_.owners().end());
-    next.kept_mine.assign(footprints_.mine().begin(), footprints_.mine().end());
-    return {next.kept, next.kept_mine};
-  }
+  if (routes_.replicated() && footprints_.owners().size() == floes) return {footprints_.owners(), footprints_.mine()};
   return {};
 }
 

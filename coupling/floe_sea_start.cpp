@@ -51,19 +51,23 @@ void FloeSeaContact::start(Floes& floes, fluid::Sea& sea, bool given) {
   cells_.assign(grid.size(), {});
   pressure_kicked_ = false;
   pose_at_states(floes);
-  // The static problem couples every floe sharing a cell: it reads every
-  // floe's pieces, gathered to every rank for this once.
-  footprints_.set_gather(true);
   footprints_.rebuild_at(floes, dynamic_, poses_, threads_);
-  footprints_.set_gather(!by_owner());
   if (given) {
     free_level_ = 0.0;
     for (std::size_t i = 0; i < n; ++i) bottom0_[i] = -floes.draft(i, rho_) * (1.0 + 1.0 / K_);
     return;
   }
   // The static problem (see the header): on the calm sea first, which fixes
-  // each floe's reference bottom (heave 0), then on the sea's waves.
-  const Footprints& fp = footprints_.pieces();
+  // each floe's reference bottom (heave 0), then on the sea's waves. It
+  // couples every floe sharing a cell, in one Gauss–Seidel sweep over the
+  // floes in floe order whose cell sums are updated floe by floe: it reads
+  // every floe's pieces, on every rank. By owner a rank holds its own
+  // floes' only: every floe's are gathered for this once, into a copy freed
+  // at the end of the start (the contact by owner never reads another
+  // floe's pieces after it: docs/parallel.md, "The footprints' area pieces
+  // by holder (foot28)").
+  Footprints gathered;
+  const Footprints& fp = footprints_.every_floe(gathered);
   std::vector<double> F(grid.size(), 0.0), S(grid.size(), 0.0), eta(grid.size());
   std::vector<double> z(n, 0.0);
   std::vector<Vec2> a(n, Vec2::Zero());

@@ -100,7 +100,10 @@ int MovingFootprints::reach_rows_from(std::span<const int> first_row) const {
 
 void MovingFootprints::set_owners(std::span<const FloePose> poses, std::span<const int> owners) {
   const std::size_t n = poses.size();
-  owner_.assign(n, 0);
+  // The owners given may be these very owners (owners(): a caller that
+  // keeps the last rebuild's, FloeSeaContact::given_owners): kept in place.
+  const bool same = !owners.empty() && owners.data() == owner_.data() && owners.size() == owner_.size();
+  if (!same) owner_.assign(n, 0);
   by_place_ = !comm_.serial() && !row_owner_.empty();
   if (by_place_ && !next_owner_rows_.empty()) {
     // The sea's slabs moved since the last rebuild: the owners follow them.
@@ -114,7 +117,7 @@ void MovingFootprints::set_owners(std::span<const FloePose> poses, std::span<con
     // by their maker at the same poses), or without slabs by their maker's
     // rule (a sea not in slabs: FloeSeaContact's strips).
     FLOESIM_ASSERT(owners.size() == n);
-    std::copy(owners.begin(), owners.end(), owner_.begin());
+    if (!same) std::copy(owners.begin(), owners.end(), owner_.begin());
     reference_whole_ = false;
   } else if (by_place_) {
     // The row of the centroid, the grid's seam crossed (periodic).
@@ -130,6 +133,40 @@ void MovingFootprints::set_owners(std::span<const FloePose> poses, std::span<con
   for (std::size_t i = 0; i < n; ++i)
     if (owner_[i] == comm_.rank()) mine_.push_back(static_cast<std::uint32_t>(i));
 }
+
+namespace {
+
+// A build appends its pieces, each array growing by doubling, and a clear
+// keeps the capacity from one build to the next: the arrays would keep up to
+// twice the most pieces any build had. An array whose spare capacity
+// exceeds a quarter of its size is copied into one with an eighth spare: a
+// copy at the builds whose count grew or fell by about a tenth, not at
+// every build.
+template <class T>
+void fit(std::vector<T>& v) {
+  if (v.capacity() - v.size() <= v.size() / 4) return;
+  std::vector<T> kept;
+  kept.reserve(v.size() + v.size() / 8);
+  kept.assign(v.begin(), v.end());
+  v.swap(kept);
+}
+
+void fit(Footprints& f) {
+  fit(f.offsets);
+  fit(f.cell);
+  fit(f.area);
+  fit(f.centroid);
+  fit(f.edge_offsets);
+  fit(f.edge_cell);
+  fit(f.edge_piece);
+  fit(f.edge_length);
+  fit(f.edge_normal);
+  fit(f.edge_twist);
+  fit(f.edge_first);
+  fit(f.edge_swept);
+}
+
+}  // namespace
 
 void MovingFootprints::rebuild_at(const Floes& floes, std::span<const std::uint8_t> include,
                                   std::span<const FloePose> reference, int threads, std::span<const int> owners) {
@@ -159,9 +196,12 @@ void MovingFootprints::rebuild_at(const Floes& floes, std::span<const std::uint8
   for (std::size_t i = 0; i < floes.size(); ++i)
     if (include[i]) largest = std::max(largest, radius_[i]);
   piece_rows_ = piece_rows_of(largest, options_.reach, grid_.dy());
+  fit(pieces_);
   area0_ = pieces_.area;
   moment0_.resize(area0_.size());
   for (std::size_t k = 0; k < area0_.size(); ++k) moment0_[k] = area0_[k] * pieces_.centroid[k];
+  fit(area0_);
+  fit(moment0_);
 }
 
 void MovingFootprints::move(std::span<const FloePose> poses, int threads) {
@@ -214,12 +254,18 @@ const std::byte* take(const std::byte* in, T* data, std::size_t count) {
 
 }  // namespace
 
-void MovingFootprints::gather_built() {
+const Footprints& MovingFootprints::every_floe(Footprints& scratch) const {
+  if (comm_.serial() || gather_) return pieces_;
+  gather_area_pieces(scratch);
+  return scratch;
+}
+
+void MovingFootprints::gather_area_pieces(Footprints& full) const {
   // pieces_ holds this rank's floes' pieces only (the other floes have none),
   // in floe order. Message: the pieces per floe of mine_, then their cells,
   // areas and centroids. Every rank knows every floe's owner: each floe's
   // pieces are taken from its owner's message, in floe order.
-  Footprints& fp = pieces_;
+  const Footprints& fp = pieces_;
   const std::size_t n = fp.floes(), count = fp.cell.size();
   std::vector<std::uint64_t> per_floe(mine_.size());
   for (std::size_t j = 0; j < mine_.size(); ++j) per_floe[j] = fp.offsets[mine_[j] + 1] - fp.offsets[mine_[j]];
@@ -253,7 +299,7 @@ void MovingFootprints::gather_built() {
     stream[r].centroid = stream[r].area + pieces * sizeof(double);
     in += sizes[r];
   }
-  Footprints full;
+  full = Footprints{};
   full.offsets.assign(n + 1, 0);
   for (std::size_t i = 0; i < n; ++i) {
     Stream& s = stream[static_cast<std::size_t>(owner_[i])];
@@ -273,6 +319,12 @@ void MovingFootprints::gather_built() {
     take(s.centroid + s.piece * sizeof(Vec2), full.centroid.data() + at, pieces);
     s.piece += pieces;
   }
+}
+
+void MovingFootprints::gather_built() {
+  Footprints& fp = pieces_;
+  Footprints full;
+  gather_area_pieces(full);
   // This rank's edge pieces point into the full list of area pieces.
   for (std::uint32_t i : mine_) {
     const auto shift = static_cast<std::ptrdiff_t>(full.offsets[i]) - static_cast<std::ptrdiff_t>(fp.offsets[i]);

@@ -48,11 +48,12 @@
 // (set_slabs, stage five) the rank whose slab of the sea's rows holds the row
 // of the floe's centroid owns it. The edge pieces stay with their floe's
 // owner: only the horizontal loads read them, and the owner computes those.
-// With set_gather(false) the area
-// pieces are not gathered either: each rank holds its own floes' pieces only
-// (the contact evaluated by owner, docs/parallel.md, stage three); the other
-// floes' entries are then empty, or left from the last gathered build, and
-// are not to be read.
+// With set_gather(false) the area pieces are not gathered either: each rank
+// holds its own floes' pieces only (the contact evaluated by owner,
+// docs/parallel.md, stage three, whose readers of another floe's pieces
+// take them per cell, parallel::CellRoutes); the other floes' ranges are
+// empty. A reader that needs every floe's pieces once (the static start)
+// asks for a gathered copy (every_floe), which it frees after.
 
 #include <cstdint>
 #include <span>
@@ -103,7 +104,8 @@ public:
   // when no slabs are set, e.g. FloeSeaContact's strips of a sea not in
   // slabs), a rebuild takes its owners from them instead of from the poses,
   // and reads the poses of its own floes (owners[i] == rank) only. On
-  // several ranks only; the same on every rank.
+  // several ranks only; the same on every rank. `owners` may be owners()
+  // itself (the last rebuild's kept).
   bool place(const Floes& floes, std::span<const std::uint8_t> include, std::span<const FloePose> poses, int threads,
              bool move, std::span<const int> owners = {});
   // Whether the next rebuild may take its owners given: the owners by place
@@ -126,6 +128,12 @@ public:
   // Whether the next builds and moves send every floe's area pieces to every
   // rank (true by default); false: each rank keeps its own floes' pieces.
   void set_gather(bool all) { gather_ = all; }
+  // Every floe's area pieces (offsets, cells, areas, centroids; no edge
+  // pieces): pieces() itself when it holds them (one rank, or gathered at
+  // each build and move), else every floe's gathered from its owner into
+  // `scratch`, in floe order, the same bits as a gathered build (collective
+  // then: one gather; every rank calls it alike).
+  const Footprints& every_floe(Footprints& scratch) const;
   // Own the floes by place from the next rebuild on: first_row as
   // fluid::Sea::slab_rows gives it (rank r's slab holds rows [first_row[r],
   // first_row[r + 1]) of the grid); empty: by index.
@@ -205,8 +213,12 @@ private:
   // owner_ and mine_ for floes at `poses` (the rebuild's), or `owners`
   // given by place (takes_owners).
   void set_owners(std::span<const FloePose> poses, std::span<const int> owners);
+  // Every floe's area pieces from their owners, in floe order, into `full`
+  // (its edge pieces left empty), after this rank built its own alone.
+  void gather_area_pieces(Footprints& full) const;
   // After this rank built its floes' pieces alone: every floe's area pieces
-  // from their owners, in floe order; the edge pieces are this rank's.
+  // from their owners (gather_area_pieces) into pieces_; the edge pieces are
+  // this rank's.
   void gather_built();
   // After this rank moved its floes' pieces: the others' areas and centroids.
   void gather_moved();
