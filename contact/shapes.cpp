@@ -71,12 +71,13 @@ void make_room(CollisionShapes& s, std::size_t needed) {
     compact(s, live + needed + (live + needed) / 4);
 }
 
-// A bound on the vertices floe i's parts take: a partition adds diagonals
-// only (core/convex_partition.hpp), each giving its two ends to one more
-// piece, at most n - 3 of them: n + 2 (n - 3) < 3 n.
+// The vertices floe i's parts take, or a bound on them: a convex floe's
+// own n (most floes: exact, so that the room reserved is not inflated); a
+// partition adds diagonals only (core/convex_partition.hpp), each giving
+// its two ends to one more piece, at most n - 3 of them: n + 2 (n - 3) < 3 n.
 std::size_t bound_of(const Floes& floes, std::size_t i) {
-  const std::size_t n = floes.offsets[i + 1] - floes.offsets[i];
-  return n < 4 ? n : 3 * n;
+  const auto v = floes.vertices(i);
+  return is_convex(v) ? v.size() : 3 * v.size();
 }
 
 // The per-floe arrays sized to the floes (floes added since: no parts, their radii set).
