@@ -37,13 +37,14 @@ std::size_t vertices_of(const CollisionShapes& s, std::size_t i) {
 }
 
 // The held floes' parts copied in floe order into arrays with room for
-// `capacity` vertices (and as many parts, in proportion).
+// `capacity` vertices (and parts in the stored parts' proportion to the
+// stored vertices).
 void compact(CollisionShapes& s, std::size_t capacity) {
-  const std::size_t live_parts = s.vertex_offsets.size() - 1;
+  const std::size_t stored = s.vertex_offsets.size() - 1;  // parts, dead ones included
   std::vector<std::size_t> offsets{0};
   std::vector<Vec2> vertices;
   vertices.reserve(capacity);
-  offsets.reserve(1 + (s.vertices.empty() ? live_parts : live_parts * capacity / s.vertices.size() + 1));
+  offsets.reserve(1 + (s.vertices.empty() ? stored : stored * capacity / s.vertices.size() + 1));
   for (std::size_t i = 0; i < s.part_count.size(); ++i) {
     if (s.part_count[i] == 0) continue;
     const std::size_t from = s.first_part[i];
