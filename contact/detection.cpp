@@ -181,7 +181,7 @@ void PosedShapes::update(const Floes& floes, std::size_t i) {
   const FloeState& s = floes.state[i];
   const double c = std::cos(s.yaw), sn = std::sin(s.yaw);
   Box fb = box_of({}, 0.0);
-  for (std::size_t p = shapes.part_offsets[i]; p < shapes.part_offsets[i + 1]; ++p) {
+  for (std::size_t p = shapes.parts_begin(i); p < shapes.parts_end(i); ++p) {
     for (std::size_t k = shapes.vertex_offsets[p]; k < shapes.vertex_offsets[p + 1]; ++k) {
       const Vec2& b = shapes.vertices[k];
       world_[k] = {s.x + c * b.x() - sn * b.y(), s.y + sn * b.x() + c * b.y()};
@@ -237,9 +237,9 @@ NearPair measure_pair(const PosedShapes& posed, std::uint32_t a, std::uint32_t b
   } else {
     // Vertices of b's part, shifted (small: a few dozen at most).
     thread_local std::vector<Vec2> shifted;
-    for (std::size_t pa = shapes.part_offsets[a]; pa < shapes.part_offsets[a + 1]; ++pa) {
+    for (std::size_t pa = shapes.parts_begin(a); pa < shapes.parts_end(a); ++pa) {
       const std::span<const Vec2> A = posed.part(pa);
-      for (std::size_t pb = shapes.part_offsets[b]; pb < shapes.part_offsets[b + 1]; ++pb) {
+      for (std::size_t pb = shapes.parts_begin(b); pb < shapes.parts_end(b); ++pb) {
         const double part_gap = box_gap(posed.part_box(pa), shifted_box(posed.part_box(pb), shift), n);
         if (part_gap > range) {
           axis_bound(part_gap, n);

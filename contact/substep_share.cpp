@@ -139,8 +139,9 @@ bool Stepper::whole(std::uint32_t i) const {
   const FloeState& s = floes_.state[i];
   bool finite = std::isfinite(s.x) && std::isfinite(s.y) && std::isfinite(s.yaw) && std::isfinite(s.vx) &&
                 std::isfinite(s.vy) && std::isfinite(s.yaw_rate) && std::isfinite(shapes_.radius[i]) &&
-                std::isfinite(det_->reach[i]) && (floes_.is_static[i] || std::isfinite(floes_.mass[i]));
-  for (std::size_t p = shapes_.part_offsets[i]; finite && p < shapes_.part_offsets[i + 1]; ++p)
+                std::isfinite(det_->reach[i]) && (floes_.is_static[i] || std::isfinite(floes_.mass[i])) &&
+                shapes_.has(i);  // a shape held by band: none where the rank neither holds it nor was sent it
+  for (std::size_t p = shapes_.parts_begin(i); finite && p < shapes_.parts_end(i); ++p)
     for (const Vec2& v : shapes_.part(p)) finite = finite && std::isfinite(v.x()) && std::isfinite(v.y());
   return finite;
 }

@@ -198,7 +198,7 @@ void Simulation::restore(const Checkpoint& c) {
     quadrature_ = build_footprint_quadrature(scenario_.floes);
   else
     quadrature_.forget();
-  shapes_ = contact::build_collision_shapes(scenario_.floes);
+  build_shapes();
   // The owners by place start again from the restored places, as at a
   // run's start (the strips by equal counts, or the sea's slabs), and the
   // detection is made by place.

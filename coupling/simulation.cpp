@@ -86,7 +86,6 @@ Simulation::Simulation(Scenario scenario, parallel::Communicator comm)
   // start's detection, which holds the rank's floes' (hold_quadrature).
   if (comm_.serial()) quadrature_ = build_footprint_quadrature(scenario_.floes);
   moorings_ = Moorings(scenario_.floes, c.floes.floes);  // anchored where the floes start (also on a restart)
-  shapes_ = contact::build_collision_shapes(scenario_.floes);
   detection_options_.collision_distance = c.contact.collision_distance;
   detection_options_.domain = make_domain(scenario_);
   detection_options_.horizon = c.run.dt_max;
@@ -99,6 +98,7 @@ Simulation::Simulation(Scenario scenario, parallel::Communicator comm)
   impulse_options_.warm = warm_.get();
   impulse_options_.dump_failed_lcps = c.contact.dump_failed_lcps;
   advance_share_options_.on_part = c.run.advance_on_part;
+  build_shapes();  // serially every floe's; held by band: the radii (the parts at the start's detection)
   wrap_periodic();
   fluid::SeaOptions sea_options;
   sea_options.tank = {c.sea.tank.enabled, c.sea.tank.generation_length, c.sea.tank.absorption_length,
@@ -307,6 +307,7 @@ void Simulation::drift(StepContext& ctx) {
     // (hand_over_moved), or taken by the owners at a rejected try's, need
     // not be in its held set there: their quadratures built here.
     quadrature_.ensure(scenario_.floes, owners_.mine());
+    shapes_.ensure(scenario_.floes, owners_.mine());  // as the quadrature's (hold_shapes)
     drift_velocities(scenario_.floes, quadrature_, drift_params_, current, wind, ctx.dt, owners_.mine(), water);
     owners_.charge(parallel::thread_seconds() - start);
     // The drifted states to the ranks that read them: with the state held
@@ -426,7 +427,7 @@ void Simulation::on_floes_changed() {
     quadrature_ = build_footprint_quadrature(scenario_.floes);
   else
     quadrature_.forget();
-  shapes_ = contact::build_collision_shapes(scenario_.floes);
+  build_shapes();
   // The reaches (new pieces included) are set and the pieces are placed (appended at the same indices with the same ids
   // on every rank: Percussion::conclude on the same initiations in floe
   // order) and the detection made by place, as after a step.
@@ -598,6 +599,9 @@ bool Simulation::detect_and_check(StepContext& ctx) {
   // detection; else whole_detection() gathers them when a step needs them
   // (record runs too: the record's places are keyed by pair, ContactPlace).
   const bool whole = !advance_share_options_.on_part;
+  // The shapes of the floes the detection poses (held.index: the floes
+  // entering the held set built; none dropped until the step is kept).
+  if (shapes_held_by_band()) shapes_.ensure(scenario_.floes, held.index);
   contact::Detection next = parallel::detect(comm_, owners_, scenario_.floes, shapes_, detection_options_,
                                              comm_.serial() ? nullptr : &part, whole, &held);
   // The first overlapping pair and its distance at t, found from the ranks'
@@ -621,6 +625,7 @@ bool Simulation::detect_and_check(StepContext& ctx) {
   detection_ = std::move(next);
   held_ = std::move(held);
   hold_quadrature();
+  hold_shapes();
   // The copies of the floes this rank does not hold (held_now()) are stale
   // from here on, whatever the
   // drift's exchange (the vertical drift that follows is over the held

@@ -221,6 +221,9 @@ public:
   // The drift's quadrature: serially every floe's; on several ranks the
   // points of the floes this rank holds only (hold_quadrature).
   const FootprintQuadrature& quadrature() const { return quadrature_; }
+  // The collision shapes: on several ranks the parts of the floes this rank
+  // holds only (hold_shapes), every floe's radius.
+  const contact::CollisionShapes& shapes() const { return shapes_; }
   const parallel::AdvanceShareCounts& advance_share() const { return advance_share_; }  // stage seven
   const parallel::AdvanceShareCounts& collide_share() const { return collide_share_; }  // the step-start collisions
   long rejected_steps() const { return rejected_steps_; }
@@ -349,6 +352,19 @@ private:
   // them, each rank its own floes', which it holds (a floe come to it
   // since: ensure() at the drift). Serially nothing (every floe's, built).
   void hold_quadrature();
+  // The collision shapes held by band (docs/parallel.md, "The collision
+  // shapes held by band (shapes28)"; contact/shapes.hpp): on several ranks
+  // with the advance on each rank's part, at each detection that sets
+  // held_, the parts of the floes this rank holds (held_now()) and none
+  // of the others' (CollisionShapes::hold); the detection's entering floes'
+  // built before it poses them, the floes come by a move of the cuts at
+  // the drift, routed floes' with their pairs, every floe's on the whole
+  // paths (parallel::advance_on_part). Else every floe's: serially, and
+  // with the advance from the whole detection, whose share set-up and
+  // fallback read every pair's floes on every rank.
+  bool shapes_held_by_band() const;
+  void build_shapes();  // every floe's, or (held by band) the radii alone
+  void hold_shapes();
   // The poison mode's hook after the phase `phase` (poison_mode.cpp): opens,
   // checks and closes its windows; nothing when the mode is off.
   void probe(const char* phase, StepContext& ctx) {

@@ -98,6 +98,7 @@ void Simulation::detect_in_place() {
   std::optional<parallel::HaloPart> halo = halo_part(nullptr, nullptr);
   held_ = hold_band({}, {}, halo ? &*halo : nullptr);
   hold_quadrature();
+  hold_shapes();
   note_arrived(halo);
   if (halo) announced_ = std::move(halo->announced);
   wrap_entering(held_.index);

@@ -1,6 +1,6 @@
 // The per-floe structures held by band and their memory on this rank
 // (docs/parallel.md, "The arrays held by band: measured (mem27)"):
-// Simulation::hold_quadrature, Simulation::floe_memory.
+// Simulation::hold_quadrature, Simulation::hold_shapes, Simulation::floe_memory.
 
 #include "coupling/simulation.hpp"
 
@@ -12,6 +12,22 @@ void Simulation::hold_quadrature() {
   // floes of its band are kept too, so that a floe migrating to it across
   // a cut has its points already.
   if (!comm_.serial()) quadrature_.hold(scenario_.floes, held_now());
+}
+
+bool Simulation::shapes_held_by_band() const { return !comm_.serial() && advance_share_options_.on_part; }
+
+void Simulation::build_shapes() {
+  // A shape is a function of the floe's body vertices (every rank keeps
+  // every floe's): held by band, each rank builds the held floes' at the
+  // detection (hold_shapes), not every floe's here first.
+  if (shapes_held_by_band())
+    shapes_.forget(scenario_.floes);
+  else
+    shapes_ = contact::build_collision_shapes(scenario_.floes);
+}
+
+void Simulation::hold_shapes() {
+  if (shapes_held_by_band()) shapes_.hold(scenario_.floes, held_now());
 }
 
 Simulation::FloeMemory Simulation::floe_memory() const {

@@ -460,7 +460,7 @@ RoutedShapes routed_shapes(const contact::CollisionShapes& shapes, std::span<con
     out.radius.push_back(shapes.radius[i]);
     out.reach.push_back(reach[i]);
     out.parts.push_back(static_cast<std::uint32_t>(shapes.parts_of(i)));
-    for (std::size_t p = shapes.part_offsets[i]; p < shapes.part_offsets[i + 1]; ++p) {
+    for (std::size_t p = shapes.parts_begin(i); p < shapes.parts_end(i); ++p) {
       const std::span<const Vec2> v = shapes.part(p);
       out.vertices.push_back(static_cast<std::uint32_t>(v.size()));
       out.vertex.insert(out.vertex.end(), v.begin(), v.end());
@@ -475,8 +475,19 @@ void hold(const RoutedShapes& routed, contact::CollisionShapes& shapes, std::spa
     const std::uint32_t i = routed.floe[k];
     shapes.radius[i] = routed.radius[k];
     reach[i] = routed.reach[k];
+    if (!shapes.has(i)) {
+      // Not held here: its parts go to the arrays' end (as an entering
+      // floe's, CollisionShapes::hold), kept until the next detection's hold.
+      const std::span<const std::uint32_t> sizes(routed.vertices.data() + part, routed.parts[k]);
+      std::size_t count = 0;
+      for (const std::uint32_t s : sizes) count += s;
+      shapes.append(i, sizes, std::span<const Vec2>(routed.vertex.data() + vertex, count));
+      part += routed.parts[k];
+      vertex += count;
+      continue;
+    }
     FLOESIM_ASSERT(shapes.parts_of(i) == routed.parts[k]);
-    for (std::size_t p = shapes.part_offsets[i]; p < shapes.part_offsets[i + 1]; ++p, ++part) {
+    for (std::size_t p = shapes.parts_begin(i); p < shapes.parts_end(i); ++p, ++part) {
       FLOESIM_ASSERT(shapes.vertex_offsets[p + 1] - shapes.vertex_offsets[p] == routed.vertices[part]);
       std::copy_n(routed.vertex.begin() + static_cast<std::ptrdiff_t>(vertex), routed.vertices[part],
                   shapes.vertices.begin() + static_cast<std::ptrdiff_t>(shapes.vertex_offsets[p]));
@@ -628,8 +639,11 @@ void advance_on_part(const Communicator& comm, std::span<const int> owner, std::
   // The advance reads the floes' states (W^+ of the collisions), never the
   // step-start copy: it asks for the states alone (96 B a floe the rank does
   // not hold, when they are not whole).
+  // The whole paths below read every floe's shape: those this rank does not
+  // hold (contact/shapes.hpp) built from their vertices first.
   if (counts.whole_now()) {
     whole.state(WholeState::state);
+    shapes.ensure_every(floes);
     contact::advance_with_collisions(floes, shapes, whole.detection(), dt, options, stats, report);
     return;
   }
@@ -674,6 +688,7 @@ void advance_on_part(const Communicator& comm, std::span<const int> owner, std::
         // it. And every floe's reach from its owner (a rank wrote only its
         // band's at the detection, band18; 8 bytes a floe, in such a step only).
         whole.state(WholeState::state);
+        shapes.ensure_every(floes);
         start = floes.state;
         start_whole = true;
         std::vector<double> reach = part.reach;
@@ -772,6 +787,7 @@ void advance_on_part(const Communicator& comm, std::span<const int> owner, std::
   floes.state = start;
   // After a rebuild `start` is whole already: the fallback gathers nothing more.
   if (!start_whole) whole.state(WholeState::state);
+  shapes.ensure_every(floes);
   contact::advance_with_collisions(floes, shapes, whole.detection(), dt, options, stats, report);
 }
 

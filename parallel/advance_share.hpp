@@ -139,9 +139,11 @@ struct RoutedShapes {
 };
 RoutedShapes routed_shapes(const contact::CollisionShapes& shapes, std::span<const double> reach,
                            std::span<const std::uint32_t> floes);
-// Writes the shapes into `shapes` (the floes' parts and vertices in their
-// places: the layout is every rank's until piece 9 of the halo plan) and
-// the reaches into `reach`.
+// Writes the shapes into `shapes` and the reaches into `reach`: a floe
+// whose parts `shapes` holds has them overwritten in place (the same bits
+// as its sender's, which built them from the same vertices), a floe whose
+// parts it does not hold (held by band, contact/shapes.hpp) gets them
+// appended.
 void hold(const RoutedShapes& routed, contact::CollisionShapes& shapes, std::span<double> reach);
 std::vector<std::byte> pack(const RoutedShapes& routed);
 RoutedShapes unpack_routed_shapes(std::span<const std::byte> bytes);

@@ -174,6 +174,12 @@ contact::Detection detect_part(const FloeOwners& owners, int rank, const Floes& 
                                const contact::CollisionShapes& shapes, contact::DetectionOptions options,
                                const HeldFloes* held) {
   options.subset = detection_subset(owners, rank, floes, shapes, options, held);
+  // The shapes may be held by band (contact/shapes.hpp): a floe posed
+  // without its parts would have an empty box and no pair, silently.
+  for (const std::uint32_t i : options.subset.posed)
+    if (!shapes.has(i))
+      throw RunError("the detection of rank " + std::to_string(rank) + "'s part: floe " + std::to_string(i) +
+                     " is posed without its collision shape (not built where it is held)");
   return contact::detect(floes, shapes, options);
 }
 

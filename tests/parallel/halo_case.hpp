@@ -66,7 +66,7 @@ inline contact::CollisionShapes poisoned(contact::CollisionShapes shapes, const 
   for (std::size_t i = 0; i < held.size(); ++i) {
     if (held[i]) continue;
     poison(shapes.radius[i]);
-    for (std::size_t p = shapes.part_offsets[i]; p < shapes.part_offsets[i + 1]; ++p)
+    for (std::size_t p = shapes.parts_begin(i); p < shapes.parts_end(i); ++p)
       for (std::size_t k = shapes.vertex_offsets[p]; k < shapes.vertex_offsets[p + 1]; ++k)
         shapes.vertices[k] = Vec2::Constant(kNaN);
   }

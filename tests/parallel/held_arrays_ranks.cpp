@@ -1,5 +1,6 @@
-// The drift's quadrature held by band (docs/parallel.md, "The arrays held
-// by band: measured (mem27)") over the ranks mpirun started, run by ctest
+// The drift's quadrature and the collision shapes held by band
+// (docs/parallel.md, "The arrays held by band: measured (mem27)", "The
+// collision shapes held by band (shapes28)") over the ranks mpirun started, run by ctest
 // as mpi.held_arrays_ranks_N under `mpirun --oversubscribe -np N` (N = 1,
 // 2, 3) and serially without MPI.
 //
@@ -9,9 +10,10 @@
 // strips' cuts and the bands' edges. A distributed Simulation and a serial
 // one step to 900 s; after every step, on each rank: every floe it holds
 // (its band at the last detection and its own floes, held_floes() and
-// floe_owners().mine()) has its quadrature points, the same bytes as the
-// serial run's whole build; every other floe has none; and the held
-// floes' states are the serial run's. On 2 and 3 ranks some floe must
+// floe_owners().mine()) has its quadrature points and its collision
+// shape's parts, the same bytes as the serial run's whole build; every
+// other floe has neither; every floe's radius is the serial one; and the
+// held floes' states are the serial run's. On 2 and 3 ranks some floe must
 // enter and some leave a rank's held set during the run (else the test is
 // weak), and the serial run must have collisions.
 #include <algorithm>
@@ -54,15 +56,32 @@ std::string moving_pack() {
       });
 }
 
-void check_quadrature(const parallel::Communicator& comm, std::vector<std::string>& failures) {
+// Why floe i's shape on this rank (`s`) is not the serial build's (`whole`),
+// or empty when it is: its parts one by one, vertex bytes and count.
+std::string shape_differs(const contact::CollisionShapes& s, const contact::CollisionShapes& whole, std::size_t i) {
+  if (!s.has(i)) return "has no shape";
+  if (s.parts_of(i) != whole.parts_of(i)) return "has another count of parts";
+  for (std::size_t k = 0; k < s.parts_of(i); ++k) {
+    const std::span<const Vec2> v = s.part(s.parts_begin(i) + k), w = whole.part(whole.parts_begin(i) + k);
+    if (v.size() != w.size() || std::memcmp(v.data(), w.data(), v.size_bytes()) != 0)
+      return "has part " + std::to_string(k) + " unlike the serial build";
+  }
+  return {};
+}
+
+void check_held(const parallel::Communicator& comm, std::vector<std::string>& failures) {
   const std::string text = moving_pack();
   Simulation ranks(build_scenario(parse_config(text, "moving.toml", ".")), comm);
   Simulation serial(build_scenario(parse_config(text, "moving.toml", ".")));
   const std::size_t n = serial.floes().size();
   const FootprintQuadrature& whole = serial.quadrature();
-  long entered = 0, left = 0;
-  std::vector<std::uint8_t> had(n, 0);
-  for (std::size_t i = 0; i < n; ++i) had[i] = ranks.quadrature().has(i);
+  const contact::CollisionShapes& whole_shapes = serial.shapes();
+  long entered = 0, left = 0, shapes_entered = 0, shapes_left = 0;
+  std::vector<std::uint8_t> had(n, 0), had_shape(n, 0);
+  for (std::size_t i = 0; i < n; ++i) {
+    had[i] = ranks.quadrature().has(i);
+    had_shape[i] = ranks.shapes().has(i);
+  }
   int step = 0;
   while (serial.time() < 900.0) {
     ranks.step(900.0);
@@ -75,10 +94,19 @@ void check_quadrature(const parallel::Communicator& comm, std::vector<std::strin
       for (const std::uint32_t i : ranks.floe_owners().mine()) held[i] = 1;
     }
     const FootprintQuadrature& q = ranks.quadrature();
+    const contact::CollisionShapes& shapes = ranks.shapes();
     std::string wrong;
+    if (shapes.radius.size() != n ||
+        std::memcmp(shapes.radius.data(), whole_shapes.radius.data(), n * sizeof(double)) != 0)
+      wrong = "the radii differ from the serial build's";
     for (std::size_t i = 0; i < n && wrong.empty(); ++i) {
       if (!held[i]) {
         if (q.has(i)) wrong = "floe " + std::to_string(i) + " is not held but has quadrature points";
+        else if (shapes.has(i)) wrong = "floe " + std::to_string(i) + " is not held but has a collision shape";
+        continue;
+      }
+      if (const std::string why = shape_differs(shapes, whole_shapes, i); !why.empty()) {
+        wrong = "held floe " + std::to_string(i) + " " + why;
         continue;
       }
       const std::span<const Vec2> p = q.points(i), pw = whole.points(i);
@@ -97,6 +125,10 @@ void check_quadrature(const parallel::Communicator& comm, std::vector<std::strin
       entered += now && !had[i];
       left += !now && had[i];
       had[i] = now;
+      const std::uint8_t shaped = shapes.has(i);
+      shapes_entered += shaped && !had_shape[i];
+      shapes_left += !shaped && had_shape[i];
+      had_shape[i] = shaped;
     }
   }
   const std::vector<FloeState> written = ranks.writer_states();  // collective
@@ -104,20 +136,23 @@ void check_quadrature(const parallel::Communicator& comm, std::vector<std::strin
                                                            n * sizeof(FloeState)) != 0))
     failures.push_back("the gathered states differ from the serial run's at the end");
   const long entered_all = comm.sum(entered), left_all = comm.sum(left);
-  if (!comm.serial() && (entered_all == 0 || left_all == 0))
+  const long shapes_entered_all = comm.sum(shapes_entered), shapes_left_all = comm.sum(shapes_left);
+  if (!comm.serial() && (entered_all == 0 || left_all == 0 || shapes_entered_all == 0 || shapes_left_all == 0))
     failures.push_back("no floe entered or left a held set: a weak test");
   if (serial.collision_stats().lcps == 0) failures.push_back("no collision: a weak test");
   if (comm.rank() == 0)
-    std::printf("%d rank(s): %d steps, %ld LCPs; floes entering a held set %ld, leaving %ld (all ranks); rank 0 "
-                "holds the points of %zu of %zu floes\n",
+    std::printf("%d rank(s): %d steps, %ld LCPs; floes entering a held set %ld, leaving %ld (all ranks; shapes: "
+                "%ld, %ld); rank 0 holds the points of %zu of %zu floes, the shapes of %zu\n",
                 comm.size(), step, static_cast<long>(serial.collision_stats().lcps), entered_all, left_all,
-                static_cast<std::size_t>(std::count(had.begin(), had.end(), 1)), n);
+                shapes_entered_all, shapes_left_all, static_cast<std::size_t>(std::count(had.begin(), had.end(), 1)),
+                n, static_cast<std::size_t>(std::count(had_shape.begin(), had_shape.end(), 1)));
 }
 
 }  // namespace
 
 int main() {
   parallel::Session session;
-  return test::run_checks(session.world(), "the quadrature held by band: held floes' as the serial build, no other",
-                          check_quadrature);
+  return test::run_checks(session.world(),
+                          "the quadrature and collision shapes held by band: held floes' as the serial build, no other",
+                          check_held);
 }

@@ -555,7 +555,7 @@ bool play_parts(const Case& c, const parallel::FloeOwners& strips, std::span<con
               constexpr double nan = std::numeric_limits<double>::quiet_NaN();
               contact::CollisionShapes& sh = shapes[k];
               sh.radius[i] = nan;
-              for (std::size_t q = sh.part_offsets[i]; q < sh.part_offsets[i + 1]; ++q)
+              for (std::size_t q = sh.parts_begin(i); q < sh.parts_end(i); ++q)
                 for (std::size_t v = sh.vertex_offsets[q]; v < sh.vertex_offsets[q + 1]; ++v)
                   sh.vertices[v] = Vec2::Constant(nan);
               poisoned->dropped = i;
