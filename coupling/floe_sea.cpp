@@ -115,32 +115,36 @@ void FloeSeaContact::floes_changed(const Floes& floes) {
   footprints_.forget();
   next_owners_.owner.clear();  // the next rebuild by index (reads no place), until owners by place are known
   next_owners_.drifted = false;
-  const std::size_t n = floes.size(), old = bottom0_.size();
-  dynamic_.assign(n, 0);
-  tilt_.assign(n, 0);
-  body_moments_.resize(n);
-  bottom0_.resize(n);
-  loads_.assign(n, {});
-  first_half_.assign(n, Eigen::Vector3d::Zero());
-  step_horizontal_.assign(n, Eigen::Vector3d::Zero());
+  const std::size_t n = floes.size(), old = constants_.bottom0.size();
+  // The groups of one entry a floe sized with the floes (the header's
+  // members; the implicit step's at the step, the serial places at
+  // order_by_owner). Every constant is set below but a staying floe's
+  // bottom0; the kicks' loads are the old floes'.
+  fit_floes(constants_, n);
+  fit_floes(kicks_, n);
+  fit_floes(evaluated_, n);
+  std::fill(kicks_.loads.begin(), kicks_.loads.end(), FloeSeaLoad{});
+  std::fill(kicks_.first_half.begin(), kicks_.first_half.end(), Eigen::Vector3d::Zero());
+  std::fill(kicks_.step_horizontal.begin(), kicks_.step_horizontal.end(), Eigen::Vector3d::Zero());
   step_mean_pending_ = false;
   double min_mass_per_area = INFINITY;
   for (std::size_t i = 0; i < n; ++i) {
-    dynamic_[i] = floes.is_static[i] ? 0 : 1;
+    constants_.dynamic[i] = floes.is_static[i] ? 0 : 1;
     const PolygonMoments m = polygon_moments(floes.vertices(i));
     const double rh = floes.density[i] * floes.thickness[i];
-    body_moments_[i] << rh * m.sxx, rh * m.sxy, rh * m.sxy, rh * m.syy;
+    constants_.body_moments[i] << rh * m.sxx, rh * m.sxy, rh * m.sxy, rh * m.syy;
     // A slope is resisted when the floe spans about two cells along it: its
     // smallest radius of gyration is at least half a cell. A long-crested sea
     // (dims = 1) is uniform across, so it never resists roll.
-    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(body_moments_[i] / std::max(floes.mass[i], 1e-300));
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(constants_.body_moments[i] /
+                                                             std::max(floes.mass[i], 1e-300));
     const double gyration = std::sqrt(std::max(eig.eigenvalues()[0], 0.0));
-    if (gyration >= 0.5 * std::max(grid_.dx(), grid_.dims == 2 ? grid_.dy() : 0.0))
-      tilt_[i] = grid_.dims == 2 ? 2 : 1;
+    const bool resists = gyration >= 0.5 * std::max(grid_.dx(), grid_.dims == 2 ? grid_.dy() : 0.0);
+    constants_.tilt[i] = !resists ? 0 : grid_.dims == 2 ? 2 : 1;
     // A new floe (a piece of a split) floats at its draft (and compliance)
     // below the calm sea's free level, as its parent did.
-    if (i >= old) bottom0_[i] = free_level_ - floes.draft(i, rho_) * (1.0 + 1.0 / K_);
-    if (dynamic_[i]) min_mass_per_area = std::min(min_mass_per_area, rh);
+    if (i >= old) constants_.bottom0[i] = free_level_ - floes.draft(i, rho_) * (1.0 + 1.0 / K_);
+    if (constants_.dynamic[i]) min_mass_per_area = std::min(min_mass_per_area, rh);
   }
   // Leapfrog's linear limit is 2 / omega_pen. The contact is not linear (it
   // opens and closes, and the coverage changes as edges cross cells): at
@@ -154,32 +158,37 @@ void FloeSeaContact::floes_changed(const Floes& floes) {
 }
 
 FloeSeaState FloeSeaContact::saved_state() const {
-  FloeSeaState s{true, bottom0_, loads_h_, penalty_energy(), {}, {}};
+  FloeSeaState s{true, constants_.bottom0, loads_h_, penalty_energy(), {}, {}};
   // Every floe's reference pose (from the floes' owners when the last
   // rebuild posed each rank's own floes only: collective, as save() is).
   for (const FloePose& p : footprints_.whole_reference()) s.footprint_reference.push_back({p.x, p.y, p.yaw});
   // The implicit step's mean horizontal loads cannot be evaluated again from the state.
   if (step_mean_loads_ && loads_h_ >= 0.0)
-    for (const FloeSeaLoad& load : loads_) s.mean_horizontal.push_back({load.horizontal[0], load.horizontal[1], load.horizontal[2]});
+    for (const FloeSeaLoad& load : kicks_.loads)
+      s.mean_horizontal.push_back({load.horizontal[0], load.horizontal[1], load.horizontal[2]});
   return s;
 }
 
 void FloeSeaContact::restore(const FloeSeaState& state, const Floes& floes, fluid::Sea& sea, IncidentSea* incident) {
   floes_changed(floes);
-  bottom0_ = state.bottom0;
+  constants_.bottom0 = state.bottom0;
   // The footprints move from where they were last built: built there again,
   // they move to the same bits.
   if (!state.footprint_reference.empty()) {
-    poses_.clear();
-    for (const auto& p : state.footprint_reference) poses_.push_back({p[0], p[1], p[2]});
+    FLOESIM_ASSERT(state.footprint_reference.size() == evaluated_.poses.size());
+    for (std::size_t i = 0; i < evaluated_.poses.size(); ++i) {
+      const auto& p = state.footprint_reference[i];
+      evaluated_.poses[i] = {p[0], p[1], p[2]};
+    }
     clear_footprint_cells();
-    footprints_.rebuild_at(floes, dynamic_, poses_, threads_);
+    footprints_.rebuild_at(floes, constants_.dynamic, evaluated_.poses, threads_);
   }
   if (state.loads_h >= 0.0) evaluate_loads(floes, sea, incident, state.loads_h);
-  if (state.mean_horizontal.size() == loads_.size())
-    for (std::size_t i = 0; i < loads_.size(); ++i) {
-      loads_[i].horizontal = {state.mean_horizontal[i][0], state.mean_horizontal[i][1], state.mean_horizontal[i][2]};
-      step_horizontal_[i] = loads_[i].horizontal;
+  if (state.mean_horizontal.size() == kicks_.loads.size())
+    for (std::size_t i = 0; i < kicks_.loads.size(); ++i) {
+      const auto& mean = state.mean_horizontal[i];
+      kicks_.loads[i].horizontal = {mean[0], mean[1], mean[2]};
+      kicks_.step_horizontal[i] = kicks_.loads[i].horizontal;
     }
   penalty_energy_ = state.penalty_energy;
   energy_pending_ = false;
@@ -194,17 +203,18 @@ Eigen::Matrix2d FloeSeaContact::tilt_inertia(const Floes& floes, std::size_t i, 
   Eigen::Matrix2d R;
   R << c, -s, s, c;
   const double h = floes.thickness[i];
-  return R * body_moments_[i] * R.transpose() + floes.mass[i] * h * h / 12.0 * Eigen::Matrix2d::Identity();
+  return R * constants_.body_moments[i] * R.transpose() + floes.mass[i] * h * h / 12.0 * Eigen::Matrix2d::Identity();
 }
 
 void FloeSeaContact::pose_at_states(const Floes& floes, std::span<const std::uint32_t> which) {
-  poses_.resize(floes.size());
-  for (const std::uint32_t i : which) poses_[i] = {floes.state[i].x, floes.state[i].y, floes.state[i].yaw};
+  FLOESIM_ASSERT(evaluated_.poses.size() == floes.size());
+  for (const std::uint32_t i : which) evaluated_.poses[i] = {floes.state[i].x, floes.state[i].y, floes.state[i].yaw};
 }
 
 void FloeSeaContact::pose_at_states(const Floes& floes) {
-  poses_.resize(floes.size());
-  for (std::size_t i = 0; i < floes.size(); ++i) poses_[i] = {floes.state[i].x, floes.state[i].y, floes.state[i].yaw};
+  FLOESIM_ASSERT(evaluated_.poses.size() == floes.size());
+  for (std::size_t i = 0; i < floes.size(); ++i)
+    evaluated_.poses[i] = {floes.state[i].x, floes.state[i].y, floes.state[i].yaw};
 }
 
 void FloeSeaContact::clear_footprint_cells() {
@@ -225,7 +235,7 @@ void FloeSeaContact::clear_footprint_cells() {
 
 void FloeSeaContact::place_footprints(const Floes& floes, bool move, std::span<const int> owners) {
   clear_footprint_cells();
-  footprints_.place(floes, dynamic_, poses_, threads_, move, owners);
+  footprints_.place(floes, constants_.dynamic, evaluated_.poses, threads_, move, owners);
   // By owner, this rank's floes only, in the serial order (the others'
   // pieces are not here).
   if (by_owner()) {
@@ -238,7 +248,7 @@ void FloeSeaContact::place_footprints(const Floes& floes, bool move, std::span<c
   // read and written where each floe lies: this keeps them in cache).
   order_.clear();
   for (std::size_t i = 0; i < floes.size(); ++i)
-    if (dynamic_[i] && fp.offsets[i] < fp.offsets[i + 1]) order_.push_back(static_cast<std::uint32_t>(i));
+    if (constants_.dynamic[i] && fp.offsets[i] < fp.offsets[i + 1]) order_.push_back(static_cast<std::uint32_t>(i));
   std::sort(order_.begin(), order_.end(),
             [&](std::uint32_t x, std::uint32_t y) { return fp.cell[fp.offsets[x]] < fp.cell[fp.offsets[y]]; });
   const double inv_cell_area = 1.0 / cell_area_;
@@ -258,7 +268,7 @@ void FloeSeaContact::evaluate(const Floes& floes, fluid::Sea& sea, double h) {
   // pieces it builds); any other rebuild, every floe's (set_owners finds
   // the owners by place from them).
   pose_at_states(floes, footprints_.mine());
-  const bool move = footprints_.movable(dynamic_, poses_);
+  const bool move = footprints_.movable(constants_.dynamic, evaluated_.poses);
   const GivenOwners given = move ? GivenOwners{} : given_owners(floes.size());
   if (!move && !given.owner.empty()) pose_at_states(floes, given.mine);
   else if (!move) pose_at_states(floes);
@@ -286,12 +296,12 @@ void FloeSeaContact::evaluate(const Floes& floes, fluid::Sea& sea, double h) {
   std::vector<double>& u = eval_.penetration;
   std::vector<double>& psi = eval_.psi;
   std::vector<double>& force = eval_.force;
-  std::vector<double>& wetted = eval_.wetted;
+  std::vector<double>& wetted = evaluated_.wetted;
   u.assign(fp.cell.size(), 0.0);
   psi.resize(fp.cell.size());
   force.assign(fp.cell.size(), 0.0);
-  wetted.assign(floes.size(), 0.0);
-  for (FloeSeaLoad& load : loads_) load = {};
+  std::fill(wetted.begin(), wetted.end(), 0.0);
+  for (FloeSeaLoad& load : kicks_.loads) load = {};
   const double law_start = owned_clock();
   // Vertical: the law on each area piece, floe by floe (on threads); then
   // the pieces' sums into the cells, in order (the same sums whatever the
@@ -300,9 +310,9 @@ void FloeSeaContact::evaluate(const Floes& floes, fluid::Sea& sea, double h) {
 #pragma omp parallel for num_threads(threads_) schedule(dynamic, 16) if (floes_in_order > kFloesPerThread)
   for (std::ptrdiff_t j = 0; j < floes_in_order; ++j) {
     const std::uint32_t i = order_[static_cast<std::size_t>(j)];
-    FloeSeaLoad& load = loads_[i];
+    FloeSeaLoad& load = kicks_.loads[i];
     const FloeState& st = floes.state[i];
-    const double z = st.heave + bottom0_[i];
+    const double z = st.heave + constants_.bottom0[i];
     const Vec2 a{st.pitch, st.roll}, ar{st.pitch_rate, st.roll_rate};
     const double c = damper_kick * weak_coefficient(floes, i);
     const double inv_mass = 1.0 / (floes.density[i] * floes.thickness[i]) + sea_inverse_mass_;
@@ -345,8 +355,7 @@ void FloeSeaContact::evaluate(const Floes& floes, fluid::Sea& sea, double h) {
       }
   }
   // Strong part, horizontal: -dV/dG and -dV/dyaw at the present slopes.
-  slope_.resize(floes.size());
-  for (std::uint32_t i : order_) slope_[i] = {floes.state[i].pitch, floes.state[i].roll};
+  for (std::uint32_t i : order_) evaluated_.slope[i] = {floes.state[i].pitch, floes.state[i].roll};
   horizontal_loads(u);
   penalty_energy_ = energy;
 }
@@ -357,7 +366,7 @@ void FloeSeaContact::horizontal_loads(std::span<const double> u) {
   // the cell's pieces.
   const Footprints& fp = footprints_.pieces();
   const std::vector<double>& psi = eval_.psi;
-  const std::vector<double>& wetted = eval_.wetted;
+  const std::vector<double>& wetted = evaluated_.wetted;
   const double ks = s_ * kappa_, inv_cell_area = 1.0 / cell_area_;
   if (ks <= 0.0) return;
   // Each rank its own floes (their edge pieces are only there); the caller
@@ -368,7 +377,7 @@ void FloeSeaContact::horizontal_loads(std::span<const double> u) {
   for (std::ptrdiff_t j = 0; j < floes_in_order; ++j) {
     const std::uint32_t i = order_[static_cast<std::size_t>(j)];
     if (!footprints_.owns(i)) continue;
-    const Vec2 a = slope_[i];
+    const Vec2 a = evaluated_.slope[i];
     Vec2 fh = Vec2::Zero();
     double torque = 0.0;
     for (std::size_t k = fp.edge_offsets[i]; k < fp.edge_offsets[i + 1]; ++k) {
@@ -392,19 +401,19 @@ void FloeSeaContact::horizontal_loads(std::span<const double> u) {
     }
     // The explicit-G term of dV/dG: -psi_c a_c(P0) u a, summed over the area pieces.
     fh -= ks * wetted[i] * a;
-    loads_[i].horizontal = {fh.x(), fh.y(), torque};
+    kicks_.loads[i].horizontal = {fh.x(), fh.y(), torque};
   }
   charge_owned(start);
 }
 
 void FloeSeaContact::evaluate_loads(const Floes& floes, fluid::Sea& sea, IncidentSea* incident, double h) {
   evaluate(floes, sea, h);
-  update_water(floes, sea, incident);
+  update_water(sea, incident);
   share_owned();
   // After an implicit step the horizontal loads are that step's mean (zero
   // on a floe that had no pieces on the step's midpoint footprint).
   if (step_mean_pending_)
-    for (std::size_t i = 0; i < loads_.size(); ++i) loads_[i].horizontal = step_horizontal_[i];
+    for (std::size_t i = 0; i < kicks_.loads.size(); ++i) kicks_.loads[i].horizontal = kicks_.step_horizontal[i];
 }
 
 void FloeSeaContact::ready_loads(const Floes& floes, fluid::Sea& sea, IncidentSea* incident, double h) {
@@ -413,8 +422,8 @@ void FloeSeaContact::ready_loads(const Floes& floes, fluid::Sea& sea, IncidentSe
   if (loads_h_ < 0.0 || (explicit_damper && loads_h_ != h)) evaluate_loads(floes, sea, incident, h);
 }
 
-void FloeSeaContact::update_water(const Floes& floes, const fluid::Sea& sea, IncidentSea* incident) {
-  water_.assign(floes.size(), Vec2::Zero());
+void FloeSeaContact::update_water(const fluid::Sea& sea, IncidentSea* incident) {
+  std::fill(evaluated_.water.begin(), evaluated_.water.end(), Vec2::Zero());
   water_by_owner_ = false;  // zero on every rank
   if (!incident) return;
   water_by_owner_ = !comm_.serial();
@@ -444,7 +453,7 @@ void FloeSeaContact::update_water(const Floes& floes, const fluid::Sea& sea, Inc
       sum0 += fp.area[k] * Vec2{u0[c], v0[c]};
       sum1 += fp.area[k] * Vec2{u1[c], v1[c]};
     }
-    if (area > 0.0) water_[i] = ((1.0 - w) * sum0 + w * sum1) / area;
+    if (area > 0.0) evaluated_.water[i] = ((1.0 - w) * sum0 + w * sum1) / area;
   }
   charge_owned(start);
 }
@@ -473,20 +482,20 @@ void FloeSeaContact::kick_floes(Floes& floes, double h) {
   // The explicit damper's loads depend on the rates this kick changes.
   if (!implicit_ && s_ < 1.0) loads_h_ = -1.0;
   for (std::size_t i = 0; i < floes.size(); ++i) {
-    if (!dynamic_[i]) continue;
+    if (!constants_.dynamic[i]) continue;
     FloeState& st = floes.state[i];
-    const FloeSeaLoad& load = loads_[i];
+    const FloeSeaLoad& load = kicks_.loads[i];
     // The implicit step applies the vertical law and the weight itself (the
     // loads' vertical part is zero): no vertical kick. Every rank's copy of
     // every floe's vertical DOFs is then the implicit step's alone, which
     // it reads; the kick would turn a stale copy's yaw into them.
     if (!implicit_) {
       st.heave_rate += h * load.vertical[0] / floes.mass[i];
-      if (tilt_[i] == 2) {
+      if (constants_.tilt[i] == 2) {
         const Eigen::Vector2d da = tilt_inertia(floes, i).ldlt().solve(load.vertical.tail<2>());
         st.pitch_rate += h * da[0];
         st.roll_rate += h * da[1];
-      } else if (tilt_[i] == 1) {
+      } else if (constants_.tilt[i] == 1) {
         st.pitch_rate += h * load.vertical[1] / tilt_inertia(floes, i)(0, 0);
       }
     }
@@ -495,8 +504,8 @@ void FloeSeaContact::kick_floes(Floes& floes, double h) {
     // to 2 h F_mean (the header's "Horizontal loads of the implicit step").
     Eigen::Vector3d impulse = h * load.horizontal;
     if (step_mean_loads_) {
-      if (step_mean_pending_) impulse = 2.0 * h * step_horizontal_[i] - first_half_[i];
-      else first_half_[i] = impulse;
+      if (step_mean_pending_) impulse = 2.0 * h * kicks_.step_horizontal[i] - kicks_.first_half[i];
+      else kicks_.first_half[i] = impulse;
     }
     st.vx += impulse[0] / floes.mass[i];
     st.vy += impulse[1] / floes.mass[i];
@@ -527,36 +536,26 @@ void FloeSeaContact::advance_vertical(Floes& floes, std::span<const FloeState> s
 }
 
 double FloeSeaContact::vertical_kinetic(const Floes& floes, std::size_t i) const {
-  if (!dynamic_[i]) return 0.0;
+  if (!constants_.dynamic[i]) return 0.0;
   const FloeState& st = floes.state[i];
   const Eigen::Vector2d ar(st.pitch_rate, st.roll_rate);
   return 0.5 * floes.mass[i] * st.heave_rate * st.heave_rate + 0.5 * ar.dot(tilt_inertia(floes, i) * ar);
 }
 
 double FloeSeaContact::weight_energy(const Floes& floes, std::size_t i) const {
-  return dynamic_[i] ? floes.mass[i] * g_ * floes.state[i].heave : 0.0;
+  return constants_.dynamic[i] ? floes.mass[i] * g_ * floes.state[i].heave : 0.0;
 }
 
 FloeSeaContact::Memory FloeSeaContact::memory(std::span<const std::uint8_t> held) const {
-  const std::size_t k = held_count(held, dynamic_.size());
+  const std::size_t k = held_count(held, constants_.dynamic.size());
   Memory m;
   FloeBytes& f = m.per_floe;
-  f += per_floe_bytes(dynamic_, k);
-  f += per_floe_bytes(tilt_, k);
-  f += per_floe_bytes(bottom0_, k);
-  f += per_floe_bytes(body_moments_, k);
-  f += per_floe_bytes(poses_, k);
-  f += per_floe_bytes(loads_, k);
-  f += per_floe_bytes(water_, k);
-  f += per_floe_bytes(slope_, k);
-  f += per_floe_bytes(step_horizontal_, k);
-  f += per_floe_bytes(first_half_, k);
-  f += per_floe_bytes(inertia_, k);
-  f += per_floe_bytes(yaw_, k);
-  f += per_floe_bytes(free_bottom_, k);
-  f += per_floe_bytes(eval_.wetted, k);
-  f += per_floe_bytes(owner_.box, k);
-  f += per_floe_bytes(owner_.position, k);
+  f += floe_group_bytes(constants_, k);
+  f += floe_group_bytes(kicks_, k);
+  f += floe_group_bytes(evaluated_, k);
+  f += floe_group_bytes(implicit_floes_, k);
+  f += floe_group_bytes(owner_.places, k);
+  // Not a group: empty until the owners by place are known (set_next_owners).
   f += per_floe_bytes(next_owners_.owner, k);
   m.footprints = footprints_.memory(held);
   return m;

@@ -125,6 +125,7 @@
 #include "core/checkpoint.hpp"
 #include "core/floes.hpp"
 #include "core/params.hpp"
+#include "coupling/floe_sea_arrays.hpp"
 #include "coupling/footprint.hpp"
 #include "coupling/moving_footprint.hpp"
 #include "coupling/penalty_step.hpp"
@@ -135,12 +136,6 @@ namespace floesim {
 
 namespace fluid { class Sea; }
 class IncidentSea;
-
-// Loads of the sea on floe i, world frame.
-struct FloeSeaLoad {
-  Eigen::Vector3d vertical = Eigen::Vector3d::Zero();    // Fz (N, weight included), moments about G (N m)
-  Eigen::Vector3d horizontal = Eigen::Vector3d::Zero();  // Fx, Fy (N), torque about z (N m)
-};
 
 class FloeSeaContact {
 public:
@@ -181,7 +176,7 @@ public:
   // mean over its footprint, at the time of the loads' evaluation. On
   // several ranks, of this rank's floes (MovingFootprints::mine) only, until
   // hand_water_over gives each floe's to the rank that drifts it.
-  std::span<const Vec2> water_velocity() const { return water_; }
+  std::span<const Vec2> water_velocity() const { return evaluated_.water; }
   // On several ranks: the water velocity of each floe whose coupling owner
   // (MovingFootprints::owners) is not drift_owner[i] goes from the first to
   // the second (one all-to-all, none when the owners agree; collective).
@@ -317,7 +312,7 @@ public:
   double weight_energy(const Floes& floes, std::size_t i) const;
 
   // Height of floe i's bottom at its centroid, z_b(G) = zeta + z0 (m).
-  double bottom(const Floes& floes, std::size_t i) const { return floes.state[i].heave + bottom0_[i]; }
+  double bottom(const Floes& floes, std::size_t i) const { return floes.state[i].heave + constants_.bottom0[i]; }
   // Evaluated by owner (above), this rank's floes' pieces only.
   const Footprints& footprints() const { return footprints_.pieces(); }
   // Placements of the footprints and how many of them were rebuilds
@@ -348,7 +343,7 @@ public:
     long shared = 0, pieces = 0, alone_here = 0, alone_sent = 0;
   };
   const RoutedCells& routed_cells() const { return owner_.routed_counts; }
-  std::span<const FloeSeaLoad> loads() const { return loads_; }
+  std::span<const FloeSeaLoad> loads() const { return kicks_.loads; }
   std::span<const double> pressure() const { return pressure_; }
   double strong_share() const { return s_; }
   double kappa() const { return kappa_; }
@@ -359,11 +354,13 @@ public:
 
   // What the coupling allocates per floe on this rank, against the held
   // floes' entries (core/floe_bytes.hpp; `held` empty: every floe): its
-  // arrays of one entry a floe (the constants it derives, the poses, loads,
-  // water velocities and slopes, the implicit step's, the owners' boxes
-  // and places in the serial order, the next owners), and the footprints'
+  // arrays of one entry a floe (its groups, coupling/floe_sea_arrays.hpp:
+  // the constants it derives, the kicks' loads, the poses, water velocities
+  // and slopes, the implicit step's, the owners' boxes and places in the
+  // serial order; and the next owners), and the footprints'
   // (MovingFootprints::memory). Not counted: the per-cell arrays (the sea's
-  // grid, not the floes) and the per-piece scratch of one evaluation.
+  // grid, not the floes), the per-piece scratch of one evaluation and the
+  // lists of floes (order_, owner_.serial, next_owners_.mine and held).
   struct Memory {
     FloeBytes per_floe;
     MovingFootprints::Memory footprints;
@@ -391,7 +388,7 @@ private:
   }
   Eigen::Matrix2d tilt_inertia(const Floes& floes, std::size_t i, double yaw) const;
   // Clears the cells of the present footprints, places them with floe i at
-  // poses_[i] (moved if `move`, MovingFootprints::movable's verdict, else
+  // evaluated_.poses[i] (moved if `move`, MovingFootprints::movable's verdict, else
   // rebuilt: coupling/moving_footprint.hpp) and sums the cells' coverage
   // (cells_[c].coverage).
   // With `owners` given by place (take_place_owners), a rebuild takes them.
@@ -435,7 +432,7 @@ private:
   // settle_energy sums the terms in the serial order).
   double sum_cells_by_owner(double ks);
   // By owner: order_ <- this rank's floes in the serial order, and
-  // owner_.position every floe's place in that order (one gather of the
+  // owner_.places.position every floe's place in that order (one gather of the
   // floes' first cells, with their boxes; in a flume not in slabs, with the
   // ranks of their shares of columns: next_owners_).
   void order_by_owner(std::size_t floes);
@@ -445,27 +442,27 @@ private:
   // By owner: the penalty energy from every rank's terms
   // (owner_.energy_*), summed in the serial order (one gather).
   void settle_energy() const;
-  // poses_ <- the floes' present poses: every floe's, or those of `which`
+  // evaluated_.poses <- the floes' present poses: every floe's, or those of `which`
   // (the others' entries are left as they were, and not read).
   void pose_at_states(const Floes& floes);
   void pose_at_states(const Floes& floes, std::span<const std::uint32_t> which);
   // The contact at the present state for a kick of length h (see evaluate_loads).
   void evaluate(const Floes& floes, fluid::Sea& sea, double h);
-  // loads_[i].horizontal = -dV/dG, -dV/dyaw (the header's formulas) for the
-  // pieces' [delta]^+ u, with eval_.psi, eval_.wetted, cells_[c].sum and
-  // slope_ already set for them.
+  // kicks_.loads[i].horizontal = -dV/dG, -dV/dyaw (the header's formulas) for the
+  // pieces' [delta]^+ u, with eval_.psi, evaluated_.wetted, cells_[c].sum and
+  // evaluated_.slope already set for them.
   // On several ranks, for this rank's floes only (share_owned completes them).
   void horizontal_loads(std::span<const double> u);
   // The owners' loads to every rank, in one call (nothing when serial).
   void share_owned();
   // Implicit: the step's mean horizontal loads (the header's "Horizontal
-  // loads of the implicit step") into step_horizontal_.
+  // loads of the implicit step") into kicks_.step_horizontal.
   void step_mean_horizontal(const Floes& floes, std::span<const FloeState> start);
   // Mean over each floe's footprint (weights a_c) of the incident waves'
   // velocity at the sea's time (zero without incident waves).
   // On several ranks, for this rank's floes only (hand_water_over gives
   // them to the ranks that drift them).
-  void update_water(const Floes& floes, const fluid::Sea& sea, IncidentSea* incident);
+  void update_water(const fluid::Sea& sea, IncidentSea* incident);
   void implicit_step(Floes& floes, std::span<const FloeState> start, fluid::Sea& sea, double h);
   // The static start's pressure, held by a sea with a static part (a
   // truncated BEM sea's correction): p = rho g (W - eta), W the waves.
@@ -476,13 +473,13 @@ private:
   // a move, the given owners' for a rebuild with owners (given_owners),
   // every floe only for a rebuild by index.
   void place_midpoint_footprints(const Floes& floes, std::span<const FloeState> start);
-  // poses_[i] <- floe i's pose at the midpoint from start[i] to its present
+  // evaluated_.poses[i] <- floe i's pose at the midpoint from start[i] to its present
   // place, for i in `which` (a static floe's: its present place).
   void pose_at_midpoint(const Floes& floes, std::span<const FloeState> start, std::span<const std::uint32_t> which);
   // On several ranks: the present yaw of each floe of order_ that resists a
-  // slope (tilt_ > 0; its tilt inertia turns with it), from its coupling
+  // slope (constants_.tilt > 0; its tilt inertia turns with it), from its coupling
   // owner, which holds it (the other ranks' copies of its horizontal state
-  // may be stale: the halo exchange), into yaw_ (per floe; the others'
+  // may be stale: the halo exchange), into implicit_floes_.yaw (per floe; the others'
   // entries are not read). One gather, 8 B a tilted floe.
   void gather_tilted_yaw(const Floes& floes);
   // The sea's part of the implicit step's operator: out = G_sea u on the
@@ -495,17 +492,21 @@ private:
   double sea_inverse_mass_ = 0.0;  // 1 / m_sea: eta' per unit pressure impulse on one cell (m^2 s / kg... per Pa s)
   double stable_step_ = 0.0;
   double cell_area_ = 1.0;
-  std::vector<std::uint8_t> dynamic_;
-  std::vector<std::uint8_t> tilt_;           // slopes resisted: 0 none, 1 pitch, 2 pitch and roll
-  std::vector<double> bottom0_;             // z0_i, m
+  // The arrays of one entry a floe, in groups of one life (coupling/
+  // floe_sea_arrays.hpp: each group sized and counted as one). Sized with
+  // the floes (floes_changed): the floes' constants; the loads the kicks
+  // apply (zeroed there); what an evaluation poses and finds per floe.
+  // Sized at each implicit step: the implicit step's (empty with the
+  // explicit kicks). By owner, the serial places: owner_.places.
+  FloeSeaConstants constants_;
+  FloeSeaKicks kicks_;
+  FloeSeaEvaluated evaluated_;
+  FloeSeaImplicit implicit_floes_;
   double free_level_ = 0.0;                 // the calm sea's free level (m; eta has zero mean)
-  std::vector<Eigen::Matrix2d> body_moments_;  // rho h ∫ r r^T in the body frame
   MovingFootprints footprints_;
-  std::vector<FloePose> poses_;  // where the next placement puts each floe (the floes it reads)
   // take_place_owners' owners, for the next evaluation (empty: none given).
   std::span<const int> place_owner_, place_rows_;
   std::span<const std::uint32_t> place_mine_;
-  std::vector<FloeSeaLoad> loads_;
   std::vector<double> pressure_;
   struct CellSums {
     double coverage = 0.0;  // Phi_c: the share of cell c under floes
@@ -545,10 +546,10 @@ private:
     std::vector<int> receivers;
     std::vector<double> alone_totals;
     // The serial order (order_by_owner): per floe the box of its pieces'
-    // cells (parallel::CellBox, first_cell kNoCell: not in the order) and
-    // its place in the order, and the order.
-    std::vector<parallel::CellBox> box;
-    std::vector<std::uint32_t> position, serial;
+    // cells and its place in the order (a group of one entry a floe), and
+    // the order.
+    FloeSeaSerialPlaces places;
+    std::vector<std::uint32_t> serial;
     // Routed: the pieces of the cells of `cells` grouped by cell (cell j's
     // are [first[j], first[j + 1])), each with its floe's position (keys)
     // and its coverage (values).
@@ -636,13 +637,9 @@ private:
   std::vector<std::uint32_t> order_;  // dynamic floes with pieces, by their first cell
   bool pressure_kicked_ = false;  // the sea's last kick was with pressure_ as it is
   double loads_h_ = -1.0;         // the kick length of the last evaluation (< 0: stale)
-  std::vector<Vec2> water_;       // incident velocity under each floe, with the loads
-  bool water_by_owner_ = false;   // water_ holds this rank's floes' only (several ranks, incident waves)
-  std::vector<Vec2> slope_;       // per floe: the bottom slope the horizontal loads are taken at
-  // Implicit integrator, per floe: the last step's mean horizontal load, and
-  // the impulse the present step's first half kick applied; pending: the
-  // mean is this step's and its second half kick is to come.
-  std::vector<Eigen::Vector3d> step_horizontal_, first_half_;
+  bool water_by_owner_ = false;   // evaluated_.water holds this rank's floes' only (several ranks, incident waves)
+  // Implicit integrator: the mean in kicks_.step_horizontal is this step's
+  // and its second half kick is to come.
   bool step_mean_pending_ = false;
   bool implicit_ = false;
   bool step_mean_loads_ = false;  // implicit, [coupling] horizontal_loads = "step_mean"
@@ -654,17 +651,13 @@ private:
   ImplicitStats implicit_stats_;
   double self_response_h_ = -1.0, self_response_ = 0.0;  // sea's node response to its own pressure over h
   std::vector<double> grid_work_, grid_eta_;  // grid-sized scratch of the implicit step
-  std::vector<VerticalInertia> inertia_;      // per floe, the implicit step's
-  std::vector<double> yaw_;                   // per floe: gather_tilted_yaw's (the tilted floes of order_)
-  std::vector<Eigen::Vector3d> free_bottom_;  // per floe: (z, a) at t + h with no penalty
   struct ImplicitPieces {                     // per piece, the implicit step's problem
     std::vector<double> spring, damper, start, free_end;
   } pieces_;
-  struct EvaluationScratch {
+  struct EvaluationScratch {           // per area piece, one evaluation's
     std::vector<double> penetration;  // [delta]^+ of each area piece
     std::vector<double> psi;          // psi of each area piece's cell
     std::vector<double> force;        // of each area piece on the sea (N)
-    std::vector<double> wetted;       // per floe: sum psi_c a_c [delta_c]^+
   } eval_;
   mutable double penalty_energy_ = 0.0;
   double owned_seconds_ = 0.0;  // take_owned_seconds()

@@ -48,12 +48,12 @@ void FloeSeaContact::pose_at_midpoint(const Floes& floes, std::span<const FloeSt
   // At the step's end the vertical forces would lag the drift by h / 2: a
   // first-order error. A periodic grid's seam is crossed by the shorter way.
   const bool periodic = grid_.edge == fluid::GridEdge::periodic;
-  poses_.resize(floes.size());
+  FLOESIM_ASSERT(evaluated_.poses.size() == floes.size());
   for (const std::uint32_t i : which) {
     const FloeState& s = floes.state[i];
-    FloePose& p = poses_[i];
+    FloePose& p = evaluated_.poses[i];
     p = {s.x, s.y, s.yaw};
-    if (!dynamic_[i] || i >= start.size()) continue;
+    if (!constants_.dynamic[i] || i >= start.size()) continue;
     double dx = p.x - start[i].x, dy = p.y - start[i].y;
     if (periodic) {
       dx -= grid_.lx * std::round(dx / grid_.lx);
@@ -71,7 +71,7 @@ void FloeSeaContact::place_midpoint_footprints(const Floes& floes, std::span<con
   // are stale, and the owners that build or move a floe's pieces hold it
   // (its present state and step-start copy: Simulation::held_now).
   pose_at_midpoint(floes, start, footprints_.mine());
-  const bool move = footprints_.movable(dynamic_, poses_);
+  const bool move = footprints_.movable(constants_.dynamic, evaluated_.poses);
   const GivenOwners given = move ? GivenOwners{} : given_owners(floes.size());
   if (!move && !given.owner.empty()) {
     pose_at_midpoint(floes, start, given.mine);
@@ -84,28 +84,28 @@ void FloeSeaContact::place_midpoint_footprints(const Floes& floes, std::span<con
 }
 
 void FloeSeaContact::gather_tilted_yaw(const Floes& floes) {
-  yaw_.resize(floes.size());
   if (comm_.serial()) {
-    for (const std::uint32_t i : order_) yaw_[i] = floes.state[i].yaw;
+    for (const std::uint32_t i : order_) implicit_floes_.yaw[i] = floes.state[i].yaw;
     return;
   }
-  // order_ and tilt_ are the same on every rank (every floe's pieces are
+  // order_ and constants_.tilt are the same on every rank (every floe's pieces are
   // gathered), and so are the owners: the entries line up.
   const std::span<const int> owner = footprints_.owners();
   std::vector<double> yaw;
   std::vector<int> by;
   for (const std::uint32_t i : order_) {
-    if (tilt_[i] == 0) continue;
+    if (constants_.tilt[i] == 0) continue;
     yaw.push_back(owner[i] == comm_.rank() ? floes.state[i].yaw : 0.0);
     by.push_back(owner[i]);
   }
   comm_.complete_owned(yaw, by);
   std::size_t j = 0;
   for (const std::uint32_t i : order_)
-    if (tilt_[i] != 0) yaw_[i] = yaw[j++];
+    if (constants_.tilt[i] != 0) implicit_floes_.yaw[i] = yaw[j++];
 }
 
 void FloeSeaContact::implicit_step(Floes& floes, std::span<const FloeState> start, fluid::Sea& sea, double h) {
+  fit_floes(implicit_floes_, floes.size());  // the implicit step's per-floe arrays
   // The footprints at the midpoint of the floes' horizontal motion over the step.
   place_midpoint_footprints(floes, start);
   const Footprints& fp = footprints_.pieces();
@@ -116,18 +116,18 @@ void FloeSeaContact::implicit_step(Floes& floes, std::span<const FloeState> star
   // solve alone writes them, alike on every rank, and the explicit kicks do
   // not: kick_floes), its constants, and its yaw, from its owner.
   gather_tilted_yaw(floes);
-  inertia_.assign(floes.size(), {});
+  std::fill(implicit_floes_.inertia.begin(), implicit_floes_.inertia.end(), VerticalInertia{});
   for (std::uint32_t i : order_) {
-    VerticalInertia& in = inertia_[i];
-    in.slopes = tilt_[i];
+    VerticalInertia& in = implicit_floes_.inertia[i];
+    in.slopes = constants_.tilt[i];
     in.mass(0, 0) = floes.mass[i];
     in.inverse_mass(0, 0) = 1.0 / floes.mass[i];
-    if (tilt_[i] == 2) {
-      const Eigen::Matrix2d J = tilt_inertia(floes, i, yaw_[i]);
+    if (constants_.tilt[i] == 2) {
+      const Eigen::Matrix2d J = tilt_inertia(floes, i, implicit_floes_.yaw[i]);
       in.mass.bottomRightCorner<2, 2>() = J;
       in.inverse_mass.bottomRightCorner<2, 2>() = J.inverse();
-    } else if (tilt_[i] == 1) {
-      in.mass(1, 1) = tilt_inertia(floes, i, yaw_[i])(0, 0);
+    } else if (constants_.tilt[i] == 1) {
+      in.mass(1, 1) = tilt_inertia(floes, i, implicit_floes_.yaw[i])(0, 0);
       in.inverse_mass(1, 1) = 1.0 / in.mass(1, 1);
     }
   }
@@ -138,16 +138,16 @@ void FloeSeaContact::implicit_step(Floes& floes, std::span<const FloeState> star
   // this footprint.
   ImplicitPieces& q = pieces_;
   for (auto* v : {&q.spring, &q.damper, &q.start, &q.free_end}) v->assign(n, 0.0);
-  free_bottom_.assign(floes.size(), Eigen::Vector3d::Zero());  // z, a at t + h with no penalty
+  std::fill(implicit_floes_.free_bottom.begin(), implicit_floes_.free_bottom.end(), Eigen::Vector3d::Zero());
   const double ks = s_ * kappa_;
   double scale = 0.0;  // the thickest draft: the residual's unit
   for (std::uint32_t i : order_) scale = std::max(scale, floes.draft(i, rho_));
   const std::span<const double> eta0 = sea.elevation();
   for_each_floe(order_, threads_, [&](std::uint32_t i) {
     const FloeState& st = floes.state[i];
-    const double z = st.heave + bottom0_[i];
+    const double z = st.heave + constants_.bottom0[i];
     const Vec2 a{st.pitch, st.roll};
-    free_bottom_[i] = {z + h * st.heave_rate - 0.5 * h * h * g_, st.pitch + h * st.pitch_rate,
+    implicit_floes_.free_bottom[i] = {z + h * st.heave_rate - 0.5 * h * h * g_, st.pitch + h * st.pitch_rate,
                        st.roll + h * st.roll_rate};
     const double damper = (1.0 - s_) * weak_coefficient(floes, i) / h;
     for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k) {
@@ -159,7 +159,7 @@ void FloeSeaContact::implicit_step(Floes& floes, std::span<const FloeState> star
   });
   sea.midpoint_free_elevation(h, grid_eta_);
   for_each_floe(order_, threads_, [&](std::uint32_t i) {
-    const Eigen::Vector3d& b = free_bottom_[i];
+    const Eigen::Vector3d& b = implicit_floes_.free_bottom[i];
     for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k)
       q.free_end[k] = grid_eta_[fp.cell[k]] - b[0] - b[1] * fp.centroid[k].x() - b[2] * fp.centroid[k].y();
   });
@@ -181,7 +181,7 @@ void FloeSeaContact::implicit_step(Floes& floes, std::span<const FloeState> star
   problem.step = h;
   problem.offsets = fp.offsets;
   problem.bodies = order_;
-  problem.inertia = inertia_;
+  problem.inertia = implicit_floes_.inertia;
   problem.lever = fp.centroid;
   problem.spring = q.spring;
   problem.damper = q.damper;
@@ -213,7 +213,7 @@ void FloeSeaContact::implicit_step(Floes& floes, std::span<const FloeState> star
     Eigen::Vector3d F(-floes.mass[i] * g_, 0.0, 0.0);
     for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k)
       F += f[k] * Eigen::Vector3d(1.0, fp.centroid[k].x(), fp.centroid[k].y());
-    const Eigen::Vector3d acc = inertia_[i].inverse_mass * F;
+    const Eigen::Vector3d acc = implicit_floes_.inertia[i].inverse_mass * F;
     st.heave += h * st.heave_rate + hh * acc[0];
     st.pitch += h * st.pitch_rate + hh * acc[1];
     st.roll += h * st.roll_rate + hh * acc[2];
@@ -223,7 +223,7 @@ void FloeSeaContact::implicit_step(Floes& floes, std::span<const FloeState> star
   }
   // Floes with no pieces (outside the sea) drift, as with the explicit kicks.
   for (std::size_t i = 0; i < floes.size(); ++i) {
-    if (!dynamic_[i] || fp.offsets[i] < fp.offsets[i + 1]) continue;
+    if (!constants_.dynamic[i] || fp.offsets[i] < fp.offsets[i + 1]) continue;
     FloeState& st = floes.state[i];
     st.heave += h * st.heave_rate;
     st.pitch += h * st.pitch_rate;
@@ -248,14 +248,13 @@ void FloeSeaContact::step_mean_horizontal(const Floes& floes, std::span<const Fl
   std::vector<double>& psi = eval_.psi;
   u.assign(fp.cell.size(), 0.0);
   psi.resize(fp.cell.size());
-  eval_.wetted.assign(floes.size(), 0.0);
-  slope_.resize(floes.size());
+  std::fill(evaluated_.wetted.begin(), evaluated_.wetted.end(), 0.0);
   for_each_floe(order_, threads_, [&](std::uint32_t i) {
     // The midpoint slopes, read by the owner's horizontal loads only (its
     // step-start copy is current; another rank's may be stale).
     if (footprints_.owns(i)) {
       const FloeState& st = floes.state[i];
-      slope_[i] = 0.5 * Vec2{st.pitch + start[i].pitch, st.roll + start[i].roll};
+      evaluated_.slope[i] = 0.5 * Vec2{st.pitch + start[i].pitch, st.roll + start[i].roll};
     }
     double wet = 0.0;
     for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k) {
@@ -264,15 +263,15 @@ void FloeSeaContact::step_mean_horizontal(const Floes& floes, std::span<const Fl
       u[k] = step_force(1.0, 0.0, pieces_.start[k], d1[k]).f;
       wet += psi[k] * area0[k] * u[k];
     }
-    eval_.wetted[i] = wet;
+    evaluated_.wetted[i] = wet;
   });
   for (std::uint32_t i : order_)
     for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k)
       if (u[k] > 0.0) cells_[fp.cell[k]].sum += fp.area[k] * u[k] * u[k];
   horizontal_loads(u);
   share_owned();
-  std::fill(step_horizontal_.begin(), step_horizontal_.end(), Eigen::Vector3d::Zero());
-  for (std::uint32_t i : order_) step_horizontal_[i] = loads_[i].horizontal;
+  std::fill(kicks_.step_horizontal.begin(), kicks_.step_horizontal.end(), Eigen::Vector3d::Zero());
+  for (std::uint32_t i : order_) kicks_.step_horizontal[i] = kicks_.loads[i].horizontal;
   step_mean_pending_ = true;
 }
 

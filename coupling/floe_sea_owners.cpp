@@ -12,7 +12,7 @@
 // floe, with the box below on a sea in slabs) and every rank sorts
 // them as the serial run does (the same input, the same comparisons: the
 // same permutation, ties included), keeps its own floes in that order
-// (order_) and knows every floe's place in it (owner_.position).
+// (order_) and knows every floe's place in it (owner_.places.position).
 //
 // Sea in slabs (stages five and eight, routed()). A cell where only this
 // rank's floes have pieces is summed here, into cells_ and pressure_
@@ -156,32 +156,33 @@ void FloeSeaContact::order_by_owner(std::size_t floes) {
   // Each floe's first cell, and with the boxes (boxed()) the box of its
   // cells, which tells the other ranks where its pieces may share a cell.
   const bool boxes = boxed();
-  o.box.assign(floes, {});
+  fit_floes(o.places, floes);
+  std::fill(o.places.box.begin(), o.places.box.end(), parallel::CellBox{});
   for (std::uint32_t i : footprints_.mine())
-    if (i < fp.floes() && dynamic_[i] && fp.offsets[i] < fp.offsets[i + 1]) {
+    if (i < fp.floes() && constants_.dynamic[i] && fp.offsets[i] < fp.offsets[i + 1]) {
       if (boxes) {
         const std::span<const std::uint32_t> cells(fp.cell.data() + fp.offsets[i], fp.offsets[i + 1] - fp.offsets[i]);
-        o.box[i] = parallel::CellBox::of(cells, grid_.nx, grid_.ny);
+        o.places.box[i] = parallel::CellBox::of(cells, grid_.nx, grid_.ny);
       } else {
-        o.box[i].first_cell = fp.cell[fp.offsets[i]];
+        o.places.box[i].first_cell = fp.cell[fp.offsets[i]];
       }
     }
   if (next_owners_.column.empty()) {
-    comm_.complete_owned(o.box, footprints_.owners());
+    comm_.complete_owned(o.places.box, footprints_.owners());
   } else {
     // With each box, the rank of the share of columns of the floe's present
-    // place (poses_ holds this rank's floes' present poses: evaluate posed
+    // place (evaluated_.poses holds this rank's floes' present poses: evaluate posed
     // them).
     struct Placed {
       parallel::CellBox box;
       std::int32_t owner;
     };
     std::vector<Placed> placed(floes, Placed{{}, 0});
-    for (std::uint32_t i : footprints_.mine()) placed[i] = {o.box[i], column_owner(poses_[i])};
+    for (std::uint32_t i : footprints_.mine()) placed[i] = {o.places.box[i], column_owner(evaluated_.poses[i])};
     comm_.complete_owned(placed, footprints_.owners());
     std::vector<int> owner(floes);
     for (std::size_t i = 0; i < floes; ++i) {
-      o.box[i] = placed[i].box;
+      o.places.box[i] = placed[i].box;
       owner[i] = placed[i].owner;
     }
     set_next_owners(owner);
@@ -189,14 +190,14 @@ void FloeSeaContact::order_by_owner(std::size_t floes) {
   // place_footprints' serial sort, on the same floes in the same order.
   o.serial.clear();
   for (std::size_t i = 0; i < floes; ++i)
-    if (o.box[i].first_cell != kNoCell) o.serial.push_back(static_cast<std::uint32_t>(i));
+    if (o.places.box[i].first_cell != kNoCell) o.serial.push_back(static_cast<std::uint32_t>(i));
   std::sort(o.serial.begin(), o.serial.end(),
-            [&](std::uint32_t x, std::uint32_t y) { return o.box[x].first_cell < o.box[y].first_cell; });
-  o.position.assign(floes, kNoCell);
+            [&](std::uint32_t x, std::uint32_t y) { return o.places.box[x].first_cell < o.places.box[y].first_cell; });
+  std::fill(o.places.position.begin(), o.places.position.end(), kNoCell);
   order_.clear();
   for (std::size_t j = 0; j < o.serial.size(); ++j) {
     const std::uint32_t i = o.serial[j];
-    o.position[i] = static_cast<std::uint32_t>(j);
+    o.places.position[i] = static_cast<std::uint32_t>(j);
     if (footprints_.owns(i)) order_.push_back(i);
   }
 }
@@ -293,13 +294,13 @@ void FloeSeaContact::sum_coverage_by_owner() {
     // about two cells of its slab of the owners); no other box is read.
     std::vector<std::uint32_t> near;
     if (footprints_.by_place()) {
-      near = box_neighbours(o.serial, footprints_.owners(), comm_.rank(), footprints_.owner_slabs(), o.box, grid_,
-                            footprints_.piece_rows());
+      near = box_neighbours(o.serial, footprints_.owners(), comm_.rank(), footprints_.owner_slabs(), o.places.box,
+                            grid_, footprints_.piece_rows());
     } else {
       for (const std::uint32_t i : o.serial)
         if (!footprints_.owns(i)) near.push_back(i);
     }
-    mark_shared_cells(near, o.box, footprints_.owners(), grid_.nx, grid_.ny, o.interior_row, o.kind,
+    mark_shared_cells(near, o.places.box, footprints_.owners(), grid_.nx, grid_.ny, o.interior_row, o.kind,
                       OwnerCells::kRoutedRow, OwnerCells::kShared, rank_words, o.marks);
   } else {
     o.marks.painted.clear();
@@ -359,7 +360,7 @@ void FloeSeaContact::sum_coverage_by_owner() {
       // its floe's key, in order_ (the serial order) as this loop meets it.
       const std::uint32_t j = listed(c);
       ++o.first[j + 1];
-      o.routed_pieces.push_back({static_cast<std::uint32_t>(k), o.position[i], j, 0});
+      o.routed_pieces.push_back({static_cast<std::uint32_t>(k), o.places.position[i], j, 0});
     }
   }
   // The kinds back to the rows' (the boxes move with the floes).
@@ -461,7 +462,7 @@ double FloeSeaContact::sum_cells_by_owner(double ks) {
       o.parts[2 * at + 1] = force[k] * inv_cell_area;
     }
     if (o.energy_terms.size() > terms) {
-      o.energy_keys.push_back(o.position[i]);
+      o.energy_keys.push_back(o.places.position[i]);
       o.energy_counts.push_back(static_cast<std::uint32_t>(o.energy_terms.size() - terms));
     }
   }
@@ -499,17 +500,17 @@ void FloeSeaContact::share_owned() {
   struct Owned {
     double fx, fy, torque, fz, mx, my;
   };
-  std::vector<Owned> owned(loads_.size());
+  std::vector<Owned> owned(kicks_.loads.size());
   for (std::uint32_t i : footprints_.mine()) {
-    const Eigen::Vector3d& f = loads_[i].horizontal;
-    const Eigen::Vector3d& v = loads_[i].vertical;
+    const Eigen::Vector3d& f = kicks_.loads[i].horizontal;
+    const Eigen::Vector3d& v = kicks_.loads[i].vertical;
     owned[i] = {f[0], f[1], f[2], v[0], v[1], v[2]};
   }
   comm_.complete_owned(owned, footprints_.owners());
   for (std::size_t i = 0; i < owned.size(); ++i) {
     if (footprints_.owns(i)) continue;
-    loads_[i].horizontal = {owned[i].fx, owned[i].fy, owned[i].torque};
-    loads_[i].vertical = {owned[i].fz, owned[i].mx, owned[i].my};
+    kicks_.loads[i].horizontal = {owned[i].fx, owned[i].fy, owned[i].torque};
+    kicks_.loads[i].vertical = {owned[i].fz, owned[i].mx, owned[i].my};
   }
 }
 
@@ -522,14 +523,16 @@ void FloeSeaContact::hand_water_over(std::span<const int> drift_owner) {
   // implicit step's sea too) they are these owners from the next rebuild on
   // (next_owners_), but in a flume with the explicit kicks (shares of its
   // columns).
-  if ((routes_.replicated() || implicit_) && next_owners_.column.empty() && drift_owner.size() == dynamic_.size())
+  if ((routes_.replicated() || implicit_) && next_owners_.column.empty() &&
+      drift_owner.size() == constants_.dynamic.size())
     set_next_owners(drift_owner);
   // The drift's exchange that follows sends each floe's state to its next
   // owner too (Simulation::send_to_holders): from here on they hold them.
   next_owners_.current = true;
   if (comm_.serial() || !water_by_owner_) return;
-  FLOESIM_ASSERT(drift_owner.size() == water_.size() && footprints_.owners().size() == water_.size());
-  comm_.hand_over(water_, footprints_.owners(), drift_owner);
+  FLOESIM_ASSERT(drift_owner.size() == evaluated_.water.size() &&
+                 footprints_.owners().size() == evaluated_.water.size());
+  comm_.hand_over(evaluated_.water, footprints_.owners(), drift_owner);
 }
 
 }  // namespace floesim

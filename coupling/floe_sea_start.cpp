@@ -51,10 +51,10 @@ void FloeSeaContact::start(Floes& floes, fluid::Sea& sea, bool given) {
   cells_.assign(grid.size(), {});
   pressure_kicked_ = false;
   pose_at_states(floes);
-  footprints_.rebuild_at(floes, dynamic_, poses_, threads_);
+  footprints_.rebuild_at(floes, constants_.dynamic, evaluated_.poses, threads_);
   if (given) {
     free_level_ = 0.0;
-    for (std::size_t i = 0; i < n; ++i) bottom0_[i] = -floes.draft(i, rho_) * (1.0 + 1.0 / K_);
+    for (std::size_t i = 0; i < n; ++i) constants_.bottom0[i] = -floes.draft(i, rho_) * (1.0 + 1.0 / K_);
     return;
   }
   // The static problem (see the header): on the calm sea first, which fixes
@@ -79,7 +79,7 @@ void FloeSeaContact::start(Floes& floes, fluid::Sea& sea, bool given) {
   for (std::size_t k = 0; k < fp.cell.size(); ++k) psi[k] = subcell_weight(coverage[fp.cell[k]]);
   auto weight = [&](std::size_t k) { return fp.area[k] / cell_area_ * psi[k]; };
   for (std::size_t i = 0; i < n; ++i) {
-    if (!dynamic_[i]) continue;
+    if (!constants_.dynamic[i]) continue;
     z[i] = -floes.draft(i, rho_) * (1.0 + 1.0 / K_);
     for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k) F[fp.cell[k]] += weight(k);
   }
@@ -88,14 +88,14 @@ void FloeSeaContact::start(Floes& floes, fluid::Sea& sea, bool given) {
   auto solve = [&](std::span<const double> W) {
     std::fill(S.begin(), S.end(), 0.0);
     for (std::size_t i = 0; i < n; ++i)
-      if (dynamic_[i])
+      if (constants_.dynamic[i])
         for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k) S[fp.cell[k]] += weight(k) * zb(i, k);
     double change = INFINITY;
     int sweeps = 0;
     for (; sweeps < 200 && change > 1e-13; ++sweeps) {
       change = 0.0;
       for (std::size_t i = 0; i < n; ++i) {
-        if (!dynamic_[i] || fp.offsets[i] == fp.offsets[i + 1]) continue;
+        if (!constants_.dynamic[i] || fp.offsets[i] == fp.offsets[i + 1]) continue;
         Eigen::Matrix3d A = Eigen::Matrix3d::Zero();
         Eigen::Vector3d b(-floes.mass[i] * g_ / kappa_, 0.0, 0.0);
         for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k) {
@@ -109,7 +109,7 @@ void FloeSeaContact::start(Floes& floes, fluid::Sea& sea, bool given) {
         }
         // Slopes the discrete footprint cannot resist stay 0 (a floe within a
         // few cells; roll in a long-crested sea).
-        const Eigen::Vector3d x = solve_tilted(A, b, tilt_[i]);
+        const Eigen::Vector3d x = solve_tilted(A, b, constants_.tilt[i]);
         for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k) S[fp.cell[k]] -= weight(k) * zb(i, k);
         change = std::max(change, std::abs(x[0] - z[i]) / floes.draft(i, rho_));
         z[i] = x[0];
@@ -135,7 +135,7 @@ void FloeSeaContact::start(Floes& floes, fluid::Sea& sea, bool given) {
   const double calm_level = solve(std::vector<double>(grid.size(), 0.0));
   free_level_ = -calm_level;  // the free water's level once eta has zero mean
   for (std::size_t i = 0; i < n; ++i)
-    if (dynamic_[i]) bottom0_[i] = z[i] - calm_level;
+    if (constants_.dynamic[i]) constants_.bottom0[i] = z[i] - calm_level;
   // The waves in the sea: the floes start from the least-squares plane of the
   // waves under them (and take the plane of the waves' rates as theirs),
   // then settle on the waves.
@@ -149,7 +149,7 @@ void FloeSeaContact::start(Floes& floes, fluid::Sea& sea, bool given) {
   const std::vector<double> eta_t(wave_w.begin(), wave_w.end());
   sea.release_field(fluid::Field::velocity_z);
   for (std::size_t i = 0; i < n; ++i) {
-    if (!dynamic_[i]) continue;
+    if (!constants_.dynamic[i]) continue;
     FloeState& st = floes.state[i];
     Eigen::Matrix3d A = Eigen::Matrix3d::Zero();
     Eigen::Vector3d be = Eigen::Vector3d::Zero(), bw = Eigen::Vector3d::Zero();
@@ -160,7 +160,7 @@ void FloeSeaContact::start(Floes& floes, fluid::Sea& sea, bool given) {
       bw += fp.area[k] * eta_t[fp.cell[k]] * phi;
     }
     if (!(A(0, 0) > 0.0)) continue;
-    const Eigen::Vector3d xe = solve_tilted(A, be, tilt_[i]), xw = solve_tilted(A, bw, tilt_[i]);
+    const Eigen::Vector3d xe = solve_tilted(A, be, constants_.tilt[i]), xw = solve_tilted(A, bw, constants_.tilt[i]);
     z[i] += xe[0];
     a[i] += Vec2{xe[1], xe[2]};
     st.heave_rate = xw[0];
@@ -171,9 +171,9 @@ void FloeSeaContact::start(Floes& floes, fluid::Sea& sea, bool given) {
   sea.set_surface(eta, eta_t);
   hold_static_pressure(sea, wave_eta, eta);
   for (std::size_t i = 0; i < n; ++i) {
-    if (!dynamic_[i]) continue;
+    if (!constants_.dynamic[i]) continue;
     FloeState& st = floes.state[i];
-    st.heave = z[i] - wave_level - bottom0_[i];
+    st.heave = z[i] - wave_level - constants_.bottom0[i];
     st.pitch = a[i].x();
     st.roll = a[i].y();
   }

@@ -2,16 +2,20 @@
 // parallel.md, "The arrays held by band: measured (mem27)"): what a held
 // mask says the held floes' entries take is what the same structures
 // built for those floes alone take, and a serial Simulation holds every
-// floe.
+// floe; the coupling's per-floe arrays are counted by their groups
+// (coupling/floe_sea_arrays.hpp), each of which lists all its arrays.
 #include <doctest/doctest.h>
 
 #include <sstream>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "contact/shapes.hpp"
 #include "core/config.hpp"
 #include "coupling/drift.hpp"
+#include "coupling/floe_sea.hpp"
+#include "coupling/floe_sea_arrays.hpp"
 #include "coupling/scenario.hpp"
 #include "coupling/simulation.hpp"
 
@@ -38,6 +42,22 @@ std::string varied_floes() {
   }
   return t.str();
 }
+
+// The same floes on a small periodic spectral sea.
+std::string varied_floes_on_sea(const char* integrator) {
+  return varied_floes() +
+         "[sea]\nmodel = \"spectral\"\ndims = 2\nsize = [300.0, 40.0]\ncells = [64, 16]\ndepth = 20.0\n"
+         "[coupling]\nstiffness = 100.0\nintegrator = \"" +
+         integrator + "\"\n";
+}
+
+// A group with an array its list leaves out.
+struct LeftOut {
+  std::vector<double> a;
+  std::vector<Vec2> b;
+  std::vector<std::uint8_t> c;
+  static auto arrays(auto& g) { return std::tie(g.a, g.b); }
+};
 }  // namespace
 
 TEST_CASE("floe memory: the held floes' entries are those of the held floes built alone") {
@@ -91,4 +111,56 @@ TEST_CASE("floe memory: a serial run holds every floe") {
   }
   CHECK(sum.whole == m.parts.back().second.whole);
   CHECK(sum.held == m.parts.back().second.held);
+}
+
+TEST_CASE("floe memory: a group of per-floe arrays is sized and counted by its list of all of them") {
+  // The coupling's groups list every member (also static_asserted where
+  // they are defined); a list that leaves one out is caught.
+  CHECK(lists_every_array<FloeSeaConstants>());
+  CHECK(lists_every_array<FloeSeaKicks>());
+  CHECK(lists_every_array<FloeSeaEvaluated>());
+  CHECK(lists_every_array<FloeSeaImplicit>());
+  CHECK(lists_every_array<FloeSeaSerialPlaces>());
+  CHECK_FALSE(lists_every_array<LeftOut>());
+  CHECK(floe_entry_bytes<LeftOut>() == sizeof(double) + sizeof(Vec2));
+
+  FloeSeaConstants g;
+  fit_floes(g, 7);
+  g.bottom0[3] = -0.5;
+  CHECK(g.dynamic.size() == 7);
+  CHECK(g.tilt.size() == 7);
+  CHECK(g.body_moments.size() == 7);
+  const std::size_t entry = 2 * sizeof(std::uint8_t) + sizeof(double) + sizeof(Eigen::Matrix2d);
+  CHECK(floe_entry_bytes<FloeSeaConstants>() == entry);
+  CHECK(floe_group_bytes(g, 7).whole == 7 * entry);  // exactly the floes' places
+  CHECK(floe_group_bytes(g, 3).held == 3 * entry);
+  // Grown (a split): exactly the new count's places, the entries kept.
+  fit_floes(g, 10);
+  CHECK(floe_group_bytes(g, 10).whole == 10 * entry);
+  CHECK(g.bottom0[3] == -0.5);
+  CHECK(floe_group_bytes(FloeSeaImplicit{}, 10).whole == 0);  // unused: nothing
+  CHECK(floe_group_bytes(FloeSeaImplicit{}, 10).held == 0);
+}
+
+TEST_CASE("floe memory: the coupling's per-floe arrays are its groups', one entry a floe") {
+  const std::size_t explicit_entry = floe_entry_bytes<FloeSeaConstants>() + floe_entry_bytes<FloeSeaKicks>() +
+                                     floe_entry_bytes<FloeSeaEvaluated>();
+  for (const char* integrator : {"explicit", "implicit"}) {
+    CAPTURE(integrator);
+    Simulation sim(build_scenario(parse_config(varied_floes_on_sea(integrator), "varied.toml", ".")));
+    sim.step(2.0);
+    REQUIRE(sim.floe_sea() != nullptr);
+    const bool implicit = integrator[0] == 'i';
+    REQUIRE(sim.floe_sea()->implicit() == implicit);
+    if (implicit) REQUIRE(sim.floe_sea()->implicit_stats().steps > 0);
+    // Serially: no owners (their serial places, the next owners) and every
+    // floe held; the implicit step's group only with the implicit step.
+    const std::size_t entry = explicit_entry + (implicit ? floe_entry_bytes<FloeSeaImplicit>() : 0);
+    const FloeBytes every = sim.floe_sea()->memory({}).per_floe;
+    CHECK(every.held == 9 * entry);
+    CHECK(every.whole == every.held);  // sized with the floes: no spare places
+    std::vector<std::uint8_t> mask(9, 0);
+    mask[2] = mask[6] = 1;
+    CHECK(sim.floe_sea()->memory(mask).per_floe.held == 2 * entry);
+  }
 }
