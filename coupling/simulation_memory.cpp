@@ -47,6 +47,7 @@ Simulation::FloeMemory Simulation::floe_memory() const {
     add("coupling", c.per_floe);
     add("footprint_areas", c.footprints.area_pieces);
     add("footprint_edges", c.footprints.edge_pieces);
+    add("footprint_floes", c.footprints.per_floe);  // poses, radii, owners a floe
   }
   FloeBytes reach = per_floe_bytes(detection_.reach, m.held);
   if (detection_part_) reach += per_floe_bytes(detection_part_->reach, m.held);
