@@ -256,7 +256,7 @@ PercussionAnalyses Percussion::analyse(const Floes& floes, const contact::Impuls
   return out;
 }
 
-bool Percussion::conclude(Floes& floes, PercussionAnalyses all) {
+bool Percussion::conclude(Floes& floes, PercussionAnalyses all, std::vector<std::uint32_t>* split) {
   const auto begin = std::chrono::steady_clock::now();
   stats_.counts += all.counts;
   std::vector<FloeInitiation>& initiations = all.initiations;
@@ -303,6 +303,7 @@ bool Percussion::conclude(Floes& floes, PercussionAnalyses all) {
       if (apply_split(floes, i, fi, decision, fi.event)) {
         changed = true;
         made.push_back(before);
+        if (split) split->push_back(static_cast<std::uint32_t>(i));
       }
       stats_.split_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - cut).count();
     }

@@ -265,8 +265,10 @@ public:
   // and splits in floe order, each split as decided by its share unless an
   // earlier split of the step was within reach, or undecided (then decided
   // here, against the floes as they then are). Returns true if the set of
-  // floes changed.
-  bool conclude(Floes& floes, PercussionAnalyses all);
+  // floes changed. `split` (if given) gets the indices of the floes split,
+  // in floe order: each is now its first piece, the second appended
+  // (FloeOwners::place_pieces takes them).
+  bool conclude(Floes& floes, PercussionAnalyses all, std::vector<std::uint32_t>* split = nullptr);
   // Whether conclude(all) may split a floe, and so read floes' states (the
   // parents', their neighbours'): conclude splits only a floe whose decision
   // is a split, or undecided, and takes a decision again only near a split

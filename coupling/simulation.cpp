@@ -404,8 +404,8 @@ void Simulation::percussion(StepContext& ctx) {
   PercussionAnalyses all = combine(comm_.allgather_parts(pack(mine), unpack_percussion), percussion_ranks_);
   // Every rank applies every split, deciding it again from the parent's
   // neighbours where an earlier split came near, and the pieces take their
-  // parent's state; then the owners are assigned from every floe's place
-  // (detect_in_place). With the state held by owner a rank's copies of the
+  // parent's state; then the pieces' owners from their places, the other
+  // floes' from their owners (place_pieces, detect_in_place). With the state held by owner a rank's copies of the
   // floes it does not hold are stale, so when a split may be made (an
   // initiation through a floe whose share decided a split: the same on every
   // rank, Percussion::may_split) every floe's state comes from its owner
@@ -416,7 +416,23 @@ void Simulation::percussion(StepContext& ctx) {
     percussion_ranks_.whole_gathers += whole_state_counts_.gathers - before.gathers;
     percussion_ranks_.whole_bytes += whole_state_counts_.bytes - before.bytes;
   }
-  if (percussion_->conclude(scenario_.floes, std::move(all))) on_floes_changed();
+  // The pieces' owners from their states (every rank builds them alike),
+  // the other floes' from their owners (detect_in_place).
+  std::vector<std::uint32_t> split;
+  if (percussion_->conclude(scenario_.floes, std::move(all), &split)) {
+    owners_.place_pieces(scenario_.floes, split);
+    on_floes_changed();
+    // The poison mode (a test) checks them against assign() over every
+    // floe's place, which every copy holds current here (gathered above;
+    // not with the mutation `stale`, which gathers nothing).
+    if (poison_ && !poison_->options().stale) {
+      parallel::FloeOwners by_place = owners_;
+      by_place.assign(scenario_.floes);
+      if (!std::ranges::equal(by_place.owner(), owners_.owner()) || by_place.mine() != owners_.mine())
+        throw RunError("poison: rank " + std::to_string(comm_.rank()) + ": the owners after the splits at t = " +
+                       std::to_string(t_) + " are not assign()'s over every floe's place");
+    }
+  }
 }
 
 void Simulation::on_floes_changed() {

@@ -89,7 +89,13 @@ void Simulation::detect_in_place() {
     held_ = hold_band();
     return;
   }
-  owners_.assign(scenario_.floes);
+  // The owners at the floes' present places: after a split (the pieces
+  // owned by place_pieces) from the owners' own floes, as at a step's
+  // detection (FloeOwners::migrate: their leave notices; no other floe's
+  // copy read); at the start and after a restore (no owners yet) from
+  // every floe's place, every copy the file's.
+  if (owners_.assigned_for(scenario_.floes)) owners_.migrate(comm_, scenario_.floes);
+  else owners_.assign(scenario_.floes);
   set_reach();
   wrap_entering(owners_.mine());
   // Outside a step nothing is known of who held what (the start, a
