@@ -452,4 +452,67 @@ TEST_CASE("the owners after the splits, the pieces' from their places and the ot
   CHECK(notices > 0);
 }
 
+TEST_CASE("a split step concluded on every rank reads only the states the owners' split_readers send") {
+  // Simulation::percussion's limited gather (docs/parallel.md, "The split
+  // step's owners and gather by holder (split28)"), on simulated ranks:
+  // each owner lists, against its held floes (its band, poisoned outside),
+  // its through cracks' parents that may split or be decided again and
+  // their neighbours (Percussion::split_readers); a rank that concludes on
+  // a copy in which only every owner's listed floes are not NaN, with that
+  // mask (`readable`), makes the serial splits and events: the same floe
+  // count and ids, every listed floe and every piece bit for bit. Strips of
+  // equal counts on 2, 3 and 7 ranks, periodic and open.
+  // The mutation it names: the parents alone sent (no neighbours); a
+  // decision taken again then misses its neighbours (NaN places compare
+  // false), and some conclusion differs (counted: > 0).
+  std::size_t listed = 0, differ_parents_only = 0;
+  for (const bool periodic : {true, false}) {
+    CAPTURE(periodic);
+    const Pack p = moving_pack(11, periodic, 0.5, kConcentration);
+    const std::size_t n = p.floes.size();
+    Percussion serial_percussion(split_params(), opening(p));
+    std::vector<FloeInitiation> decided = cracks(p.floes);
+    for (FloeInitiation& fi : decided) fi.split = serial_percussion.decide_split(p.floes, fi.floe, fi);
+    Floes serial = p.floes;
+    REQUIRE(serial_percussion.conclude(serial, analyses_of(decided)));
+    const std::vector<FractureEventRow> serial_events = serial_percussion.take_events();
+    REQUIRE(serial_percussion.stats().splits_redone > 0);
+    for (const int ranks : {2, 3, 7}) {
+      CAPTURE(ranks);
+      parallel::FloeOwners owners(0, ranks, p.detect.domain);
+      owners.assign(p.floes);
+      Held readable(n, 0), parents_only(n, 0);
+      for (int r = 0; r < ranks; ++r) {
+        const Held band = halo_band(owners, r, p.floes, p.shapes, p.detect);
+        PercussionAnalyses mine;
+        for (const FloeInitiation& fi : decided)
+          if (owners.owner()[fi.floe] == r) mine.initiations.push_back(fi);
+        Percussion share(split_params(), opening(p));
+        for (const std::uint32_t j : share.split_readers(poisoned(p.floes, band), mine, band)) {
+          REQUIRE(band[j]);
+          readable[j] = 1;
+        }
+        for (const FloeInitiation& fi : mine.initiations)
+          if (decided_against_neighbours(fi.split.verdict)) parents_only[fi.floe] = 1;
+      }
+      listed += count_held(readable);
+      const auto conclude_on = [&](const Held& mask, bool check) {
+        Percussion every(split_params(), opening(p));
+        Floes f = poisoned(p.floes, mask);
+        every.conclude(f, analyses_of(decided), nullptr, mask);
+        bool same = f.size() == serial.size() && f.ids_issued == serial.ids_issued && same_bytes(f.id, serial.id) &&
+                    same_events(every.take_events(), serial_events);
+        for (std::size_t j = 0; same && j < f.size(); ++j)
+          if (j >= n || mask[j]) same = same_floe(f, j, serial, j);
+        if (check) CHECK(same);
+        return same;
+      };
+      conclude_on(readable, true);
+      if (!conclude_on(parents_only, false)) ++differ_parents_only;
+    }
+  }
+  MESSAGE("floes listed: " << listed << "; the parents alone: " << differ_parents_only << " of 6 conclusions differ");
+  CHECK(differ_parents_only > 0);
+}
+
 TEST_SUITE_END();
