@@ -256,7 +256,8 @@ PercussionAnalyses Percussion::analyse(const Floes& floes, const contact::Impuls
   return out;
 }
 
-bool Percussion::conclude(Floes& floes, PercussionAnalyses all) {
+bool Percussion::conclude(Floes& floes, PercussionAnalyses all, std::vector<std::uint32_t>* split,
+                          std::span<const std::uint8_t> readable) {
   const auto begin = std::chrono::steady_clock::now();
   stats_.counts += all.counts;
   std::vector<FloeInitiation>& initiations = all.initiations;
@@ -298,11 +299,12 @@ bool Percussion::conclude(Floes& floes, PercussionAnalyses all) {
       // polygons) stand whatever the other splits.
       const bool again = decided_against_neighbours(decision.verdict) && changed_near(i);
       if (again) ++stats_.splits_redone;
-      if (again || decision.verdict == SplitVerdict::undecided) decision = decide_split(floes, i, fi);
+      if (again || decision.verdict == SplitVerdict::undecided) decision = decide_split(floes, i, fi, readable);
       const Made before{floes.state[i].x, floes.state[i].y, radius_of(floes, i), i, floes.size()};
       if (apply_split(floes, i, fi, decision, fi.event)) {
         changed = true;
         made.push_back(before);
+        if (split) split->push_back(static_cast<std::uint32_t>(i));
       }
       stats_.split_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - cut).count();
     }
@@ -376,15 +378,7 @@ SplitDecision Percussion::decide_split(const Floes& floes, std::size_t i, const 
   for (double gap = gap_; gap >= 1e-3 * gap_; gap *= 0.25) {
     const auto plan = fracture::plan_split(floes, i, chord, gap, min_area);
     if (!plan) break;
-    if (near.empty()) {
-      near.push_back(i);
-      const double ri = radius_of(floes, i);
-      for (std::size_t j = 0; j < floes.size(); ++j) {
-        if (j == i || (!held.empty() && !held[j])) continue;
-        const double d = std::hypot(floes.state[j].x - floes.state[i].x, floes.state[j].y - floes.state[i].y);
-        if (d <= ri + radius_of(floes, j) + gap_) near.push_back(j);
-      }
-    }
+    if (near.empty()) near = split_neighbours(floes, i, held);
     Floes trial = floes.select(near);
     fracture::apply_split(trial, 0, *plan, fracture::piece_states(*plan, floes.state[i], floes.inertia_z[i]));
     if (!any_overlap(trial)) return {SplitVerdict::split, gap};
@@ -393,6 +387,32 @@ SplitDecision Percussion::decide_split(const Floes& floes, std::size_t i, const 
   if (!near.empty()) return {SplitVerdict::refused_overlap, 0.0};
   if (fracture::plan_split(floes, i, chord, gap_, 0.0)) return {SplitVerdict::refused_small, 0.0};
   return {SplitVerdict::refused_chord, 0.0};
+}
+
+std::vector<std::size_t> Percussion::split_neighbours(const Floes& floes, std::size_t i,
+                                                      std::span<const std::uint8_t> held) const {
+  std::vector<std::size_t> near{i};
+  const double ri = radius_of(floes, i);
+  for (std::size_t j = 0; j < floes.size(); ++j) {
+    if (j == i || (!held.empty() && j < held.size() && !held[j])) continue;
+    const double d = std::hypot(floes.state[j].x - floes.state[i].x, floes.state[j].y - floes.state[i].y);
+    if (d <= ri + radius_of(floes, j) + gap_) near.push_back(j);
+  }
+  return near;
+}
+
+std::vector<std::uint32_t> Percussion::split_readers(const Floes& floes, const PercussionAnalyses& mine,
+                                                     std::span<const std::uint8_t> held) const {
+  std::vector<std::uint32_t> out;
+  if (!params_.split) return out;
+  for (const FloeInitiation& fi : mine.initiations) {
+    const SplitVerdict v = fi.split.verdict;
+    if (!fi.through || !(decided_against_neighbours(v) || v == SplitVerdict::undecided)) continue;
+    for (const std::size_t j : split_neighbours(floes, fi.floe, held)) out.push_back(static_cast<std::uint32_t>(j));
+  }
+  std::sort(out.begin(), out.end());
+  out.erase(std::unique(out.begin(), out.end()), out.end());
+  return out;
 }
 
 bool Percussion::apply_split(Floes& floes, std::size_t i, const FloeInitiation& fi, SplitDecision decision,

@@ -220,11 +220,12 @@ struct PercussionRanks {
   long steps = 0;
   std::vector<long> checks;
   std::vector<double> seconds;
-  // The steps with a crack through a floe (a split may be made), which
-  // gather every floe's state first (Simulation::whole_state), and the
-  // bytes this rank received in those gathers (the summary's
-  // parallel.fracture_whole_state; docs/parallel.md, "A split step by its
-  // holders").
+  // The steps in which a split may be made (Percussion::may_split), which
+  // gather the states conclude reads first (every share's split_readers,
+  // Simulation::split_states), and the bytes this rank received in those
+  // gathers (the summary's parallel.fracture_whole_state, a name kept from
+  // when every floe's state was gathered; docs/parallel.md, "The split
+  // step's owners and gather by holder (split28)").
   long whole_gathers = 0;
   long long whole_bytes = 0;
 };
@@ -265,8 +266,14 @@ public:
   // and splits in floe order, each split as decided by its share unless an
   // earlier split of the step was within reach, or undecided (then decided
   // here, against the floes as they then are). Returns true if the set of
-  // floes changed.
-  bool conclude(Floes& floes, PercussionAnalyses all);
+  // floes changed. `split` (if given) gets the indices of the floes split,
+  // in floe order: each is now its first piece, the second appended
+  // (FloeOwners::place_pieces takes them). `readable` (per floe before the
+  // splits, 1: current; empty: every floe): the floes whose states it may
+  // read, which must hold every share's split_readers; the pieces it
+  // appends are read too (built from their parents).
+  bool conclude(Floes& floes, PercussionAnalyses all, std::vector<std::uint32_t>* split = nullptr,
+                std::span<const std::uint8_t> readable = {});
   // Whether conclude(all) may split a floe, and so read floes' states (the
   // parents', their neighbours'): conclude splits only a floe whose decision
   // is a split, or undecided, and takes a decision again only near a split
@@ -285,8 +292,29 @@ public:
   // (docs/parallel.md, "Splits"; tests/parallel/test_halo_split.cpp).
   // `held` (per floe, 1: held; empty: every floe): the floes it may read,
   // which must hold those (the owner's band does): the same decision.
+  // The floes past held's end (pieces appended since) are read.
   SplitDecision decide_split(const Floes& floes, std::size_t i, const FloeInitiation& fi,
                              std::span<const std::uint8_t> held = {}) const;
+  // The floes a split of floe i is decided against, the one rule of
+  // decide_split's neighbours: floe i first, then ascending every other
+  // floe it may read (`held` as decide_split's) whose centroid lies within
+  // R_i + R_j + gap of floe i's.
+  std::vector<std::size_t> split_neighbours(const Floes& floes, std::size_t i,
+                                            std::span<const std::uint8_t> held = {}) const;
+  // The floes whose states conclude() may read for a share's initiations
+  // `mine`, analysed against `held` (docs/parallel.md, "The split step's
+  // owners and gather by holder (split28)"): each floe cracked through whose
+  // verdict may be taken again or applied (split, refused_overlap,
+  // undecided) and its neighbours (split_neighbours over `held`),
+  // ascending, each once. Why every share's lists hold all that conclude
+  // reads: changed_near reads such a parent's place; a split reads its
+  // parent alone; a decision taken again reads the parent's neighbours at
+  // its turn, which are the floes within reach at the analysis (a floe not
+  // split keeps its place; the owner's band holds every one of them), the
+  // indices of earlier splits (parents with a split verdict, listed) and
+  // the pieces appended (built on every rank from their listed parents).
+  std::vector<std::uint32_t> split_readers(const Floes& floes, const PercussionAnalyses& mine,
+                                           std::span<const std::uint8_t> held) const;
 
   // The initiations since the last call.
   std::vector<FractureEventRow> take_events();

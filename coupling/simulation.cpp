@@ -405,19 +405,48 @@ void Simulation::percussion(StepContext& ctx) {
   PercussionAnalyses all = combine(comm_.allgather_parts(pack(mine), unpack_percussion), percussion_ranks_);
   // Every rank applies every split, deciding it again from the parent's
   // neighbours where an earlier split came near, and the pieces take their
-  // parent's state; then the owners are assigned from every floe's place
-  // (detect_in_place). With the state held by owner a rank's copies of the
-  // floes it does not hold are stale, so when a split may be made (an
-  // initiation through a floe whose share decided a split: the same on every
-  // rank, Percussion::may_split) every floe's state comes from its owner
-  // first: one gather, in such a step only.
+  // parent's state; then the pieces' owners from their places, the other
+  // floes' from their owners (place_pieces, detect_in_place). With the
+  // state held by owner a rank's copies of the floes it does not hold are
+  // stale, so when a split may be made (an initiation through a floe whose
+  // share decided a split: the same on every rank, Percussion::may_split)
+  // the states conclude reads (each owner's split_readers: the parents and
+  // their neighbours) come from their owners first: one gather, in such a
+  // step only, and conclude reads those alone (and the pieces). With a
+  // floe-sea coupling every floe's state is gathered still: the coupling
+  // reads unheld floes after a split (likely its next rebuild, which poses
+  // every floe after FloeSeaContact::floes_changed; docs/parallel.md, "The
+  // split step's owners and gather by holder").
+  std::vector<std::uint8_t> readable;
   if (percussion_->may_split(all)) {
-    const WholeStateCounts before = whole_state_counts_;  // none gathered if every state is current already
-    whole_state(ctx, parallel::WholeState::state);
-    percussion_ranks_.whole_gathers += whole_state_counts_.gathers - before.gathers;
-    percussion_ranks_.whole_bytes += whole_state_counts_.bytes - before.bytes;
+    if (floe_sea_) {
+      const WholeStateCounts before = whole_state_counts_;  // none gathered if every state is current already
+      whole_state(ctx, parallel::WholeState::state);
+      percussion_ranks_.whole_gathers += whole_state_counts_.gathers - before.gathers;
+      percussion_ranks_.whole_bytes += whole_state_counts_.bytes - before.bytes;
+    } else {
+      readable = split_states(percussion_->split_readers(scenario_.floes, mine, held), held);
+    }
   }
-  if (percussion_->conclude(scenario_.floes, std::move(all))) on_floes_changed();
+  // The pieces' owners from their states (every rank builds them alike),
+  // the other floes' from their owners (detect_in_place).
+  std::vector<std::uint32_t> split;
+  if (percussion_->conclude(scenario_.floes, std::move(all), &split, readable)) {
+    owners_.place_pieces(scenario_.floes, split);
+    on_floes_changed();
+    // The poison mode (a test) checks them against assign() over every
+    // floe's place, each floe's state gathered from its owner for it (a
+    // test's gather; not with the mutation `stale`, which gathers nothing).
+    if (poison_ && !poison_->options().stale) {
+      Floes places = scenario_.floes;
+      comm_.complete_owned(places.state, owners_.owner());
+      parallel::FloeOwners by_place = owners_;
+      by_place.assign(places);
+      if (!std::ranges::equal(by_place.owner(), owners_.owner()) || by_place.mine() != owners_.mine())
+        throw RunError("poison: rank " + std::to_string(comm_.rank()) + ": the owners after the splits at t = " +
+                       std::to_string(t_) + " are not assign()'s over every floe's place");
+    }
+  }
 }
 
 void Simulation::on_floes_changed() {
@@ -630,7 +659,7 @@ bool Simulation::detect_and_check(StepContext& ctx) {
   // from here on, whatever the
   // drift's exchange (the vertical drift that follows is over the held
   // floes; with the state held by owner they were since the drift unless
-  // gathered): a split's whole_state gathers them.
+  // gathered): a split gathers the states it reads (split_states).
   if (halo) announced_ = std::move(halo->announced);
   if (!held_now().empty()) state_whole_ = false;
   detection_whole_ = comm_.serial() || whole;

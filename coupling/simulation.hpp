@@ -436,6 +436,11 @@ private:
   bool state_whole_ = true;
   WholeStateCounts whole_state_counts_;
   void whole_state(StepContext& ctx, parallel::WholeState what);
+  // Collective, in a step where a split may be made: `readers` (this
+  // rank's Percussion::split_readers) sent to every rank with their states;
+  // returns the floes whose states every rank now has alike (every rank's
+  // readers), which Percussion::conclude may read. `held`: held_now().
+  std::vector<std::uint8_t> split_states(std::span<const std::uint32_t> readers, std::span<const std::uint8_t> held);
   parallel::WholeOnDemand whole_on_demand(StepContext& ctx);
   contact::CollisionStats stats_;
   std::unique_ptr<Percussion> percussion_;  // [fracture] enabled

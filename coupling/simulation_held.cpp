@@ -6,6 +6,7 @@
 // simulation.cpp.
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 
 #include "core/error.hpp"
 #include "coupling/simulation.hpp"
@@ -89,12 +90,19 @@ void Simulation::detect_in_place() {
     held_ = hold_band();
     return;
   }
-  owners_.assign(scenario_.floes);
+  // The owners at the floes' present places: after a split (the pieces
+  // owned by place_pieces) from the owners' own floes, as at a step's
+  // detection (FloeOwners::migrate: their leave notices; no other floe's
+  // copy read); at the start and after a restore (no owners yet) from
+  // every floe's place, every copy the file's.
+  if (owners_.assigned_for(scenario_.floes)) owners_.migrate(comm_, scenario_.floes);
+  else owners_.assign(scenario_.floes);
   set_reach();
   wrap_entering(owners_.mine());
   // Outside a step nothing is known of who held what (the start, a
-  // restore: every copy is the file's; a split: gathered first): every
-  // entering floe's state goes with its notice.
+  // restore: every copy is the file's; a split: the split's readers
+  // gathered, the other unheld copies stale): every entering floe's state
+  // goes with its notice.
   std::optional<parallel::HaloPart> halo = halo_part(nullptr, nullptr);
   held_ = hold_band({}, {}, halo ? &*halo : nullptr);
   hold_quadrature();
@@ -224,8 +232,8 @@ void Simulation::whole_state(StepContext& ctx, parallel::WholeState what) {
   // state_whole_ (one flag: both whole) is set only by the gather of both.
   // The state alone leaves the step-start copies stale, so a later ask in
   // the step gathers again; the advance, which asks for the state alone,
-  // keeps what it gathered (its `start`) and asks once; a split asks for
-  // the state alone after the step (nothing reads the step-start copy then).
+  // keeps what it gathered (its `start`) and asks once. (A split gathers
+  // only the states it reads: split_states.)
   //
   // The poison mode's mutation `stale` (coupling/poison_mode.hpp) gathers
   // nothing: a step that reads every floe then reads the poison.
@@ -255,6 +263,40 @@ void Simulation::whole_state(StepContext& ctx, parallel::WholeState what) {
       ctx.start[i] = both[i][1];
     }
   state_whole_ = true;
+}
+
+std::vector<std::uint8_t> Simulation::split_states(std::span<const std::uint32_t> readers,
+                                                   std::span<const std::uint8_t> held) {
+  // Each rank sends its readers (its parents that may split or be decided
+  // again, and their neighbours among its held floes: current copies) to
+  // every rank, 100 B a floe (its index, 4 B, and state, 96 B), in one
+  // allgather_bytes (two calls). Only the floes a rank does not hold take
+  // them, as in whole_state: a held copy is current already, and the poison
+  // mode's NaN in one stays to be reported. Every rank gets every rank's
+  // readers, so the mask is the same everywhere. The poison mode's mutation
+  // `stale` writes none: conclude then reads the poison.
+  std::vector<FloeState>& state = scenario_.floes.state;
+  constexpr std::size_t kRecord = sizeof(std::uint32_t) + sizeof(FloeState);
+  std::vector<std::byte> message(readers.size() * kRecord);
+  for (std::size_t k = 0; k < readers.size(); ++k) {
+    std::memcpy(message.data() + k * kRecord, &readers[k], sizeof(std::uint32_t));
+    std::memcpy(message.data() + k * kRecord + sizeof(std::uint32_t), &state[readers[k]], sizeof(FloeState));
+  }
+  const long long before = comm_.traffic().bytes;
+  std::vector<std::size_t> counts;
+  const std::vector<std::byte> all = comm_.allgather_bytes(message, counts);
+  ++percussion_ranks_.whole_gathers;
+  percussion_ranks_.whole_bytes += comm_.traffic().bytes - before;
+  const bool stale = poison_ && poison_->options().stale;
+  std::vector<std::uint8_t> readable(state.size(), 0);
+  for (std::size_t at = 0; at + kRecord <= all.size(); at += kRecord) {
+    std::uint32_t i = 0;
+    std::memcpy(&i, all.data() + at, sizeof i);
+    FLOESIM_ASSERT(i < state.size());
+    readable[i] = 1;
+    if (!stale && !held.empty() && !held[i]) std::memcpy(&state[i], all.data() + at + sizeof i, sizeof(FloeState));
+  }
+  return readable;
 }
 
 parallel::WholeOnDemand Simulation::whole_on_demand(StepContext& ctx) {

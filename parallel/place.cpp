@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iterator>
 #include <limits>
 #include <numeric>
 
@@ -126,6 +127,30 @@ void FloeOwners::assign(const Floes& floes) {
   for (std::size_t i = 0; i < n; ++i) keys[i] = key(floes.state[i]);
   if (!has_slabs() && !cut_) set_cuts(cut_by_cost(keys, std::vector<double>(n, 1.0), ranks_));
   assign_keys(keys);
+}
+
+void FloeOwners::place_pieces(const Floes& floes, std::span<const std::uint32_t> replaced) {
+  FLOESIM_ASSERT((cut_ || has_slabs()) && owner_.size() <= floes.size());
+  const std::size_t before = owner_.size();
+  owner_.resize(floes.size());
+  for (const std::uint32_t i : replaced) {
+    FLOESIM_ASSERT(i < before);
+    owner_[i] = owner_at(floes.state[i]);
+  }
+  for (std::size_t j = before; j < floes.size(); ++j) owner_[j] = owner_at(floes.state[j]);
+  // This rank's floes, ascending: a replaced parent's index kept only if
+  // its first piece is here, the pieces that land here merged in.
+  std::vector<std::uint32_t> pieces;
+  for (const std::uint32_t i : replaced)
+    if (owner_[i] == rank_) pieces.push_back(i);
+  for (std::size_t j = before; j < floes.size(); ++j)
+    if (owner_[j] == rank_) pieces.push_back(static_cast<std::uint32_t>(j));
+  std::sort(pieces.begin(), pieces.end());
+  std::erase_if(mine_, [&](std::uint32_t i) { return owner_[i] != rank_; });
+  std::vector<std::uint32_t> merged;
+  merged.reserve(mine_.size() + pieces.size());
+  std::set_union(mine_.begin(), mine_.end(), pieces.begin(), pieces.end(), std::back_inserter(merged));
+  mine_ = std::move(merged);
 }
 
 std::vector<LeaveNotice> FloeOwners::leaving(int rank, const Floes& floes) const {

@@ -151,8 +151,20 @@ public:
   std::vector<LeaveNotice> leaving(int rank, const Floes& floes) const;
   void take_leaving(std::span<const LeaveNotice> notices);
   // Whether leaving() may replace assign() for `floes`: cuts set and an
-  // owner for each floe (not at the start, after a restore or a split).
+  // owner for each floe (not at the start or after a restore; after a
+  // split once place_pieces has owned its pieces).
   bool assigned_for(const Floes& floes) const { return (cut_ || has_slabs()) && owner_.size() == floes.size(); }
+  // The owners of a step's split pieces (docs/parallel.md, "The split
+  // step's owners and gather by holder (split28)"): each split replaces its
+  // parent at the parent's index (`replaced`, any order) by its first piece
+  // and appends its second (indices owner().size() and on). Each piece's
+  // owner is owner_at of its state, which every rank builds alike from the
+  // parent's (Percussion::conclude): the owner assign() gives it, without
+  // reading any other floe. The other floes keep their owners: with the
+  // cuts set and the owners assigned for the floes before the split,
+  // leaving()/take_leaving() (or migrate()) then give assign()'s owners for
+  // every floe from the owners' own floes.
+  void place_pieces(const Floes& floes, std::span<const std::uint32_t> replaced);
   // The rank whose strip holds a floe in state s (the one rule of assign and
   // leaving): the owner of its key (with slabs its centroid's grid row, a
   // whole number held exactly in a double; else its place), which the cuts'

@@ -32,7 +32,7 @@ usage: check_record_ranks.py FLOESIM MPIEXEC WORKDIR [--floes N] [--t-end T] [--
    and tried again with the meeting clusters joined on one rank (each try
    recording afresh; these steps do not fall back whole:
    `parallel.advance_joined`), or redone whole.
-3. In both: every floe's state is gathered before the splits
+3. In both: the states the splits read are gathered before them
    (`parallel.fracture_whole_state`) in exactly the steps where a floe split
    (the serial run's /events/fracture rows with a piece): a step whose
    cracks are all refused (a sliver, a chord, the neighbours) gathers
@@ -95,8 +95,8 @@ def split_steps(path):
 
 
 def check_split_gathers(p, serial, what):
-    """Item 3: the steps that gathered every floe's state before a split are
-    the steps in which a floe split."""
+    """Item 3: the steps that gathered states before a split (the split's
+    readers since split28) are the steps in which a floe split."""
     gathered = int(summary(p).get("parallel.fracture_whole_state", "-1 steps").split()[0])
     steps = split_steps(serial)
     print(f"{what}: every floe's state gathered before the splits in {gathered} steps, "

@@ -362,4 +362,157 @@ TEST_CASE("a split decided on the strip alone (no band) reads floes it does not 
   CHECK(differ > 0);
 }
 
+TEST_CASE("the owners after the splits, the pieces' from their places and the others' from their owners, are assign's") {
+  // Simulation::percussion and detect_in_place on several ranks (docs/
+  // parallel.md, "The split step's owners and gather by holder (split28)"),
+  // on simulated ranks. Each rank's owners are assigned at the last
+  // detection's places (the pack); the floes then split (the serial
+  // conclude) and move (60 s at their velocities, so that some leave their
+  // strips and some pieces land in another strip than their parent's). Each rank owns the pieces (FloeOwners::place_pieces) on a
+  // copy in which only the split parents' indices and the appended pieces
+  // are not NaN, then announces its own floes leaving its strip from a copy
+  // in which only its own floes are not NaN (leaving), and every rank
+  // applies every rank's notices (take_leaving, as migrate). Checked: every
+  // rank's owner array and own floes are assign()'s over every floe's place
+  // after the splits, entry for entry. Strips of equal counts, uneven, and
+  // the sea's slabs (periodic box), on 2, 3 and 7 ranks.
+  // Counted, that the case reaches both rules: the pieces whose owner by
+  // place is another rank than their parent's (the leave notices would
+  // carry them if they kept their parent's owner) and the unsplit floes'
+  // notices. The mutation it names: place_pieces setting the owners but
+  // leaving the own floes (mine()) as they were.
+  std::size_t across = 0, notices = 0;
+  for (const bool periodic : {true, false}) {
+    CAPTURE(periodic);
+    const Pack p = moving_pack(11, periodic, 0.5, kConcentration);
+    const std::size_t n = p.floes.size();
+    const contact::Domain& box = p.detect.domain;
+    Floes after = p.floes;
+    Percussion percussion(split_params(), opening(p));
+    std::vector<FloeInitiation> decided = cracks(after);
+    for (FloeInitiation& fi : decided) fi.split = percussion.decide_split(after, fi.floe, fi);
+    std::vector<std::uint32_t> parents;
+    REQUIRE(percussion.conclude(after, analyses_of(decided), &parents));
+    for (FloeState& s : after.state) {
+      s.x += 60.0 * s.vx;
+      s.y += 60.0 * s.vy;
+      if (!box.periodic) continue;
+      s.x = box.xmin + std::fmod(std::fmod(s.x - box.xmin, box.width()) + box.width(), box.width());
+      s.y = box.ymin + std::fmod(std::fmod(s.y - box.ymin, box.height()) + box.height(), box.height());
+    }
+    REQUIRE(after.size() == n + parents.size());
+    REQUIRE(std::is_sorted(parents.begin(), parents.end()));
+    Held pieces(after.size(), 0);
+    for (const std::uint32_t i : parents) pieces[i] = 1;
+    for (std::size_t j = n; j < after.size(); ++j) pieces[j] = 1;
+    const Floes only_pieces = poisoned(after, pieces);
+    for (const Strips kind : {Strips::equal, Strips::uneven, Strips::slabs}) {
+      if (kind == Strips::slabs && !(periodic && p.window[2] == 0.0)) continue;
+      for (const int ranks : {2, 3, 7}) {
+        CAPTURE(strips_name(kind));
+        CAPTURE(ranks);
+        const parallel::FloeOwners like = owners_of(p, ranks, kind);
+        const auto owners_on = [&](int rank, const Floes& floes) {
+          parallel::FloeOwners o(rank, ranks, box);
+          if (like.has_slabs()) o.set_slabs(like.slabs());
+          else o.set_cuts(like.cuts());
+          o.assign(floes);
+          return o;
+        };
+        std::vector<parallel::FloeOwners> by_own;
+        std::vector<std::vector<parallel::LeaveNotice>> sent;
+        for (int r = 0; r < ranks; ++r) {
+          parallel::FloeOwners o = owners_on(r, p.floes);
+          o.place_pieces(only_pieces, parents);
+          REQUIRE(o.assigned_for(after));
+          Held own(after.size(), 0);
+          for (const std::uint32_t j : o.mine()) own[j] = 1;
+          sent.push_back(o.leaving(r, poisoned(after, own)));
+          notices += sent.back().size();
+          by_own.push_back(std::move(o));
+        }
+        for (int r = 0; r < ranks; ++r) {
+          CAPTURE(r);
+          parallel::FloeOwners& o = by_own[static_cast<std::size_t>(r)];
+          for (int s = 0; s < ranks; ++s) o.take_leaving(sent[static_cast<std::size_t>(s)]);
+          const parallel::FloeOwners whole = owners_on(r, after);
+          CHECK(std::ranges::equal(o.owner(), whole.owner()));
+          CHECK(o.mine() == whole.mine());
+        }
+        const parallel::FloeOwners whole = owners_on(0, after);
+        for (std::size_t m = 0; m < parents.size(); ++m) {
+          const int parent = like.owner()[parents[m]];
+          across += (whole.owner()[parents[m]] != parent ? 1 : 0) + (whole.owner()[n + m] != parent ? 1 : 0);
+        }
+      }
+    }
+  }
+  MESSAGE("the pieces owned by another rank than their parent's: " << across << "; notices: " << notices);
+  CHECK(across > 0);
+  CHECK(notices > 0);
+}
+
+TEST_CASE("a split step concluded on every rank reads only the states the owners' split_readers send") {
+  // Simulation::percussion's limited gather (docs/parallel.md, "The split
+  // step's owners and gather by holder (split28)"), on simulated ranks:
+  // each owner lists, against its held floes (its band, poisoned outside),
+  // its through cracks' parents that may split or be decided again and
+  // their neighbours (Percussion::split_readers); a rank that concludes on
+  // a copy in which only every owner's listed floes are not NaN, with that
+  // mask (`readable`), makes the serial splits and events: the same floe
+  // count and ids, every listed floe and every piece bit for bit. Strips of
+  // equal counts on 2, 3 and 7 ranks, periodic and open.
+  // The mutation it names: the parents alone sent (no neighbours); a
+  // decision taken again then misses its neighbours (NaN places compare
+  // false), and some conclusion differs (counted: > 0).
+  std::size_t listed = 0, differ_parents_only = 0;
+  for (const bool periodic : {true, false}) {
+    CAPTURE(periodic);
+    const Pack p = moving_pack(11, periodic, 0.5, kConcentration);
+    const std::size_t n = p.floes.size();
+    Percussion serial_percussion(split_params(), opening(p));
+    std::vector<FloeInitiation> decided = cracks(p.floes);
+    for (FloeInitiation& fi : decided) fi.split = serial_percussion.decide_split(p.floes, fi.floe, fi);
+    Floes serial = p.floes;
+    REQUIRE(serial_percussion.conclude(serial, analyses_of(decided)));
+    const std::vector<FractureEventRow> serial_events = serial_percussion.take_events();
+    REQUIRE(serial_percussion.stats().splits_redone > 0);
+    for (const int ranks : {2, 3, 7}) {
+      CAPTURE(ranks);
+      parallel::FloeOwners owners(0, ranks, p.detect.domain);
+      owners.assign(p.floes);
+      Held readable(n, 0), parents_only(n, 0);
+      for (int r = 0; r < ranks; ++r) {
+        const Held band = halo_band(owners, r, p.floes, p.shapes, p.detect);
+        PercussionAnalyses mine;
+        for (const FloeInitiation& fi : decided)
+          if (owners.owner()[fi.floe] == r) mine.initiations.push_back(fi);
+        Percussion share(split_params(), opening(p));
+        for (const std::uint32_t j : share.split_readers(poisoned(p.floes, band), mine, band)) {
+          REQUIRE(band[j]);
+          readable[j] = 1;
+        }
+        for (const FloeInitiation& fi : mine.initiations)
+          if (decided_against_neighbours(fi.split.verdict)) parents_only[fi.floe] = 1;
+      }
+      listed += count_held(readable);
+      const auto conclude_on = [&](const Held& mask, bool check) {
+        Percussion every(split_params(), opening(p));
+        Floes f = poisoned(p.floes, mask);
+        every.conclude(f, analyses_of(decided), nullptr, mask);
+        bool same = f.size() == serial.size() && f.ids_issued == serial.ids_issued && same_bytes(f.id, serial.id) &&
+                    same_events(every.take_events(), serial_events);
+        for (std::size_t j = 0; same && j < f.size(); ++j)
+          if (j >= n || mask[j]) same = same_floe(f, j, serial, j);
+        if (check) CHECK(same);
+        return same;
+      };
+      conclude_on(readable, true);
+      if (!conclude_on(parents_only, false)) ++differ_parents_only;
+    }
+  }
+  MESSAGE("floes listed: " << listed << "; the parents alone: " << differ_parents_only << " of 6 conclusions differ");
+  CHECK(differ_parents_only > 0);
+}
+
 TEST_SUITE_END();
