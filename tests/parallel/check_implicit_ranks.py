@@ -43,9 +43,13 @@ reports NaN.
 """
 import os
 import re
+import sys
 from pathlib import Path
 
 from ranks_harness import finish, half_pack, need, ocean_toml, phase_bytes, ranks_check, summary
+
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent.parent / "scripts" / "scenarios"))
+from whole_seas import SEAS, pack_command  # per case: its [sea] and its pack's arguments
 
 args, harness = ranks_check(
     "floesim was built without MPI (FLOESIM_MPI=OFF): the implicit step on several ranks is not checked",
@@ -55,25 +59,13 @@ failures = []
 run, mpirun = harness.run, harness.mpirun
 EXAMPLES = Path(__file__).resolve().parent.parent.parent / "examples"
 
+# check_whole_seas.py's BEM basin and pack (scripts/scenarios/whole_seas.py) with the implicit step.
 BEM = """[run]
 t_end = 2.0
 dt_max = 0.02
 output_interval = 0.5
 threads = 1
-
-[sea]
-model = "bem"
-dims = 2
-size = [12.0, 6.0]
-cells = [24, 12]
-depth = 2.0
-rho = 1000.0
-
-[sea.waves]
-kind = "standing"
-amplitude = 0.05
-wavelength = 24.0
-
+""" + SEAS["bem"][0] + """
 [floes]
 pack = "bem_pack.h5"
 
@@ -82,8 +74,7 @@ stiffness = 100.0
 law = "strong"
 integrator = "implicit"
 """
-need(run([args.floesim, "pack", "--floes", "150", "--box", "12", "6", "--concentration", "0.7", "--seed", "3",
-          "--thickness", "0.2", "-o", "bem_pack.h5"]), "bem: floesim pack")
+need(run(pack_command(args.floesim, "bem", "bem_pack.h5")), "bem: floesim pack")
 half_pack(run, args.floesim)
 CASES = {  # name: (configuration, --until, floes whose drift bytes are bounded or None)
     "bem": (BEM, [], 150),
