@@ -48,7 +48,7 @@ ap.add_argument("--note", default="")
 ap.add_argument("--half", action="store_true", help="500 floes in the lower half of the box")
 args = ap.parse_args()
 
-floesim = os.path.join(args.build, "bin", "floesim")
+floesim = os.path.join(os.path.abspath(args.build), "bin", "floesim")  # the runs start in a scratch folder
 work = tempfile.mkdtemp(prefix="floesim_ocean_ranks_")
 config = os.path.join(work, "ocean.toml")
 if args.half:
