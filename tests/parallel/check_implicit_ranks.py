@@ -42,7 +42,6 @@ whose tilt term reads the yaw): the ocean's `step` run fails, the tank's
 reports NaN.
 """
 import os
-import re
 import sys
 from pathlib import Path
 
@@ -101,29 +100,10 @@ for name, (text, until, floes) in CASES.items():
             if not drift < 0.6 * whole:
                 failures.append(f"{name} on {n} ranks: rank 0's drift phase received {drift} B, not under 0.6 x 96 B "
                                 f"x {floes} floes x {steps} steps = {0.6 * whole:.0f} (every state to every rank?)")
-    for poison in ("step", "step-lure"):
-        p = harness.poisoned(2, poison, "run", config, "-o", f"{name}_{poison}.h5", "-q", *until)
-        poisoned = [int(m.group(1)) for m in re.finditer(r"windows, (\d+) floes poisoned", p.stderr)]
-        reported = [int(m.group(1)) for m in re.finditer(r"(\d+) phases reported", p.stderr)]
-        what = f"{name} on 2 ranks, poison mode {poison}"
-        print(f"{what}: exit {p.returncode}, floes poisoned {poisoned}, phases reported {reported}")
-        if p.returncode != 0:
-            failures.append(f"{what}: exit {p.returncode}\n{p.stderr[-3000:]}")
-            continue
-        harness.same(f"{name}_{poison}.h5", f"{name}_serial.h5", f"{what}, against the serial run", failures)
-        if len(poisoned) != 2 or any(reported) or (floes and min(poisoned) == 0):
-            failures.append(f"{what}: floes poisoned {poisoned}, phases reported {reported} (every rank must report "
-                            f"none{' and poison floes' if floes else ''})\n{p.stderr[-3000:]}")
+    harness.poison_clean(name, config, f"{name}_serial.h5", failures, floes=bool(floes), extra=until)
 
 # A restart across rank counts: the checkpoint holds the step's mean
 # horizontal loads and the footprints' reference poses, gathered from the
 # owners that posed them.
-need(mpirun(2, "run", os.path.join(W, "bem.toml"), "-o", "bem_half.h5", "-q", "--until", "1"),
-     "bem: the first half on 2 ranks")
-p = mpirun(3, "run", "--restart", "bem_half.h5", "-o", "bem_rest3.h5", "-q")
-if p.returncode != 0:
-    failures.append(f"bem: restart on 3 ranks: exit {p.returncode}\n{p.stderr}")
-else:
-    harness.same("bem_rest3.h5", "bem_serial.h5", "bem: half on 2 ranks, continued on 3, against the serial run",
-                 failures)
+harness.restart_2_on_3("bem", os.path.join(W, "bem.toml"), "bem_serial.h5", failures)
 finish(failures)

@@ -217,32 +217,13 @@ elif ("flume", 2) in penalty:
                         f"made, more than 1.2 times the {along} with it numbered along x (owners by index?)")
 
 # The poison mode: the coupling, the seas and the step read only floes
-# their rank holds.
+# their rank holds (none poisoned in the 2 m flume: every band holds every floe).
 for name in SEAS:
-    for poison in ("step", "step-lure"):
-        p = harness.poisoned(2, poison, "run", os.path.join(W, f"{name}.toml"), "-o", f"{name}_{poison}.h5", "-q")
-        poisoned = [int(m.group(1)) for m in re.finditer(r"windows, (\d+) floes poisoned", p.stderr)]
-        reported = [int(m.group(1)) for m in re.finditer(r"(\d+) phases reported", p.stderr)]
-        what = f"{name} on 2 ranks, poison mode {poison}"
-        print(f"{what}: exit {p.returncode}, floes poisoned {poisoned}, phases reported {reported}")
-        if p.returncode != 0:
-            failures.append(f"{what}: exit {p.returncode}\n{p.stderr[-2000:]}")
-            continue
-        harness.same(f"{name}_{poison}.h5", f"{name}_serial.h5", f"{what}, against the serial run", failures)
-        if len(poisoned) != 2 or any(reported) or (name != "flume" and min(poisoned) == 0):
-            failures.append(f"{what}: floes poisoned {poisoned}, phases reported {reported} (every rank must "
-                            f"report none{'' if name == 'flume' else ' and poison floes'})")
+    harness.poison_clean(name, os.path.join(W, f"{name}.toml"), f"{name}_serial.h5", failures, floes=name != "flume")
 
 # A restart across rank counts: the bem case's first half on 2 ranks, the
 # rest from its checkpoint on 3 ranks.
-need(mpirun(2, "run", os.path.join(W, "bem.toml"), "-o", "bem_half.h5", "-q", "--until", "1"),
-     "bem: the first half on 2 ranks")
-p = mpirun(3, "run", "--restart", "bem_half.h5", "-o", "bem_rest3.h5", "-q")
-if p.returncode != 0:
-    failures.append(f"bem: restart on 3 ranks: exit {p.returncode}\n{p.stderr}")
-else:
-    harness.same("bem_rest3.h5", "bem_serial.h5", "bem: half on 2 ranks, continued on 3, against the serial run",
-                 failures)
+harness.restart_2_on_3("bem", os.path.join(W, "bem.toml"), "bem_serial.h5", failures)
 # Splits on a sea not in slabs: the wide flume with fracture (its floes
 # crack and split within the 2 s), on 2 ranks from the parts (the default,
 # the halo exchange) and from the whole detection (`advance_on_part =

@@ -12,6 +12,7 @@ a run that must exit 0, a file that must equal another bit for bit (or
 must not: a mutation), and the check's end."""
 import argparse
 import os
+import re
 import subprocess
 import sys
 
@@ -55,6 +56,38 @@ class Ranks:
         FLOESIM_TEST_POISON_UNHELD set to `poison` (None: unset; docs/parallel.md,
         "The poison mode of the run")."""
         return self.mpirun(n, *floesim_args, hooks={"FLOESIM_TEST_POISON_UNHELD": poison} if poison else None)
+
+    def poison_clean(self, name, config, serial, failures, floes=True, extra=()):
+        """The case `name` (its configuration, its serial run file) on 2 ranks
+        in the poison modes `step` and `step-lure`: each run must exit 0, equal
+        the serial run bit for bit, every rank report no phase and, with
+        `floes`, poison floes (the exchanges leave unheld copies that no phase
+        reads)."""
+        for poison in ("step", "step-lure"):
+            p = self.poisoned(2, poison, "run", config, "-o", f"{name}_{poison}.h5", "-q", *extra)
+            poisoned = [int(m.group(1)) for m in re.finditer(r"windows, (\d+) floes poisoned", p.stderr)]
+            reported = [int(m.group(1)) for m in re.finditer(r"(\d+) phases reported", p.stderr)]
+            what = f"{name} on 2 ranks, poison mode {poison}"
+            print(f"{what}: exit {p.returncode}, floes poisoned {poisoned}, phases reported {reported}")
+            if p.returncode != 0:
+                failures.append(f"{what}: exit {p.returncode}\n{p.stderr[-3000:]}")
+                continue
+            self.same(f"{name}_{poison}.h5", serial, f"{what}, against the serial run", failures)
+            if len(poisoned) != 2 or any(reported) or (floes and min(poisoned) == 0):
+                failures.append(f"{what}: floes poisoned {poisoned}, phases reported {reported} (every rank must "
+                                f"report none{' and poison floes' if floes else ''})\n{p.stderr[-3000:]}")
+
+    def restart_2_on_3(self, name, config, serial, failures):
+        """The case's first second on 2 ranks, the rest from its checkpoint on 3
+        ranks: the run file must equal the serial one bit for bit."""
+        need(self.mpirun(2, "run", config, "-o", f"{name}_half.h5", "-q", "--until", "1"),
+             f"{name}: the first half on 2 ranks")
+        p = self.mpirun(3, "run", "--restart", f"{name}_half.h5", "-o", f"{name}_rest3.h5", "-q")
+        if p.returncode != 0:
+            failures.append(f"{name}: restart on 3 ranks: exit {p.returncode}\n{p.stderr}")
+        else:
+            self.same(f"{name}_rest3.h5", serial, f"{name}: half on 2 ranks, continued on 3, against the serial run",
+                      failures)
 
     def compare(self, a, b, rtol):
         """`floesim compare` of two run files within the relative `rtol` (no absolute slack)."""
