@@ -61,15 +61,20 @@ void compact(CollisionShapes& s, std::size_t capacity) {
 }
 
 // Room for `needed` more vertices: compacted when the dead vertices exceed
-// half the live ones (a compaction copies the live vertices, at most twice
-// the dead ones it frees) or when the appends would reallocate (a doubling
-// would hold up to twice the vertices), into room for a quarter more than
-// the live and needed vertices. `needed` is a bound (bound_of) when the
-// partition is not made yet.
+// options.compact_dead times the live ones or when the appends would
+// reallocate, into room for options.spare more than the live and needed
+// vertices (CollisionShapesOptions: why). `needed` is a bound (bound_of)
+// when the partition is not made yet.
 void make_room(CollisionShapes& s, std::size_t needed) {
+  const CollisionShapesOptions& o = s.options;
+  FLOESIM_ASSERT(o.compact_dead >= 0.0 && o.spare >= 0.0);
   const std::size_t live = s.vertices.size() - s.dead_vertices;
-  if (2 * s.dead_vertices > live || s.vertices.size() + needed > s.vertices.capacity())
-    compact(s, live + needed + (live + needed) / 4);
+  const auto share = [](double fraction, std::size_t n) {
+    return static_cast<std::size_t>(fraction * static_cast<double>(n));
+  };
+  if (static_cast<double>(s.dead_vertices) > o.compact_dead * static_cast<double>(live) ||
+      s.vertices.size() + needed > s.vertices.capacity())
+    compact(s, live + needed + share(o.spare, live + needed));
 }
 
 // The vertices floe i's parts take, or a bound on them: a convex floe's
@@ -98,8 +103,9 @@ void extend_collision_shapes(CollisionShapes& s, const Floes& floes, std::size_t
   for (std::size_t i = first; i < floes.size(); ++i) append_floe(s, floes, i);
 }
 
-CollisionShapes build_collision_shapes(const Floes& floes) {
+CollisionShapes build_collision_shapes(const Floes& floes, const CollisionShapesOptions& options) {
   CollisionShapes s;
+  s.options = options;
   extend_collision_shapes(s, floes, 0);
   s.vertex_offsets.shrink_to_fit();
   s.vertices.shrink_to_fit();
@@ -155,7 +161,9 @@ void CollisionShapes::append(std::size_t floe, std::span<const std::uint32_t> si
 }
 
 void CollisionShapes::forget(const Floes& floes) {
+  const CollisionShapesOptions kept = options;
   *this = CollisionShapes();
+  options = kept;
   size_to(*this, floes);
 }
 

@@ -13,10 +13,11 @@
 // set gets its parts appended at the end (built from its vertices, which
 // every rank keeps: the same bits), a floe leaving leaves dead parts
 // behind, and the arrays are compacted in floe order when the dead
-// vertices exceed half the live ones or an append would outgrow the
-// capacity. A floe's parts are contiguous and in the order the partition
-// gives; every reader walks a floe's parts in that order and indexes the
-// floes by floe number, so the layout changes no result.
+// vertices exceed a fraction of the live ones or an append would outgrow
+// the capacity (CollisionShapesOptions). A floe's parts are contiguous and
+// in the order the partition gives; every reader walks a floe's parts in
+// that order and indexes the floes by floe number, so the layout changes
+// no result.
 //
 // The radius stays every floe's (8 B a floe): it is what decides who holds
 // a floe (the band's half width R_j + reach_j + xi/2, parallel/place.hpp),
@@ -28,6 +29,19 @@
 
 namespace floesim::contact {
 
+// When the held floes' arrays are compacted (CollisionShapes::hold,
+// ensure, append; their layout only: no result reads it). A compaction
+// copies the live vertices; an append that outgrows the capacity would
+// reallocate by doubling and hold up to twice the vertices.
+struct CollisionShapesOptions {
+  // Compacted when the dead vertices exceed this fraction of the live ones:
+  // at 0.5 a compaction copies at most twice the dead vertices it frees.
+  double compact_dead = 0.5;
+  // A compaction leaves room for this fraction more than the live and the
+  // needed vertices, so that the next floes entering append in place.
+  double spare = 0.25;
+};
+
 struct CollisionShapes {
   std::vector<std::size_t> first_part;         // per floe: its first part
   std::vector<std::uint32_t> part_count;       // per floe: its parts (0: not held)
@@ -35,6 +49,7 @@ struct CollisionShapes {
   std::vector<Vec2> vertices;                  // m, body frame, counter-clockwise per part
   std::vector<double> radius;                  // per floe, every floe: max |vertex| (bounding circle about G)
   std::size_t dead_vertices = 0;               // vertices in no held floe's parts (left by floes let go)
+  CollisionShapesOptions options;              // kept by forget()
 
   std::span<const Vec2> part(std::size_t p) const {
     return {vertices.data() + vertex_offsets[p], vertex_offsets[p + 1] - vertex_offsets[p]};
@@ -62,7 +77,7 @@ struct CollisionShapes {
   // holds the parts one after the other, `sizes` their vertex counts.
   void append(std::size_t floe, std::span<const std::uint32_t> sizes, std::span<const Vec2> vertices);
   // Every floe's parts dropped and every radius set from `floes` (the floes
-  // changed: a split's parent, a restart), the arrays freed.
+  // changed: a split's parent, a restart), the arrays freed; the options kept.
   void forget(const Floes& floes);
 
   // What these arrays allocate, against the entries of the floes `held`
@@ -72,7 +87,7 @@ struct CollisionShapes {
 };
 
 // Every floe's shape, in floe order, the arrays fitted to their size.
-CollisionShapes build_collision_shapes(const Floes& floes);
+CollisionShapes build_collision_shapes(const Floes& floes, const CollisionShapesOptions& options = {});
 
 // Appends the shapes of floes [first, floes.size()) (after floes were added, e.g. a split).
 void extend_collision_shapes(CollisionShapes& shapes, const Floes& floes, std::size_t first);

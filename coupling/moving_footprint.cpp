@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
+#include <tuple>
 
 #include "core/error.hpp"
 #include "coupling/parallel.hpp"
@@ -15,7 +16,9 @@ namespace floesim {
 
 MovingFootprints::MovingFootprints(const fluid::SurfaceGrid& grid, FootprintKernel kernel,
                                    FootprintMotionOptions options)
-    : grid_(grid), kernel_(kernel), options_(options) {}
+    : grid_(grid), kernel_(kernel), options_(options) {
+  FLOESIM_ASSERT(options.fit_slack >= 0.0 && options.fit_spare >= 0.0);
+}
 
 FloePose window_displacement(const fluid::SurfaceGrid& grid, const FloePose& reference, const FloePose& at) {
   FloePose d{at.x - reference.x, at.y - reference.y, at.yaw - reference.yaw};
@@ -136,34 +139,25 @@ void MovingFootprints::set_owners(std::span<const FloePose> poses, std::span<con
 
 namespace {
 
-// A build appends its pieces, each array growing by doubling, and a clear
-// keeps the capacity from one build to the next: the arrays would keep up to
-// twice the most pieces any build had. An array whose spare capacity
-// exceeds a quarter of its size is copied into one with an eighth spare: a
-// copy at the builds whose count grew or fell by about a tenth, not at
-// every build.
+// Copies `v` into an array with o.fit_spare times its size spare when its
+// spare capacity exceeds o.fit_slack times its size
+// (FootprintMotionOptions: why).
 template <class T>
-void fit(std::vector<T>& v) {
-  if (v.capacity() - v.size() <= v.size() / 4) return;
+void fit(std::vector<T>& v, const FootprintMotionOptions& o) {
+  const auto share = [&](double fraction) {
+    return static_cast<std::size_t>(fraction * static_cast<double>(v.size()));
+  };
+  if (v.capacity() - v.size() <= share(o.fit_slack)) return;
   std::vector<T> kept;
-  kept.reserve(v.size() + v.size() / 8);
+  kept.reserve(v.size() + share(o.fit_spare));
   kept.assign(v.begin(), v.end());
   v.swap(kept);
 }
 
-void fit(Footprints& f) {
-  fit(f.offsets);
-  fit(f.cell);
-  fit(f.area);
-  fit(f.centroid);
-  fit(f.edge_offsets);
-  fit(f.edge_cell);
-  fit(f.edge_piece);
-  fit(f.edge_length);
-  fit(f.edge_normal);
-  fit(f.edge_twist);
-  fit(f.edge_first);
-  fit(f.edge_swept);
+void fit(Footprints& f, const FootprintMotionOptions& o) {
+  std::apply([&](auto&... v) { (fit(v, o), ...); },
+             std::tie(f.offsets, f.cell, f.area, f.centroid, f.edge_offsets, f.edge_cell, f.edge_piece, f.edge_length,
+                      f.edge_normal, f.edge_twist, f.edge_first, f.edge_swept));
 }
 
 }  // namespace
@@ -196,12 +190,12 @@ void MovingFootprints::rebuild_at(const Floes& floes, std::span<const std::uint8
   for (std::size_t i = 0; i < floes.size(); ++i)
     if (include[i]) largest = std::max(largest, radius_[i]);
   piece_rows_ = piece_rows_of(largest, options_.reach, grid_.dy());
-  fit(pieces_);
+  fit(pieces_, options_);
   area0_ = pieces_.area;
   moment0_.resize(area0_.size());
   for (std::size_t k = 0; k < area0_.size(); ++k) moment0_[k] = area0_[k] * pieces_.centroid[k];
-  fit(area0_);
-  fit(moment0_);
+  fit(area0_, options_);
+  fit(moment0_, options_);
 }
 
 void MovingFootprints::move(std::span<const FloePose> poses, int threads) {

@@ -80,6 +80,16 @@ struct FootprintMotionOptions {
   // Cells a floe's vertices may move before its pieces are rebuilt ([coupling]
   // footprint_reach). 0: rebuilt at every placement.
   double reach = 0.0;
+  // The pieces' arrays after each rebuild (their layout only: no result
+  // reads a capacity). A build appends, each array growing by doubling, and
+  // a clear keeps the capacity from one build to the next, so an array
+  // would keep up to twice the most pieces any build had. An array whose
+  // spare capacity exceeds fit_slack times its size is copied into one with
+  // fit_spare times its size spare. The defaults copy at the builds whose
+  // count grew or fell by about a tenth, not at every build; with
+  // fit_spare > fit_slack every rebuild copies. Both >= 0.
+  double fit_slack = 0.25;
+  double fit_spare = 0.125;
 };
 
 class MovingFootprints {

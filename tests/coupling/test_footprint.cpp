@@ -6,6 +6,7 @@
 // integrals.
 #include <doctest/doctest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <numbers>
@@ -599,5 +600,75 @@ TEST_CASE("moved footprints: every piece lies within reach_rows() rows of its fl
       }
       CHECK(farthest >= reach - 4);
     }
+  }
+}
+
+TEST_CASE("moved footprints: the fit's thresholds change the pieces' arrays' capacity, not the pieces") {
+  // FootprintMotionOptions::fit_slack, fit_spare: the arrays' layout after a
+  // rebuild. With slack 0 and spare 1 an array with any spare capacity is
+  // copied into one twice its size; with the defaults an array keeps at
+  // most a quarter of its size spare. The pieces are the same bits either
+  // way, built and moved.
+  const fluid::SurfaceGrid grid = box_grid();
+  std::mt19937_64 rng(5);
+  Floes floes = mixed_floes(rng, 6);
+  scatter(floes, grid, rng);
+  const std::vector<std::uint8_t> include(floes.size(), 1);
+  FootprintMotionOptions roomy{0.5};
+  roomy.fit_slack = 0.0;
+  roomy.fit_spare = 1.0;
+  MovingFootprints fitted(grid, FootprintKernel::tent, {0.5}), spare(grid, FootprintKernel::tent, roomy);
+  std::vector<FloePose> p = poses_of(floes);
+  const auto same_pieces = [&] {
+    const Footprints &a = fitted.pieces(), &b = spare.pieces();
+    CHECK(a.offsets == b.offsets);
+    CHECK(a.cell == b.cell);
+    CHECK(a.area == b.area);
+    CHECK(a.centroid == b.centroid);
+    CHECK(a.edge_offsets == b.edge_offsets);
+    CHECK(a.edge_cell == b.edge_cell);
+    CHECK(a.edge_normal == b.edge_normal);
+    CHECK(a.edge_twist == b.edge_twist);
+    CHECK(std::equal(fitted.reference_area().begin(), fitted.reference_area().end(),
+                     spare.reference_area().begin(), spare.reference_area().end()));
+  };
+  // After a rebuild each array's spare capacity is within the slack, or the
+  // spare of a copy (`copied` counts those, of the arrays with entries,
+  // whose spare is beyond the slack).
+  const auto layout = [](const Footprints& f, const FootprintMotionOptions& o, int& copied) {
+    copied = 0;
+    bool rule = true;
+    const auto check = [&](const auto& v) {
+      const auto share = [&](double fraction) {
+        return static_cast<std::size_t>(fraction * static_cast<double>(v.size()));
+      };
+      const std::size_t room = v.capacity() - v.size();
+      rule = rule && (room <= share(o.fit_slack) || room == share(o.fit_spare));
+      copied += !v.empty() && room > share(o.fit_slack);
+    };
+    check(f.offsets), check(f.cell), check(f.area), check(f.centroid), check(f.edge_offsets), check(f.edge_cell);
+    check(f.edge_piece), check(f.edge_length), check(f.edge_normal), check(f.edge_twist), check(f.edge_first);
+    check(f.edge_swept);
+    return rule;
+  };
+  for (int rebuild = 0; rebuild < 2; ++rebuild) {
+    CAPTURE(rebuild);
+    REQUIRE(fitted.place(floes, include, p, 1));
+    REQUIRE(spare.place(floes, include, p, 1));
+    same_pieces();
+    int copied_fitted = 0, copied_spare = 0;
+    CHECK(layout(fitted.pieces(), FootprintMotionOptions{}, copied_fitted));
+    CHECK(layout(spare.pieces(), roomy, copied_spare));
+    CHECK(copied_fitted == 0);  // none more than a quarter spare
+    // The options are read: arrays twice their size, which the defaults
+    // never leave.
+    MESSAGE("arrays copied twice their size: " << copied_spare << " of 12");
+    CHECK(copied_spare > 0);
+    // A move inside the window (the same on both), then a rebuild elsewhere.
+    for (FloePose& q : p) q.x += 0.2 * grid.dx();
+    REQUIRE_FALSE(fitted.place(floes, include, p, 1));
+    REQUIRE_FALSE(spare.place(floes, include, p, 1));
+    same_pieces();
+    for (FloePose& q : p) q.y += 3.0 * grid.dy();
   }
 }
