@@ -173,16 +173,17 @@ public:
   // travel from it to the other ranks that kick the floe only (share_owned).
   // Why every holder kicks, not the drift's owner alone: between the
   // second half kick and the next drift's exchange (which sends each
-  // owner's state to the floe's holders) three readers take a held copy's
-  // kicked rates on a rank that does not own the floe:
+  // owner's state to the floe's holders) two readers take a held copy's
+  // kicked rates on a rank that does not drift the floe:
   //  - the step's start copy (Simulation::choose_dt copies every state
   //    before the first half kick): the collisions of the band read its
   //    rates (contact/step_collisions.cpp, smooth_kick: the arm velocity at
-  //    the step's start of both floes of a contact);
-  //  - the drift's migration: a floe crossing a cut is drifted by its new
-  //    owner from that rank's band copy, which must carry both half kicks;
+  //    the step's start of both floes of a contact), and no exchange sends
+  //    it (the detection's leave notices carry it for the floes changing
+  //    owner only);
   //  - the explicit damper's evaluation at the first half kick (s < 1) on
-  //    the coupling owner, which reads its floes' vertical rates.
+  //    the coupling owner (which need not drift the floe), which reads its
+  //    floes' vertical rates.
   // An unheld copy is stale and read by no one (the poison mode's check):
   // it is not kicked, and its loads do not travel. With the implicit step
   // (every rank holds every floe's vertical DOFs; the first half kick's
