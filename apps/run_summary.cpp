@@ -229,6 +229,10 @@ void print_coupling_ranks(std::ostream& o, const Simulation& sim) {
   if (cells.shared + cells.alone_here + cells.alone_sent > 0)
     o << "parallel.coupling_cells: " << cells.shared << " shared (" << cells.pieces << " pieces), " << cells.alone_here
       << " alone owned, " << cells.alone_sent << " alone sent\n";
+  const FloeSeaContact::SharedLoads& loads = fs->shared_loads();
+  if (loads.asked + loads.whole > 0)
+    o << "parallel.coupling_loads: " << loads.asked << " by request (" << loads.asked_floes << " floes), "
+      << loads.whole << " to every rank (" << loads.whole_floes << " floes)\n";
 }
 
 // With a sea in slabs the strips are its slabs: their first rows (then the

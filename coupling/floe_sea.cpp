@@ -406,20 +406,23 @@ void FloeSeaContact::horizontal_loads(std::span<const double> u) {
   charge_owned(start);
 }
 
-void FloeSeaContact::evaluate_loads(const Floes& floes, fluid::Sea& sea, IncidentSea* incident, double h) {
+void FloeSeaContact::evaluate_loads(const Floes& floes, fluid::Sea& sea, IncidentSea* incident, double h,
+                                    std::span<const std::uint8_t> kicked) {
   evaluate(floes, sea, h);
   update_water(sea, incident);
-  share_owned();
+  share_owned(kicked);
   // After an implicit step the horizontal loads are that step's mean (zero
   // on a floe that had no pieces on the step's midpoint footprint).
   if (step_mean_pending_)
     for (std::size_t i = 0; i < kicks_.loads.size(); ++i) kicks_.loads[i].horizontal = kicks_.step_horizontal[i];
 }
 
-void FloeSeaContact::ready_loads(const Floes& floes, fluid::Sea& sea, IncidentSea* incident, double h) {
+void FloeSeaContact::ready_loads(const Floes& floes, fluid::Sea& sea, IncidentSea* incident, double h,
+                                 std::span<const std::uint8_t> kicked, bool kickers_moved) {
   // Only the explicit damper's loads depend on the kick length.
   const bool explicit_damper = !implicit_ && s_ < 1.0;
-  if (loads_h_ < 0.0 || (explicit_damper && loads_h_ != h)) evaluate_loads(floes, sea, incident, h);
+  if (loads_h_ < 0.0 || (explicit_damper && loads_h_ != h)) evaluate_loads(floes, sea, incident, h, kicked);
+  else if (kickers_moved) share_owned(kicked);
 }
 
 void FloeSeaContact::update_water(const fluid::Sea& sea, IncidentSea* incident) {
@@ -478,11 +481,15 @@ void FloeSeaContact::kick_sea(fluid::Sea& sea, double h) {
   }
 }
 
-void FloeSeaContact::kick_floes(Floes& floes, double h) {
+void FloeSeaContact::kick_floes(Floes& floes, double h, std::span<const std::uint8_t> kicked) {
   // The explicit damper's loads depend on the rates this kick changes.
   if (!implicit_ && s_ < 1.0) loads_h_ = -1.0;
+  // The floes this rank holds, whose loads share_owned brought (the
+  // header's "The kick by its holders"); the implicit step kicks every floe.
+  const bool every = kicked.empty() || implicit_;
+  FLOESIM_ASSERT(every || kicked.size() == floes.size());
   for (std::size_t i = 0; i < floes.size(); ++i) {
-    if (!constants_.dynamic[i]) continue;
+    if (!constants_.dynamic[i] || (!every && !kicked[i])) continue;
     FloeState& st = floes.state[i];
     const FloeSeaLoad& load = kicks_.loads[i];
     // The implicit step applies the vertical law and the weight itself (the

@@ -164,13 +164,46 @@ public:
   // With the implicit integrator the vertical law and the weight are left out
   // of the pressure and the vertical loads (advance_vertical applies them);
   // the horizontal forces and the penalty energy are the same.
-  void evaluate_loads(const Floes& floes, fluid::Sea& sea, IncidentSea* incident, double h);
-  void ready_loads(const Floes& floes, fluid::Sea& sea, IncidentSea* incident, double h);
-  // Apply the loads over h: to the floes' vertical and horizontal rates; to
+  //
+  // The kick by its holders (docs/parallel.md, "The kick by owner
+  // (kick29)"). On several ranks `kicked` marks, per floe, the floes this
+  // rank kicks (1; empty: every floe), which are the floes it holds
+  // (Simulation::held_now, with the state held by owner). A floe's loads
+  // are computed by its coupling owner (MovingFootprints::owners) alone and
+  // travel from it to the other ranks that kick the floe only (share_owned).
+  // Why every holder kicks, not the drift's owner alone: between the
+  // second half kick and the next drift's exchange (which sends each
+  // owner's state to the floe's holders) two readers take a held copy's
+  // kicked rates on a rank that does not drift the floe:
+  //  - the step's start copy (Simulation::choose_dt copies every state
+  //    before the first half kick): the collisions of the band read its
+  //    rates (contact/step_collisions.cpp, smooth_kick: the arm velocity at
+  //    the step's start of both floes of a contact), and no exchange sends
+  //    it (the detection's leave notices carry it for the floes changing
+  //    owner only);
+  //  - the explicit damper's evaluation at the first half kick (s < 1) on
+  //    the coupling owner (which need not drift the floe), which reads its
+  //    floes' vertical rates.
+  // An unheld copy is stale and read by no one (the poison mode's check):
+  // it is not kicked, and its loads do not travel. With the implicit step
+  // (every rank holds every floe's vertical DOFs; the first half kick's
+  // impulse, kicks_.first_half, is read by the second on a rank whose held
+  // set the detection between them changed) `kicked` is not used: every
+  // floe's loads go to every rank and every rank kicks every floe.
+  // `kickers_moved` (the same on every rank): the loads are current but the
+  // holders changed since they travelled (a rejected try, whose drift gave
+  // its owners floes): they travel again, without a new evaluation.
+  void evaluate_loads(const Floes& floes, fluid::Sea& sea, IncidentSea* incident, double h,
+                      std::span<const std::uint8_t> kicked = {});
+  void ready_loads(const Floes& floes, fluid::Sea& sea, IncidentSea* incident, double h,
+                   std::span<const std::uint8_t> kicked = {}, bool kickers_moved = false);
+  // Apply the loads over h: to the floes' vertical and horizontal rates (of
+  // the floes `kicked` marks, as given to the evaluation or ready_loads
+  // that made the loads; empty: every floe); to
   // the sea's modal velocities (a second kick_sea with the same evaluation
   // repeats the sea's last kick, without projecting the pressure again:
   // nothing else may kick the sea in between).
-  void kick_floes(Floes& floes, double h);
+  void kick_floes(Floes& floes, double h, std::span<const std::uint8_t> kicked = {});
   void kick_sea(fluid::Sea& sea, double h);
   // The incident waves' orbital velocity under each floe (m/s, world), the
   // mean over its footprint, at the time of the loads' evaluation. On
@@ -343,6 +376,15 @@ public:
     long shared = 0, pieces = 0, alone_here = 0, alone_sent = 0;
   };
   const RoutedCells& routed_cells() const { return owner_.routed_counts; }
+  // On several ranks, the loads' travels since the start (share_owned):
+  // to the ranks that kick each floe (`asked`: the calls; `asked_floes`:
+  // the floes' loads this rank received) and to every rank (`whole`,
+  // `whole_floes`: the start, a restore, the implicit step, the advance
+  // from the whole detection).
+  struct SharedLoads {
+    long asked = 0, asked_floes = 0, whole = 0, whole_floes = 0;
+  };
+  const SharedLoads& shared_loads() const { return shared_loads_; }
   std::span<const FloeSeaLoad> loads() const { return kicks_.loads; }
   std::span<const double> pressure() const { return pressure_; }
   double strong_share() const { return s_; }
@@ -453,8 +495,12 @@ private:
   // evaluated_.slope already set for them.
   // On several ranks, for this rank's floes only (share_owned completes them).
   void horizontal_loads(std::span<const double> u);
-  // The owners' loads to every rank, in one call (nothing when serial).
-  void share_owned();
+  // The owners' loads (horizontal and vertical, 48 B a floe) to the ranks
+  // that kick each floe (`kicked` on each: the floes it asks its coupling
+  // owner for; two all-to-alls: the requests, then the loads), or with
+  // `kicked` empty or the implicit step, to every rank (one call). Nothing
+  // when serial.
+  void share_owned(std::span<const std::uint8_t> kicked = {});
   // Implicit: the step's mean horizontal loads (the header's "Horizontal
   // loads of the implicit step") into kicks_.step_horizontal.
   void step_mean_horizontal(const Floes& floes, std::span<const FloeState> start);
@@ -636,6 +682,7 @@ private:
   parallel::CellRoutes routes_;
   std::vector<std::uint32_t> order_;  // dynamic floes with pieces, by their first cell
   bool pressure_kicked_ = false;  // the sea's last kick was with pressure_ as it is
+  SharedLoads shared_loads_;
   double loads_h_ = -1.0;         // the kick length of the last evaluation (< 0: stale)
   bool water_by_owner_ = false;   // evaluated_.water holds this rank's floes' only (several ranks, incident waves)
   // Implicit integrator: the mean in kicks_.step_horizontal is this step's

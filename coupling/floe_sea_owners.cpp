@@ -58,6 +58,7 @@
 // is settled from the terms likewise.
 #include <algorithm>
 #include <bit>
+#include <cstring>
 #include <utility>
 
 #include "coupling/floe_sea.hpp"
@@ -493,25 +494,73 @@ double FloeSeaContact::sum_cells_by_owner(double ks) {
   return total;
 }
 
-void FloeSeaContact::share_owned() {
+void FloeSeaContact::share_owned(std::span<const std::uint8_t> kicked) {
   if (comm_.serial()) return;
   // The vertical loads too: by owner only the owner has them (replicated,
   // the owner's are every rank's, to the bit).
   struct Owned {
     double fx, fy, torque, fz, mx, my;
   };
-  std::vector<Owned> owned(kicks_.loads.size());
-  for (std::uint32_t i : footprints_.mine()) {
+  const auto pack = [&](std::uint32_t i) {
     const Eigen::Vector3d& f = kicks_.loads[i].horizontal;
     const Eigen::Vector3d& v = kicks_.loads[i].vertical;
-    owned[i] = {f[0], f[1], f[2], v[0], v[1], v[2]};
+    return Owned{f[0], f[1], f[2], v[0], v[1], v[2]};
+  };
+  const auto unpack = [&](std::size_t i, const Owned& o) {
+    kicks_.loads[i].horizontal = {o.fx, o.fy, o.torque};
+    kicks_.loads[i].vertical = {o.fz, o.mx, o.my};
+  };
+  const std::span<const int> owner = footprints_.owners();
+  if (kicked.empty() || implicit_) {
+    // Every floe's loads to every rank (the implicit step: the header's
+    // "The kick by its holders").
+    std::vector<Owned> owned(kicks_.loads.size());
+    for (std::uint32_t i : footprints_.mine()) owned[i] = pack(i);
+    comm_.complete_owned(owned, owner);
+    ++shared_loads_.whole;
+    for (std::size_t i = 0; i < owned.size(); ++i)
+      if (!footprints_.owns(i)) {
+        unpack(i, owned[i]);
+        ++shared_loads_.whole_floes;
+      }
+    return;
   }
-  comm_.complete_owned(owned, footprints_.owners());
-  for (std::size_t i = 0; i < owned.size(); ++i) {
-    if (footprints_.owns(i)) continue;
-    kicks_.loads[i].horizontal = {owned[i].fx, owned[i].fy, owned[i].torque};
-    kicks_.loads[i].vertical = {owned[i].fz, owned[i].mx, owned[i].my};
+  // By request: only the rank that kicks a floe knows it holds it (its band
+  // is its owner's announcement, Simulation::held_now), so each rank asks
+  // each coupling owner for the dynamic floes it kicks and does not own
+  // (4 B a floe, one alltoall_bytes: two calls), and the owner answers in
+  // the order asked (48 B a floe, one alltoall: both sides know the counts).
+  FLOESIM_ASSERT(kicked.size() == kicks_.loads.size() && owner.size() == kicks_.loads.size());
+  const std::size_t ranks = static_cast<std::size_t>(comm_.size());
+  std::vector<std::vector<std::uint32_t>> ask(ranks);
+  for (std::size_t i = 0; i < kicked.size(); ++i)
+    if (kicked[i] && constants_.dynamic[i] && owner[i] != comm_.rank())
+      ask[static_cast<std::size_t>(owner[i])].push_back(static_cast<std::uint32_t>(i));
+  std::vector<std::size_t> ask_bytes(ranks), asked_bytes;
+  std::vector<std::uint32_t> asks;
+  for (std::size_t r = 0; r < ranks; ++r) {
+    asks.insert(asks.end(), ask[r].begin(), ask[r].end());
+    ask_bytes[r] = ask[r].size() * sizeof(std::uint32_t);
   }
+  std::vector<std::byte> asked;
+  comm_.alltoall_bytes(std::as_bytes(std::span<const std::uint32_t>(asks)), ask_bytes, asked, asked_bytes);
+  std::vector<Owned> answer(asked.size() / sizeof(std::uint32_t)), answered(asks.size());
+  for (std::size_t k = 0; k < answer.size(); ++k) {
+    std::uint32_t i = 0;
+    std::memcpy(&i, asked.data() + k * sizeof(i), sizeof(i));
+    FLOESIM_ASSERT(i < owner.size() && owner[i] == comm_.rank());
+    answer[k] = pack(i);
+  }
+  std::vector<std::size_t> answer_bytes(ranks), answered_bytes(ranks);
+  for (std::size_t r = 0; r < ranks; ++r) {
+    answer_bytes[r] = asked_bytes[r] / sizeof(std::uint32_t) * sizeof(Owned);
+    answered_bytes[r] = ask[r].size() * sizeof(Owned);
+  }
+  comm_.alltoall(std::as_bytes(std::span<const Owned>(answer)), answer_bytes,
+                 std::as_writable_bytes(std::span<Owned>(answered)), answered_bytes);
+  for (std::size_t k = 0; k < asks.size(); ++k) unpack(asks[k], answered[k]);
+  ++shared_loads_.asked;
+  shared_loads_.asked_floes += static_cast<long>(asks.size());
 }
 
 void FloeSeaContact::hand_water_over(std::span<const int> drift_owner) {

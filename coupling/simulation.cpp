@@ -239,14 +239,17 @@ void Simulation::floes_half_kick(StepContext& ctx) {
   // every floe, so every floe's state comes from its owner first (rare).
   if (owners_off_places_) whole_state(ctx, parallel::WholeState::state);
   else offer_place_owners();
-  floe_sea_->ready_loads(scenario_.floes, *sea_, incident_.get(), 0.5 * ctx.dt);
+  // Each rank kicks the floes it holds (kicked_floes); a rejected try's
+  // drift gave its owners floes since the loads travelled.
+  const std::vector<std::uint8_t> kicked = kicked_floes();
+  floe_sea_->ready_loads(scenario_.floes, *sea_, incident_.get(), 0.5 * ctx.dt, kicked, owners_off_places_);
   // The offer holds for this evaluation only: the drift's update moves the
   // owners and may reallocate their arrays. Withdrawn here (an evaluation
   // has cleared it already), so that a try redone after an overlap finds
   // no offer, rather than spans into the rejected try's arrays, and its
   // rebuild poses every floe.
   floe_sea_->take_place_owners({}, {}, {});
-  floe_sea_->kick_floes(scenario_.floes, 0.5 * ctx.dt);
+  floe_sea_->kick_floes(scenario_.floes, 0.5 * ctx.dt, kicked);
 }
 
 void Simulation::offer_place_owners() {
@@ -457,9 +460,10 @@ void Simulation::sea_half_kick(StepContext& ctx) {
   // across): a rebuild of the footprints takes them, and poses this rank's
   // floes only.
   offer_place_owners();
-  floe_sea_->evaluate_loads(scenario_.floes, *sea_, incident_.get(), 0.5 * ctx.dt);
+  const std::vector<std::uint8_t> kicked = kicked_floes();
+  floe_sea_->evaluate_loads(scenario_.floes, *sea_, incident_.get(), 0.5 * ctx.dt, kicked);
   add_owned_momentum(std::span(ctx.momenta).subspan<StepContext::kBeforeSeaKick, 2>());
-  floe_sea_->kick_floes(scenario_.floes, 0.5 * ctx.dt);
+  floe_sea_->kick_floes(scenario_.floes, 0.5 * ctx.dt, kicked);
   floe_sea_->kick_sea(*sea_, 0.5 * ctx.dt);
   add_owned_momentum(std::span(ctx.momenta).subspan<StepContext::kAfterSeaKick, 2>());
 }

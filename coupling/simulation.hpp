@@ -345,6 +345,12 @@ private:
   // (one rank, no detection yet). With the implicit step every rank holds
   // every floe's vertical DOFs besides (not marked).
   std::vector<std::uint8_t> held_now() const;
+  // The floes this rank kicks with the sea's loads (FloeSeaContact::
+  // kick_floes): with the halo exchange the floes it holds (held_now()),
+  // whose rates its collisions (the step-start copy) and its law (the
+  // explicit damper) read before the next drift's exchange; else every
+  // floe (empty), each rank reading every floe.
+  std::vector<std::uint8_t> kicked_floes() const;
   // The drift's quadrature held by band (docs/parallel.md, "The arrays held
   // by band: measured (mem27)"): on several ranks, at each detection that
   // sets held_, the points of the floes this rank holds (held_now()) and

@@ -68,6 +68,10 @@ std::vector<std::uint8_t> Simulation::held_now() const {
   return held;
 }
 
+std::vector<std::uint8_t> Simulation::kicked_floes() const {
+  return halo_exchange() ? held_now() : std::vector<std::uint8_t>{};
+}
+
 void Simulation::start_owners() {
   // One decomposition (docs/parallel.md, stage seven): with a sea in slabs
   // the floes' strips are its slabs, moved by whole blocks of the

@@ -45,6 +45,11 @@ Checked, on 2 and 3 ranks:
     bound in the wide flume, whose first half kicks rebuild the footprints
     with the last rebuild's owners (by index there, every floe posed: 2.2
     times the bound on 2 ranks, 1.4 on 3);
+  - the kick by its holders (docs/parallel.md, "The kick by owner
+    (kick29)"): on bem, tank and wide rank 0 takes each evaluation's loads
+    by request (parallel.coupling_loads: at least one request a step, at
+    most one share to every rank, the start's) and receives fewer than 0.6
+    of every floe's loads an evaluation;
   - with the halo exchange (every sea with the explicit kicks), rank 0's
     drift phase (parallel.phase.drift) receives less than 0.6 of every
     floe's state (96 B) each step on the bem, tank and wide cases, whose
@@ -195,6 +200,17 @@ for name, (sea, pack) in SEAS.items():
         if name in SOME_HELD and not drift < 0.6 * whole:
             failures.append(f"{name} on {n} ranks: rank 0's drift phase received {drift} bytes, not under 0.6 x "
                             f"96 B x {pack[1]} floes x {steps} steps = {0.6 * whole:.0f} (every state to every rank?)")
+        # The kick by its holders: each evaluation's loads travel from the
+        # coupling's owner to the other ranks that hold the floe only (after
+        # the start's, which every rank takes).
+        loads = s.get("parallel.coupling_loads", "")
+        print(f"{name}: {n} ranks, rank 0's loads: {loads}")
+        m = re.match(r"(\d+) by request \((\d+) floes\), (\d+) to every rank", loads)
+        if name in SOME_HELD and (not m or int(m.group(1)) < steps or int(m.group(3)) > 1 or
+                                  not int(m.group(2)) < 0.6 * int(pack[1]) * int(m.group(1))):
+            failures.append(f"{name} on {n} ranks: rank 0's loads ({loads or 'none'}) not by request at every "
+                            f"evaluation, or not under 0.6 of {pack[1]} floes an evaluation (every floe's to every "
+                            f"rank?)")
 
 # The flume's floes numbered along x: the same owners by place, so the same
 # traffic within the runs' own drift (the two packs' serial runs differ in
