@@ -349,8 +349,16 @@ public:
   double kappa() const { return kappa_; }
   // Notes for the user (calibrated share, capillarity neglected at the start).
   const std::vector<std::string>& notes() const { return notes_; }
-  // Floes whose contact rebuilt data must be redone (after a split).
-  void floes_changed(const Floes& floes);
+  // Floes whose contact rebuilt data must be redone (after a split). On
+  // several ranks after a split, `owner` is every floe's owner by place
+  // (parallel::FloeOwners after place_pieces and migrate; the same on every
+  // rank), each of which holds its floes' whole states current: on a sea not
+  // in slabs and with the implicit step they become the next rebuild's
+  // owners (next_owners_, held), so that it poses each rank's floes only
+  // (on a sea in slabs the first half kick offers the same owners,
+  // take_place_owners). Empty (the start, a restore, serially): the next
+  // rebuild finds its owners from every floe's pose.
+  void floes_changed(const Floes& floes, std::span<const int> owner = {});
 
   // What the coupling allocates per floe on this rank, against the held
   // floes' entries (core/floe_bytes.hpp; `held` empty: every floe): its

@@ -145,7 +145,8 @@ FloeSeaContact::GivenOwners FloeSeaContact::given_owners(std::size_t floes) cons
   // floes its rank holds. The footprints' own arrays, given back to them
   // (MovingFootprints::set_owners keeps its owners when given them).
   // None given (by index, every floe posed) only when no rebuild owns these
-  // floes yet: the start, a restore, a split, where every copy is current.
+  // floes yet: the start and a restore, where every copy is the file's (a
+  // split hands the owners by place as next owners: floes_changed).
   if (routes_.replicated() && footprints_.owners().size() == floes) return {footprints_.owners(), footprints_.mine()};
   return {};
 }

@@ -463,8 +463,10 @@ void Simulation::on_floes_changed() {
   detect_in_place();
   if (floe_sea_) {
     // A split piece keeps its parent's reference bottom (same thickness);
-    // the loads are evaluated afresh for the new footprints.
-    floe_sea_->floes_changed(scenario_.floes);
+    // the loads are evaluated afresh for the new footprints, built by the
+    // owners just placed (they hold their floes; the other copies may be
+    // stale since the split gathered only what it reads).
+    floe_sea_->floes_changed(scenario_.floes, comm_.serial() ? std::span<const int>{} : owners_.owner());
   }
 }
 
