@@ -627,12 +627,14 @@ private:
   int column_owner(const FloePose& p) const;
   // The owners a rebuild of this evaluation takes, and this rank's floes
   // among them (empty: none given, the footprints find them). The spans
-  // stay valid until the rebuild (they may be the footprints' own).
+  // stay valid until the rebuild. Called only before a rebuild: when they
+  // are the last rebuild's, it tells the footprints to keep them
+  // (MovingFootprints::keep_owners) and returns their own arrays.
   struct GivenOwners {
     std::span<const int> owner;
     std::span<const std::uint32_t> mine;
   };
-  GivenOwners given_owners(std::size_t floes) const;
+  GivenOwners given_owners(std::size_t floes);
   // The sea's slabs (fluid::Sea::slab_rows; empty: whole on every rank), and
   // by owner on them, the routes of the cells' sums to the slabs' ranks;
   // the next evaluation clears pressure_ in routes_.owned() (the cells the
