@@ -198,8 +198,9 @@ void print_whole_state(std::ostream& o, const Simulation& sim) {
 // The fracture analyses by owner (a run with fracture only): the steps that
 // exchanged them, each rank's checks (they sum to fracture.checks) and its
 // wall time in them; the CPU seconds of those analyses charged to the
-// strips' moves (part of strip_seconds_total), over every window; of the
-// whole state's gathers, the ones before a split (a crack through a floe).
+// strips' moves (part of strip_seconds_total), over every window; the
+// gathers of the states a split reads (its parents and their neighbours),
+// in the steps where a split may be made, and rank 0's bytes in them.
 void print_fracture_ranks(std::ostream& o, const Simulation& sim) {
   if (!sim.percussion_stats()) return;
   const PercussionRanks& fr = sim.percussion_ranks();
@@ -209,7 +210,7 @@ void print_fracture_ranks(std::ostream& o, const Simulation& sim) {
   values(o, fr.seconds);
   o << "\nparallel.fracture_charged:";
   values(o, sim.floe_owners().fracture_seconds());
-  o << "\nparallel.fracture_whole_state: " << fr.whole_gathers << " steps, " << fr.whole_bytes << " bytes\n";
+  o << "\nparallel.split_gathers: " << fr.split_gathers << " steps, " << fr.split_bytes << " bytes\n";
 }
 
 // The floe-sea contact by owner (a run with a sea): the slabs the

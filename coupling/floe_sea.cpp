@@ -110,12 +110,36 @@ FloeSeaContact::FloeSeaContact(const CouplingParams& params, const SeaParams& se
   floes_changed(floes);
 }
 
-void FloeSeaContact::floes_changed(const Floes& floes) {
+void FloeSeaContact::floes_changed(const Floes& floes, std::span<const int> owner) {
   loads_h_ = -1.0;  // the loads and the water velocity are the old floes'
   footprints_.forget();
-  next_owners_.owner.clear();  // the next rebuild by index (reads no place), until owners by place are known
-  next_owners_.drifted = false;
   const std::size_t n = floes.size(), old = constants_.bottom0.size();
+  // The next rebuild's owners. The last rebuild's (footprints_.owners(),
+  // kept by given_owners until new owners hold their floes) and the next
+  // owners known before a split are sized for the old floes. After a split
+  // the owners by place hold every floe's whole state current: their own
+  // floes (the unsplit ones since the step's detection, the notices of
+  // migrate carrying the states of those that changed owner) and the
+  // pieces (built on every rank alike from their parents' states, which
+  // the split gathered). So they may pose and build the next rebuild at
+  // once, as next owners that have held their floes through a vertical
+  // drift (`drifted`) and a drift's exchange (`current`). In a flume they
+  // stand for the columns' shares until order_by_owner finds those at that
+  // rebuild (any owners that hold their floes give the serial sums). Not on
+  // a sea in slabs, whose owners follow its rows (takes_owners): the first
+  // half kick offers the drift's (Simulation::offer_place_owners). Without
+  // owners, the next rebuild is by index (every floe posed), or on the
+  // slabs by every floe's place: every copy must then be current (the
+  // start, a restore).
+  if (!owner.empty() && (routes_.replicated() || implicit_)) {
+    FLOESIM_ASSERT(owner.size() == n);
+    set_next_owners(owner);
+    next_owners_.current = true;
+    next_owners_.drifted = true;
+  } else {
+    next_owners_.owner.clear();
+    next_owners_.drifted = false;
+  }
   // The groups of one entry a floe sized with the floes (the header's
   // members; the implicit step's at the step, the serial places at
   // order_by_owner). Every constant is set below but a staying floe's

@@ -391,8 +391,16 @@ public:
   double kappa() const { return kappa_; }
   // Notes for the user (calibrated share, capillarity neglected at the start).
   const std::vector<std::string>& notes() const { return notes_; }
-  // Floes whose contact rebuilt data must be redone (after a split).
-  void floes_changed(const Floes& floes);
+  // Floes whose contact rebuilt data must be redone (after a split). On
+  // several ranks after a split, `owner` is every floe's owner by place
+  // (parallel::FloeOwners after place_pieces and migrate; the same on every
+  // rank), each of which holds its floes' whole states current: on a sea not
+  // in slabs and with the implicit step they become the next rebuild's
+  // owners (next_owners_, held), so that it poses each rank's floes only
+  // (on a sea in slabs the first half kick offers the same owners,
+  // take_place_owners). Empty (the start, a restore, serially): the next
+  // rebuild finds its owners from every floe's pose.
+  void floes_changed(const Floes& floes, std::span<const int> owner = {});
 
   // What the coupling allocates per floe on this rank, against the held
   // floes' entries (core/floe_bytes.hpp; `held` empty: every floe): its
@@ -665,12 +673,14 @@ private:
   int column_owner(const FloePose& p) const;
   // The owners a rebuild of this evaluation takes, and this rank's floes
   // among them (empty: none given, the footprints find them). The spans
-  // stay valid until the rebuild (they may be the footprints' own).
+  // stay valid until the rebuild. Called only before a rebuild: when they
+  // are the last rebuild's, it tells the footprints to keep them
+  // (MovingFootprints::keep_owners) and returns their own arrays.
   struct GivenOwners {
     std::span<const int> owner;
     std::span<const std::uint32_t> mine;
   };
-  GivenOwners given_owners(std::size_t floes) const;
+  GivenOwners given_owners(std::size_t floes);
   // The sea's slabs (fluid::Sea::slab_rows; empty: whole on every rank), and
   // by owner on them, the routes of the cells' sums to the slabs' ranks;
   // the next evaluation clears pressure_ in routes_.owned() (the cells the

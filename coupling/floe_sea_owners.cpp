@@ -131,7 +131,7 @@ int FloeSeaContact::column_owner(const FloePose& p) const {
   return next_owners_.column[static_cast<std::size_t>(column)];
 }
 
-FloeSeaContact::GivenOwners FloeSeaContact::given_owners(std::size_t floes) const {
+FloeSeaContact::GivenOwners FloeSeaContact::given_owners(std::size_t floes) {
   // The drift's owners on the sea's slabs (take_place_owners)...
   if (place_owner_.size() == floes && footprints_.takes_owners(place_rows_)) return {place_owner_, place_mine_};
   // ...or by place on a sea not in slabs, once their new owners hold
@@ -143,11 +143,15 @@ FloeSeaContact::GivenOwners FloeSeaContact::given_owners(std::size_t floes) cons
   // ...or, not in slabs, the last rebuild's owners kept: each holds its
   // floes current (own_floes()), so a rebuild before the new owners hold
   // theirs (a first half kick with stale loads, a redone try) poses only
-  // floes its rank holds. The footprints' own arrays, given back to them
-  // (MovingFootprints::set_owners keeps its owners when given them).
+  // floes its rank holds. The footprints are told to keep them
+  // (keep_owners), and their arrays are returned for the poses.
   // None given (by index, every floe posed) only when no rebuild owns these
-  // floes yet: the start, a restore, a split, where every copy is current.
-  if (routes_.replicated() && footprints_.owners().size() == floes) return {footprints_.owners(), footprints_.mine()};
+  // floes yet: the start and a restore, where every copy is the file's (a
+  // split hands the owners by place as next owners: floes_changed).
+  if (routes_.replicated() && footprints_.owners().size() == floes) {
+    footprints_.keep_owners();
+    return {footprints_.owners(), footprints_.mine()};
+  }
   return {};
 }
 

@@ -103,10 +103,12 @@ int MovingFootprints::reach_rows_from(std::span<const int> first_row) const {
 
 void MovingFootprints::set_owners(std::span<const FloePose> poses, std::span<const int> owners) {
   const std::size_t n = poses.size();
-  // The owners given may be these very owners (owners(): a caller that
-  // keeps the last rebuild's, FloeSeaContact::given_owners): kept in place.
-  const bool same = !owners.empty() && owners.data() == owner_.data() && owners.size() == owner_.size();
-  if (!same) owner_.assign(n, 0);
+  // Kept (keep_owners): the owners are those of the last rebuild, in place.
+  const bool keep = std::exchange(keep_owners_, false);
+  // (owners() given without keep_owners() would be cleared before its copy.)
+  FLOESIM_ASSERT(keep ? owner_.size() == n && (owners.empty() || owners.data() == owner_.data())
+                      : owners.empty() || owners.data() != owner_.data());
+  if (!keep) owner_.assign(n, 0);
   by_place_ = !comm_.serial() && !row_owner_.empty();
   if (by_place_ && !next_owner_rows_.empty()) {
     // The sea's slabs moved since the last rebuild: the owners follow them.
@@ -115,12 +117,14 @@ void MovingFootprints::set_owners(std::span<const FloePose> poses, std::span<con
     next_owner_rows_.clear();
   }
   reference_whole_ = true;
-  if (!comm_.serial() && !owners.empty()) {
+  if (keep) {
+    reference_whole_ = false;  // the poses of this rank's floes only
+  } else if (!comm_.serial() && !owners.empty()) {
     // Given: by place on these slabs (takes_owners: the rule below, applied
     // by their maker at the same poses), or without slabs by their maker's
     // rule (a sea not in slabs: FloeSeaContact's strips).
     FLOESIM_ASSERT(owners.size() == n);
-    if (!same) std::copy(owners.begin(), owners.end(), owner_.begin());
+    std::copy(owners.begin(), owners.end(), owner_.begin());
     reference_whole_ = false;
   } else if (by_place_) {
     // The row of the centroid, the grid's seam crossed (periodic).

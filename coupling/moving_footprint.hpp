@@ -114,10 +114,20 @@ public:
   // when no slabs are set, e.g. FloeSeaContact's strips of a sea not in
   // slabs), a rebuild takes its owners from them instead of from the poses,
   // and reads the poses of its own floes (owners[i] == rank) only. On
-  // several ranks only; the same on every rank. `owners` may be owners()
-  // itself (the last rebuild's kept).
+  // several ranks only; the same on every rank. After keep_owners() it
+  // keeps owners() (`owners` empty, or owners() itself).
   bool place(const Floes& floes, std::span<const std::uint8_t> include, std::span<const FloePose> poses, int threads,
              bool move, std::span<const int> owners = {});
+  // The next rebuild keeps the last rebuild's owners (owners(), mine()) and
+  // reads the poses of its own floes only: for a caller whose present
+  // owners still hold their floes and that has no newer ones to give
+  // (FloeSeaContact::given_owners on a sea not in slabs). On several ranks,
+  // with owners() sized for the present floes; the same on every rank.
+  // Spent by that rebuild.
+  void keep_owners() {
+    FLOESIM_ASSERT(!comm_.serial() && !owner_.empty());
+    keep_owners_ = true;
+  }
   // Whether the next rebuild may take its owners given: the owners by place
   // (set_slabs) on the slabs first_row, which are those its owners follow
   // (the grid's rows, the row of the centroid: parallel::grid_row, the rule
@@ -221,7 +231,7 @@ public:
 private:
   void move(std::span<const FloePose> poses, int threads);
   // owner_ and mine_ for floes at `poses` (the rebuild's), or `owners`
-  // given by place (takes_owners).
+  // given by place (takes_owners), or owner_ kept (keep_owners).
   void set_owners(std::span<const FloePose> poses, std::span<const int> owners);
   // Every floe's area pieces from their owners, in floe order, into `full`
   // (its edge pieces left empty), after this rank built its own alone.
@@ -246,6 +256,7 @@ private:
   double owned_seconds_ = 0.0;  // take_owned_seconds()
   parallel::Communicator comm_;
   bool gather_ = true;
+  bool keep_owners_ = false;    // keep_owners(): the next rebuild keeps owner_ and mine_
   std::vector<int> row_owner_;  // by place: per grid row, the rank whose slab holds it; empty: by index
   std::vector<int> owner_;      // per floe
   std::vector<std::uint32_t> mine_;

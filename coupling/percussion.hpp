@@ -223,11 +223,10 @@ struct PercussionRanks {
   // The steps in which a split may be made (Percussion::may_split), which
   // gather the states conclude reads first (every share's split_readers,
   // Simulation::split_states), and the bytes this rank received in those
-  // gathers (the summary's parallel.fracture_whole_state, a name kept from
-  // when every floe's state was gathered; docs/parallel.md, "The split
-  // step's owners and gather by holder (split28)").
-  long whole_gathers = 0;
-  long long whole_bytes = 0;
+  // gathers (the summary's parallel.split_gathers; docs/parallel.md, "The
+  // split step's owners and gather by holder (split28)").
+  long split_gathers = 0;
+  long long split_bytes = 0;
 };
 
 // One share's analyses as bytes for parallel::Communicator::allgather_parts,

@@ -377,21 +377,13 @@ void Simulation::percussion(StepContext& ctx) {
   // the states conclude reads (each owner's split_readers: the parents and
   // their neighbours) come from their owners first: one gather, in such a
   // step only, and conclude reads those alone (and the pieces). With a
-  // floe-sea coupling every floe's state is gathered still: the coupling
-  // reads unheld floes after a split (likely its next rebuild, which poses
-  // every floe after FloeSeaContact::floes_changed; docs/parallel.md, "The
-  // split step's owners and gather by holder").
+  // floe-sea coupling too: after the split the coupling's next rebuild is
+  // built by the owners just placed, which hold their floes
+  // (FloeSeaContact::floes_changed; docs/parallel.md, "The split step's
+  // gather with a sea (splitsea29)").
   std::vector<std::uint8_t> readable;
-  if (percussion_->may_split(all)) {
-    if (floe_sea_) {
-      const WholeStateCounts before = whole_state_counts_;  // none gathered if every state is current already
-      whole_state(ctx, parallel::WholeState::state);
-      percussion_ranks_.whole_gathers += whole_state_counts_.gathers - before.gathers;
-      percussion_ranks_.whole_bytes += whole_state_counts_.bytes - before.bytes;
-    } else {
-      readable = split_states(percussion_->split_readers(scenario_.floes, mine, held), held);
-    }
-  }
+  if (percussion_->may_split(all))
+    readable = split_states(percussion_->split_readers(scenario_.floes, mine, held), held);
   // The pieces' owners from their states (every rank builds them alike),
   // the other floes' from their owners (detect_in_place).
   std::vector<std::uint32_t> split;
@@ -427,8 +419,10 @@ void Simulation::on_floes_changed() {
   detect_in_place();
   if (floe_sea_) {
     // A split piece keeps its parent's reference bottom (same thickness);
-    // the loads are evaluated afresh for the new footprints.
-    floe_sea_->floes_changed(scenario_.floes);
+    // the loads are evaluated afresh for the new footprints, built by the
+    // owners just placed (they hold their floes; the other copies may be
+    // stale since the split gathered only what it reads).
+    floe_sea_->floes_changed(scenario_.floes, comm_.serial() ? std::span<const int>{} : owners_.owner());
   }
 }
 

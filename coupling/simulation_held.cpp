@@ -289,8 +289,8 @@ std::vector<std::uint8_t> Simulation::split_states(std::span<const std::uint32_t
   const long long before = comm_.traffic().bytes;
   std::vector<std::size_t> counts;
   const std::vector<std::byte> all = comm_.allgather_bytes(message, counts);
-  ++percussion_ranks_.whole_gathers;
-  percussion_ranks_.whole_bytes += comm_.traffic().bytes - before;
+  ++percussion_ranks_.split_gathers;
+  percussion_ranks_.split_bytes += comm_.traffic().bytes - before;
   const bool stale = poison_ && poison_->options().stale;
   std::vector<std::uint8_t> readable(state.size(), 0);
   for (std::size_t at = 0; at + kRecord <= all.size(); at += kRecord) {

@@ -33,7 +33,7 @@ usage: check_record_ranks.py FLOESIM MPIEXEC WORKDIR [--floes N] [--t-end T] [--
    recording afresh; these steps do not fall back whole:
    `parallel.advance_joined`), or redone whole.
 3. In both: the states the splits read are gathered before them
-   (`parallel.fracture_whole_state`) in exactly the steps where a floe split
+   (`parallel.split_gathers`) in exactly the steps where a floe split
    (the serial run's /events/fracture rows with a piece): a step whose
    cracks are all refused (a sliver, a chord, the neighbours) gathers
    nothing (Percussion::may_split; docs/parallel.md, "A split step by its
@@ -97,9 +97,9 @@ def split_steps(path):
 def check_split_gathers(p, serial, what):
     """Item 3: the steps that gathered states before a split (the split's
     readers since split28) are the steps in which a floe split."""
-    gathered = int(summary(p).get("parallel.fracture_whole_state", "-1 steps").split()[0])
+    gathered = int(summary(p).get("parallel.split_gathers", "-1 steps").split()[0])
     steps = split_steps(serial)
-    print(f"{what}: every floe's state gathered before the splits in {gathered} steps, "
+    print(f"{what}: the splits' readers' states gathered before the splits in {gathered} steps, "
           f"{steps} steps with a split (serial)")
     if steps == 0 or gathered != steps:
         failures.append(f"{what}: the states gathered for the splits in {gathered} steps, not the {steps} "

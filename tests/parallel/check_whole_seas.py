@@ -82,7 +82,10 @@ Then the wide flume with fracture (286 floes at 2 s from 160) on 2 ranks,
 from the parts and from the whole detection (advance_on_part = false), bit
 for bit with the serial run: a split reads its parent's state on every
 rank, whose vertical drift only its holders made (with the split's gather
-skipped after the drift's whole exchange, 284 floes on 2 ranks).
+skipped after the drift's whole exchange, 284 floes on 2 ranks). From the
+parts: rank 0's split gathers (parallel.split_gathers) below a quarter of
+every floe's state a split step (the split's readers only, the sea's
+coupling built by the owners after a split), and the poison modes clean.
 """
 import math
 import os
@@ -268,7 +271,24 @@ for label, run_table in (("from the parts", RUN), ("from the whole detection", R
     p = mpirun(2, "run", config, "-o", config.replace(".toml", "_2.h5"), "-q")
     if p.returncode != 0:
         failures.append(f"wide with splits {label} on 2 ranks: exit {p.returncode}\n{p.stderr}")
-    else:
-        harness.same(config.replace(".toml", "_2.h5"), serial, f"wide with splits {label}: 2 ranks against the "
-                     f"serial run", failures)
+        continue
+    harness.same(config.replace(".toml", "_2.h5"), serial, f"wide with splits {label}: 2 ranks against the "
+                 f"serial run", failures)
+    if run_table != RUN:
+        continue
+    # A split step gathers only the states its conclusion reads (the split's
+    # readers: the parents and their neighbours, 100 B a floe), with the sea
+    # as without: rank 0's bytes in those gathers are below a quarter of the
+    # 160 floes' states (96 B) a step, which every floe's state (the whole
+    # gather, about 6 times that bound here) exceeds. And in the poison mode
+    # the coupling's rebuild after a split poses only floes its rank holds
+    # (the owners just placed, FloeSeaContact::floes_changed): with the
+    # rebuild by index (every floe posed) the run ended with signal 11.
+    m = re.match(r"(\d+) steps, (\d+) bytes", summary(p).get("parallel.split_gathers", ""))
+    bound = None if not m else int(m.group(1)) * 160 * 96 / 4
+    print(f"wide with splits {label}: rank 0's split gathers {m.group(0) if m else None} (bound {bound} bytes)")
+    if not m or int(m.group(1)) == 0 or int(m.group(2)) >= bound:
+        failures.append(f"wide with splits {label}: rank 0's split gathers "
+                        f"({summary(p).get('parallel.split_gathers')}) not below a quarter of every floe's state")
+    harness.poison_clean("wide_split", config, serial, failures)
 finish(failures)

@@ -57,23 +57,25 @@ class Ranks:
         "The poison mode of the run")."""
         return self.mpirun(n, *floesim_args, hooks={"FLOESIM_TEST_POISON_UNHELD": poison} if poison else None)
 
-    def poison_clean(self, name, config, serial, failures, floes=True, extra=()):
-        """The case `name` (its configuration, its serial run file) on 2 ranks
-        in the poison modes `step` and `step-lure`: each run must exit 0, equal
-        the serial run bit for bit, every rank report no phase and, with
+    def poison_clean(self, name, config, serial, failures, floes=True, extra=(), ranks=2):
+        """The case `name` (its configuration, its serial run file) on `ranks`
+        ranks in the poison modes `step` and `step-lure`: each run must exit 0,
+        equal the serial run bit for bit, every rank report no phase and, with
         `floes`, poison floes (the exchanges leave unheld copies that no phase
-        reads)."""
+        reads): on every rank, or with floes="any" on one at least (a small
+        case whose every floe some rank holds)."""
         for poison in ("step", "step-lure"):
-            p = self.poisoned(2, poison, "run", config, "-o", f"{name}_{poison}.h5", "-q", *extra)
+            p = self.poisoned(ranks, poison, "run", config, "-o", f"{name}_{poison}.h5", "-q", *extra)
             poisoned = [int(m.group(1)) for m in re.finditer(r"windows, (\d+) floes poisoned", p.stderr)]
             reported = [int(m.group(1)) for m in re.finditer(r"(\d+) phases reported", p.stderr)]
-            what = f"{name} on 2 ranks, poison mode {poison}"
+            what = f"{name} on {ranks} ranks, poison mode {poison}"
             print(f"{what}: exit {p.returncode}, floes poisoned {poisoned}, phases reported {reported}")
             if p.returncode != 0:
                 failures.append(f"{what}: exit {p.returncode}\n{p.stderr[-3000:]}")
                 continue
             self.same(f"{name}_{poison}.h5", serial, f"{what}, against the serial run", failures)
-            if len(poisoned) != 2 or any(reported) or (floes and min(poisoned) == 0):
+            none = floes and (max(poisoned, default=0) if floes == "any" else min(poisoned, default=0)) == 0
+            if len(poisoned) != ranks or any(reported) or none:
                 failures.append(f"{what}: floes poisoned {poisoned}, phases reported {reported} (every rank must "
                                 f"report none{' and poison floes' if floes else ''})\n{p.stderr[-3000:]}")
 
