@@ -2,9 +2,10 @@
 """bench/scaling_model.py: a weak-scaling model of floesim's distributed step to 1024 ranks.
 
 The model is of the decomposition docs/parallel.md plans (its "next
-stages") and, beside it, of the step that runs today (below). The plan: each
-rank owns a square of sea and the floes whose centroid it holds, the sea's transforms are distributed,
-and a rank exchanges only halos with its neighbours. Weak scaling: every rank
+stages") and, beside it, of the step that runs today (below). The plan:
+each rank owns a square of sea and the floes whose centroid it holds, the
+sea's transforms are distributed, and a rank exchanges only halos with its
+neighbours. Weak scaling: every rank
 keeps bench/ocean's share (its pack: 1000 floes on a 1 km, 512^2-cell
 square), so P ranks run P km^2, P 10^3 floes, 512^2 P cells. docs/scaling.md
 derives the terms; one step on P ranks costs
@@ -73,7 +74,7 @@ import ocean_pack  # noqa: E402  (bench/ocean's pack)
 # Measured (docs/scaling.md, "The step that runs today"; bench/results/whole_pack_s29_epyc-2core.csv).
 WHOLE_IMPLICIT_BYTES = 2 * 3511.0 + 2 * 48.0 + 8.0  # two gathers of the pieces, two of the loads, the yaw
 WHOLE_IMPLICIT_CALLS = 5.0
-WHOLE_PASS_NS = 310.0  # rank 0 of 2 less half the serial run, per floe: an upper estimate
+WHOLE_PASS_NS = 150.0  # rank 0 of 2 less its share of the serial run, per floe (0.08 to 0.19 us; by symbol 0.14)
 
 ap = argparse.ArgumentParser()
 # Measured inputs (bench/ocean, docs/scaling.md says where each comes from).
