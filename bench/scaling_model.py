@@ -2,9 +2,10 @@
 """bench/scaling_model.py: a weak-scaling model of floesim's distributed step to 1024 ranks.
 
 The model is of the decomposition docs/parallel.md plans (its "next
-stages"), not of today's replicated state: each rank owns a square of sea
-and the floes whose centroid it holds, the sea's transforms are distributed,
-and a rank exchanges only halos with its neighbours. Weak scaling: every rank
+stages") and, beside it, of the step that runs today (below). The plan:
+each rank owns a square of sea and the floes whose centroid it holds, the
+sea's transforms are distributed, and a rank exchanges only halos with its
+neighbours. Weak scaling: every rank
 keeps bench/ocean's share (its pack: 1000 floes on a 1 km, 512^2-cell
 square), so P ranks run P km^2, P 10^3 floes, 512^2 P cells. docs/scaling.md
 derives the terms; one step on P ranks costs
@@ -24,6 +25,27 @@ derives the terms; one step on P ranks costs
   R(P)   the step's agreements (time step, failures, stopping): r reductions of
          latency alpha log2 P
 
+The step that runs today (the "today" columns) is the planned one plus what
+still grows with the total floe count N = 1000 P on every rank
+(docs/scaling.md, "The step that runs today"):
+
+  T_today(P) = T_slabs(P) + W(P) + V (P - 1) 1000 + S(P)
+
+  W(P)   the whole-pack exchanges: w bytes a floe a step of every floe to every
+         rank (today's all-gathers, `complete_owned`), in c calls a step, each a
+         ring all-gather of its w N / c bytes: (P - 1) alpha + (w N / c) (P - 1) / P / beta
+  V      the per-rank passes over every floe (the owners' assignment, the
+         advance's set-up, the held masks): seconds a floe a step, on the
+         1000 (P - 1) floes a rank does not own (its own 1000 are in C)
+  S(P)   the implicit step's sea, whole on every rank today: its transforms on
+         the whole sea, F P log2(n P) / log2 n, instead of the rank's share and
+         its transposes (a lower bound: the solve's other per-cell work, in C,
+         is whole on every rank too)
+
+and the floes' whole-pack arrays take m bytes a floe on every rank (memory,
+not time). --no-whole sets W, V, S and m to zero: today's columns are then
+the planned slabs' step (the check in the commit that added them).
+
 with a message of b bytes taking alpha + b / beta, and beta the rank's share of
 its node's network when P fills more than a node. alpha, the node's bandwidth
 and the ranks per node are a cluster's, not this machine's (assumed, command
@@ -31,7 +53,9 @@ line); every other input is measured on bench/ocean and named in the CSV.
 
 usage: bench/scaling_model.py [--step-ms 22.6] [--fft-share 0.13] [--pieces-per-floe 130]
                               [--alpha-us 2] [--node-gbs 12.5] [--ranks-per-node 32]
-                              [--memory-gbs 5] [--build build] [--csv FILE | -]
+                              [--memory-gbs 5] [--whole-bytes-explicit 12.8] [--whole-bytes-implicit ...]
+                              [--whole-pass-ns ...] [--floe-memory-bytes 400] [--no-whole]
+                              [--build build] [--csv FILE | -]
 """
 import argparse
 import math
@@ -47,6 +71,11 @@ ROOT = os.path.dirname(HERE)
 sys.path.insert(0, os.path.join(ROOT, "scripts", "scenarios"))
 import ocean_pack  # noqa: E402  (bench/ocean's pack)
 
+# Measured (docs/scaling.md, "The step that runs today"; bench/results/whole_pack_s29_epyc-2core.csv).
+WHOLE_IMPLICIT_BYTES = 2 * 3511.0 + 2 * 48.0 + 8.0  # two gathers of the pieces, two of the loads, the yaw
+WHOLE_IMPLICIT_CALLS = 5.0
+WHOLE_PASS_NS = 150.0  # rank 0 of 2 less its share of the serial run, per floe (0.08 to 0.19 us; by symbol 0.14)
+
 ap = argparse.ArgumentParser()
 # Measured inputs (bench/ocean, docs/scaling.md says where each comes from).
 ap.add_argument("--step-ms", type=float, default=22.6,
@@ -61,6 +90,23 @@ ap.add_argument("--pieces-per-floe", type=float, default=130.0,
 ap.add_argument("--state-bytes", type=int, default=96, help="a floe's state (FloeState)")
 ap.add_argument("--piece-bytes", type=int, default=12, help="a piece's (cell, area) for the owner of its cell")
 ap.add_argument("--reductions", type=int, default=2, help="agreements a step (time step; failures and stopping)")
+# The step that runs today: what grows with the total floe count on every rank (measured on
+# bench/ocean's pack at 1000 and 4000 floes on 2 ranks, docs/scaling.md "The step that runs today").
+ap.add_argument("--whole-bytes-explicit", type=float, default=12.8,
+                help="bytes a floe a step of every floe to every rank, explicit step: the boxes of order_by_owner "
+                     "(12 B an evaluation, one a step) and the strips' keys (8 B every 10 steps)")
+ap.add_argument("--whole-calls-explicit", type=float, default=1.1, help="those all-gathers a step")
+ap.add_argument("--whole-bytes-implicit", type=float, default=WHOLE_IMPLICIT_BYTES,
+                help="the same for the implicit step: its area pieces (3511 B a floe of bench/ocean's pack) twice, "
+                     "its loads (48 B) twice, the tilted floes' yaw (8 B)")
+ap.add_argument("--whole-calls-implicit", type=float, default=WHOLE_IMPLICIT_CALLS, help="those all-gathers a step")
+ap.add_argument("--whole-pass-ns", type=float, default=WHOLE_PASS_NS,
+                help="the per-rank passes over every floe, ns a floe a step (rank 0 of 2 less half the serial "
+                     "step's work, per floe: includes the by-owner code's own work on the rank's floes)")
+ap.add_argument("--floe-memory-bytes", type=float, default=400.0,
+                help="the floes' arrays still whole-pack on every rank, bytes a floe (docs/scaling.md)")
+ap.add_argument("--no-whole", action="store_true",
+                help="set every whole-pack term to zero: the today columns are then the planned slabs'")
 # A cluster's network (assumed).
 ap.add_argument("--alpha-us", type=float, default=2.0, help="latency of a message, us")
 ap.add_argument("--node-gbs", type=float, default=12.5, help="a node's network bandwidth, GB/s (100 Gb/s)")
@@ -146,6 +192,34 @@ def model(P, step_ms, transforms, r, block_halo):
     return compute, fft_p, slab_x, slab_h, block_x, block_h, reductions
 
 
+def today(P, kind, fft_p, slab_x):
+    """What the step that runs today adds to the planned slabs' step, per rank and
+    step (s): the whole-pack all-gathers, the passes over the floes the rank does
+    not own, and (implicit) the whole sea's transforms on every rank instead of the
+    rank's share and its transposes; and the floes' whole-pack memory (bytes). All
+    zero with --no-whole."""
+    if args.no_whole:
+        return 0.0, 0.0, 0.0, 0.0, 0.0
+    floes = FLOES * P
+    memory = args.floe_memory_bytes * floes
+    if P == 1:
+        return 0.0, 0.0, 0.0, 0.0, memory
+    alpha = args.alpha_us * 1e-6
+    beta = args.node_gbs * 1e9 / args.ranks_per_node if P > args.ranks_per_node else args.memory_gbs * 1e9
+    per_floe = args.whole_bytes_explicit if kind == "explicit" else args.whole_bytes_implicit
+    calls = args.whole_calls_explicit if kind == "explicit" else args.whole_calls_implicit
+    received = per_floe * floes   # every floe's bytes reach every rank (an all-gather counts its own part too)
+    # calls ring all-gathers a step, together of `received` bytes: (P - 1) messages each.
+    exchange = calls * (P - 1) * alpha + received * (P - 1) / P / beta
+    passes = args.whole_pass_ns * 1e-9 * FLOES * (P - 1)
+    # The implicit step keeps the sea whole on every rank: every rank transforms
+    # the whole n P cells (n P log(n P) against its share's n log(n P)) and
+    # transposes nothing. Its solve's other per-cell work (in C) is whole too and
+    # not counted here: for the implicit step this term is a lower bound.
+    sea = fft_p * (P - 1) - slab_x if kind == "implicit" else 0.0
+    return received, exchange, passes, sea, memory
+
+
 c, r, window = pack_radii()
 state, straddle = halo_blocks(c, r, window)
 rows = []
@@ -157,11 +231,14 @@ for kind, step_ms, transforms in (("explicit", args.step_ms, TRANSFORMS_EXPLICIT
         slab = compute + fft_p + slab_x + slab_h + red
         block = compute + fft_p + block_x + block_h + red
         base = base or slab
+        received, exchange, passes, sea, memory = today(P, kind, fft_p, slab_x)
+        now = slab + exchange + passes + sea
         side = 512 * math.isqrt(P)
         rows.append([kind, P, P * FLOES, f"{side}x{side}", f"{compute * 1e3:.2f}", f"{fft_p * 1e3:.2f}",
                      f"{slab_x * 1e3:.3f}", f"{slab_h * 1e3:.3f}", f"{slab * 1e3:.2f}", f"{base / slab:.3f}",
                      f"{block_x * 1e3:.3f}", f"{block_h * 1e3:.3f}", f"{block * 1e3:.2f}", f"{base / block:.3f}",
-                     f"{red * 1e3:.4f}"])
+                     f"{red * 1e3:.4f}", f"{received / 1e6:.3f}", f"{exchange * 1e3:.3f}", f"{passes * 1e3:.3f}",
+                     f"{sea * 1e3:.2f}", f"{now * 1e3:.2f}", f"{base / now:.3f}", f"{memory / 1e6:.1f}"])
 
 commit = subprocess.run(["git", "-C", ROOT, "rev-parse", "--short", "HEAD"], capture_output=True, text=True).stdout.strip()
 lines = [
@@ -176,8 +253,15 @@ lines = [
     "# per rank and step, ms: compute = the step less its transforms; fft = the transforms' work on the rank's share "
     "of the whole sea; for slabs and for square blocks: the transposes, the halo, the step and the efficiency "
     "T(1) / T(P); reductions (both)",
+    f"# today (the step that runs, slabs): the planned slabs' step plus the whole-pack all-gathers "
+    f"({'zero: --no-whole' if args.no_whole else f'{args.whole_bytes_explicit:g} B a floe a step explicit, {args.whole_bytes_implicit:g} implicit, every floe to every rank'}; "
+    f"MB received a step and ms), the passes over every floe ({0 if args.no_whole else args.whole_pass_ns:g} ns a floe a step), "
+    f"the implicit step's whole sea (its transforms on every rank); the step, its efficiency against T(1) and the floes' "
+    f"whole-pack arrays per rank ({0 if args.no_whole else args.floe_memory_bytes:g} B a floe, MB)",
     "integrator,ranks,floes,cells,compute_ms,fft_ms,slab_transpose_ms,slab_halo_ms,slab_step_ms,slab_efficiency,"
-    "block_transpose_ms,block_halo_ms,block_step_ms,block_efficiency,reductions_ms",
+    "block_transpose_ms,block_halo_ms,block_step_ms,block_efficiency,reductions_ms,"
+    "today_whole_mb,today_whole_exchange_ms,today_whole_passes_ms,today_whole_sea_ms,today_step_ms,today_efficiency,"
+    "today_floe_memory_mb",
 ] + [",".join(str(x) for x in r) for r in rows]
 text = "\n".join(lines) + "\n"
 if args.csv != "-":
