@@ -48,7 +48,7 @@ args = ap.parse_args()
 if args.floes < 1 or args.cells < 16 or not args.until > 0:
     sys.exit("large.py: --floes >= 1, --cells >= 16 and --until > 0 expected")
 
-floesim = os.path.join(args.build, "bin", "floesim")
+floesim = os.path.join(os.path.abspath(args.build), "bin", "floesim")  # the runs start in the work folder
 if not os.access(floesim, os.X_OK):
     sys.exit(f"large.py: no {floesim} (build it: cmake --build {args.build} --target floesim)")
 os.makedirs(args.work, exist_ok=True)
