@@ -33,6 +33,9 @@ cuts move from the equal shares toward the floes (parallel.slab_rows, every
   - with the blend law (the explicit damper, whose loads are evaluated at
     the first half kick and kicked into the sea after the drift that moves
     the cuts), the runs on 2 and 3 ranks equal the serial one bit for bit.
+  - a move of the cuts in a rejected try ("moved in a redo" below): the
+    step that moves the slabs is redone after an overlap, and the runs on 2
+    and 3 ranks equal the serial one bit for bit.
 """
 import os
 import sys
@@ -120,6 +123,64 @@ for n in (2, 3):
     print(f"{n} ranks ({out}): {'equal' if p.returncode == 0 else 'DIFFERENT'} to the serial run (bit for bit)")
     if p.returncode != 0:
         failures.append(f"{out} against the serial run:\n{p.stdout}")
+# The slabs moved in a try that is then rejected (docs/parallel.md, "The
+# kick by owner (kick29)"): the move's drift hands floes its old bands did
+# not hold to their new owners (hand_over_moved), the try is redone from the
+# step's start with half the dt, and the redo's first half kick kicks those
+# floes on their new holders with the loads of the step's start, which must
+# travel again (ready_loads' kickers_moved; the strong law: no damper, so
+# the loads are not evaluated again). Without that second share the run
+# leaves the serial one at the redo (on 2 and 3 ranks).
+# The cuts may move only every StripOptions::rebalance_steps (10) steps, so
+# the overlap is timed for the 11th step: no wind, waves of 1 cm, the
+# penalty spring soft enough (stiffness 0.05) for dt = dt_max = 0.25 s, and a
+# 2 m square A at 4 m/s (slowed by the drag) meets B, at rest 7.3 m ahead,
+# just after t = 2.5 s; B, thrown past its reach (set at rest), overlaps C
+# 0.2 m ahead: the try is rejected. Every floe lies below y = 30 m, in rank
+# 0's strip of the equal slabs (cut at row 16, y = 32 m), so the first
+# window moves the cut toward them (to row 8, y = 16 m, on 2 ranks): the
+# floes above it, A, B and C among them, far out of rank 1's old band, go to
+# rank 1 at that try.
+# Both in the same step, from the summary: to t = 2.5 s, 10 steps, none
+# redone, no move; to 2.75 s, one move and one step redone, in 12 steps (the
+# 11th's first try of 0.25 s rejected, its redo and the next step 0.125 s).
+def square(x, y):
+    return f"[[{x}, {y}], [{x + 2}, {y}], [{x + 2}, {y + 2}], [{x}, {y + 2}]]"
+
+
+redo_floes = [(30.0, 20.0 - 2.0 - 7.3, 4.0), (30.0, 20.0, 0.0), (30.0, 22.2, 0.0)]
+redo_floes += [(2.0 + 4.0 * i, 2.0 + 5.0 * j, 0.0) for i in range(6) for j in range(6)]
+redo = os.path.join(W, "moved_redo.toml")
+with open(redo, "w") as f:
+    f.write('[run]\nt_end = 3.0\ndt_max = 0.25\noutput_interval = 0.5\nthreads = 1\n\n'
+            '[sea]\nmodel = "spectral"\ndims = 2\nsize = [64.0, 64.0]\ncells = [32, 32]\ndepth = 20.0\n\n'
+            '[sea.waves]\nkind = "regular"\namplitude = 0.01\nwavelength = 16.0\n\n'
+            '[contact]\ndomain = "periodic"\nbox = [0.0, 64.0, 0.0, 64.0]\nrestitution = 1.0\n\n'
+            '[forcing]\nwind = [0.0, 0.0]\n\n[coupling]\nlaw = "strong"\nstiffness = 0.05\n')
+    for x, y, vy in redo_floes:
+        f.write(f"\n[[floes.floe]]\nvertices = {square(x, y)}\nvelocity = [0.0, {vy}]\nthickness = 0.5\n")
+need(run([floesim, "run", redo, "-o", "redo_serial.h5", "-q"]), "moved in a redo: the serial run")
+for n in (2, 3):
+    counts = {}
+    for until in ("2.5", "2.75", None):
+        out = f"redo{n}_{until or 'end'}.h5"
+        p = need(mpirun(n, "run", redo, "-o", out, *(("--until", until) if until else ())),
+                 f"moved in a redo: the run on {n} ranks to {until or 'the end'}")
+        s = summary(p)
+        counts[until] = (int(s.get("steps", "0")), int(s.get("steps_redone", "0")),
+                         int(s.get("parallel.strip_moves", "0")))
+        rows = s.get("parallel.slab_rows")
+    print(f"moved in a redo on {n} ranks: (steps, redone, moves) to 2.5 s {counts['2.5']}, to 2.75 s "
+          f"{counts['2.75']}, to the end {counts[None]}; slabs at the end {rows}")
+    if counts["2.5"] != (10, 0, 0) or counts["2.75"] != (12, 1, 1):
+        failures.append(f"moved in a redo on {n} ranks: the move and the redo were not in the 11th step "
+                        f"(to 2.5 s {counts['2.5']}, to 2.75 s {counts['2.75']}; want (10, 0, 0) and (12, 1, 1)): "
+                        "the case would not test a move in a rejected try")
+    p = compare(f"redo{n}_end.h5", "redo_serial.h5", "0")
+    print(f"moved in a redo on {n} ranks: {'equal' if p.returncode == 0 else 'DIFFERENT'} to the serial run "
+          "(bit for bit)")
+    if p.returncode != 0:
+        failures.append(f"moved in a redo on {n} ranks against the serial run:\n{p.stdout}")
 p = compare("ranks2.h5", "ranks2_again.h5", "0")
 print(f"two runs on 2 ranks: {'equal' if p.returncode == 0 else 'DIFFERENT'} (bit for bit)")
 if p.returncode != 0:
