@@ -180,6 +180,7 @@ double Simulation::step(double t_stop) {
   { PhaseTimer _(profile_, Phase::percussion, comm_); percussion(ctx); }         probe("percussion", ctx);
   { PhaseTimer _(profile_, Phase::check, comm_);      close_step(ctx); }         probe("check", ctx);
   ++steps_;
+  start_copies_ = std::move(ctx.start);  // the next step's copies go into this array
   warm_->tick();  // the jam LCPs' warm starts age by one step
   return ctx.dt;
 }
@@ -214,7 +215,7 @@ StepContext Simulation::choose_dt(double t_stop) {
   // sub-stepped by advance() (contact/substep.hpp); with fracture on, every
   // solve of the step hands its impulses to the percussion phase
   // (impulse_record_), whatever sub-step it fell in.
-  ctx.start = scenario_.floes.state;
+  copy_start(ctx);
   return ctx;
 }
 

@@ -92,7 +92,11 @@ struct StepContext {
   double t = 0.0;      // s, time at the start of the step
   double dt = 0.0;     // s
   ForcingSample forcing;
-  std::vector<FloeState> start;  // the floes at t, to redo a rejected step
+  // The floes at t, to redo a rejected step (Simulation::copy_start): every
+  // floe's, or (start_held not empty) those of the floes marked there, the
+  // others' entries left as they were (stale, unread).
+  std::vector<FloeState> start;
+  std::vector<std::uint8_t> start_held;  // per floe, 1 if copied into start; empty: every floe
   // The dynamic floes' momentum (x, y; kg m/s) at the try's start (before
   // the first half kick), after the drift, after the collisions and after
   // the advance, then before and after the sea's second half kick, as exact
@@ -262,6 +266,15 @@ public:
 
 private:
   StepContext choose_dt(double t_stop);
+  // The step-start copies into ctx.start, in the array of the last step
+  // (start_copies_): every floe's serially, before the first detection,
+  // while every copy is current (state_whole_) and without the halo
+  // exchange (whose ranks read every floe); else the held floes'
+  // (held_now()), the only ones a rank reads. restore_start() puts them
+  // back at a rejected try.
+  void copy_start(StepContext& ctx);
+  void restore_start(const StepContext& ctx);
+  std::vector<FloeState> start_copies_;  // ctx.start between steps: its allocation kept
   void sample_forcing(StepContext& ctx) const;
   void sea_flow(const StepContext& ctx);
   void floes_half_kick(StepContext& ctx);

@@ -194,7 +194,7 @@ bool Simulation::detect_and_check(StepContext& ctx) {
   if (overlap.any) {
     // Redo the step with half the time.
     ++rejected_steps_;
-    scenario_.floes.state = ctx.start;
+    restore_start(ctx);
     owners_off_places_ = !comm_.serial();  // the owners took the try's notices
     ctx.dt *= 0.5;
     if (ctx.dt < kFloorFraction * scenario_.config.run.dt_max * std::pow(0.5, kMaxHalvings / 2)) {

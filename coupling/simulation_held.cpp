@@ -44,6 +44,48 @@ void Simulation::hand_over_moved(StepContext& ctx, std::span<const int> detected
   comm_.hand_over_each(detected, owners_.owner(), scenario_.floes.state, ctx.start, detection_part_->reach);
 }
 
+void Simulation::copy_start(StepContext& ctx) {
+  // The readers of ctx.start on a rank read the floes it holds: the
+  // collisions and the advance (the pairs of its part, all held), the
+  // vertical drift (held_now()), hand_over_moved (the old owner sends its
+  // own floes'), the detection's notices (a leaving floe's, from its old
+  // owner), whole_state (the owners' entries for the others) and the
+  // poison mode's checks (the held floes'). Their entries are the ones
+  // copied; a floe that comes to the rank within the step gets its entry
+  // with its state (hand_over_moved, the notices, whole_state). Where a
+  // rank may read every floe (no halo exchange; or state_whole_, every
+  // copy as current as the run made it: before the first drift's exchange,
+  // whose step may pose every floe) every entry is copied, as serially. The array is the last step's: no allocation while
+  // the floe count holds.
+  const std::vector<FloeState>& state = scenario_.floes.state;
+  ctx.start = std::move(start_copies_);
+  ctx.start_held.clear();
+  if (halo_exchange() && !state_whole_) ctx.start_held = held_now();
+  if (ctx.start_held.empty()) {
+    ctx.start.assign(state.begin(), state.end());
+    return;
+  }
+  ctx.start.resize(state.size());  // a split's pieces: new entries, written below where held
+  for (std::size_t i = 0; i < state.size(); ++i)
+    if (ctx.start_held[i]) ctx.start[i] = state[i];
+}
+
+void Simulation::restore_start(const StepContext& ctx) {
+  // A rejected try's floes back at t: the entries copied, and those
+  // written since for the floes that came to this rank (held_now(): its
+  // own floes now, from the try's notices or a move of the cuts). With
+  // every entry current (a whole copy, or whole_state's gather of both in
+  // the try) every floe's.
+  std::vector<FloeState>& state = scenario_.floes.state;
+  const std::vector<std::uint8_t> held = ctx.start_held.empty() || state_whole_ ? std::vector<std::uint8_t>{} : held_now();
+  if (held.size() != state.size()) {
+    state = ctx.start;
+    return;
+  }
+  for (std::size_t i = 0; i < state.size(); ++i)
+    if (ctx.start_held[i] || held[i]) state[i] = ctx.start[i];
+}
+
 std::vector<std::uint8_t> Simulation::held_now() const {
   // The last detection's band and own floes (held_); the floes this rank
   // owns now: after a move of the cuts some of those were in no band of
