@@ -50,7 +50,7 @@ import os
 import re
 import sys
 
-from ranks_harness import need, ocean_toml, ranks_check, summary
+from ranks_harness import need, ocean_toml, ranks_check, squares_on_sea, summary
 
 
 def options(ap):
@@ -222,21 +222,10 @@ if os.path.exists(os.path.join(W, "moved_2.h5")):
 # Serially and on 2 and 3 ranks, in the poison mode too (the unheld copies
 # NaN: a rebuild posing a floe not gathered reads NaN), bit for bit, each
 # run having redone a step (`steps_redone`).
-def square(x, y):
-    return f"[[{x}, {y}], [{x + 2}, {y}], [{x + 2}, {y + 2}], [{x}, {y + 2}]]"
-
-
 redo_floes = [(30.0, 28.0, 4.0), (30.0, 30.05, 0.0), (30.0, 32.55, 0.0)]
 redo_floes += [(2.0 + 4.0 * i, 4.0 + 10.0 * j, 0.0) for i in range(5) for j in range(6)]
 redo = os.path.join(W, "sea_redo.toml")
-with open(redo, "w") as f:
-    f.write('[run]\nt_end = 2.0\ndt_max = 0.25\noutput_interval = 0.5\nthreads = 1\n\n'
-            '[sea]\nmodel = "spectral"\ndims = 2\nsize = [64.0, 64.0]\ncells = [32, 32]\ndepth = 20.0\n\n'
-            '[sea.waves]\nkind = "regular"\namplitude = 0.2\nwavelength = 16.0\n\n'
-            '[contact]\ndomain = "periodic"\nbox = [0.0, 64.0, 0.0, 64.0]\nrestitution = 1.0\n\n'
-            '[forcing]\nwind = [15.0, 5.0]\n\n[coupling]\nlaw = "weak"\n')
-    for x, y, vy in redo_floes:
-        f.write(f"\n[[floes.floe]]\nvertices = {square(x, y)}\nvelocity = [0.0, {vy}]\nthickness = 0.5\n")
+squares_on_sea(redo, redo_floes, 2.0, 0.2, (15.0, 5.0), 'law = "weak"')
 s = summary(need(run([args.floesim, "run", redo, "-o", "redo_serial.h5", "-q"]), "redo: serial run"))
 print(f"redo: serial, {s.get('steps')} steps, {s.get('steps_redone')} redone after an overlap")
 if s.get("steps_redone", "0") == "0":

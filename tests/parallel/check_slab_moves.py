@@ -40,7 +40,7 @@ cuts move from the equal shares toward the floes (parallel.slab_rows, every
 import os
 import sys
 
-from ranks_harness import half_pack, need, ocean_toml, ranks_check, summary
+from ranks_harness import half_pack, need, ocean_toml, ranks_check, squares_on_sea, summary
 
 args, harness = ranks_check("floesim was built without MPI (FLOESIM_MPI=OFF): the moving slabs are not checked")
 floesim, W = args.floesim, args.workdir
@@ -144,21 +144,10 @@ for n in (2, 3):
 # Both in the same step, from the summary: to t = 2.5 s, 10 steps, none
 # redone, no move; to 2.75 s, one move and one step redone, in 12 steps (the
 # 11th's first try of 0.25 s rejected, its redo and the next step 0.125 s).
-def square(x, y):
-    return f"[[{x}, {y}], [{x + 2}, {y}], [{x + 2}, {y + 2}], [{x}, {y + 2}]]"
-
-
 redo_floes = [(30.0, 20.0 - 2.0 - 7.3, 4.0), (30.0, 20.0, 0.0), (30.0, 22.2, 0.0)]
 redo_floes += [(2.0 + 4.0 * i, 2.0 + 5.0 * j, 0.0) for i in range(6) for j in range(6)]
 redo = os.path.join(W, "moved_redo.toml")
-with open(redo, "w") as f:
-    f.write('[run]\nt_end = 3.0\ndt_max = 0.25\noutput_interval = 0.5\nthreads = 1\n\n'
-            '[sea]\nmodel = "spectral"\ndims = 2\nsize = [64.0, 64.0]\ncells = [32, 32]\ndepth = 20.0\n\n'
-            '[sea.waves]\nkind = "regular"\namplitude = 0.01\nwavelength = 16.0\n\n'
-            '[contact]\ndomain = "periodic"\nbox = [0.0, 64.0, 0.0, 64.0]\nrestitution = 1.0\n\n'
-            '[forcing]\nwind = [0.0, 0.0]\n\n[coupling]\nlaw = "strong"\nstiffness = 0.05\n')
-    for x, y, vy in redo_floes:
-        f.write(f"\n[[floes.floe]]\nvertices = {square(x, y)}\nvelocity = [0.0, {vy}]\nthickness = 0.5\n")
+squares_on_sea(redo, redo_floes, 3.0, 0.01, (0.0, 0.0), 'law = "strong"\nstiffness = 0.05')
 need(run([floesim, "run", redo, "-o", "redo_serial.h5", "-q"]), "moved in a redo: the serial run")
 for n in (2, 3):
     counts = {}

@@ -183,6 +183,24 @@ stiffness = 100.0
 {coupling}"""
 
 
+def squares_on_sea(path, floes, t_end, amplitude, wind, law):
+    """Writes a 64 m periodic box on a 32^2 spectral sea (regular waves of
+    16 m, depth 20 m) with 2 m square floes 0.5 m thick, each (x, y, vy): its
+    lower-left corner and its velocity along y; `law` is the [coupling]
+    section's lines. The redone-step cases of check_sea_ranks.py and
+    check_slab_moves.py."""
+    def square(x, y):
+        return f"[[{x}, {y}], [{x + 2}, {y}], [{x + 2}, {y + 2}], [{x}, {y + 2}]]"
+    with open(path, "w") as f:
+        f.write(f'[run]\nt_end = {t_end}\ndt_max = 0.25\noutput_interval = 0.5\nthreads = 1\n\n'
+                '[sea]\nmodel = "spectral"\ndims = 2\nsize = [64.0, 64.0]\ncells = [32, 32]\ndepth = 20.0\n\n'
+                f'[sea.waves]\nkind = "regular"\namplitude = {amplitude}\nwavelength = 16.0\n\n'
+                '[contact]\ndomain = "periodic"\nbox = [0.0, 64.0, 0.0, 64.0]\nrestitution = 1.0\n\n'
+                f'[forcing]\nwind = [{wind[0]}, {wind[1]}]\n\n[coupling]\n{law}\n')
+        for x, y, vy in floes:
+            f.write(f"\n[[floes.floe]]\nvertices = {square(x, y)}\nvelocity = [0.0, {vy}]\nthickness = 0.5\n")
+
+
 def need(p, what):
     """p, if it exited 0; else the check stops, saying what failed and its output."""
     if p.returncode != 0:
