@@ -358,6 +358,8 @@ private:
   // (one rank, no detection yet). With the implicit step every rank holds
   // every floe's vertical DOFs besides (not marked).
   std::vector<std::uint8_t> held_now() const;
+  // Whether held_now() marks a part (not empty), without building the mask.
+  bool holds_part() const;
   // The floes this rank kicks with the sea's loads (FloeSeaContact::
   // kick_floes): with the halo exchange the floes it holds (held_now()),
   // whose rates its collisions (the step-start copy) and its law (the

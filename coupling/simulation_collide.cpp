@@ -215,7 +215,7 @@ bool Simulation::detect_and_check(StepContext& ctx) {
   // floes; with the state held by owner they were since the drift unless
   // gathered): a split gathers the states it reads (split_states).
   if (halo) announced_ = std::move(halo->announced);
-  if (!held_now().empty()) state_whole_ = false;
+  if (holds_part()) state_whole_ = false;
   detection_whole_ = comm_.serial() || whole;
   if (!comm_.serial()) {
     detection_part_ = std::move(part);

@@ -101,13 +101,18 @@ std::vector<std::uint8_t> Simulation::held_now() const {
   // alone writes, alike on every rank (FloeSeaContact::implicit_step): not
   // marked here, this is the held set of the whole state.
   const std::size_t n = scenario_.floes.size();
-  if (comm_.serial() || held_.mask.size() != n || owners_.owner().size() != n) return {};
+  if (!holds_part()) return {};
   std::vector<std::uint8_t> held = held_.mask;
   for (const std::uint32_t i : owners_.mine()) held[i] = 1;
   if (floe_sea_)
     for (const std::uint32_t i : floe_sea_->own_floes())
       if (i < n) held[i] = 1;
   return held;
+}
+
+bool Simulation::holds_part() const {
+  const std::size_t n = scenario_.floes.size();
+  return !comm_.serial() && held_.mask.size() == n && owners_.owner().size() == n;
 }
 
 std::vector<std::uint8_t> Simulation::kicked_floes() const {
