@@ -2,7 +2,7 @@
 """Distributed runs on the seas not in slabs against the serial run
 (docs/parallel.md, "The seas not in slabs in the serial order").
 
-usage: check_whole_seas.py FLOESIM MPIEXEC WORKDIR [--ranks 2 3]
+usage: check_whole_seas.py FLOESIM MPIEXEC WORKDIR [--ranks 2 3] [--part ranks|poison|all]
        check_whole_seas.py --no-mpi    (MPI not built: exits 77, ctest's skip code)
 
 A BEM sea, a spectral tank and a long-crested spectral sea (dims = 1) are
@@ -86,6 +86,12 @@ skipped after the drift's whole exchange, 284 floes on 2 ranks). From the
 parts: rank 0's split gathers (parallel.split_gathers) below a quarter of
 every floe's state a split step (the split's readers only, the sea's
 coupling built by the owners after a split), and the poison modes clean.
+
+`--part ranks` runs the cases on 2 and 3 ranks and the flume numbered along
+x; `--part poison` the poison mode, the restart and the splits (each part
+makes the packs and serial runs it compares with): ctest runs the two as
+two tests, each well under its timeout when oversubscribed ranks share the
+cores with other jobs (the whole took 48-54 s alone, 68-119 s in the suite).
 """
 import math
 import os
@@ -100,7 +106,8 @@ from whole_seas import SEAS, pack_command  # per case: its [sea] and its pack's 
 
 args, harness = ranks_check(
     "floesim was built without MPI (FLOESIM_MPI=OFF): the runs on the seas not in slabs are not checked",
-    lambda ap: ap.add_argument("--ranks", type=int, nargs="+", default=[2, 3]))
+    lambda ap: (ap.add_argument("--ranks", type=int, nargs="+", default=[2, 3]),
+                ap.add_argument("--part", choices=("ranks", "poison", "all"), default="all")))
 W = args.workdir
 failures = []
 run, mpirun = harness.run, harness.mpirun
@@ -164,7 +171,8 @@ def penalty_bytes(p):
     return phase_bytes(p, "penalty")
 
 
-penalty = {}  # (case, ranks) -> rank 0's penalty bytes
+RANKS, POISON = args.part in ("ranks", "all"), args.part in ("poison", "all")
+serial_steps = {}  # case -> the serial run's steps
 for name, (sea, pack) in SEAS.items():
     need(run(pack_command(args.floesim, name, f"{name}_pack.h5")), f"{name}: floesim pack")
     config = os.path.join(W, f"{name}.toml")
@@ -172,7 +180,12 @@ for name, (sea, pack) in SEAS.items():
         f.write(RUN + sea + coupling(name, f"{name}_pack.h5"))
     s = summary(need(run([args.floesim, "run", config, "-o", f"{name}_serial.h5", "-q"]), f"{name}: serial run"))
     print(f"{name}: serial to 2 s, {s.get('steps')} steps")
-    steps = int(s["steps"])
+    serial_steps[name] = int(s["steps"])
+
+penalty = {}  # (case, ranks) -> rank 0's penalty bytes
+for name, (sea, pack) in SEAS.items() if RANKS else ():
+    config = os.path.join(W, f"{name}.toml")
+    steps = serial_steps[name]
     nx, ny, dx, dy = GRIDS[name]
     along_x = ny == 1 or nx >= ny  # the strips' rule (FloeSeaContact::set_strips)
     d = math.ceil(largest_radius(f"{name}_pack.h5") / (dx if along_x else dy)) + 2
@@ -218,38 +231,28 @@ for name, (sea, pack) in SEAS.items():
 # The flume's floes numbered along x: the same owners by place, so the same
 # traffic within the runs' own drift (the two packs' serial runs differ in
 # their floes' order, so in round-off).
-numbered_along_x("flume_pack.h5", "flume_x_pack.h5")
-config = os.path.join(W, "flume_x.toml")
-with open(config, "w") as f:
-    f.write(RUN + SEAS["flume"][0] + coupling("flume", "flume_x_pack.h5"))
-need(run([args.floesim, "run", config, "-o", "flume_x_serial.h5", "-q"]), "flume numbered along x: serial run")
-p = mpirun(2, "run", config, "-o", "flume_x_2.h5", "-q")
-if p.returncode != 0:
-    failures.append(f"flume numbered along x on 2 ranks: exit {p.returncode}\n{p.stderr}")
-elif ("flume", 2) in penalty:
-    harness.same("flume_x_2.h5", "flume_x_serial.h5", "flume numbered along x: 2 ranks against the serial run",
-                 failures)
-    along, made = penalty_bytes(p), penalty["flume", 2]
-    print(f"flume on 2 ranks, rank 0's penalty bytes: {made} (numbered as made), {along} (numbered along x)")
-    if not made <= 1.2 * along:
-        failures.append(f"flume on 2 ranks: rank 0's penalty phase received {made} bytes with the pack numbered as "
-                        f"made, more than 1.2 times the {along} with it numbered along x (owners by index?)")
+def flume_along_x():
+    numbered_along_x("flume_pack.h5", "flume_x_pack.h5")
+    config = os.path.join(W, "flume_x.toml")
+    with open(config, "w") as f:
+        f.write(RUN + SEAS["flume"][0] + coupling("flume", "flume_x_pack.h5"))
+    need(run([args.floesim, "run", config, "-o", "flume_x_serial.h5", "-q"]), "flume numbered along x: serial run")
+    p = mpirun(2, "run", config, "-o", "flume_x_2.h5", "-q")
+    if p.returncode != 0:
+        failures.append(f"flume numbered along x on 2 ranks: exit {p.returncode}\n{p.stderr}")
+    elif ("flume", 2) in penalty:
+        harness.same("flume_x_2.h5", "flume_x_serial.h5", "flume numbered along x: 2 ranks against the serial run",
+                     failures)
+        along, made = penalty_bytes(p), penalty["flume", 2]
+        print(f"flume on 2 ranks, rank 0's penalty bytes: {made} (numbered as made), {along} (numbered along x)")
+        if not made <= 1.2 * along:
+            failures.append(f"flume on 2 ranks: rank 0's penalty phase received {made} bytes with the pack numbered as "
+                            f"made, more than 1.2 times the {along} with it numbered along x (owners by index?)")
 
-# The poison mode: the coupling, the seas and the step read only floes
-# their rank holds (none poisoned in the 2 m flume: every band holds every floe).
-for name in SEAS:
-    harness.poison_clean(name, os.path.join(W, f"{name}.toml"), f"{name}_serial.h5", failures, floes=name != "flume")
 
-# A restart across rank counts: the bem case's first half on 2 ranks, the
-# rest from its checkpoint on 3 ranks.
-harness.restart_2_on_3("bem", os.path.join(W, "bem.toml"), "bem_serial.h5", failures)
-# Splits on a sea not in slabs: the wide flume with fracture (its floes
-# crack and split within the 2 s), on 2 ranks from the parts (the default,
-# the halo exchange) and from the whole detection (`advance_on_part =
-# false`: the drift sends every state). A split reads its parent's state on
-# every rank; the vertical drift before it moves only the floes each rank
-# holds, so the other copies' heave, pitch and roll are stale whatever the
-# drift's exchange, and whole_state must gather them.
+if RANKS:
+    flume_along_x()
+
 FRACTURE = """
 [fracture]
 enabled = true
@@ -259,36 +262,58 @@ split = true
 mesh_size = 0.2
 min_fragment_area = 0.05
 """
-for label, run_table in (("from the parts", RUN), ("from the whole detection", RUN + "advance_on_part = false\n")):
-    config = os.path.join(W, "wide_split.toml" if run_table == RUN else "wide_split_whole.toml")
-    with open(config, "w") as f:
-        f.write(run_table + SEAS["wide"][0] + coupling("wide", "wide_pack.h5") + FRACTURE)
-    serial = config.replace(".toml", "_serial.h5")
-    s = summary(need(run([args.floesim, "run", config, "-o", serial, "-q"]), f"wide with splits {label}: serial run"))
-    print(f"wide with splits {label}: serial to 2 s, {s.get('floes')} floes from 160")
-    if int(s.get("floes", 0)) <= 160:
-        failures.append(f"wide with splits {label}: no floe split in the serial run ({s.get('floes')} floes)")
-    p = mpirun(2, "run", config, "-o", config.replace(".toml", "_2.h5"), "-q")
-    if p.returncode != 0:
-        failures.append(f"wide with splits {label} on 2 ranks: exit {p.returncode}\n{p.stderr}")
-        continue
-    harness.same(config.replace(".toml", "_2.h5"), serial, f"wide with splits {label}: 2 ranks against the "
-                 f"serial run", failures)
-    if run_table != RUN:
-        continue
-    # A split step gathers only the states its conclusion reads (the split's
-    # readers: the parents and their neighbours, 100 B a floe), with the sea
-    # as without: rank 0's bytes in those gathers are below a quarter of the
-    # 160 floes' states (96 B) a step, which every floe's state (the whole
-    # gather, about 6 times that bound here) exceeds. And in the poison mode
-    # the coupling's rebuild after a split poses only floes its rank holds
-    # (the owners just placed, FloeSeaContact::floes_changed): with the
-    # rebuild by index (every floe posed) the run ended with signal 11.
-    m = re.match(r"(\d+) steps, (\d+) bytes", summary(p).get("parallel.split_gathers", ""))
-    bound = None if not m else int(m.group(1)) * 160 * 96 / 4
-    print(f"wide with splits {label}: rank 0's split gathers {m.group(0) if m else None} (bound {bound} bytes)")
-    if not m or int(m.group(1)) == 0 or int(m.group(2)) >= bound:
-        failures.append(f"wide with splits {label}: rank 0's split gathers "
-                        f"({summary(p).get('parallel.split_gathers')}) not below a quarter of every floe's state")
-    harness.poison_clean("wide_split", config, serial, failures)
+
+
+def poison_restart_splits():
+    # The poison mode: the coupling, the seas and the step read only floes
+    # their rank holds (none poisoned in the 2 m flume: every band holds every floe).
+    for name in SEAS:
+        harness.poison_clean(name, os.path.join(W, f"{name}.toml"), f"{name}_serial.h5", failures, floes=name != "flume")
+
+    # A restart across rank counts: the bem case's first half on 2 ranks, the
+    # rest from its checkpoint on 3 ranks.
+    harness.restart_2_on_3("bem", os.path.join(W, "bem.toml"), "bem_serial.h5", failures)
+    # Splits on a sea not in slabs: the wide flume with fracture (its floes
+    # crack and split within the 2 s), on 2 ranks from the parts (the default,
+    # the halo exchange) and from the whole detection (`advance_on_part =
+    # false`: the drift sends every state). A split reads its parent's state on
+    # every rank; the vertical drift before it moves only the floes each rank
+    # holds, so the other copies' heave, pitch and roll are stale whatever the
+    # drift's exchange, and whole_state must gather them.
+    for label, run_table in (("from the parts", RUN), ("from the whole detection", RUN + "advance_on_part = false\n")):
+        config = os.path.join(W, "wide_split.toml" if run_table == RUN else "wide_split_whole.toml")
+        with open(config, "w") as f:
+            f.write(run_table + SEAS["wide"][0] + coupling("wide", "wide_pack.h5") + FRACTURE)
+        serial = config.replace(".toml", "_serial.h5")
+        s = summary(need(run([args.floesim, "run", config, "-o", serial, "-q"]), f"wide with splits {label}: serial run"))
+        print(f"wide with splits {label}: serial to 2 s, {s.get('floes')} floes from 160")
+        if int(s.get("floes", 0)) <= 160:
+            failures.append(f"wide with splits {label}: no floe split in the serial run ({s.get('floes')} floes)")
+        p = mpirun(2, "run", config, "-o", config.replace(".toml", "_2.h5"), "-q")
+        if p.returncode != 0:
+            failures.append(f"wide with splits {label} on 2 ranks: exit {p.returncode}\n{p.stderr}")
+            continue
+        harness.same(config.replace(".toml", "_2.h5"), serial, f"wide with splits {label}: 2 ranks against the "
+                     f"serial run", failures)
+        if run_table != RUN:
+            continue
+        # A split step gathers only the states its conclusion reads (the split's
+        # readers: the parents and their neighbours, 100 B a floe), with the sea
+        # as without: rank 0's bytes in those gathers are below a quarter of the
+        # 160 floes' states (96 B) a step, which every floe's state (the whole
+        # gather, about 6 times that bound here) exceeds. And in the poison mode
+        # the coupling's rebuild after a split poses only floes its rank holds
+        # (the owners just placed, FloeSeaContact::floes_changed): with the
+        # rebuild by index (every floe posed) the run ended with signal 11.
+        m = re.match(r"(\d+) steps, (\d+) bytes", summary(p).get("parallel.split_gathers", ""))
+        bound = None if not m else int(m.group(1)) * 160 * 96 / 4
+        print(f"wide with splits {label}: rank 0's split gathers {m.group(0) if m else None} (bound {bound} bytes)")
+        if not m or int(m.group(1)) == 0 or int(m.group(2)) >= bound:
+            failures.append(f"wide with splits {label}: rank 0's split gathers "
+                            f"({summary(p).get('parallel.split_gathers')}) not below a quarter of every floe's state")
+        harness.poison_clean("wide_split", config, serial, failures)
+
+
+if POISON:
+    poison_restart_splits()
 finish(failures)
