@@ -143,12 +143,17 @@ public:
   // modes (ModalBank::midpoint). The elevation the step would reach with no
   // pressure, and the change of elevation a pressure p alone causes (linear
   // and symmetric in p: ∫ p' midpoint_response(p) = ∫ p midpoint_response(p'));
-  // neither changes the state.
+  // neither changes the state. p and eta are grid().size() values; in
+  // slabs (slab_rows(), spectral.hpp) each rank reads its slab's rows of p
+  // and writes its slab's rows of eta alone (the other rows are neither
+  // read nor written), the whole sea's values to the bit, and the three
+  // operations are collective (every rank calls each, in the same order).
   void midpoint_free_elevation(double h, std::span<double> eta);
   void midpoint_response(std::span<const double> p, double h, std::span<double> eta);
   // Advances the state over h with p held over the step; t += h. A tank's
   // relaxation zones act over h / 2 before and after (as in flow()).
-  // On a sea with a static part (below) p becomes the pressure held.
+  // On a sea with a static part (below) p becomes the pressure held. In
+  // slabs each rank reads its rows of p and advances its modes.
   virtual void midpoint_step(std::span<const double> p, double h);
 
   // The static part of a truncated BEM sea (`[sea] bem_static_correction`;
@@ -285,7 +290,9 @@ protected:
   // the settled one.
   virtual void settle() {}
   // The modal load s of a pressure (kick(p, h) is v += h gain s), and the
-  // elevation on the grid of modal amplitudes q.
+  // elevation on the grid of modal amplitudes q; both laid out like the
+  // bank's q. In slabs: this rank's rows of the pressure to its modes, its
+  // modes to its rows of the elevation (collective).
   virtual void project(std::span<const double> pressure, std::span<double> s) = 0;
   virtual void synthesize(std::span<const double> q, std::span<double> eta) = 0;
   // The static part (see hold_pressure), s = project(pressure): hold the

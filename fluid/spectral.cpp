@@ -326,19 +326,33 @@ void SpectralSea::midpoint_step(std::span<const double> p, double h) {
 
 void SpectralSea::project(std::span<const double> pressure, std::span<double> s) {
   Impl& m = *impl_;
-  FLOESIM_ASSERT(!m.slab && pressure.size() == m.n && s.size() == 2 * m.nc);
-  m.forward(pressure, m.spec);
+  FLOESIM_ASSERT(pressure.size() == m.n && s.size() == 2 * m.modes);
+  // In slabs the slab transform (collective): this rank's rows of the
+  // pressure to its columns of the spectrum, each block the serial plan's.
+  if (m.slab) m.forward_slab(pressure, m.spec);
+  else m.forward(pressure, m.spec);
   m.staged = false;
+  // spec's layout to the bank's (one copy when not in slabs; else each
+  // row's columns, spec's row iy at iy stride, the bank's at iy width).
   const double* f = reinterpret_cast<const double*>(m.spec);
-  std::copy(f, f + 2 * m.nc, s.begin());
+  m.for_own_modes([&](std::size_t first, std::size_t stop, std::size_t mode, std::size_t at) {
+    std::copy(f + 2 * at, f + 2 * (at + stop - first), s.begin() + static_cast<std::ptrdiff_t>(2 * mode));
+  });
 }
 
 void SpectralSea::synthesize(std::span<const double> q, std::span<double> eta) {
   Impl& m = *impl_;
-  FLOESIM_ASSERT(!m.slab && q.size() == 2 * m.nc && eta.size() == m.n);
-  std::copy(q.begin(), q.end(), reinterpret_cast<double*>(m.spec));
+  FLOESIM_ASSERT(q.size() == 2 * m.modes && eta.size() == m.n);
+  double* to = reinterpret_cast<double*>(m.spec);
+  m.for_own_modes([&](std::size_t first, std::size_t stop, std::size_t mode, std::size_t at) {
+    std::copy(q.begin() + static_cast<std::ptrdiff_t>(2 * mode), q.begin() + static_cast<std::ptrdiff_t>(2 * (mode + stop - first)),
+              to + 2 * at);
+  });
   m.staged = false;
-  m.backward(eta, m.spec);
+  // In slabs this rank's rows of eta alone (no gather: the implicit step's
+  // products read the rows of their own slab).
+  if (m.slab) m.backward_rows(eta, m.spec);
+  else m.backward(eta, m.spec);
 }
 
 void SpectralSea::compute_field(Field f, std::span<double> out) {

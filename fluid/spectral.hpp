@@ -39,8 +39,12 @@
 // arithmetic, so the state and the fields are the serial ones to the bit.
 // The transforms' scratch is this rank's too (its rows of the real side,
 // its columns of the spectra); set_surface uses the slab transform as well
-// (collective: every rank sets the surface, at set-up). project and
-// synthesize (the implicit step) are not used in slabs.
+// (collective: every rank sets the surface, at set-up). The implicit
+// step's midpoint operations (Sea::midpoint_*) use the slab transform too:
+// project reads this rank's rows of the pressure into its modes, synthesize
+// writes its modes to its rows of the elevation (no gather), each mode's
+// factor the one of its place in the whole spectrum, so each rank's rows are
+// the whole sea's to the bit.
 
 #include <memory>
 

@@ -198,10 +198,7 @@ struct SpectralSea::Impl {
     if (slab) {
       const Sea::WindowRows w = window(halo);
       FLOESIM_ASSERT(out.size() == static_cast<std::size_t>(w.rows) * static_cast<std::size_t>(nx));
-      double* own = rows.begin < rows.end ? out.data() + at_row(w, rows.begin) : nullptr;
-      double* to = own && aligned(own) ? own : real;
-      slab->backward(from, to, threads);
-      if (own && to == real) std::copy(real, real + real_size, own);
+      backward_own(rows.begin < rows.end ? out.data() + at_row(w, rows.begin) : nullptr, from);
       if (halo == -1) ranks.allgather(std::as_writable_bytes(out), row_bytes);
       else if (halo == Sea::gather_to_writer) gather_rows(out);
       else exchange_halo(out, halo, w);
@@ -211,6 +208,21 @@ struct SpectralSea::Impl {
     if (fft2) fft2->backward(from, to, threads);
     else fftw_execute_dft_c2r(c2r, from, to);
     if (to == real) std::copy(real, real + n, out.begin());
+  }
+  // In slabs: this rank's rows of `out`, a whole field (n values), <-
+  // IFFT(from) there (collective: the transposes); the other rows are
+  // neither read nor written.
+  void backward_rows(std::span<double> out, fftw_complex* from) {
+    FLOESIM_ASSERT(slab && out.size() == n);
+    backward_own(rows.begin < rows.end ? out.data() + row_offset() : nullptr, from);
+  }
+  // In slabs: `own` (this rank's rows, consecutive; nullptr for an empty
+  // slab) <- IFFT(from) there, through `real` when `own` lacks the plans'
+  // alignment.
+  void backward_own(double* own, fftw_complex* from) {
+    double* to = own && aligned(own) ? own : real;
+    slab->backward(from, to, threads);
+    if (own && to == real) std::copy(real, real + real_size, own);
   }
   // Every rank's rows to rank 0, whose whole window `out` receives them in
   // place (the slabs are consecutive, rank 0's first); the other ranks send
