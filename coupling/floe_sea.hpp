@@ -539,6 +539,12 @@ private:
   // The sea's part of the implicit step's operator: out = G_sea u on the
   // pieces (coupling/penalty_step.hpp).
   void sea_response(fluid::Sea& sea, double h, std::span<const double> u, std::span<double> out);
+  // grid_work_ <- the pressures u_k / cell area of the pieces, each cell's
+  // summed from zero in the coverage's serial order (order_, each floe's
+  // pieces in their order: the cells' sums of the explicit step), so that
+  // a cell's bits do not depend on the floes' indices (docs/parallel.md,
+  // "The implicit step's serial rules (impl30)"). grid_work_ is zero on entry.
+  void pressure_of_pieces(std::span<const double> u);
 
   FootprintKernel kernel_ = FootprintKernel::cell;
   double rho_ = 1025.0, g_ = 9.81, sigma_ = 0.0, K_ = 1000.0, s_ = 1.0, kappa_ = 0.0;

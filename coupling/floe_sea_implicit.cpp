@@ -31,13 +31,19 @@ void for_each_floe(const std::vector<std::uint32_t>& order, int threads, F&& f) 
 
 }  // namespace
 
-void FloeSeaContact::sea_response(fluid::Sea& sea, double h, std::span<const double> u, std::span<double> out) {
+void FloeSeaContact::pressure_of_pieces(std::span<const double> u) {
+  // Serial: pieces of several floes share cells.
   const Footprints& fp = footprints_.pieces();
   const double inv_cell_area = 1.0 / cell_area_;
+  for (const std::uint32_t i : order_)
+    for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k) grid_work_[fp.cell[k]] += u[k] * inv_cell_area;
+}
+
+void FloeSeaContact::sea_response(fluid::Sea& sea, double h, std::span<const double> u, std::span<double> out) {
+  const Footprints& fp = footprints_.pieces();
   // The pressure of the forces u, held over h, lowers the nodes by the
-  // sea's midpoint response (G_sea u is minus that change). The scatter is
-  // in order: pieces of several floes share nodes.
-  for (std::size_t k = 0; k < fp.cell.size(); ++k) grid_work_[fp.cell[k]] += u[k] * inv_cell_area;
+  // sea's midpoint response (G_sea u is minus that change).
+  pressure_of_pieces(u);
   sea.midpoint_response(grid_work_, h, grid_eta_);
   for_each_index(fp.cell.size(), threads_, [&](std::size_t k) { out[k] = -grid_eta_[fp.cell[k]]; });
   for (std::uint32_t c : fp.cell) grid_work_[c] = 0.0;
@@ -230,8 +236,7 @@ void FloeSeaContact::implicit_step(Floes& floes, std::span<const FloeState> star
     st.roll += h * st.roll_rate;
   }
   // ... and the sea.
-  const double inv_cell_area = 1.0 / cell_area_;
-  for (std::size_t k = 0; k < n; ++k) grid_work_[fp.cell[k]] += f[k] * inv_cell_area;
+  pressure_of_pieces(f);
   sea.midpoint_step(grid_work_, h);
   for (std::size_t k = 0; k < n; ++k) grid_work_[fp.cell[k]] = 0.0;
   if (step_mean_loads_) step_mean_horizontal(floes, start);

@@ -8,10 +8,8 @@
 
 namespace floesim {
 
-using parallel::dot;
 using parallel::for_each_index;
 using parallel::for_each_of;
-using parallel::max_abs;
 
 namespace {
 
@@ -76,34 +74,74 @@ void PenaltyStepSolver::precondition(const PenaltyStepProblem& p, std::span<cons
   });
 }
 
+std::array<double, 2> PenaltyStepSolver::dots(const PenaltyStepProblem& p, std::span<const double> a,
+                                              std::span<const double> b, std::span<const double> c,
+                                              std::span<const double> d) {
+  // Each body's terms in its pieces' order, on any thread (the same bits);
+  // then the bodies' partials exactly, in whatever order they are listed.
+  const bool two = !c.empty();
+  const std::size_t m = p.bodies.size();
+  partial_.resize(2 * m);
+  for_each_index(m, threads_, [&](std::size_t j) {
+    const std::uint32_t i = p.bodies[j];
+    double s = 0.0, t = 0.0;
+    if (two) {
+      for (std::size_t k = p.offsets[i]; k < p.offsets[i + 1]; ++k) {
+        s += a[k] * b[k];
+        t += c[k] * d[k];
+      }
+    } else {
+      for (std::size_t k = p.offsets[i]; k < p.offsets[i + 1]; ++k) s += a[k] * b[k];
+    }
+    partial_[2 * j] = s;
+    partial_[2 * j + 1] = t;
+  }, static_cast<std::size_t>(parallel::kFloesPerThread));
+  std::array<ExactSum, 2> sums;
+  for (std::size_t j = 0; j < m; ++j) {
+    sums[0].add(partial_[2 * j]);
+    if (two) sums[1].add(partial_[2 * j + 1]);
+  }
+  if (reduction_->sum) reduction_->sum(std::span<ExactSum>(sums.data(), two ? 2 : 1));
+  return {sums[0].value(), sums[1].value()};
+}
+
+double PenaltyStepSolver::max_abs(const PenaltyStepProblem& p, std::span<const double> x) const {
+  double m = 0.0;
+  for (const std::uint32_t i : p.bodies)
+    for (std::size_t k = p.offsets[i]; k < p.offsets[i + 1]; ++k) m = std::max(m, std::abs(x[k]));
+  return reduction_->max ? reduction_->max(m) : m;
+}
+
 long PenaltyStepSolver::conjugate_gradients(const PenaltyStepProblem& p, const SeaResponse& sea, double eta,
                                             int max_iterations, int threads) {
   // On entry r_ holds the right-hand side b (w = 0); on exit w_ the solution
   // and gsw_ = G S w, summed from the products G S dir the iteration makes
-  // anyway (the Newton step needs it: one application of G saved).
+  // anyway (the Newton step needs it: one application of G saved). r . z and
+  // r . r of the same r come from one reduction: two an iteration.
   const std::size_t n = r_.size();
   std::fill(w_.begin(), w_.end(), 0.0);
   std::fill(gsw_.begin(), gsw_.end(), 0.0);
-  const double bound = eta * std::sqrt(dot(r_, r_, threads));
   precondition(p, r_, z_, threads);
+  auto [rz, rr] = dots(p, r_, z_, r_, r_);
+  const double bound = eta * std::sqrt(rr);
   dir_ = z_;
-  double rz = dot(r_, z_, threads);
   long it = 0;
-  for (; it < max_iterations && std::sqrt(dot(r_, r_, threads)) > bound; ++it) {
+  for (; it < max_iterations && std::sqrt(rr) > bound; ++it) {
     for_each_index(n, threads, [&](std::size_t k) { tmp_[k] = sq_[k] * dir_[k]; });
     apply_g(p, sea, tmp_, gdir_, threads);
     for_each_index(n, threads, [&](std::size_t k) { Ap_[k] = dir_[k] + sq_[k] * gdir_[k]; });
-    const double alpha = rz / dot(dir_, Ap_, threads);
+    const double alpha = rz / dots(p, dir_, Ap_)[0];
     for_each_index(n, threads, [&](std::size_t k) {
       w_[k] += alpha * dir_[k];
       gsw_[k] += alpha * gdir_[k];
       r_[k] -= alpha * Ap_[k];
     });
     precondition(p, r_, z_, threads);
-    const double rz_new = dot(r_, z_, threads);
+    const auto [rz_new, rr_new] = dots(p, r_, z_, r_, r_);
     const double beta = rz_new / rz;
     for_each_index(n, threads, [&](std::size_t k) { dir_[k] = z_[k] + beta * dir_[k]; });
     rz = rz_new;
+    rr = rr_new;
   }
   return it;
 }
@@ -111,6 +149,8 @@ long PenaltyStepSolver::conjugate_gradients(const PenaltyStepProblem& p, const S
 PenaltyStepResult PenaltyStepSolver::solve(const PenaltyStepProblem& p, const SeaResponse& sea,
                                            const PenaltyStepOptions& options) {
   const int threads = std::max(options.threads, 1);
+  threads_ = threads;
+  reduction_ = &options.reduction;
   const std::size_t n = p.start.size();
   for (auto* v : {&d1_, &f_, &R_, &sq_, &einv_, &w_, &r_, &z_, &dir_, &Ap_, &tmp_, &gdir_, &gsw_, &step_, &trial_, &ftrial_, &Rtrial_})
     v->assign(n, 0.0);
@@ -130,7 +170,8 @@ PenaltyStepResult PenaltyStepSolver::solve(const PenaltyStepProblem& p, const Se
     std::copy(p.start.begin(), p.start.end(), d1_.begin());
   }
   residual(p, sea, d1_, f_, R_, threads);
-  double norm = max_abs(R_);
+  double norm = max_abs(p, R_);
+  double norm2 = -1.0;  // |R|_2 (< 0: not yet summed)
 
   const double self = p.self_response;
   double cap = options.forcing;  // the loosest relative tolerance allowed now
@@ -156,28 +197,30 @@ PenaltyStepResult PenaltyStepSolver::solve(const PenaltyStepProblem& p, const Se
 
     // The Newton step s = -R - G S w.
     for_each_index(n, threads, [&](std::size_t k) { step_[k] = -R_[k] - gsw_[k]; });
-    // Backtracking on the residual's 2-norm.
-    const double norm2 = std::sqrt(dot(R_, R_, threads));
-    double t = 1.0;
+    // Backtracking on the residual's 2-norm (the accepted trial's is the
+    // next step's: one reduction a trial).
+    if (norm2 < 0.0) norm2 = std::sqrt(dots(p, R_, R_)[0]);
+    double t = 1.0, norm2_new = 0.0;
     for (;;) {
       for_each_index(n, threads, [&](std::size_t k) { trial_[k] = d1_[k] + t * step_[k]; });
       residual(p, sea, trial_, ftrial_, Rtrial_, threads);
-      if (std::sqrt(dot(Rtrial_, Rtrial_, threads)) < (1.0 - 1e-4 * t) * norm2 || t < 1e-6) break;
+      norm2_new = std::sqrt(dots(p, Rtrial_, Rtrial_)[0]);
+      if (norm2_new < (1.0 - 1e-4 * t) * norm2 || t < 1e-6) break;
       t *= 0.5;
     }
     d1_.swap(trial_);
     f_.swap(ftrial_);
     R_.swap(Rtrial_);
     previous = norm;
-    norm = max_abs(R_);
+    norm = max_abs(p, R_);
     // An inexact step that missed the tolerance it aimed at: the scaled norm
     // did not bound the residual; solve tightly from now on. One that barely
     // reduced the residual: solve tighter.
-    const double norm2_new = std::sqrt(dot(R_, R_, threads));
     if (norm > p.tolerance && eta > options.cg_tolerance) {
       if (aims_at_tolerance) cap = options.cg_tolerance;
       else if (norm2_new > options.stall_ratio * norm2) cap = std::max(cap * options.forcing_cut, options.cg_tolerance);
     }
+    norm2 = norm2_new;
   }
   result.residual = norm;
   result.responses = responses_;

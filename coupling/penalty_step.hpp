@@ -48,7 +48,18 @@
 // Predictor. Newton starts from d1 = d_free - G f(d0, d0): the step with the
 // forces at its start held over it (error O(h^3) where the contact is
 // smooth), at the cost of one application of G.
+//
+// Reductions. Every dot product and the residual's largest |R_k| run over the
+// pieces of the bodies listed, body by body: each body's terms summed in its
+// pieces' order (plain doubles), then the bodies' partial sums exactly
+// (ExactSum, core/exact_sum.hpp). A dot's bits thus depend neither on the
+// order the bodies are listed or stored in, nor on the thread count, nor on
+// how the bodies are split between processes, once the processes' ExactSums
+// are merged (PenaltyStepReduction; docs/parallel.md, "The implicit step's
+// serial rules (impl30)"). The conjugate gradients make two reductions an
+// iteration: p . Ap, then r . z with r . r (the same r) in one call.
 
+#include <array>
 #include <cstdint>
 #include <functional>
 #include <span>
@@ -57,6 +68,7 @@
 #include <Eigen/Core>
 #include <Eigen/Cholesky>
 
+#include "core/exact_sum.hpp"
 #include "core/geometry.hpp"
 
 namespace floesim {
@@ -74,7 +86,11 @@ struct VerticalInertia {
 struct PenaltyStepProblem {
   double step = 0.0;                         // h (s)
   // Body i's pieces are [offsets[i], offsets[i + 1]); only the bodies listed
-  // in `bodies` take part (the others have no pieces, or are static).
+  // in `bodies` take part (the others have no pieces, or are static, or are
+  // another process's: PenaltyStepReduction), in any order. The solver
+  // reads and writes every piece's entries but sums and checks only the
+  // listed bodies' pieces; the sea response must give the listed bodies'
+  // pieces their answer whatever the others' entries hold.
   std::span<const std::size_t> offsets;
   std::span<const std::uint32_t> bodies;
   std::span<const VerticalInertia> inertia;  // per body
@@ -91,6 +107,18 @@ struct PenaltyStepProblem {
 // out = G_sea u on the pieces (m), u the pieces' forces (N).
 using SeaResponse = std::function<void(std::span<const double> u, std::span<double> out)>;
 
+// The part of the solver's reductions over the bodies other processes hold
+// (the header's "Reductions"). Empty members: this process holds every body
+// (serial; no communication).
+struct PenaltyStepReduction {
+  // On entry each of `sums` holds this process's bodies' terms; on exit the
+  // sum over every process's bodies, the same on every process (one
+  // collective call: parallel::Communicator::sum adds the limbs as integers).
+  std::function<void(std::span<ExactSum> sums)> sum;
+  // The largest of every process's `value` (a max is exact in any order).
+  std::function<double(double value)> max;
+};
+
 struct PenaltyStepOptions {
   int max_newton = 40;
   int max_cg = 500;                // per Newton step
@@ -101,6 +129,7 @@ struct PenaltyStepOptions {
   double forcing_cut = 0.1;        // ... lowers the loosest tolerance by this factor
   bool predictor = true;           // start from d_free - G f(d0, d0) (else from d0)
   int threads = 1;                 // results do not depend on it
+  PenaltyStepReduction reduction;  // across processes (empty: serial)
 };
 
 enum class PenaltyStepStatus { converged, newton_limit };
@@ -132,6 +161,16 @@ private:
   // Conjugate gradients on (I + S G S) w = b to the relative residual eta; returns the iterations.
   long conjugate_gradients(const PenaltyStepProblem& p, const SeaResponse& sea, double eta, int max_iterations,
                            int threads);
+  // The header's "Reductions": {a . b, c . d} over the listed bodies' pieces
+  // in one pass and one reduction call (c, d empty: a . b alone, the second 0).
+  std::array<double, 2> dots(const PenaltyStepProblem& p, std::span<const double> a, std::span<const double> b,
+                             std::span<const double> c = {}, std::span<const double> d = {});
+  // max_k |x_k| over the listed bodies' pieces (every process's).
+  double max_abs(const PenaltyStepProblem& p, std::span<const double> x) const;
+
+  const PenaltyStepReduction* reduction_ = nullptr;  // the options' of the solve under way
+  int threads_ = 1;
+  std::vector<double> partial_;  // dots: per listed body, its partial sums
 
   long responses_ = 0;
   std::vector<double> d1_, f_, R_, sq_, einv_, w_, r_, z_, dir_, Ap_, tmp_, gdir_, gsw_, step_, trial_, ftrial_, Rtrial_;

@@ -8,12 +8,18 @@
 
 #include <doctest/doctest.h>
 
+#include <array>
+#include <barrier>
 #include <cmath>
+#include <cstdint>
 #include <random>
+#include <thread>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Dense>
 
+#include "core/exact_sum.hpp"
 #include "coupling/penalty_law.hpp"
 #include "coupling/penalty_step.hpp"
 
@@ -196,4 +202,202 @@ TEST_CASE("penalty step: a Newton limit is reported as a status, with the residu
   CHECK(r.newton == 1);
   CHECK(r.residual > 1e-14);
   CHECK(r.residual == doctest::Approx(c.residual(solver.end())).epsilon(1e-6));
+}
+
+namespace {
+
+// The case's pieces stored with its bodies in another order: new body j is
+// the case's body perm[j], its pieces in their order; listed in `listed`
+// (new indices). `old_of[k]` is the case's index of stored piece k.
+struct Stored {
+  std::vector<std::size_t> offsets{0};
+  std::vector<std::uint32_t> bodies, old_of;
+  std::vector<VerticalInertia> inertia;
+  std::vector<Vec2> lever;
+  std::vector<double> spring, damper, start, free_end;
+
+  Stored(const Case& c, const std::vector<std::uint32_t>& perm, std::vector<std::uint32_t> listed)
+      : bodies(std::move(listed)) {
+    for (const std::uint32_t b : perm) {
+      inertia.push_back(c.inertia[b]);
+      for (std::size_t k = c.offsets[b]; k < c.offsets[b + 1]; ++k) {
+        old_of.push_back(static_cast<std::uint32_t>(k));
+        lever.push_back(c.lever[k]);
+        spring.push_back(c.spring[k]);
+        damper.push_back(c.damper[k]);
+        start.push_back(c.start[k]);
+        free_end.push_back(c.free_end[k]);
+      }
+      offsets.push_back(old_of.size());
+    }
+  }
+
+  PenaltyStepProblem problem(const Case& c, double tolerance) const {
+    PenaltyStepProblem p = c.problem(tolerance);
+    p.offsets = offsets;
+    p.bodies = bodies;
+    p.inertia = inertia;
+    p.lever = lever;
+    p.spring = spring;
+    p.damper = damper;
+    p.start = start;
+    p.free_end = free_end;
+    return p;
+  }
+
+  // The case's sea, summed in the case's piece order whatever the storage:
+  // each stored piece gets the bits the case's piece gets.
+  SeaResponse sea(const Case& c) const {
+    return [this, &c](std::span<const double> in, std::span<double> out) {
+      Eigen::VectorXd u(Eigen::Index(in.size()));
+      for (std::size_t k = 0; k < in.size(); ++k) u[Eigen::Index(old_of[k])] = in[k];
+      const Eigen::VectorXd y = c.g_sea * u;
+      for (std::size_t k = 0; k < out.size(); ++k) out[k] = y[Eigen::Index(old_of[k])];
+    };
+  }
+};
+
+}  // namespace
+
+TEST_CASE("penalty step: the solution's bits do not depend on the order the bodies' pieces are stored or listed in") {
+  // Pieces entering and leaving contact, dampers on half of them: several
+  // Newton steps, each with its conjugate gradients.
+  Case c(2.0e5, 0.03, 2);
+  for (std::size_t k = 0; k < c.damper.size(); k += 2) c.damper[k] = 0.3 * c.spring[k];
+  const double tolerance = 1e-10;
+  PenaltyStepSolver reference;
+  const PenaltyStepResult a = reference.solve(c.problem(tolerance), c.sea(), PenaltyStepOptions{});
+  REQUIRE(a.status == PenaltyStepStatus::converged);
+  REQUIRE(a.newton >= 2);
+  // Stored 2, 0, 1 and listed backwards; stored 1, 2, 0 and listed 2, 0, 1.
+  const std::vector<std::pair<std::vector<std::uint32_t>, std::vector<std::uint32_t>>> orders{
+      {{2, 0, 1}, {2, 1, 0}}, {{1, 2, 0}, {2, 0, 1}}, {{0, 1, 2}, {1, 2, 0}}};
+  for (const auto& [perm, listed] : orders) {
+    const Stored s(c, perm, listed);
+    PenaltyStepSolver solver;
+    const PenaltyStepResult b = solver.solve(s.problem(c, tolerance), s.sea(c), PenaltyStepOptions{});
+    CAPTURE(perm[0]);
+    CAPTURE(listed[0]);
+    CHECK(b.newton == a.newton);
+    CHECK(b.cg == a.cg);
+    CHECK(b.residual == a.residual);
+    int differ = 0;
+    for (std::size_t k = 0; k < s.old_of.size(); ++k) {
+      differ += solver.end()[k] != reference.end()[s.old_of[k]];
+      differ += solver.force()[k] != reference.force()[s.old_of[k]];
+    }
+    CHECK(differ == 0);
+  }
+}
+
+namespace {
+
+// Two "processes" (threads, in lockstep at each collective call) solve the
+// case, each listing its own bodies (`held`): each gives the sea its own
+// bodies' pieces' forces (the others' entries of its vectors are never
+// read), and the reduction hook adds the two processes' ExactSum words as
+// integers, as parallel::Communicator::sum does. Returns the number of
+// stored entries (d1 and f on each process's own pieces) whose bits differ
+// from the serial solve's, and checks the counts.
+int split_differences(const Case& c, double tolerance, const PenaltyStepOptions& base,
+                      const std::array<std::vector<std::uint32_t>, 2>& held) {
+  PenaltyStepSolver serial;
+  const PenaltyStepResult a = serial.solve(c.problem(tolerance), c.sea(), base);
+  REQUIRE(a.status == PenaltyStepStatus::converged);
+  const std::size_t n = c.start.size();
+  std::barrier sync(2);
+  std::vector<double> forces(n);                   // the sea's input, from both
+  std::array<std::vector<std::int64_t>, 2> words;  // each one's ExactSum words
+  std::array<double, 2> largest{};                 // each one's max
+  std::array<PenaltyStepSolver, 2> solver;
+  std::array<PenaltyStepResult, 2> result;
+  std::array<long, 2> calls{};
+  auto process = [&](int rank) {
+    const std::size_t me = std::size_t(rank), other = 1 - me;
+    PenaltyStepProblem p = c.problem(tolerance);
+    p.bodies = held[me];
+    PenaltyStepOptions options = base;
+    options.reduction.sum = [&](std::span<ExactSum> sums) {
+      words[me].clear();
+      for (ExactSum& s : sums)
+        for (std::int64_t w : s.limbs()) words[me].push_back(w);
+      sync.arrive_and_wait();
+      for (std::size_t j = 0; j < sums.size(); ++j) {
+        std::array<std::int64_t, ExactSum::kWords> total{};
+        for (std::size_t w = 0; w < total.size(); ++w)
+          total[w] = words[me][j * total.size() + w] + words[other][j * total.size() + w];
+        sums[j] = ExactSum::from_limbs(total);
+      }
+      ++calls[me];
+      sync.arrive_and_wait();
+    };
+    options.reduction.max = [&](double value) {
+      largest[me] = value;
+      sync.arrive_and_wait();
+      const double m = std::max(largest[0], largest[1]);
+      sync.arrive_and_wait();
+      return m;
+    };
+    const SeaResponse sea = [&](std::span<const double> in, std::span<double> out) {
+      for (std::uint32_t i : held[me])
+        for (std::size_t k = c.offsets[i]; k < c.offsets[i + 1]; ++k) forces[k] = in[k];
+      sync.arrive_and_wait();
+      const Eigen::VectorXd y = c.g_sea * Eigen::Map<const Eigen::VectorXd>(forces.data(), Eigen::Index(n));
+      sync.arrive_and_wait();
+      for (std::size_t k = 0; k < n; ++k) out[k] = y[Eigen::Index(k)];
+    };
+    result[me] = solver[me].solve(p, sea, options);
+    // A process that made fewer calls (a broken rule) leaves the other to
+    // finish alone rather than wait for ever: the counts below then differ.
+    sync.arrive_and_drop();
+  };
+  std::thread second(process, 1);
+  process(0);
+  second.join();
+
+  int differ = 0;
+  for (std::size_t rank = 0; rank < 2; ++rank) {
+    CAPTURE(rank);
+    const PenaltyStepResult& b = result[rank];
+    CHECK(b.newton == a.newton);
+    CHECK(b.cg == a.cg);
+    CHECK(b.residual == a.residual);
+    CHECK(calls[rank] > 2 * b.cg);  // two sums a CG iteration, and the Newton steps'
+    for (std::uint32_t i : held[rank])
+      for (std::size_t k = c.offsets[i]; k < c.offsets[i + 1]; ++k) {
+        differ += solver[rank].end()[k] != serial.end()[k];
+        differ += solver[rank].force()[k] != serial.force()[k];
+      }
+  }
+  return differ;
+}
+
+}  // namespace
+
+TEST_CASE("penalty step: bodies split between two processes, their sums merged by the reduction hook, give the serial bits") {
+  // Pieces entering and leaving contact, dampers on half of them; the Newton
+  // steps solved inexactly and tightly; the bodies split two ways.
+  for (const unsigned seed : {2u, 3u, 4u, 5u}) {
+    Case c(2.0e5, 0.03, seed);
+    for (std::size_t k = 0; k < c.damper.size(); k += 2) c.damper[k] = 0.3 * c.spring[k];
+    PenaltyStepOptions inexact, tight;
+    tight.forcing = tight.cg_tolerance;
+    for (const PenaltyStepOptions& options : {inexact, tight})
+      for (const auto& held : {std::array<std::vector<std::uint32_t>, 2>{{{0, 2}, {1}}},
+                               std::array<std::vector<std::uint32_t>, 2>{{{1}, {2, 0}}}}) {
+        CAPTURE(seed);
+        CAPTURE(options.forcing);
+        CAPTURE(held[0].size());
+        CHECK(split_differences(c, 1e-10, options, held) == 0);
+      }
+  }
+  // A process whose one body is out of the water all along (d0, d1 < 0: no
+  // force, S = 0 on its pieces, r = 0 there): its conjugate gradients stop
+  // when the other's do only if r . r is summed over both.
+  Case c(2.0e5, 0.03, 2);
+  for (std::size_t k = c.offsets[1]; k < c.offsets[2]; ++k) {
+    c.start[k] = -0.5;
+    c.free_end[k] = -0.5;
+  }
+  CHECK(split_differences(c, 1e-10, PenaltyStepOptions{}, {{{1}, {0, 2}}}) == 0);
 }
