@@ -483,6 +483,9 @@ private:
   void clear_footprint_cells();
   // The contact is evaluated by owner: several ranks, explicit kicks.
   bool by_owner() const { return !comm_.serial() && !implicit_; }
+  // The footprints' version: changes whenever the pieces do: a placement (moved or rebuilt) or a
+  // rebuild without one (the start, a restore).
+  long footprint_version() const { return footprints_.placements() + footprints_.rebuilds(); }
   // The cells' sums by owner go through routes_ (by owner, always): to the
   // slabs' ranks on a sea in slabs (in_slabs()), to every rank on a sea
   // whole on every rank.
@@ -658,7 +661,9 @@ private:
     std::vector<std::uint32_t> energy_keys, energy_counts;
     std::vector<double> energy_terms;
     RoutedCells routed_counts;  // since the start, this rank's
-    long routes_placement = -1;  // the footprints' placement the routes were opened for
+    // The footprints' placements and rebuilds when the routes were opened
+    // (any new pieces change the count; footprint_version()).
+    long routes_footprints = -1;
   } owner_;
   // cell_product's scratch (the routed pieces' values, the alone cells'
   // totals, the answers per cell of owner_.cells and owner_.alone) and counts.

@@ -51,7 +51,7 @@ void FloeSeaContact::cell_product(std::span<const double> u, double scale, const
     for (const std::uint32_t c : fp.cell) grid_work_[c] = 0.0;
     return;
   }
-  FLOESIM_ASSERT(in_slabs() && owner_.routes_placement == footprints_.placements());
+  FLOESIM_ASSERT(in_slabs() && owner_.routes_footprints == footprint_version());
   const OwnerCells& o = owner_;
   ProductScratch& p = product_;
   const int rank = comm_.rank();
