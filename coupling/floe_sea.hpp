@@ -483,8 +483,9 @@ private:
   void clear_footprint_cells();
   // The contact is evaluated by owner: several ranks, explicit kicks.
   bool by_owner() const { return !comm_.serial() && !implicit_; }
-  // The footprints' version: changes whenever the pieces do: a placement (moved or rebuilt) or a
-  // rebuild without one (the start, a restore).
+  // The footprints' version: it changes whenever the pieces do, at a
+  // placement (moved or rebuilt) or a rebuild without one (the start, a
+  // restore).
   long footprint_version() const { return footprints_.placements() + footprints_.rebuilds(); }
   // The cells' sums by owner go through routes_ (by owner, always): to the
   // slabs' ranks on a sea in slabs (in_slabs()), to every rank on a sea

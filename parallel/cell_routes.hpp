@@ -55,7 +55,8 @@
 //                        pieces or alone: one call
 // The routes hold for any number of add() and answer() calls until the next
 // open: the implicit step's products (the footprints fixed for a solve) open
-// them once and send 8 bytes a piece and a cell each way a product.
+// them once, then send a product 8 bytes a piece (add(), width 1) and 8
+// bytes a cell back (answer()).
 // Between the calls, owned() and total() give the cells received and their
 // totals (index() finds a cell there), after add() alone_owned() and
 // alone_total() the alone cells'.
