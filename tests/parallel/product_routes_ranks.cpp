@@ -71,10 +71,10 @@ std::string pack_on_sea() {
     << "[sea.waves]\nkind = \"jonswap\"\nhs = 0.5\ntp = 6.0\n"
     << "[contact]\ndomain = \"periodic\"\nbox = [0.0, " << kBox << ", 0.0, " << kBox << "]\n"
     << "[coupling]\nlaw = \"strong\"\nstiffness = 100.0\nstart = \"given\"\n";
-  // At each cut (row 64 on 2 ranks, 48 and 88 on 3), two combs: the cell
+  // At each cut (row 64 on 2 ranks, 48 and 88 on 3), four combs: the cell
   // (cut - 1, column) holds the tall floes' edges and the small floe between.
   for (const int cut : {48, 64, 88})
-    for (const int column : {20, 70}) {
+    for (const int column : {20, 70, 80, 118}) {
       const double y = cut * kCell, x = column * kCell;
       rectangle(t, x - 6.0, x + 0.1, y - 3.0, y + 10.0);  // centroid above the cut
       rectangle(t, x + 0.3, x + 1.2, y - 1.5, y - 0.1);   // below it
