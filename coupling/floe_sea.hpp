@@ -117,6 +117,7 @@
 // waves' rates; each floe takes their least-squares plane.
 
 #include <algorithm>
+#include <functional>
 #include <span>
 #include <string>
 #include <utility>
@@ -376,6 +377,41 @@ public:
     long shared = 0, pieces = 0, alone_here = 0, alone_sent = 0;
   };
   const RoutedCells& routed_cells() const { return owner_.routed_counts; }
+
+  // The pieces' values through the sea's cells and back: the communication
+  // of the implicit step's product G_sea u (docs/parallel.md, "The products'
+  // routes (answer30)"), on the footprints of the last evaluation. Each
+  // cell's value is sum_k scale u[k] over the pieces k in it, from zero, the
+  // floes in the coverage's serial order (order_: by first cell), each
+  // floe's pieces in order; respond(first_row, cells, response) then maps
+  // the cells' values to the sea's response on the rows this rank holds:
+  // `cells` and `response` are rows [first_row, first_row + rows) of the grid
+  // (x fastest; `response` to be filled); out[k] = the response at piece
+  // k's cell. u and out: one value a piece of footprints().
+  // - By owner on a sea in slabs (explicit kicks today): this rank's pieces;
+  //   a cell summed here alone (its pieces all this rank's) adds them
+  //   here, one of another slab then sent to its rank as the total; a
+  //   shared cell's pieces travel to the ranks the coverage's open named
+  //   (CellRoutes::add, 8 bytes a piece), each summing them from zero in key
+  //   order (the floes' serial positions): the serial sum. The routes are the
+  //   coverage's (opened once an evaluation); the response at the cells
+  //   this rank's pieces read in other slabs comes back from their ranks
+  //   (CellRoutes::answer, 8 bytes a cell). Two all-to-alls; collective.
+  // - Otherwise (serially, or every floe's pieces on every rank): the whole
+  //   grid here, first_row = 0. A sea by owner not in slabs: not supported
+  //   (its cells have no one owner to respond).
+  // Every value out[k] is then the serial run's to the bit: the same sums
+  // in the same order, and the response of each cell from its one owner.
+  using SlabResponse = std::function<void(int first_row, std::span<const double> cells, std::span<double> response)>;
+  void cell_product(std::span<const double> u, double scale, const SlabResponse& respond, std::span<double> out);
+  // cell_product's calls since the start and the bytes this rank received
+  // from the others in them: the pieces and alone totals to the cells'
+  // summing ranks (scatter), the responses back (answer).
+  struct CellProductStats {
+    long products = 0;
+    long long scatter_bytes = 0, answer_bytes = 0;
+  };
+  const CellProductStats& cell_product_stats() const { return product_.stats; }
   // On several ranks, the loads' travels since the start (share_owned):
   // to the ranks that kick each floe (`asked`: the calls; `asked_floes`:
   // the floes' loads this rank received) and to every rank (`whole`,
@@ -447,6 +483,10 @@ private:
   void clear_footprint_cells();
   // The contact is evaluated by owner: several ranks, explicit kicks.
   bool by_owner() const { return !comm_.serial() && !implicit_; }
+  // The footprints' version: it changes whenever the pieces do, at a
+  // placement (moved or rebuilt) or a rebuild without one (the start, a
+  // restore).
+  long footprint_version() const { return footprints_.placements() + footprints_.rebuilds(); }
   // The cells' sums by owner go through routes_ (by owner, always): to the
   // slabs' ranks on a sea in slabs (in_slabs()), to every rank on a sea
   // whole on every rank.
@@ -628,7 +668,16 @@ private:
     std::vector<std::uint32_t> energy_keys, energy_counts;
     std::vector<double> energy_terms;
     RoutedCells routed_counts;  // since the start, this rank's
+    // The footprints' placements and rebuilds when the routes were opened
+    // (any new pieces change the count; footprint_version()).
+    long routes_footprints = -1;
   } owner_;
+  // cell_product's scratch (the routed pieces' values, the alone cells'
+  // totals, the answers per cell of owner_.cells and owner_.alone) and counts.
+  struct ProductScratch {
+    std::vector<double> parts, alone_totals, cells_answer, alone_answer;
+    CellProductStats stats;
+  } product_;
   static constexpr std::uint32_t kNoCell = parallel::CellBox::kNone;
   // The coupling's owners by place on a sea not in slabs (routes_.
   // replicated(); docs/parallel.md, "The seas not in slabs, their floes by

@@ -387,6 +387,7 @@ void FloeSeaContact::sum_coverage_by_owner() {
   o.routed_counts.pieces += static_cast<long>(o.first.back());
   o.routed_counts.alone_here += static_cast<long>(alone_here);
   o.routed_counts.alone_sent += static_cast<long>(o.alone.size());
+  o.routes_footprints = footprint_version();
   if (!one_round()) {
     // Each cell to its slab's rank, which sends the total back.
     routes_.open(comm_, o.cells, o.first, o.keys, o.values, 1, o.alone);

@@ -262,6 +262,9 @@ public:
   std::span<const double> sea_elevation();
   // The floe–sea contact, if the run has a sea and floes that move.
   const FloeSeaContact* floe_sea() const { return floe_sea_.get(); }
+  // The same, for the contact's operations a caller drives between steps
+  // (FloeSeaContact::cell_product: tests/parallel/product_routes_ranks.cpp).
+  FloeSeaContact* floe_sea() { return floe_sea_.get(); }
   std::vector<std::string> notes() const;  // said once at the start (e.g. calibrated blend)
 
 private:

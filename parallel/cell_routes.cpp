@@ -140,6 +140,20 @@ void CellRoutes::send_pieces(const Communicator& comm, std::span<const std::uint
   for (std::size_t k = 0; k < cells.size(); ++k)
     for (std::uint32_t q = receivers_first[k]; q < receivers_first[k + 1]; ++q)
       route_[next[static_cast<std::size_t>(receivers[q])]++] = static_cast<std::uint32_t>(k);
+  // In slabs, the routes answer() comes back along: each cell's to its
+  // owner, and the alone cells' (each to its owner).
+  rank_ = comm.rank();
+  route_to_owner_.assign(route_.size(), 0);
+  answers_in_.assign(ranks, 0);
+  if (!replicated_) {
+    for (std::size_t r = 0, j = 0; r < ranks; ++r)
+      for (const std::size_t end = j + sent_[r]; j < end; ++j)
+        if (owner(cells[route_[j]]) == static_cast<int>(r)) {
+          route_to_owner_[j] = 1;
+          ++answers_in_[r];
+        }
+    for (const std::uint32_t c : alone) ++answers_in_[static_cast<std::size_t>(owner(c))];
+  }
   alone_route_.clear();
   alone_count_ = alone.size();
   if (replicated_) {
@@ -194,6 +208,7 @@ void CellRoutes::send_pieces(const Communicator& comm, std::span<const std::uint
   received_.assign(ranks, 0);
   received_pieces_.assign(ranks, 0);
   received_alone_.assign(ranks, 0);
+  answers_out_.assign(ranks, 0);
   const std::byte* in = receive_.data();
   for (std::size_t r = 0; r < ranks; ++r) {
     const std::size_t n = static_cast<std::size_t>(at<std::uint64_t>(in, 0));
@@ -213,7 +228,9 @@ void CellRoutes::send_pieces(const Communicator& comm, std::span<const std::uint
       from_.push_back(slot_[c] - 1);
       count_.push_back(q);
       m += q;
+      if (!replicated_ && owner(c) == comm.rank()) ++answers_out_[r];
     }
+    if (!replicated_) answers_out_[r] += n_alone;
     for (std::size_t j = 0; j < n_alone; ++j) alone_owned_.push_back(at<std::uint32_t>(alone_cell, j));
     received_[r] = n;
     received_pieces_[r] = m;
@@ -330,6 +347,56 @@ double CellRoutes::add(const Communicator& comm, std::span<const double> parts, 
   }
   sum_pieces();
   return sum;
+}
+
+void CellRoutes::answer(const Communicator& comm, std::span<const double> slab, std::span<double> out,
+                        std::span<double> alone_out) {
+  const std::size_t ranks = received_.size();
+  FLOESIM_ASSERT(!replicated_ && comm.rank() == rank_ && out.size() + 1 == first_.size() &&
+                 alone_out.size() == alone_count_);
+  const std::size_t me = static_cast<std::size_t>(rank_);
+  const std::size_t base = static_cast<std::size_t>(first_row_[me]) * columns_;
+  FLOESIM_ASSERT(slab.size() == static_cast<std::size_t>(first_row_[me + 1] - first_row_[me]) * columns_);
+  // Every cell of the open comes back once: it named its owner exactly once
+  // among its receivers (distinct), an alone cell went to its owner.
+  FLOESIM_ASSERT(static_cast<std::size_t>(std::count(route_to_owner_.begin(), route_to_owner_.end(), 1)) == out.size());
+  // To each rank, in the order it sent them: the values of the cells of its
+  // open it sent here that this rank owns, then of its alone cells here.
+  std::size_t send_total = 0, receive_total = 0;
+  bytes_.resize(ranks);
+  receive_bytes_.resize(ranks);
+  for (std::size_t r = 0; r < ranks; ++r) {
+    bytes_[r] = answers_out_[r] * sizeof(double);
+    receive_bytes_[r] = answers_in_[r] * sizeof(double);
+    send_total += bytes_[r];
+    receive_total += receive_bytes_[r];
+  }
+  send_.resize(send_total);
+  std::byte* message = send_.data();
+  for (std::size_t r = 0, j = 0, a = 0; r < ranks; ++r) {
+    for (const std::size_t end = j + received_[r]; j < end; ++j) {
+      const std::uint32_t c = owned_[from_[j]];
+      if (owner(c) == rank_) message = put(message, &slab[c - base], 1);
+    }
+    for (const std::size_t end = a + received_alone_[r]; a < end; ++a) message = put(message, &slab[alone_owned_[a] - base], 1);
+  }
+  receive_.resize(receive_total);
+  comm.alltoall(send_, bytes_, receive_, receive_bytes_);
+  // Back along this rank's routes, rank by rank as sent.
+  std::size_t v = 0;
+  for (std::size_t r = 0, j = 0, a = 0; r < ranks; ++r) {
+    for (const std::size_t end = j + sent_[r]; j < end; ++j)
+      if (route_to_owner_[j]) out[route_[j]] = at<double>(receive_.data(), v++);
+    for (const std::size_t end = a + sent_alone_[r]; a < end; ++a) alone_out[alone_route_[a]] = at<double>(receive_.data(), v++);
+  }
+  FLOESIM_ASSERT(v * sizeof(double) == receive_total);
+}
+
+std::size_t CellRoutes::received_from_others() const {
+  std::size_t bytes = 0;
+  for (std::size_t r = 0; r < receive_bytes_.size(); ++r)
+    if (static_cast<int>(r) != rank_) bytes += receive_bytes_[r];
+  return bytes;
 }
 
 }  // namespace floesim::parallel

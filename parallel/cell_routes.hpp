@@ -48,6 +48,15 @@
 //   add(values, extra, alone totals)  new values for the same pieces, one
 //                        number from every rank summed over all ranks, and
 //                        the alone cells' totals: one call
+//   answer(slab values, out, alone out)  in slabs, after open() or
+//                        open_shared(): per cell a value its owner computed
+//                        (from the totals: a response), back along the
+//                        open's routes to every rank that sent the cell,
+//                        pieces or alone: one call
+// The routes hold for any number of add() and answer() calls until the next
+// open: the implicit step's products (the footprints fixed for a solve) open
+// them once, then send a product 8 bytes a piece (add(), width 1) and 8
+// bytes a cell back (answer()).
 // Between the calls, owned() and total() give the cells received and their
 // totals (index() finds a cell there), after add() alone_owned() and
 // alone_total() the alone cells'.
@@ -174,6 +183,20 @@ public:
   // same on every rank).
   double add(const Communicator& comm, std::span<const double> parts, int width, double extra,
              std::span<const double> alone_totals = {});
+  // In slabs, after open() or open_shared() (whose every cell names its
+  // owner among its receivers): each owner's values of its slab's cells
+  // back to the ranks that sent them in the open, pieces or alone.
+  // `slab`: this rank's slab's rows of a per-cell field, from its first row
+  // (rows x columns values, x fastest), of which the cells other ranks sent
+  // here are read. out[k] gets the owner's value of this rank's cells[k] of
+  // the open, alone_out[j] of its alone[j] (a cell this rank owns comes from
+  // its own `slab`, by the same route). One collective call (its sizes known
+  // from the open): 8 bytes a cell from another rank's slab.
+  void answer(const Communicator& comm, std::span<const double> slab, std::span<double> out,
+              std::span<double> alone_out);
+  // The bytes this rank received from the other ranks in the last open(),
+  // open_shared(), reply(), add() or answer() (its own part not counted).
+  std::size_t received_from_others() const;
   // The cells some rank sent this rank pieces of in the last open() (those
   // it owns) or open_shared() (those it was named a receiver of), in the
   // order they first arrived (rank order), and their totals.
@@ -199,6 +222,14 @@ private:
   // received_), pieces (sent_pieces_, received_pieces_) and alone cells
   // (sent_alone_, received_alone_).
   std::vector<std::uint32_t> route_, alone_route_, first_;
+  // Per entry of route_, whether its receiver is the cell's owner (in
+  // slabs: then answer() brings the owner's value back along it); per rank,
+  // the values answer() receives from it (this rank's cells it owns and its
+  // alone cells there) and sends to it (the cells it sent here that this
+  // rank owns, and its alone cells here).
+  std::vector<std::uint8_t> route_to_owner_;
+  std::vector<std::size_t> answers_in_, answers_out_;
+  int rank_ = 0;  // this rank, at the last open
   std::size_t alone_count_ = 0;  // the last open's alone cells
   std::vector<std::size_t> sent_, received_, sent_pieces_, received_pieces_, sent_alone_, received_alone_;
   std::vector<std::uint32_t> from_;   // per received cell, in rank order: its index in owned_
