@@ -85,7 +85,7 @@ std::vector<std::uint8_t> CellRoutes::interior_rows(int reach) const {
 }
 
 void CellRoutes::open(const Communicator& comm, std::span<const std::uint32_t> cells, std::span<const std::uint32_t> first,
-                      std::span<const std::uint32_t> keys, std::span<const double> parts, int width,
+                      std::span<const PieceKey> keys, std::span<const double> parts, int width,
                       std::span<const std::uint32_t> alone) {
   // Each cell to its owner alone.
   FLOESIM_ASSERT(!replicated_);
@@ -101,7 +101,7 @@ void CellRoutes::open(const Communicator& comm, std::span<const std::uint32_t> c
 }
 
 void CellRoutes::open_shared(const Communicator& comm, std::span<const std::uint32_t> cells,
-                             std::span<const std::uint32_t> first, std::span<const std::uint32_t> keys,
+                             std::span<const std::uint32_t> first, std::span<const PieceKey> keys,
                              std::span<const double> parts, int width, std::span<const std::uint32_t> receivers_first,
                              std::span<const int> receivers, std::span<const std::uint32_t> alone) {
   FLOESIM_ASSERT(receivers_first.size() == cells.size() + 1 && receivers.size() == receivers_first.back());
@@ -110,7 +110,7 @@ void CellRoutes::open_shared(const Communicator& comm, std::span<const std::uint
 }
 
 void CellRoutes::send_pieces(const Communicator& comm, std::span<const std::uint32_t> cells,
-                             std::span<const std::uint32_t> first, std::span<const std::uint32_t> keys,
+                             std::span<const std::uint32_t> first, std::span<const PieceKey> keys,
                              std::span<const double> parts, int width, std::span<const std::uint32_t> receivers_first,
                              std::span<const int> receivers, std::span<const std::uint32_t> alone) {
   const std::size_t ranks = static_cast<std::size_t>(comm.size()), w = static_cast<std::size_t>(width);
@@ -160,7 +160,7 @@ void CellRoutes::send_pieces(const Communicator& comm, std::span<const std::uint
   std::size_t total_bytes = 0;
   for (std::size_t r = 0; r < ranks; ++r) {
     bytes_[r] = 2 * sizeof(std::uint64_t) + (sent_[r] * 2 + sent_alone_[r]) * sizeof(std::uint32_t) +
-                sent_pieces_[r] * (sizeof(std::uint32_t) + w * sizeof(double));
+                sent_pieces_[r] * (sizeof(PieceKey) + w * sizeof(double));
     total_bytes += bytes_[r];
   }
   send_.resize(total_bytes);
@@ -222,8 +222,8 @@ void CellRoutes::send_pieces(const Communicator& comm, std::span<const std::uint
     keys_.resize(before + m);
     values_.resize((before + m) * w);
     if (m > 0) {
-      std::memcpy(keys_.data() + before, key, m * sizeof(std::uint32_t));
-      std::memcpy(values_.data() + before * w, key + m * sizeof(std::uint32_t), m * w * sizeof(double));
+      std::memcpy(keys_.data() + before, key, m * sizeof(PieceKey));
+      std::memcpy(values_.data() + before * w, key + m * sizeof(PieceKey), m * w * sizeof(double));
     }
     in += receive_bytes_[r];
   }
@@ -250,7 +250,8 @@ void CellRoutes::send_pieces(const Communicator& comm, std::span<const std::uint
 
 void CellRoutes::open(const Communicator& comm, std::span<const std::uint32_t> cells, std::span<const double> parts,
                       int width) {
-  std::vector<std::uint32_t> first(cells.size() + 1), keys(cells.size(), 0);
+  std::vector<std::uint32_t> first(cells.size() + 1);
+  std::vector<PieceKey> keys(cells.size(), 0);
   for (std::size_t k = 0; k <= cells.size(); ++k) first[k] = static_cast<std::uint32_t>(k);
   open(comm, cells, first, keys, parts, width);
 }
