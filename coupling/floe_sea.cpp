@@ -274,8 +274,7 @@ void FloeSeaContact::place_footprints(const Floes& floes, bool move, std::span<c
   order_.clear();
   for (std::size_t i = 0; i < floes.size(); ++i)
     if (constants_.dynamic[i] && fp.offsets[i] < fp.offsets[i + 1]) order_.push_back(static_cast<std::uint32_t>(i));
-  const auto key = [&](std::uint32_t i) { return serial_key(fp.cell[fp.offsets[i]], i); };
-  std::sort(order_.begin(), order_.end(), [&](std::uint32_t x, std::uint32_t y) { return key(x) < key(y); });
+  std::sort(order_.begin(), order_.end(), [&](std::uint32_t x, std::uint32_t y) { return serial_key(x) < serial_key(y); });
   const double inv_cell_area = 1.0 / cell_area_;
   for (std::uint32_t i : order_)
     for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k) cells_[fp.cell[k]].coverage += fp.area[k] * inv_cell_area;

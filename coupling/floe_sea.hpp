@@ -709,9 +709,13 @@ private:
   // The serial order of the floes in the cells' sums: by the first cell of
   // their pieces, ties broken by floe index (a total order, so a key each
   // floe's owner computes alone, from its own pieces: no rank needs the
-  // other floes' first cells to place its own among them).
-  static parallel::PieceKey serial_key(std::uint32_t first_cell, std::uint32_t floe) {
-    return (parallel::PieceKey{first_cell} << 32) | floe;
+  // other floes' first cells to place its own among them). As one number,
+  // first cell x floes + index (below cells x floes: 4 bytes on the wire
+  // when that is at most 2^32, CellRoutes::set_largest_key). Floe i has
+  // pieces.
+  parallel::PieceKey serial_key(std::uint32_t i) const {
+    const Footprints& fp = footprints_.pieces();
+    return parallel::PieceKey{fp.cell[fp.offsets[i]]} * constants_.dynamic.size() + i;
   }
   bool pressure_kicked_ = false;  // the sea's last kick was with pressure_ as it is
   SharedLoads shared_loads_;

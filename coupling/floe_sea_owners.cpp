@@ -178,8 +178,8 @@ void FloeSeaContact::order_by_owner(std::size_t floes) {
         o.known.push_back(i);
       }
     }
-  const auto key = [&](std::uint32_t i) { return serial_key(fp.cell[fp.offsets[i]], i); };
-  std::sort(order_.begin(), order_.end(), [&](std::uint32_t x, std::uint32_t y) { return key(x) < key(y); });
+  std::sort(order_.begin(), order_.end(), [&](std::uint32_t x, std::uint32_t y) { return serial_key(x) < serial_key(y); });
+  routes_.set_largest_key(parallel::PieceKey{grid_.size()} * floes);
   if (!next_owners_.column.empty()) {
     // A flume: the rank of the share of columns of each floe's present
     // place (evaluated_.poses holds this rank's floes' present poses:
@@ -381,7 +381,7 @@ void FloeSeaContact::sum_coverage_by_owner() {
       // its floe's key, in order_ (the serial order) as this loop meets it.
       const std::uint32_t j = listed(c);
       ++o.first[j + 1];
-      o.routed_pieces.push_back({serial_key(fp.cell[fp.offsets[i]], i), static_cast<std::uint32_t>(k), j, 0});
+      o.routed_pieces.push_back({serial_key(i), static_cast<std::uint32_t>(k), j, 0});
     }
   }
   // The kinds back to the rows' (the boxes move with the floes).
@@ -483,7 +483,7 @@ double FloeSeaContact::sum_cells_by_owner(double ks) {
       o.parts[2 * at + 1] = force[k] * inv_cell_area;
     }
     if (o.energy_terms.size() > terms) {
-      o.energy_keys.push_back(serial_key(fp.cell[fp.offsets[i]], i));
+      o.energy_keys.push_back(serial_key(i));
       o.energy_counts.push_back(static_cast<std::uint32_t>(o.energy_terms.size() - terms));
     }
   }

@@ -160,7 +160,7 @@ void CellRoutes::send_pieces(const Communicator& comm, std::span<const std::uint
   std::size_t total_bytes = 0;
   for (std::size_t r = 0; r < ranks; ++r) {
     bytes_[r] = 2 * sizeof(std::uint64_t) + (sent_[r] * 2 + sent_alone_[r]) * sizeof(std::uint32_t) +
-                sent_pieces_[r] * (sizeof(PieceKey) + w * sizeof(double));
+                sent_pieces_[r] * (key_bytes_ + w * sizeof(double));
     total_bytes += bytes_[r];
   }
   send_.resize(total_bytes);
@@ -175,7 +175,16 @@ void CellRoutes::send_pieces(const Communicator& comm, std::span<const std::uint
       out = put(out, &count, 1);
     }
     for (std::size_t j = alone_begin; j < alone_begin + sent_alone_[r]; ++j) out = put(out, &alone[alone_route_[j]], 1);
-    for (std::size_t j = begin; j < end; ++j) out = put(out, &keys[first[route_[j]]], first[route_[j] + 1] - first[route_[j]]);
+    for (std::size_t j = begin; j < end; ++j)
+      for (std::uint32_t p = first[route_[j]]; p < first[route_[j] + 1]; ++p) {
+        if (key_bytes_ == sizeof(PieceKey)) {
+          out = put(out, &keys[p], 1);
+        } else {
+          FLOESIM_ASSERT(keys[p] <= 0xffffffffu);
+          const std::uint32_t key = static_cast<std::uint32_t>(keys[p]);
+          out = put(out, &key, 1);
+        }
+      }
     for (std::size_t j = begin; j < end; ++j)
       out = put(out, &parts[first[route_[j]] * w], (first[route_[j] + 1] - first[route_[j]]) * w);
   }
@@ -222,8 +231,12 @@ void CellRoutes::send_pieces(const Communicator& comm, std::span<const std::uint
     keys_.resize(before + m);
     values_.resize((before + m) * w);
     if (m > 0) {
-      std::memcpy(keys_.data() + before, key, m * sizeof(PieceKey));
-      std::memcpy(values_.data() + before * w, key + m * sizeof(PieceKey), m * w * sizeof(double));
+      if (key_bytes_ == sizeof(PieceKey)) {
+        std::memcpy(keys_.data() + before, key, m * sizeof(PieceKey));
+      } else {
+        for (std::size_t p = 0; p < m; ++p) keys_[before + p] = at<std::uint32_t>(key, p);
+      }
+      std::memcpy(values_.data() + before * w, key + m * key_bytes_, m * w * sizeof(double));
     }
     in += receive_bytes_[r];
   }

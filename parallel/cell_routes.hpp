@@ -130,6 +130,9 @@ public:
   // `rows` cells (no slabs): open_shared() only, no open() or reply().
   static CellRoutes replicated(int ranks, std::size_t columns, std::size_t rows);
   bool empty() const { return first_row_.empty() && !replicated_; }
+  // Every key of the next opens is below `bound` (the same on every rank):
+  // when bound <= 2^32 the keys travel as 4 bytes, else 8 (the default).
+  void set_largest_key(PieceKey bound) { key_bytes_ = bound <= (PieceKey{1} << 32) ? 4 : 8; }
   bool replicated() const { return replicated_; }
   // The rank whose slab holds `cell` (in slabs).
   int owner(std::uint32_t cell) const { return row_owner_[cell / columns_]; }
@@ -218,6 +221,7 @@ private:
   std::vector<double> values_;        // per received piece, `width_` values
   std::vector<double> totals_, alone_totals_;
   int width_ = 0;
+  std::size_t key_bytes_ = sizeof(PieceKey);  // a key's bytes on the wire (set_largest_key)
   // Sums owned cell j's values w from zero in key order, into totals_.
   void sum_pieces();
   // open() and open_shared(): cells[k] to receivers[receivers_first[k]...].

@@ -130,11 +130,16 @@ bool routes_equal_merge(const parallel::Communicator& comm, int nx, int ny, cons
 // sums some other cells alone (none of any rank's pieces lie there): their
 // owners must receive exactly the cells of their slab and the senders'
 // totals, bit for bit.
-bool pieces_in_key_order(const parallel::Communicator& comm, int nx, int ny, const std::vector<int>& cut, unsigned seed) {
+// `narrow`: the keys mapped to 0..7 in the same order and sent as 4 bytes
+// (CellRoutes::set_largest_key(8)).
+bool pieces_in_key_order(const parallel::Communicator& comm, int nx, int ny, const std::vector<int>& cut, unsigned seed,
+                         bool narrow) {
   const std::size_t n = static_cast<std::size_t>(nx) * static_cast<std::size_t>(ny);
   std::mt19937_64 rng(seed * 7 + static_cast<unsigned>(comm.rank()));
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   auto [cells, first, keys, one, two] = random_pieces(n, 0.0, rng);
+  if (narrow)
+    for (parallel::PieceKey& k : keys) k = (k >> 32) * 2 + (k & 1);
   // The reference: every rank's pieces (cell, key, rank, index), sorted, summed from zero.
   std::vector<std::uint32_t> piece_cell(keys.size());
   for (std::size_t j = 0; j < cells.size(); ++j)
@@ -172,6 +177,7 @@ bool pieces_in_key_order(const parallel::Communicator& comm, int nx, int ny, con
   for (std::size_t k = 0; k < all_alone.size(); ++k)
     if (row_owner[all_alone[k] / static_cast<std::uint32_t>(nx)] == comm.rank()) expected_alone.push_back({all_alone[k], all_alone_totals[k]});
   parallel::CellRoutes routes(cut, static_cast<std::size_t>(nx));
+  if (narrow) routes.set_largest_key(8);
   bool equal = true;
   routes.open(comm, cells, first, keys, one, 1, alone);
   for (std::size_t j = 0; j < routes.owned().size(); ++j) equal = equal && same_bits(routes.total(j, 0), ref1[routes.owned()[j]]);
@@ -332,7 +338,8 @@ int main() {
     }
     if (ranks >= 3) cut[2] = cut[1];
     if (!routes_equal_merge(comm, nx, ny, cut, static_cast<unsigned>(nx))) ++failed;
-    if (!pieces_in_key_order(comm, nx, ny, cut, static_cast<unsigned>(ny))) ++failed;
+    if (!pieces_in_key_order(comm, nx, ny, cut, static_cast<unsigned>(ny), false)) ++failed;
+    if (!pieces_in_key_order(comm, nx, ny, cut, static_cast<unsigned>(ny), true)) ++failed;
     if (!pieces_summed_by_receivers(comm, nx, ny, cut, static_cast<unsigned>(nx + ny), false)) ++failed;
     if (!pieces_summed_by_receivers(comm, nx, ny, cut, static_cast<unsigned>(nx + ny + 1), true)) ++failed;
   }
