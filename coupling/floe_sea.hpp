@@ -273,13 +273,13 @@ public:
   // footprints' last rebuild: MovingFootprints::set_slabs), and each cell
   // the pieces of several ranks' floes may share is summed from the pieces
   // themselves, in the serial order (parallel::CellRoutes with the floes'
-  // serial positions as keys), by every rank that needs it: the ranks whose
+  // serial keys, serial_key), by every rank that needs it: the ranks whose
   // floes' boxes cover it and the rank whose slab holds its row (without
   // the boxes, by the slab's rank, which sends the coverage and the sums
   // back to the ranks with pieces there); a
   // cell deeper in a slab than any floe of another rank reaches, or under
-  // no other rank's floe's box of cells (parallel::CellBox, gathered with
-  // the serial order), is summed by the rank whose floes lie there alone,
+  // no other rank's floe's box of cells (parallel::CellBox, sent by its
+  // owner to the ranks that may share its cells), is summed by the rank whose floes lie there alone,
   // which sends only the pressure's total to the cell's slab's rank. Every cell's sums are then the serial
   // run's to the bit, whichever rank owns which floe. pressure() then holds
   // this rank's slab's rows only, which is what its sea's kick reads. A sea
@@ -408,11 +408,11 @@ public:
   // floes' entries (core/floe_bytes.hpp; `held` empty: every floe): its
   // arrays of one entry a floe (its groups, coupling/floe_sea_arrays.hpp:
   // the constants it derives, the kicks' loads, the poses, water velocities
-  // and slopes, the implicit step's, the owners' boxes and places in the
-  // serial order; and the next owners), and the footprints'
+  // and slopes, the implicit step's, the boxes this rank has
+  // (owner_.places); and the next owners), and the footprints'
   // (MovingFootprints::memory). Not counted: the per-cell arrays (the sea's
   // grid, not the floes), the per-piece scratch of one evaluation and the
-  // lists of floes (order_, owner_.serial, next_owners_.mine and held).
+  // lists of floes (order_, owner_.near and known, next_owners_.mine and held).
   struct Memory {
     FloeBytes per_floe;
     MovingFootprints::Memory footprints;
