@@ -230,6 +230,8 @@ void print_coupling_ranks(std::ostream& o, const Simulation& sim) {
   if (cells.shared + cells.alone_here + cells.alone_sent > 0)
     o << "parallel.coupling_cells: " << cells.shared << " shared (" << cells.pieces << " pieces), " << cells.alone_here
       << " alone owned, " << cells.alone_sent << " alone sent\n";
+  if (cells.boxes_sent + cells.boxes_received > 0)
+    o << "parallel.coupling_boxes: " << cells.boxes_sent << " sent, " << cells.boxes_received << " received\n";
   const FloeSeaContact::SharedLoads& loads = fs->shared_loads();
   if (loads.asked + loads.whole > 0)
     o << "parallel.coupling_loads: " << loads.asked << " by request (" << loads.asked_floes << " floes), "

@@ -53,7 +53,7 @@ line); every other input is measured on bench/ocean and named in the CSV.
 
 usage: bench/scaling_model.py [--step-ms 22.6] [--fft-share 0.13] [--pieces-per-floe 130]
                               [--alpha-us 2] [--node-gbs 12.5] [--ranks-per-node 32]
-                              [--memory-gbs 5] [--whole-bytes-explicit 12.8] [--whole-bytes-implicit ...]
+                              [--memory-gbs 5] [--whole-bytes-explicit 0.8] [--whole-bytes-implicit ...]
                               [--whole-pass-ns ...] [--floe-memory-bytes 400] [--no-whole]
                               [--build build] [--csv FILE | -]
 """
@@ -92,10 +92,10 @@ ap.add_argument("--piece-bytes", type=int, default=12, help="a piece's (cell, ar
 ap.add_argument("--reductions", type=int, default=2, help="agreements a step (time step; failures and stopping)")
 # The step that runs today: what grows with the total floe count on every rank (measured on
 # bench/ocean's pack at 1000 and 4000 floes on 2 ranks, docs/scaling.md "The step that runs today").
-ap.add_argument("--whole-bytes-explicit", type=float, default=12.8,
-                help="bytes a floe a step of every floe to every rank, explicit step: the boxes of order_by_owner "
-                     "(12 B an evaluation, one a step) and the strips' keys (8 B every 10 steps)")
-ap.add_argument("--whole-calls-explicit", type=float, default=1.1, help="those all-gathers a step")
+ap.add_argument("--whole-bytes-explicit", type=float, default=0.8,
+                help="bytes a floe a step of every floe to every rank, explicit step: the strips' keys (8 B every "
+                     "10 steps; the boxes of order_by_owner, 12 B a step, go by holder since boxes30)")
+ap.add_argument("--whole-calls-explicit", type=float, default=0.1, help="those all-gathers a step")
 ap.add_argument("--whole-bytes-implicit", type=float, default=WHOLE_IMPLICIT_BYTES,
                 help="the same for the implicit step: its area pieces (3511 B a floe of bench/ocean's pack) twice, "
                      "its loads (48 B) twice, the tilted floes' yaw (8 B)")

@@ -269,12 +269,12 @@ void FloeSeaContact::place_footprints(const Floes& floes, bool move, std::span<c
   const Footprints& fp = footprints_.pieces();
   // Floes in the order of their first cell, so that floes next to each
   // other on the grid come one after the other (the grid's arrays are
-  // read and written where each floe lies: this keeps them in cache).
+  // read and written where each floe lies: this keeps them in cache); ties
+  // by floe index (serial_key: the order by owner is this one).
   order_.clear();
   for (std::size_t i = 0; i < floes.size(); ++i)
     if (constants_.dynamic[i] && fp.offsets[i] < fp.offsets[i + 1]) order_.push_back(static_cast<std::uint32_t>(i));
-  std::sort(order_.begin(), order_.end(),
-            [&](std::uint32_t x, std::uint32_t y) { return fp.cell[fp.offsets[x]] < fp.cell[fp.offsets[y]]; });
+  std::sort(order_.begin(), order_.end(), [&](std::uint32_t x, std::uint32_t y) { return serial_key(x) < serial_key(y); });
   const double inv_cell_area = 1.0 / cell_area_;
   for (std::uint32_t i : order_)
     for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k) cells_[fp.cell[k]].coverage += fp.area[k] * inv_cell_area;

@@ -274,13 +274,13 @@ public:
   // footprints' last rebuild: MovingFootprints::set_slabs), and each cell
   // the pieces of several ranks' floes may share is summed from the pieces
   // themselves, in the serial order (parallel::CellRoutes with the floes'
-  // serial positions as keys), by every rank that needs it: the ranks whose
+  // serial keys, serial_key), by every rank that needs it: the ranks whose
   // floes' boxes cover it and the rank whose slab holds its row (without
   // the boxes, by the slab's rank, which sends the coverage and the sums
   // back to the ranks with pieces there); a
   // cell deeper in a slab than any floe of another rank reaches, or under
-  // no other rank's floe's box of cells (parallel::CellBox, gathered with
-  // the serial order), is summed by the rank whose floes lie there alone,
+  // no other rank's floe's box of cells (parallel::CellBox, sent by its
+  // owner to the ranks that may share its cells), is summed by the rank whose floes lie there alone,
   // which sends only the pressure's total to the cell's slab's rank. Every cell's sums are then the serial
   // run's to the bit, whichever rank owns which floe. pressure() then holds
   // this rank's slab's rows only, which is what its sea's kick reads. A sea
@@ -372,9 +372,11 @@ public:
   // interior since the start, per evaluation summed: those sent as pieces
   // (shared with another rank's floes, or possibly: their boxes meet), and
   // those summed here alone, owned here or by another rank (then sent as
-  // the pressure's total).
+  // the pressure's total). With the boxes (boxed()), the floes' boxes this
+  // rank sent and received (order_by_owner: to the ranks that read them).
   struct RoutedCells {
     long shared = 0, pieces = 0, alone_here = 0, alone_sent = 0;
+    long boxes_sent = 0, boxes_received = 0;
   };
   const RoutedCells& routed_cells() const { return owner_.routed_counts; }
 
@@ -442,11 +444,11 @@ public:
   // floes' entries (core/floe_bytes.hpp; `held` empty: every floe): its
   // arrays of one entry a floe (its groups, coupling/floe_sea_arrays.hpp:
   // the constants it derives, the kicks' loads, the poses, water velocities
-  // and slopes, the implicit step's, the owners' boxes and places in the
-  // serial order; and the next owners), and the footprints'
+  // and slopes, the implicit step's, the boxes this rank has
+  // (owner_.places); and the next owners), and the footprints'
   // (MovingFootprints::memory). Not counted: the per-cell arrays (the sea's
   // grid, not the floes), the per-piece scratch of one evaluation and the
-  // lists of floes (order_, owner_.serial, next_owners_.mine and held).
+  // lists of floes (order_, owner_.near and known, next_owners_.mine and held).
   struct Memory {
     FloeBytes per_floe;
     MovingFootprints::Memory footprints;
@@ -521,10 +523,13 @@ private:
   // returns the energy, the ranks' parts summed in rank order (until
   // settle_energy sums the terms in the serial order).
   double sum_cells_by_owner(double ks);
-  // By owner: order_ <- this rank's floes in the serial order, and
-  // owner_.places.position every floe's place in that order (one gather of the
-  // floes' first cells, with their boxes; in a flume not in slabs, with the
-  // ranks of their shares of columns: next_owners_).
+  // By owner: order_ <- this rank's floes in the serial order (serial_key,
+  // from its own pieces), and with the boxes (boxed()) each of its floes'
+  // box sent to the ranks that may have pieces in its cells (owner_.near on
+  // them; docs/parallel.md, "The boxes by holder (boxes30)"): with slabs,
+  // the ranks box_readers names; not in slabs, the ranks whose box of all
+  // their pieces' cells (gathered, 12 B a rank) it meets. In a flume not in
+  // slabs, every floe's share of columns to every rank (next_owners_).
   void order_by_owner(std::size_t floes);
   // next_owners_ for the routes (on replicated routes, in a flume, the
   // columns' shares); the floes' next owners forgotten.
@@ -645,27 +650,37 @@ private:
     std::vector<std::uint32_t> receivers_first;
     std::vector<int> receivers;
     std::vector<double> alone_totals;
-    // The serial order (order_by_owner): per floe the box of its pieces'
-    // cells and its place in the order (a group of one entry a floe), and
-    // the order.
+    // The boxes this rank has (order_by_owner): per floe the box of its
+    // pieces' cells (a group of one entry a floe), set for this rank's
+    // floes of order_ and the floes in `near`, whose boxes their owners
+    // sent here because they may cover a cell of this rank's pieces (the
+    // others' entries empty); `known`, the floes whose entries are set.
+    // With slabs, row_owner: per row, its rank in the owners' slabs
+    // (footprints_.owner_slabs(), kept in owner_slabs); not in slabs,
+    // rank_box: per rank, the box of all its pieces' cells.
     FloeSeaSerialPlaces places;
-    std::vector<std::uint32_t> serial;
+    std::vector<std::uint32_t> near, known;
+    std::vector<int> row_owner, owner_slabs;
+    std::vector<parallel::CellBox> rank_box;
     // Routed: the pieces of the cells of `cells` grouped by cell (cell j's
-    // are [first[j], first[j + 1])), each with its floe's position (keys)
+    // are [first[j], first[j + 1])), each with its floe's serial key (keys)
     // and its coverage (values).
-    std::vector<std::uint32_t> first, keys;
+    std::vector<std::uint32_t> first;
+    std::vector<parallel::PieceKey> keys;
     std::vector<double> values;
     // Routed: the pieces of the cells of `cells` in order_'s order (the
     // pieces' loops meet them so), each with its index among the
-    // footprints' pieces, its floe's position, its cell's index in `cells`
+    // footprints' pieces, its floe's serial key, its cell's index in `cells`
     // and its place among the pieces grouped by cell.
     struct RoutedPiece {
-      std::uint32_t piece, key, cell, at;
+      parallel::PieceKey key;
+      std::uint32_t piece, cell, at;
     };
     std::vector<RoutedPiece> routed_pieces;
     // Routed: this rank's terms of the penalty energy, per floe with terms
-    // (its position and count), in order_.
-    std::vector<std::uint32_t> energy_keys, energy_counts;
+    // (its serial key and count), in order_.
+    std::vector<parallel::PieceKey> energy_keys;
+    std::vector<std::uint32_t> energy_counts;
     std::vector<double> energy_terms;
     RoutedCells routed_counts;  // since the start, this rank's
     // The footprints' placements and rebuilds when the routes were opened
@@ -745,7 +760,18 @@ private:
   std::vector<int> slab_rows_;
   std::vector<int> first_slab_rows_;  // the slabs at set-up (the incident sea's, which do not move)
   parallel::CellRoutes routes_;
-  std::vector<std::uint32_t> order_;  // dynamic floes with pieces, by their first cell
+  std::vector<std::uint32_t> order_;  // dynamic floes with pieces (by owner: this rank's), by serial_key
+  // The serial order of the floes in the cells' sums: by the first cell of
+  // their pieces, ties broken by floe index (a total order, so a key each
+  // floe's owner computes alone, from its own pieces: no rank needs the
+  // other floes' first cells to place its own among them). As one number,
+  // first cell x floes + index (below cells x floes: 4 bytes on the wire
+  // when that is at most 2^32, CellRoutes::set_largest_key). Floe i has
+  // pieces.
+  parallel::PieceKey serial_key(std::uint32_t i) const {
+    const Footprints& fp = footprints_.pieces();
+    return parallel::PieceKey{fp.cell[fp.offsets[i]]} * constants_.dynamic.size() + i;
+  }
   bool pressure_kicked_ = false;  // the sea's last kick was with pressure_ as it is
   SharedLoads shared_loads_;
   double loads_h_ = -1.0;         // the kick length of the last evaluation (< 0: stale)

@@ -17,7 +17,7 @@
 //   FloeSeaKicks        the loads the kicks apply; sized and zeroed with the floes
 //   FloeSeaEvaluated    what an evaluation of the contact poses and finds per floe; sized with the floes
 //   FloeSeaImplicit     the implicit step's; sized at each implicit step (empty with the explicit kicks)
-//   FloeSeaSerialPlaces by owner, the floes' boxes and places in the serial order; sized at each order_by_owner
+//   FloeSeaSerialPlaces by owner, the boxes of the floes this rank has; sized at each order_by_owner
 
 #include <cstddef>
 #include <cstdint>
@@ -132,13 +132,11 @@ struct FloeSeaImplicit {
 };
 static_assert(lists_every_array<FloeSeaImplicit>());
 
-// By owner, the serial order (order_by_owner): each floe's box of its
-// pieces' cells (parallel::CellBox, first_cell kNone: not in the order)
-// and its place in the order.
+// By owner (order_by_owner): each floe's box of its pieces' cells
+// (parallel::CellBox, first_cell kNone: none, or not sent to this rank).
 struct FloeSeaSerialPlaces {
   std::vector<parallel::CellBox> box;
-  std::vector<std::uint32_t> position;
-  static auto arrays(auto& g) { return std::tie(g.box, g.position); }
+  static auto arrays(auto& g) { return std::tie(g.box); }
 };
 static_assert(lists_every_array<FloeSeaSerialPlaces>());
 

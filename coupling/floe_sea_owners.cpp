@@ -5,14 +5,14 @@
 // gives after it (the cells' sum of a_k u_k^2 and the pressure).
 //
 // The serial loop adds a cell's pieces floe by floe in order_ (every dynamic
-// floe with pieces, sorted by its first cell), each floe's pieces in their
-// order; a floe's pieces are not interleaved with another's. A floating-point
-// sum depends on the order of its terms, so each rank works in that order:
-// the floes' first cells are gathered (in a parallel::CellBox, 12 bytes a
-// floe, with the box below on a sea in slabs) and every rank sorts
-// them as the serial run does (the same input, the same comparisons: the
-// same permutation, ties included), keeps its own floes in that order
-// (order_) and knows every floe's place in it (owner_.places.position).
+// floe with pieces, sorted by serial_key: its first cell, then its index),
+// each floe's pieces in their order; a floe's pieces are not interleaved
+// with another's. A floating-point sum depends on the order of its terms,
+// so each rank works in that order: the key is a floe's own (its owner
+// computes it from its pieces alone), so each rank sorts its own floes by
+// it (order_), and every piece or energy term that leaves the rank carries
+// its floe's key, by which the receivers merge every rank's terms into the
+// serial order.
 //
 // Sea in slabs (stages five and eight, routed()). A cell where only this
 // rank's floes have pieces is summed here, into cells_ and pressure_
@@ -21,15 +21,16 @@
 // cells deeper in a rank's slab than any other rank's floe reaches
 // (CellRoutes::interior_rows) and, on the rows between, the cells under no
 // other rank's floe's box (parallel::CellBox: the rows and columns of a
-// floe's pieces, gathered with the floes' first cells); if another rank
+// floe's pieces, sent by its owner to the ranks that may have pieces in
+// its rows: order_by_owner); if another rank
 // owns such a cell (its slab holds the row), the pressure's total goes to
 // it (CellRoutes' alone cells: 4 bytes a cell before the law, 8 after).
 // Every other cell (under a box of another rank's floe: shared, or nearly)
-// travels as its pieces, each with its floe's serial position as key:
-// before the law the cell, its pieces' count, keys and coverage (8 bytes a
-// cell, 12 a piece); after it the pieces' a u^2 and pressure (16 bytes a
-// piece). With the boxes (boxed()) they go to every rank that needs the
-// cell's totals (CellRoutes::open_shared, one all-to-all): the ranks whose
+// travels as its pieces, each with its floe's serial key: before the law
+// the cell, its pieces' count, keys and coverage (8 bytes a cell, 16 a
+// piece); after it the pieces' a u^2 and pressure (16 bytes a piece).
+// With the boxes (boxed()) they go to every rank that needs the cell's
+// totals (CellRoutes::open_shared, one all-to-all): the ranks whose
 // floes' boxes cover it (all that may have pieces there), the rank whose
 // slab holds its row (the pressure, for its sea's kick) and this one; each
 // adds every rank's pieces from zero in key order, which is the serial
@@ -158,60 +159,81 @@ FloeSeaContact::GivenOwners FloeSeaContact::given_owners(std::size_t floes) {
 void FloeSeaContact::order_by_owner(std::size_t floes) {
   const Footprints& fp = footprints_.pieces();
   OwnerCells& o = owner_;
-  // Each floe's first cell, and with the boxes (boxed()) the box of its
-  // cells, which tells the other ranks where its pieces may share a cell.
   const bool boxes = boxed();
   fit_floes(o.places, floes);
-  std::fill(o.places.box.begin(), o.places.box.end(), parallel::CellBox{});
-  for (std::uint32_t i : footprints_.mine())
+  for (const std::uint32_t i : o.known)
+    if (i < floes) o.places.box[i] = parallel::CellBox{};
+  o.known.clear();
+  o.near.clear();
+  // This rank's floes in the serial order (place_footprints' rule, on its
+  // floes alone), with, when boxed, the box of each one's cells, which tells
+  // the ranks that receive it where its pieces may share a cell.
+  order_.clear();
+  for (const std::uint32_t i : footprints_.mine())
     if (i < fp.floes() && constants_.dynamic[i] && fp.offsets[i] < fp.offsets[i + 1]) {
+      order_.push_back(i);
       if (boxes) {
         const std::span<const std::uint32_t> cells(fp.cell.data() + fp.offsets[i], fp.offsets[i + 1] - fp.offsets[i]);
         o.places.box[i] = parallel::CellBox::of(cells, grid_.nx, grid_.ny);
-      } else {
-        o.places.box[i].first_cell = fp.cell[fp.offsets[i]];
+        o.known.push_back(i);
       }
     }
-  if (next_owners_.column.empty()) {
-    comm_.complete_owned(o.places.box, footprints_.owners());
-  } else {
-    // With each box, the rank of the share of columns of the floe's present
-    // place (evaluated_.poses holds this rank's floes' present poses: evaluate posed
-    // them).
-    struct Placed {
-      parallel::CellBox box;
-      std::int32_t owner;
-    };
-    std::vector<Placed> placed(floes, Placed{{}, 0});
-    for (std::uint32_t i : footprints_.mine()) placed[i] = {o.places.box[i], column_owner(evaluated_.poses[i])};
-    comm_.complete_owned(placed, footprints_.owners());
-    std::vector<int> owner(floes);
-    for (std::size_t i = 0; i < floes; ++i) {
-      o.places.box[i] = placed[i].box;
-      owner[i] = placed[i].owner;
-    }
+  std::sort(order_.begin(), order_.end(), [&](std::uint32_t x, std::uint32_t y) { return serial_key(x) < serial_key(y); });
+  routes_.set_largest_key(parallel::PieceKey{grid_.size()} * floes);
+  if (!next_owners_.column.empty()) {
+    // A flume: the rank of the share of columns of each floe's present
+    // place (evaluated_.poses holds this rank's floes' present poses:
+    // evaluate posed them), from its owner to every rank.
+    std::vector<int> owner(floes, 0);
+    for (const std::uint32_t i : footprints_.mine()) owner[i] = column_owner(evaluated_.poses[i]);
+    comm_.complete_owned(owner, footprints_.owners());
     set_next_owners(owner);
   }
-  // place_footprints' serial sort, on the same floes in the same order.
-  o.serial.clear();
-  for (std::size_t i = 0; i < floes; ++i)
-    if (o.places.box[i].first_cell != kNoCell) o.serial.push_back(static_cast<std::uint32_t>(i));
-  std::sort(o.serial.begin(), o.serial.end(),
-            [&](std::uint32_t x, std::uint32_t y) { return o.places.box[x].first_cell < o.places.box[y].first_cell; });
-  std::fill(o.places.position.begin(), o.places.position.end(), kNoCell);
-  order_.clear();
-  for (std::size_t j = 0; j < o.serial.size(); ++j) {
-    const std::uint32_t i = o.serial[j];
-    o.places.position[i] = static_cast<std::uint32_t>(j);
-    if (footprints_.owns(i)) order_.push_back(i);
+  if (!boxes) return;
+  // Each box to the ranks that read it (sum_coverage_by_owner marks the
+  // cells other ranks' boxes cover among its pieces' cells): a box that
+  // covers a cell of rank r's pieces reaches within the rows of r's pieces
+  // (with slabs) or meets r's box of its pieces' cells (not in slabs), so
+  // r gets every box it needs, from the box's owner alone.
+  const std::size_t ranks = static_cast<std::size_t>(comm_.size());
+  std::vector<std::vector<std::uint32_t>> to(ranks);
+  if (footprints_.by_place()) {
+    const std::span<const int> slabs = footprints_.owner_slabs();
+    if (!std::equal(slabs.begin(), slabs.end(), o.owner_slabs.begin(), o.owner_slabs.end())) {
+      o.owner_slabs.assign(slabs.begin(), slabs.end());
+      o.row_owner = parallel::row_owners(slabs);
+    }
+    std::vector<int> readers;
+    for (const std::uint32_t i : order_) {
+      readers.clear();
+      box_readers(o.places.box[i], comm_.rank(), o.row_owner, grid_.nx, footprints_.piece_rows(), readers);
+      for (const int r : readers) to[static_cast<std::size_t>(r)].push_back(i);
+    }
+  } else {
+    const parallel::CellBox mine =
+        order_.empty() ? parallel::CellBox{} : parallel::CellBox::of(fp.cell, grid_.nx, grid_.ny);
+    // (Every rank's box: one call, the counts known.)
+    const std::vector<std::size_t> counts(ranks, sizeof(parallel::CellBox));
+    const std::vector<std::byte> all = comm_.allgather_known(std::as_bytes(std::span(&mine, 1)), counts);
+    o.rank_box.resize(ranks);
+    std::memcpy(static_cast<void*>(o.rank_box.data()), all.data(), all.size());
+    for (const std::uint32_t i : order_)
+      for (std::size_t r = 0; r < ranks; ++r)
+        if (static_cast<int>(r) != comm_.rank() && boxes_meet(o.places.box[i], o.rank_box[r], grid_.nx, grid_.ny))
+          to[r].push_back(i);
   }
+  o.near = comm_.send_items(o.places.box, to);
+  o.known.insert(o.known.end(), o.near.begin(), o.near.end());
+  for (const std::vector<std::uint32_t>& t : to) o.routed_counts.boxes_sent += static_cast<long>(t.size());
+  o.routed_counts.boxes_received += static_cast<long>(o.near.size());
 }
 
 void FloeSeaContact::settle_energy() const {
   // Every rank's terms, then summed from zero floe by floe in the serial
   // order (each floe's terms in their order), as evaluate() sums them.
   const OwnerCells& o = owner_;
-  std::vector<std::byte> message(sizeof(std::uint64_t) + o.energy_keys.size() * 2 * sizeof(std::uint32_t) +
+  std::vector<std::byte> message(sizeof(std::uint64_t) +
+                                 o.energy_keys.size() * (sizeof(parallel::PieceKey) + sizeof(std::uint32_t)) +
                                  o.energy_terms.size() * sizeof(double));
   const std::uint64_t n = o.energy_keys.size();
   put(put(put(put(message.data(), &n, 1), o.energy_keys.data(), o.energy_keys.size()), o.energy_counts.data(),
@@ -221,7 +243,8 @@ void FloeSeaContact::settle_energy() const {
   std::vector<std::byte> all;
   comm_.allgather_bytes(message, bytes, all);
   struct Floe {
-    std::uint32_t key, count;
+    parallel::PieceKey key;
+    std::uint32_t count;
     const std::byte* terms;
   };
   std::vector<Floe> floes;
@@ -229,11 +252,11 @@ void FloeSeaContact::settle_energy() const {
   for (std::size_t b : bytes) {
     const std::size_t m = static_cast<std::size_t>(at<std::uint64_t>(in, 0));
     const std::byte* keys = in + sizeof(std::uint64_t);
-    const std::byte* counts = keys + m * sizeof(std::uint32_t);
+    const std::byte* counts = keys + m * sizeof(parallel::PieceKey);
     const std::byte* terms = counts + m * sizeof(std::uint32_t);
     for (std::size_t j = 0; j < m; ++j) {
       const std::uint32_t count = at<std::uint32_t>(counts, j);
-      floes.push_back({at<std::uint32_t>(keys, j), count, terms});
+      floes.push_back({at<parallel::PieceKey>(keys, j), count, terms});
       terms += count * sizeof(double);
     }
     in += b;
@@ -295,17 +318,10 @@ void FloeSeaContact::sum_coverage_by_owner() {
   // too.
   if (boxes) {
     // The boxes of the other ranks' floes that may cover a cell of this
-    // rank's pieces (coupling/shared_cells.hpp: a row within R_max and
-    // about two cells of its slab of the owners); no other box is read.
-    std::vector<std::uint32_t> near;
-    if (footprints_.by_place()) {
-      near = box_neighbours(o.serial, footprints_.owners(), comm_.rank(), footprints_.owner_slabs(), o.places.box,
-                            grid_, footprints_.piece_rows());
-    } else {
-      for (const std::uint32_t i : o.serial)
-        if (!footprints_.owns(i)) near.push_back(i);
-    }
-    mark_shared_cells(near, o.places.box, footprints_.owners(), grid_.nx, grid_.ny, o.interior_row, o.kind,
+    // rank's pieces, which their owners sent here (order_by_owner; with
+    // slabs, coupling/shared_cells.hpp: a row within R_max and about two
+    // cells of its slab of the owners; not in slabs, meeting its box).
+    mark_shared_cells(o.near, o.places.box, footprints_.owners(), grid_.nx, grid_.ny, o.interior_row, o.kind,
                       OwnerCells::kRoutedRow, OwnerCells::kShared, rank_words, o.marks);
   } else {
     o.marks.painted.clear();
@@ -365,7 +381,7 @@ void FloeSeaContact::sum_coverage_by_owner() {
       // its floe's key, in order_ (the serial order) as this loop meets it.
       const std::uint32_t j = listed(c);
       ++o.first[j + 1];
-      o.routed_pieces.push_back({static_cast<std::uint32_t>(k), o.places.position[i], j, 0});
+      o.routed_pieces.push_back({serial_key(i), static_cast<std::uint32_t>(k), j, 0});
     }
   }
   // The kinds back to the rows' (the boxes move with the floes).
@@ -468,7 +484,7 @@ double FloeSeaContact::sum_cells_by_owner(double ks) {
       o.parts[2 * at + 1] = force[k] * inv_cell_area;
     }
     if (o.energy_terms.size() > terms) {
-      o.energy_keys.push_back(o.places.position[i]);
+      o.energy_keys.push_back(serial_key(i));
       o.energy_counts.push_back(static_cast<std::uint32_t>(o.energy_terms.size() - terms));
     }
   }

@@ -48,6 +48,24 @@ std::vector<std::uint32_t> box_neighbours(std::span<const std::uint32_t> candida
                                           std::span<const int> first_row, std::span<const parallel::CellBox> box,
                                           const fluid::SurfaceGrid& grid, int own_rows);
 
+// The sender's side of box_neighbours: the ranks other than `owner` whose
+// box_neighbours would keep a floe of `owner` with box b, i.e. the ranks
+// whose slab holds a row within own_rows of one of the box's rows (on the
+// grid's circle), with row_owner the owners' slabs per row
+// (parallel::row_owners(first_row)). Appended to `out` ascending, each
+// once. So the owner of a floe sends its box to exactly the ranks that read
+// it (FloeSeaContact::order_by_owner), and needs no other rank's floes.
+void box_readers(const parallel::CellBox& b, int owner, std::span<const int> row_owner, int columns, int own_rows,
+                 std::vector<int>& out);
+
+// Whether two boxes hold a common cell: their rows' ranges and their
+// columns' ranges, as CellBox::for_each visits them (the grid's seams
+// crossed), both meet. A box empty (first_cell kNone) meets none. On a sea
+// not in slabs a floe's box goes to the ranks whose box of all their
+// pieces' cells it meets: a cell of that rank's pieces it covers lies in
+// both.
+bool boxes_meet(const parallel::CellBox& a, const parallel::CellBox& b, int columns, int rows);
+
 // The cells of the boxes of `floes` (each another rank's, owner[j]) in
 // rows outside the slab's interior (interior_row[y] == 0): each cell whose
 // kind is `open` becomes `shared` (listed in `painted`, numbered in

@@ -85,7 +85,7 @@ std::vector<std::uint8_t> CellRoutes::interior_rows(int reach) const {
 }
 
 void CellRoutes::open(const Communicator& comm, std::span<const std::uint32_t> cells, std::span<const std::uint32_t> first,
-                      std::span<const std::uint32_t> keys, std::span<const double> parts, int width,
+                      std::span<const PieceKey> keys, std::span<const double> parts, int width,
                       std::span<const std::uint32_t> alone) {
   // Each cell to its owner alone.
   FLOESIM_ASSERT(!replicated_);
@@ -101,7 +101,7 @@ void CellRoutes::open(const Communicator& comm, std::span<const std::uint32_t> c
 }
 
 void CellRoutes::open_shared(const Communicator& comm, std::span<const std::uint32_t> cells,
-                             std::span<const std::uint32_t> first, std::span<const std::uint32_t> keys,
+                             std::span<const std::uint32_t> first, std::span<const PieceKey> keys,
                              std::span<const double> parts, int width, std::span<const std::uint32_t> receivers_first,
                              std::span<const int> receivers, std::span<const std::uint32_t> alone) {
   FLOESIM_ASSERT(receivers_first.size() == cells.size() + 1 && receivers.size() == receivers_first.back());
@@ -110,7 +110,7 @@ void CellRoutes::open_shared(const Communicator& comm, std::span<const std::uint
 }
 
 void CellRoutes::send_pieces(const Communicator& comm, std::span<const std::uint32_t> cells,
-                             std::span<const std::uint32_t> first, std::span<const std::uint32_t> keys,
+                             std::span<const std::uint32_t> first, std::span<const PieceKey> keys,
                              std::span<const double> parts, int width, std::span<const std::uint32_t> receivers_first,
                              std::span<const int> receivers, std::span<const std::uint32_t> alone) {
   const std::size_t ranks = static_cast<std::size_t>(comm.size()), w = static_cast<std::size_t>(width);
@@ -174,7 +174,7 @@ void CellRoutes::send_pieces(const Communicator& comm, std::span<const std::uint
   std::size_t total_bytes = 0;
   for (std::size_t r = 0; r < ranks; ++r) {
     bytes_[r] = 2 * sizeof(std::uint64_t) + (sent_[r] * 2 + sent_alone_[r]) * sizeof(std::uint32_t) +
-                sent_pieces_[r] * (sizeof(std::uint32_t) + w * sizeof(double));
+                sent_pieces_[r] * (key_bytes_ + w * sizeof(double));
     total_bytes += bytes_[r];
   }
   send_.resize(total_bytes);
@@ -189,7 +189,16 @@ void CellRoutes::send_pieces(const Communicator& comm, std::span<const std::uint
       out = put(out, &count, 1);
     }
     for (std::size_t j = alone_begin; j < alone_begin + sent_alone_[r]; ++j) out = put(out, &alone[alone_route_[j]], 1);
-    for (std::size_t j = begin; j < end; ++j) out = put(out, &keys[first[route_[j]]], first[route_[j] + 1] - first[route_[j]]);
+    for (std::size_t j = begin; j < end; ++j)
+      for (std::uint32_t p = first[route_[j]]; p < first[route_[j] + 1]; ++p) {
+        if (key_bytes_ == sizeof(PieceKey)) {
+          out = put(out, &keys[p], 1);
+        } else {
+          FLOESIM_ASSERT(keys[p] <= 0xffffffffu);
+          const std::uint32_t key = static_cast<std::uint32_t>(keys[p]);
+          out = put(out, &key, 1);
+        }
+      }
     for (std::size_t j = begin; j < end; ++j)
       out = put(out, &parts[first[route_[j]] * w], (first[route_[j] + 1] - first[route_[j]]) * w);
   }
@@ -239,8 +248,12 @@ void CellRoutes::send_pieces(const Communicator& comm, std::span<const std::uint
     keys_.resize(before + m);
     values_.resize((before + m) * w);
     if (m > 0) {
-      std::memcpy(keys_.data() + before, key, m * sizeof(std::uint32_t));
-      std::memcpy(values_.data() + before * w, key + m * sizeof(std::uint32_t), m * w * sizeof(double));
+      if (key_bytes_ == sizeof(PieceKey)) {
+        std::memcpy(keys_.data() + before, key, m * sizeof(PieceKey));
+      } else {
+        for (std::size_t p = 0; p < m; ++p) keys_[before + p] = at<std::uint32_t>(key, p);
+      }
+      std::memcpy(values_.data() + before * w, key + m * key_bytes_, m * w * sizeof(double));
     }
     in += receive_bytes_[r];
   }
@@ -267,7 +280,8 @@ void CellRoutes::send_pieces(const Communicator& comm, std::span<const std::uint
 
 void CellRoutes::open(const Communicator& comm, std::span<const std::uint32_t> cells, std::span<const double> parts,
                       int width) {
-  std::vector<std::uint32_t> first(cells.size() + 1), keys(cells.size(), 0);
+  std::vector<std::uint32_t> first(cells.size() + 1);
+  std::vector<PieceKey> keys(cells.size(), 0);
   for (std::size_t k = 0; k <= cells.size(); ++k) first[k] = static_cast<std::uint32_t>(k);
   open(comm, cells, first, keys, parts, width);
 }

@@ -72,6 +72,11 @@
 
 namespace floesim::parallel {
 
+// A piece's order key: the pieces of a cell are summed in ascending keys.
+// 64 bits, so that a key can be a pair each sender computes alone (the
+// contact's (first cell, floe index), FloeSeaContact::serial_key).
+using PieceKey = std::uint64_t;
+
 // Per row of the grid, the rank whose slab holds it, for slabs given by
 // their first rows (ranks + 1 values, the last the row count): rank r's slab
 // is rows [first_row[r], first_row[r + 1]).
@@ -134,6 +139,9 @@ public:
   // `rows` cells (no slabs): open_shared() only, no open() or reply().
   static CellRoutes replicated(int ranks, std::size_t columns, std::size_t rows);
   bool empty() const { return first_row_.empty() && !replicated_; }
+  // Every key of the next opens is below `bound` (the same on every rank):
+  // when bound <= 2^32 the keys travel as 4 bytes, else 8 (the default).
+  void set_largest_key(PieceKey bound) { key_bytes_ = bound <= (PieceKey{1} << 32) ? 4 : 8; }
   bool replicated() const { return replicated_; }
   // The rank whose slab holds `cell` (in slabs).
   int owner(std::uint32_t cell) const { return row_owner_[cell / columns_]; }
@@ -157,7 +165,7 @@ public:
   // owners (replicated: every other rank) receive them now and their
   // totals with the next add().
   void open(const Communicator& comm, std::span<const std::uint32_t> cells, std::span<const std::uint32_t> first,
-            std::span<const std::uint32_t> keys, std::span<const double> parts, int width,
+            std::span<const PieceKey> keys, std::span<const double> parts, int width,
             std::span<const std::uint32_t> alone = {});
   // As open(), but cell cells[j] goes to the ranks receivers[q] for q in
   // [receivers_first[j], receivers_first[j + 1]) (distinct; this rank among
@@ -167,7 +175,7 @@ public:
   // needs its total: then each of them gets every piece. No reply(); add()
   // sends the new values along the same routes.
   void open_shared(const Communicator& comm, std::span<const std::uint32_t> cells, std::span<const std::uint32_t> first,
-                   std::span<const std::uint32_t> keys, std::span<const double> parts, int width,
+                   std::span<const PieceKey> keys, std::span<const double> parts, int width,
                    std::span<const std::uint32_t> receivers_first, std::span<const int> receivers,
                    std::span<const std::uint32_t> alone = {});
   // One piece a cell, all keys equal: the parts summed in rank order
@@ -239,15 +247,17 @@ private:
   // The received pieces (in rank order, then the senders' order) in the
   // order they are summed: owned cell j's are order_[order_first_[j]] up to
   // order_[order_first_[j + 1]], by key; keys_ per received piece.
-  std::vector<std::uint32_t> order_, order_first_, keys_;
+  std::vector<std::uint32_t> order_, order_first_;
+  std::vector<PieceKey> keys_;
   std::vector<double> values_;        // per received piece, `width_` values
   std::vector<double> totals_, alone_totals_;
   int width_ = 0;
+  std::size_t key_bytes_ = sizeof(PieceKey);  // a key's bytes on the wire (set_largest_key)
   // Sums owned cell j's values w from zero in key order, into totals_.
   void sum_pieces();
   // open() and open_shared(): cells[k] to receivers[receivers_first[k]...].
   void send_pieces(const Communicator& comm, std::span<const std::uint32_t> cells, std::span<const std::uint32_t> first,
-                   std::span<const std::uint32_t> keys, std::span<const double> parts, int width,
+                   std::span<const PieceKey> keys, std::span<const double> parts, int width,
                    std::span<const std::uint32_t> receivers_first, std::span<const int> receivers,
                    std::span<const std::uint32_t> alone);
   bool to_owners_ = true;  // the last open was open(): reply() may follow

@@ -30,11 +30,14 @@ namespace {
 bool same_bits(double a, double b) { return std::memcmp(&a, &b, sizeof(double)) == 0; }
 
 // A rank's random pieces: the cells of n where a uniform draw in (-1, 1) is
-// below `below`, shuffled; 1 to 3 pieces a cell with keys in 0..7 (a
-// sender's pieces of a cell come in key order, first[j] the first of cell
-// j's); one value a piece (`one`) and two (`two`), spread over ten decades.
+// below `below`, shuffled; 1 to 3 pieces a cell with 8 keys, 0 or 1 in
+// each of the keys' two 32-bit halves' low bits (the high half orders
+// first: a key cut to 32 bits orders them otherwise; a sender's pieces of
+// a cell come in key order, first[j] the first of cell j's); one value a
+// piece (`one`) and two (`two`), spread over ten decades.
 struct RandomPieces {
-  std::vector<std::uint32_t> cells, first, keys;
+  std::vector<std::uint32_t> cells, first;
+  std::vector<parallel::PieceKey> keys;
   std::vector<double> one, two;
 };
 RandomPieces random_pieces(std::size_t n, double below, std::mt19937_64& rng) {
@@ -46,8 +49,8 @@ RandomPieces random_pieces(std::size_t n, double below, std::mt19937_64& rng) {
   std::shuffle(r.cells.begin(), r.cells.end(), rng);
   for (std::size_t j = 0; j < r.cells.size(); ++j) {
     const int count = 1 + static_cast<int>(rng() % 3);
-    std::vector<std::uint32_t> k;
-    for (int q = 0; q < count; ++q) k.push_back(static_cast<std::uint32_t>(rng() % 8));
+    std::vector<parallel::PieceKey> k;
+    for (int q = 0; q < count; ++q) k.push_back((parallel::PieceKey{rng() % 4} << 32) | (rng() % 2));
     std::sort(k.begin(), k.end());
     r.keys.insert(r.keys.end(), k.begin(), k.end());
     r.first.push_back(static_cast<std::uint32_t>(r.keys.size()));
@@ -127,18 +130,23 @@ bool routes_equal_merge(const parallel::Communicator& comm, int nx, int ny, cons
 // sums some other cells alone (none of any rank's pieces lie there): their
 // owners must receive exactly the cells of their slab and the senders'
 // totals, bit for bit.
-bool pieces_in_key_order(const parallel::Communicator& comm, int nx, int ny, const std::vector<int>& cut, unsigned seed) {
+// `narrow`: the keys mapped to 0..7 in the same order and sent as 4 bytes
+// (CellRoutes::set_largest_key(8)).
+bool pieces_in_key_order(const parallel::Communicator& comm, int nx, int ny, const std::vector<int>& cut, unsigned seed,
+                         bool narrow) {
   const std::size_t n = static_cast<std::size_t>(nx) * static_cast<std::size_t>(ny);
   std::mt19937_64 rng(seed * 7 + static_cast<unsigned>(comm.rank()));
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   auto [cells, first, keys, one, two] = random_pieces(n, 0.0, rng);
+  if (narrow)
+    for (parallel::PieceKey& k : keys) k = (k >> 32) * 2 + (k & 1);
   // The reference: every rank's pieces (cell, key, rank, index), sorted, summed from zero.
   std::vector<std::uint32_t> piece_cell(keys.size());
   for (std::size_t j = 0; j < cells.size(); ++j)
     for (std::uint32_t p = first[j]; p < first[j + 1]; ++p) piece_cell[p] = cells[j];
   std::vector<std::size_t> counts;
   const std::vector<std::uint32_t> all_cell = comm.allgather<std::uint32_t>(piece_cell);
-  const std::vector<std::uint32_t> all_key = comm.allgather<std::uint32_t>(keys);
+  const std::vector<parallel::PieceKey> all_key = comm.allgather<parallel::PieceKey>(keys);
   const std::vector<double> all_one = comm.allgather<double>(one), all_two = comm.allgather<double>(two);
   std::vector<std::size_t> order(all_cell.size());
   for (std::size_t k = 0; k < order.size(); ++k) order[k] = k;  // index order is rank order, then the sender's
@@ -169,6 +177,7 @@ bool pieces_in_key_order(const parallel::Communicator& comm, int nx, int ny, con
   for (std::size_t k = 0; k < all_alone.size(); ++k)
     if (row_owner[all_alone[k] / static_cast<std::uint32_t>(nx)] == comm.rank()) expected_alone.push_back({all_alone[k], all_alone_totals[k]});
   parallel::CellRoutes routes(cut, static_cast<std::size_t>(nx));
+  if (narrow) routes.set_largest_key(8);
   bool equal = true;
   routes.open(comm, cells, first, keys, one, 1, alone);
   for (std::size_t j = 0; j < routes.owned().size(); ++j) equal = equal && same_bits(routes.total(j, 0), ref1[routes.owned()[j]]);
@@ -223,7 +232,7 @@ bool pieces_summed_by_receivers(const parallel::Communicator& comm, int nx, int 
   for (std::size_t j = 0; j < cells.size(); ++j)
     for (std::uint32_t p = first[j]; p < first[j + 1]; ++p) piece_cell[p] = cells[j];
   const std::vector<std::uint32_t> all_cell = comm.allgather<std::uint32_t>(piece_cell);
-  const std::vector<std::uint32_t> all_key = comm.allgather<std::uint32_t>(keys);
+  const std::vector<parallel::PieceKey> all_key = comm.allgather<parallel::PieceKey>(keys);
   const std::vector<double> all_one = comm.allgather<double>(one), all_two = comm.allgather<double>(two);
   const std::vector<std::uint32_t> all_cells = comm.allgather<std::uint32_t>(cells);
   const std::vector<std::uint64_t> cell_counts = comm.allgather<std::uint64_t>(std::vector<std::uint64_t>{cells.size()});
@@ -329,7 +338,8 @@ int main() {
     }
     if (ranks >= 3) cut[2] = cut[1];
     if (!routes_equal_merge(comm, nx, ny, cut, static_cast<unsigned>(nx))) ++failed;
-    if (!pieces_in_key_order(comm, nx, ny, cut, static_cast<unsigned>(ny))) ++failed;
+    if (!pieces_in_key_order(comm, nx, ny, cut, static_cast<unsigned>(ny), false)) ++failed;
+    if (!pieces_in_key_order(comm, nx, ny, cut, static_cast<unsigned>(ny), true)) ++failed;
     if (!pieces_summed_by_receivers(comm, nx, ny, cut, static_cast<unsigned>(nx + ny), false)) ++failed;
     if (!pieces_summed_by_receivers(comm, nx, ny, cut, static_cast<unsigned>(nx + ny + 1), true)) ++failed;
   }

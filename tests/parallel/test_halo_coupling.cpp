@@ -160,6 +160,18 @@ TEST_CASE("the shared cells' marks on a rank read only the boxes of other ranks'
             const Read b = read_marks(fp, owner, r, interior_row, kind_near, marks, nx);
             CHECK(a.shared == b.shared);
             CHECK(a.ranks == b.ranks);
+            // The senders' side (order_by_owner): each floe's owner sends
+            // its box to the ranks box_readers names, which are exactly the
+            // ranks whose box_neighbours keep it.
+            std::vector<std::uint32_t> sent;
+            std::vector<int> readers;
+            for (const std::uint32_t j : all) {
+              readers.clear();
+              box_readers(box[j], owner[j], row_owner, nx, own_rows, readers);
+              CHECK(std::is_sorted(readers.begin(), readers.end()));
+              if (std::find(readers.begin(), readers.end(), r) != readers.end()) sent.push_back(j);
+            }
+            CHECK(sent == near);
             read_full += others.size();
             read_near += near.size();
             // The mutation: without the own floes' rows.
@@ -181,6 +193,93 @@ TEST_CASE("the shared cells' marks on a rank read only the boxes of other ranks'
       CHECK(read_near < read_full);
       CHECK(thin_misses > 0);
     }
+}
+
+TEST_CASE("not in slabs, the boxes that meet a rank's box of its pieces' cells mark its pieces' cells as every other rank's box does (simulated ranks)") {
+  // FloeSeaContact::order_by_owner on a sea not in slabs (BEM, a tank, a
+  // flume: every row a boundary row): a floe's box goes to the ranks whose
+  // box of all their pieces' cells (parallel::CellBox::of, gathered) it
+  // meets (boxes_meet). The marks of rank r's pieces' cells from those boxes
+  // only, every other box poisoned, equal the marks from every other rank's
+  // box. Owners by strips of rows (the drift's) and by index (every floe
+  // anywhere), 2, 3 and 7 ranks. The mutation, named: one box that meets
+  // left out changes some rank's marks.
+  const SeaPack s = sea_pack(7);
+  const std::size_t n = s.floes.size();
+  const int nx = s.grid.nx, ny = s.grid.ny;
+  Footprints fp;
+  build_footprints(s.floes, std::vector<std::uint8_t>(n, 1), s.grid, fp, FootprintKernel::cell, 1, s.poses);
+  std::vector<parallel::CellBox> box(n);
+  for (std::size_t i = 0; i < n; ++i)
+    box[i] = parallel::CellBox::of(std::span(fp.cell.data() + fp.offsets[i], fp.offsets[i + 1] - fp.offsets[i]), nx, ny);
+  const std::vector<std::uint8_t> interior_row(static_cast<std::size_t>(ny), 0);
+  const std::vector<std::uint8_t> kind0(s.grid.size(), kOpen);
+  std::size_t read_full = 0, read_meet = 0, misses = 0, tries = 0;
+  for (const int ranks : {2, 3, 7})
+    for (const bool strips : {true, false}) {
+      CAPTURE(ranks);
+      CAPTURE(strips);
+      const std::vector<int> row_owner = parallel::row_owners(slabs(ranks, ny, false));
+      std::vector<int> owner(n);
+      for (std::size_t i = 0; i < n; ++i)
+        owner[i] = strips ? row_owner[static_cast<std::size_t>(parallel::grid_row(s.poses[i].y, s.grid.dy(), ny))]
+                          : static_cast<int>(i % static_cast<std::size_t>(ranks));
+      // Each rank's box of its pieces' cells, the first cell first.
+      std::vector<parallel::CellBox> rank_box(static_cast<std::size_t>(ranks));
+      for (int r = 0; r < ranks; ++r) {
+        std::vector<std::uint32_t> cells;
+        for (std::size_t i = 0; i < n; ++i)
+          if (owner[i] == r) cells.insert(cells.end(), fp.cell.begin() + fp.offsets[i], fp.cell.begin() + fp.offsets[i + 1]);
+        rank_box[static_cast<std::size_t>(r)] = parallel::CellBox::of(cells, nx, ny);
+      }
+      const std::size_t words = (static_cast<std::size_t>(ranks) + 63) / 64;
+      for (int r = 0; r < ranks; ++r) {
+        CAPTURE(r);
+        std::vector<std::uint32_t> others, meet;
+        for (std::uint32_t j = 0; j < n; ++j)
+          if (owner[j] != r) {
+            others.push_back(j);
+            if (boxes_meet(box[j], rank_box[static_cast<std::size_t>(r)], nx, ny)) meet.push_back(j);
+            // Symmetric, as the test of two arcs is.
+            CHECK(boxes_meet(box[j], rank_box[static_cast<std::size_t>(r)], nx, ny) ==
+                  boxes_meet(rank_box[static_cast<std::size_t>(r)], box[j], nx, ny));
+          }
+        std::vector<std::uint8_t> kind_full = kind0;
+        SharedMarks full;
+        mark_shared_cells(others, box, owner, nx, ny, interior_row, kind_full, kOpen, kShared, words, full);
+        std::vector<parallel::CellBox> poisoned_box(n);
+        for (parallel::CellBox& b : poisoned_box) {
+          b.first_cell = 0;
+          b.row_hi = static_cast<std::int16_t>(ny - 1);
+          b.column_hi = static_cast<std::int16_t>(nx - 1);
+        }
+        for (const std::uint32_t j : meet) poisoned_box[j] = box[j];
+        std::vector<std::uint8_t> kind_meet = kind0;
+        SharedMarks marks;
+        mark_shared_cells(meet, poisoned_box, owner, nx, ny, interior_row, kind_meet, kOpen, kShared, words, marks);
+        const Read a = read_marks(fp, owner, r, interior_row, kind_full, full, nx);
+        const Read b = read_marks(fp, owner, r, interior_row, kind_meet, marks, nx);
+        CHECK(a.shared == b.shared);
+        CHECK(a.ranks == b.ranks);
+        read_full += others.size();
+        read_meet += meet.size();
+        // The mutation: each box that meets left out in turn.
+        for (std::size_t q = 0; q < meet.size(); ++q) {
+          std::vector<std::uint32_t> less = meet;
+          less.erase(less.begin() + static_cast<std::ptrdiff_t>(q));
+          std::vector<std::uint8_t> kind_less = kind0;
+          SharedMarks less_marks;
+          mark_shared_cells(less, box, owner, nx, ny, interior_row, kind_less, kOpen, kShared, words, less_marks);
+          const Read t = read_marks(fp, owner, r, interior_row, kind_less, less_marks, nx);
+          ++tries;
+          if (t.shared != a.shared || t.ranks != a.ranks) ++misses;
+        }
+      }
+    }
+  MESSAGE("boxes read " << read_meet << " of " << read_full << "; one box left out changed the marks in " << misses
+                        << " of " << tries);
+  CHECK(read_meet < read_full);
+  CHECK(misses > 0);
 }
 
 TEST_CASE("the footprints' window test over each rank's own floes, agreed by one minimum, is the whole verdict (simulated ranks, lured poses)") {
