@@ -55,7 +55,7 @@ usage: bench/scaling_model.py [--step-ms 22.6] [--fft-share 0.13] [--pieces-per-
                               [--alpha-us 2] [--node-gbs 12.5] [--ranks-per-node 32]
                               [--memory-gbs 5] [--whole-bytes-explicit 0.8] [--whole-bytes-implicit ...]
                               [--whole-pass-ns ...] [--floe-memory-bytes 400] [--no-whole]
-                              [--build build] [--csv FILE | -]
+                              [--build build] [--pack bench/ocean/ocean_pack.h5] [--csv FILE | -]
 """
 import argparse
 import math
@@ -113,6 +113,8 @@ ap.add_argument("--node-gbs", type=float, default=12.5, help="a node's network b
 ap.add_argument("--ranks-per-node", type=int, default=32)
 ap.add_argument("--memory-gbs", type=float, default=5.0, help="a rank's copy bandwidth within a node, GB/s")
 ap.add_argument("--build", default=os.path.join(ROOT, "build"), help="where floesim is, to write the pack if missing")
+ap.add_argument("--pack", default=os.path.join(HERE, "ocean", "ocean_pack.h5"),
+                help="bench/ocean's pack (written there by the build's floesim if missing)")
 ap.add_argument("--csv", default="-")
 args = ap.parse_args()
 
@@ -124,7 +126,7 @@ TRANSFORMS_EXPLICIT = 2    # one forward (the kick), one backward (the elevation
 
 def pack_radii():
     """Centroids, circumradii and window of bench/ocean's pack (one rank's share)."""
-    pack = os.path.join(HERE, "ocean", "ocean_pack.h5")
+    pack = args.pack
     if not os.path.exists(pack):
         floesim = os.path.join(args.build, "bin", "floesim")
         if not os.access(floesim, os.X_OK):
