@@ -102,6 +102,9 @@ void FloeSeaContact::place_midpoint_footprints(const Floes& floes, std::span<con
     for (std::size_t i = 0; i < every.size(); ++i) every[i] = static_cast<std::uint32_t>(i);
     pose_at_midpoint(floes, start, every);
   }
+  place_owner_ = {};  // offered for this placement only (evaluate()'s rule)
+  place_rows_ = {};
+  place_mine_ = {};
   place_footprints(floes, move, given.owner);
 }
 

@@ -441,6 +441,9 @@ void Simulation::sea_flow(const StepContext& ctx) {
   }
   floe_sea_->kick_sea(*sea_, 0.5 * ctx.dt);
   if (slabs_to_follow_) follow_slabs();  // the kick above took the pressure on the slabs it was summed on
+  // The implicit step's midpoint footprints: a rebuild takes the drift's
+  // owners by place, which hold their floes (as the half kick's evaluation).
+  if (floe_sea_->implicit()) offer_place_owners();
   floe_sea_->advance_vertical(scenario_.floes, ctx.start, *sea_, ctx.dt, held_now());
 }
 
