@@ -290,9 +290,11 @@ public:
   // the same routes make every cell's sums on every rank
   // (parallel::CellRoutes::replicated: a cell under another rank's floe's
   // box as pieces to every rank, any other cell's pressure as its total),
-  // the serial sums to the bit too. The implicit step
-  // stays replicated on every floe's pieces (gathered), to the bit, its
-  // floes posed and built by the drift's owners (next_owners_). Every
+  // the serial sums to the bit too. The implicit step runs by owner on a
+  // sea in slabs too (implicit_step: each rank its floes' pieces, the
+  // products through cell_product); on a sea whole on every rank it stays
+  // replicated on every floe's pieces (gathered), to the bit, its floes
+  // posed and built by the drift's owners (next_owners_). Every
   // rank calls every method in the same order (they may exchange data).
   void set_communicator(const parallel::Communicator& comm) {
     comm_ = comm;
@@ -388,7 +390,8 @@ public:
   // `cells` and `response` are rows [first_row, first_row + rows) of the grid
   // (x fastest; `response` to be filled); out[k] = the response at piece
   // k's cell. u and out: one value a piece of footprints().
-  // - By owner on a sea in slabs (explicit kicks today): this rank's pieces;
+  // - By owner on a sea in slabs (the implicit step's products and free
+  //   elevation; scatter_to_slab alone for its midpoint_step): this rank's pieces;
   //   a cell summed here alone (its pieces all this rank's) adds them
   //   here, one of another slab then sent to its rank as the total; a
   //   shared cell's pieces travel to the ranks the coverage's open named
