@@ -15,7 +15,7 @@ through the cells' routes and the slab sea, the dots' exact sums over the
 ranks, and the vertical DOFs all-gathered after the solve. The floes' whole
 states go to the ranks that hold them only (the drift's exchange), and the
 drift's owners pose and build their floes' pieces at the step's midpoint.
-Four cases, in each of which a rank does not hold some floes on 2 ranks:
+Five cases, in each of which a rank does not hold some floes on 2 ranks:
   - bem: check_whole_seas.py's BEM basin (150 floes, 12 m x 6 m, walls) with
     the implicit step, to 2 s (100 steps);
   - ocean: ranks_harness's small ocean (120 floes in the lower half of a
@@ -23,6 +23,8 @@ Four cases, in each of which a rank does not hold some floes on 2 ranks:
     holds no floe at first, and the slabs move (load balance: checked);
   - slabs: a bench-like periodic ocean in slabs, 300 floes over the whole
     200 m box, to 2 s;
+  - moved: slabs to 1 s with footprint_reach = 0.3 (the footprints moved by
+    their owners between rebuilds: 40 moves, 1 rebuild);
   - tank: examples/wave_tank_disc.toml (one disc in a tank) to 2 s.
 Checked:
   - on 2 and 3 ranks the run file equals the serial one bit for bit
@@ -36,7 +38,7 @@ Checked:
     does not hold NaN, or wrong but finite, after each exchange; the
     vertical DOFs, which every rank holds, checked in every floe): bit for
     bit, no phase reported, floes poisoned on bem and ocean;
-  - ocean and slabs run with the sea in slabs (parallel.slab_rows printed,
+  - ocean, slabs and moved run with the sea in slabs (parallel.slab_rows printed,
     N + 1 cuts), and the ocean's slabs move on 2 ranks (parallel.strip_moves);
   - the bem and slabs cases stopped half-way on 2 ranks and continued from
     their checkpoints on 3 ranks equal the serial run bit for bit.
@@ -49,7 +51,8 @@ and the restart; the implicit step's zero vertical kick kept (kick_floes,
 whose tilt term reads the yaw): the ocean's `step` run fails, the tank's
 reports NaN. In slabs (slabs30): the dots' partials summed as doubles in
 rank order, the answer route off, and the self-response from each rank's own
-slab's first node each make ocean and slabs differ on 2 and 3 ranks.
+slab's first node each make ocean and slabs differ on 2 and 3 ranks (the answer route off:
+ocean's runs and slabs' on 3 ranks fail with an error).
 """
 import os
 import sys
@@ -92,9 +95,10 @@ CASES = {  # name: (configuration, --until, floes whose drift bytes are bounded 
     "bem": (BEM, [], 150),
     "ocean": (ocean_toml("half_pack.h5", 5.0, 2.5, coupling=IMPLICIT), [], 120),
     "slabs": (ocean_toml("slabs_pack.h5", 2.0, 0.5, coupling=IMPLICIT), [], 300),
+    "moved": (ocean_toml("slabs_pack.h5", 1.0, 0.5, coupling=IMPLICIT + "footprint_reach = 0.3\n"), [], 300),
     "tank": ((EXAMPLES / "wave_tank_disc.toml").read_text(), ["--until", "2"], None),
 }
-SLABS = ("ocean", "slabs")  # a spectral sea, dims = 2, no tank: in slabs
+SLABS = ("ocean", "slabs", "moved")  # a spectral sea, dims = 2, no tank: in slabs
 for name, (text, until, floes) in CASES.items():
     config = os.path.join(W, f"{name}.toml")
     with open(config, "w") as f:
