@@ -131,7 +131,7 @@ void FloeSeaContact::floes_changed(const Floes& floes, std::span<const int> owne
   // owners, the next rebuild is by index (every floe posed), or on the
   // slabs by every floe's place: every copy must then be current (the
   // start, a restore).
-  if (!owner.empty() && (routes_.replicated() || implicit_)) {
+  if (!owner.empty() && (routes_.replicated() || implicit_whole())) {
     FLOESIM_ASSERT(owner.size() == n);
     set_next_owners(owner);
     next_owners_.current = true;

@@ -290,9 +290,11 @@ public:
   // the same routes make every cell's sums on every rank
   // (parallel::CellRoutes::replicated: a cell under another rank's floe's
   // box as pieces to every rank, any other cell's pressure as its total),
-  // the serial sums to the bit too. The implicit step
-  // stays replicated on every floe's pieces (gathered), to the bit, its
-  // floes posed and built by the drift's owners (next_owners_). Every
+  // the serial sums to the bit too. The implicit step runs by owner on a
+  // sea in slabs too (implicit_step: each rank its floes' pieces, the
+  // products through cell_product); on a sea whole on every rank it stays
+  // replicated on every floe's pieces (gathered), to the bit, its floes
+  // posed and built by the drift's owners (next_owners_). Every
   // rank calls every method in the same order (they may exchange data).
   void set_communicator(const parallel::Communicator& comm) {
     comm_ = comm;
@@ -390,7 +392,8 @@ public:
   // `cells` and `response` are rows [first_row, first_row + rows) of the grid
   // (x fastest; `response` to be filled); out[k] = the response at piece
   // k's cell. u and out: one value a piece of footprints().
-  // - By owner on a sea in slabs (explicit kicks today): this rank's pieces;
+  // - By owner on a sea in slabs (the implicit step's products and free
+  //   elevation; scatter_to_slab alone for its midpoint_step): this rank's pieces;
   //   a cell summed here alone (its pieces all this rank's) adds them
   //   here, one of another slab then sent to its rank as the total; a
   //   shared cell's pieces travel to the ranks the coverage's open named
@@ -483,8 +486,13 @@ private:
   void place_footprints(const Floes& floes, bool move, std::span<const int> owners = {});
   // Zeroes pressure_ and cells_ where the present footprints lie.
   void clear_footprint_cells();
-  // The contact is evaluated by owner: several ranks, explicit kicks.
-  bool by_owner() const { return !comm_.serial() && !implicit_; }
+  // The contact is evaluated by owner: several ranks, with the explicit
+  // kicks on any sea, with the implicit step on a sea in slabs (spectral,
+  // dims = 2, no tank: slab_rows_ not empty). The implicit step on a sea
+  // whole on every rank (BEM, a tank, dims = 1) solves every floe's pieces
+  // on every rank (implicit_whole()).
+  bool by_owner() const { return !comm_.serial() && (!implicit_ || !slab_rows_.empty()); }
+  bool implicit_whole() const { return implicit_ && !by_owner(); }
   // The footprints' version: it changes whenever the pieces do, at a
   // placement (moved or rebuilt) or a rebuild without one (the start, a
   // restore).
@@ -584,6 +592,17 @@ private:
   // The sea's part of the implicit step's operator: out = G_sea u on the
   // pieces (coupling/penalty_step.hpp).
   void sea_response(fluid::Sea& sea, double h, std::span<const double> u, std::span<double> out);
+  // By owner on a sea in slabs, the first half of cell_product: grid_work_
+  // <- on this rank's slab rows, each cell's sum_k scale u[k] over every
+  // rank's pieces in it (the serial sum); scatter_clear() zeroes what it
+  // wrote (grid_work_ is zero between products). Collective.
+  void scatter_to_slab(std::span<const double> u, double scale);
+  void scatter_clear();
+  // By owner, after the solve: every floe's vertical DOFs (heave, pitch,
+  // roll and their rates, 48 B a floe) from its coupling owner to every
+  // rank, which holds them all as the whole path does (the poison mode's
+  // hold_vertical). One all-gather.
+  void share_vertical(Floes& floes) const;
   // grid_work_ <- the pressures u_k / cell area of the pieces, each cell's
   // summed from zero in the coverage's serial order (order_, each floe's
   // pieces in their order: the cells' sums of the explicit step), so that

@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <sstream>
 
 #include <Eigen/Dense>
@@ -41,6 +42,21 @@ void FloeSeaContact::pressure_of_pieces(std::span<const double> u) {
 
 void FloeSeaContact::sea_response(fluid::Sea& sea, double h, std::span<const double> u, std::span<double> out) {
   const Footprints& fp = footprints_.pieces();
+  if (by_owner()) {
+    // The same sums and response through the cells' routes (cell_product):
+    // the slab's rows of grid_work_ hold the cells' serial sums, and the
+    // slab sea reads and writes its rows of whole-grid arrays (p, eta), the
+    // rows cell_product hands over.
+    cell_product(u, 1.0 / cell_area_,
+                 [&](int, [[maybe_unused]] std::span<const double> cells, [[maybe_unused]] std::span<double> response) {
+                   FLOESIM_ASSERT(cells.empty() || (cells.data() >= grid_work_.data() &&
+                                                    response.data() - grid_eta_.data() == cells.data() - grid_work_.data()));
+                   sea.midpoint_response(grid_work_, h, grid_eta_);
+                 },
+                 out);
+    for (double& v : out) v = -v;
+    return;
+  }
   // The pressure of the forces u, held over h, lowers the nodes by the
   // sea's midpoint response (G_sea u is minus that change).
   pressure_of_pieces(u);
@@ -86,11 +102,15 @@ void FloeSeaContact::place_midpoint_footprints(const Floes& floes, std::span<con
     for (std::size_t i = 0; i < every.size(); ++i) every[i] = static_cast<std::uint32_t>(i);
     pose_at_midpoint(floes, start, every);
   }
+  place_owner_ = {};  // offered for this placement only (evaluate()'s rule)
+  place_rows_ = {};
+  place_mine_ = {};
   place_footprints(floes, move, given.owner);
 }
 
 void FloeSeaContact::gather_tilted_yaw(const Floes& floes) {
-  if (comm_.serial()) {
+  // By owner order_ is this rank's floes, whose present yaw it holds.
+  if (comm_.serial() || by_owner()) {
     for (const std::uint32_t i : order_) implicit_floes_.yaw[i] = floes.state[i].yaw;
     return;
   }
@@ -117,10 +137,12 @@ void FloeSeaContact::implicit_step(Floes& floes, std::span<const FloeState> star
   const Footprints& fp = footprints_.pieces();
   const std::size_t n = fp.cell.size();
   // Each floe's vertical inertia on the DOFs it has, at its present yaw.
-  // The solve is every rank's, over every floe's pieces; what it reads of
-  // each floe is its vertical DOFs, which every rank holds current (the
-  // solve alone writes them, alike on every rank, and the explicit kicks do
-  // not: kick_floes), its constants, and its yaw, from its owner.
+  // By owner (a sea in slabs) each rank solves over its own floes' pieces,
+  // whose states it holds; else the solve is every rank's, over every
+  // floe's pieces, and what it reads of each floe is its vertical DOFs,
+  // which every rank holds current (the solve alone writes them, alike on
+  // every rank: share_vertical by owner; the explicit kicks do not:
+  // kick_floes), its constants, and its yaw, from its owner.
   gather_tilted_yaw(floes);
   std::fill(implicit_floes_.inertia.begin(), implicit_floes_.inertia.end(), VerticalInertia{});
   for (std::uint32_t i : order_) {
@@ -148,7 +170,13 @@ void FloeSeaContact::implicit_step(Floes& floes, std::span<const FloeState> star
   const double ks = s_ * kappa_;
   double scale = 0.0;  // the thickest draft: the residual's unit
   for (std::uint32_t i : order_) scale = std::max(scale, floes.draft(i, rho_));
-  const std::span<const double> eta0 = sea.elevation();
+  if (by_owner()) scale = comm_.max(scale);  // over every rank's floes: exact
+  // The elevation at t as evaluate() reads it: by place, this rank's pieces
+  // lie within reach_rows() of its slab, the halo exchanged there only.
+  const bool halo = routed() && footprints_.by_place();
+  if (halo) sea.set_field_halo(footprints_.reach_rows());
+  const fluid::RowWindow eta0 = sea.field(fluid::Field::elevation);
+  if (halo) sea.set_field_halo(-1);
   for_each_floe(order_, threads_, [&](std::uint32_t i) {
     const FloeState& st = floes.state[i];
     const double z = st.heave + constants_.bottom0[i];
@@ -163,11 +191,29 @@ void FloeSeaContact::implicit_step(Floes& floes, std::span<const FloeState> star
       q.start[k] = eta0[fp.cell[k]] - z - a.dot(fp.centroid[k]);
     }
   });
-  sea.midpoint_free_elevation(h, grid_eta_);
+  // The free elevation at t + h at each piece's cell, into free_end. By
+  // owner the slab sea computes its rows only, and a piece in another slab
+  // reads its cell from that slab's rank by the answer route (the coverage's
+  // routes, no pressure scattered: zero values): the field's halo window is
+  // the elevation's at t, not this midpoint extrapolation, which exists on
+  // its slab's rank alone.
+  if (by_owner()) {
+    const std::vector<double> none(n, 0.0);
+    cell_product(none, 0.0,
+                 [&](int, std::span<const double>, [[maybe_unused]] std::span<double> response) {
+                   FLOESIM_ASSERT(response.empty() || response.data() >= grid_eta_.data());
+                   sea.midpoint_free_elevation(h, grid_eta_);
+                 },
+                 q.free_end);
+  } else {
+    sea.midpoint_free_elevation(h, grid_eta_);
+    for (const std::uint32_t i : order_)
+      for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k) q.free_end[k] = grid_eta_[fp.cell[k]];
+  }
   for_each_floe(order_, threads_, [&](std::uint32_t i) {
     const Eigen::Vector3d& b = implicit_floes_.free_bottom[i];
     for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k)
-      q.free_end[k] = grid_eta_[fp.cell[k]] - b[0] - b[1] * fp.centroid[k].x() - b[2] * fp.centroid[k].y();
+      q.free_end[k] = q.free_end[k] - b[0] - b[1] * fp.centroid[k].x() - b[2] * fp.centroid[k].y();
   });
   // The sea's response on a node to its own pressure over h: the diagonal of
   // G_sea, for the preconditioner (a periodic sea's is the same on every node).
@@ -177,9 +223,19 @@ void FloeSeaContact::implicit_step(Floes& floes, std::span<const FloeState> star
                                static_cast<std::size_t>(grid_.nx / 2);
     const std::size_t node = grid_.edge == fluid::GridEdge::periodic ? 0 : middle;
     grid_work_[node] = 1.0;
-    sea.midpoint_response(grid_work_, h, grid_eta_);
+    sea.midpoint_response(grid_work_, h, grid_eta_);  // collective in slabs
     grid_work_[node] = 0.0;
     self_response_ = std::max(-grid_eta_[node], 0.0);
+    if (by_owner()) {
+      // In slabs only the rank whose slab holds the node's row has it: its
+      // value to every rank (8 B), so that every rank's preconditioner is
+      // the serial one.
+      const int row = static_cast<int>(node / static_cast<std::size_t>(grid_.nx));
+      int root = 0;
+      while (root + 1 < comm_.size() && slab_rows_[static_cast<std::size_t>(root) + 1] <= row) ++root;
+      const std::vector<std::byte> got = comm_.broadcast(std::as_bytes(std::span(&self_response_, 1)), root);
+      std::memcpy(&self_response_, got.data(), sizeof(double));
+    }
     self_response_h_ = h;
   }
 
@@ -197,6 +253,12 @@ void FloeSeaContact::implicit_step(Floes& floes, std::span<const FloeState> star
   problem.tolerance = newton_tolerance_ * std::max(scale, 1e-300);
   PenaltyStepOptions options = solver_options_;
   options.threads = threads_;
+  if (by_owner()) {
+    // The bodies are this rank's floes: the dots' exact partial sums added
+    // over the ranks as integers, the largest residual over the ranks.
+    options.reduction.sum = [this](std::span<ExactSum> sums) { comm_.sum(sums); };
+    options.reduction.max = [this](double value) { return comm_.max(value); };
+  }
   const PenaltyStepResult result = solver_.solve(
       problem, [&](std::span<const double> u, std::span<double> out) { sea_response(sea, h, u, out); }, options);
   ++implicit_stats_.steps;
@@ -227,19 +289,51 @@ void FloeSeaContact::implicit_step(Floes& floes, std::span<const FloeState> star
     st.pitch_rate += h * acc[1];
     st.roll_rate += h * acc[2];
   }
-  // Floes with no pieces (outside the sea) drift, as with the explicit kicks.
+  // Floes with no pieces (outside the sea) drift, as with the explicit kicks
+  // (by owner, each by its coupling owner, whose pieces it would be).
   for (std::size_t i = 0; i < floes.size(); ++i) {
-    if (!constants_.dynamic[i] || fp.offsets[i] < fp.offsets[i + 1]) continue;
+    if (!constants_.dynamic[i] || fp.offsets[i] < fp.offsets[i + 1] || (by_owner() && !footprints_.owns(i))) continue;
     FloeState& st = floes.state[i];
     st.heave += h * st.heave_rate;
     st.pitch += h * st.pitch_rate;
     st.roll += h * st.roll_rate;
   }
-  // ... and the sea.
-  pressure_of_pieces(f);
-  sea.midpoint_step(grid_work_, h);
-  for (std::size_t k = 0; k < n; ++k) grid_work_[fp.cell[k]] = 0.0;
+  if (by_owner()) share_vertical(floes);
+  // ... and the sea (by owner, the cells' sums through the routes, as a
+  // product's).
+  if (by_owner()) {
+    scatter_to_slab(f, 1.0 / cell_area_);
+    sea.midpoint_step(grid_work_, h);
+    scatter_clear();
+  } else {
+    pressure_of_pieces(f);
+    sea.midpoint_step(grid_work_, h);
+    for (std::size_t k = 0; k < n; ++k) grid_work_[fp.cell[k]] = 0.0;
+  }
   if (step_mean_loads_) step_mean_horizontal(floes, start);
+}
+
+void FloeSeaContact::share_vertical(Floes& floes) const {
+  struct Vertical {
+    double heave, pitch, roll, heave_rate, pitch_rate, roll_rate;
+  };
+  std::vector<Vertical> v(floes.size(), Vertical{});
+  for (std::size_t i = 0; i < floes.size(); ++i)
+    if (constants_.dynamic[i] && footprints_.owns(i)) {
+      const FloeState& st = floes.state[i];
+      v[i] = {st.heave, st.pitch, st.roll, st.heave_rate, st.pitch_rate, st.roll_rate};
+    }
+  comm_.complete_owned(v, footprints_.owners());
+  for (std::size_t i = 0; i < floes.size(); ++i)
+    if (constants_.dynamic[i] && !footprints_.owns(i)) {
+      FloeState& st = floes.state[i];
+      st.heave = v[i].heave;
+      st.pitch = v[i].pitch;
+      st.roll = v[i].roll;
+      st.heave_rate = v[i].heave_rate;
+      st.pitch_rate = v[i].pitch_rate;
+      st.roll_rate = v[i].roll_rate;
+    }
 }
 
 void FloeSeaContact::step_mean_horizontal(const Floes& floes, std::span<const FloeState> start) {
@@ -270,13 +364,32 @@ void FloeSeaContact::step_mean_horizontal(const Floes& floes, std::span<const Fl
     }
     evaluated_.wetted[i] = wet;
   });
-  for (std::uint32_t i : order_)
-    for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k)
-      if (u[k] > 0.0) cells_[fp.cell[k]].sum += fp.area[k] * u[k] * u[k];
+  if (by_owner()) {
+    // The cells' sums of a u^2 through the routes, as an evaluation's (no
+    // force: the pressure it writes is zero). Its energy terms are not the
+    // penalty energy's: the last evaluation's are kept.
+    OwnerCells& o = owner_;
+    std::vector<parallel::PieceKey> keys = std::move(o.energy_keys);
+    std::vector<std::uint32_t> counts = std::move(o.energy_counts);
+    std::vector<double> terms = std::move(o.energy_terms);
+    const bool pending = energy_pending_;
+    eval_.force.assign(fp.cell.size(), 0.0);
+    sum_cells_by_owner(s_ * kappa_);
+    o.energy_keys = std::move(keys);
+    o.energy_counts = std::move(counts);
+    o.energy_terms = std::move(terms);
+    energy_pending_ = pending;
+  } else {
+    for (std::uint32_t i : order_)
+      for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k)
+        if (u[k] > 0.0) cells_[fp.cell[k]].sum += fp.area[k] * u[k] * u[k];
+  }
+  // Zero for a floe without pieces on this footprint; by owner its owner's
+  // zero reaches every rank (share_owned).
+  for (FloeSeaLoad& load : kicks_.loads) load.horizontal = Eigen::Vector3d::Zero();
   horizontal_loads(u);
   share_owned();
-  std::fill(kicks_.step_horizontal.begin(), kicks_.step_horizontal.end(), Eigen::Vector3d::Zero());
-  for (std::uint32_t i : order_) kicks_.step_horizontal[i] = kicks_.loads[i].horizontal;
+  for (std::size_t i = 0; i < kicks_.loads.size(); ++i) kicks_.step_horizontal[i] = kicks_.loads[i].horizontal;
   step_mean_pending_ = true;
 }
 

@@ -140,7 +140,7 @@ FloeSeaContact::GivenOwners FloeSeaContact::given_owners(std::size_t floes) {
   // of the floes they hold; with the implicit step (whose vertical DOFs
   // every rank holds, next_owners_) from the drift's exchange on...
   const NextOwners& next = next_owners_;
-  if (next.owner.size() == floes && (next.drifted || (implicit_ && next.current))) return {next.owner, next.mine};
+  if (next.owner.size() == floes && (next.drifted || (implicit_whole() && next.current))) return {next.owner, next.mine};
   // ...or, not in slabs, the last rebuild's owners kept: each holds its
   // floes current (own_floes()), so a rebuild before the new owners hold
   // theirs (a first half kick with stale loads, a redone try) poses only
@@ -593,7 +593,7 @@ void FloeSeaContact::hand_water_over(std::span<const int> drift_owner) {
   // implicit step's sea too) they are these owners from the next rebuild on
   // (next_owners_), but in a flume with the explicit kicks (shares of its
   // columns).
-  if ((routes_.replicated() || implicit_) && next_owners_.column.empty() &&
+  if ((routes_.replicated() || implicit_whole()) && next_owners_.column.empty() &&
       drift_owner.size() == constants_.dynamic.size())
     set_next_owners(drift_owner);
   // The drift's exchange that follows sends each floe's state to its next

@@ -51,13 +51,40 @@ void FloeSeaContact::cell_product(std::span<const double> u, double scale, const
     for (const std::uint32_t c : fp.cell) grid_work_[c] = 0.0;
     return;
   }
-  FLOESIM_ASSERT(in_slabs() && owner_.routes_footprints == footprint_version());
+  scatter_to_slab(u, scale);
+  // The response on this rank's slab, every cell's value there being the
+  // serial sum (zero where no piece lies); then the responses at the
+  // cells of this rank's pieces in other slabs, from their ranks.
   const OwnerCells& o = owner_;
   ProductScratch& p = product_;
   const int rank = comm_.rank();
-  // The scatter: the routed pieces' values listed by the coverage's pass
-  // (routed_pieces, in order_'s order as this loop meets them), every other
-  // piece added into its cell here.
+  const std::size_t nx = static_cast<std::size_t>(grid_.nx);
+  const std::size_t first = static_cast<std::size_t>(slab_rows_[static_cast<std::size_t>(rank)]) * nx;
+  const std::size_t count = static_cast<std::size_t>(slab_rows_[static_cast<std::size_t>(rank) + 1]) * nx - first;
+  const std::span<double> slab_eta = std::span(grid_eta_).subspan(first, count);
+  respond(slab_rows_[static_cast<std::size_t>(rank)], std::span<const double>(grid_work_).subspan(first, count), slab_eta);
+  p.cells_answer.resize(o.cells.size());
+  p.alone_answer.resize(o.alone.size());
+  routes_.answer(comm_, slab_eta, p.cells_answer, p.alone_answer);
+  p.stats.answer_bytes += static_cast<long long>(routes_.received_from_others());
+  // (A routed cell of this slab comes back with its own value.)
+  for (std::size_t j = 0; j < o.cells.size(); ++j) grid_eta_[o.cells[j]] = p.cells_answer[j];
+  for (std::size_t j = 0; j < o.alone.size(); ++j) grid_eta_[o.alone[j]] = p.alone_answer[j];
+  for (const std::uint32_t i : order_)
+    for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k) out[k] = grid_eta_[fp.cell[k]];
+  scatter_clear();
+}
+
+void FloeSeaContact::scatter_to_slab(std::span<const double> u, double scale) {
+  FLOESIM_ASSERT(in_slabs() && owner_.routes_footprints == footprint_version());
+  const Footprints& fp = footprints_.pieces();
+  if (grid_work_.size() != grid_.size()) grid_work_.assign(grid_.size(), 0.0);
+  const OwnerCells& o = owner_;
+  ProductScratch& p = product_;
+  const int rank = comm_.rank();
+  // The routed pieces' values listed by the coverage's pass (routed_pieces,
+  // in order_'s order as this loop meets them), every other piece added
+  // into its cell here.
   p.parts.assign(o.first.back(), 0.0);
   std::size_t next = 0;
   for (const std::uint32_t i : order_)
@@ -77,28 +104,13 @@ void FloeSeaContact::cell_product(std::span<const double> u, double scale, const
     if (routes_.holds(rank, held[j])) grid_work_[held[j]] = routes_.total(j, 0);
   const std::span<const std::uint32_t> alone_here = routes_.alone_owned();
   for (std::size_t j = 0; j < alone_here.size(); ++j) grid_work_[alone_here[j]] = routes_.alone_total(j);
-  // The response on this rank's slab, every cell's value there being the
-  // serial sum (zero where no piece lies); then the responses at the
-  // cells of this rank's pieces in other slabs, from their ranks.
-  const std::size_t nx = static_cast<std::size_t>(grid_.nx);
-  const std::size_t first = static_cast<std::size_t>(slab_rows_[static_cast<std::size_t>(rank)]) * nx;
-  const std::size_t count = static_cast<std::size_t>(slab_rows_[static_cast<std::size_t>(rank) + 1]) * nx - first;
-  const std::span<double> slab_eta = std::span(grid_eta_).subspan(first, count);
-  respond(slab_rows_[static_cast<std::size_t>(rank)], std::span<const double>(grid_work_).subspan(first, count), slab_eta);
-  p.cells_answer.resize(o.cells.size());
-  p.alone_answer.resize(o.alone.size());
-  routes_.answer(comm_, slab_eta, p.cells_answer, p.alone_answer);
-  p.stats.answer_bytes += static_cast<long long>(routes_.received_from_others());
-  // (A routed cell of this slab comes back with its own value.)
-  for (std::size_t j = 0; j < o.cells.size(); ++j) grid_eta_[o.cells[j]] = p.cells_answer[j];
-  for (std::size_t j = 0; j < o.alone.size(); ++j) grid_eta_[o.alone[j]] = p.alone_answer[j];
-  for (const std::uint32_t i : order_)
-    for (std::size_t k = fp.offsets[i]; k < fp.offsets[i + 1]; ++k) out[k] = grid_eta_[fp.cell[k]];
-  // grid_work_ back to zero: the cells of this rank's pieces and those the
-  // routes wrote.
-  for (const std::uint32_t c : fp.cell) grid_work_[c] = 0.0;
-  for (const std::uint32_t c : held) grid_work_[c] = 0.0;
-  for (const std::uint32_t c : alone_here) grid_work_[c] = 0.0;
+}
+
+void FloeSeaContact::scatter_clear() {
+  // The cells of this rank's pieces and those the routes wrote.
+  for (const std::uint32_t c : footprints_.pieces().cell) grid_work_[c] = 0.0;
+  for (const std::uint32_t c : routes_.owned()) grid_work_[c] = 0.0;
+  for (const std::uint32_t c : routes_.alone_owned()) grid_work_[c] = 0.0;
 }
 
 }  // namespace floesim

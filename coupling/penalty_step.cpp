@@ -74,12 +74,11 @@ void PenaltyStepSolver::precondition(const PenaltyStepProblem& p, std::span<cons
   });
 }
 
-std::array<double, 2> PenaltyStepSolver::dots(const PenaltyStepProblem& p, std::span<const double> a,
-                                              std::span<const double> b, std::span<const double> c,
-                                              std::span<const double> d) {
+std::array<double, 2> PenaltyStepSolver::reduce_dots(const PenaltyStepProblem& p, std::span<const double> a,
+                                                     std::span<const double> b, std::span<const double> c,
+                                                     std::span<const double> d, bool two) {
   // Each body's terms in its pieces' order, on any thread (the same bits);
   // then the bodies' partials exactly, in whatever order they are listed.
-  const bool two = !c.empty();
   const std::size_t m = p.bodies.size();
   partial_.resize(2 * m);
   for_each_index(m, threads_, [&](std::size_t j) {
@@ -130,7 +129,7 @@ long PenaltyStepSolver::conjugate_gradients(const PenaltyStepProblem& p, const S
     for_each_index(n, threads, [&](std::size_t k) { tmp_[k] = sq_[k] * dir_[k]; });
     apply_g(p, sea, tmp_, gdir_, threads);
     for_each_index(n, threads, [&](std::size_t k) { Ap_[k] = dir_[k] + sq_[k] * gdir_[k]; });
-    const double alpha = rz / dots(p, dir_, Ap_)[0];
+    const double alpha = rz / dot(p, dir_, Ap_);
     for_each_index(n, threads, [&](std::size_t k) {
       w_[k] += alpha * dir_[k];
       gsw_[k] += alpha * gdir_[k];
@@ -199,12 +198,12 @@ PenaltyStepResult PenaltyStepSolver::solve(const PenaltyStepProblem& p, const Se
     for_each_index(n, threads, [&](std::size_t k) { step_[k] = -R_[k] - gsw_[k]; });
     // Backtracking on the residual's 2-norm (the accepted trial's is the
     // next step's: one reduction a trial).
-    if (norm2 < 0.0) norm2 = std::sqrt(dots(p, R_, R_)[0]);
+    if (norm2 < 0.0) norm2 = std::sqrt(dot(p, R_, R_));
     double t = 1.0, norm2_new = 0.0;
     for (;;) {
       for_each_index(n, threads, [&](std::size_t k) { trial_[k] = d1_[k] + t * step_[k]; });
       residual(p, sea, trial_, ftrial_, Rtrial_, threads);
-      norm2_new = std::sqrt(dots(p, Rtrial_, Rtrial_)[0]);
+      norm2_new = std::sqrt(dot(p, Rtrial_, Rtrial_));
       if (norm2_new < (1.0 - 1e-4 * t) * norm2 || t < 1e-6) break;
       t *= 0.5;
     }

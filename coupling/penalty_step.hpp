@@ -162,9 +162,18 @@ private:
   long conjugate_gradients(const PenaltyStepProblem& p, const SeaResponse& sea, double eta, int max_iterations,
                            int threads);
   // The header's "Reductions": {a . b, c . d} over the listed bodies' pieces
-  // in one pass and one reduction call (c, d empty: a . b alone, the second 0).
+  // in one pass and one reduction call; dot: a . b alone. The count is the
+  // caller's, not read from the spans: a process with no pieces has empty
+  // ones and must make the same reduction call as the others.
   std::array<double, 2> dots(const PenaltyStepProblem& p, std::span<const double> a, std::span<const double> b,
-                             std::span<const double> c = {}, std::span<const double> d = {});
+                             std::span<const double> c, std::span<const double> d) {
+    return reduce_dots(p, a, b, c, d, true);
+  }
+  double dot(const PenaltyStepProblem& p, std::span<const double> a, std::span<const double> b) {
+    return reduce_dots(p, a, b, {}, {}, false)[0];
+  }
+  std::array<double, 2> reduce_dots(const PenaltyStepProblem& p, std::span<const double> a, std::span<const double> b,
+                                    std::span<const double> c, std::span<const double> d, bool two);
   // max_k |x_k| over the listed bodies' pieces (every process's).
   double max_abs(const PenaltyStepProblem& p, std::span<const double> x) const;
 

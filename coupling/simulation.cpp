@@ -100,12 +100,11 @@ Simulation::Simulation(Scenario scenario, parallel::Communicator comm)
                       c.sea.tank.rate, c.sea.tank.ramp_periods};
   sea_options.threads = resolve_threads(c.run.threads);
   // On several ranks the spectral sea runs in slabs (docs/parallel.md, stage
-  // four) with the explicit kicks; the implicit step and a tank keep it
-  // whole on every rank. The incident waves' sea (below) runs in slabs
-  // alike (each rank holds its modes, and its fields' and snapshots' slab
-  // and halo rows: the row window).
-  if (!comm_.serial() && c.sea.model == SeaModel::spectral && c.sea.dims == 2 && !c.sea.tank.enabled &&
-      c.coupling.integrator == CouplingIntegrator::explicit_kicks) {
+  // four; with the implicit step too since slabs30: its solve by owner); a
+  // tank keeps it whole on every rank. The incident waves' sea (below) runs
+  // in slabs alike (each rank holds its modes, and its fields' and
+  // snapshots' slab and halo rows: the row window).
+  if (!comm_.serial() && c.sea.model == SeaModel::spectral && c.sea.dims == 2 && !c.sea.tank.enabled) {
     sea_options.ranks = parallel::sea_ranks(comm_);
   }
   const fluid::SeaOptions incident_options = sea_options;
@@ -442,6 +441,9 @@ void Simulation::sea_flow(const StepContext& ctx) {
   }
   floe_sea_->kick_sea(*sea_, 0.5 * ctx.dt);
   if (slabs_to_follow_) follow_slabs();  // the kick above took the pressure on the slabs it was summed on
+  // The implicit step's midpoint footprints: a rebuild takes the drift's
+  // owners by place, which hold their floes (as the half kick's evaluation).
+  if (floe_sea_->implicit()) offer_place_owners();
   floe_sea_->advance_vertical(scenario_.floes, ctx.start, *sea_, ctx.dt, held_now());
 }
 

@@ -16,13 +16,15 @@
 //   count of pieces times a piece's 52 bytes and one offset a floe); the
 //   same with the floes' heave given (start = "given": no static problem,
 //   nothing gathered at the start);
-// - the implicit step (replicated on every floe's pieces): every floe's area
-//   pieces on every rank, the serial run's bytes;
+// - the implicit step, by owner on this sea in slabs since slabs30 (docs/
+//   parallel.md, "The implicit step on the slabs (slabs30)"): as the
+//   explicit kicks, each rank its own floes' pieces only, the serial bytes;
 // - the held floes' states are the serial run's (the static start, which
 //   reads every floe's pieces gathered for it, included).
 // The mutations this catches: gathering at every rebuild by owner (other
 // floes' pieces, and the bytes); not gathering for the static start (the
-// states differ from the first step); not gathering for the implicit step.
+// states differ from the first step). (The implicit step's gather on a sea
+// not in slabs is check_implicit_ranks.py's bem and tank cases'.)
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -88,7 +90,7 @@ bool rebuilt_always(const Simulation& sim) {
   return sim.floe_sea()->footprint_rebuilds() >= sim.floe_sea()->footprint_placements();
 }
 
-// One variant: `by_owner` (explicit kicks) or the implicit step (every floe's pieces on every rank).
+// One variant: `by_owner` (this rank's floes' pieces only) or not (every floe's pieces on every rank).
 void check_variant(const parallel::Communicator& comm, const std::string& name, const std::string& coupling,
                    bool by_owner, std::vector<std::string>& failures) {
   const std::string text = floes_on_sea(coupling);
@@ -163,6 +165,6 @@ int main() {
         check_variant(comm, "given", "start = \"given\"\n", true, f);
       },
       [](const parallel::Communicator& comm, test::Failures& f) {
-        check_variant(comm, "implicit", "integrator = \"implicit\"\n", false, f);
+        check_variant(comm, "implicit", "integrator = \"implicit\"\n", true, f);
       });
 }
