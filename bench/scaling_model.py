@@ -37,10 +37,12 @@ still grows with the total floe count N = 1000 P on every rank
   V      the per-rank passes over every floe (the owners' assignment, the
          advance's set-up, the held masks): seconds a floe a step, on the
          1000 (P - 1) floes a rank does not own (its own 1000 are in C)
-  S(P)   the implicit step's sea, whole on every rank today: its transforms on
+  S(P)   with --implicit-whole-sea (the implicit step before slabs30, and on a
+         sea not in slabs), its sea whole on every rank: its transforms on
          the whole sea, F P log2(n P) / log2 n, instead of the rank's share and
          its transposes (a lower bound: the solve's other per-cell work, in C,
-         is whole on every rank too)
+         is whole on every rank too); since slabs30 the implicit step on a sea
+         in slabs transforms its slab (S = 0)
 
 and the floes' whole-pack arrays take m bytes a floe on every rank (memory,
 not time). --no-whole sets W, V, S and m to zero: today's columns are then
@@ -54,7 +56,7 @@ line); every other input is measured on bench/ocean and named in the CSV.
 usage: bench/scaling_model.py [--step-ms 22.6] [--fft-share 0.13] [--pieces-per-floe 130]
                               [--alpha-us 2] [--node-gbs 12.5] [--ranks-per-node 32]
                               [--memory-gbs 5] [--whole-bytes-explicit 0.8] [--whole-bytes-implicit ...]
-                              [--whole-pass-ns ...] [--floe-memory-bytes 400] [--no-whole]
+                              [--whole-pass-ns ...] [--floe-memory-bytes 400] [--no-whole] [--implicit-whole-sea]
                               [--build build] [--pack bench/ocean/ocean_pack.h5] [--csv FILE | -]
 """
 import argparse
@@ -72,8 +74,15 @@ sys.path.insert(0, os.path.join(ROOT, "scripts", "scenarios"))
 import ocean_pack  # noqa: E402  (bench/ocean's pack)
 
 # Measured (docs/scaling.md, "The step that runs today"; bench/results/whole_pack_s29_epyc-2core.csv).
-WHOLE_IMPLICIT_BYTES = 2 * 3511.0 + 2 * 48.0 + 8.0  # two gathers of the pieces, two of the loads, the yaw
-WHOLE_IMPLICIT_CALLS = 5.0
+# The implicit step by owner on the sea in slabs (since slabs30): the vertical DOFs
+# (48 B) once and the loads (48 B) twice a step, every floe's to every rank
+# (bench/results/whole_pack_s30_epyc-2core.csv). With --implicit-whole-sea, the step
+# before slabs30 (and on a sea not in slabs): the area pieces gathered twice, the
+# loads twice, the tilted floes' yaw (whole_pack_s29), and the sea whole on every rank.
+WHOLE_IMPLICIT_BYTES = 3 * 48.0
+WHOLE_IMPLICIT_CALLS = 3.0
+WHOLE_SEA_IMPLICIT_BYTES = 2 * 3511.0 + 2 * 48.0 + 8.0
+WHOLE_SEA_IMPLICIT_CALLS = 5.0
 WHOLE_PASS_NS = 150.0  # rank 0 of 2 less its share of the serial run, per floe (0.08 to 0.19 us; by symbol 0.14)
 
 ap = argparse.ArgumentParser()
@@ -96,10 +105,15 @@ ap.add_argument("--whole-bytes-explicit", type=float, default=0.8,
                 help="bytes a floe a step of every floe to every rank, explicit step: the strips' keys (8 B every "
                      "10 steps; the boxes of order_by_owner, 12 B a step, go by holder since boxes30)")
 ap.add_argument("--whole-calls-explicit", type=float, default=0.1, help="those all-gathers a step")
-ap.add_argument("--whole-bytes-implicit", type=float, default=WHOLE_IMPLICIT_BYTES,
-                help="the same for the implicit step: its area pieces (3511 B a floe of bench/ocean's pack) twice, "
-                     "its loads (48 B) twice, the tilted floes' yaw (8 B)")
-ap.add_argument("--whole-calls-implicit", type=float, default=WHOLE_IMPLICIT_CALLS, help="those all-gathers a step")
+ap.add_argument("--whole-bytes-implicit", type=float, default=None,
+                help="the same for the implicit step: its vertical DOFs (48 B) once and its loads (48 B) twice "
+                     "(144); with --implicit-whole-sea its area pieces (3511 B a floe of bench/ocean's pack) "
+                     "twice, its loads twice, the tilted floes' yaw (8 B): 7126")
+ap.add_argument("--whole-calls-implicit", type=float, default=None,
+                help="those all-gathers a step (3; with --implicit-whole-sea 5)")
+ap.add_argument("--implicit-whole-sea", action="store_true",
+                help="price the implicit step as it ran before slabs30 (and still runs on a sea not in slabs): "
+                     "the sea whole on every rank, every floe's pieces gathered, the solve replicated")
 ap.add_argument("--whole-pass-ns", type=float, default=WHOLE_PASS_NS,
                 help="the per-rank passes over every floe, ns a floe a step (rank 0 of 2 less half the serial "
                      "step's work, per floe: includes the by-owner code's own work on the rank's floes)")
@@ -117,6 +131,10 @@ ap.add_argument("--pack", default=os.path.join(HERE, "ocean", "ocean_pack.h5"),
                 help="bench/ocean's pack (written there by the build's floesim if missing)")
 ap.add_argument("--csv", default="-")
 args = ap.parse_args()
+if args.whole_bytes_implicit is None:
+    args.whole_bytes_implicit = WHOLE_SEA_IMPLICIT_BYTES if args.implicit_whole_sea else WHOLE_IMPLICIT_BYTES
+if args.whole_calls_implicit is None:
+    args.whole_calls_implicit = WHOLE_SEA_IMPLICIT_CALLS if args.implicit_whole_sea else WHOLE_IMPLICIT_CALLS
 
 CELLS = 512 * 512          # a rank's cells
 SIDE = 1000.0              # a rank's square, m
@@ -218,7 +236,7 @@ def today(P, kind, fft_p, slab_x):
     # the whole n P cells (n P log(n P) against its share's n log(n P)) and
     # transposes nothing. Its solve's other per-cell work (in C) is whole too and
     # not counted here: for the implicit step this term is a lower bound.
-    sea = fft_p * (P - 1) - slab_x if kind == "implicit" else 0.0
+    sea = fft_p * (P - 1) - slab_x if kind == "implicit" and args.implicit_whole_sea else 0.0
     return received, exchange, passes, sea, memory
 
 
